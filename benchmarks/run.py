@@ -1,0 +1,63 @@
+"""Benchmark runner (not tests): imports every ``benchmarks/bench_*.py``, calls its
+``run() -> list[dict]`` (keys: name, value, unit, target, note) and prints a rich table.
+
+    python benchmarks/run.py              # every benchmark
+    python benchmarks/run.py dual         # only bench_dual.py (``bench_dual`` also works)
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+HERE = Path(__file__).resolve().parent
+
+
+def discover(names: list[str]) -> list[Path]:
+    """Paths of the bench modules to run: all of them, or those named on the command line."""
+    available = {p.stem: p for p in sorted(HERE.glob("bench_*.py"))}
+    if not names:
+        return list(available.values())
+    chosen = []
+    for name in names:
+        stem = name if name.startswith("bench_") else f"bench_{name}"
+        stem = stem.removesuffix(".py")
+        if stem not in available:
+            raise SystemExit(f"no benchmark {stem!r}; available: {', '.join(available) or 'none'}")
+        chosen.append(available[stem])
+    return chosen
+
+
+def load(path: Path) -> ModuleType:
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    if spec is None or spec.loader is None:
+        raise SystemExit(f"cannot import {path}")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def main(argv: list[str]) -> int:
+    console = Console()
+    table = Table(title="screwkit benchmarks")
+    for column in ("module", "name", "value", "unit", "target", "note"):
+        table.add_column(column, overflow="fold")
+    for path in discover(argv):
+        rows: list[dict[str, Any]] = load(path).run()
+        for row in rows:
+            value = row.get("value")
+            text = f"{value:.4g}" if isinstance(value, float) else str(value)
+            table.add_row(path.stem, str(row.get("name", "")), text, str(row.get("unit", "")),
+                          str(row.get("target", "")), str(row.get("note", "")))
+    console.print(table)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,1 @@
+"""The ``screwkit`` command line."""

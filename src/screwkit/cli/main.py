@@ -1,0 +1,161 @@
+"""``screwkit`` command line (typer + rich). Every subcommand prints a readable table by default
+and, with ``--json``, one JSON document in SI units (keys in docs/cli.md). A user mistake exits
+with status 2 and a one-paragraph message, never a traceback."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, Any, TypeVar
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+from screwkit import __version__
+
+app = typer.Typer(
+    name="screwkit",
+    help="Analysis, synthesis and dynamic balancing of spatial linkages (dual-number screw calculus).",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+console = Console()
+err_console = Console(stderr=True)
+
+T = TypeVar("T")
+
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON document (SI units) instead of tables.")]
+OutputOpt = Annotated[Path | None, typer.Option("--output", "-o", help="Write the JSON document to this file (atomically).")]
+
+
+def _user_errors() -> tuple[type[BaseException], ...]:
+    from screwkit.io.spec import SpecError
+    from screwkit.io.units import UnitError
+    from screwkit.kinematics.motion import AssemblyError
+    from screwkit.model.linkage import LinkageError
+
+    return (SpecError, UnitError, AssemblyError, LinkageError, ValueError, FileNotFoundError)
+
+
+def _guard(fn: Callable[[], T]) -> T:
+    try:
+        return fn()
+    except _user_errors() as exc:
+        err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
+        raise typer.Exit(2) from None
+
+
+def _emit(doc: dict[str, Any], as_json: bool, output: Path | None, table: Callable[[], None]) -> None:
+    from screwkit.io.results import dumps, write_atomic
+
+    text = dumps(doc)
+    if output is not None:
+        _guard(lambda: write_atomic(output, text + "\n"))
+    if as_json:
+        sys.stdout.write(text + "\n")
+    else:
+        table()
+        if output is not None:
+            console.print(f"wrote {output}")
+
+
+@app.callback(invoke_without_command=True)
+def main(version: Annotated[bool, typer.Option("--version", help="Print the version.")] = False) -> None:
+    if version:
+        console.print(f"screwkit {__version__}")
+        raise typer.Exit(0)
+
+
+@app.command()
+def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML).")]) -> None:
+    """Load and validate spec files and say what each describes."""
+    from screwkit.io.spec import load_spec
+
+    for path in specs:
+        spec = _guard(lambda p=path: load_spec(p))  # type: ignore[misc]
+        console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+
+
+def _fmt(x: float, angle: bool) -> str:
+    if x != x:
+        return "—"
+    return f"{np.degrees(x):10.4f}" if angle else f"{x:10.6g}"
+
+
+@app.command()
+def analyze(
+    spec: Annotated[Path, typer.Argument(help="Spec file (TOML).")],
+    as_json: JsonOpt = False,
+    output: OutputOpt = None,
+) -> None:
+    """Positions, velocities and accelerations of every joint variable in every assembly mode."""
+    from screwkit.io.spec import load_spec
+    from screwkit.kinematics.analysis import analyze as run
+
+    s = _guard(lambda: load_spec(spec))
+    _, doc = _guard(lambda: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point))
+
+    def table() -> None:
+        console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
+        console.print("angles in degrees, lengths in metres, rates per second (SI)")
+        for mode in doc["modes"]:
+            names = [n for n in mode["variables"] if "." not in n] or list(mode["variables"])[:4]
+            t = Table(title=f"assembly mode {mode['mode']}", show_lines=False)
+            t.add_column("input (deg)", justify="right")
+            for n in names:
+                t.add_column(n, justify="right")
+                t.add_column(f"{n}'", justify="right")
+                t.add_column(f"{n}''", justify="right")
+            for i, x in enumerate(doc["input"]):
+                row = [f"{np.degrees(x):8.3f}"]
+                for n in names:
+                    ang = not (n in ("S", "s4") or n.endswith(".s"))
+                    row += [_fmt(mode["variables"][n][i], ang), _fmt(mode["velocities"][n][i], False),
+                            _fmt(mode["accelerations"][n][i], False)]
+                t.add_row(*row)
+            console.print(t)
+            for ev in mode["events"]:
+                console.print(f"  • {escape(ev)}", highlight=False)
+            missing = int((~np.asarray(mode["assembles"])).sum())
+            if missing:
+                console.print(f"  • does not assemble at {missing} of {len(doc['input'])} inputs", highlight=False)
+
+    _emit(doc, as_json, output, table)
+
+
+@app.command()
+def demo(
+    examples: Annotated[Path, typer.Argument(help="Folder of spec files.")] = Path("examples"),
+    output_dir: Annotated[Path, typer.Option("--output-dir", help="Where results are written.")] = Path("out"),
+) -> None:
+    """Run the main job on every bundled example: validate, analyse, write the results."""
+    from screwkit.io.results import dumps, write_atomic
+    from screwkit.io.spec import load_spec
+    from screwkit.kinematics.analysis import analyze as run
+
+    files = sorted(examples.glob("*.toml"))
+    if not files:
+        _guard(lambda: (_ for _ in ()).throw(ValueError(f"no spec files (*.toml) in {examples}")))
+    output_dir.mkdir(parents=True, exist_ok=True)
+    t = Table(title=f"screwkit demo: {len(files)} examples")
+    for col in ("example", "family", "samples", "modes", "assembling", "max closure residual", "written"):
+        t.add_column(col)
+    for f in files:
+        spec = _guard(lambda f=f: load_spec(f))  # type: ignore[misc]
+        console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+        _, doc = _guard(lambda s=spec: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point))  # type: ignore[misc]
+        out = output_dir / f"{f.stem}.analysis.json"
+        write_atomic(out, dumps(doc) + "\n")
+        res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)
+        asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])
+        t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", str(out))
+    console.print(t)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    app()

@@ -1,0 +1,102 @@
+"""Dual-number screw calculus: dual numbers, dual vectors (lines), 3×3 screw matrices, dual
+quaternions, screw parameters, dual Euler angles and conversions (docs/conventions.md)."""
+
+from screwkit.dual.checks import (
+    check_rotation_matrix,
+    check_screw_matrix_parts,
+    check_transform,
+    check_unit_dual_quaternion,
+    check_unit_line,
+    check_unit_vector,
+    check_vector3,
+)
+from screwkit.dual.conversions import (
+    dual_quaternion_from_rigid_transform,
+    dual_quaternion_from_screw_matrix,
+    dual_quaternion_from_transform,
+    rigid_transform_from_dual_quaternion,
+    rigid_transform_from_screw_matrix,
+    rotation_from_screw_matrix,
+    screw_matrix_from_dual_quaternion,
+    screw_matrix_from_rigid_transform,
+    screw_matrix_from_rotation,
+    screw_matrix_from_transform,
+    transform_from_dual_quaternion,
+    transform_from_screw_matrix,
+)
+from screwkit.dual.euler import (
+    DualEulerAngles,
+    dual_euler_from_screw_matrix,
+    screw_matrix_from_dual_euler,
+)
+from screwkit.dual.number import (
+    Dual,
+    DualDivisionError,
+    acos,
+    asin,
+    atan,
+    atan2,
+    cos,
+    exp,
+    log,
+    sin,
+    sqrt,
+    tan,
+)
+from screwkit.dual.quaternion import DualQuaternion
+from screwkit.dual.screw_matrix import ScrewMatrix, skew, vee
+from screwkit.dual.screw_parameters import (
+    ScrewParameters,
+    screw_matrix_about_line,
+    screw_matrix_from_screw_parameters,
+    screw_parameters_from_screw_matrix,
+)
+from screwkit.dual.vector import DualVector, common_normal, dual_angle
+
+__all__ = [
+    "Dual",
+    "DualDivisionError",
+    "DualEulerAngles",
+    "DualQuaternion",
+    "DualVector",
+    "ScrewMatrix",
+    "ScrewParameters",
+    "acos",
+    "asin",
+    "atan",
+    "atan2",
+    "check_rotation_matrix",
+    "check_screw_matrix_parts",
+    "check_transform",
+    "check_unit_dual_quaternion",
+    "check_unit_line",
+    "check_unit_vector",
+    "check_vector3",
+    "common_normal",
+    "cos",
+    "dual_angle",
+    "dual_euler_from_screw_matrix",
+    "dual_quaternion_from_rigid_transform",
+    "dual_quaternion_from_screw_matrix",
+    "dual_quaternion_from_transform",
+    "exp",
+    "log",
+    "rigid_transform_from_dual_quaternion",
+    "rigid_transform_from_screw_matrix",
+    "rotation_from_screw_matrix",
+    "screw_matrix_about_line",
+    "screw_matrix_from_dual_euler",
+    "screw_matrix_from_dual_quaternion",
+    "screw_matrix_from_rigid_transform",
+    "screw_matrix_from_rotation",
+    "screw_matrix_from_screw_parameters",
+    "screw_matrix_from_transform",
+    "screw_parameters_from_screw_matrix",
+    "sin",
+    "skew",
+    "sqrt",
+    "tan",
+    "transform_from_dual_quaternion",
+    "transform_from_screw_matrix",
+    "vee",
+]

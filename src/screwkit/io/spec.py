@@ -1,0 +1,323 @@
+"""Mechanism spec files: TOML with units, validated with pydantic.
+
+Every error names the file, the key, what is wrong and what would be right
+(``docs/spec-format.md`` documents every key).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from screwkit.io.units import UnitError, to_si
+from screwkit.model.linkage import Link, Linkage, LinkageError
+
+Value = float | int | str
+
+
+class SpecError(ValueError):
+    """A spec file that cannot be used; the message says where and how to fix it."""
+
+
+FAMILY_DIMENSIONS: dict[str, dict[str, str]] = {
+    "RSRC": {"d1": "length", "d2": "length", "d3": "length", "a": "length", "b": "length",
+             "e": "length", "delta0": "angle", "lambda0": "angle"},
+    "CSSP": {"a1": "length", "a2": "length", "a4": "length", "alpha4": "angle", "s1": "length"},
+    "4R": {"a": "length", "d1": "length", "d2": "length", "d3": "length"},
+    "RSSR": {"d1": "length", "d2": "length", "d3": "length", "a": "length", "b": "length",
+             "lambda0": "angle", "output_offset": "length"},
+    "RCCC": {"a1": "length", "a2": "length", "a3": "length", "a4": "length", "alpha1": "angle",
+             "alpha2": "angle", "alpha3": "angle", "alpha4": "angle", "input_offset": "length"},
+}
+OPTIONAL_DIMENSIONS = {"CSSP": {"s1"}, "RSSR": {"output_offset"}, "RCCC": {"input_offset"}}
+FAMILY_ALIASES = {"rsrc": "RSRC", "cssp": "CSSP", "4r": "4R", "fourbar": "4R", "rssr": "RSSR",
+                  "rccc": "RCCC", "loop": "LOOP"}
+INPUT_KIND = {"RSRC": "angle", "CSSP": "angle", "4R": "angle", "RSSR": "angle", "RCCC": "angle"}
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class MechanismTable(_Strict):
+    family: str
+    name: str | None = None
+    source: str | None = Field(None, description="where the example comes from (seed, section)")
+    description: str | None = None
+
+    @field_validator("family")
+    @classmethod
+    def _family(cls, v: str) -> str:
+        key = FAMILY_ALIASES.get(v.lower())
+        if key is None:
+            raise ValueError(f"unknown family {v!r}; use one of RSRC, CSSP, 4R, RSSR, RCCC, LOOP")
+        return key
+
+
+class MotionTable(_Strict):
+    start: Value = 0.0
+    stop: Value = 360.0
+    step: Value = 10.0
+    speed: Value = Field(1.0, description="input speed (angular velocity for a crank)")
+    acceleration: Value = 0.0
+    periodic: bool | None = Field(None, description="drop the stop sample when it repeats the start")
+    mode: int = Field(0, ge=0, description="assembly mode used by dynamics and balancing")
+
+
+class JointTable(_Strict):
+    name: str
+    kind: Literal["R", "P", "C", "H", "U", "S"]
+    length: Value = 0.0
+    twist: Value = 0.0
+    offset: Value = 0.0
+    pitch: Value = 0.0
+    input: bool = False
+
+
+class LinkMassTable(_Strict):
+    mass: Value | None = None
+    weight: Value | None = None
+    com: list[Value] = Field(default_factory=lambda: [0.0, 0.0, 0.0])  # type: ignore[arg-type]
+    inertia: list[Value] | list[list[Value]] | None = None
+    principal_axes: list[list[float]] | None = None
+
+
+class CouplerPointTable(_Strict):
+    f: Value = 0.0
+    g: Value = 0.0
+    h: Value = 0.0
+
+
+class SpecFile(_Strict):
+    mechanism: MechanismTable
+    units: dict[str, str] = Field(default_factory=dict)
+    dimensions: dict[str, Value] = Field(default_factory=dict)
+    joints: list[JointTable] = Field(default_factory=list)
+    motion: MotionTable = Field(default_factory=MotionTable)  # type: ignore[arg-type]
+    links: dict[str, LinkMassTable] = Field(default_factory=dict)
+    coupler_point: CouplerPointTable | None = None
+    gravity: Value | None = None
+    balancing: dict[str, Any] | None = None
+    synthesis: dict[str, Any] | None = None
+
+
+class MechanismSpec:
+    """A validated spec file, converted to SI. Build the model with :meth:`linkage`."""
+
+    def __init__(self, raw: SpecFile, path: str) -> None:
+        self.raw = raw
+        self.path = path
+        self.family = raw.mechanism.family
+        self.name = raw.mechanism.name or Path(path).stem
+        self.source = raw.mechanism.source
+        self.units = dict(raw.units)
+        self.dimensions = self._dimensions()
+        self.inputs = self._input_samples()
+        self.speed = self._si(raw.motion.speed, self._rate_kind(), "motion.speed")
+        self.acceleration = self._si(raw.motion.acceleration, self._rate_kind(2), "motion.acceleration")
+        self.mode = raw.motion.mode
+        self.gravity_magnitude = (
+            None if raw.gravity is None else self._si(raw.gravity, "acceleration", "gravity")
+        )
+        self.coupler_point: tuple[float, float, float] | None = None
+        if raw.coupler_point is not None:
+            if self.family != "RSRC":
+                self._fail("coupler_point", f"coupler points are defined for the RSRC (Bagci App. C); this is a {self.family}")
+            cp = raw.coupler_point
+            self.coupler_point = (self._si(cp.f, "length", "coupler_point.f"),
+                                  self._si(cp.g, "length", "coupler_point.g"),
+                                  self._si(cp.h, "length", "coupler_point.h"))
+        self._linkage = self._build()
+
+    # --- helpers ---------------------------------------------------------------------------
+    def _fail(self, key: str, message: str) -> None:
+        raise SpecError(f"{self.path}: [{key}] {message}")
+
+    def _default_unit(self, kind: str) -> str | None:
+        return self.units.get(kind)
+
+    def _si(self, value: Any, kind: str, key: str) -> float:
+        try:
+            return to_si(value, kind, self._default_unit(kind))
+        except UnitError as exc:
+            self._fail(key, str(exc))
+        raise AssertionError  # unreachable
+
+    def _rate_kind(self, order: int = 1) -> str:
+        base = "angle" if self.family != "LOOP" or self._loop_input_is_angle() else "length"
+        if base == "angle":
+            return "angular_velocity" if order == 1 else "angular_acceleration"
+        return "velocity" if order == 1 else "acceleration"
+
+    def _loop_input_is_angle(self) -> bool:
+        ins = [j for j in self.raw.joints if j.input]
+        return not ins or ins[0].kind != "P"
+
+    def _dimensions(self) -> dict[str, float]:
+        if self.family == "LOOP":
+            if self.raw.dimensions:
+                self._fail("dimensions", "a LOOP family takes its geometry from [[joints]]; remove [dimensions]")
+            return {}
+        wanted = FAMILY_DIMENSIONS[self.family]
+        unknown = sorted(set(self.raw.dimensions) - set(wanted))
+        if unknown:
+            self._fail("dimensions", f"unknown key(s) {unknown} for a {self.family}; expected {sorted(wanted)}")
+        missing = sorted(set(wanted) - set(self.raw.dimensions) - OPTIONAL_DIMENSIONS.get(self.family, set()))
+        if missing:
+            self._fail("dimensions", f"missing {missing} for a {self.family} (e.g. d1 = \"2.0 in\")")
+        return {k: self._si(v, wanted[k], f"dimensions.{k}") for k, v in self.raw.dimensions.items()}
+
+    def _input_samples(self) -> np.ndarray:
+        m = self.raw.motion
+        kind = "angle" if self._rate_kind() == "angular_velocity" else "length"
+        start = self._si(m.start, kind, "motion.start")
+        stop = self._si(m.stop, kind, "motion.stop")
+        step = self._si(m.step, kind, "motion.step")
+        if step <= 0:
+            self._fail("motion.step", f"the step must be positive; got {m.step!r}")
+        if stop < start:
+            self._fail("motion.stop", f"stop ({m.stop!r}) must not be below start ({m.start!r})")
+        n = int(math.floor((stop - start) / step + 1e-9)) + 1
+        if n > 10_000_000:
+            self._fail("motion.step", f"{n} samples is too many; use a larger step")
+        x = start + step * np.arange(n)
+        periodic = m.periodic
+        if periodic is None:
+            periodic = kind == "angle" and abs((stop - start) - 2 * math.pi) < 1e-9
+        if periodic and n > 1 and abs(x[-1] - (start + 2 * math.pi)) < 1e-9:
+            x = x[:-1]  # 0° and 360° are the same sample: count it once
+        return x
+
+    def _masses(self, link_names: list[str]) -> list[Link]:
+        from screwkit.model.mass import MassProperties
+
+        unknown = sorted(set(self.raw.links) - set(link_names))
+        if unknown:
+            self._fail("links", f"no link named {unknown} in a {self.family}; links are {link_names}")
+        g = self.gravity_magnitude if self.gravity_magnitude is not None else 9.80665
+        out = []
+        for name in link_names:
+            t = self.raw.links.get(name)
+            if t is None:
+                out.append(Link(name))
+                continue
+            key = f"links.{name}"
+            if (t.mass is None) == (t.weight is None):
+                self._fail(key, "give exactly one of mass (e.g. \"0.86 kg\") or weight (e.g. \"1.9 lbf\")")
+            mass = (self._si(t.mass, "mass", key + ".mass") if t.mass is not None
+                    else self._si(t.weight, "force", key + ".weight") / g)
+            if len(t.com) != 3:
+                self._fail(key + ".com", f"give 3 coordinates; got {len(t.com)}")
+            com = [self._si(v, "length", f"{key}.com") for v in t.com]
+            if t.inertia is None:
+                self._fail(key + ".inertia", "give the principal moments [Ixx, Iyy, Izz] or a 3×3 tensor about the CoM")
+            inertia = t.inertia
+            try:
+                if inertia and isinstance(inertia[0], list):
+                    I = np.array([[self._si(v, "inertia", f"{key}.inertia") for v in row] for row in inertia])  # type: ignore[union-attr]
+                    props = MassProperties(mass, np.array(com), I)
+                else:
+                    moments = [self._si(v, "inertia", f"{key}.inertia") for v in inertia]  # type: ignore[union-attr]
+                    if len(moments) != 3:
+                        self._fail(key + ".inertia", f"give 3 principal moments; got {len(moments)}")
+                    props = MassProperties.from_principal(mass, np.array(com), np.array(moments), t.principal_axes)
+            except SpecError:
+                raise
+            except ValueError as exc:
+                self._fail(key, str(exc))
+            out.append(Link(name, props))
+        return out
+
+    def _build(self) -> Linkage:
+        from screwkit.model import families
+
+        d = self.dimensions
+        try:
+            if self.family == "RSRC":
+                lk = families.rsrc(**d)
+            elif self.family == "CSSP":
+                lk = families.cssp(d["a1"], d["a2"], d["a4"], d["alpha4"], d.get("s1", 0.0))
+            elif self.family == "4R":
+                lk = families.fourbar(d["a"], d["d1"], d["d2"], d["d3"])
+            elif self.family == "RSSR":
+                lk = families.rssr(d["d1"], d["d2"], d["d3"], d["a"], d["b"], d["lambda0"], d.get("output_offset", 0.0))
+            elif self.family == "RCCC":
+                lk = families.rccc((d["a1"], d["a2"], d["a3"], d["a4"]),
+                                   (d["alpha1"], d["alpha2"], d["alpha3"], d["alpha4"]), d.get("input_offset", 0.0))
+            else:
+                lk = self._loop()
+        except LinkageError as exc:
+            self._fail("dimensions" if self.family != "LOOP" else "joints", str(exc))
+        if self.raw.links:
+            lk = lk.with_links(self._masses([link.name for link in lk.links]))
+        return lk
+
+    def _loop(self) -> Linkage:
+        from screwkit.model.joints import Joint
+
+        if len(self.raw.joints) < 2:
+            self._fail("joints", "a LOOP needs a [[joints]] list of at least 2 joints")
+        joints, lengths, twists, inputs = [], [], [], []
+        for k, j in enumerate(self.raw.joints):
+            key = f"joints[{k}]"
+            off_kind = "angle" if j.kind == "P" else "length"
+            try:
+                joints.append(Joint(j.name, j.kind, self._si(j.offset, off_kind, key + ".offset"),
+                                    self._si(j.pitch, "length", key + ".pitch")))
+            except ValueError as exc:
+                self._fail(key, str(exc))
+            lengths.append(self._si(j.length, "length", key + ".length"))
+            twists.append(self._si(j.twist, "angle", key + ".twist"))
+            if j.input:
+                inputs.append(f"{j.name}.{joints[-1].freedoms[0]}")
+        if len(inputs) != 1:
+            self._fail("joints", f"mark exactly one joint with input = true; {len(inputs)} marked")
+        return Linkage.from_hartenberg_denavit(self.name, joints, lengths, twists, inputs, family=None)
+
+    # --- public ------------------------------------------------------------------------------
+    @property
+    def linkage(self) -> Linkage:
+        return self._linkage
+
+    def describe(self) -> str:
+        lk = self._linkage
+        dims = ", ".join(f"{k}={v:.6g}" for k, v in self.dimensions.items())
+        n = len(self.inputs)
+        joints = "".join(j.kind for j in lk.joints)
+        src = f" — source: {self.source}" if self.source else ""
+        return (f"{self.name}: {self.family} ({joints}) {dims}; {n} input samples "
+                f"{np.degrees(self.inputs[0]):.6g}…{np.degrees(self.inputs[-1]):.6g} deg{src}")
+
+
+def _format_validation(path: str, exc: ValidationError) -> str:
+    lines = [f"{path}: the spec file is not valid:"]
+    for err in exc.errors():
+        loc = ".".join(str(p) for p in err["loc"])
+        msg = err["msg"]
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key (check the spelling; see docs/spec-format.md)"
+        lines.append(f"  [{loc}] {msg}")
+    return "\n".join(lines)
+
+
+def load_spec(path: str | Path) -> MechanismSpec:
+    """Read and validate a spec file; raises :class:`SpecError` with a specific message."""
+    p = Path(path)
+    if not p.is_file():
+        raise SpecError(f"{p}: no such spec file")
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(f"{p}: not valid TOML: {exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise SpecError(f"{p}: not a text file ({exc})") from exc
+    try:
+        raw = SpecFile.model_validate(data)
+    except ValidationError as exc:
+        raise SpecError(_format_validation(str(p), exc)) from exc
+    return MechanismSpec(raw, str(p))

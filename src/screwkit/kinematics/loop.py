@@ -1,0 +1,244 @@
+"""The loop-closure map of a :class:`~screwkit.model.Linkage`, batched over samples.
+
+A configuration holds every freedom: one column per scalar freedom (R, P, C, H, U) and one
+rotation matrix per spherical joint. :func:`forward` walks the loop once and returns, for every
+joint, its frame before and after its motion (as (R, d) pairs — the real form of the screw
+matrix R + ε[d]×R), the closure displacement G = Π J_i L_i (identity when the loop closes), and
+the unit screws of every freedom in the ground frame, which are the columns of the loop-closure
+Jacobian (Bagci 1969 eqs. 3.19–3.26: the skew operator of joint i, carried to the base).
+
+Screws are 6-vectors (ω; v): ω the direction (angular part) and v the velocity of the point at
+the ground origin, so a revolute about the line through c along u is (u; c × u), a prismatic
+along u is (0; u) and a helical of pitch h is (u; c × u + h u).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from screwkit.model.linkage import Linkage
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Configuration:
+    """Joint state of a batch of samples.
+
+    ``scalars`` (N, n_scalar): the scalar freedoms (R/P/C/H/U) in loop order;
+    ``spherical`` (N, n_S, 3, 3): the rotation of each spherical joint (child frame relative to
+    the joint frame).
+    """
+
+    scalars: Array
+    spherical: Array
+
+    @property
+    def size(self) -> int:
+        return int(self.scalars.shape[0])
+
+    def take(self, index: NDArray[np.intp] | slice) -> Configuration:
+        return Configuration(self.scalars[index], self.spherical[index])
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where each freedom of a linkage lives in a :class:`Configuration` and in the Jacobian."""
+
+    names: tuple[str, ...]  # all freedoms, loop order (Jacobian columns)
+    joint_of: tuple[int, ...]  # joint index of each freedom
+    scalar_col: tuple[int, ...]  # column in Configuration.scalars, or -1 for S freedoms
+    spherical_of_joint: dict[int, int]  # joint index -> index in Configuration.spherical
+    is_translation: tuple[bool, ...]  # P/C s freedoms carry length units
+    n_scalar: int
+    n_spherical: int
+
+
+def layout(linkage: Linkage) -> Layout:
+    names: list[str] = []
+    joint_of: list[int] = []
+    scalar_col: list[int] = []
+    is_tr: list[bool] = []
+    sph: dict[int, int] = {}
+    col = 0
+    for i, j in enumerate(linkage.joints):
+        if j.kind == "S":
+            sph[i] = len(sph)
+        for f in j.freedoms:
+            names.append(f"{j.name}.{f}")
+            joint_of.append(i)
+            is_tr.append(f == "s")
+            if j.kind == "S":
+                scalar_col.append(-1)
+            else:
+                scalar_col.append(col)
+                col += 1
+    return Layout(tuple(names), tuple(joint_of), tuple(scalar_col), sph, tuple(is_tr), col, len(sph))
+
+
+def rot_z(angle: Array) -> Array:
+    c, s = np.cos(angle), np.sin(angle)
+    z, o = np.zeros_like(c), np.ones_like(c)
+    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
+
+
+def rot_x(angle: Array) -> Array:
+    c, s = np.cos(angle), np.sin(angle)
+    z, o = np.zeros_like(c), np.ones_like(c)
+    return np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2)
+
+
+@dataclass(frozen=True)
+class LoopFrames:
+    """Frames of one pass round the loop (ground frame), batch-first.
+
+    ``before_R/before_p`` (N, n, 3, 3)/(N, n, 3): joint i's frame before its motion;
+    ``after_R/after_p``: after it (= the body frame of moving link i for i < n);
+    ``closure_R/closure_p``: G = Π J_i L_i; ``screws`` (N, 6, m): unit freedom screws;
+    ``centres`` (N, n, 3): joint centres (origin of the joint frame after the offset);
+    ``axes`` (N, n, 3): joint z axes.
+    """
+
+    before_R: Array
+    before_p: Array
+    after_R: Array
+    after_p: Array
+    closure_R: Array
+    closure_p: Array
+    screws: Array
+    centres: Array
+    axes: Array
+
+
+def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None) -> LoopFrames:
+    """Walk the loop J_1 L_1 ··· J_n L_n for every sample (vectorised over samples)."""
+    lay = lay or layout(linkage)
+    N = conf.size
+    n = len(linkage.joints)
+    R = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
+    p = np.zeros((N, 3))
+    bR = np.empty((N, n, 3, 3))
+    bp = np.empty((N, n, 3))
+    aR = np.empty((N, n, 3, 3))
+    ap = np.empty((N, n, 3))
+    centres = np.empty((N, n, 3))
+    axes = np.empty((N, n, 3))
+    cols: list[Array] = []
+    q = conf.scalars
+    fi = 0  # running freedom index
+    for i, (joint, link) in enumerate(zip(linkage.joints, linkage.link_transforms, strict=True)):
+        bR[:, i] = R
+        bp[:, i] = p
+        u = R[..., :, 2]
+        kind = joint.kind
+        if kind == "P":
+            centre = p
+        else:
+            centre = p + joint.offset * u
+        centres[:, i] = centre
+        axes[:, i] = u
+        if kind == "R":
+            th = q[:, lay.scalar_col[fi]]
+            jR = rot_z(th)
+            jp = np.array([0.0, 0.0, joint.offset]) * np.ones((N, 1))
+            cols.append(np.concatenate([u, np.cross(centre, u)], -1))
+        elif kind == "P":
+            s = q[:, lay.scalar_col[fi]]
+            jR = np.broadcast_to(rot_z(np.array(joint.offset)), (N, 3, 3))
+            jp = np.stack([np.zeros(N), np.zeros(N), s], -1)
+            cols.append(np.concatenate([np.zeros_like(u), u], -1))
+        elif kind == "C":
+            th = q[:, lay.scalar_col[fi]]
+            s = q[:, lay.scalar_col[fi + 1]]
+            jR = rot_z(th)
+            jp = np.stack([np.zeros(N), np.zeros(N), s], -1)
+            cols.append(np.concatenate([u, np.cross(centre, u)], -1))
+            cols.append(np.concatenate([np.zeros_like(u), u], -1))
+        elif kind == "H":
+            th = q[:, lay.scalar_col[fi]]
+            jR = rot_z(th)
+            jp = np.stack([np.zeros(N), np.zeros(N), joint.offset + joint.pitch * th], -1)
+            cols.append(np.concatenate([u, np.cross(centre, u) + joint.pitch * u], -1))
+        elif kind == "U":
+            t1 = q[:, lay.scalar_col[fi]]
+            t2 = q[:, lay.scalar_col[fi + 1]]
+            r1 = rot_z(t1)
+            jR = r1 @ rot_x(t2)
+            jp = np.array([0.0, 0.0, joint.offset]) * np.ones((N, 1))
+            u2 = (R @ r1)[..., :, 0]
+            cols.append(np.concatenate([u, np.cross(centre, u)], -1))
+            cols.append(np.concatenate([u2, np.cross(centre, u2)], -1))
+        else:  # S
+            jR = conf.spherical[:, lay.spherical_of_joint[i]]
+            jp = np.array([0.0, 0.0, joint.offset]) * np.ones((N, 1))
+            child = R @ jR
+            for k in range(3):
+                w = child[..., :, k]
+                cols.append(np.concatenate([w, np.cross(centre, w)], -1))
+        fi += joint.dof
+        # after the joint motion: T <- T · J
+        p = p + np.einsum("nij,nj->ni", R, jp)
+        R = R @ jR
+        aR[:, i] = R
+        ap[:, i] = p
+        # then the constant link transform: T <- T · L
+        lR = link.real
+        lp = link.translation
+        p = p + R @ lp
+        R = R @ lR
+    screws = np.stack(cols, axis=-1)
+    return LoopFrames(bR, bp, aR, ap, R, p, screws, centres, axes)
+
+
+def closure_twist(R: Array, p: Array) -> Array:
+    """The twist ξ (ω; v) with exp(ξ) = G = (R, p): the exact SE(3) logarithm, batched.
+
+    Its norm is the loop-closure error; Newton drives it to zero."""
+    w = Rotation.from_matrix(R).as_rotvec()
+    th = np.linalg.norm(w, axis=-1)
+    W = _skew(w)
+    small = th < 1e-6
+    ths = np.where(small, 1.0, th)
+    # V^{-1} = I - W/2 + (1/θ²)(1 - (θ/2) cot(θ/2)) W²
+    coef = np.where(small, 1.0 / 12.0, (1.0 - (ths / 2.0) / np.tan(ths / 2.0)) / ths**2)
+    Vinv = np.eye(3) - 0.5 * W + coef[..., None, None] * (W @ W)
+    v = np.einsum("...ij,...j->...i", Vinv, p)
+    return np.concatenate([w, v], -1)
+
+
+def _skew(v: Array) -> Array:
+    z = np.zeros_like(v[..., 0])
+    return np.stack(
+        [
+            np.stack([z, -v[..., 2], v[..., 1]], -1),
+            np.stack([v[..., 2], z, -v[..., 0]], -1),
+            np.stack([-v[..., 1], v[..., 0], z], -1),
+        ],
+        -2,
+    )
+
+
+def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configuration:
+    """Move a configuration by freedom increments ``delta`` (N, m): scalars add, spherical
+    joints turn by exp([δ]) about their own moving axes (R ← R·exp([δ]))."""
+    q = conf.scalars.copy()
+    sph = conf.spherical.copy()
+    cols = np.array(lay.scalar_col)
+    scal = cols >= 0
+    q[:, cols[scal]] += delta[:, np.nonzero(scal)[0]]
+    for j, k in lay.spherical_of_joint.items():
+        idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
+        d = delta[:, idx]
+        sph[:, k] = sph[:, k] @ Rotation.from_rotvec(d).as_matrix()
+    return Configuration(q, sph)
+
+
+def lie_bracket(a: Array, b: Array) -> Array:
+    """[a, b] of twists (ω; v): (ωa × ωb; ωa × vb − ωb × va)."""
+    wa, va = a[..., :3], a[..., 3:]
+    wb, vb = b[..., :3], b[..., 3:]
+    return np.concatenate([np.cross(wa, wb), np.cross(wa, vb) - np.cross(wb, va)], -1)

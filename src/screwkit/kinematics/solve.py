@@ -1,0 +1,168 @@
+"""Generic position solver for any single loop: damped Newton on the loop-closure equation
+(Bagci 1969 §3.3, eqs. 3.19–3.48, the reduced form Σ ĥ_i Q̂_i = Ĝᵀ − I, here with the exact
+SE(3) logarithm as residual and minimum-norm steps), started from many points to find every
+assembly mode. Batched over samples × starts; no Python loop over samples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from screwkit.kinematics.loop import (
+    Array,
+    Configuration,
+    Layout,
+    apply_increment,
+    closure_twist,
+    forward,
+    layout,
+)
+from screwkit.model.linkage import Linkage
+
+CLOSURE_TOL = 1e-11  # residual (radians, and lengths / length scale) accepted as closed
+
+
+@dataclass(frozen=True)
+class NewtonResult:
+    conf: Configuration
+    residual: Array  # (N,) closure error: max(|rotation|, |translation| / length scale)
+    converged: NDArray[np.bool_]
+    iterations: int
+
+
+def _scales(lay: Layout, L: float) -> tuple[Array, Array]:
+    rows = np.array([1.0, 1.0, 1.0, 1.0 / L, 1.0 / L, 1.0 / L])
+    cols = np.array([L if t else 1.0 for t in lay.is_translation])
+    return rows, cols
+
+
+def set_inputs(conf: Configuration, lay: Layout, input_names: tuple[str, ...], values: Array) -> Configuration:
+    q = conf.scalars.copy()
+    for k, name in enumerate(input_names):
+        q[:, lay.scalar_col[lay.names.index(name)]] = values[:, k]
+    return Configuration(q, conf.spherical)
+
+
+def newton(
+    linkage: Linkage,
+    conf: Configuration,
+    max_iter: int = 60,
+    tol: float = CLOSURE_TOL,
+    max_step: float = 0.5,
+    lay: Layout | None = None,
+) -> NewtonResult:
+    """Close the loop from ``conf`` by damped Gauss–Newton with minimum-norm steps over the
+    passive freedoms (inputs are held). Works on every sample at once."""
+    lay = lay or layout(linkage)
+    L = linkage.length_scale
+    rows, cols = _scales(lay, L)
+    passive = np.array([n not in linkage.inputs for n in lay.names])
+    pidx = np.nonzero(passive)[0]
+    N = conf.size
+    res = np.full(N, np.inf)
+    active = np.ones(N, dtype=bool)
+    it = 0
+    for it in range(1, max_iter + 1):  # noqa: B007 - loop over iterations, vectorised over samples
+        fr = forward(linkage, conf, lay)
+        xi = closure_twist(fr.closure_R, fr.closure_p) * rows
+        res = np.max(np.abs(xi), axis=-1)
+        active = res > tol
+        if not np.any(active):
+            break
+        Js = fr.screws[active][:, :, pidx] * rows[:, None] * cols[pidx][None, :]
+        step = -np.einsum("nij,nj->ni", np.linalg.pinv(Js, rcond=1e-10), xi[active])
+        big = np.max(np.abs(step), axis=-1, keepdims=True)
+        step *= np.minimum(1.0, max_step / np.maximum(big, 1e-300))
+        delta = np.zeros((N, len(lay.names)))
+        sub = np.zeros((step.shape[0], len(lay.names)))
+        sub[:, pidx] = step * cols[pidx]
+        delta[active] = sub
+        conf = apply_increment(conf, delta, lay)
+    else:
+        fr = forward(linkage, conf, lay)
+        xi = closure_twist(fr.closure_R, fr.closure_p) * rows
+        res = np.max(np.abs(xi), axis=-1)
+    ok = np.isfinite(res) & (res <= max(tol * 10, 1e-10))
+    return NewtonResult(conf, res, ok, it)
+
+
+def random_configurations(linkage: Linkage, count: int, rng: np.random.Generator, lay: Layout | None = None) -> Configuration:
+    """``count`` random starting configurations: angles uniform in (−π, π], translations
+    uniform within ± the length scale, spherical joints uniformly random rotations."""
+    lay = lay or layout(linkage)
+    L = linkage.length_scale
+    q = np.empty((count, lay.n_scalar))
+    for f in range(len(lay.names)):
+        c = lay.scalar_col[f]
+        if c < 0:
+            continue
+        if lay.is_translation[f]:
+            q[:, c] = rng.uniform(-L, L, count)
+        else:
+            q[:, c] = rng.uniform(-np.pi, np.pi, count)
+    sph = np.empty((count, lay.n_spherical, 3, 3))
+    for k in range(lay.n_spherical):
+        sph[:, k] = Rotation.random(count, random_state=rng).as_matrix()
+    return Configuration(q, sph)
+
+
+def signature(linkage: Linkage, conf: Configuration, lay: Layout | None = None) -> Array:
+    """A vector per sample that identifies an assembly up to passive freedoms: every joint
+    centre (divided by the length scale) and every non-spherical joint axis, in the ground
+    frame. Two configurations with the same signature are the same assembly."""
+    fr = forward(linkage, conf, lay)
+    L = linkage.length_scale
+    parts = [fr.centres.reshape(conf.size, -1) / L]
+    ax = [fr.axes[:, i] for i, j in enumerate(linkage.joints) if j.kind != "S"]
+    if ax:
+        parts.append(np.concatenate(ax, -1))
+    return np.concatenate(parts, -1)
+
+
+@dataclass(frozen=True)
+class Assemblies:
+    """Every assembly found at each sample: ``conf`` (N, K) flattened as N*K samples with
+    ``found`` (N, K) saying which slots hold a distinct closed configuration."""
+
+    conf: Configuration
+    found: NDArray[np.bool_]
+    signature: Array  # (N, K, d)
+
+
+def find_assemblies(
+    linkage: Linkage,
+    input_values: Array,
+    starts: int = 48,
+    seed: int = 0,
+    max_modes: int = 16,
+    tol_same: float = 1e-6,
+) -> Assemblies:
+    """All assembly modes at each row of ``input_values`` (N, n_inputs), by Newton from
+    ``starts`` random points per sample, vectorised over samples × starts. Returns at most
+    ``max_modes`` distinct assemblies per sample (by :func:`signature`)."""
+    lay = layout(linkage)
+    values = np.atleast_2d(np.asarray(input_values, dtype=float))
+    N = values.shape[0]
+    rng = np.random.default_rng(seed)
+    conf0 = random_configurations(linkage, N * starts, rng, lay)
+    conf0 = set_inputs(conf0, lay, linkage.inputs, np.repeat(values, starts, axis=0))
+    res = newton(linkage, conf0, max_iter=80, lay=lay)
+    sig = signature(linkage, res.conf, lay).reshape(N, starts, -1)
+    ok = res.converged.reshape(N, starts)
+    # de-duplicate within each sample: keep the first of every cluster (vectorised pairwise)
+    d = np.max(np.abs(sig[:, :, None, :] - sig[:, None, :, :]), axis=-1)  # (N, K, K)
+    same = (d < tol_same) & ok[:, None, :] & ok[:, :, None]
+    earlier = np.tril(np.ones((starts, starts), dtype=bool), k=-1)
+    dup = np.any(same & earlier[None], axis=-1)
+    keep = ok & ~dup
+    # compact to max_modes slots
+    order = np.argsort(~keep, axis=1, kind="stable")[:, :max_modes]
+    found = np.take_along_axis(keep, order, axis=1)
+    flat = (np.arange(N)[:, None] * starts + order).ravel()
+    conf = res.conf.take(flat)
+    sig_k = np.take_along_axis(sig, order[..., None], axis=1)
+    return Assemblies(conf, found, sig_k)

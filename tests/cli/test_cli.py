@@ -1,0 +1,166 @@
+"""The command line: readable tables, JSON documents in SI, atomic output, user errors as exit
+status 2 with a one-paragraph message (no traceback)."""
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from screwkit.cli.main import app
+from screwkit.io.spec import SpecError, load_spec
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+runner = CliRunner()
+
+
+def test_every_bundled_example_validates():
+    files = sorted(EXAMPLES.glob("*.toml"))
+    assert len(files) >= 12
+    r = runner.invoke(app, ["validate", *map(str, files)])
+    assert r.exit_code == 0, r.output
+    assert r.output.count("ok ") == len(files)
+
+
+def test_analyze_json_shape_and_units(tmp_path):
+    out = tmp_path / "fig7.json"
+    r = runner.invoke(
+        app, ["analyze", str(EXAMPLES / "bagci_fig7_rsrc.toml"), "--json", "-o", str(out)]
+    )
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    assert doc == json.loads(out.read_text())
+    n = len(doc["input"])
+    assert n == 36 and abs(doc["input"][1] - np.radians(10)) < 1e-12  # SI: radians
+    assert len(doc["modes"]) == 2
+    for mode in doc["modes"]:
+        assert len(mode["assembles"]) == n
+        for key in ("phi0", "S", "chi0"):
+            assert len(mode["variables"][key]) == n
+            assert len(mode["velocities"][key]) == n
+            assert len(mode["accelerations"][key]) == n
+        assert set(mode["coupler_point"]) == {"x", "y", "z"}
+
+
+def test_analyze_table_output():
+    r = runner.invoke(app, ["analyze", str(EXAMPLES / "bagci_example3_4r.toml")])
+    assert r.exit_code == 0, r.output
+    assert "assembly mode 0" in r.output and "phi0" in r.output
+
+
+def test_cssp_names_in_json():
+    r = runner.invoke(app, ["analyze", str(EXAMPLES / "rahman_cssp.toml"), "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    for key in ("s4", "theta2", "eta2"):
+        assert key in doc["modes"][0]["variables"]
+    # 3000 rpm in SI
+    assert abs(doc["input_speed"] - 3000 * 2 * np.pi / 60) < 1e-9
+
+
+def test_non_assembling_range_is_reported_not_hidden():
+    # Bagci's Example 7 mechanism (d3 rebuilt) does not assemble for θ0 ≈ 299°…318°
+    r = runner.invoke(
+        app, ["analyze", str(EXAMPLES / "bagci_example7_double_crank.toml"), "--json"]
+    )
+    doc = json.loads(r.stdout)
+    any_mode = np.any([m["assembles"] for m in doc["modes"]], axis=0)
+    assert not any_mode[6]  # θ0 = 305.35°
+    assert any("stops assembling" in e for m in doc["modes"] for e in m["events"])
+    assert all(m["variables"]["phi0"][6] is None for m in doc["modes"])
+
+
+def _bad(tmp_path, text):
+    p = tmp_path / "bad.toml"
+    p.write_text(text)
+    return p
+
+
+@pytest.mark.parametrize(
+    "text, fragment",
+    [
+        ('[mechanism]\nfamily = "RSRC"\n[dimensions]\nd1 = "2 in"\n', "missing"),
+        ('[mechanism]\nfamily = "XYZ"\n', "unknown family"),
+        (
+            '[mechanism]\nfamily = "4R"\n[dimensions]\na = "3 kg"\nd1 = 1\nd2 = 3\nd3 = 2.5\n',
+            "is not a length",
+        ),
+        (
+            '[mechanism]\nfamily = "4R"\n[dimensions]\na = -3\nd1 = 1\nd2 = 3\nd3 = 2.5\n',
+            "positive length",
+        ),
+        (
+            '[mechanism]\nfamily = "4R"\n[dimensions]\na = 3\nd1 = 1\nd2 = 3\nd3 = 2.5\n[motion]\nstep = 0\n',
+            "step must be positive",
+        ),
+        (
+            '[mechanism]\nfamily = "4R"\n[dimensions]\na = 3\nd1 = 1\nd2 = 3\nd3 = 2.5\nd4 = 1\n',
+            "unknown key",
+        ),
+        ('[mechanism]\nfamily = "4R"\ncolour = "red"\n', "unknown key"),
+        ("[mechanism\n", "not valid TOML"),
+        (
+            '[mechanism]\nfamily = "4R"\n[dimensions]\na = 30\nd1 = 1\nd2 = 3\nd3 = 2.5\n',
+            "does not close",
+        ),
+        (
+            '[mechanism]\nfamily = "CSSP"\n[dimensions]\na1=2\na2=8\na4=1\nalpha4=4\n[links.crank]\nmass = 1\ninertia=[1, 1, 5]\n',
+            "links.crank",
+        ),
+    ],
+)
+def test_user_errors_exit_2_with_a_message(tmp_path, text, fragment):
+    p = _bad(tmp_path, text)
+    r = runner.invoke(app, ["analyze", str(p)])
+    assert r.exit_code == 2
+    assert "Traceback" not in r.output
+    assert fragment in r.output.replace("\n", " ")
+    assert str(p.name) in r.output.replace("\n", "") or "does not close" in r.output
+
+
+def test_failed_run_leaves_no_output_file(tmp_path):
+    p = _bad(
+        tmp_path, '[mechanism]\nfamily = "4R"\n[dimensions]\na = 30\nd1 = 1\nd2 = 3\nd3 = 2.5\n'
+    )
+    out = tmp_path / "result.json"
+    r = runner.invoke(app, ["analyze", str(p), "--json", "-o", str(out)])
+    assert r.exit_code == 2 and not out.exists()
+    assert not [f for f in os.listdir(tmp_path) if f.startswith(".result")]
+
+
+def test_units_defaults_and_explicit_units_agree(tmp_path):
+    a = load_spec(
+        _bad(
+            tmp_path,
+            '[mechanism]\nfamily = "4R"\n[units]\nlength = "in"\n[dimensions]\na = 3\nd1 = 1\nd2 = 3\nd3 = 2.5\n',
+        )
+    )
+    b = load_spec(
+        _bad(
+            tmp_path,
+            '[mechanism]\nfamily = "4R"\n[dimensions]\na = "3 in"\nd1 = "25.4 mm"\nd2 = "3 in"\nd3 = "2.5 in"\n',
+        )
+    )
+    assert a.dimensions == pytest.approx(b.dimensions, rel=1e-12)
+    assert a.dimensions["a"] == pytest.approx(3 * 0.0254)
+
+
+def test_weights_become_masses_with_the_spec_gravity():
+    s = load_spec(EXAMPLES / "rahman_cssp.toml")
+    crank = s.linkage.links[0].mass
+    # 1.9 lbf / 386.4 in/s² in kg
+    assert crank.mass == pytest.approx(1.9 * 4.4482216152605 / (386.4 * 0.0254), rel=1e-12)
+
+
+def test_spec_error_is_a_value_error():
+    with pytest.raises(SpecError, match="no such spec file"):
+        load_spec("does-not-exist.toml")
+
+
+def test_demo_runs_every_example(tmp_path):
+    r = runner.invoke(app, ["demo", str(EXAMPLES), "--output-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    written = sorted(tmp_path.glob("*.analysis.json"))
+    assert len(written) == len(list(EXAMPLES.glob("*.toml")))
