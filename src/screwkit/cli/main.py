@@ -129,6 +129,29 @@ def analyze(
 
 
 @app.command()
+def mobility(
+    spec: Annotated[Path, typer.Argument(help="Spec file (TOML).")],
+    as_json: JsonOpt = False,
+    output: OutputOpt = None,
+) -> None:
+    """Mobility by formula (each term shown) and from the loop's screw Jacobian at a sample
+    configuration: redundant constraints and undetermined (passive) motions named by joint."""
+    from screwkit.io.spec import load_spec
+    from screwkit.kinematics.mobility_check import linkage_mobility
+
+    s = _guard(lambda: load_spec(spec))
+    doc = _guard(lambda: linkage_mobility(s.linkage, s.inputs))
+
+    def table() -> None:
+        console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
+        for line in doc["summary"]:
+            console.print(escape(str(line)), highlight=False)
+            console.print()
+
+    _emit(doc, as_json, output, table)
+
+
+@app.command()
 def demo(
     examples: Annotated[Path, typer.Argument(help="Folder of spec files.")] = Path("examples"),
     output_dir: Annotated[Path, typer.Option("--output-dir", help="Where results are written.")] = Path("out"),
@@ -137,6 +160,7 @@ def demo(
     from screwkit.io.results import dumps, write_atomic
     from screwkit.io.spec import load_spec
     from screwkit.kinematics.analysis import analyze as run
+    from screwkit.kinematics.mobility_check import linkage_mobility
 
     files = sorted(examples.glob("*.toml"))
     if not files:
@@ -151,6 +175,8 @@ def demo(
         _, doc = _guard(lambda s=spec: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point))  # type: ignore[misc]
         out = output_dir / f"{f.stem}.analysis.json"
         write_atomic(out, dumps(doc) + "\n")
+        mob = _guard(lambda s=spec: linkage_mobility(s.linkage, s.inputs))  # type: ignore[misc]
+        write_atomic(output_dir / f"{f.stem}.mobility.json", dumps(mob) + "\n")
         res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)
         asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])
         t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", str(out))
