@@ -164,3 +164,19 @@ def test_demo_runs_every_example(tmp_path):
     assert r.exit_code == 0, r.output
     written = sorted(tmp_path.glob("*.analysis.json"))
     assert len(written) == len(list(EXAMPLES.glob("*.toml")))
+
+
+def test_dynamics_json_has_the_documented_keys():
+    r = runner.invoke(app, ["dynamics", str(EXAMPLES / "rahman_cssp.toml"), "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    for key in ("shaking_force", "shaking_moment", "moment_point", "reactions", "efforts"):
+        assert key in doc
+    assert len(doc["shaking_force"]) == 36 and len(doc["shaking_force"][0]) == 3
+    assert set(doc["reactions"]) == {"crank", "pin", "ball", "slider"}
+    assert "crank.theta" in doc["efforts"]
+
+
+def test_dynamics_without_masses_says_which_link():
+    r = runner.invoke(app, ["dynamics", str(EXAMPLES / "bagci_fig7_rsrc.toml")])
+    assert r.exit_code == 2 and "links.crank" in r.output.replace("\n", "")

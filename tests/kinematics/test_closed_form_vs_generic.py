@@ -54,3 +54,4 @@ def test_rahman_example_range():
     s4 = max((seed_variables(lk, md)[0]["s4"] for md in m.modes), key=lambda s: np.nanmean(s))
     assert s4.min() / 0.0254 == pytest.approx(6.10, abs=0.01)
     assert s4.max() / 0.0254 == pytest.approx(9.96, abs=0.01)
+

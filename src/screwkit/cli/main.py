@@ -152,6 +152,60 @@ def mobility(
 
 
 @app.command()
+def dynamics(
+    spec: Annotated[Path, typer.Argument(help="Spec file (TOML) with [links.<name>] mass properties.")],
+    as_json: JsonOpt = False,
+    output: OutputOpt = None,
+    gravity: Annotated[bool, typer.Option("--gravity/--no-gravity", help="Include gravity along −z (magnitude from the spec, default 9.80665 m/s²).")] = False,
+) -> None:
+    """Shaking force and moment, every joint reaction and the actuator efforts over the cycle,
+    with the RMS and peak of each (one assembly mode: [motion].mode)."""
+    from screwkit.io.spec import load_spec
+
+    s = _guard(lambda: load_spec(spec))
+    doc = _guard(lambda: _dynamics_doc(s, gravity))
+
+    def table() -> None:
+        console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
+        console.print(f"assembly mode {doc['mode']}; {escape(doc['indeterminacy'])}", highlight=False)
+        t = Table(title="loads over the cycle (SI: N, N·m)")
+        for col in ("quantity", "RMS", "peak"):
+            t.add_column(col, justify="right")
+        for name, st in doc["summary"].items():
+            if isinstance(st, dict) and "rms" in st:
+                t.add_row(name, f"{st['rms']:.6g}", f"{st['peak']:.6g}")
+            elif isinstance(st, dict):
+                for sub, st2 in st.items():
+                    t.add_row(f"{name} {sub}", f"{st2['rms']:.6g}", f"{st2['peak']:.6g}")
+        console.print(t)
+
+    _emit(doc, as_json, output, table)
+
+
+def _dynamics_doc(s: Any, gravity: bool) -> dict[str, Any]:
+    from screwkit.dynamics import inverse_dynamics
+    from screwkit.kinematics.motion import motion
+
+    lk = s.linkage
+    missing = [link.name for link in lk.links if link.mass is None]
+    if missing:
+        raise ValueError(f"{s.path}: dynamics needs mass properties for every link; add [links.{missing[0]}] "
+                         f"(missing: {missing}; see docs/spec-format.md)")
+    m = motion(lk, s.inputs, s.speed, s.acceleration)
+    if s.mode >= len(m.modes):
+        raise ValueError(f"{s.path}: [motion.mode] = {s.mode} but the mechanism has {len(m.modes)} assembly mode(s) (0…{len(m.modes) - 1})")
+    g = None
+    if gravity:
+        g = [0.0, 0.0, -(s.gravity_magnitude or 9.80665)]
+    dyn = inverse_dynamics(lk, m.modes[s.mode], gravity=g)
+    doc = dyn.as_dict()
+    doc["mode"] = s.mode
+    doc["summary"] = dyn.summary()
+    doc["indeterminacy"] = dyn.indeterminacy.describe()
+    return doc
+
+
+@app.command()
 def demo(
     examples: Annotated[Path, typer.Argument(help="Folder of spec files.")] = Path("examples"),
     output_dir: Annotated[Path, typer.Option("--output-dir", help="Where results are written.")] = Path("out"),
@@ -177,6 +231,9 @@ def demo(
         write_atomic(out, dumps(doc) + "\n")
         mob = _guard(lambda s=spec: linkage_mobility(s.linkage, s.inputs))  # type: ignore[misc]
         write_atomic(output_dir / f"{f.stem}.mobility.json", dumps(mob) + "\n")
+        if all(link.mass is not None for link in spec.linkage.links):
+            dyn = _guard(lambda s=spec: _dynamics_doc(s, False))  # type: ignore[misc]
+            write_atomic(output_dir / f"{f.stem}.dynamics.json", dumps(dyn) + "\n")
         res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)
         asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])
         t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", str(out))

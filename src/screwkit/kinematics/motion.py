@@ -11,7 +11,8 @@ centre lies between that sample and the next).
 Velocities solve the loop-closure rate equation J_p q̇_p = −J_in q̇_in (Bagci eqs. 3.27–3.48
 differentiated; Rahman §1.4 done with the true axes); accelerations J_p q̈_p = −J_in q̈_in − J̇q̇
 with J̇q̇ = Σ_{j<k} [S_j, S_k] q̇_j q̇_k (Lie brackets of the freedom screws). Passive freedoms
-(e.g. the spin of an S–S connecting rod) take the minimum-norm rates. Where J_p loses rank
+take the minimum-norm rates, except the spin of a link between two spherical joints (an S–S
+rod), which is zero (ω·u = 0, Rahman 1996 §1.2). Where J_p loses rank
 beyond its passive freedoms the configuration is singular: it is flagged, not divided through.
 """
 
@@ -209,6 +210,10 @@ def motion(
     return Motion(linkage, X, np.array(Xd), np.array(Xdd), modes)
 
 
+def _unit(d: Array) -> Array:
+    return np.asarray(d / np.linalg.norm(d, axis=-1, keepdims=True))
+
+
 def _mode_motion(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArray[np.bool_],
                  Xd: Array, Xdd: Array, events: list[str]) -> ModeMotion:
     N = conf.size
@@ -221,7 +226,19 @@ def _mode_motion(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArr
     rows = np.array([1, 1, 1, 1 / L, 1 / L, 1 / L])
     cols = np.array([L if t else 1.0 for t in lay.is_translation])
     S = fr.screws  # (N, 6, m)
-    Jp = S[:, :, p_idx] * rows[None, :, None] * cols[p_idx][None, None, :]
+    # Passive spin of a link between two spherical joints (an S–S rod): the rule is zero
+    # absolute spin, ω_link·u = 0 with u the line of the two ball centres (Rahman 1996 §1.2).
+    # Then α_link·u = −ω·u̇ = 0 too, and an axisymmetric rod's axial inertia does no work.
+    spin_links = [i for i in range(len(linkage.joints) - 1)
+                  if linkage.joints[i].kind == "S" and linkage.joints[i + 1].kind == "S"]
+    C = np.zeros((N, len(spin_links), m))
+    for r, i in enumerate(spin_links):
+        d = fr.centres[:, i + 1] - fr.centres[:, i]
+        u = d / np.linalg.norm(d, axis=-1, keepdims=True)
+        upto = [f for f in range(m) if lay.joint_of[f] <= i]
+        C[:, r, upto] = np.einsum("ni,nif->nf", u, S[:, :3, upto])
+    Jp = np.concatenate([S[:, :, p_idx] * rows[None, :, None], C[:, :, p_idx]], axis=1)
+    Jp = Jp * cols[p_idx][None, None, :]
     sv = np.linalg.svd(Jp, compute_uv=False)
     tol = SINGULAR_RTOL * sv[:, :1]
     rank = np.sum(sv > tol, axis=-1)
@@ -230,7 +247,8 @@ def _mode_motion(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArr
     pinv = np.linalg.pinv(Jp, rcond=1e-10)
     qd = np.zeros((N, m))
     qd[:, in_idx] = Xd
-    rhs = -np.einsum("nij,nj->ni", S[:, :, in_idx], Xd) * rows
+    rhs = np.concatenate([-np.einsum("nij,nj->ni", S[:, :, in_idx], Xd) * rows,
+                          -np.einsum("nij,nj->ni", C[:, :, in_idx], Xd)], axis=1)
     qd[:, p_idx] = np.einsum("nij,nj->ni", pinv, rhs) * cols[p_idx]
     # J̇q̇ = Σ_k [V_before(k), S_k] q̇_k, V_before(k) = motion of the loop before freedom k
     bracket = np.zeros((N, 6))
@@ -254,7 +272,12 @@ def _mode_motion(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArr
         k += len(ks)
     qdd = np.zeros((N, m))
     qdd[:, in_idx] = Xdd
-    rhs2 = (-np.einsum("nij,nj->ni", S[:, :, in_idx], Xdd) - bracket) * rows
+    spin_bias = np.stack(
+        [np.einsum("ni,ni->n", _unit(fr.centres[:, i + 1] - fr.centres[:, i]),
+                   link_bias[:, i, :3]) for r, i in enumerate(spin_links)], axis=1,
+    ) if spin_links else np.zeros((N, 0))
+    rhs2 = np.concatenate([(-np.einsum("nij,nj->ni", S[:, :, in_idx], Xdd) - bracket) * rows,
+                           -np.einsum("nij,nj->ni", C[:, :, in_idx], Xdd) - spin_bias], axis=1)
     qdd[:, p_idx] = np.einsum("nij,nj->ni", pinv, rhs2) * cols[p_idx]
     # link twists and accelerations (ground frame, spatial form), per moving link i < n
     link_A = np.zeros_like(link_V)
@@ -267,7 +290,7 @@ def _mode_motion(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArr
     nl = len(linkage.joints) - 1
     bR = linkage.base.real
     bp = linkage.base.translation
-    Rw = np.einsum("ij,nljk->nljk", bR, fr.after_R[:, :nl])
+    Rw = np.einsum("ij,nljk->nlik", bR, fr.after_R[:, :nl])
     pw = np.einsum("ij,nlj->nli", bR, fr.after_p[:, :nl]) + bp
     w = link_V[:, :nl, :3]
     v0 = link_V[:, :nl, 3:]

@@ -1,0 +1,151 @@
+"""The result of an inverse-dynamics analysis: loads over the motion cycle (frozen, batch-first).
+
+Conventions (../shared/DESIGN.md, docs/dynamics.md): every vector is in the world frame, SI
+units. A joint reaction is the force and moment exerted on the distal link by the proximal link
+(on the moving link by the ground for the two ground joints), moment about the joint centre. The
+shaking force and moment are what the moving links exert on the ground, moment about
+``moment_point``. Samples where ``valid`` is False (no assembly, or a singular configuration)
+hold NaN in the arrays and ``None`` in :meth:`Dynamics.as_dict`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Indeterminacy:
+    """What the rigid-body joint model leaves undetermined, generic over the mode.
+
+    ``count``: number of statically indeterminate wrench components (6 − rank of the passive
+    statics); the returned reactions are the minimum-norm ones (docs/dynamics.md).
+    ``directions`` (count, 6): unit self-stress wrenches (f; m about the world origin) that can
+    be added to every joint reaction alike without changing any link's balance.
+    ``idle_freedoms``: passive motions the joints cannot load (an S–S rod spinning about its
+    axis); link loads along them show up in :attr:`Dynamics.residual`.
+    """
+
+    count: int
+    directions: Array
+    idle_freedoms: int
+
+    def describe(self) -> str:
+        parts = []
+        if self.count:
+            parts.append(
+                f"{self.count} reaction component(s) statically indeterminate (overconstrained "
+                "loop); the minimum-norm reactions are given"
+            )
+        if self.idle_freedoms:
+            parts.append(
+                f"{self.idle_freedoms} idle passive freedom(s) (e.g. a rod spinning about its own "
+                "axis) that the joints cannot load; any load along them is reported as residual"
+            )
+        return "; ".join(parts) if parts else "statically determinate"
+
+
+def _listify(a: Array, valid: NDArray[np.bool_]) -> list[Any]:
+    out: list[Any] = []
+    for ok, row in zip(valid, a, strict=True):
+        out.append(np.asarray(row).tolist() if ok else None)
+    return out
+
+
+def _stats(values: Array, valid: NDArray[np.bool_]) -> dict[str, float]:
+    """RMS and peak of a load over the valid samples (vector loads by their magnitude)."""
+    v = values[valid]
+    mag = np.abs(v) if v.ndim == 1 else np.linalg.norm(v, axis=-1)
+    if mag.size == 0:
+        return {"rms": float("nan"), "peak": float("nan")}
+    return {"rms": float(np.sqrt(np.mean(mag**2))), "peak": float(np.max(mag))}
+
+
+@dataclass(frozen=True, eq=False)
+class Dynamics:
+    """Loads of one assembly mode over the motion cycle (N samples).
+
+    Attributes
+    ----------
+    inputs:
+        (N, n_in) input values per sample (NaN where unknown), names in ``input_names``.
+    shaking_force, shaking_moment:
+        (N, 3) what the moving links exert on the ground; moment about ``moment_point``.
+    reactions:
+        ``{joint: {"force": (N, 3), "moment": (N, 3)}}``, moment about the joint centre.
+    efforts:
+        ``{driven freedom: (N,)}``: torque (N·m) of a driven rotation, force (N) of a driven
+        translation, exerted by the proximal link on the distal link along the freedom.
+    residual:
+        (N,) unbalanced generalised force along idle passive freedoms (N, moments divided by the
+        length scale), zero when the joint model can carry every link load.
+    residual_scale:
+        largest joint load over the cycle in the same units (to read ``residual`` relatively).
+    """
+
+    input_names: tuple[str, ...]
+    inputs: Array
+    valid: NDArray[np.bool_]
+    shaking_force: Array
+    shaking_moment: Array
+    moment_point: Array
+    reactions: Mapping[str, Mapping[str, Array]]
+    joint_centres: Array
+    efforts: Mapping[str, Array]
+    indeterminacy: Indeterminacy
+    residual: Array
+    residual_scale: float
+    gravity: Array
+
+    @property
+    def relative_residual(self) -> Array:
+        """``residual / residual_scale`` per sample."""
+        return self.residual / max(self.residual_scale, np.finfo(float).tiny)
+
+    def summary(self) -> dict[str, dict[str, float]]:
+        """RMS and peak over the valid samples of every load (vectors by magnitude)."""
+        out = {
+            "shaking_force": _stats(self.shaking_force, self.valid),
+            "shaking_moment": _stats(self.shaking_moment, self.valid),
+        }
+        for name, r in self.reactions.items():
+            out[f"{name}.force"] = _stats(r["force"], self.valid)
+            out[f"{name}.moment"] = _stats(r["moment"], self.valid)
+        for name, e in self.efforts.items():
+            out[f"effort {name}"] = _stats(e, self.valid)
+        out["relative_residual"] = _stats(self.relative_residual, self.valid)
+        return out
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-able dictionary (SI units, lists, ``None`` where a sample is not valid)."""
+        v = self.valid
+        return {
+            "units": {"force": "N", "moment": "N*m", "effort": "N*m or N", "length": "m"},
+            "input_names": list(self.input_names),
+            "inputs": _listify(self.inputs, v),
+            "valid": v.tolist(),
+            "moment_point": self.moment_point.tolist(),
+            "gravity": self.gravity.tolist(),
+            "shaking_force": _listify(self.shaking_force, v),
+            "shaking_moment": _listify(self.shaking_moment, v),
+            "reactions": {
+                name: {"force": _listify(r["force"], v), "moment": _listify(r["moment"], v)}
+                for name, r in self.reactions.items()
+            },
+            "efforts": {name: _listify(e, v) for name, e in self.efforts.items()},
+            "indeterminacy": {
+                "count": self.indeterminacy.count,
+                "idle_freedoms": self.indeterminacy.idle_freedoms,
+                "directions": self.indeterminacy.directions.tolist(),
+                "description": self.indeterminacy.describe(),
+            },
+            "residual": _listify(self.residual, v),
+            "residual_scale": self.residual_scale,
+            "summary": self.summary(),
+        }
