@@ -25,6 +25,8 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 console = Console()
+if not console.is_terminal:
+    console.width = max(console.width, 160)  # files and pipes get the full tables
 err_console = Console(stderr=True)
 
 T = TypeVar("T")
@@ -81,10 +83,10 @@ def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML)
         console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
 
 
-def _fmt(x: float, angle: bool) -> str:
-    if x != x:
+def _fmt(x: float | None, angle: bool) -> str:
+    if x is None or x != x:
         return "—"
-    return f"{np.degrees(x):10.4f}" if angle else f"{x:10.6g}"
+    return f"{np.degrees(x):.4f}" if angle else f"{x:.6g}"
 
 
 @app.command()
@@ -92,19 +94,21 @@ def analyze(
     spec: Annotated[Path, typer.Argument(help="Spec file (TOML).")],
     as_json: JsonOpt = False,
     output: OutputOpt = None,
+    method: Annotated[str, typer.Option("--method", help="auto (closed form where the family has one), closed, or generic (any loop; every joint variable).")] = "auto",
 ) -> None:
     """Positions, velocities and accelerations of every joint variable in every assembly mode."""
     from screwkit.io.spec import load_spec
     from screwkit.kinematics.analysis import analyze as run
 
     s = _guard(lambda: load_spec(spec))
-    _, doc = _guard(lambda: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point))
+    _, doc = _guard(lambda: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point, method))
 
     def table() -> None:
         console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
-        console.print("angles in degrees, lengths in metres, rates per second (SI)")
+        console.print(f"method: {doc['method']}; angles in degrees, lengths in metres, rates per second (SI)")
         for mode in doc["modes"]:
-            names = [n for n in mode["variables"] if "." not in n] or list(mode["variables"])[:4]
+            names = [n for n in mode["variables"] if "." not in n and n not in ("theta0", "theta1")]
+            names = names or [n for n in mode["variables"] if n != doc["input_name"]][:4]
             t = Table(title=f"assembly mode {mode['mode']}", show_lines=False)
             t.add_column("input (deg)", justify="right")
             for n in names:

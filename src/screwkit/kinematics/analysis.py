@@ -11,12 +11,32 @@ from screwkit.kinematics.motion import Motion, motion
 from screwkit.kinematics.named import seed_variables
 from screwkit.model.linkage import Linkage
 
+CLOSED_FORM_FAMILIES = ("RSRC", "4R")
+
 
 def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, acceleration: float = 0.0,
-            coupler_point: tuple[float, float, float] | None = None) -> tuple[Motion, dict[str, Any]]:
-    """Motion of every assembly mode over ``inputs`` and its JSON-able document (SI)."""
+            coupler_point: tuple[float, float, float] | None = None,
+            method: str = "auto") -> tuple[Motion | None, dict[str, Any]]:
+    """Motion of every assembly mode over ``inputs`` and its JSON-able document (SI).
+
+    ``method``: ``"closed"`` uses the family's closed form (RSRC quartic, Bagci eqs. 3.59–3.82;
+    the planar 4R as its δ0 = λ0 = b = e = 0 case), ``"generic"`` the generic loop solver, and
+    ``"auto"`` the closed form where the family has one and the sweep has ≥ 2 samples. The
+    closed form returns the seed's variables only; the generic solver every joint variable too.
+    """
+    if method not in ("auto", "closed", "generic"):
+        raise ValueError(f"method must be 'auto', 'closed' or 'generic'; got {method!r}")
+    has_closed = linkage.family in CLOSED_FORM_FAMILIES and len(inputs) >= 2
+    if method == "closed" and not has_closed:
+        raise ValueError(
+            f"no closed form for a {linkage.family or 'general loop'} (closed forms: "
+            f"{', '.join(CLOSED_FORM_FAMILIES)}, with at least 2 input samples); use --method generic"
+        )
+    if method in ("auto", "closed") and has_closed:
+        return None, _closed_form(linkage, np.asarray(inputs, dtype=float), speed, acceleration,
+                                  coupler_point)
     m = motion(linkage, inputs, speed, acceleration)
-    modes = []
+    modes: list[dict[str, Any]] = []
     for k, md in enumerate(m.modes):
         v, vd, vdd = seed_variables(linkage, md)
         entry: dict[str, Any] = {
@@ -36,6 +56,7 @@ def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, accelerati
             entry["coupler_point"] = {"x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
         modes.append(entry)
     doc = {
+        "method": "generic",
         "mechanism": linkage.name,
         "family": linkage.family,
         "units": {"length": "m", "angle": "rad", "time": "s",
@@ -49,3 +70,121 @@ def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, accelerati
         "modes": modes,
     }
     return m, doc
+
+
+def _closed_form(linkage: Linkage, theta: np.ndarray, speed: float, acceleration: float,
+                 coupler_point: tuple[float, float, float] | None) -> dict[str, Any]:
+    from screwkit.kinematics.rsrc import (
+        RSRCDimensions,
+        RSRCPositions,
+        rsrc_coupler_point,
+        rsrc_motion,
+        rsrc_rates,
+    )
+
+    p = dict(linkage.parameters)
+    planar = linkage.family == "4R"
+    if planar:
+        dims = RSRCDimensions(d1=p["d1"], d2=p["d2"], d3=p["d3"], a=p["a"], b=0.0, e=0.0,
+                              delta0=0.0, lambda0=0.0)
+    else:
+        dims = RSRCDimensions(**p)
+    mot = rsrc_motion(dims, theta)
+    case = "delta0_n_pi" if planar else _case(dims)
+    pos = RSRCPositions(mot.theta0, mot.phi0, mot.chi0, mot.S, mot.assembles, case)  # type: ignore[arg-type]
+    rates = rsrc_rates(dims, pos, speed, acceleration)
+    cp = rsrc_coupler_point(dims, pos, *coupler_point) if coupler_point is not None else None
+    residual = _master_loop_residual(dims, pos)
+    modes: list[dict[str, Any]] = []
+    for j in range(mot.phi0.shape[1]):
+        ok = mot.assembles[:, j]
+        if not ok.any():
+            continue
+        variables = {"theta0": theta, "phi0": mot.phi0[:, j], "chi0": mot.chi0[:, j]}
+        velocities = {"theta0": np.full_like(theta, speed), "phi0": rates.phi0_dot[:, j],
+                      "chi0": rates.chi0_dot[:, j]}
+        accelerations = {"theta0": np.full_like(theta, acceleration), "phi0": rates.phi0_ddot[:, j],
+                         "chi0": rates.chi0_ddot[:, j]}
+        if not planar:
+            variables["S"] = mot.S[:, j]
+            velocities["S"] = rates.S_dot[:, j]
+            accelerations["S"] = rates.S_ddot[:, j]
+        for table in (variables, velocities, accelerations):
+            for key, values in table.items():
+                if key != "theta0":
+                    table[key] = np.where(ok, values, np.nan)
+        events = [f"{e.kind} assembling at input [{e.theta0!r}] (limit position or dead centre)"
+                  for e in mot.events if e.branch == j]
+        entry: dict[str, Any] = {
+            "mode": len(modes),
+            "assembles": ok,
+            "singular": ok & ~rates.valid[:, j],
+            "events": events,
+            "variables": variables,
+            "velocities": velocities,
+            "accelerations": accelerations,
+            "closure_residual": np.where(ok, residual[:, j], np.nan),
+        }
+        if cp is not None:
+            xyz = cp.global_xyz[:, j]
+            entry["coupler_point"] = {"x": xyz[:, 0], "y": xyz[:, 1], "z": xyz[:, 2]}
+        modes.append(entry)
+    if not modes:
+        from screwkit.kinematics.motion import AssemblyError
+
+        raise AssemblyError(
+            f"{linkage.name}: the loop does not close at any of the {len(theta)} inputs "
+            f"(from {theta[0]!r} to {theta[-1]!r}); check the dimensions"
+        )
+    return {
+        "method": "closed",
+        "mechanism": linkage.name,
+        "family": linkage.family,
+        "units": {"length": "m", "angle": "rad", "time": "s",
+                  "velocities": "d/dt of each variable (rad/s or m/s)",
+                  "accelerations": "d2/dt2 of each variable (rad/s^2 or m/s^2)"},
+        "input_name": linkage.inputs[0],
+        "input": theta,
+        "input_speed": speed,
+        "input_acceleration": acceleration,
+        "parameters": p,
+        "modes": modes,
+    }
+
+
+def _case(dims: Any) -> str:
+    s = np.sin(dims.delta0)
+    c = np.cos(dims.delta0)
+    if abs(s) < 1e-12:
+        return "delta0_n_pi"
+    if abs(c) < 1e-12:
+        return "delta0_half_pi"
+    return "general"
+
+
+def _master_loop_residual(dims: Any, pos: Any) -> np.ndarray:
+    """|sphere centre from the input side − from the output side| / length scale, Bagci's
+    master position loop (reference spec §3.1) — an independent check of the closed form."""
+    th = pos.theta0[:, None]
+    phi, S, chi = pos.phi0, pos.S, pos.chi0
+    lam, dl = dims.lambda0, dims.delta0
+    # vectors in the output frame, then R_y(λ0); rotations written out per component
+    # w = e e1 − d2 R_x(−χ) e2 = (e, −d2 cos χ, d2 sin χ)
+    wx, wy, wz = dims.e, -dims.d2 * np.cos(chi), dims.d2 * np.sin(chi)
+    # R_y(−δ) w
+    ux = np.cos(dl) * wx - np.sin(dl) * wz
+    uy = wy
+    uz = np.sin(dl) * wx + np.cos(dl) * wz
+    # d3 e2 + that, then R_x(φ)
+    yy = dims.d3 + uy
+    rx, ry, rz = ux, np.cos(phi) * yy - np.sin(phi) * uz, np.sin(phi) * yy + np.cos(phi) * uz
+    # −S e1 + that, then R_y(λ)
+    rx = rx - S
+    gx = np.cos(lam) * rx + np.sin(lam) * rz
+    gy = ry
+    gz = -np.sin(lam) * rx + np.cos(lam) * rz
+    ex = dims.b + gx - 0.0
+    ey = dims.a + gy - dims.d1 * np.cos(th)
+    ez = gz - dims.d1 * np.sin(th)
+    L = dims.d1 + dims.d2 + abs(dims.d3) + abs(dims.a) + abs(dims.b) + abs(dims.e)
+    return np.asarray(np.sqrt(ex**2 + ey**2 + ez**2) / L)

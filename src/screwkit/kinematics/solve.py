@@ -151,11 +151,23 @@ def find_assemblies(
     conf0 = random_configurations(linkage, N * starts, rng, lay)
     conf0 = set_inputs(conf0, lay, linkage.inputs, np.repeat(values, starts, axis=0))
     res = newton(linkage, conf0, max_iter=80, lay=lay)
+    fr = forward(linkage, res.conf, lay)
     sig = signature(linkage, res.conf, lay).reshape(N, starts, -1)
     ok = res.converged.reshape(N, starts)
+    # Near a double root (a limit position) the closure error grows only quadratically with
+    # the distance from the root, so Newton's roots scatter by ~√tolerance: merge within that
+    # wider radius where the passive Jacobian is near-singular.
+    rows, cols = _scales(lay, linkage.length_scale)
+    pidx = [k for k, n in enumerate(lay.names) if n not in linkage.inputs]
+    Jp = fr.screws[:, :, pidx] * rows[None, :, None] * cols[pidx][None, None, :]
+    sv = np.linalg.svd(Jp, compute_uv=False)
+    generic_rank = int(np.max(np.sum(sv > 1e-6 * sv[:, :1], axis=-1)))
+    weakest = sv[:, generic_rank - 1] / sv[:, 0] if generic_rank > 0 else np.ones(len(sv))
+    radius = np.where(weakest < 1e-3, np.sqrt(tol_same) * 3e-2, tol_same).reshape(N, starts)
     # de-duplicate within each sample: keep the first of every cluster (vectorised pairwise)
     d = np.max(np.abs(sig[:, :, None, :] - sig[:, None, :, :]), axis=-1)  # (N, K, K)
-    same = (d < tol_same) & ok[:, None, :] & ok[:, :, None]
+    near = np.maximum(radius[:, :, None], radius[:, None, :])
+    same = (d < near) & ok[:, None, :] & ok[:, :, None]
     earlier = np.tril(np.ones((starts, starts), dtype=bool), k=-1)
     dup = np.any(same & earlier[None], axis=-1)
     keep = ok & ~dup
