@@ -95,6 +95,7 @@ def analyze(
     as_json: JsonOpt = False,
     output: OutputOpt = None,
     method: Annotated[str, typer.Option("--method", help="auto (closed form where the family has one), closed, or generic (any loop; every joint variable).")] = "auto",
+    plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of every variable and its rates over the input, and the coupler curve projections.")] = None,
 ) -> None:
     """Positions, velocities and accelerations of every joint variable in every assembly mode."""
     from screwkit.io.spec import load_spec
@@ -102,6 +103,10 @@ def analyze(
 
     s = _guard(lambda: load_spec(spec))
     _, doc = _guard(lambda: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point, method))
+    if plot is not None:
+        from screwkit.report.plots import plot_analysis
+
+        _guard(lambda: plot_analysis(doc, plot))
 
     def table() -> None:
         console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
@@ -128,6 +133,45 @@ def analyze(
             missing = int((~np.asarray(mode["assembles"])).sum())
             if missing:
                 console.print(f"  • does not assemble at {missing} of {len(doc['input'])} inputs", highlight=False)
+
+    _emit(doc, as_json, output, table)
+
+
+@app.command()
+def limits(
+    spec: Annotated[Path, typer.Argument(help="Spec file (TOML) of an RSRC or a planar 4R.")],
+    as_json: JsonOpt = False,
+    output: OutputOpt = None,
+    dwell_tolerance: Annotated[float, typer.Option("--dwell-tol", help="A derivative dᵏφ0/dθ0ᵏ counts as vanishing below this (rad/radᵏ). Printed dimensions hold a designed dwell only to ~1e-4.")] = 1e-6,
+    at: Annotated[list[float] | None, typer.Option("--at", help="Also give the dwell order at this input angle (degrees); repeatable.")] = None,
+) -> None:
+    """Limit positions of the output rotation and translation over a full turn, and the order
+    of the instantaneous dwell at each rotation limit (Bagci App. D)."""
+    from screwkit.io.spec import load_spec
+    from screwkit.kinematics.analysis import limits as run
+
+    s = _guard(lambda: load_spec(spec))
+    doc = _guard(lambda: run(s.linkage, dwell_tolerance, at=[float(np.radians(x)) for x in at or []]))
+
+    def table() -> None:
+        console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
+        t = Table(title=f"limit positions (dwell tolerance {dwell_tolerance:g})")
+        for col in ("kind", "branch", "θ0 (deg)", "φ0 (deg)", "S (m)", "2nd derivative", "dwell order"):
+            t.add_column(col, justify="right")
+        for lim in doc["limits"]:
+            t.add_row(lim["kind"], str(lim["branch"]), f"{np.degrees(lim['theta0']):.4f}",
+                      f"{np.degrees(lim['phi0']):.4f}", "—" if lim["S"] is None else f"{lim['S']:.6g}",
+                      f"{lim['second_derivative']:.4g}", str(lim.get("dwell_order", "—")))
+        console.print(t)
+        if doc["dwells_at"]:
+            t2 = Table(title="dwell order at given inputs")
+            for col in ("θ0 (deg)", "inversion", "φ0 (deg)", "dwell order", "dφ0/dθ0 … (rad/radᵏ)"):
+                t2.add_column(col, justify="right")
+            for d in doc["dwells_at"]:
+                t2.add_row(f"{np.degrees(d['theta0']):.4f}", str(d["inversion_label"]),
+                           f"{np.degrees(d['phi0']):.4f}", str(d["dwell_order"]),
+                           ", ".join(f"{x:.3g}" for x in d["derivatives"]))
+            console.print(t2)
 
     _emit(doc, as_json, output, table)
 
@@ -213,6 +257,7 @@ def _dynamics_doc(s: Any, gravity: bool) -> dict[str, Any]:
 def demo(
     examples: Annotated[Path, typer.Argument(help="Folder of spec files.")] = Path("examples"),
     output_dir: Annotated[Path, typer.Option("--output-dir", help="Where results are written.")] = Path("out"),
+    plots: Annotated[bool, typer.Option("--plots/--no-plots", help="Also write a PNG per example.")] = True,
 ) -> None:
     """Run the main job on every bundled example: validate, analyse, write the results."""
     from screwkit.io.results import dumps, write_atomic
@@ -233,6 +278,10 @@ def demo(
         _, doc = _guard(lambda s=spec: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point))  # type: ignore[misc]
         out = output_dir / f"{f.stem}.analysis.json"
         write_atomic(out, dumps(doc) + "\n")
+        if plots:
+            from screwkit.report.plots import plot_analysis
+
+            _guard(lambda d=doc, f=f: plot_analysis(d, output_dir / f"{f.stem}.analysis.png"))  # type: ignore[misc]
         mob = _guard(lambda s=spec: linkage_mobility(s.linkage, s.inputs))  # type: ignore[misc]
         write_atomic(output_dir / f"{f.stem}.mobility.json", dumps(mob) + "\n")
         if all(link.mass is not None for link in spec.linkage.links):

@@ -188,3 +188,62 @@ def _master_loop_residual(dims: Any, pos: Any) -> np.ndarray:
     ez = gz - dims.d1 * np.sin(th)
     L = dims.d1 + dims.d2 + abs(dims.d3) + abs(dims.a) + abs(dims.b) + abs(dims.e)
     return np.asarray(np.sqrt(ex**2 + ey**2 + ez**2) / L)
+
+
+def limits(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: int = 5,
+           at: list[float] | None = None) -> dict[str, Any]:
+    """Limit positions of the output rotation and translation over a full input turn, each with
+    the order of its instantaneous dwell (Bagci 1969, App. D: rotation limits Q4 = 0, eq. D.1;
+    translation limits by the corrected eq. D.3; dwell order = number of vanishing consecutive
+    derivatives dᵏφ0/dθ0ᵏ, k = 1…max_order, within ``dwell_tolerance`` rad/radᵏ)."""
+    from screwkit.kinematics.rsrc import (
+        RSRCDimensions,
+        rsrc_dwell_order,
+        rsrc_rotation_limits,
+        rsrc_translation_limits,
+    )
+
+    if linkage.family not in CLOSED_FORM_FAMILIES:
+        raise ValueError(
+            f"limit positions and dwells are computed for the RSRC and the planar 4R "
+            f"(Bagci App. D); this is a {linkage.family or 'general loop'}"
+        )
+    if not dwell_tolerance > 0:
+        raise ValueError(f"the dwell tolerance must be positive; got {dwell_tolerance}")
+    p = dict(linkage.parameters)
+    planar = linkage.family == "4R"
+    dims = (RSRCDimensions(d1=p["d1"], d2=p["d2"], d3=p["d3"], a=p["a"], b=0.0, e=0.0,
+                           delta0=0.0, lambda0=0.0) if planar else RSRCDimensions(**p))
+    out: list[dict[str, Any]] = []
+    rot = rsrc_rotation_limits(dims)
+    if rot:
+        order, deriv = rsrc_dwell_order(dims, np.array([r.theta0 for r in rot]),
+                                        np.array([r.phi0 for r in rot]), tol=dwell_tolerance,
+                                        max_order=max_order)
+    for k, r in enumerate(rot):
+        out.append({"kind": "rotation", "theta0": r.theta0, "phi0": r.phi0, "chi0": r.chi0,
+                    "S": None if planar else r.S, "second_derivative": r.second_derivative,
+                    "branch": r.branch, "dwell_order": int(order[k]),
+                    "derivatives": deriv[k]})
+    if not planar:
+        for r in rsrc_translation_limits(dims):
+            out.append({"kind": "translation", "theta0": r.theta0, "phi0": r.phi0, "chi0": r.chi0,
+                        "S": r.S, "second_derivative": r.second_derivative, "branch": r.branch})
+    dwells: list[dict[str, Any]] = []
+    if at:
+        from screwkit.kinematics.rsrc import rsrc_positions
+
+        th = np.asarray(at, dtype=float)
+        pos = rsrc_positions(dims, th)
+        for j in range(pos.phi0.shape[1]):
+            ok = pos.assembles[:, j]
+            if not ok.any():
+                continue
+            order, deriv = rsrc_dwell_order(dims, th[ok], pos.phi0[ok, j], tol=dwell_tolerance,
+                                            max_order=max_order)
+            for t, ph, o, dv in zip(th[ok], pos.phi0[ok, j], order, deriv, strict=True):
+                dwells.append({"theta0": t, "inversion_label": j + 1, "phi0": ph,
+                               "dwell_order": int(o), "derivatives": dv})
+    return {"mechanism": linkage.name, "family": linkage.family,
+            "dwell_tolerance": dwell_tolerance, "units": {"angle": "rad", "length": "m"},
+            "limits": out, "dwells_at": dwells}

@@ -56,38 +56,57 @@ def newton(
     lay: Layout | None = None,
 ) -> NewtonResult:
     """Close the loop from ``conf`` by damped Gauss–Newton with minimum-norm steps over the
-    passive freedoms (inputs are held). Works on every sample at once."""
+    passive freedoms (inputs are held). Works on every sample at once; each iteration touches
+    only the samples that have not converged or stalled.
+
+    The step is δ = −Jᵀ(JJᵀ + μI)⁻¹ξ with a tiny μ (10⁻¹² of the largest eigenvalue): the
+    minimum-norm Gauss–Newton step, also where J has fewer independent rows than 6 (a planar
+    loop seen in space)."""
     lay = lay or layout(linkage)
     L = linkage.length_scale
     rows, cols = _scales(lay, L)
     passive = np.array([n not in linkage.inputs for n in lay.names])
     pidx = np.nonzero(passive)[0]
     N = conf.size
+    q = conf.scalars.copy()
+    sph = conf.spherical.copy()
     res = np.full(N, np.inf)
-    active = np.ones(N, dtype=bool)
+    best = np.full(N, np.inf)
+    stall = np.zeros(N, dtype=int)
+    todo = np.arange(N)
     it = 0
     for it in range(1, max_iter + 1):  # noqa: B007 - loop over iterations, vectorised over samples
-        fr = forward(linkage, conf, lay)
+        sub = Configuration(q[todo], sph[todo])
+        fr = forward(linkage, sub, lay)
         xi = closure_twist(fr.closure_R, fr.closure_p) * rows
-        res = np.max(np.abs(xi), axis=-1)
-        active = res > tol
-        if not np.any(active):
+        r = np.max(np.abs(xi), axis=-1)
+        res[todo] = r
+        improved = r < 0.5 * best[todo]
+        stall[todo] = np.where(improved, 0, stall[todo] + 1)
+        best[todo] = np.minimum(best[todo], r)
+        keep = (r > tol) & (stall[todo] < 8)
+        if not np.any(keep):
             break
-        Js = fr.screws[active][:, :, pidx] * rows[:, None] * cols[pidx][None, :]
-        step = -np.einsum("nij,nj->ni", np.linalg.pinv(Js, rcond=1e-10), xi[active])
+        todo, xi, fr_screws = todo[keep], xi[keep], fr.screws[keep]
+        J = fr_screws[:, :, pidx] * rows[:, None] * cols[pidx][None, :]
+        JJt = J @ np.swapaxes(J, -1, -2)
+        mu = 1e-12 * np.maximum(np.trace(JJt, axis1=-2, axis2=-1), 1e-300)
+        A = JJt + mu[:, None, None] * np.eye(6)
+        y = np.linalg.solve(A, xi[..., None])[..., 0]
+        step = -np.einsum("nji,nj->ni", J, y)
         big = np.max(np.abs(step), axis=-1, keepdims=True)
         step *= np.minimum(1.0, max_step / np.maximum(big, 1e-300))
-        delta = np.zeros((N, len(lay.names)))
-        sub = np.zeros((step.shape[0], len(lay.names)))
-        sub[:, pidx] = step * cols[pidx]
-        delta[active] = sub
-        conf = apply_increment(conf, delta, lay)
+        delta = np.zeros((len(todo), len(lay.names)))
+        delta[:, pidx] = step * cols[pidx]
+        moved = apply_increment(Configuration(q[todo], sph[todo]), delta, lay)
+        q[todo] = moved.scalars
+        sph[todo] = moved.spherical
     else:
-        fr = forward(linkage, conf, lay)
-        xi = closure_twist(fr.closure_R, fr.closure_p) * rows
-        res = np.max(np.abs(xi), axis=-1)
+        sub = Configuration(q[todo], sph[todo])
+        fr = forward(linkage, sub, lay)
+        res[todo] = np.max(np.abs(closure_twist(fr.closure_R, fr.closure_p) * rows), axis=-1)
     ok = np.isfinite(res) & (res <= max(tol * 10, 1e-10))
-    return NewtonResult(conf, res, ok, it)
+    return NewtonResult(Configuration(q, sph), res, ok, it)
 
 
 def random_configurations(linkage: Linkage, count: int, rng: np.random.Generator, lay: Layout | None = None) -> Configuration:

@@ -1,0 +1,1 @@
+"""Pictures and reports of results (matplotlib, imported lazily: ``pip install screwkit[plot]``)."""
