@@ -12,14 +12,17 @@ from screwkit.kinematics.analysis import analyze
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
-@pytest.mark.parametrize("name", ["bagci_fig7_rsrc", "bagci_example1", "bagci_example3_4r",
+@pytest.mark.parametrize("name", ["bagci_fig7_rsrc", "bagci_example1", "bagci_example3_4r", "rahman_cssp",
                                   "bagci_example7_double_crank", "bagci_fig10_double_crank"])
 def test_closed_form_and_generic_analyses_agree(name):
     s = load_spec(EXAMPLES / f"{name}.toml")
-    _, c = analyze(s.linkage, s.inputs, 1.3, 0.4, s.coupler_point, method="closed")
-    _, g = analyze(s.linkage, s.inputs, 1.3, 0.4, s.coupler_point, method="generic")
+    speed = s.speed if s.family == "CSSP" else 1.3
+    _, c = analyze(s.linkage, s.inputs, speed, 0.4, s.coupler_point, method="closed")
+    _, g = analyze(s.linkage, s.inputs, speed, 0.4, s.coupler_point, method="generic")
     assert c["method"] == "closed" and g["method"] == "generic"
-    keys = ["phi0"] + (["S", "chi0"] if s.family == "RSRC" else [])
+    lead = "s4" if s.family == "CSSP" else "phi0"
+    keys = {"RSRC": ["phi0", "S", "chi0"], "4R": ["phi0"], "CSSP": ["s4", "theta2", "eta2"]}[s.family]
+    scale = s.speed if s.family == "CSSP" else 1.0
     assert sum(np.sum(m["assembles"]) for m in c["modes"]) == sum(np.sum(m["assembles"]) for m in g["modes"])
     for mc in c["modes"]:
         ok = mc["assembles"]
@@ -28,7 +31,7 @@ def test_closed_form_and_generic_analyses_agree(name):
             both = ok & mg["assembles"]
             if not both.any():
                 continue
-            d = np.abs(np.angle(np.exp(1j * (mc["variables"]["phi0"][both] - mg["variables"]["phi0"][both]))))
+            d = np.abs(np.angle(np.exp(1j * (mc["variables"][lead][both] - mg["variables"][lead][both]))))
             if d.max() < 1e-9:
                 matches.append((mg, both))
         covered = np.zeros_like(ok)
@@ -36,8 +39,8 @@ def test_closed_form_and_generic_analyses_agree(name):
             covered |= both
             for k in keys:
                 # both are exact formulas: agreement to round-off of O(1) quantities
-                np.testing.assert_allclose(mc["velocities"][k][both], mg["velocities"][k][both], atol=1e-9)
-                np.testing.assert_allclose(mc["accelerations"][k][both], mg["accelerations"][k][both], atol=1e-8)
+                np.testing.assert_allclose(mc["velocities"][k][both], mg["velocities"][k][both], atol=1e-9 * scale)
+                np.testing.assert_allclose(mc["accelerations"][k][both], mg["accelerations"][k][both], atol=1e-8 * scale**2)
             if "coupler_point" in mc:
                 for ax in "xyz":
                     np.testing.assert_allclose(mc["coupler_point"][ax][both], mg["coupler_point"][ax][both], atol=1e-12)

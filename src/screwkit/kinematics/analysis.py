@@ -11,7 +11,7 @@ from screwkit.kinematics.motion import Motion, motion
 from screwkit.kinematics.named import seed_variables
 from screwkit.model.linkage import Linkage
 
-CLOSED_FORM_FAMILIES = ("RSRC", "4R")
+CLOSED_FORM_FAMILIES = ("RSRC", "4R", "CSSP")
 
 
 def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, acceleration: float = 0.0,
@@ -20,7 +20,7 @@ def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, accelerati
     """Motion of every assembly mode over ``inputs`` and its JSON-able document (SI).
 
     ``method``: ``"closed"`` uses the family's closed form (RSRC quartic, Bagci eqs. 3.59–3.82;
-    the planar 4R as its δ0 = λ0 = b = e = 0 case), ``"generic"`` the generic loop solver, and
+    the planar 4R as its δ0 = λ0 = b = e = 0 case; the CSSP quadratic in s4, Rahman §1.2), ``"generic"`` the generic loop solver, and
     ``"auto"`` the closed form where the family has one and the sweep has ≥ 2 samples. The
     closed form returns the seed's variables only; the generic solver every joint variable too.
     """
@@ -32,6 +32,8 @@ def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, accelerati
             f"no closed form for a {linkage.family or 'general loop'} (closed forms: "
             f"{', '.join(CLOSED_FORM_FAMILIES)}, with at least 2 input samples); use --method generic"
         )
+    if method in ("auto", "closed") and has_closed and linkage.family == "CSSP":
+        return None, _cssp_closed_form(linkage, np.asarray(inputs, dtype=float), speed, acceleration)
     if method in ("auto", "closed") and has_closed:
         return None, _closed_form(linkage, np.asarray(inputs, dtype=float), speed, acceleration,
                                   coupler_point)
@@ -247,3 +249,63 @@ def limits(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: int = 5,
     return {"mechanism": linkage.name, "family": linkage.family,
             "dwell_tolerance": dwell_tolerance, "units": {"angle": "rad", "length": "m"},
             "limits": out, "dwells_at": dwells}
+
+
+def _cssp_closed_form(linkage: Linkage, theta: np.ndarray, speed: float,
+                      acceleration: float) -> dict[str, Any]:
+    """Both roots of Rahman's quadratic in s4 (§1.2) with exact rates; the two roots are the
+    two assembly modes and stay separate (they meet only at a branch point, where the mode
+    stops)."""
+    from screwkit.kinematics.cssp import CSSPDimensions, cssp_motion
+
+    p = dict(linkage.parameters)
+    dims = CSSPDimensions(p["a1"], p["a2"], p["a4"], p["alpha4"], p.get("s1", 0.0))
+    modes: list[dict[str, Any]] = []
+    for root in (1, -1):
+        cf = cssp_motion(dims, theta, speed, acceleration, mode=root, allow_partial=True)
+        ok = np.asarray(cf.assembles)
+        if not ok.any():
+            continue
+        names = ("s4", "theta2", "eta2", "theta3", "eta3")
+        variables = {"theta1": theta, **{n: getattr(cf, n) for n in names}}
+        velocities = {"theta1": np.full_like(theta, speed),
+                      **{n: getattr(cf, f"{n}_dot") for n in names}}
+        accelerations = {"theta1": np.full_like(theta, acceleration),
+                         **{n: getattr(cf, f"{n}_ddot") for n in names}}
+        for table in (variables, velocities, accelerations):
+            for key in names:
+                table[key] = np.where(ok, table[key], np.nan)
+        stops = np.nonzero(ok[:-1] & ~ok[1:])[0]
+        starts = np.nonzero(~ok[:-1] & ok[1:])[0] + 1
+        events = [f"stops assembling after input [{theta[i]!r}] (branch point before [{theta[i + 1]!r}])"
+                  for i in stops]
+        events += [f"starts assembling at input [{theta[i]!r}]" for i in starts]
+        modes.append({
+            "mode": len(modes),
+            "root": "s4 = -b + sqrt(b^2 - c)" if root == 1 else "s4 = -b - sqrt(b^2 - c)",
+            "assembles": ok,
+            "singular": np.zeros_like(ok),
+            "events": events,
+            "variables": variables,
+            "velocities": velocities,
+            "accelerations": accelerations,
+            "closure_residual": np.where(ok, cf.loop_closure_gap / (p["a1"] + p["a2"]), np.nan),
+        })
+    if not modes:
+        from screwkit.kinematics.motion import AssemblyError
+
+        raise AssemblyError(f"{linkage.name}: the loop does not close at any of the {len(theta)} inputs")
+    return {
+        "method": "closed",
+        "mechanism": linkage.name,
+        "family": linkage.family,
+        "units": {"length": "m", "angle": "rad", "time": "s",
+                  "velocities": "d/dt of each variable (rad/s or m/s)",
+                  "accelerations": "d2/dt2 of each variable (rad/s^2 or m/s^2)"},
+        "input_name": linkage.inputs[0],
+        "input": theta,
+        "input_speed": speed,
+        "input_acceleration": acceleration,
+        "parameters": p,
+        "modes": modes,
+    }
