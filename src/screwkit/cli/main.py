@@ -145,8 +145,7 @@ def limits(
     dwell_tolerance: Annotated[float, typer.Option("--dwell-tol", help="A derivative dᵏφ0/dθ0ᵏ counts as vanishing below this (rad/radᵏ). Printed dimensions hold a designed dwell only to ~1e-4.")] = 1e-6,
     at: Annotated[list[float] | None, typer.Option("--at", help="Also give the dwell order at this input angle (degrees); repeatable.")] = None,
 ) -> None:
-    """Limit positions of the output rotation and translation over a full turn, and the order
-    of the instantaneous dwell at each rotation limit (Bagci App. D)."""
+    """Limit positions of the output rotation and translation over a full turn, and the order of the instantaneous dwell at each rotation limit (Bagci App. D)."""
     from screwkit.io.spec import load_spec
     from screwkit.kinematics.analysis import limits as run
 
@@ -182,8 +181,7 @@ def mobility(
     as_json: JsonOpt = False,
     output: OutputOpt = None,
 ) -> None:
-    """Mobility by formula (each term shown) and from the loop's screw Jacobian at a sample
-    configuration: redundant constraints and undetermined (passive) motions named by joint."""
+    """Mobility by formula (each term shown) and from the loop's screw Jacobian at a sample configuration: redundant constraints and undetermined (passive) motions named by joint."""
     from screwkit.io.spec import load_spec
     from screwkit.kinematics.mobility_check import linkage_mobility
 
@@ -206,8 +204,7 @@ def dynamics(
     output: OutputOpt = None,
     gravity: Annotated[bool, typer.Option("--gravity/--no-gravity", help="Include gravity along −z (magnitude from the spec, default 9.80665 m/s²).")] = False,
 ) -> None:
-    """Shaking force and moment, every joint reaction and the actuator efforts over the cycle,
-    with the RMS and peak of each (one assembly mode: [motion].mode)."""
+    """Shaking force and moment, every joint reaction and the actuator efforts over the cycle, with the RMS and peak of each (one assembly mode: motion.mode in the spec)."""
     from screwkit.io.spec import load_spec
 
     s = _guard(lambda: load_spec(spec))
@@ -232,20 +229,18 @@ def dynamics(
 
 def _dynamics_doc(s: Any, gravity: bool) -> dict[str, Any]:
     from screwkit.dynamics import inverse_dynamics
-    from screwkit.kinematics.motion import motion
+    from screwkit.kinematics.analysis import mode_motion
 
     lk = s.linkage
     missing = [link.name for link in lk.links if link.mass is None]
     if missing:
         raise ValueError(f"{s.path}: dynamics needs mass properties for every link; add [links.{missing[0]}] "
                          f"(missing: {missing}; see docs/spec-format.md)")
-    m = motion(lk, s.inputs, s.speed, s.acceleration)
-    if s.mode >= len(m.modes):
-        raise ValueError(f"{s.path}: [motion.mode] = {s.mode} but the mechanism has {len(m.modes)} assembly mode(s) (0…{len(m.modes) - 1})")
+    mm = mode_motion(lk, s.inputs, s.speed, s.acceleration, s.mode)
     g = None
     if gravity:
         g = [0.0, 0.0, -(s.gravity_magnitude or 9.80665)]
-    dyn = inverse_dynamics(lk, m.modes[s.mode], gravity=g)
+    dyn = inverse_dynamics(lk, mm, gravity=g)
     doc = dyn.as_dict()
     doc["mode"] = s.mode
     doc["summary"] = dyn.summary()
@@ -291,6 +286,15 @@ def demo(
         asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])
         t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", str(out))
     console.print(t)
+
+
+def _register_subcommands() -> None:
+    from screwkit.cli.balance_cmd import register as register_balance
+
+    register_balance(app)
+
+
+_register_subcommands()
 
 
 if __name__ == "__main__":  # pragma: no cover

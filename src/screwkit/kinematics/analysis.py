@@ -309,3 +309,30 @@ def _cssp_closed_form(linkage: Linkage, theta: np.ndarray, speed: float,
         "parameters": p,
         "modes": modes,
     }
+
+
+def mode_motion(linkage: Linkage, inputs: np.ndarray, speed: float, acceleration: float,
+                mode: int = 0) -> Any:
+    """The full link motion (a :class:`~screwkit.kinematics.motion.ModeMotion`) of assembly mode
+    ``mode``, as dynamics and balancing need it. The CSSP takes its closed form (no Newton;
+    mode 0 is the seed's root s4 = −b + √(b² − c), mode 1 the other), with the same numbering
+    as ``analyze``; every other loop the generic solver's modes."""
+    from screwkit.kinematics.motion import AssemblyError
+
+    if mode < 0:
+        raise ValueError(f"the assembly mode is an index ≥ 0; got {mode}")
+    if linkage.family == "CSSP":
+        from screwkit.kinematics.cssp_motion import cssp_mode_motion
+
+        if mode > 1:
+            raise ValueError(f"a CSSP has 2 assembly modes (0: s4 = −b + √(b² − c), 1: the other root); got mode {mode}")
+        mm = cssp_mode_motion(linkage, inputs, speed, acceleration, mode=1 if mode == 0 else -1,
+                              allow_partial=True)
+        if not np.any(mm.assembles):
+            raise AssemblyError(f"{linkage.name}: assembly mode {mode} does not close at any input")
+        return mm
+    m = motion(linkage, inputs, speed, acceleration)
+    if mode >= len(m.modes):
+        raise ValueError(f"{linkage.name}: assembly mode {mode} asked for, but the mechanism has "
+                         f"{len(m.modes)} assembly mode(s) over these inputs (0…{len(m.modes) - 1})")
+    return m.modes[mode]
