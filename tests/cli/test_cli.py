@@ -160,10 +160,15 @@ def test_spec_error_is_a_value_error():
 
 
 def test_demo_runs_every_example(tmp_path):
-    r = runner.invoke(app, ["demo", str(EXAMPLES), "--output-dir", str(tmp_path)])
+    r = runner.invoke(app, ["demo", str(EXAMPLES), "--output-dir", str(tmp_path), "--no-plots"])
     assert r.exit_code == 0, r.output
     written = sorted(tmp_path.glob("*.analysis.json"))
     assert len(written) == len(list(EXAMPLES.glob("*.toml")))
+    # the main job reproduces both seed systems: synthesis of Bagci's examples, dynamics and
+    # balancing of Rahman's
+    assert len(list(tmp_path.glob("bagci_example*_synthesis.synthesis.json"))) >= 7
+    assert (tmp_path / "rahman_cssp.dynamics.json").exists()
+    assert (tmp_path / "rahman_cssp_balance.balance.json").exists()
 
 
 def test_dynamics_json_has_the_documented_keys():

@@ -265,7 +265,7 @@ def demo(
         _guard(lambda: (_ for _ in ()).throw(ValueError(f"no spec files (*.toml) in {examples}")))
     output_dir.mkdir(parents=True, exist_ok=True)
     t = Table(title=f"screwkit demo: {len(files)} examples")
-    for col in ("example", "family", "samples", "modes", "assembling", "max closure residual", "written"):
+    for col in ("example", "family", "samples", "modes", "assembling", "max closure residual", "jobs"):
         t.add_column(col)
     for f in files:
         spec = _guard(lambda f=f: load_spec(f))  # type: ignore[misc]
@@ -279,18 +279,34 @@ def demo(
             _guard(lambda d=doc, f=f: plot_analysis(d, output_dir / f"{f.stem}.analysis.png"))  # type: ignore[misc]
         mob = _guard(lambda s=spec: linkage_mobility(s.linkage, s.inputs))  # type: ignore[misc]
         write_atomic(output_dir / f"{f.stem}.mobility.json", dumps(mob) + "\n")
+        jobs = ["analysis", "mobility"]
         if all(link.mass is not None for link in spec.linkage.links):
             dyn = _guard(lambda s=spec: _dynamics_doc(s, False))  # type: ignore[misc]
             write_atomic(output_dir / f"{f.stem}.dynamics.json", dumps(dyn) + "\n")
+            jobs.append("dynamics")
+        if spec.raw.balancing is not None:
+            from screwkit.balancing.spec import balance_from_spec
+
+            bal = _guard(lambda s=spec: balance_from_spec(s))  # type: ignore[misc]
+            write_atomic(output_dir / f"{f.stem}.balance.json", dumps(bal.as_dict()) + "\n")
+            jobs.append("balance")
+        if spec.raw.synthesis is not None:
+            from screwkit.cli.synthesize_cmd import synthesis_document
+
+            syn = _guard(lambda s=spec: synthesis_document(s))  # type: ignore[misc]
+            write_atomic(output_dir / f"{f.stem}.synthesis.json", dumps(syn) + "\n")
+            jobs.append("synthesis")
         res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)
         asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])
-        t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", str(out))
+        t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", ", ".join(jobs))
     console.print(t)
 
 
 def _register_subcommands() -> None:
     from screwkit.cli.balance_cmd import register as register_balance
+    from screwkit.cli.synthesize_cmd import register as register_synthesize
 
+    register_synthesize(app)
     register_balance(app)
 
 

@@ -1,0 +1,56 @@
+"""Dimensional synthesis of the RSRC (and its plane 4R case) for screw generation.
+
+Bagci 1969, Chapters IV-V: least-squares fit of a desired screw displacement
+psi_d(theta) = psi_d0(theta) + eps S_d(theta) with exact derivatives (App. E), constraints for
+dwells and exact ranges through the parameters of constraint q1, q2 (eqs. 5.13-5.21) or as
+equality constraints, multi-start over starts and assembly modes, and the overlay technique.
+See docs/synthesis.md.
+"""
+
+from screwkit.synthesis.constraints import output_crank_from_constraints, q_from_dwell
+from screwkit.synthesis.equality import RangeConstraint, synthesize_equality_constrained
+from screwkit.synthesis.expressions import ExpressionError, parse_expression
+from screwkit.synthesis.overlay import OverlayResult, overlay_fit
+from screwkit.synthesis.problem import (
+    ConstraintConstruction,
+    ConstraintPoint,
+    RSRCSynthesisProblem,
+)
+from screwkit.synthesis.residuals import NotAssembled, ResidualModel
+from screwkit.synthesis.solve import (
+    RangeCheck,
+    SynthesisError,
+    SynthesisResult,
+    check_range,
+    evaluate_design,
+    synthesize,
+    synthesize_multistart,
+)
+from screwkit.synthesis.targets import LIBRARY, ScrewTarget, data_function, library_function
+
+__all__ = [
+    "LIBRARY",
+    "ConstraintConstruction",
+    "ConstraintPoint",
+    "ExpressionError",
+    "NotAssembled",
+    "OverlayResult",
+    "RSRCSynthesisProblem",
+    "RangeCheck",
+    "RangeConstraint",
+    "ResidualModel",
+    "ScrewTarget",
+    "SynthesisError",
+    "SynthesisResult",
+    "check_range",
+    "data_function",
+    "evaluate_design",
+    "library_function",
+    "output_crank_from_constraints",
+    "overlay_fit",
+    "parse_expression",
+    "q_from_dwell",
+    "synthesize",
+    "synthesize_equality_constrained",
+    "synthesize_multistart",
+]
