@@ -215,3 +215,19 @@ def test_analyze_plot_writes_a_png(tmp_path):
     r = runner.invoke(app, ["analyze", str(EXAMPLES / "bagci_fig7_rsrc.toml"), "--plot", str(png)])
     assert r.exit_code == 0, r.output
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+
+
+@pytest.mark.parametrize("name", ["rsrc_fig7_dynamics", "fourbar_dynamics", "rssr_spatial"])
+def test_dynamics_runs_on_every_family_from_the_cli(name):
+    r = runner.invoke(app, ["dynamics", str(EXAMPLES / f"{name}.toml"), "--json", "--gravity"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    assert max(doc["residual"]) < 1e-10 * doc["residual_scale"]
+    if name == "fourbar_dynamics":
+        assert "3 reaction component(s) statically indeterminate" in doc["indeterminacy"]
+
+
+def test_gravity_direction_is_validated(tmp_path):
+    p = _bad(tmp_path, 'gravity_direction = [0, 0, 0]\n[mechanism]\nfamily = "4R"\n[dimensions]\na = 3\nd1 = 1\nd2 = 3\nd3 = 2.5\n')
+    r = runner.invoke(app, ["analyze", str(p)])
+    assert r.exit_code == 2 and "gravity_direction" in r.output

@@ -202,7 +202,7 @@ def dynamics(
     spec: Annotated[Path, typer.Argument(help="Spec file (TOML) with [links.<name>] mass properties.")],
     as_json: JsonOpt = False,
     output: OutputOpt = None,
-    gravity: Annotated[bool, typer.Option("--gravity/--no-gravity", help="Include gravity along −z (magnitude from the spec, default 9.80665 m/s²).")] = False,
+    gravity: Annotated[bool, typer.Option("--gravity/--no-gravity", help="Include gravity: magnitude 'gravity' (default 9.80665 m/s²) along 'gravity_direction' (default −z) of the spec.")] = False,
 ) -> None:
     """Shaking force and moment, every joint reaction and the actuator efforts over the cycle, with the RMS and peak of each (one assembly mode: motion.mode in the spec)."""
     from screwkit.io.spec import load_spec
@@ -239,7 +239,7 @@ def _dynamics_doc(s: Any, gravity: bool) -> dict[str, Any]:
     mm = mode_motion(lk, s.inputs, s.speed, s.acceleration, s.mode)
     g = None
     if gravity:
-        g = [0.0, 0.0, -(s.gravity_magnitude or 9.80665)]
+        g = (s.gravity_magnitude or 9.80665) * s.gravity_direction
     dyn = inverse_dynamics(lk, mm, gravity=g)
     doc = dyn.as_dict()
     doc["mode"] = s.mode

@@ -102,6 +102,7 @@ class SpecFile(_Strict):
     links: dict[str, LinkMassTable] = Field(default_factory=dict)
     coupler_point: CouplerPointTable | None = None
     gravity: Value | None = None
+    gravity_direction: list[float] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
     balancing: dict[str, Any] | None = None
     synthesis: dict[str, Any] | None = None
 
@@ -124,6 +125,10 @@ class MechanismSpec:
         self.gravity_magnitude = (
             None if raw.gravity is None else self._si(raw.gravity, "acceleration", "gravity")
         )
+        gd = np.asarray(raw.gravity_direction, dtype=float)
+        if gd.shape != (3,) or not np.all(np.isfinite(gd)) or np.linalg.norm(gd) == 0:
+            self._fail("gravity_direction", f"give a non-zero world vector [x, y, z]; got {raw.gravity_direction}")
+        self.gravity_direction = gd / np.linalg.norm(gd)
         self.coupler_point: tuple[float, float, float] | None = None
         if raw.coupler_point is not None:
             if self.family != "RSRC":
