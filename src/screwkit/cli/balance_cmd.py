@@ -25,7 +25,9 @@ def register(app: typer.Typer) -> None:
         from rich.table import Table
 
         from screwkit.balancing.spec import balance_from_spec
-        from screwkit.cli.main import _emit, _guard, console
+        from screwkit.cli.common import console
+        from screwkit.cli.common import emit as _emit
+        from screwkit.cli.common import guard as _guard
         from screwkit.io.spec import load_spec
 
         s = _guard(lambda: load_spec(spec))

@@ -4,18 +4,16 @@ with status 2 and a one-paragraph message, never a traceback."""
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, Any, TypeVar
+from typing import Annotated, Any
 
 import numpy as np
 import typer
-from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
 from screwkit import __version__
+from screwkit.cli.common import JsonOpt, OutputOpt, console, emit, guard
 
 app = typer.Typer(
     name="screwkit",
@@ -24,46 +22,8 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-console = Console()
-if not console.is_terminal:
-    console.width = max(console.width, 160)  # files and pipes get the full tables
-err_console = Console(stderr=True)
-
-T = TypeVar("T")
-
-JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON document (SI units) instead of tables.")]
-OutputOpt = Annotated[Path | None, typer.Option("--output", "-o", help="Write the JSON document to this file (atomically).")]
-
-
-def _user_errors() -> tuple[type[BaseException], ...]:
-    from screwkit.io.spec import SpecError
-    from screwkit.io.units import UnitError
-    from screwkit.kinematics.motion import AssemblyError
-    from screwkit.model.linkage import LinkageError
-
-    return (SpecError, UnitError, AssemblyError, LinkageError, ValueError, FileNotFoundError)
-
-
-def _guard(fn: Callable[[], T]) -> T:
-    try:
-        return fn()
-    except _user_errors() as exc:
-        err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
-        raise typer.Exit(2) from None
-
-
-def _emit(doc: dict[str, Any], as_json: bool, output: Path | None, table: Callable[[], None]) -> None:
-    from screwkit.io.results import dumps, write_atomic
-
-    text = dumps(doc)
-    if output is not None:
-        _guard(lambda: write_atomic(output, text + "\n"))
-    if as_json:
-        sys.stdout.write(text + "\n")
-    else:
-        table()
-        if output is not None:
-            console.print(f"wrote {output}")
+_guard = guard
+_emit = emit
 
 
 @app.callback(invoke_without_command=True)

@@ -57,8 +57,14 @@ def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, accelerati
             p = md.link_origin[:, 1] + np.einsum("nij,j->ni", R, np.asarray(coupler_point))
             entry["coupler_point"] = {"x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
         modes.append(entry)
-    doc = {
-        "method": "generic",
+    return m, _document(linkage, "generic", inputs, speed, acceleration, modes)
+
+
+def _document(linkage: Linkage, method: str, inputs: np.ndarray, speed: float,
+              acceleration: float, modes: list[dict[str, Any]]) -> dict[str, Any]:
+    """The analysis document (SI), the same for every method (docs/cli.md)."""
+    return {
+        "method": method,
         "mechanism": linkage.name,
         "family": linkage.family,
         "units": {"length": "m", "angle": "rad", "time": "s",
@@ -71,7 +77,6 @@ def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, accelerati
         "parameters": dict(linkage.parameters),
         "modes": modes,
     }
-    return m, doc
 
 
 def _closed_form(linkage: Linkage, theta: np.ndarray, speed: float, acceleration: float,
@@ -138,20 +143,7 @@ def _closed_form(linkage: Linkage, theta: np.ndarray, speed: float, acceleration
             f"{linkage.name}: the loop does not close at any of the {len(theta)} inputs "
             f"(from {theta[0]!r} to {theta[-1]!r}); check the dimensions"
         )
-    return {
-        "method": "closed",
-        "mechanism": linkage.name,
-        "family": linkage.family,
-        "units": {"length": "m", "angle": "rad", "time": "s",
-                  "velocities": "d/dt of each variable (rad/s or m/s)",
-                  "accelerations": "d2/dt2 of each variable (rad/s^2 or m/s^2)"},
-        "input_name": linkage.inputs[0],
-        "input": theta,
-        "input_speed": speed,
-        "input_acceleration": acceleration,
-        "parameters": p,
-        "modes": modes,
-    }
+    return _document(linkage, "closed", theta, speed, acceleration, modes)
 
 
 def _case(dims: Any) -> str:
@@ -295,20 +287,7 @@ def _cssp_closed_form(linkage: Linkage, theta: np.ndarray, speed: float,
         from screwkit.kinematics.motion import AssemblyError
 
         raise AssemblyError(f"{linkage.name}: the loop does not close at any of the {len(theta)} inputs")
-    return {
-        "method": "closed",
-        "mechanism": linkage.name,
-        "family": linkage.family,
-        "units": {"length": "m", "angle": "rad", "time": "s",
-                  "velocities": "d/dt of each variable (rad/s or m/s)",
-                  "accelerations": "d2/dt2 of each variable (rad/s^2 or m/s^2)"},
-        "input_name": linkage.inputs[0],
-        "input": theta,
-        "input_speed": speed,
-        "input_acceleration": acceleration,
-        "parameters": p,
-        "modes": modes,
-    }
+    return _document(linkage, "closed", theta, speed, acceleration, modes)
 
 
 def mode_motion(linkage: Linkage, inputs: np.ndarray, speed: float, acceleration: float,
