@@ -118,3 +118,15 @@ def test_property_loop_closes(a: float, d1: float, d2: float, d3: float,
     dims = fourbar(a=a, d1=d1, d2=d2, d3=d3)
     pos = fourbar_positions(dims, theta)
     assert loop_residual(dims, pos) < 1e-10 * (a + d1 + d2 + d3)
+
+
+def test_output_angles_equal_fourbar_positions():
+    from screwkit.kinematics.fourbar import fourbar_output_angles
+
+    for dims in (fourbar(3.0, 1.0, 3.5, 2.0), fourbar(2.0, 1.8, 2.2, 1.5), fourbar(1.0, 3.0, 3.0, 1.0)):
+        th = np.linspace(0.0, 2 * np.pi, 2001)
+        p = fourbar_positions(dims, th).phi0
+        q = fourbar_output_angles(dims, th)
+        assert (np.isnan(p) == np.isnan(q)).all()
+        diff = np.angle(np.exp(1j * (q[~np.isnan(q)] - p[~np.isnan(p)])))  # ±π are one angle
+        assert np.max(np.abs(diff)) < 1e-13

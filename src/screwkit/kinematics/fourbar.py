@@ -277,3 +277,35 @@ def fourbar_rates(
     g_ddot = (dims.d1 * (tdd * s_tp + td * td * c_tp) + dims.d2 * g_dot**2 * cos_chi
               - dims.d3 * phi_dot**2) * inv / dims.d2
     return FourBarRates(phi_dot, g_dot, phi_ddot, g_ddot, locked, valid)
+
+
+def fourbar_output_angles(dims: FourBarDimensions, theta0: ArrayLike, *,
+                          double_root_tol: float = DEFAULT_DOUBLE_ROOT_TOL) -> FloatArray:
+    """Rocker angle φ0 of both assembly modes only, shape (N, 2) (column 0 = mode 1), NaN where
+    the loop does not close — `fourbar_positions` without the coupler angle, for sweeps where
+    only the output matters (Freudenstein, Bagci eq. 3.11: φ0 = atan2(M0, N0) ∓ α)."""
+    theta = _check_angles(theta0)
+    n = theta.shape[0]
+    out = np.empty((2, n))  # mode-major: contiguous writes
+    a, d1, d2, d3 = dims.a, dims.d1, dims.d2, dims.d3
+    k = d2 * d2 - d3 * d3 - a * a - d1 * d1
+    for start in range(0, n, _CHUNK):
+        blk = slice(start, start + _CHUNK)
+        sin_t, cos_t = sin_cos(theta[blk])
+        n0 = a - d1 * cos_t
+        r2 = (a * a + d1 * d1) - (2.0 * a * d1) * cos_t
+        beta = np.arctan2(-d1 * sin_t, n0)
+        cos_alpha = (k + (2.0 * a * d1) * cos_t) * (0.5 / d3) / np.sqrt(r2)
+        with np.errstate(invalid="ignore"):
+            alpha = np.arccos(cos_alpha)
+        bad = np.isnan(alpha)
+        if bad.any():  # a double root within the tolerance still assembles (as fourbar_positions)
+            near = bad & (np.abs(cos_alpha) <= 1.0 + 0.5 * double_root_tol * double_root_tol)
+            alpha[near] = np.arccos(np.clip(cos_alpha[near], -1.0, 1.0))
+        m1 = beta - alpha
+        m1[m1 <= -math.pi] += _TWO_PI
+        m2 = beta + alpha
+        m2[m2 > math.pi] -= _TWO_PI
+        out[0, blk] = m1
+        out[1, blk] = m2
+    return out.T
