@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.linalg import lstsq as scipy_lstsq
 
 from screwkit.balancing.errors import InfeasibleConstraintsError, MissingSolverError, SolverError
 
@@ -74,8 +75,8 @@ def solve_qp(
     n = Q.shape[0]
     Ae, be = _normalise_rows(np.asarray(A_eq, float).reshape(-1, n), np.asarray(b_eq, float))
     Al, bl = _normalise_rows(np.asarray(A_le, float).reshape(-1, n), np.asarray(b_le, float))
-    zero_rows = [i for i in range(len(be)) if not np.any(Ae[i]) and abs(be[i]) > 0]
-    zero_rows += [len(be) + i for i in range(len(bl)) if not np.any(Al[i]) and bl[i] < 0]
+    zero_rows = np.flatnonzero(~Ae.any(axis=1) & (np.abs(be) > 0)).tolist()
+    zero_rows += (len(be) + np.flatnonzero(~Al.any(axis=1) & (bl < 0))).tolist()
     if zero_rows:
         names = [*names_eq, *names_le]
         raise InfeasibleConstraintsError(
@@ -144,7 +145,9 @@ def _polish(H: Array, q: Array, A_eq: Array, b_eq: Array, A_le: Array, b_le: Arr
     K[:n, n:] = Aa.T
     K[n:, :n] = Aa
     rhs = np.concatenate([-2 * q, ba])
-    sol_k = np.linalg.lstsq(K, rhs, rcond=None)[0]
+    # complete orthogonal factorisation (gelsy): the minimum-norm solution like SVD-based lstsq
+    # but several times faster on these small dense KKT systems
+    sol_k = scipy_lstsq(K, rhs, lapack_driver="gelsy", check_finite=False)[0]
     x = sol_k[:n]
     lam = sol_k[n:]
     y_eq = lam[: len(b_eq)]
