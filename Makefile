@@ -12,9 +12,16 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e ".[dev]"
 	touch $(STAMP)
 
-## Run the main job on every bundled example (writes out/).
+VALIDATION := bagci1969/analysis_tables bagci1969/synthesis rahman1996/kinematics rahman1996/dynamics rahman1996/balancing
+
+## Run the main job on every bundled example and reproduce both seed systems' reports (writes out/).
 demo: $(STAMP)
 	$(BIN)/screwkit demo examples --output-dir out
+	mkdir -p out/validation
+	@for v in $(VALIDATION); do \
+		echo "validation/$$v.py -> out/validation/$$(echo $$v | tr / _).md"; \
+		$(BIN)/python validation/$$v.py > out/validation/$$(echo $$v | tr / _).md || exit 1; \
+	done
 
 ## Lint, type-check and run the whole test suite.
 test: $(STAMP)
