@@ -79,6 +79,11 @@ def test_parameters_of_constraint_and_equality_constraints_agree() -> None:
 
 def test_overlay_examples_run() -> None:
     results = synthesis.overlay_examples()
-    ccw = results["8 (ccw output)"]
-    assert ccw.assembles.all()
-    assert math.degrees(ccw.rmse_phi) < 0.5
+    _, outcomes8 = results["8"]
+    assert len(outcomes8) == 4 and all(o.result.range_check.ok for o in outcomes8)
+    assert math.degrees(outcomes8[0].result.rmse_phi) < 0.2
+    # Example 5 by the overlay with two dwells: Table IX's own max deviation (printed 1.093482
+    # deg) follows from the construction with the printed d2; the printed digits (d2 to 1e-6 in,
+    # the deviation to 1e-6 deg) leave ~1e-6 deg
+    _, outcomes5 = results["5 (two dwells, Table IX's d2)"]
+    assert math.degrees(abs(outcomes5[0].result.max_dev_phi)) == pytest.approx(1.093482, abs=5e-6)

@@ -104,3 +104,12 @@ def test_overlay_recovers_an_exact_mechanism() -> None:
     assert fit.dimensions.a == pytest.approx(3.2, abs=1e-8)
     assert fit.dimensions.b == pytest.approx(1.1, abs=1e-8)
     assert fit.rmse_phi < 1e-9
+
+
+def test_start_that_does_not_assemble_exits_2(tmp_path: Path) -> None:
+    base = (EXAMPLES / "bagci_example1_synthesis.toml").read_text()
+    bad = tmp_path / "short_coupler.toml"
+    bad.write_text(base.replace("d2 = 3.0", "d2 = 0.2"))  # the loop cannot close
+    r = runner.invoke(app, ["synthesize", str(bad)])
+    assert r.exit_code == 2
+    assert "cannot start" in r.output and "does not assemble" in r.output

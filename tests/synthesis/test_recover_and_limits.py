@@ -75,6 +75,7 @@ def test_wrong_inversion_label_is_explained() -> None:
 def test_iteration_and_time_limits_are_reported() -> None:
     result = synthesize(_ex1_problem(max_iterations=5))
     assert result.status == "iteration limit"
+    assert "stopped at the iteration limit (max_iterations = 5)" in result.message
     assert result.evaluations <= 6
     result = synthesize(_ex1_problem(time_limit=1e-4, max_iterations=100000))
     assert result.status == "time limit"
@@ -93,6 +94,8 @@ def test_target_no_mechanism_can_follow() -> None:
     assert result.status in ("converged", "iteration limit", "time limit")
     assert math.degrees(result.rmse_phi) > 5.0
     assert result.time < 4.0
+    assert "the target rotation is not followed" in result.message
+    assert "try a multistart" in result.message
 
 
 def test_contradictory_and_invalid_problems() -> None:

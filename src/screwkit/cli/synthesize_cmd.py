@@ -1,6 +1,7 @@
 """``screwkit synthesize SPEC``: dimensional synthesis of an RSRC (or plane 4R) for a desired
-screw displacement (Bagci 1969, Ch. V; keys of the spec's ``[synthesis]`` table in
-docs/synthesis.md).  Registered on the main app by ``register(app)``."""
+screw displacement (Bagci 1969, Ch. V: least squares, or the overlay technique of §5.4; keys of
+the spec's ``[synthesis]`` table in docs/synthesis.md).  Registered on the main app by
+``register(app)``."""
 
 from __future__ import annotations
 
@@ -10,30 +11,15 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-__all__ = ["register", "result_document"]
+from screwkit.cli.common import console, err_console
+from screwkit.cli.common import guard as _guard
 
-console = Console()
-err_console = Console(stderr=True)
+__all__ = ["overlay_document", "register", "result_document", "synthesis_document"]
 
-
-def _user_errors() -> tuple[type[BaseException], ...]:
-    from screwkit.io.spec import SpecError
-    from screwkit.io.units import UnitError
-
-    return (SpecError, UnitError, ValueError, FileNotFoundError)
-
-
-def _guard(fn: Any) -> Any:
-    try:
-        return fn()
-    except _user_errors() as exc:
-        err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
-        raise typer.Exit(2) from None
 
 
 def result_document(result: Any) -> dict[str, Any]:
@@ -74,7 +60,7 @@ def _plot(results: list[Any], path: Path) -> None:
     import numpy as np
 
     best = results[0]
-    rows = best.rows
+    rows = sorted(best.rows, key=lambda r: r["theta"])  # theta = 0 comes first in the result
     th = np.degrees([r["theta"] for r in rows])
     fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     axes[0].plot(th, np.degrees([r["psi_d0"] for r in rows]), "o", label="desired ψ_d0")
@@ -136,14 +122,41 @@ def _tables(name: str, results: list[Any], scale_unit: str) -> None:
                       f"whole range {'ok' if other.range_check.ok else 'NOT ok'}", highlight=False)
 
 
-def synthesis_document(s: Any, starts: int | None = None) -> dict[str, Any]:
-    """Run the synthesis of a loaded spec (its ``[synthesis]`` table) and return the JSON-able
-    document of the best result with the alternatives (used by ``demo``)."""
-    from screwkit.synthesis.config import problem_from_spec
+def overlay_document(outcome: Any) -> dict[str, Any]:
+    """An `OverlayOutcome` as a JSON-able dict: the least-squares document shape (the analysed
+    mechanism's errors and rows) plus ``method`` and the ``overlay`` keys."""
+    doc = result_document(outcome.result)
+    c = outcome.circle
+    doc["method"] = "overlay"
+    doc["overlay"] = {
+        "output_direction": "ccw" if outcome.output_direction > 0 else "cw",
+        "centre": list(c.centre),
+        "d3": c.d3,
+        "phi01": c.phi01,
+        "d2_chosen": outcome.d2_chosen,
+        "d2": c.d2,
+        "d2_refined": c.d2 != outcome.d2_chosen,
+        "circle_residual": [float(v) for v in c.circle_residual],
+        "max_circle_miss": outcome.max_circle_miss,
+        "fit_status": c.status,
+        "dwell_curvature_radii": list(outcome.dwell_curvature_radii),
+    }
+    return doc
+
+
+def _run(problem: Any, table: Any, starts: int | None) -> tuple[list[Any], list[dict[str, Any]]]:
+    """Solve by the table's method: (SynthesisResults best first, their JSON documents)."""
+    import dataclasses
+
+    from screwkit.synthesis.overlay_route import OverlayProblem, synthesize_overlay
     from screwkit.synthesis.solve import synthesize as solve_one
     from screwkit.synthesis.solve import synthesize_multistart
 
-    problem, table = problem_from_spec(s)
+    if isinstance(problem, OverlayProblem):
+        if starts is not None:
+            problem = dataclasses.replace(problem, n_starts=starts)
+        outcomes = synthesize_overlay(problem)
+        return [o.result for o in outcomes], [overlay_document(o) for o in outcomes]
     ms = table.multistart
     n_starts = starts if starts is not None else (ms.starts if ms is not None else 1)
     if n_starts == 1 and not (problem.inversion is None and problem.construction is None):
@@ -151,10 +164,112 @@ def synthesis_document(s: Any, starts: int | None = None) -> dict[str, Any]:
     else:
         results = synthesize_multistart(problem, n_starts=n_starts, seed=ms.seed if ms else 0,
                                         keep=ms.keep if ms else 3, spread=ms.spread if ms else 0.5)
-    doc = result_document(results[0])
-    doc["alternatives"] = [result_document(r) for r in results[1:]]
-    doc["spec"] = str(s.path)
+    docs = [result_document(r) for r in results]
+    for d in docs:
+        d["method"] = "least_squares"
+    return results, docs
+
+
+def _document(docs: list[dict[str, Any]], spec_path: Any) -> dict[str, Any]:
+    doc = dict(docs[0])
+    doc["alternatives"] = docs[1:]
+    doc["spec"] = str(spec_path)
     return doc
+
+
+def synthesis_document(s: Any, starts: int | None = None) -> dict[str, Any]:
+    """Run the synthesis of a loaded spec (its ``[synthesis]`` table, either method) and return
+    the JSON-able document of the best result with the alternatives (used by ``demo``)."""
+    from screwkit.synthesis.config import synthesis_from_spec
+
+    problem, table = synthesis_from_spec(s)
+    _, docs = _run(problem, table, starts)
+    return _document(docs, s.path)
+
+
+def _plot_overlay(docs: list[dict[str, Any]], problem: Any, path: Path) -> None:
+    """The overlay plane (input-crank ellipse, coupler circles, fitted output circle, overlay
+    radial lines) and desired vs generated rotation (and translation) of the best mechanism."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from screwkit.synthesis.overlay import ellipse_normal, input_ellipse_point
+
+    best = docs[0]
+    ov = best["overlay"]
+    pr = problem
+    sense = 1 if ov["output_direction"] == "ccw" else -1
+    theta = pr.target.theta_rotation
+    psi = pr.target.desired_rotation(theta)
+    th0 = pr.theta01 + pr.input_direction * theta
+    px, py = input_ellipse_point(pr.d1, pr.lambda0, th0)
+    ex, ey = input_ellipse_point(pr.d1, pr.lambda0, np.linspace(0, 2 * np.pi, 361))
+    cx, cy = ov["centre"]
+    d3, d2, phi01 = ov["d3"], ov["d2"], ov["phi01"]
+    tips = (cx + d3 * np.cos(phi01 + sense * psi), cy + d3 * np.sin(phi01 + sense * psi))
+    ring = np.linspace(0, 2 * np.pi, 181)
+    has_s = pr.target.translation is not None
+    fig = plt.figure(figsize=(12, 6))
+    ax = fig.add_subplot(1, 2, 1)
+    ax.plot(ex, ey, "k-", lw=1, label="input-crank ellipse")
+    for i in range(theta.size):
+        ax.plot(px[i] + d2 * np.cos(ring), py[i] + d2 * np.sin(ring), ":", lw=0.8,
+                color="tab:blue", label="coupler circles (d2)" if i == 0 else None)
+        ax.plot([cx, tips[0][i]], [cy, tips[1][i]], "-", lw=0.6, color="tab:orange")
+        ax.plot([px[i], tips[0][i]], [py[i], tips[1][i]], "-", lw=0.6, color="tab:gray")
+    ax.plot(px, py, "o", color="tab:blue", label="design points P_i")
+    ax.plot(cx + d3 * np.cos(ring), cy + d3 * np.sin(ring), "-", color="tab:orange",
+            label="fitted output circle (d3)")
+    ax.plot(tips[0], tips[1], "x", color="tab:red", label="overlay points C_i")
+    ax.plot([cx], [cy], "+", color="tab:orange", ms=12)
+    for dw in pr.dwells:
+        t0 = pr.theta01 + pr.input_direction * dw.theta
+        pxd, pyd = input_ellipse_point(pr.d1, pr.lambda0, t0)
+        nx, ny = ellipse_normal(pr.d1, pr.lambda0, t0, dw.tangency)
+        ax.plot([pxd, pxd + 1.5 * d2 * nx], [pyd, pyd + 1.5 * d2 * ny], "--", color="tab:green",
+                label="dwell normal")
+    ax.set_aspect("equal")
+    ax.set_title(f"overlay plane (m): {ov['output_direction']} output, "
+                 f"max circle miss {ov['max_circle_miss']:.3g} m")
+    ax.legend(fontsize=7, loc="best")
+    rows = sorted(best["rows"], key=lambda r: r["theta"])  # theta = 0 comes first in the result
+    th = np.degrees([r["theta"] for r in rows])
+    ax1 = fig.add_subplot(2 if has_s else 1, 2, 2)
+    ax1.plot(th, np.degrees([np.nan if r["psi_d0"] is None else r["psi_d0"] for r in rows]),
+             "o", label="desired ψ_d0")
+    ax1.plot(th, np.degrees([r["psi_g0"] for r in rows]), "x-", label="generated ψ_g0")
+    ax1.set_ylabel("output rotation (deg)")
+    ax1.set_xlabel("input θ from θ01 (deg)")
+    ax1.set_title(f"RMSE φ {math.degrees(best['rmse_phi']):.4g}°")
+    ax1.legend()
+    if has_s:
+        ax2 = fig.add_subplot(2, 2, 4)
+        ax2.plot(th, [np.nan if r["S_d"] is None else r["S_d"] for r in rows], "o",
+                 label="desired S_d")
+        ax2.plot(th, [r["S_g"] for r in rows], "x-", label="generated S_g")
+        ax2.set_ylabel("output translation (m)")
+        ax2.set_xlabel("input θ from θ01 (deg)")
+        ax2.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _overlay_lines(docs: list[dict[str, Any]]) -> None:
+    for k, d in enumerate(docs, start=1):
+        ov = d["overlay"]
+        radii = ", ".join(f"{r:.6g}" for r in ov["dwell_curvature_radii"])
+        d2_text = (f"d2 refined {ov['d2_chosen']:.6g} -> {ov['d2']:.6g} m" if ov["d2_refined"]
+                   else f"d2 = {ov['d2']:.6g} m (as chosen)")
+        console.print(
+            f"overlay {k}: {ov['output_direction']} output, centre ({ov['centre'][0]:.6g}, "
+            f"{ov['centre'][1]:.6g}) m, d3 = {ov['d3']:.6g} m, {d2_text}, max circle miss "
+            f"{ov['max_circle_miss']:.3g} m, RMSE_phi {math.degrees(d['rmse_phi']):.4g}°"
+            + (f"; ellipse curvature radius at the dwell(s): {radii} m" if radii else ""),
+            highlight=False)
 
 
 def register(app: typer.Typer) -> None:
@@ -166,51 +281,44 @@ def register(app: typer.Typer) -> None:
         as_json: Annotated[bool, typer.Option("--json", help="Print one JSON document (SI units) instead of tables.")] = False,
         output: Annotated[Path | None, typer.Option("--output", "-o", help="Write the JSON document to this file (atomically).")] = None,
         plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of desired vs generated.")] = None,
-        starts: Annotated[int | None, typer.Option("--starts", help="Multi-start: number of starts (overrides [synthesis.multistart]).", min=1, max=10000)] = None,
+        starts: Annotated[int | None, typer.Option("--starts", help="Multi-start: number of starts (overrides [synthesis.multistart], or [synthesis.overlay] starts).", min=1, max=10000)] = None,
     ) -> None:
         """Optimise the mechanism's dimensions to generate a desired screw displacement
-        (Bagci 1969 Ch. V: least squares with exact derivatives, dwell and range constraints)."""
+        (Bagci 1969 Ch. V: least squares with exact derivatives, dwell and range constraints;
+        or the overlay technique of §5.4 with [synthesis] method = "overlay")."""
         from screwkit.io.results import dumps, write_atomic
         from screwkit.io.spec import load_spec
-        from screwkit.synthesis.config import problem_from_spec
-        from screwkit.synthesis.solve import synthesize as solve_one
-        from screwkit.synthesis.solve import synthesize_multistart
+        from screwkit.synthesis.config import synthesis_from_spec
 
         s = _guard(lambda: load_spec(spec))
-        problem, table = _guard(lambda: problem_from_spec(s))
-        ms = table.multistart
-        n_starts = starts if starts is not None else (ms.starts if ms is not None else 1)
-        runs_all_modes = problem.inversion is None and problem.construction is None
+        problem, table = _guard(lambda: synthesis_from_spec(s))
 
-        def run() -> list[Any]:
-            if n_starts == 1 and not runs_all_modes:
-                return [solve_one(problem)]
-            return synthesize_multistart(
-                problem, n_starts=n_starts, seed=ms.seed if ms else 0,
-                keep=ms.keep if ms else 3, spread=ms.spread if ms else 0.5)
+        def run() -> tuple[list[Any], list[dict[str, Any]]]:
+            return _run(problem, table, starts)
 
         if as_json or not sys.stderr.isatty():
-            results = _guard(run)
+            results, docs = _guard(run)
         else:
             with Progress(TextColumn("synthesising"), BarColumn(), TimeElapsedColumn(),
                           console=err_console, transient=True) as progress:
                 task = progress.add_task("run", total=None)
-                results = _guard(run)
+                results, docs = _guard(run)
                 progress.update(task, completed=1, total=1)
-        doc = result_document(results[0])
-        doc["alternatives"] = [result_document(r) for r in results[1:]]
-        doc["spec"] = str(spec)
+        doc = _document(docs, spec)
+        overlay = table.method == "overlay"
         text = dumps(doc)
         if output is not None:
             _guard(lambda: write_atomic(output, text + "\n"))
         if plot is not None:
-            _guard(lambda: _plot(results, plot))
+            _guard(lambda: _plot_overlay(docs, problem, plot) if overlay else _plot(results, plot))
         if as_json:
             sys.stdout.write(text + "\n")
         else:
             unit = s.units.get("length", "m")
             _tables(s.name, results, f"1 {unit}" if table.length_scale is None
                     else str(table.length_scale))
+            if overlay:
+                _overlay_lines(docs)
             if output is not None:
                 console.print(f"wrote {output}")
             if plot is not None:

@@ -8,12 +8,17 @@ The start of the unknowns is the spec's ``[dimensions]`` table, overridden by
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from screwkit.io.units import UnitError, to_si
+from screwkit.synthesis.overlay import OverlayDwell
+from screwkit.synthesis.overlay_route import OverlayProblem
 from screwkit.synthesis.problem import (
     ANGLE_NAMES,
     DIMENSION_NAMES,
@@ -33,7 +38,8 @@ from screwkit.synthesis.targets import (
 if TYPE_CHECKING:
     from screwkit.io.spec import MechanismSpec
 
-__all__ = ["MultistartTable", "SynthesisConfigError", "SynthesisTable", "problem_from_spec"]
+__all__ = ["MultistartTable", "OverlayTable", "SynthesisConfigError", "SynthesisTable",
+           "overlay_problem_from_spec", "problem_from_spec", "synthesis_from_spec"]
 
 Value = float | int | str
 
@@ -105,11 +111,38 @@ class MultistartTable(_Strict):
     spread: float = Field(0.5, gt=0.0, le=3.0)
 
 
+class DwellTable(_Strict):
+    theta: Value
+    tangency: Literal["interior", "exterior"] = "interior"
+
+
+class OverlayTable(_Strict):
+    """``[synthesis.overlay]``: options of the overlay technique (§5.4)."""
+
+    dwells: list[DwellTable] = Field(default_factory=list)
+    keep: int = Field(3, ge=1, le=100)
+    starts: int = Field(12, ge=1, le=1000)
+    d3_range: list[Value] | None = None
+
+    @model_validator(mode="after")
+    def _check(self) -> OverlayTable:
+        if len(self.dwells) > 2:
+            raise ValueError(f"at most two dwells can be placed on the overlay, got "
+                             f"{len(self.dwells)} (two fix the output circle already)")
+        if self.d3_range is not None and len(self.d3_range) != 2:
+            raise ValueError("d3_range must be [lower, upper]")
+        return self
+
+
+OVERLAY_UNKNOWNS = ({"d3", "a", "b"}, {"d2", "d3", "a", "b"})
+
+
 class SynthesisTable(_Strict):
-    unknowns: list[str]
+    method: Literal["least_squares", "overlay"] = "least_squares"
+    unknowns: list[str] | None = None
     inversion: int | Literal["all"] = "all"
     input_direction: Literal["ccw", "cw"] = "ccw"
-    output_direction: Literal["ccw", "cw"] = "ccw"
+    output_direction: Literal["ccw", "cw", "both"] = "ccw"
     length_scale: Value | None = None
     max_iterations: int = Field(1000, ge=1, le=1_000_000)
     time_limit: float = Field(10.0, gt=0.0, le=3600.0)
@@ -119,6 +152,7 @@ class SynthesisTable(_Strict):
     translation: ComponentTable | None = None
     constraints: ConstraintsTable | None = None
     multistart: MultistartTable | None = None
+    overlay: OverlayTable | None = None
 
     @model_validator(mode="after")
     def _check(self) -> SynthesisTable:
@@ -126,9 +160,35 @@ class SynthesisTable(_Strict):
             raise ValueError("inversion must be 1, 2, 3, 4 or \"all\"")
         if self.rotation is None and self.translation is None:
             raise ValueError("give a rotation and/or a translation to generate")
+        if self.method == "overlay":
+            return self._check_overlay()
+        if self.unknowns is None:
+            raise ValueError("unknowns: give the names to solve for (method = \"least_squares\")")
+        if self.overlay is not None:
+            raise ValueError("[synthesis.overlay] belongs to method = \"overlay\"; set method "
+                             "or remove the table")
+        if self.output_direction == "both":
+            raise ValueError("output_direction = \"both\" is for method = \"overlay\"; the "
+                             "least-squares route solves one sense (\"ccw\" or \"cw\")")
         for name, pair in self.bounds.items():
             if len(pair) != 2:
                 raise ValueError(f"bounds.{name} must be [lower, upper]")
+        return self
+
+    def _check_overlay(self) -> SynthesisTable:
+        if self.rotation is None:
+            raise ValueError("the overlay technique fits the output rotation: give "
+                             "[synthesis.rotation] (the translation is only evaluated)")
+        unused = [k for k in ("constraints", "multistart") if getattr(self, k) is not None]
+        unused += ["bounds"] if self.bounds else []
+        unused += ["inversion"] if self.inversion != "all" else []
+        if unused:
+            raise ValueError(f"{unused} not used by method = \"overlay\" (it finds the output "
+                             "circle and the assembly mode from the overlay; dwells go in "
+                             "[synthesis.overlay] dwells)")
+        if self.unknowns is not None and set(self.unknowns) not in OVERLAY_UNKNOWNS:
+            raise ValueError(f"unknowns of the overlay are [\"d3\", \"a\", \"b\"] or, to refine "
+                             f"the coupler too, [\"d2\", \"d3\", \"a\", \"b\"]; got {self.unknowns}")
         return self
 
 
@@ -140,8 +200,26 @@ def _kind(name: str) -> str:
     return "angle" if name in ANGLE_NAMES else "length"
 
 
-def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, SynthesisTable]:
-    """Validate ``spec.raw.synthesis`` and build the problem (SI units inside)."""
+@dataclass(frozen=True)
+class _Parsed:
+    """The parts of a ``[synthesis]`` table that both routes share (SI units)."""
+
+    table: SynthesisTable
+    si: Callable[[Any, str, str], float]
+    start: dict[str, float]
+    target: ScrewTarget
+    length_scale: float
+
+
+def synthesis_from_spec(spec: MechanismSpec
+                        ) -> tuple[RSRCSynthesisProblem | OverlayProblem, SynthesisTable]:
+    """The problem of either route, as the ``[synthesis]`` table's ``method`` asks."""
+    if isinstance(spec.raw.synthesis, dict) and spec.raw.synthesis.get("method") == "overlay":
+        return overlay_problem_from_spec(spec)
+    return problem_from_spec(spec)
+
+
+def _parse(spec: MechanismSpec) -> _Parsed:
     path = spec.path
     if spec.family != "RSRC":
         raise SynthesisConfigError(f"{path}: synthesis is implemented for the RSRC family (and its "
@@ -221,6 +299,20 @@ def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, Synthe
                              tra[0] if tra else None, tra[1] if tra else np.zeros(0))
     except ValueError as exc:
         raise _fail(path, "rotation", str(exc)) from None
+    scale = (length_unit if table.length_scale is None
+             else si(table.length_scale, "length", "length_scale"))
+    return _Parsed(table, si, start, target, scale)
+
+
+def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, SynthesisTable]:
+    """Validate ``spec.raw.synthesis`` and build the least-squares problem (SI units inside)."""
+    parsed = _parse(spec)
+    table, si, start, target = parsed.table, parsed.si, parsed.start, parsed.target
+    path = spec.path
+    if table.method != "least_squares":
+        raise SynthesisConfigError(f"{path}: [synthesis] method = {table.method!r}: use "
+                                   "overlay_problem_from_spec (screwkit synthesize does)")
+    assert table.unknowns is not None
     construction = None
     if table.constraints is not None:
         pts_c = []
@@ -245,8 +337,7 @@ def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, Synthe
     bounds = {}
     for name, (lo, hi) in table.bounds.items():
         bounds[name] = (si(lo, _kind(name), f"bounds.{name}"), si(hi, _kind(name), f"bounds.{name}"))
-    scale = (length_unit if table.length_scale is None
-             else si(table.length_scale, "length", "length_scale"))
+    scale = parsed.length_scale
     try:
         problem = RSRCSynthesisProblem(
             target=target, start=start, unknowns=tuple(table.unknowns), bounds=bounds,
@@ -254,6 +345,46 @@ def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, Synthe
             input_direction=1 if table.input_direction == "ccw" else -1,
             output_direction=1 if table.output_direction == "ccw" else -1,
             length_scale=scale, construction=construction,
+            max_iterations=table.max_iterations, time_limit=table.time_limit)
+    except ValueError as exc:
+        raise SynthesisConfigError(f"{path}: [synthesis] {exc}") from None
+    return problem, table
+
+
+def overlay_problem_from_spec(spec: MechanismSpec) -> tuple[OverlayProblem, SynthesisTable]:
+    """Validate a ``[synthesis]`` table with ``method = "overlay"`` and build the overlay problem
+    (Bagci 1969, §5.4).  d1, d2, lambda0, delta0 (must be 0) and e come from ``[dimensions]`` /
+    ``[synthesis.start]``, theta01 from ``[synthesis.start]``; d3, a, b are found."""
+    parsed = _parse(spec)
+    table, si, start = parsed.table, parsed.si, parsed.start
+    path = spec.path
+    if table.method != "overlay":
+        raise SynthesisConfigError(f"{path}: [synthesis] method is {table.method!r}, not "
+                                   "\"overlay\"")
+    if abs(math.sin(start.get("delta0", 0.0))) > 1e-12:
+        raise _fail(path, "start.delta0", "the overlay technique needs delta0 = 0 (the coupler "
+                    "ellipse is then a circle of radius d2, Bagci §5.4); use method = "
+                    "\"least_squares\" for delta0 != 0")
+    for name in ("d1", "d2", "lambda0"):
+        if name not in start:
+            raise _fail(path, f"start.{name}", f"the overlay needs {name} (in [dimensions] or "
+                        "[synthesis.start])")
+    ov = table.overlay if table.overlay is not None else OverlayTable.model_validate({})
+    dwells = tuple(OverlayDwell(si(d.theta, "angle", f"overlay.dwells[{i}].theta"), d.tangency)
+                   for i, d in enumerate(ov.dwells, start=1))
+    d3_range = None
+    if ov.d3_range is not None:
+        lo, hi = (si(v, "length", "overlay.d3_range") for v in ov.d3_range)
+        d3_range = (lo, hi)
+    senses = {"ccw": (1,), "cw": (-1,), "both": (1, -1)}[table.output_direction]
+    try:
+        problem = OverlayProblem(
+            target=parsed.target, d1=start["d1"], d2=start["d2"], lambda0=start["lambda0"],
+            theta01=start["theta01"], e=start.get("e", 0.0),
+            input_direction=1 if table.input_direction == "ccw" else -1,
+            output_directions=senses, dwells=dwells,
+            refine_d2=table.unknowns is not None and "d2" in table.unknowns, keep=ov.keep,
+            n_starts=ov.starts, d3_range=d3_range, length_scale=parsed.length_scale,
             max_iterations=table.max_iterations, time_limit=table.time_limit)
     except ValueError as exc:
         raise SynthesisConfigError(f"{path}: [synthesis] {exc}") from None

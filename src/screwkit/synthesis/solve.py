@@ -156,6 +156,36 @@ def check_range(problem: RSRCSynthesisProblem, ev: Evaluation, n_samples: int = 
     return RangeCheck(ok, tuple(gaps), tuple(mismatch), trans, msg)
 
 
+def _fit_notes(problem: RSRCSynthesisProblem, psi_d: FloatArray, s_d: FloatArray,
+               r_phi: FloatArray, r_s: FloatArray, check: RangeCheck, status: Status) -> list[str]:
+    """Plain-language notes for the result message: a limit that was hit, a target the result
+    does not follow (a maximum deviation above 10 % of the desired range of that component),
+    a result that does not run the whole range."""
+    notes = []
+    if status == "iteration limit":
+        notes.append(f"stopped at the iteration limit (max_iterations = {problem.max_iterations}): "
+                     "the result is the best point reached, not a converged optimum")
+    elif status == "time limit":
+        notes.append(f"stopped at the time limit ({problem.time_limit:g} s): the result is the best "
+                     "point reached, not a converged optimum")
+    for name, desired, res, unit, scale in (("rotation", psi_d, r_phi, "deg", math.degrees(1.0)),
+                                            ("translation", s_d, r_s, "m", 1.0)):
+        finite = desired[np.isfinite(desired)]
+        if res.size == 0 or finite.size == 0:
+            continue
+        span = float(np.ptp(np.append(finite, 0.0)))
+        worst = float(np.max(np.abs(res)))
+        if worst > 0.1 * span:
+            notes.append(
+                f"the target {name} is not followed: the generated {name} deviates by up to "
+                f"{worst * scale:.4g} {unit} over a desired range of {span * scale:.4g} {unit}; "
+                "this family may not generate it from this start: try a multistart, other design "
+                "constants, other bounds or another assembly mode")
+    if not check.ok:
+        notes.append(f"the result does not run the whole range: {check.message}")
+    return notes
+
+
 def _result(problem: RSRCSynthesisProblem, model: ResidualModel, ev: Evaluation, label: int,
             iterations: int, evaluations: int, elapsed: float, status: Status,
             message: str) -> SynthesisResult:
@@ -200,6 +230,8 @@ def _result(problem: RSRCSynthesisProblem, model: ResidualModel, ev: Evaluation,
             "S_d": float(s_all[i]),
         })
     check = check_range(problem, ev)
+    message = "; ".join(m for m in (message, *_fit_notes(problem, psi_all, s_all, r_phi, r_s,
+                                                          check, status)) if m)
     # the program label (root ordering, Bagci's I8/I9) of the result's configuration at theta = 0
     pos = rsrc_positions(dimensions_of({k: np.array([v]) for k, v in ev.params.items()}),
                          ev.theta0[:1])
