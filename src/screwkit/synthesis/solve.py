@@ -168,6 +168,10 @@ def _fit_notes(problem: RSRCSynthesisProblem, psi_d: FloatArray, s_d: FloatArray
     elif status == "time limit":
         notes.append(f"stopped at the time limit ({problem.time_limit:g} s): the result is the best "
                      "point reached, not a converged optimum")
+    # a component is "not followed" when the worst deviation exceeds 10 % of its desired range,
+    # or, for a component meant to stay constant, a floor: 1° for rotation, 1 % of the length
+    # scale for translation
+    floors = {"rotation": math.radians(1.0), "translation": 0.01 * problem.length_scale}
     for name, desired, res, unit, scale in (("rotation", psi_d, r_phi, "deg", math.degrees(1.0)),
                                             ("translation", s_d, r_s, "m", 1.0)):
         finite = desired[np.isfinite(desired)]
@@ -175,7 +179,7 @@ def _fit_notes(problem: RSRCSynthesisProblem, psi_d: FloatArray, s_d: FloatArray
             continue
         span = float(np.ptp(np.append(finite, 0.0)))
         worst = float(np.max(np.abs(res)))
-        if worst > 0.1 * span:
+        if worst > max(0.1 * span, floors[name]):
             notes.append(
                 f"the target {name} is not followed: the generated {name} deviates by up to "
                 f"{worst * scale:.4g} {unit} over a desired range of {span * scale:.4g} {unit}; "
