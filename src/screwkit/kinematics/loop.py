@@ -86,6 +86,12 @@ def rot_z(angle: Array) -> Array:
     return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
 
 
+def rot_y(angle: Array) -> Array:
+    c, s = np.cos(angle), np.sin(angle)
+    z, o = np.zeros_like(c), np.ones_like(c)
+    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
+
+
 def rot_x(angle: Array) -> Array:
     c, s = np.cos(angle), np.sin(angle)
     z, o = np.zeros_like(c), np.ones_like(c)
@@ -167,9 +173,9 @@ def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None) ->
             t1 = q[:, lay.scalar_col[fi]]
             t2 = q[:, lay.scalar_col[fi + 1]]
             r1 = rot_z(t1)
-            jR = r1 @ rot_x(t2)
+            jR = r1 @ rot_y(t2)
             jp = np.array([0.0, 0.0, joint.offset]) * np.ones((N, 1))
-            u2 = (R @ r1)[..., :, 0]
+            u2 = (R @ r1)[..., :, 1]
             cols.append(np.concatenate([u, np.cross(centre, u)], -1))
             cols.append(np.concatenate([u2, np.cross(centre, u2)], -1))
         else:  # S

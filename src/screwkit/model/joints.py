@@ -10,11 +10,13 @@ R     theta                              Z(θ + ε·offset)
 P     s                                  Z(angle + ε·s)
 C     theta, s                           Z(θ + ε·s)
 H     theta                              Z(θ + ε·(offset + pitch·θ))
-U     theta1, theta2                     Z(ε·offset) · Rz(θ1) · Rx(θ2)
+U     theta1, theta2                     Z(ε·offset) · Rz(θ1) · Ry(θ2)
 S     wx, wy, wz (body increments)        Z(ε·offset) · R, R any rotation
 ====  =================================  =========================================
 
-An S joint's orientation is held as a rotation matrix (no Euler-angle singularity); its three
+The second axis of a U joint is the y axis after the first rotation, so the link that follows
+(along x, Hartenberg–Denavit) is perpendicular to both axes at zero. An S joint's orientation
+is held as a rotation matrix (no Euler-angle singularity); its three
 freedoms are small rotations about the joint's own moving axes.
 """
 
@@ -39,7 +41,7 @@ JOINT_DESCRIPTIONS: dict[str, str] = {
     "P": "prismatic (translation along the joint axis)",
     "C": "cylindrical (rotation about and translation along the joint axis)",
     "H": "helical (rotation about the axis with translation pitch·angle along it)",
-    "U": "universal (rotation about z, then about the new x axis)",
+    "U": "universal (rotation about z, then about the new y axis; the next link leaves along x)",
     "S": "spherical (any rotation about the joint centre)",
 }
 
