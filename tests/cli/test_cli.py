@@ -169,6 +169,10 @@ def test_demo_runs_every_example(tmp_path):
     assert len(list(tmp_path.glob("bagci_example*_synthesis.synthesis.json"))) >= 7
     assert (tmp_path / "rahman_cssp.dynamics.json").exists()
     assert (tmp_path / "rahman_cssp_balance.balance.json").exists()
+    # and an HTML index people can open
+    page = (tmp_path / "index.html").read_text()
+    assert page.startswith("<!doctype html>") and "rahman_cssp_balance" in page
+    assert "balancing objective G" in page and "shaking force RMS" in page
 
 
 def test_dynamics_json_has_the_documented_keys():

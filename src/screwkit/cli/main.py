@@ -227,6 +227,7 @@ def demo(
     t = Table(title=f"screwkit demo: {len(files)} examples")
     for col in ("example", "family", "samples", "modes", "assembling", "max closure residual", "jobs"):
         t.add_column(col)
+    entries: list[dict[str, Any]] = []
     for f in files:
         spec = _guard(lambda f=f: load_spec(f))  # type: ignore[misc]
         console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
@@ -259,7 +260,32 @@ def demo(
         res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)
         asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])
         t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", ", ".join(jobs))
+        summary: list[tuple[str, Any]] = [
+            ("input samples", len(spec.inputs)), ("analysis method", doc["method"]),
+            ("assembly modes (samples assembling)", f"{len(doc['modes'])} ({asm})"),
+            ("max loop-closure residual", f"{res:.1e}"),
+            ("mobility (formula / Jacobian)", f"{mob['formula']['mobility']} / {mob['numeric']['mobility']}"),
+        ]
+        if "dynamics" in jobs:
+            sf = dyn["summary"]["shaking_force"]
+            summary.append(("shaking force RMS / peak (N)", f"{sf['rms']:.6g} / {sf['peak']:.6g}"))
+        if "balance" in jobs:
+            g = bal.as_dict()["measures"]
+            summary.append(("balancing objective G before → after", f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
+        if "synthesis" in jobs:
+            summary.append(("synthesis RMSE (φ rad, S m)", f"{syn.get('rmse_phi')} , {syn.get('rmse_S')}"))
+        entries.append({
+            "name": f.stem, "family": spec.family, "description": spec.describe(),
+            "jobs": [(j, f"{f.stem}.{j}.json") for j in jobs], "summary": summary,
+            "picture": f"{f.stem}.analysis.png" if plots else None,
+        })
     console.print(t)
+    from screwkit.report.html import write_index
+
+    reports = sorted(Path("validation").glob("*/*.md")) if Path("validation").is_dir() else []
+    index = _guard(lambda: write_index(output_dir, entries, [Path("..") / r for r in reports]
+                                       if output_dir.resolve().parent == Path.cwd().resolve() else None))
+    console.print(f"wrote {index}")
 
 
 def _register_subcommands() -> None:
