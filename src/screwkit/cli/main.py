@@ -63,6 +63,7 @@ def analyze(
 
     s = _guard(lambda: load_spec(spec))
     _, doc = _guard(lambda: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point, method))
+    doc["mechanism"] = s.name
     if plot is not None:
         from screwkit.report.plots import plot_analysis
 
@@ -232,6 +233,7 @@ def demo(
         spec = _guard(lambda f=f: load_spec(f))  # type: ignore[misc]
         console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
         _, doc = _guard(lambda s=spec: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point))  # type: ignore[misc]
+        doc["mechanism"] = spec.name
         out = output_dir / f"{f.stem}.analysis.json"
         write_atomic(out, dumps(doc) + "\n")
         if plots:

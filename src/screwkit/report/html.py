@@ -37,7 +37,8 @@ def write_index(output_dir: Path, entries: list[dict[str, Any]], reports: list[P
     if reports:
         parts.append("<h2>Seed reproductions</h2><ul>")
         for r in reports:
-            parts.append(f"<li><a href='{html.escape(r.as_posix())}'>{html.escape(r.name)}</a></li>")
+            label = f"{r.parent.name}/{r.name}"
+            parts.append(f"<li><a href='{html.escape(r.as_posix())}'>{html.escape(label)}</a></li>")
         parts.append("</ul>")
     for e in entries:
         parts.append(f"<h2 id='{html.escape(e['name'])}'>{html.escape(e['name'])}</h2>")
