@@ -1,35 +1,65 @@
-"""Speed and memory of CSSP inverse dynamics over 10⁶ samples, with Pinocchio's RNEA where
-installed.
+"""Speed and memory of CSSP inverse dynamics over 10⁶ samples, side by side with Pinocchio's
+RNEA (per call) where it is installed.
 
 ``run()`` returns a list of measurements ``{name, value, unit, target, note}``;
 ``python benchmarks/bench_dynamics.py --profile`` also prints where the dynamics spends its time.
 
-* generic path: ``motion`` (Newton + continuation) on a 72-sample sweep, per sample;
-* fast path: ``cssp_mode_motion`` (closed form, SPEC §1.2) on ``SAMPLES`` crank angles, then
-  ``inverse_dynamics`` on that ModeMotion — timed separately and together, with the
-  tracemalloc peak of the two together;
-* prototype: ``fused_cssp_dynamics`` below — the same physics for the CSSP in
-  structure-of-arrays form (one (N,) array per vector component, processed in cache-sized
-  blocks), checked against the library on every sample before it is timed. It shows what a
-  specialised kernel achieves; it is not library code.
-* Pinocchio ``rnea`` on a 3-link open chain (R, S, P) per call, if ``pinocchio`` imports.
+Times are CPU time (``time.process_time``), best of ``REPEATS`` — the machines are shared and
+their wall time varies with the load (as in bench_fourbar.py). Memory is the tracemalloc peak.
+
+* generic kinematics: ``motion`` (Newton + continuation) on a 72-sample sweep, per sample;
+* closed-form kinematics: ``cssp_mode_motion`` on ``SAMPLES`` crank angles — as it is by
+  default, without the ball joints' rotation vectors (``joint_rotations=False``) and lean
+  (``ball_joints=False``: only what the dynamics reads);
+* dynamics: ``inverse_dynamics`` on that ModeMotion (the CSSP closed-form statics, blocked), and
+  the chain kinematics + dynamics, the issue's target (≤ 1 µs per sample, ≤ 2 GiB);
+* fused: ``cssp_inverse_dynamics`` — the same loads, kinematics and dynamics block by block
+  without building the ModeMotion;
+* generic statics (``closed_form=False``) on the same motion, and the peak memory of the
+  blocked generic path for every family on 10⁶ samples (a 72-sample mode tiled);
+* prototype: ``fused_cssp_dynamics`` below, the hand-specialised kernel the library path was
+  built from (axisymmetric rod only; not library code), checked against the library first;
+* Pinocchio ``rnea`` on a 3-link open chain (R, S, P), per call, if ``pinocchio`` imports.
 """
 
 from __future__ import annotations
 
 import cProfile
 import io
+import math
 import pstats
 import sys
 import time
 import tracemalloc
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 SAMPLES = 1_000_000
-BLOCK = 16_384  # samples per block of the fused kernel (its temporaries stay in L2 cache)
+REPEATS = 3
+BLOCK = 16_384  # samples per block of the prototype kernel
 INCH = 0.0254
+GRAVITY = [0.0, 0.0, -9.80665]
+
+
+def _best_time(fn: Callable[[], Any], repeats: int = REPEATS) -> float:
+    """Best CPU time (process_time) of ``repeats`` calls, in seconds."""
+    best = math.inf
+    for _ in range(repeats):
+        start = time.process_time()
+        fn()
+        best = min(best, time.process_time() - start)
+    return best
+
+
+def _peak_mib(fn: Callable[[], Any]) -> float:
+    """tracemalloc peak of one call, MiB (numpy reports its allocations to tracemalloc)."""
+    tracemalloc.start()
+    fn()
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    return peak / 2**20
 
 
 def _cssp() -> tuple[Any, float]:
@@ -154,7 +184,7 @@ def fused_cssp_dynamics(linkage: Any, theta: np.ndarray, omega: float, omega_dot
         "m3": slider.mass, "slider_offset": tuple(slider_R @ slider.com),
     }
     n = theta.shape[0]
-    out = {k: np.empty((n, 3)) for k in ("shaking_force", "shaking_moment", "crank.force",
+    out: dict[str, np.ndarray] = {k: np.empty((n, 3)) for k in ("shaking_force", "shaking_moment", "crank.force",
                                          "crank.moment", "pin.force", "ball.force",
                                          "slider.force", "slider.moment")}
     out["input_torque"] = np.empty(n)
@@ -178,7 +208,8 @@ def _check_fused(lk: Any, omega: float, gravity: list[float]) -> float:
     for joint in ("crank", "pin", "ball", "slider"):
         forces.append((got[f"{joint}.force"], ref.reactions[joint]["force"]))
         # ball joints carry no moment: the prototype does not store one
-        mine = got.get(f"{joint}.moment", np.zeros_like(ref.reactions[joint]["moment"]))
+        mine: np.ndarray = got.get(f"{joint}.moment",
+                                   np.zeros_like(ref.reactions[joint]["moment"]))
         moments.append((mine, ref.reactions[joint]["moment"]))
     worst = 0.0
     for group in (forces, moments):
@@ -192,17 +223,17 @@ def _generic_kinematics(lk: Any, omega: float) -> float:
     from screwkit.kinematics.motion import motion
 
     base = 72
-    t0 = time.perf_counter()
-    motion(lk, np.linspace(0.0, 2 * np.pi, base, endpoint=False), omega, 0.0)
-    return (time.perf_counter() - t0) / base * 1e6
+    theta = np.linspace(0.0, 2 * np.pi, base, endpoint=False)
+    return _best_time(lambda: motion(lk, theta, omega, 0.0), 1) / base * 1e6
 
 
 def _pinocchio() -> dict[str, Any]:
+    name = "pinocchio rnea, 3-link open chain (R, S, P), per call"
     try:
         import pinocchio as pin  # type: ignore[import-not-found]
     except ImportError:
-        return {"name": "pinocchio rnea, 3-link open chain (R, S, P)", "value": None,
-                "unit": "us/sample", "target": None, "note": "pin not installed"}
+        return {"name": name, "value": None, "unit": "us/sample", "target": None,
+                "note": "pin not installed (pip install pin to compare)"}
     model = pin.Model()
     parent = 0
     for k, joint in enumerate([pin.JointModelRZ(), pin.JointModelSpherical(),
@@ -214,123 +245,171 @@ def _pinocchio() -> dict[str, Any]:
     q = pin.randomConfiguration(model)
     v = np.random.default_rng(0).normal(size=model.nv)
     a = np.random.default_rng(1).normal(size=model.nv)
-    n = 100_000
-    t0 = time.perf_counter()
-    for _ in range(n):
-        pin.rnea(model, data, q, v, a)
-    per = (time.perf_counter() - t0) / n * 1e6
-    return {"name": "pinocchio rnea, 3-link open chain (R, S, P)", "value": per,
-            "unit": "us/sample", "target": None,
-            "note": f"pinocchio {pin.__version__}, one call per sample from Python (C++ inside)"}
+    n = 200_000
+
+    def calls() -> None:
+        for _ in range(n):
+            pin.rnea(model, data, q, v, a)
+
+    per = _best_time(calls) / n * 1e6
+    return {"name": name, "value": per, "unit": "us/sample", "target": None,
+            "note": f"pinocchio {pin.__version__}, one Python call per sample (C++ inside), "
+                    f"best of {REPEATS} x {n} calls"}
 
 
-def fast_path_in_blocks(lk: Any, theta: np.ndarray, omega: float, gravity: list[float],
-                        block: int = 131_072) -> dict[str, np.ndarray]:
-    """The library fast path (cssp_mode_motion + inverse_dynamics) run block by block, the
-    results concatenated: the same numbers with a bounded working set."""
+def _tiled_mode(mode: Any, samples: int) -> Any:
+    """A ModeMotion repeated to ``samples`` samples (the loads of a long, periodic sweep)."""
+    from dataclasses import replace
+
+    reps = -(-samples // mode.assembles.size)
+
+    def tile(a: np.ndarray) -> np.ndarray:
+        return np.tile(a, (reps,) + (1,) * (a.ndim - 1))[:samples]
+
+    return replace(
+        mode, assembles=tile(mode.assembles), singular=tile(mode.singular),
+        link_rotation=tile(mode.link_rotation), link_origin=tile(mode.link_origin),
+        link_angular_velocity=tile(mode.link_angular_velocity),
+        link_origin_velocity=tile(mode.link_origin_velocity),
+        link_angular_acceleration=tile(mode.link_angular_acceleration),
+        link_origin_acceleration=tile(mode.link_origin_acceleration),
+        joint_centres=tile(mode.joint_centres), joint_axes=tile(mode.joint_axes),
+        variables={k: tile(v) for k, v in mode.variables.items()},
+    )
+
+
+def every_family_memory(samples: int = SAMPLES) -> list[dict[str, Any]]:
+    """Peak memory (and CPU time, one run) of the blocked generic ``inverse_dynamics`` on
+    ``samples`` samples of each family (random mechanisms of tests/dynamics/mechanisms.py)."""
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "dynamics"))
+    from mechanisms import FAMILIES, full_cycle  # type: ignore[import-not-found]
+
     from screwkit.dynamics import inverse_dynamics
-    from screwkit.kinematics.cssp_motion import cssp_mode_motion
 
-    parts: dict[str, list[np.ndarray]] = {}
-    for start in range(0, theta.shape[0], block):
-        th = theta[start:start + block]
-        dyn = inverse_dynamics(lk, cssp_mode_motion(lk, th, omega, 0.0, joint_rotations=False),
-                               gravity=gravity)
-        items = {"shaking_force": dyn.shaking_force, "shaking_moment": dyn.shaking_moment,
-                 "input_torque": dyn.efforts["crank.theta"]}
-        for joint, r in dyn.reactions.items():
-            items[f"{joint}.force"] = r["force"]
-            items[f"{joint}.moment"] = r["moment"]
-        for key, value in items.items():
-            parts.setdefault(key, []).append(value)
-    return {key: np.concatenate(value) for key, value in parts.items()}
+    rows = []
+    for family in FAMILIES:
+        lk, _, mode = full_cycle(family, 0, samples=72)
+        big = _tiled_mode(mode, samples)
+        start = time.process_time()
+
+        def generic(lk: Any = lk, big: Any = big) -> Any:
+            return inverse_dynamics(lk, big, GRAVITY, closed_form=False)
+
+        peak = _peak_mib(generic)
+        spent = (time.process_time() - start) / samples * 1e6
+        inputs = sum(getattr(big, f).nbytes for f in (
+            "link_rotation", "link_origin", "link_angular_velocity", "link_origin_velocity",
+            "link_angular_acceleration", "link_origin_acceleration", "joint_centres",
+            "joint_axes")) / 2**20
+        rows.append({"name": f"{family}: generic inverse_dynamics peak memory", "value": peak,
+                     "unit": "MiB", "target": 2048,
+                     "note": f"{samples} samples, blocked; {spent:.2f} us/sample (one run, "
+                             f"tracemalloc on); its ModeMotion input holds {inputs:.0f} MiB"})
+    return rows
 
 
 def profile_dynamics(samples: int = SAMPLES, top: int = 14) -> str:
-    """cProfile of ``inverse_dynamics`` on the fast-path ModeMotion (sorted by own time)."""
+    """cProfile of ``inverse_dynamics`` on the closed-form ModeMotion (sorted by own time)."""
     from screwkit.dynamics import inverse_dynamics
     from screwkit.kinematics.cssp_motion import cssp_mode_motion
 
     lk, omega = _cssp()
     theta = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
-    mode = cssp_mode_motion(lk, theta, omega, 0.0, joint_rotations=False)
+    mode = cssp_mode_motion(lk, theta, omega, 0.0, ball_joints=False)
     prof = cProfile.Profile()
     prof.enable()
-    inverse_dynamics(lk, mode, gravity=[0.0, 0.0, -9.80665])
+    inverse_dynamics(lk, mode, gravity=GRAVITY)
     prof.disable()
     buf = io.StringIO()
     pstats.Stats(prof, stream=buf).sort_stats("tottime").print_stats(top)
     return buf.getvalue()
 
 
-def run(samples: int = SAMPLES) -> list[dict[str, Any]]:
+def _dynamics_on_modes(lk: Any, theta: np.ndarray, omega: float) -> tuple[float, float, float]:
+    """inverse_dynamics on the lean and on the default-kinematics ModeMotion: µs/sample of
+    each and the peak memory (MiB) of the first."""
     from screwkit.dynamics import inverse_dynamics
     from screwkit.kinematics.cssp_motion import cssp_mode_motion
 
+    lean = cssp_mode_motion(lk, theta, omega, 0.0, ball_joints=False)
+    dyn = _best_time(lambda: inverse_dynamics(lk, lean, GRAVITY)) / theta.size * 1e6
+    peak = _peak_mib(lambda: inverse_dynamics(lk, lean, GRAVITY))
+    full = cssp_mode_motion(lk, theta, omega, 0.0, joint_rotations=False)
+    dyn_full = _best_time(lambda: inverse_dynamics(lk, full, GRAVITY)) / theta.size * 1e6
+    return dyn, peak, dyn_full
+
+
+def run(samples: int = SAMPLES, families: bool = True) -> list[dict[str, Any]]:
+    from screwkit.dynamics import cssp_inverse_dynamics, inverse_dynamics
+    from screwkit.kinematics.cssp_motion import cssp_mode_motion
+
     lk, omega = _cssp()
-    gravity = [0.0, 0.0, -9.80665]
     theta = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
-    generic = _generic_kinematics(lk, omega)
-    inverse_dynamics(lk, cssp_mode_motion(lk, theta[:1000], omega, 0.0))  # warm-up
-    t0 = time.perf_counter()
-    mode = cssp_mode_motion(lk, theta, omega, 0.0, joint_rotations=False)
-    t1 = time.perf_counter()
-    dyn = inverse_dynamics(lk, mode, gravity=gravity)
-    t2 = time.perf_counter()
-    assert np.all(np.isfinite(dyn.shaking_force))
-    del mode, dyn
-    kin_us, dyn_us = (t1 - t0) / samples * 1e6, (t2 - t1) / samples * 1e6
-    tracemalloc.start()
-    dyn = inverse_dynamics(lk, cssp_mode_motion(lk, theta, omega, 0.0, joint_rotations=False),
-                           gravity=gravity)
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    del dyn
-    t4 = time.perf_counter()
-    fast_path_in_blocks(lk, theta, omega, gravity)
-    blocks_us = (time.perf_counter() - t4) / samples * 1e6
-    tracemalloc.start()
-    fast_path_in_blocks(lk, theta, omega, gravity)
-    _, blocks_peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    agreement = _check_fused(lk, omega, gravity)
-    fused_cssp_dynamics(lk, theta[:BLOCK], omega, 0.0, gravity)  # warm-up
-    t3 = time.perf_counter()
-    fused = fused_cssp_dynamics(lk, theta, omega, 0.0, gravity)
-    fused_us = (time.perf_counter() - t3) / samples * 1e6
-    assert np.all(np.isfinite(fused["input_torque"]))
-    del fused
-    tracemalloc.start()
-    fused_cssp_dynamics(lk, theta, omega, 0.0, gravity)
-    _, fused_peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    note = f"{samples} samples, numpy, single process"
-    return [
-        {"name": "CSSP kinematics, generic solver (motion)", "value": generic,
-         "unit": "us/sample", "target": None, "note": "72-sample sweep, all assembly modes"},
-        {"name": "CSSP kinematics, closed form (cssp_mode_motion)", "value": kin_us,
-         "unit": "us/sample", "target": None, "note": note + ", joint_rotations=False"},
-        {"name": "CSSP inverse dynamics on it (inverse_dynamics)", "value": dyn_us,
-         "unit": "us/sample", "target": None, "note": note},
-        {"name": "CSSP kinematics + inverse dynamics (fast path)", "value": kin_us + dyn_us,
-         "unit": "us/sample", "target": 1.0, "note": note},
-        {"name": "CSSP fast path peak memory (tracemalloc)", "value": peak / 2**20,
-         "unit": "MiB", "target": 2048, "note": f"{peak / samples:.0f} bytes/sample"},
-        {"name": "fast path in blocks of 131072 samples", "value": blocks_us,
-         "unit": "us/sample", "target": 1.0, "note": "fast_path_in_blocks, results concatenated"},
-        {"name": "fast path in blocks, peak memory (tracemalloc)", "value": blocks_peak / 2**20,
-         "unit": "MiB", "target": 2048, "note": "bounded working set + the (N, ·) results"},
-        {"name": "prototype fused SoA CSSP kinematics + dynamics", "value": fused_us,
+    note = f"{samples} samples, numpy, one core, CPU time best of {REPEATS}"
+    rows: list[dict[str, Any]] = [
+        {"name": "CSSP kinematics, generic solver (motion)", "value":
+         _generic_kinematics(lk, omega), "unit": "us/sample", "target": None,
+         "note": "72-sample sweep, all assembly modes"}]
+    inverse_dynamics(lk, cssp_mode_motion(lk, theta[:2000], omega, 0.0), GRAVITY)  # warm-up
+    kin: dict[str, float] = {}
+    options: dict[str, dict[str, bool]] = {
+        "default": {}, "joint_rotations=False": {"joint_rotations": False},
+        "ball_joints=False": {"ball_joints": False}}
+    for label, kwargs in options.items():
+
+        def kinematics(kw: dict[str, bool] = kwargs) -> Any:
+            return cssp_mode_motion(lk, theta, omega, 0.0, **kw)
+
+        kin[label] = _best_time(kinematics) / samples * 1e6
+        rows.append({"name": f"CSSP kinematics, closed form (cssp_mode_motion, {label})",
+                     "value": kin[label], "unit": "us/sample", "target": None, "note": note})
+    dyn, dyn_peak, dyn_full = _dynamics_on_modes(lk, theta, omega)
+    chain_peak = _peak_mib(lambda: inverse_dynamics(
+        lk, cssp_mode_motion(lk, theta, omega, 0.0, ball_joints=False), GRAVITY))
+    fused = _best_time(lambda: cssp_inverse_dynamics(lk, theta, omega, 0.0, GRAVITY))
+    fused_peak = _peak_mib(lambda: cssp_inverse_dynamics(lk, theta, omega, 0.0, GRAVITY))
+    few = theta[:: max(1, samples // 100_000)]
+    generic = _best_time(lambda: inverse_dynamics(
+        lk, cssp_mode_motion(lk, few, omega, 0.0, ball_joints=False), GRAVITY,
+        closed_form=False), 1) / few.size * 1e6
+    agreement = _check_fused(lk, omega, GRAVITY)
+    fused_cssp_dynamics(lk, theta[:BLOCK], omega, 0.0, GRAVITY)  # warm-up
+    proto = _best_time(lambda: fused_cssp_dynamics(lk, theta, omega, 0.0, GRAVITY))
+    rows += [
+        {"name": "CSSP inverse_dynamics on it (closed-form statics, blocked)", "value": dyn,
          "unit": "us/sample", "target": 1.0,
-         "note": f"max |Δ| vs library {agreement:.1e} of peak (20k samples); blocks of {BLOCK}"},
-        {"name": "prototype fused kernel peak memory (tracemalloc)", "value": fused_peak / 2**20,
-         "unit": "MiB", "target": 2048, "note": "outputs (N, 3) float64 ×8 + (N,)"},
+         "note": f"{note}; {dyn_full:.3f} on the default-kinematics ModeMotion"},
+        {"name": "CSSP inverse_dynamics peak memory (tracemalloc)", "value": dyn_peak,
+         "unit": "MiB", "target": 2048, "note": "outputs + one block; the ModeMotion excluded"},
+        {"name": "CSSP chain: cssp_mode_motion(ball_joints=False) + inverse_dynamics",
+         "value": kin["ball_joints=False"] + dyn, "unit": "us/sample", "target": 1.0,
+         "note": f"with the default kinematics (rotation vectors skipped): "
+                 f"{kin['joint_rotations=False'] + dyn_full:.3f}"},
+        {"name": "CSSP chain peak memory (tracemalloc)", "value": chain_peak, "unit": "MiB",
+         "target": 2048, "note": "ModeMotion + loads + one block"},
+        {"name": "CSSP fused kinematics + dynamics (cssp_inverse_dynamics)",
+         "value": fused / samples * 1e6, "unit": "us/sample", "target": 1.0, "note": note},
+        {"name": "CSSP fused peak memory (tracemalloc)", "value": fused_peak, "unit": "MiB",
+         "target": 2048, "note": "loads + joint centres + one block"},
+        {"name": "CSSP generic loop statics (closed_form=False), per sample", "value": generic,
+         "unit": "us/sample", "target": None,
+         "note": f"{few.size} samples, one run, kinematics included"},
+        {"name": "prototype fused SoA CSSP kernel (benchmark only)", "value":
+         proto / samples * 1e6, "unit": "us/sample", "target": None,
+         "note": f"axisymmetric rod only; max |Δ| vs library {agreement:.1e} of peak"},
         _pinocchio(),
     ]
+    if families:
+        rows += every_family_memory(samples)
+    return rows
 
 
 if __name__ == "__main__":
-    for row in run():
-        print(row)
+    for row in run(families="--no-families" not in sys.argv[1:]):
+        value = row["value"]
+        text = f"{value:.3f}" if isinstance(value, float) else str(value)
+        print(f"{row['name']}: {text} {row['unit']} (target {row['target']}) - {row['note']}")
     if "--profile" in sys.argv[1:]:
         print(profile_dynamics())

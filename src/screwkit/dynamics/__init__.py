@@ -5,12 +5,14 @@ See docs/dynamics.md for conventions and for how statically indeterminate compon
 passive freedoms are reported.
 """
 
+from screwkit.dynamics.blocks import BLOCK_SAMPLES
 from screwkit.dynamics.checks import (
     DynamicsInputError,
     ExternalLoad,
     MissingMassError,
     NonAssemblingMotionError,
 )
+from screwkit.dynamics.cssp_path import cssp_inverse_dynamics
 from screwkit.dynamics.inertia import inertia_wrench_regressor, inertia_wrenches
 from screwkit.dynamics.inverse import (
     INERTIAL_PARAMETER_NAMES,
@@ -22,6 +24,7 @@ from screwkit.dynamics.result import Dynamics, Indeterminacy
 from screwkit.dynamics.screws import FreedomScrews, freedom_screws
 
 __all__ = [
+    "BLOCK_SAMPLES",
     "INERTIAL_PARAMETER_NAMES",
     "Dynamics",
     "DynamicsInputError",
@@ -31,6 +34,7 @@ __all__ = [
     "MissingMassError",
     "NonAssemblingMotionError",
     "Regressor",
+    "cssp_inverse_dynamics",
     "freedom_screws",
     "inertia_wrench_regressor",
     "inertia_wrenches",

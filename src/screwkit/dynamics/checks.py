@@ -110,13 +110,48 @@ def check_external_loads(
     return out
 
 
+def _finite_rows(arr: Array) -> NDArray[np.bool_]:
+    """Which samples (first axis) of ``arr`` are finite throughout. A NaN or an infinity makes
+    the sample's sum non-finite, so one matrix–vector product (fast in any memory layout)
+    decides for most samples; only those whose sum overflows are checked element by element."""
+    flat = arr.reshape(arr.shape[0], -1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        ok = np.isfinite(flat @ np.ones(flat.shape[1]))
+    if not ok.all():
+        suspect = np.flatnonzero(~ok)
+        ok[suspect] = np.all(np.isfinite(flat[suspect]), axis=1)
+    return ok
+
+
+def finite_samples(mode: ModeMotion) -> NDArray[np.bool_]:
+    """Which samples have a finite motion: every array that dynamics reads (the link frames,
+    their rates, the joint centres and axes)."""
+    finite = np.ones(mode.link_rotation.shape[0], dtype=bool)
+    for arr in (
+        mode.link_rotation,
+        mode.link_origin,
+        mode.link_angular_velocity,
+        mode.link_origin_velocity,
+        mode.link_angular_acceleration,
+        mode.link_origin_acceleration,
+        mode.joint_centres,
+        mode.joint_axes,
+    ):
+        finite &= _finite_rows(arr)
+    return finite
+
+
 def valid_samples(
     linkage: Linkage,
     mode: ModeMotion,
     inputs: Array,
     allow_partial: bool,
+    *,
+    check_finite: bool = True,
 ) -> NDArray[np.bool_]:
-    """Samples usable for dynamics: assembled, not singular, finite motion."""
+    """Samples usable for dynamics: assembled, not singular, finite motion.
+    ``check_finite=False`` leaves the finiteness to the caller (the blocked inverse dynamics
+    checks each block while it is in the cache, :func:`finite_samples`)."""
     if not isinstance(mode, ModeMotion):
         raise DynamicsInputError(
             f"expected one assembly mode (a ModeMotion, e.g. motion(...).modes[0]); "
@@ -128,19 +163,9 @@ def valid_samples(
             f"the motion has {mode.link_rotation.shape[1:2]} moving links but {linkage.name} has "
             f"{n_links}: pass the ModeMotion computed for this linkage"
         )
-    finite = np.ones(mode.assembles.shape, dtype=bool)
-    for arr in (
-        mode.link_rotation,
-        mode.link_origin,
-        mode.link_angular_velocity,
-        mode.link_origin_velocity,
-        mode.link_angular_acceleration,
-        mode.link_origin_acceleration,
-        mode.joint_centres,
-        mode.joint_axes,
-    ):
-        finite &= np.all(np.isfinite(arr.reshape(arr.shape[0], -1)), axis=1)
-    valid = mode.assembles & ~mode.singular & finite
+    valid = mode.assembles & ~mode.singular
+    if check_finite:
+        valid &= finite_samples(mode)
     _check_frames(linkage, mode, valid)
     if not valid.any():
         raise NonAssemblingMotionError(

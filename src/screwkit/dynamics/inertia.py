@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from screwkit.dynamics import soa
 from screwkit.dynamics.screws import Array, _cross
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.mass import MassProperties
@@ -104,3 +105,38 @@ def inertia_wrench_regressor(mode: ModeMotion, gravity: Array, reference: Array)
     moment_o = -np.einsum("...ij,...jk->...ik", R, k_moment)
     arm = _skew(mode.link_origin - reference)
     return np.concatenate([force, moment_o + arm @ force], -2)
+
+
+def inertia_wrenches_soa(
+    masses: list[MassProperties],
+    rotation: list[soa.Scalar],
+    origin: list[soa.Scalar],
+    angular_velocity: list[soa.Scalar],
+    angular_acceleration: list[soa.Scalar],
+    origin_acceleration: list[soa.Scalar],
+    gravity: Array,
+    reference: Array,
+) -> list[tuple[soa.Vec, soa.Vec]]:
+    """The direct form of the module docstring for one block of samples in structure-of-arrays
+    form: per moving link, the applied force and moment about ``reference`` as component
+    tuples. Inputs are component rows (:func:`screwkit.dynamics.soa.rows`): ``rotation`` 9 per
+    link (R[3i + j]), the others 3 per link."""
+    out = []
+    g = soa.const(gravity)
+    ref = soa.const(reference)
+    for l, mp in enumerate(masses):
+        R = rotation[9 * l : 9 * l + 9]
+        w = soa.vec(angular_velocity, 3 * l)
+        al = soa.vec(angular_acceleration, 3 * l)
+        rc = soa.rotate(R, soa.const(mp.com))
+        p_c = soa.sub(soa.add(soa.vec(origin, 3 * l), rc), ref)
+        a_c = soa.add(soa.vec(origin_acceleration, 3 * l),
+                      soa.add(soa.cross(al, rc), soa.cross(w, soa.cross(w, rc))))
+        force = soa.scale(float(mp.mass), soa.sub(g, a_c))
+        inertia = np.asarray(mp.inertia, dtype=float)
+        w_b = soa.rotate_back(R, w)
+        body = soa.add(soa.const_matvec(inertia, soa.rotate_back(R, al)),
+                       soa.cross(w_b, soa.const_matvec(inertia, w_b)))
+        moment = soa.sub(soa.cross(p_c, force), soa.rotate(R, body))
+        out.append((force, moment))
+    return out

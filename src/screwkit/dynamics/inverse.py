@@ -8,6 +8,12 @@
 3. the joint wrenches and driven efforts from the link balances and the joints' "no work along a
    passive freedom" conditions (:mod:`screwkit.dynamics.loop_statics`).
 
+The samples go through these steps in blocks (:mod:`screwkit.dynamics.blocks`), written into
+preallocated outputs. For a family with a registered closed-form statics (the CSSP,
+:mod:`screwkit.dynamics.cssp_statics`, run by :mod:`screwkit.dynamics.cssp_path`), steps 2–3
+are replaced by the closed form and step 1 runs in structure-of-arrays form: same results to
+round-off, several times faster.
+
 Every load is linear in the link loads, and those are linear in the inertial parameters, so
 ``regressor`` runs the same solve with one load column per parameter (Atkeson, An & Hollerbach
 1986 form of the Newton–Euler equations; the closed loop adds nothing non-linear).
@@ -22,56 +28,60 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from screwkit.dynamics.blocks import (
+    BLOCK_SAMPLES,
+    Outputs,
+    Selection,
+    Setup,
+    as_dynamics,
+    blocks,
+    joint_scale,
+)
 from screwkit.dynamics.checks import (
     DynamicsInputError,
     ExternalLoad,
     check_external_loads,
     check_link_masses,
     check_vector3,
+    finite_samples,
     valid_samples,
 )
+from screwkit.dynamics.cssp_path import cssp_mode_block
+from screwkit.dynamics.cssp_statics import CSSPStatics, cssp_statics_for
 from screwkit.dynamics.inertia import inertia_wrench_regressor, inertia_wrenches
 from screwkit.dynamics.loop_statics import (
-    StaticsStructure,
     solve_loop_statics,
     statics_structure,
 )
-from screwkit.dynamics.result import Array, Dynamics, Indeterminacy
-from screwkit.dynamics.screws import FreedomScrews, _cross, freedom_screws
+from screwkit.dynamics.result import Array, Dynamics
+from screwkit.dynamics.screws import _cross, freedom_screws
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
-from screwkit.model.mass import N_INERTIAL_PARAMETERS
+from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 
 INERTIAL_PARAMETER_NAMES = ("m", "mcx", "mcy", "mcz", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")
 
 
-@dataclass(frozen=True)
-class _Setup:
-    valid: Any
-    inputs: Array
-    reference: Array
-    screws: FreedomScrews
-    centres: Array  # (Nv, n, 3) relative to the reference
-    structure: StaticsStructure
-    gravity: Array
-    moment_point: Array
+class _NonFiniteMotion(Exception):
+    """Internal: a block found a non-finite sample the optimistic run did not check for."""
 
 
-def _take_valid(mode: ModeMotion, valid: Any) -> ModeMotion:
-    """A view of the mode restricted to the valid samples (only the fields dynamics reads)."""
+def _subset(mode: ModeMotion, sel: Selection) -> ModeMotion:
+    """The mode restricted to some samples (only the fields dynamics reads; views for a
+    slice)."""
     from dataclasses import replace
 
     return replace(
         mode,
-        link_rotation=mode.link_rotation[valid],
-        link_origin=mode.link_origin[valid],
-        link_angular_velocity=mode.link_angular_velocity[valid],
-        link_origin_velocity=mode.link_origin_velocity[valid],
-        link_angular_acceleration=mode.link_angular_acceleration[valid],
-        link_origin_acceleration=mode.link_origin_acceleration[valid],
-        joint_centres=mode.joint_centres[valid],
-        joint_axes=mode.joint_axes[valid],
-        variables={k: v[valid] for k, v in mode.variables.items()},
+        link_rotation=mode.link_rotation[sel],
+        link_origin=mode.link_origin[sel],
+        link_angular_velocity=mode.link_angular_velocity[sel],
+        link_origin_velocity=mode.link_origin_velocity[sel],
+        link_angular_acceleration=mode.link_angular_acceleration[sel],
+        link_origin_acceleration=mode.link_origin_acceleration[sel],
+        joint_centres=mode.joint_centres[sel],
+        joint_axes=mode.joint_axes[sel],
+        variables={k: v[sel] for k, v in mode.variables.items()},
     )
 
 
@@ -82,7 +92,10 @@ def _setup(
     moment_point: ArrayLike | None,
     inputs: ArrayLike | None,
     allow_partial: bool,
-) -> tuple[_Setup, ModeMotion]:
+    check_finite: bool = True,
+) -> Setup:
+    """What every block needs. ``check_finite=False``: the caller checks each block's
+    finiteness (:class:`_NonFiniteMotion` if it fails); only the samples read here are."""
     N = mode.assembles.shape[0]
     if inputs is None:
         input_arr = np.stack(
@@ -95,22 +108,24 @@ def _setup(
                 f"inputs must have one column per input {list(linkage.inputs)}; "
                 f"got shape {np.shape(inputs)}"
             )
-    valid = valid_samples(linkage, mode, input_arr, allow_partial)
-    sub = mode if valid.all() else _take_valid(mode, valid)
-    reference = np.mean(sub.joint_centres, axis=(0, 1))
-    fs = freedom_screws(linkage, sub, reference)
-    structure = statics_structure(fs, linkage.length_scale)
-    setup = _Setup(
+    valid = valid_samples(linkage, mode, input_arr, allow_partial, check_finite=check_finite)
+    idx = np.flatnonzero(valid)
+    centres = mode.joint_centres if idx.size == N else mode.joint_centres[idx]
+    reference = np.mean(centres, axis=(0, 1))
+    # the generic rank of the statics from (up to) 32 samples spread over the valid ones
+    take = idx[np.unique(np.linspace(0, idx.size - 1, min(32, idx.size)).astype(int))]
+    spread = _subset(mode, take)
+    if not check_finite and not (np.all(np.isfinite(reference)) and finite_samples(spread).all()):
+        raise _NonFiniteMotion
+    fs = freedom_screws(linkage, spread, reference)
+    return Setup(
         valid=valid,
         inputs=input_arr,
         reference=reference,
-        screws=fs,
-        centres=sub.joint_centres - reference,
-        structure=structure,
+        structure=statics_structure(fs, linkage.length_scale),
         gravity=check_vector3(gravity, "gravity"),
         moment_point=check_vector3(moment_point, "moment_point"),
     )
-    return setup, sub
 
 
 def _external_wrenches(
@@ -140,83 +155,72 @@ def _cross_columns(a: Array, b: Array) -> Array:
     )
 
 
-def _loads(linkage: Linkage, s: _Setup, link_wrenches: Array) -> dict[str, Any]:
-    """Every load with a trailing load-case axis K, scattered to all N samples (NaN where not
-    valid). ``link_wrenches`` (Nv, L, 6, K) about the reference point."""
-    st = solve_loop_statics(
-        s.screws, s.centres, link_wrenches, linkage.length_scale, s.structure
-    )
-    N = s.valid.shape[0]
-    K = link_wrenches.shape[-1]
+def _block_loads(
+    linkage: Linkage, s: Setup, part: ModeMotion, link_wrenches: Array
+) -> dict[str, Any]:
+    """Every load of some samples with a trailing load-case axis K, by the generic statics.
+    ``link_wrenches`` (n, L, 6, K) about the reference point."""
+    fs = freedom_screws(linkage, part, s.reference)
+    centres = part.joint_centres - s.reference
+    st = solve_loop_statics(fs, centres, link_wrenches, linkage.length_scale, s.structure)
     n = len(linkage.joints)
+    total = link_wrenches.sum(axis=1)  # (n, 6, K)
+    arm = (s.reference - s.moment_point)[None, :, None]
+    shaking_moment = total[:, 3:] + _cross_columns(arm, total[:, :3])
+    W = st.wrenches  # (n, n_joints, 6, K) proximal on distal
+    sign = np.ones(n)
+    sign[-1] = -1.0  # the last joint's distal link is the ground: report the load on the link
+    f = W[:, :, :3] * sign[None, :, None, None]
+    m_ref = W[:, :, 3:] * sign[None, :, None, None]
+    m_c = m_ref - _cross_columns(centres[..., None], f)
+    driven_names = [nm for nm, dv in zip(fs.names, fs.driven, strict=True) if dv]
+    return {
+        "shaking_force": total[:, :3],
+        "shaking_moment": shaking_moment,
+        "reaction_force": f,
+        "reaction_moment": m_c,
+        "efforts": {
+            name: st.efforts[:, driven_names.index(name)] for name in linkage.inputs
+        },
+        "residual": st.residual,
+    }
+
+
+def _loads(linkage: Linkage, s: Setup, part: ModeMotion, link_wrenches: Array) -> dict[str, Any]:
+    """:func:`_block_loads` of all valid samples at once, scattered to all N samples (NaN where
+    not valid); used by the regressor."""
+    loads = _block_loads(linkage, s, part, link_wrenches)
+    N = s.valid.shape[0]
 
     def full(a: Array) -> Array:
         out = np.full((N, *a.shape[1:]), np.nan)
         out[s.valid] = a
         return out
 
-    total = link_wrenches.sum(axis=1)  # (Nv, 6, K)
-    arm = (s.reference - s.moment_point)[None, :, None]
-    shaking_moment = total[:, 3:] + _cross_columns(arm, total[:, :3])
-    W = st.wrenches  # (Nv, n, 6, K) proximal on distal
-    sign = np.ones(n)
-    sign[-1] = -1.0  # the last joint's distal link is the ground: report the load on the link
-    f = W[:, :, :3] * sign[None, :, None, None]
-    m_ref = W[:, :, 3:] * sign[None, :, None, None]
-    m_c = m_ref - _cross_columns(s.centres[..., None], f)
-    driven_names = [nm for nm, dv in zip(s.screws.names, s.screws.driven, strict=True) if dv]
-    efforts = {
-        name: full(st.efforts[:, driven_names.index(name)]) for name in linkage.inputs
-    }
     return {
-        "shaking_force": full(total[:, :3]),
-        "shaking_moment": full(shaking_moment),
-        "reaction_force": full(f),
-        "reaction_moment": full(m_c),
-        "efforts": efforts,
-        "residual": full(st.residual),
-        "K": K,
+        key: {k: full(v) for k, v in value.items()} if key == "efforts" else full(value)
+        for key, value in loads.items()
     }
 
 
-def _as_dynamics(linkage: Linkage, mode: ModeMotion, s: _Setup, loads: dict[str, Any]) -> Dynamics:
-    """K = 1 loads → a :class:`Dynamics`."""
-    reactions = {
-        j.name: {
-            "force": loads["reaction_force"][:, k, :, 0],
-            "moment": loads["reaction_moment"][:, k, :, 0],
-        }
-        for k, j in enumerate(linkage.joints)
-    }
-    ell = linkage.length_scale
-    joint_size = np.hypot(
-        np.linalg.norm(loads["reaction_force"][..., 0], axis=-1),
-        np.linalg.norm(loads["reaction_moment"][..., 0], axis=-1) / ell,
-    )
-    scale = float(np.nanmax(joint_size)) if np.any(s.valid) else 0.0
-    directions = s.structure.indeterminate_directions.copy()
-    # moment of each self-stress direction about the world origin
-    directions[:, 3:] += _cross(np.broadcast_to(s.reference, directions[:, :3].shape),
-                                directions[:, :3])
-    return Dynamics(
-        input_names=tuple(linkage.inputs),
-        inputs=s.inputs,
-        valid=s.valid,
-        shaking_force=loads["shaking_force"][..., 0],
-        shaking_moment=loads["shaking_moment"][..., 0],
-        moment_point=s.moment_point,
-        reactions=reactions,
-        joint_centres=mode.joint_centres,
-        efforts={k: v[:, 0] for k, v in loads["efforts"].items()},
-        indeterminacy=Indeterminacy(
-            count=s.structure.indeterminate_count,
-            directions=directions,
-            idle_freedoms=s.structure.idle_count,
-        ),
-        residual=np.linalg.norm(loads["residual"][..., 0], axis=-1),
-        residual_scale=scale,
-        gravity=s.gravity,
-    )
+def _generic_block(
+    linkage: Linkage, masses: list[MassProperties], s: Setup, part: ModeMotion,
+    external_loads: Mapping[str, ExternalLoad] | None, out: Outputs,
+) -> None:
+    """One block by the generic Newton–Euler + loop statics (any single loop)."""
+    B = inertia_wrenches(masses, part, s.gravity, s.reference)
+    ext = _external_wrenches(linkage, part, external_loads, s.reference)
+    if ext is not None:
+        B = B + ext
+    loads = _block_loads(linkage, s, part, B[..., None])
+    out.shaking_force[...] = loads["shaking_force"][..., 0]
+    out.shaking_moment[...] = loads["shaking_moment"][..., 0]
+    out.reaction_force[...] = loads["reaction_force"][..., 0]
+    out.reaction_moment[...] = loads["reaction_moment"][..., 0]
+    for k, v in loads["efforts"].items():
+        out.efforts[k][...] = v[:, 0]
+    out.residual[...] = np.linalg.norm(loads["residual"][..., 0], axis=-1)
+    out.scale = joint_scale(out.reaction_force, out.reaction_moment, linkage.length_scale)
 
 
 def inverse_dynamics(
@@ -228,6 +232,8 @@ def inverse_dynamics(
     external_loads: Mapping[str, ExternalLoad] | None = None,
     inputs: ArrayLike | None = None,
     allow_partial: bool = False,
+    closed_form: bool = True,
+    block_size: int = BLOCK_SAMPLES,
 ) -> Dynamics:
     """Shaking force and moment, joint reactions and driven efforts of one assembly mode.
 
@@ -236,7 +242,8 @@ def inverse_dynamics(
     linkage:
         the loop; every moving link needs ``mass`` (a MassProperties in its body frame).
     mode_motion:
-        one mode of :func:`screwkit.kinematics.motion.motion` (``motion(...).modes[k]``).
+        one mode of :func:`screwkit.kinematics.motion.motion` (``motion(...).modes[k]``) or of
+        a closed form (e.g. :func:`screwkit.kinematics.cssp_motion.cssp_mode_motion`).
     gravity:
         gravitational acceleration, world frame (m/s²), e.g. ``(0, 0, -9.80665)``; none if
         omitted.
@@ -250,17 +257,74 @@ def inverse_dynamics(
     allow_partial:
         accept samples that do not assemble or are singular (their loads are NaN); otherwise
         they raise :class:`NonAssemblingMotionError` naming them.
+    closed_form:
+        use the family's closed-form statics where one is registered (the CSSP:
+        :mod:`screwkit.dynamics.cssp_statics`; same results to round-off); ``False`` forces
+        the generic solve.
+    block_size:
+        samples per block (module constant :data:`BLOCK_SAMPLES`); results are the same for
+        any block size, only speed and peak memory change.
 
-    Newton–Euler with the closed-loop statics of :mod:`screwkit.dynamics.loop_statics`; see
-    docs/dynamics.md for the conventions and how indeterminate components are reported.
+    Newton–Euler with the closed-loop statics of :mod:`screwkit.dynamics.loop_statics`, run
+    block by block into preallocated outputs; see docs/dynamics.md for the conventions and how
+    indeterminate components are reported.
     """
+    if not isinstance(block_size, int | np.integer) or block_size < 1:
+        raise DynamicsInputError(f"block_size must be a positive integer, got {block_size!r}")
     masses = check_link_masses(linkage)
-    s, sub = _setup(linkage, mode_motion, gravity, moment_point, inputs, allow_partial)
-    B = inertia_wrenches(masses, sub, s.gravity, s.reference)
-    ext = _external_wrenches(linkage, sub, external_loads, s.reference)
-    if ext is not None:
-        B = B + ext
-    return _as_dynamics(linkage, mode_motion, s, _loads(linkage, s, B[..., None]))
+    args = (linkage, mode_motion, masses, gravity, moment_point, external_loads, inputs,
+            allow_partial, closed_form, int(block_size))
+    if mode_motion.assembles.all() and not mode_motion.singular.any():
+        # the usual case: check finiteness block by block, while the block is in the cache
+        try:
+            return _run(*args, check_finite=False)
+        except _NonFiniteMotion:
+            pass  # start again with the full check, which names the bad samples
+    return _run(*args, check_finite=True)
+
+
+def _run(
+    linkage: Linkage,
+    mode_motion: ModeMotion,
+    masses: list[MassProperties],
+    gravity: ArrayLike | None,
+    moment_point: ArrayLike | None,
+    external_loads: Mapping[str, ExternalLoad] | None,
+    inputs: ArrayLike | None,
+    allow_partial: bool,
+    closed_form: bool,
+    block_size: int,
+    check_finite: bool,
+) -> Dynamics:
+    s = _setup(linkage, mode_motion, gravity, moment_point, inputs, allow_partial, check_finite)
+    external = check_external_loads(linkage, external_loads)
+    plan = _closed_form_plan(linkage, s) if closed_form else None
+    N = s.valid.shape[0]
+    out = Outputs.allocate(linkage, N, fill=not s.valid.all())
+    for sel in blocks(s.valid, block_size):
+        part = _subset(mode_motion, sel)
+        dest = out.block(sel)
+        if plan is not None:
+            if not cssp_mode_block(linkage, plan, masses, s, part, external, dest,
+                                   check_finite=not check_finite):
+                raise _NonFiniteMotion
+        else:
+            if not check_finite and not finite_samples(part).all():
+                raise _NonFiniteMotion
+            _generic_block(linkage, masses, s, part, external_loads, dest)
+        out.scatter(sel, dest)
+    return as_dynamics(linkage, mode_motion.joint_centres, s, out)
+
+
+def _closed_form_plan(linkage: Linkage, s: Setup) -> CSSPStatics | None:
+    """The closed-form statics registered for this linkage's family, if one applies (only the
+    CSSP has one): it needs the generic rank of the statics (6, with one idle freedom, the
+    rod spin) that the closed form assumes."""
+    plan = cssp_statics_for(linkage)
+    st = s.structure
+    if plan is None or st.rank != 6 or st.passive_count != 7:
+        return None
+    return plan
 
 
 @dataclass(frozen=True, eq=False)
@@ -285,7 +349,7 @@ class Regressor:
     constant: Mapping[str, Any]
     _linkage: Linkage
     _mode: ModeMotion
-    _setup: _Setup
+    _setup: Setup
 
     def parameters_of(self, linkage: Linkage | None = None) -> Array:
         """π of the links of ``linkage`` (default the one the regressor was built for)."""
@@ -302,25 +366,20 @@ class Regressor:
                 f"parameters must be a finite vector of length {P} (10 per moving link, "
                 f"order {self.parameter_names[:10]}…); got shape {pi.shape}"
             )
-        loads: dict[str, Any] = {
-            "shaking_force": self.shaking_force @ pi + self.constant["shaking_force"][..., 0],
-            "shaking_moment": self.shaking_moment @ pi + self.constant["shaking_moment"][..., 0],
-            "reaction_force": np.stack(
-                [r["force"] @ pi for r in self.reactions.values()], 1
-            ) + self.constant["reaction_force"][..., 0],
-            "reaction_moment": np.stack(
-                [r["moment"] @ pi for r in self.reactions.values()], 1
-            ) + self.constant["reaction_moment"][..., 0],
-            "efforts": {
-                k: v @ pi + self.constant["efforts"][k][..., 0] for k, v in self.efforts.items()
-            },
-            "residual": self.residual @ pi + self.constant["residual"][..., 0],
-        }
-        for key in ("shaking_force", "shaking_moment", "reaction_force", "reaction_moment",
-                    "residual"):
-            loads[key] = loads[key][..., None]
-        loads["efforts"] = {k: v[..., None] for k, v in loads["efforts"].items()}
-        return _as_dynamics(self._linkage, self._mode, self._setup, loads)
+        c = self.constant
+        forces = np.stack([r["force"] @ pi for r in self.reactions.values()], 1)
+        moments = np.stack([r["moment"] @ pi for r in self.reactions.values()], 1)
+        out = Outputs(
+            shaking_force=self.shaking_force @ pi + c["shaking_force"][..., 0],
+            shaking_moment=self.shaking_moment @ pi + c["shaking_moment"][..., 0],
+            reaction_force=forces + c["reaction_force"][..., 0],
+            reaction_moment=moments + c["reaction_moment"][..., 0],
+            efforts={k: v @ pi + c["efforts"][k][..., 0] for k, v in self.efforts.items()},
+            residual=np.linalg.norm(self.residual @ pi + c["residual"][..., 0], axis=-1),
+        )
+        out.scale = joint_scale(out.reaction_force, out.reaction_moment,
+                                 self._linkage.length_scale)
+        return as_dynamics(self._linkage, self._mode.joint_centres, self._setup, out)
 
 
 def regressor(
@@ -336,7 +395,8 @@ def regressor(
     """The regressor Y of every load of :func:`inverse_dynamics` in the stacked inertial
     parameters π of the moving links (load = Y·π + constant). Mass properties on the links are
     not needed (they are what π describes). Same arguments as :func:`inverse_dynamics`."""
-    s, sub = _setup(linkage, mode_motion, gravity, moment_point, inputs, allow_partial)
+    s = _setup(linkage, mode_motion, gravity, moment_point, inputs, allow_partial)
+    sub = mode_motion if s.valid.all() else _subset(mode_motion, np.flatnonzero(s.valid))
     Y = inertia_wrench_regressor(sub, s.gravity, s.reference)  # (Nv, L, 6, 10)
     Nv, L = Y.shape[:2]
     P = N_INERTIAL_PARAMETERS * L
@@ -344,8 +404,8 @@ def regressor(
     for l in range(L):
         B[:, l, :, N_INERTIAL_PARAMETERS * l : N_INERTIAL_PARAMETERS * (l + 1)] = Y[:, l]
     ext = _external_wrenches(linkage, sub, external_loads, s.reference)
-    const = _loads(linkage, s, (np.zeros((Nv, L, 6)) if ext is None else ext)[..., None])
-    loads = _loads(linkage, s, B)
+    const = _loads(linkage, s, sub, (np.zeros((Nv, L, 6)) if ext is None else ext)[..., None])
+    loads = _loads(linkage, s, sub, B)
     reactions = {
         j.name: {
             "force": loads["reaction_force"][:, k],

@@ -2,9 +2,12 @@
 
 :func:`cssp_mode_motion` gives the same result type, with the same conventions, as
 ``motion(linkage, …).modes[k]`` for a linkage built by :func:`screwkit.model.families.cssp`,
-from the exact closed form :func:`screwkit.kinematics.cssp.cssp_motion` (Rahman 1996 §2.1;
-reference SPEC §1.2) instead of the generic Newton solver. Every array is computed in one
-vectorised pass, so the inverse dynamics can run on 10⁶ samples.
+from the exact closed form of :func:`screwkit.kinematics.cssp.cssp_motion` (Rahman 1996 §2.1;
+reference SPEC §1.2) instead of the generic Newton solver. The samples are processed in blocks
+in structure-of-arrays form (:func:`cssp_block_rows`, one (n,) array per component), and the
+(N, …) arrays are views of component-major storage (each component contiguous over the
+samples), so 10⁶ samples take well under a microsecond each; the fused CSSP inverse dynamics
+(:func:`screwkit.dynamics.cssp_inverse_dynamics`) consumes the same block rows directly.
 
 Frames (those of :func:`screwkit.model.families.cssp` and :func:`screwkit.kinematics.loop.forward`):
 
@@ -30,11 +33,22 @@ derivatives of those components, with the child frame turning at the link's ω.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from screwkit.kinematics.cssp import SEED_ASSEMBLY_MODE, CSSPDimensions, cssp_motion
+from screwkit.kinematics.cssp import (
+    _GIMBAL_TOL,
+    SEED_ASSEMBLY_MODE,
+    CSSPAssemblyError,
+    CSSPDimensions,
+    _as_samples,
+    _check_mode,
+    assembly_message,
+)
 from screwkit.kinematics.loop import Configuration, rot_x
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
@@ -69,20 +83,330 @@ def cssp_dimensions(linkage: Linkage) -> CSSPDimensions:
     return CSSPDimensions(p["a1"], p["a2"], p["a4"], p["alpha4"], p["s1"])
 
 
-def _cross(a: Array, b: Array) -> Array:
-    return np.stack(
-        [
-            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
-        ],
-        -1,
+BLOCK_SAMPLES = 16384
+"""Samples per block of :func:`cssp_mode_motion` (its temporaries stay in the CPU caches)."""
+
+
+def _component_major(n: int, *shape: int) -> tuple[Array, Array]:
+    """Zeroed storage (shape…, n) and its (n, shape…) view: every component of every sample
+    row is contiguous over the samples, which the closed form writes (and the blocked inverse
+    dynamics reads) without transposing. Entries never written stay zero at no cost."""
+    storage = np.zeros((*shape, n))
+    return storage, np.moveaxis(storage, -1, 0)
+
+
+def _closed_form_block(
+    dims: CSSPDimensions, mode: int, ct: Array, st: Array, w: Any, wd: Any, s1: Any, s1d: Any,
+    s1dd: Any, disc: Array,
+) -> dict[str, Any]:
+    """Crank pin, slider ball, s4, the rod direction u and their first two rates for one block,
+    one (n,) array per component — :func:`screwkit.kinematics.cssp.cssp_motion`'s formulas
+    (SPEC §1.2) in structure-of-arrays form. ``ct``, ``st``: cos θ1, sin θ1; the rates and s1
+    are (n,) arrays or floats; ``disc`` = b² − c > 0 (placeholder 1 where the CSSP does not
+    assemble, whose samples are overwritten with NaN afterwards)."""
+    a1, a2, a4 = dims.a1, dims.a2, dims.a4
+    sa, ca = np.sin(dims.alpha4), np.cos(dims.alpha4)
+    a1c, a1s = a1 * ct, a1 * st
+    b = sa * a1s + ca * s1
+    c = (a4**2 + a1**2 - a2**2) + 2 * a4 * a1c + s1 * s1
+    root = np.sqrt(disc) if mode > 0 else -np.sqrt(disc)  # = s4 + b
+    # −b + root cancels when mode·b > 0; there use the product of the roots, s4·s4' = c
+    other = -b - root
+    cancels = (b > 0) if mode > 0 else (b < 0)
+    cancels &= other != 0
+    s4 = np.where(cancels, c / np.where(cancels, other, 1.0), root - b)
+    w2 = w * w
+    pin_v = (-a1s * w, a1c * w, s1d)
+    pin_a = (-(a1c * w2 + a1s * wd), a1c * wd - a1s * w2, s1dd)
+    b_dot = sa * pin_v[1] + ca * s1d
+    b_ddot = sa * pin_a[1] + ca * s1dd
+    c_dot = 2 * (a4 * pin_v[0] + s1 * s1d)
+    c_ddot = 2 * (a4 * pin_a[0] + s1d * s1d + s1 * s1dd)
+    inv_root = 1.0 / root
+    s4_dot = -(b_dot * s4 + 0.5 * c_dot) * inv_root
+    s4_ddot = -(s4_dot * s4_dot + 2 * b_dot * s4_dot + b_ddot * s4 + 0.5 * c_ddot) * inv_root
+    inv_a2 = 1.0 / a2
+    ball = (-a4, -sa * s4, -ca * s4)
+    u = ((-a4 - a1c) * inv_a2, (ball[1] - a1s) * inv_a2, (ball[2] - s1) * inv_a2)
+    u_dot = (-pin_v[0] * inv_a2, (-sa * s4_dot - pin_v[1]) * inv_a2,
+             (-ca * s4_dot - s1d) * inv_a2)
+    u_ddot = (-pin_a[0] * inv_a2, (-sa * s4_ddot - pin_a[1]) * inv_a2,
+              (-ca * s4_ddot - s1dd) * inv_a2)
+    return {
+        "s4": s4, "s4_dot": s4_dot, "s4_ddot": s4_ddot,
+        "pin": (a1c, a1s, s1), "pin_v": pin_v, "pin_a": pin_a, "ball": ball,
+        "u": u, "u_dot": u_dot, "u_ddot": u_ddot,
+    }
+
+
+def _combine(coefficients: Array, values: tuple[Any, Any, Any]) -> Any:
+    """Σ c_k v_k for constants c_k, skipping zero constants (and zero values given as 0.0):
+    the slider frame X(−(α4 + π/2)) and the rod frame's y3 have zero entries."""
+    total: Any = 0.0
+    for c, v in zip(coefficients.tolist(), values, strict=True):
+        if c == 0.0 or (type(v) is float and v == 0.0):
+            continue
+        term = v if c == 1.0 else (-v if c == -1.0 else c * v)
+        total = term if type(total) is float and total == 0.0 else total + term
+    return total
+
+
+def _dot3(a: tuple[Any, Any, Any], b: tuple[Any, Any, Any]) -> Any:
+    """a·b where an entry of ``a`` may be the constant 0.0 (the rod frame's y3_z)."""
+    terms = [x * y for x, y in zip(a, b, strict=True) if not (type(x) is float and x == 0.0)]
+    total = terms[0]
+    for t in terms[1:]:
+        total = total + t
+    return total
+
+
+def _cross3(a: tuple[Any, Any, Any], b: tuple[Any, Any, Any]) -> tuple[Any, Any, Any]:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+Rows = list[Any]  # one entry per component: an (n,) array, or a float for a constant
+
+
+@dataclass(frozen=True)
+class CSSPBlockRows:
+    """The link motion of one block of samples, component by component (structure of arrays),
+    world frame; entries are (n,) arrays or floats (0.0 where a component is zero throughout).
+
+    ``rotation`` 27 rows (link l, entry R[i, j] at 9l + 3i + j); ``origin``, ``velocity``,
+    ``acceleration`` (of the link origins), ``angular_velocity``, ``angular_acceleration``
+    9 rows (3l + i); ``centres``, ``axes`` 12 rows (joint j at 3j + i) — the layout of the
+    ModeMotion arrays flattened behind the sample axis. ``loop`` holds loop-frame quantities
+    of the ball joints' coordinates (crank angle cos/sin, rod frame, rod ω and α, crank rates),
+    ``s4`` (s4, ṡ4, s̈4) and ``closure`` the translational loop-closure gap (m).
+    """
+
+    rotation: Rows
+    origin: Rows
+    velocity: Rows
+    acceleration: Rows
+    angular_velocity: Rows
+    angular_acceleration: Rows
+    centres: Rows
+    axes: Rows
+    s4: tuple[Array, Array, Array]
+    closure: Array
+    loop: dict[str, Any]
+
+
+def _place(rows: Rows, R: Array, p: Array | None, rotations: bool = False) -> Rows:
+    """world = R·loop (+ p for points) for every 3-vector of ``rows``; with ``rotations`` the
+    rows are 3×3 matrices (9 per link) and each of their columns is rotated."""
+    out: Rows = list(rows)
+    if rotations:
+        groups = [[b + 3 * i + col for i in range(3)]
+                  for b in range(0, len(rows), 9) for col in range(3)]
+    else:
+        groups = [[b, b + 1, b + 2] for b in range(0, len(rows), 3)]
+    for idx in groups:
+        v = (rows[idx[0]], rows[idx[1]], rows[idx[2]])
+        for i, k in enumerate(idx):
+            value = _combine(R[i], v)
+            if p is not None and p[i] != 0.0:
+                value = float(p[i]) if type(value) is float and value == 0.0 else value + p[i]
+            out[k] = value
+    return out
+
+
+def cssp_block_rows(
+    sw: CSSPSweep, sel: slice | NDArray[np.intp], base_R: Array, base_p: Array
+) -> CSSPBlockRows:
+    """Link frames, their rates, joint centres and axes of the samples ``sel`` of a sweep
+    (:class:`CSSPBlockRows`) from the closed form (SPEC §1.2; frames of the module docstring),
+    placed in the world by the linkage base (R, p). Shared by :func:`cssp_mode_motion`, which
+    stores the rows, and the fused CSSP inverse dynamics, which consumes them block by block."""
+    dims, driven_offset = sw.dims, sw.driven_offset
+    ct, st = sw.cos[sel], sw.sin[sel]
+    w, wd = sw.block("theta1_dot", sel), sw.block("theta1_ddot", sel)
+    s1 = sw.block("s1", sel)
+    s1d, s1dd = sw.block("s1_dot", sel), sw.block("s1_ddot", sel)
+    k = _closed_form_block(dims, sw.mode, ct, st, w, wd, s1, s1d, s1dd, sw.discriminant[sel])
+    u, ud, udd = k["u"], k["u_dot"], k["u_ddot"]
+    # Rahman's rod frame {3} = Z(θ1 + θ2)·Y(η2): x3 = u, y3 = (−u_y, u_x, 0)/ρ, z3 = u × y3
+    rho2 = u[0] * u[0] + u[1] * u[1]
+    defined = rho2 > _GIMBAL_TOL**2
+    inv_rho = 1.0 / np.sqrt(np.where(defined, rho2, 1.0))
+    y3 = (np.where(defined, -u[1] * inv_rho, 0.0), np.where(defined, u[0] * inv_rho, 1.0))
+    z3 = (-u[2] * y3[1], u[2] * y3[0], u[0] * y3[1] - u[1] * y3[0])
+    rod = ((u[0], y3[0], z3[0]), (u[1], y3[1], z3[1]), (u[2], 0.0, z3[2]))
+    w_rod = _cross3(u, ud)
+    al_rod = _cross3(u, udd)
+    slider_R = rot_x(np.array(-(dims.alpha4 + np.pi / 2)))
+    k4 = dims.slider_axis
+    s4, s4d, s4dd = k["s4"], k["s4_dot"], k["s4_ddot"]
+    rotation: Rows = [ct, -st, 0.0, st, ct, 0.0, 0.0, 0.0, 1.0]
+    rotation += [rod[i][j] for i in range(3) for j in range(3)]
+    rotation += [float(x) for x in slider_R.ravel()]
+    ball = [-dims.a4, k["ball"][1], k["ball"][2]]
+    origin: Rows = [0.0, 0.0, s1, *k["pin"], *ball]
+    velocity: Rows = [0.0, 0.0, s1d, *k["pin_v"], 0.0, -k4[1] * s4d, -k4[2] * s4d]
+    acceleration: Rows = [0.0, 0.0, s1dd, *k["pin_a"], 0.0, -k4[1] * s4dd, -k4[2] * s4dd]
+    angular_velocity: Rows = [0.0, 0.0, w, *w_rod, 0.0, 0.0, 0.0]
+    angular_acceleration: Rows = [0.0, 0.0, wd, *al_rod, 0.0, 0.0, 0.0]
+    # a C joint's centre is its frame origin on z1, an R joint's sits at its offset (loop.forward)
+    centres: Rows = [0.0, 0.0, 0.0 if driven_offset else s1, *k["pin"], *ball, *ball]
+    axes: Rows = [0.0, 0.0, 1.0, 0.0, 0.0, 1.0, *z3, *(float(x) for x in k4)]
+    if not (np.array_equal(base_R, np.eye(3)) and not np.any(base_p)):
+        rotation = _place(rotation, base_R, None, rotations=True)
+        origin = _place(origin, base_R, base_p)
+        centres = _place(centres, base_R, base_p)
+        velocity = _place(velocity, base_R, None)
+        acceleration = _place(acceleration, base_R, None)
+        angular_velocity = _place(angular_velocity, base_R, None)
+        angular_acceleration = _place(angular_acceleration, base_R, None)
+        axes = _place(axes, base_R, None)
+    span = np.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+    return CSSPBlockRows(
+        rotation=rotation, origin=origin, velocity=velocity, acceleration=acceleration,
+        angular_velocity=angular_velocity, angular_acceleration=angular_acceleration,
+        centres=centres, axes=axes, s4=(s4, s4d, s4dd),
+        closure=dims.a2 * np.abs(span - 1.0),  # ||P − D1| − a2|
+        loop={"ct": ct, "st": st, "rod": rod, "w_rod": w_rod, "al_rod": al_rod, "w": w,
+              "wd": wd, "slider_R": slider_R},
     )
 
 
-def _rotate_back(R: Array, v: Array) -> Array:
-    """Rᵀ v for (N, 3, 3) R and (N, 3) v."""
-    return np.einsum("nji,nj->ni", R, v)
+def _ball_joint_block(loop: dict[str, Any], REL_st: Array, RATE_st: Array, sl: slice) -> None:
+    """The ball joints' relative rotations and rates for one block (loop frame; the base
+    cancels): pin R_crankᵀ R_rod (crank Z(θ1)), ball R_rodᵀ R_slider; rates in the child frame:
+    pin R_rod·ω_b = ω_rod − ω_crank and R_rod·ω̇_b = α_rod − α_crank + ω_rod × ω_crank; ball
+    (the slider does not turn) R_slider·ω_b = −ω_rod and R_slider·ω̇_b = −α_rod."""
+    ct, st, rod = loop["ct"], loop["st"], loop["rod"]
+    w_rod, al_rod, w, wd = loop["w_rod"], loop["al_rod"], loop["w"], loop["wd"]
+    slider_R = loop["slider_R"]
+    for j in range(3):
+        REL_st[0, 0, j, sl] = ct * rod[0][j] + st * rod[1][j]
+        REL_st[0, 1, j, sl] = ct * rod[1][j] - st * rod[0][j]
+        if j != 1:  # rod[2][1] = y3_z = 0
+            REL_st[0, 2, j, sl] = rod[2][j]
+        for i in range(3):
+            REL_st[1, i, j, sl] = _combine(slider_R[:, j], (rod[0][i], rod[1][i], rod[2][i]))
+    rel_w = (w_rod[0], w_rod[1], w_rod[2] - w)
+    rel_a = (al_rod[0] + w_rod[1] * w, al_rod[1] - w_rod[0] * w, al_rod[2] - wd)
+    St = slider_R.T
+    for j in range(3):
+        col = (rod[0][j], rod[1][j], rod[2][j])
+        RATE_st[0, j, sl] = _dot3(col, rel_w)
+        RATE_st[1, j, sl] = _dot3(col, rel_a)
+        RATE_st[2, j, sl] = _combine(-St[j], w_rod)
+        RATE_st[3, j, sl] = _combine(-St[j], al_rod)
+
+
+def _write(storage: Array, rows: Rows, sl: slice) -> None:
+    """Store a block's rows into component-major storage (zero rows are already zero)."""
+    flat = storage.reshape(-1, storage.shape[-1])
+    for r, value in enumerate(rows):
+        if not (type(value) is float and value == 0.0):
+            flat[r, sl] = value
+
+
+_RATES = ("theta1_dot", "theta1_ddot", "s1", "s1_dot", "s1_ddot")
+
+
+@dataclass(frozen=True)
+class CSSPSweep:
+    """The checked inputs of a CSSP sweep of N samples and where it assembles.
+
+    ``theta1``, ``cos``, ``sin`` (N,); ``given`` holds θ̇1, θ̈1, s1, ṡ1, s̈1 by name, each a
+    float where it is the same for every sample (the closed form then does scalar arithmetic
+    and leaves zero rows unwritten) or an (N,) array; ``discriminant`` is b² − c, 1 where the
+    CSSP does not assemble (a placeholder: those samples are NaN in the results).
+    """
+
+    dims: CSSPDimensions
+    mode: int
+    driven_offset: bool
+    n: int
+    theta1: Array
+    cos: Array
+    sin: Array
+    given: dict[str, float | Array]
+    discriminant: Array
+    assembles: NDArray[np.bool_]
+
+    def block(self, name: str, sel: slice | NDArray[np.intp]) -> float | Array:
+        """An input over some samples (a float if it is constant)."""
+        value = self.given[name]
+        return value if isinstance(value, float) else value[sel]
+
+    def full(self, name: str) -> Array:
+        """An input as a new (N,) array."""
+        value = self.given[name]
+        if not isinstance(value, float):
+            return value.copy()
+        return np.zeros(self.n) if value == 0.0 else np.full(self.n, value)
+
+
+def _given(value: ArrayLike | None, n: int, name: str, default: float) -> float | Array:
+    """A scalar input as a float, an (N,) one as a checked array."""
+    arr = np.asarray(default if value is None else value, dtype=float)
+    if arr.ndim == 0:
+        if not np.isfinite(arr):
+            raise ValueError(f"{name} must be finite, got {float(arr)!r}")
+        return float(arr)
+    return _as_samples(arr, n, name, default)
+
+
+def cssp_sweep(
+    linkage: Linkage,
+    theta1: ArrayLike,
+    theta1_dot: ArrayLike = 0.0,
+    theta1_ddot: ArrayLike = 0.0,
+    mode: int = SEED_ASSEMBLY_MODE,
+    *,
+    s1: ArrayLike | None = None,
+    s1_dot: ArrayLike = 0.0,
+    s1_ddot: ArrayLike = 0.0,
+    allow_partial: bool = False,
+) -> CSSPSweep:
+    """The inputs of :func:`cssp_mode_motion` checked and broadcast over the samples; raises
+    ``CSSPAssemblyError`` (naming the crank angles) where the CSSP does not assemble, unless
+    ``allow_partial``."""
+    dims = cssp_dimensions(linkage)
+    driven_offset = linkage.joints[0].kind == "C"
+    if not driven_offset and (
+        s1 is not None or np.any(np.asarray(s1_dot) != 0) or np.any(np.asarray(s1_ddot) != 0)
+    ):
+        raise ValueError(
+            f"{linkage.name}: the crank offset s1 is a constant of this CSSP "
+            f"(s1 = {dims.s1!r} m); build it with cssp(..., s1_is_input=True) to drive s1"
+        )
+    mode = _check_mode(mode)
+    th = np.atleast_1d(np.asarray(theta1, dtype=float))
+    if th.ndim != 1:
+        raise ValueError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
+    n = th.shape[0]
+    th = _as_samples(th, n, "theta1", 0.0)
+    given = {
+        name: _given(value, n, name, default)
+        for name, value, default in zip(
+            _RATES, (theta1_dot, theta1_ddot, s1, s1_dot, s1_ddot),
+            (0.0, 0.0, dims.s1, 0.0, 0.0), strict=True)
+    }
+    ct, st = np.cos(th), np.sin(th)
+    # the s4 quadratic's b² − c (SPEC §1.2; assembly_discriminant, with cos θ1 and sin θ1 kept
+    # for the closed form)
+    s1v = given["s1"]
+    sa, ca = np.sin(dims.alpha4), np.cos(dims.alpha4)
+    b = (dims.a1 * sa) * st + ca * s1v
+    c = (dims.a4**2 + dims.a1**2 - dims.a2**2) + (2 * dims.a1 * dims.a4) * ct + s1v * s1v
+    disc = b * b - c
+    # b² = c is a branch point of the two modes: s4 + b = 0 and the rates are unbounded
+    ok = disc > 0.0
+    if not ok.all():
+        if not allow_partial:
+            msg = assembly_message(dims, th, ok)
+            if np.any(disc == 0.0):
+                msg += (" (b² = c exactly at some samples: a branch point where the rates are "
+                        "unbounded.)")
+            raise CSSPAssemblyError(msg + " Pass allow_partial=True to get NaN there instead.",
+                                    ok)
+        disc = np.where(ok, disc, 1.0)
+    return CSSPSweep(dims, mode, driven_offset, n, th, ct, st, given, disc, ok)
 
 
 def cssp_mode_motion(
@@ -97,6 +421,7 @@ def cssp_mode_motion(
     s1_ddot: ArrayLike = 0.0,
     allow_partial: bool = False,
     joint_rotations: bool = True,
+    ball_joints: bool = True,
 ) -> ModeMotion:
     """One assembly mode of a CSSP over N crank angles, from the closed form (no Newton).
 
@@ -110,132 +435,104 @@ def cssp_mode_motion(
     Samples where the CSSP does not assemble raise ``CSSPAssemblyError`` unless
     ``allow_partial``, which marks them in ``assembles`` and fills them with NaN.
     ``joint_rotations=False`` skips the rotation vectors of the two ball joints in
-    ``variables`` (``pin.rx`` …; a third of the cost on 10⁶ samples, unused by the dynamics).
+    ``variables`` (``pin.rx`` …; the costliest part on 10⁶ samples, unused by the dynamics).
+    ``ball_joints=False`` also leaves out the ball joints' relative rotations (``conf.spherical``
+    is then a read-only NaN view) and their rates (``pin.w*``, ``ball.w*`` in ``velocities`` and
+    ``accelerations``): everything inverse dynamics reads — link frames and their rates, joint
+    centres and axes, the scalar joint variables — is kept, at two thirds of the cost.
+
+    Computed in blocks of :data:`BLOCK_SAMPLES` samples in structure-of-arrays form. The (N, …)
+    arrays are views of component-major storage (every component contiguous over the samples;
+    not C-contiguous): the values are those of the (N, …) layout, and the blocked inverse
+    dynamics reads them without a transposing copy.
     """
-    dims = cssp_dimensions(linkage)
-    driven_offset = linkage.joints[0].kind == "C"
-    if not driven_offset and (
-        s1 is not None or np.any(np.asarray(s1_dot) != 0) or np.any(np.asarray(s1_ddot) != 0)
-    ):
-        raise ValueError(
-            f"{linkage.name}: the crank offset s1 is a constant of this CSSP "
-            f"(s1 = {dims.s1!r} m); build it with cssp(..., s1_is_input=True) to drive s1"
-        )
-    cf = cssp_motion(
-        dims, theta1, theta1_dot, theta1_ddot, mode,
-        s1=s1, s1_dot=s1_dot, s1_ddot=s1_ddot, allow_partial=allow_partial,
-    )
-    n = cf.theta1.shape[0]
-    ok = cf.assembles
-    ct, st = np.cos(cf.theta1), np.sin(cf.theta1)
+    sw = cssp_sweep(linkage, theta1, theta1_dot, theta1_ddot, mode, s1=s1, s1_dot=s1_dot,
+                    s1_ddot=s1_ddot, allow_partial=allow_partial)
+    driven_offset, n, ok = sw.driven_offset, sw.n, sw.assembles
+    th = sw.theta1
 
-    # link l's rotation (crank Z(θ1), rod Rahman's {3}, slider X(−(α4 + π/2))), origin, and
-    # their rates, written in place (np.stack of (N, 3) pieces costs as much as the closed form)
-    link_rotation = np.zeros((n, 3, 3, 3))
-    link_rotation[:, 0, 0, 0], link_rotation[:, 0, 0, 1] = ct, -st
-    link_rotation[:, 0, 1, 0], link_rotation[:, 0, 1, 1] = st, ct
-    link_rotation[:, 0, 2, 2] = 1.0
-    link_rotation[:, 1] = cf.rod_frame
-    link_rotation[:, 2] = rot_x(np.array(-(dims.alpha4 + np.pi / 2)))
-    crank_R, rod_R, slider_R = link_rotation[:, 0], link_rotation[:, 1], link_rotation[:, 2]
+    R_st, link_rotation = _component_major(n, 3, 3, 3)
+    O_st, link_origin = _component_major(n, 3, 3)
+    V_st, link_origin_velocity = _component_major(n, 3, 3)
+    A_st, link_origin_acceleration = _component_major(n, 3, 3)
+    W_st, link_angular_velocity = _component_major(n, 3, 3)
+    AL_st, link_angular_acceleration = _component_major(n, 3, 3)
+    C_st, joint_centres = _component_major(n, 4, 3)
+    X_st, joint_axes = _component_major(n, 4, 3)
+    joint_rotations = joint_rotations and ball_joints
+    if ball_joints:
+        # pin: R_crankᵀR_rod, ball: R_rodᵀR_slider; pin, ball joint rates and "accelerations"
+        REL_st, relative = _component_major(n, 2, 3, 3)
+        RATE_st, _ = _component_major(n, 4, 3)
+    else:
+        relative = np.broadcast_to(np.nan, (n, 2, 3, 3))
+    s4_st = np.empty((3, n))  # s4, ṡ4, s̈4
+    closure = np.empty(n)
+    base_R, base_p = linkage.base.real, linkage.base.translation
+    for start in range(0, n, BLOCK_SAMPLES):
+        sl = slice(start, min(start + BLOCK_SAMPLES, n))
+        rows = cssp_block_rows(sw, sl, base_R, base_p)
+        for storage, component_rows in ((R_st, rows.rotation), (O_st, rows.origin),
+                                (V_st, rows.velocity), (A_st, rows.acceleration),
+                                (W_st, rows.angular_velocity),
+                                (AL_st, rows.angular_acceleration), (C_st, rows.centres),
+                                (X_st, rows.axes)):
+            _write(storage, component_rows, sl)
+        s4_st[0, sl], s4_st[1, sl], s4_st[2, sl] = rows.s4
+        closure[sl] = rows.closure
+        if ball_joints:
+            _ball_joint_block(rows.loop, REL_st, RATE_st, sl)
 
-    link_origin = np.zeros((n, 3, 3))
-    link_origin[:, 0, 2] = cf.s1
-    link_origin[:, 1] = cf.crank_pin
-    link_origin[:, 2] = cf.slider_ball
-    link_origin_velocity = np.zeros((n, 3, 3))
-    link_origin_velocity[:, 0, 2] = cf.s1_dot
-    link_origin_velocity[:, 1] = cf.crank_pin_velocity
-    link_origin_velocity[:, 2] = cf.slider_ball_velocity
-    link_origin_acceleration = np.zeros((n, 3, 3))
-    link_origin_acceleration[:, 0, 2] = cf.s1_ddot
-    link_origin_acceleration[:, 1] = cf.crank_pin_acceleration
-    link_origin_acceleration[:, 2] = cf.slider_ball_acceleration
-    link_angular_velocity = np.zeros((n, 3, 3))
-    link_angular_velocity[:, 0, 2] = cf.theta1_dot
-    link_angular_velocity[:, 1] = cf.rod_angular_velocity
-    link_angular_acceleration = np.zeros((n, 3, 3))
-    link_angular_acceleration[:, 0, 2] = cf.theta1_ddot
-    link_angular_acceleration[:, 1] = cf.rod_angular_acceleration
-    crank_w, rod_w = link_angular_velocity[:, 0], link_angular_velocity[:, 1]
-    crank_al, rod_al = link_angular_acceleration[:, 0], link_angular_acceleration[:, 1]
-
-    # joint centres and axes; a C joint's centre is its frame origin on z1, an R joint's sits at
-    # its offset (loop.forward)
-    joint_centres = np.zeros((n, 4, 3))
-    if not driven_offset:
-        joint_centres[:, 0, 2] = cf.s1
-    joint_centres[:, 1] = cf.crank_pin
-    joint_centres[:, 2] = cf.slider_ball
-    joint_centres[:, 3] = cf.slider_ball
-    joint_axes = np.zeros((n, 4, 3))
-    joint_axes[:, 0, 2] = 1.0
-    joint_axes[:, 1, 2] = 1.0
-    joint_axes[:, 2] = rod_R[:, :, 2]
-    joint_axes[:, 3] = dims.slider_axis
-
-    # joint variables in the generic solver's layout
-    pin_rel = crank_R.transpose(0, 2, 1) @ rod_R  # R_crankᵀ R_rod (matmul: 3× einsum's speed)
-    ball_rel = rod_R.transpose(0, 2, 1) @ slider_R  # R_rodᵀ R_slider
-    scalars = [cf.theta1] + ([cf.s1] if driven_offset else []) + [cf.s4]
-    conf = Configuration(np.stack(scalars, -1), np.stack([pin_rel, ball_rel], 1))
+    pin_rel, ball_rel = relative[:, 0], relative[:, 1]
+    s1_all = sw.full("s1")
+    scalars = [th] + ([s1_all] if driven_offset else []) + [s4_st[0]]
+    conf = Configuration(np.stack(scalars, -1), relative)
     first = linkage.joints[0].name
     pin, ball, slider = (j.name for j in linkage.joints[1:])
-    variables: dict[str, Array] = {f"{first}.theta": cf.theta1.copy()}
-    velocities: dict[str, Array] = {f"{first}.theta": cf.theta1_dot.copy()}
-    accelerations: dict[str, Array] = {f"{first}.theta": cf.theta1_ddot.copy()}
+    variables: dict[str, Array] = {f"{first}.theta": th}
+    velocities: dict[str, Array] = {f"{first}.theta": sw.full("theta1_dot")}
+    accelerations: dict[str, Array] = {f"{first}.theta": sw.full("theta1_ddot")}
     if driven_offset:
-        variables[f"{first}.s"] = cf.s1.copy()
-        velocities[f"{first}.s"] = cf.s1_dot.copy()
-        accelerations[f"{first}.s"] = cf.s1_ddot.copy()
-    # ball-joint rates in the child frame: pin R_rod·ω_b = ω_rod − ω_crank and
-    # R_rod·ω̇_b = α_rod − α_crank + ω_rod × ω_crank; ball (slider does not turn)
-    # R_slider·ω_b = −ω_rod and R_slider·ω̇_b = −α_rod
-    pin_rate = _rotate_back(rod_R, rod_w - crank_w)
-    pin_acc = _rotate_back(rod_R, rod_al - crank_al + _cross(rod_w, crank_w))
-    ball_rate = _rotate_back(slider_R, -rod_w)
-    ball_acc = _rotate_back(slider_R, -rod_al)
+        variables[f"{first}.s"] = s1_all
+        velocities[f"{first}.s"] = sw.full("s1_dot")
+        accelerations[f"{first}.s"] = sw.full("s1_ddot")
     if joint_rotations:
         safe = np.where(ok[:, None, None], 1.0, 0.0)
         eye = np.where(ok[:, None, None], 0.0, 1.0) * np.eye(3)
         pin_rv = Rotation.from_matrix(np.nan_to_num(pin_rel) * safe + eye).as_rotvec()
         ball_rv = Rotation.from_matrix(np.nan_to_num(ball_rel) * safe + eye).as_rotvec()
-    for name, rate, acc, rv in (
-        (pin, pin_rate, pin_acc, pin_rv if joint_rotations else None),
-        (ball, ball_rate, ball_acc, ball_rv if joint_rotations else None),
-    ):
+    for name, r, rv in ((pin, 0, pin_rv if joint_rotations else None),
+                        (ball, 2, ball_rv if joint_rotations else None)):
+        if not ball_joints:
+            break
         for a, ax in enumerate("xyz"):
             if rv is not None:
                 variables[f"{name}.r{ax}"] = np.where(ok, rv[:, a], np.nan)
-            velocities[f"{name}.w{ax}"] = rate[:, a]
-            accelerations[f"{name}.w{ax}"] = acc[:, a]
-    variables[f"{slider}.s"] = cf.s4
-    velocities[f"{slider}.s"] = cf.s4_dot
-    accelerations[f"{slider}.s"] = cf.s4_ddot
+            velocities[f"{name}.w{ax}"] = RATE_st[r, a]
+            accelerations[f"{name}.w{ax}"] = RATE_st[r + 1, a]
+    variables[f"{slider}.s"] = s4_st[0]
+    velocities[f"{slider}.s"] = s4_st[1]
+    accelerations[f"{slider}.s"] = s4_st[2]
 
     arrays = [link_rotation, link_origin, link_angular_velocity, link_origin_velocity,
               link_angular_acceleration, link_origin_acceleration, joint_centres, joint_axes]
-    base_R, base_p = linkage.base.real, linkage.base.translation
-    if not (np.array_equal(base_R, np.eye(3)) and not np.any(base_p)):
-        # place the loop in the world: rotate every vector, translate the points
-        arrays = [np.einsum("ij,n...jk->n...ik", base_R, arrays[0])] + [
-            np.einsum("ij,n...j->n...i", base_R, a) for a in arrays[1:]
-        ]
-        arrays[1] = arrays[1] + base_p
-        arrays[6] = arrays[6] + base_p
     bad = ~ok
     if bad.any():
         for arr in arrays:
             arr[bad] = np.nan
+        if ball_joints:
+            relative[bad] = np.nan
+        conf.scalars[bad, -1] = np.nan
         for table in (variables, velocities, accelerations):
             for values in table.values():
                 values[bad] = np.nan
-    closure = cf.loop_closure_gap / linkage.length_scale
+        closure[bad] = np.nan
+    closure /= linkage.length_scale
     events: list[str] = []
     if bad.any() and ok.any():
         events.append(f"does not assemble at {int(bad.sum())} of {n} sample(s)")
     return ModeMotion(
-        assembles=ok.copy(),
+        assembles=ok,
         singular=np.zeros(n, dtype=bool),
         conf=conf,
         variables=variables,
@@ -254,4 +551,12 @@ def cssp_mode_motion(
     )
 
 
-__all__ = ["NotACSSPError", "cssp_dimensions", "cssp_mode_motion"]
+__all__ = [
+    "CSSPBlockRows",
+    "CSSPSweep",
+    "NotACSSPError",
+    "cssp_block_rows",
+    "cssp_dimensions",
+    "cssp_mode_motion",
+    "cssp_sweep",
+]
