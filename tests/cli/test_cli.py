@@ -221,7 +221,7 @@ def test_analyze_plot_writes_a_png(tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
 
 
-@pytest.mark.parametrize("name", ["rsrc_fig7_dynamics", "fourbar_dynamics", "rssr_spatial"])
+@pytest.mark.parametrize("name", ["rsrc_fig7_dynamics", "fourbar_dynamics", "rssr_spatial", "rccc_loop"])
 def test_dynamics_runs_on_every_family_from_the_cli(name):
     r = runner.invoke(app, ["dynamics", str(EXAMPLES / f"{name}.toml"), "--json", "--gravity"])
     assert r.exit_code == 0, r.output
@@ -235,3 +235,15 @@ def test_gravity_direction_is_validated(tmp_path):
     p = _bad(tmp_path, 'gravity_direction = [0, 0, 0]\n[mechanism]\nfamily = "4R"\n[dimensions]\na = 3\nd1 = 1\nd2 = 3\nd3 = 2.5\n')
     r = runner.invoke(app, ["analyze", str(p)])
     assert r.exit_code == 2 and "gravity_direction" in r.output
+
+
+def test_dynamics_of_a_partly_assembling_mode_reports_where(tmp_path):
+    text = (EXAMPLES / "fourbar_dynamics.toml").read_text()
+    text = text.replace("a = 300\nd1 = 100\nd2 = 300\nd3 = 250", "a = 200\nd1 = 180\nd2 = 220\nd3 = 150")
+    p = tmp_path / "triple_rocker.toml"
+    p.write_text(text)
+    r = runner.invoke(app, ["dynamics", str(p), "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    assert "does not assemble" in doc["note"]
+    assert any(v is None for v in doc["shaking_force"]) and any(v is not None for v in doc["shaking_force"])

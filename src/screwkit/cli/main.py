@@ -174,6 +174,8 @@ def dynamics(
     def table() -> None:
         console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
         console.print(f"assembly mode {doc['mode']}; {escape(doc['indeterminacy'])}", highlight=False)
+        if "note" in doc:
+            console.print(f"[yellow]note:[/] {escape(doc['note'])}", highlight=False)
         t = Table(title="loads over the cycle (SI: N, N·m)")
         for col in ("quantity", "RMS", "peak"):
             t.add_column(col, justify="right")
@@ -201,8 +203,15 @@ def _dynamics_doc(s: Any, gravity: bool) -> dict[str, Any]:
     g = None
     if gravity:
         g = (s.gravity_magnitude or 9.80665) * s.gravity_direction
-    dyn = inverse_dynamics(lk, mm, gravity=g)
+    ok = np.asarray(mm.assembles) & ~np.asarray(mm.singular)
+    partial = not ok.all()
+    dyn = inverse_dynamics(lk, mm, gravity=g, inputs=s.inputs, allow_partial=partial)
     doc = dyn.as_dict()
+    if partial:
+        bad = np.degrees(s.inputs[~ok])
+        doc["note"] = (f"mode {s.mode} does not assemble (or is singular) at {int((~ok).sum())} of "
+                       f"{len(ok)} inputs ({', '.join(f'{x:.6g}' for x in bad[:8])}"
+                       f"{' …' if len(bad) > 8 else ''} deg): the loads there are null")
     doc["mode"] = s.mode
     doc["summary"] = dyn.summary()
     doc["indeterminacy"] = dyn.indeterminacy.describe()
