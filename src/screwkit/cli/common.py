@@ -31,7 +31,7 @@ def user_errors() -> tuple[type[BaseException], ...]:
     from screwkit.kinematics.motion import AssemblyError
     from screwkit.model.linkage import LinkageError
 
-    return (SpecError, UnitError, AssemblyError, LinkageError, ValueError, FileNotFoundError)
+    return (SpecError, UnitError, AssemblyError, LinkageError, ValueError, OSError)
 
 
 def guard(fn: Callable[[], T]) -> T:

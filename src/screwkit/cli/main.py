@@ -76,13 +76,13 @@ def analyze(
             names = [n for n in mode["variables"] if "." not in n and n not in ("theta0", "theta1")]
             names = names or [n for n in mode["variables"] if n != doc["input_name"]][:4]
             t = Table(title=f"assembly mode {mode['mode']}", show_lines=False)
-            t.add_column("input (deg)", justify="right")
+            t.add_column("input (deg)" if s.input_is_angle else "input (m)", justify="right")
             for n in names:
                 t.add_column(n, justify="right")
                 t.add_column(f"{n}'", justify="right")
                 t.add_column(f"{n}''", justify="right")
             for i, x in enumerate(doc["input"]):
-                row = [f"{np.degrees(x):8.3f}"]
+                row = [f"{np.degrees(x):8.3f}" if s.input_is_angle else f"{x:.6g}"]
                 for n in names:
                     ang = not (n in ("S", "s4") or n.endswith(".s"))
                     row += [_fmt(mode["variables"][n][i], ang), _fmt(mode["velocities"][n][i], False),

@@ -40,10 +40,16 @@ def write_atomic(path: str | Path, text: str) -> None:
     p = Path(path)
     if p.parent and not p.parent.exists():
         raise ValueError(f"cannot write {p}: folder {p.parent} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", dir=str(p.parent or "."))
+    if p.is_dir():
+        raise ValueError(f"cannot write {p}: it is a folder; give a file name, e.g. {p / 'result.json'}")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", dir=str(p.parent or "."))
+    except OSError as exc:
+        raise ValueError(f"cannot write {p}: {exc.strerror}") from exc
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; results are ordinary files
         os.replace(tmp, p)
     except BaseException:
         if os.path.exists(tmp):
@@ -53,3 +59,9 @@ def write_atomic(path: str | Path, text: str) -> None:
 
 def dumps(doc: Any) -> str:
     return json.dumps(jsonable(doc), indent=1, allow_nan=False)
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask

@@ -12,12 +12,21 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+    field_validator,
+)
 
-from screwkit.io.units import UnitError, to_si
+from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
-Value = float | int | str
+Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
 
 
 class SpecError(ValueError):
@@ -117,6 +126,14 @@ class MechanismSpec:
         self.name = raw.mechanism.name or Path(path).stem
         self.source = raw.mechanism.source
         self.units = dict(raw.units)
+        for kind, unit in self.units.items():
+            if kind not in KIND_UNITS or kind == "dimensionless":
+                kinds = ", ".join(k for k in KIND_UNITS if k != "dimensionless")
+                self._fail(f"units.{kind}", f"unknown kind {kind!r}; the kinds are {kinds}")
+            try:
+                check_unit(unit, kind)
+            except UnitError as exc:
+                self._fail(f"units.{kind}", str(exc))
         self.dimensions = self._dimensions()
         self.inputs = self._input_samples()
         self.speed = self._si(raw.motion.speed, self._rate_kind(), "motion.speed")
@@ -125,6 +142,9 @@ class MechanismSpec:
         self.gravity_magnitude = (
             None if raw.gravity is None else self._si(raw.gravity, "acceleration", "gravity")
         )
+        if self.gravity_magnitude is not None and not self.gravity_magnitude > 0:
+            self._fail("gravity", f"gravity must be a positive acceleration (it turns weights into "
+                                  f"masses and sets the weight loads); got {raw.gravity!r}")
         gd = np.asarray(raw.gravity_direction, dtype=float)
         if gd.shape != (3,) or not np.all(np.isfinite(gd)) or np.linalg.norm(gd) == 0:
             self._fail("gravity_direction", f"give a non-zero world vector [x, y, z]; got {raw.gravity_direction}")
@@ -180,6 +200,11 @@ class MechanismSpec:
     def _input_samples(self) -> np.ndarray:
         m = self.raw.motion
         kind = "angle" if self._rate_kind() == "angular_velocity" else "length"
+        if kind == "length":
+            missing = [k for k in ("start", "stop", "step") if k not in m.model_fields_set]
+            if missing:
+                self._fail("motion", f"the input is a translation: give {missing} as lengths "
+                                     f"(e.g. start = \"0 mm\", stop = \"50 mm\", step = \"1 mm\")")
         start = self._si(m.start, kind, "motion.start")
         stop = self._si(m.stop, kind, "motion.stop")
         step = self._si(m.step, kind, "motion.step")
@@ -205,6 +230,7 @@ class MechanismSpec:
         if unknown:
             self._fail("links", f"no link named {unknown} in a {self.family}; links are {link_names}")
         g = self.gravity_magnitude if self.gravity_magnitude is not None else 9.80665
+        # (gravity > 0 is checked at load)
         out = []
         for name in link_names:
             t = self.raw.links.get(name)
@@ -271,6 +297,9 @@ class MechanismSpec:
         for k, j in enumerate(self.raw.joints):
             key = f"joints[{k}]"
             off_kind = "angle" if j.kind == "P" else "length"
+            if j.kind == "C" and j.offset not in (0, 0.0, "0"):
+                self._fail(f"{key}.offset", "a C joint has no constant offset (both its rotation "
+                                           "and its translation are variables); remove offset")
             try:
                 joints.append(Joint(j.name, j.kind, self._si(j.offset, off_kind, key + ".offset"),
                                     self._si(j.pitch, "length", key + ".pitch")))
@@ -295,8 +324,16 @@ class MechanismSpec:
         n = len(self.inputs)
         joints = "".join(j.kind for j in lk.joints)
         src = f" — source: {self.source}" if self.source else ""
-        return (f"{self.name}: {self.family} ({joints}) {dims}; {n} input samples "
-                f"{np.degrees(self.inputs[0]):.6g}…{np.degrees(self.inputs[-1]):.6g} deg{src}")
+        if self.input_is_angle:
+            span = f"{np.degrees(self.inputs[0]):.6g}…{np.degrees(self.inputs[-1]):.6g} deg"
+        else:
+            span = f"{self.inputs[0]:.6g}…{self.inputs[-1]:.6g} m"
+        return f"{self.name}: {self.family} ({joints}) {dims}; {n} input samples {span}{src}"
+
+    @property
+    def input_is_angle(self) -> bool:
+        """Whether the driven freedom is a rotation (else a translation, in metres)."""
+        return self._rate_kind() == "angular_velocity"
 
 
 def _format_validation(path: str, exc: ValidationError) -> str:

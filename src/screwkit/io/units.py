@@ -52,11 +52,13 @@ def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
     """
     ureg = registry()
     target = KIND_UNITS[kind]
+    if default_unit is not None:
+        check_unit(default_unit, kind)
     if isinstance(value, bool):
         raise UnitError(f"expected a {kind.replace('_', ' ')}, e.g. {EXAMPLES[kind]}; got {value!r}")
     if isinstance(value, int | float):
         if default_unit is None or kind == "dimensionless":
-            return float(value)
+            return _finite(float(value), value, kind)
         q = ureg.Quantity(float(value), default_unit)
     elif isinstance(value, str):
         try:
@@ -67,8 +69,15 @@ def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
             ) from exc
         if not isinstance(q, pint.Quantity):
             q = ureg.Quantity(float(q), default_unit or target or "")
-        elif q.dimensionless and default_unit and kind != "dimensionless":
+        elif q.unitless and default_unit and kind != "dimensionless":
+            # a number written as text ("2"): the default unit applies. A unit the user wrote
+            # ("1.2 rad" under angle = "deg") is kept, even if pint calls it dimensionless.
             q = ureg.Quantity(float(q.magnitude), default_unit)
+        if kind == "angular_velocity" and "hertz" in str(q.units):
+            raise UnitError(
+                f"{value!r} is ambiguous for an angular speed (Hz is 1/s, with no angle): write "
+                f"revolutions as \"50 rev/s\" or \"3000 rpm\", or radians as \"314.16 rad/s\""
+            )
     else:
         raise UnitError(f"expected a {kind.replace('_', ' ')}, e.g. {EXAMPLES[kind]}; got {value!r}")
     try:
@@ -78,6 +87,26 @@ def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
             f"{value!r} is not a {kind.replace('_', ' ')} (its unit is {q.units}); "
             f"write e.g. {EXAMPLES[kind]}"
         ) from exc
+    return _finite(out, value, kind)
+
+
+def _finite(out: float, value: Any, kind: str) -> float:
     if out != out or out in (float("inf"), float("-inf")):
         raise UnitError(f"{value!r} is not a finite {kind.replace('_', ' ')}")
     return out
+
+
+def check_unit(unit: str, kind: str) -> None:
+    """Raise :class:`UnitError` unless ``unit`` is a unit pint knows and of the right kind."""
+    ureg = registry()
+    try:
+        q = ureg.Quantity(1.0, unit)
+    except Exception as exc:  # UndefinedUnitError and friends
+        raise UnitError(f"unknown unit {unit!r} for {kind.replace('_', ' ')}; write e.g. "
+                        f"{EXAMPLES[kind]}") from exc
+    target = KIND_UNITS[kind]
+    try:
+        q.to(target) if target else q.to("")
+    except pint.DimensionalityError as exc:
+        raise UnitError(f"{unit!r} is not a unit of {kind.replace('_', ' ')}; write e.g. "
+                        f"{EXAMPLES[kind]}") from exc

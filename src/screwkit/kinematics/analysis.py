@@ -146,6 +146,18 @@ def _closed_form(linkage: Linkage, theta: np.ndarray, speed: float, acceleration
     return _document(linkage, "closed", theta, speed, acceleration, modes)
 
 
+def _unwrap_runs(angle: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """Continuous angles along each run of assembling samples, each run starting in (−π, π]."""
+    out = np.array(angle, dtype=float)
+    idx = np.flatnonzero(ok & np.isfinite(out))
+    if idx.size == 0:
+        return out
+    for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1):
+        values = np.unwrap(out[run])
+        out[run] = values - 2 * np.pi * np.round(values[0] / (2 * np.pi))
+    return out
+
+
 def _case(dims: Any) -> str:
     s = np.sin(dims.delta0)
     c = np.cos(dims.delta0)
@@ -197,7 +209,7 @@ def limits(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: int = 5,
         rsrc_translation_limits,
     )
 
-    if linkage.family not in CLOSED_FORM_FAMILIES:
+    if linkage.family not in ("RSRC", "4R"):
         raise ValueError(
             f"limit positions and dwells are computed for the RSRC and the planar 4R "
             f"(Bagci App. D); this is a {linkage.family or 'general loop'}"
@@ -267,6 +279,8 @@ def _cssp_closed_form(linkage: Linkage, theta: np.ndarray, speed: float,
         for table in (variables, velocities, accelerations):
             for key in names:
                 table[key] = np.where(ok, table[key], np.nan)
+        for key in ("theta2", "eta2", "theta3", "eta3"):
+            variables[key] = _unwrap_runs(variables[key], ok)
         stops = np.nonzero(ok[:-1] & ~ok[1:])[0]
         starts = np.nonzero(~ok[:-1] & ok[1:])[0] + 1
         events = [f"stops assembling after input [{theta[i]!r}] (branch point before [{theta[i + 1]!r}])"
@@ -311,6 +325,30 @@ def mode_motion(linkage: Linkage, inputs: np.ndarray, speed: float, acceleration
             raise AssemblyError(f"{linkage.name}: assembly mode {mode} does not close at any input")
         return mm
     m = motion(linkage, inputs, speed, acceleration)
+    if linkage.family in ("RSRC", "4R") and len(inputs) >= 2:
+        # number the modes as `analyze` does (the closed form's branches): pick the generic
+        # branch that is the same configuration as closed-form mode `mode`
+        _, doc = analyze(linkage, inputs, speed, acceleration, method="closed")
+        if mode >= len(doc["modes"]):
+            raise ValueError(f"{linkage.name}: assembly mode {mode} asked for, but the mechanism "
+                             f"has {len(doc['modes'])} assembly mode(s) over these inputs "
+                             f"(0…{len(doc['modes']) - 1}, numbered as `screwkit analyze`)")
+        target = doc["modes"][mode]
+        best, overlap = None, 0
+        for md in m.modes:
+            v, _, _ = seed_variables(linkage, md)
+            both = np.asarray(target["assembles"]) & md.assembles
+            if not both.any():
+                continue
+            d = np.angle(np.exp(1j * (v["phi0"][both] - target["variables"]["phi0"][both])))
+            if np.max(np.abs(d)) < 1e-6 and both.sum() > overlap:
+                best, overlap = md, int(both.sum())
+        if best is None:
+            raise ValueError(f"{linkage.name}: the generic solver did not find assembly mode "
+                             f"{mode} of the closed form (a finer step may help)")
+        # where the closed form continues the branch past a limit position the generic solver
+        # starts a new one: the samples beyond it are reported as not assembling
+        return best
     if mode >= len(m.modes):
         raise ValueError(f"{linkage.name}: assembly mode {mode} asked for, but the mechanism has "
                          f"{len(m.modes)} assembly mode(s) over these inputs (0…{len(m.modes) - 1})")

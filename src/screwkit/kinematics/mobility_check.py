@@ -16,17 +16,23 @@ from screwkit.model.linkage import Linkage
 
 def linkage_mobility(linkage: Linkage, input_values: np.ndarray) -> dict[str, Any]:
     """Formula and numerical mobility of ``linkage`` at the first input value where it
-    assembles (all assembly modes found there are checked and must agree)."""
+    assembles (the first assembly found there), searching the inputs a few at a time."""
     lay = layout(linkage)
     X = np.atleast_2d(np.asarray(input_values, dtype=float).reshape(len(input_values), -1))
-    asm = find_assemblies(linkage, X, starts=24)
-    rows = np.nonzero(asm.found.any(axis=1))[0]
-    if rows.size == 0:
+    asm = None
+    i = -1
+    for start in range(0, len(X), 8):
+        block = find_assemblies(linkage, X[start:start + 8], starts=24)
+        rows = np.nonzero(block.found.any(axis=1))[0]
+        if rows.size:
+            asm, i = block, int(rows[0])
+            X_i = X[start + i]
+            break
+    if asm is None:
         raise ValueError(
             f"{linkage.name}: the loop does not close at any of the given inputs, so its "
             "mobility at a configuration cannot be computed; check the dimensions"
         )
-    i = int(rows[0])
     slot = int(np.argmax(asm.found[i]))
     K = asm.found.shape[1]
     fr = forward(linkage, asm.conf.take(np.array([i * K + slot])), lay)
@@ -39,7 +45,7 @@ def linkage_mobility(linkage: Linkage, input_values: np.ndarray) -> dict[str, An
     return {
         "mechanism": linkage.name,
         "pairs": kinds,
-        "sample_input": X[i],
+        "sample_input": X_i,
         "formula": formula.as_dict(),
         "numeric": numeric.as_dict(),
         "comparison": comparison.as_dict(),

@@ -191,23 +191,70 @@ def motion(
     N = X.shape[0]
     Xd = np.broadcast_to(_as_inputs(linkage, input_rates, "input rates"), X.shape)
     Xdd = np.broadcast_to(_as_inputs(linkage, input_accelerations, "input accelerations"), X.shape)
-    asm = find_assemblies(linkage, X, starts=starts, seed=seed)
+    asm = _find_all(linkage, X, starts, seed)
     if not asm.found.any():
         raise AssemblyError(
             f"{linkage.name}: the loop does not close at any of the {N} inputs "
-            f"(from {X[0].tolist()} to {X[-1].tolist()}); check the dimensions"
+            f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
+            "check the dimensions"
         )
+    tracks = _track(linkage, lay, X, asm)
+    # a documented, deterministic mode order: by the first sample where the mode assembles,
+    # then by its configuration there (joint centres and axes), not by the random starts
+    def key(track: tuple[Configuration, NDArray[np.bool_], list[int]]) -> tuple[float, ...]:
+        conf, mask, _ = track
+        first = int(np.argmax(mask))
+        sig = signature(linkage, conf.take(np.array([first])), lay)[0]
+        return (float(first), *np.round(sig, 9).tolist())
+
     modes = []
-    for conf, mask, stops in _track(linkage, lay, X, asm):
+    for conf, mask, stops in sorted(tracks, key=key):
         events = [
-            f"stops assembling after input {X[s - 1].tolist()} (limit position or dead centre before {X[s].tolist()})"
+            f"stops assembling after input {format_inputs(linkage, X[s - 1])} (limit position "
+            f"or dead centre before {format_inputs(linkage, X[s])})"
             for s in stops
         ]
         first = int(np.argmax(mask))
         if first > 0:
-            events.insert(0, f"starts assembling at input {X[first].tolist()}")
-        modes.append(_mode_motion(linkage, lay, conf, mask, Xd, Xdd, events))
+            events.insert(0, f"starts assembling at input {format_inputs(linkage, X[first])}")
+        modes.append(_mode_motion(linkage, lay, conf, mask, X, Xd, Xdd, events))
     return Motion(linkage, X, np.array(Xd), np.array(Xdd), modes)
+
+
+def format_inputs(linkage: Linkage, x: Array) -> str:
+    """Input values for a message: degrees for rotations, metres for translations."""
+    parts = []
+    for name, v in zip(linkage.inputs, np.atleast_1d(x), strict=True):
+        if name.endswith(".s"):
+            parts.append(f"{name} = {float(v):.6g} m")
+        else:
+            parts.append(f"{name} = {float(np.degrees(v)):.6g} deg")
+    return ", ".join(parts)
+
+
+def _find_all(linkage: Linkage, X: Array, starts: int, seed: int) -> Assemblies:
+    """Every assembly at every sample. Random starts can miss a root, most often where the
+    number of roots changes (a branch is born or dies): samples whose count differs from a
+    neighbour's are searched again with four times the starts, keeping the richer answer."""
+    asm = find_assemblies(linkage, X, starts=starts, seed=seed)
+    count = asm.found.sum(axis=1)
+    if len(count) < 2:
+        return asm
+    differs = np.zeros(len(count), dtype=bool)
+    differs[1:] |= count[1:] != count[:-1]
+    differs[:-1] |= count[:-1] != count[1:]
+    idx = np.nonzero(differs)[0]
+    if idx.size == 0:
+        return asm
+    again = find_assemblies(linkage, X[idx], starts=4 * starts, seed=seed + 1)
+    K = asm.found.shape[1]
+    better = again.found.sum(axis=1) > count[idx]
+    for r, i in zip(np.nonzero(better)[0], idx[better], strict=True):
+        asm.found[i] = again.found[r]
+        asm.signature[i] = again.signature[r]
+        asm.conf.scalars[i * K:(i + 1) * K] = again.conf.scalars[r * K:(r + 1) * K]
+        asm.conf.spherical[i * K:(i + 1) * K] = again.conf.spherical[r * K:(r + 1) * K]
+    return asm
 
 
 def _unit(d: Array) -> Array:
@@ -215,7 +262,7 @@ def _unit(d: Array) -> Array:
 
 
 def _mode_motion(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArray[np.bool_],
-                 Xd: Array, Xdd: Array, events: list[str]) -> ModeMotion:
+                 X: Array, Xd: Array, Xdd: Array, events: list[str]) -> ModeMotion:
     N = conf.size
     fr = forward(linkage, conf, lay)
     L = linkage.length_scale
@@ -307,8 +354,12 @@ def _mode_motion(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArr
         c = lay.scalar_col[f]
         if c >= 0:
             values = conf.scalars[:, c].copy()
-            if not lay.is_translation[f] and mask.any():
-                values[mask] = np.unwrap(values[mask])  # continuous angle along the branch
+            if name in linkage.inputs:
+                values = X[:, linkage.inputs.index(name)].copy()  # exactly as given
+            elif not lay.is_translation[f] and mask.any():
+                # continuous along the branch, starting in (−π, π] (as the closed forms do)
+                run = np.unwrap(values[mask])
+                values[mask] = run - 2 * np.pi * np.round(run[0] / (2 * np.pi))
             variables[name] = values
         velocities[name] = qd[:, f]
         accelerations[name] = qdd[:, f]

@@ -163,8 +163,18 @@ def find_assemblies(
     """All assembly modes at each row of ``input_values`` (N, n_inputs), by Newton from
     ``starts`` random points per sample, vectorised over samples × starts. Returns at most
     ``max_modes`` distinct assemblies per sample (by :func:`signature`)."""
-    lay = layout(linkage)
     values = np.atleast_2d(np.asarray(input_values, dtype=float))
+    chunk = max(1, 65536 // max(starts, 1))  # bounded memory: ~65k Newton problems at a time
+    if values.shape[0] > chunk:
+        parts = [find_assemblies(linkage, values[i:i + chunk], starts, seed + i, max_modes, tol_same)
+                 for i in range(0, values.shape[0], chunk)]
+        return Assemblies(
+            Configuration(np.concatenate([p.conf.scalars for p in parts]),
+                          np.concatenate([p.conf.spherical for p in parts])),
+            np.concatenate([p.found for p in parts]),
+            np.concatenate([p.signature for p in parts]),
+        )
+    lay = layout(linkage)
     N = values.shape[0]
     rng = np.random.default_rng(seed)
     conf0 = random_configurations(linkage, N * starts, rng, lay)

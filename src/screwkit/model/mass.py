@@ -212,11 +212,16 @@ class MassProperties:
         elif axes_as != "columns":
             raise ValueError(f"axes_as must be 'columns' or 'rows', got {axes_as!r}")
         orth_err = float(np.max(np.abs(axes.T @ axes - np.eye(3))))
-        if orth_err > 1e-9:
+        if orth_err > 1e-5 or np.linalg.det(axes) <= 0:
             raise ValueError(
-                f"principal_axes must be orthonormal (a direction-cosine matrix); "
-                f"max |L^T L - 1| = {orth_err:.3e}. Re-orthonormalise it (e.g. by QR or SVD)."
+                f"principal_axes must be orthonormal and right-handed (a direction-cosine matrix); "
+                f"max |L^T L - 1| = {orth_err:.3e}, det = {np.linalg.det(axes):.6g}. Check its "
+                "entries (printed direction cosines to 5-6 decimals are accepted)."
             )
+        if orth_err > 0.0:
+            # direction cosines typed to a few decimals: the nearest rotation (polar factor)
+            u, _, vt = np.linalg.svd(axes)
+            axes = u @ vt
         return cls(mass, _vector3(com, "com"), axes @ np.diag(moments) @ axes.T)
 
     @classmethod

@@ -10,7 +10,15 @@ from typing import Any
 
 import numpy as np
 
-ANGLE_NAMES = {"phi0", "chi0", "theta2", "eta2", "theta0", "theta1"}
+ANGLE_NAMES = {"phi0", "chi0", "theta2", "eta2", "theta3", "eta3", "theta0", "theta1"}
+LENGTH_NAMES = {"S", "s4"}
+
+
+def _is_angle(name: str) -> bool:
+    """Seed names by list; joint freedoms by kind (``.s`` is a translation, the rest angles)."""
+    if "." in name:
+        return not name.endswith(".s")
+    return name in ANGLE_NAMES or name not in LENGTH_NAMES
 
 
 def _pyplot() -> Any:
@@ -36,6 +44,9 @@ def save_figure(fig: Any, path: str | Path) -> None:
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=110, bbox_inches="tight")
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
         os.replace(tmp, p)
     finally:
         if os.path.exists(tmp):
@@ -55,7 +66,7 @@ def plot_analysis(doc: dict[str, Any], path: str | Path) -> None:
     rows = len(names) + (1 if has_cp else 0)
     fig, axes = plt.subplots(rows, 3, figsize=(13, 2.8 * rows), squeeze=False)
     for r, name in enumerate(names):
-        angle = name in ANGLE_NAMES
+        angle = _is_angle(name)
         for c, (key, label) in enumerate((("variables", ""), ("velocities", "'"), ("accelerations", "''"))):
             ax = axes[r, c]
             for m in modes:
