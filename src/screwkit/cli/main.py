@@ -72,6 +72,8 @@ def analyze(
     def table() -> None:
         console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
         console.print(f"method: {doc['method']}; angles in degrees, lengths in metres, rates per second (SI)")
+        if "method_note" in doc:
+            console.print(f"[yellow]note:[/] {escape(doc['method_note'])}", highlight=False)
         for mode in doc["modes"]:
             names = [n for n in mode["variables"] if "." not in n and n not in ("theta0", "theta1")]
             names = names or [n for n in mode["variables"] if n != doc["input_name"]][:4]
@@ -208,10 +210,11 @@ def _dynamics_doc(s: Any, gravity: bool) -> dict[str, Any]:
     dyn = inverse_dynamics(lk, mm, gravity=g, inputs=s.inputs, allow_partial=partial)
     doc = dyn.as_dict()
     if partial:
-        bad = np.degrees(s.inputs[~ok])
+        bad = np.degrees(s.inputs[~ok]) if s.input_is_angle else s.inputs[~ok]
+        unit = "deg" if s.input_is_angle else "m"
         doc["note"] = (f"mode {s.mode} does not assemble (or is singular) at {int((~ok).sum())} of "
                        f"{len(ok)} inputs ({', '.join(f'{x:.6g}' for x in bad[:8])}"
-                       f"{' …' if len(bad) > 8 else ''} deg): the loads there are null")
+                       f"{' …' if len(bad) > 8 else ''} {unit}): the loads there are null")
     doc["mode"] = s.mode
     doc["summary"] = dyn.summary()
     doc["indeterminacy"] = dyn.indeterminacy.describe()

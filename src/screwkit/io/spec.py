@@ -250,6 +250,9 @@ class MechanismSpec:
             inertia = t.inertia
             try:
                 if inertia and isinstance(inertia[0], list):
+                    if len(inertia) != 3 or any(not isinstance(r, list) or len(r) != 3 for r in inertia):
+                        self._fail(key + ".inertia", "a full inertia tensor is 3 rows of 3 numbers "
+                                   "(about the CoM, link axes); or give the 3 principal moments")
                     I = np.array([[self._si(v, "inertia", f"{key}.inertia") for v in row] for row in inertia])  # type: ignore[union-attr]
                     props = MassProperties(mass, np.array(com), I)
                 else:

@@ -20,7 +20,8 @@ def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, accelerati
     """Motion of every assembly mode over ``inputs`` and its JSON-able document (SI).
 
     ``method``: ``"closed"`` uses the family's closed form (RSRC quartic, Bagci eqs. 3.59–3.82;
-    the planar 4R as its δ0 = λ0 = b = e = 0 case; the CSSP quadratic in s4, Rahman §1.2), ``"generic"`` the generic loop solver, and
+    the planar 4R as its δ0 = λ0 = b = e = 0 case; the CSSP quadratic in s4, Rahman §1.2),
+    ``"generic"`` the generic loop solver, and
     ``"auto"`` the closed form where the family has one and the sweep has ≥ 2 samples. The
     closed form returns the seed's variables only; the generic solver every joint variable too.
     """
@@ -57,7 +58,11 @@ def analyze(linkage: Linkage, inputs: np.ndarray, speed: float = 1.0, accelerati
             p = md.link_origin[:, 1] + np.einsum("nij,j->ni", R, np.asarray(coupler_point))
             entry["coupler_point"] = {"x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
         modes.append(entry)
-    return m, _document(linkage, "generic", inputs, speed, acceleration, modes)
+    doc = _document(linkage, "generic", inputs, speed, acceleration, modes)
+    if method == "auto" and linkage.family in CLOSED_FORM_FAMILIES and not has_closed:
+        doc["method_note"] = ("one input sample: the generic solver was used (the closed form "
+                              "tracks branches over at least 2 samples)")
+    return m, doc
 
 
 def _document(linkage: Linkage, method: str, inputs: np.ndarray, speed: float,

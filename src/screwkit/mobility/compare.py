@@ -134,7 +134,7 @@ def compare_mobility(
         )
     if numeric.locked_freedoms:
         lines.append(
-            "locked at this configuration (no motion moves them): "
+            "stationary at this configuration (no instantaneous motion moves them): "
             + ", ".join(numeric.locked_freedoms)
         )
     if numeric.redundant_freedoms:

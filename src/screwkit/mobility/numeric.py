@@ -320,7 +320,8 @@ class NumericMobility:
             + "; ".join(f"loop {lc.loop} {lc.general}" for lc in self.loop_constraints),
         ]
         if self.locked_freedoms:
-            lines.append("  locked (no motion moves them): " + ", ".join(self.locked_freedoms))
+            lines.append("  stationary at this configuration (no instantaneous motion moves them): "
+                         + ", ".join(self.locked_freedoms))
         if self.input_names is not None:
             ins = ", ".join(self.input_names)
             if self.undetermined_motions == 0:
