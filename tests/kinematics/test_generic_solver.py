@@ -181,3 +181,10 @@ def test_bad_input_shapes():
     lk = fourbar(3.0, 1.0, 3.0, 2.5)
     with pytest.raises(ValueError, match="finite"):
         motion(lk, [0.0, np.nan])
+
+
+def test_too_many_samples_for_the_generic_solver_is_refused_up_front():
+    from screwkit.kinematics.motion import MAX_GENERIC_SAMPLES
+
+    with pytest.raises(ValueError, match="too many for the generic solver"):
+        motion(fourbar(3.0, 1.0, 3.0, 2.5), np.linspace(0, 1, MAX_GENERIC_SAMPLES + 1))

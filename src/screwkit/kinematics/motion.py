@@ -38,6 +38,7 @@ from screwkit.kinematics.solve import Assemblies, find_assemblies, newton, signa
 from screwkit.model.linkage import Linkage
 
 SINGULAR_RTOL = 1e-7
+MAX_GENERIC_SAMPLES = 20_000
 
 
 class AssemblyError(ValueError):
@@ -191,6 +192,12 @@ def motion(
     N = X.shape[0]
     Xd = np.broadcast_to(_as_inputs(linkage, input_rates, "input rates"), X.shape)
     Xdd = np.broadcast_to(_as_inputs(linkage, input_accelerations, "input accelerations"), X.shape)
+    if N > MAX_GENERIC_SAMPLES:
+        raise ValueError(
+            f"{linkage.name}: {N} input samples is too many for the generic solver, which follows "
+            f"every branch sample by sample (~10 ms a sample): use at most {MAX_GENERIC_SAMPLES} "
+            "(a larger step), or a family with a closed form (RSRC, 4R, CSSP)"
+        )
     asm = _find_all(linkage, X, starts, seed)
     if not asm.found.any():
         raise AssemblyError(
