@@ -60,10 +60,64 @@ def prepare(
     reg = regressor(linkage, mode, gravity=gravity, inputs=inputs)
     norm = normalisation or default_normalisation(linkage, mode, speed)
     rows = load_rows(linkage, mode, reg, norm)
+    _check_idle_spin(linkage, mode, reg, variables)
     extra = consistency_constraints(reg, variables)
     x_in = (np.asarray(inputs, dtype=float).reshape(mode.assembles.shape[0], -1)[:, 0]
             if inputs is not None else mode.variables[linkage.inputs[0]])
     return BalancingSetup(linkage, mode, reg, rows, variables, extra, np.asarray(x_in))
+
+
+#: relative idle-spin residual (docs/dynamics.md) above which the original design is refused
+IDLE_RESIDUAL_RTOL = 1e-8
+
+
+def _ss_links(linkage: Linkage) -> list[int]:
+    """Indices of the moving links between two spherical joints (link k joins joints k, k+1)."""
+    kinds = [j.kind for j in linkage.joints]
+    return [k for k in range(len(linkage.links))
+            if kinds[k] == "S" and kinds[(k + 1) % len(kinds)] == "S"]
+
+
+def _rod_description(linkage: Linkage, mode: ModeMotion, k: int) -> str:
+    """Transverse principal moments and CoM offset of S–S link k about the line of its ball
+    centres (at the first assembled sample), for the error message."""
+    mp = linkage.links[k].mass
+    i = int(np.flatnonzero(mode.assembles & ~mode.singular)[0])
+    R, o = mode.link_rotation[i, k], mode.link_origin[i, k]
+    c0, c1 = mode.joint_centres[i, k], mode.joint_centres[i, (k + 1) % len(linkage.joints)]
+    u = R.T @ (c1 - c0)
+    u /= np.linalg.norm(u)
+    p0 = R.T @ (c0 - o)
+    e = np.linalg.svd(u[None, :])[2][1:]  # two unit vectors normal to the axis (link frame)
+    transverse = np.linalg.eigvalsh(e @ np.asarray(mp.inertia) @ e.T)
+    r = np.asarray(mp.com) - p0
+    offset = float(np.linalg.norm(r - (r @ u) * u))
+    return (f"link {linkage.links[k].name!r} (transverse moments of inertia about its CoM "
+            f"{transverse[0]:.6g} and {transverse[1]:.6g} kg*m^2, CoM {offset:.3g} m off the line "
+            "of its ball centres)")
+
+
+def _check_idle_spin(linkage: Linkage, mode: ModeMotion, reg: Regressor,
+                     variables: DesignVariables) -> None:
+    """The original design must already balance the idle spin of every S–S rod (docs/dynamics.md:
+    an S–S rod must be axisymmetric about the line of its ball centres, CoM on that line, for
+    its idle spin to carry no load). Otherwise the consistency equalities cannot hold and the
+    QP would only report "infeasible constraints"."""
+    if reg.residual.size == 0 or reg._setup.structure.idle_count == 0:
+        return
+    dyn = reg.apply(variables.physical_parameters(variables.original))
+    worst = float(np.max(dyn.relative_residual, initial=0.0))
+    if worst <= IDLE_RESIDUAL_RTOL:
+        return
+    rods = [_rod_description(linkage, mode, k) for k in _ss_links(linkage)
+            if linkage.links[k].mass is not None]
+    raise BalancingError(
+        f"{'; '.join(rods) or 'an S-S link'}: the original design loads the idle spin of the "
+        f"rod about the line of its ball centres (residual up to {worst:.3g} of the largest "
+        "joint load). Two ball joints cannot carry that moment: an S-S rod must be axisymmetric "
+        "about the line of its ball centres, with its CoM on it (equal transverse moments; "
+        "docs/dynamics.md, 'idle passive freedoms'). Make the rod's two transverse moments "
+        "equal (e.g. inertia = [Ia, I, I] with x along the rod) before balancing")
 
 
 def _check_free_counterweights(variables: DesignVariables, weights: Mapping[str, float]) -> None:
@@ -119,6 +173,14 @@ def solve_setup(setup: BalancingSetup, weights: Mapping[str, float]) -> BalanceR
             "the optimum is not unique: the Hessian is singular and the loads do not change "
             f"along {len(opt.directions)} direction(s) of the variables; the member nearest to "
             "the original design (least relative change) is returned")
+    indeterminate = setup.regressor._setup.structure.indeterminate_count
+    if indeterminate and (w["R"] > 0 or w["M"] > 0):
+        notes.append(
+            f"{indeterminate} reaction component(s) are statically indeterminate (overconstrained "
+            "loop, e.g. a planar 4R solved as a spatial one): the bearing measures R and M use the "
+            "minimum-norm reactions (docs/dynamics.md), one choice among many, so their optimum "
+            "depends on that choice; real bearing loads depend on clearances and compliance. "
+            "Weight only F, T and T0 for results independent of it")
     if setup.extra_constraints:
         notes.append(f"{len(setup.extra_constraints)} equality(ies) keep S-S links axisymmetric "
                      "(the idle spin of a rod between two ball joints carries no load)")

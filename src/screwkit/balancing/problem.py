@@ -123,6 +123,30 @@ def consistency_constraints(reg: Regressor, variables: DesignVariables) -> list[
     return out
 
 
+def canonical_basis(basis: Array, tol: float = 1e-9) -> Array:
+    """A basis of the column space of ``basis`` (n, k) that depends only on the space: the reduced
+    row-echelon form of ``basisᵀ`` against the variable order (pivots chosen in column order),
+    each direction scaled to unit length with its leading (pivot) entry positive. Any orthonormal
+    basis an eigen-solver returns (which differs between machines) gives the same answer."""
+    A = np.array(basis, dtype=float).T  # (k, n) rows span the space
+    k, n = A.shape
+    row = 0
+    for j in range(n):
+        if row == k:
+            break
+        p = row + int(np.argmax(np.abs(A[row:, j])))
+        if abs(A[p, j]) <= tol:
+            continue
+        A[[row, p]] = A[[p, row]]
+        A[row] /= A[row, j]
+        others = np.arange(k) != row
+        A[others] -= np.outer(A[others, j], A[row])
+        row += 1
+    A = A[:row]
+    A[np.abs(A) <= tol * np.abs(A).max(initial=1.0)] = 0.0
+    return (A / np.linalg.norm(A, axis=1, keepdims=True)).T
+
+
 def _rows(cons: list[LinearConstraint], kind: str, n: int) -> tuple[Array, Array, list[str]]:
     sel = [c for c in cons if c.kind == kind]
     A = np.array([c.coefficients for c in sel]).reshape(-1, n)
@@ -193,13 +217,14 @@ def solve_balancing(objective: QuadraticObjective, variables: DesignVariables,
         sol = solve_qp(np.eye(n), -z0, Ae, be, A_opt, b_opt, ne,
                        [*nl, *(["optimal set"] * 2 * rng.shape[1])])
         z = sol.x
-        # directions of the optimal set: an orthonormal basis of null(Q) within the equalities
+        # directions of the optimal set: a canonical basis of null(Q) within the equalities
         basis = null
         if len(be):
             sub = Ae @ null
             _, s, Vt = np.linalg.svd(sub) if sub.size else (None, np.zeros(0), np.eye(null.shape[1]))
             rank = int(np.sum(s > 1e-9 * max(float(s.max()) if s.size else 0.0, 1e-300)))
             basis = null @ Vt[rank:].T
+        basis = canonical_basis(basis)
         for k in range(basis.shape[1]):
             d = basis[:, k]
             ends = []

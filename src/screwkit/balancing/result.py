@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.measures import MEASURE_TITLES, MEASURES, Normalisation
 from screwkit.balancing.problem import NonUniqueDirection, QuadraticObjective
 from screwkit.balancing.variables import DesignVariables
@@ -27,6 +28,11 @@ SAMPLE_LOADS = (
     ("bearing_moment", "sqrt(sum of |joint moment|^2), input torque removed", "N*m"),
     ("input_torque", "input torque (signed)", "N*m"),
 )
+
+
+#: a measure below this fraction of the largest measure (before or after) is round-off: its
+#: percentage change is reported as None / "n/a"
+NEGLIGIBLE_MEASURE = 1e-12
 
 
 def percent_change(before: float, after: float) -> float:
@@ -66,10 +72,17 @@ class BalanceResult:
     def names(self) -> tuple[str, ...]:
         return self.variables.names
 
-    def changes(self) -> dict[str, float]:
-        """Percentage change of each measure's mean (and of G)."""
-        return {k: percent_change(self.measures_before[k], self.measures_after[k])
-                for k in (*MEASURES, "G")}
+    def changes(self) -> dict[str, float | None]:
+        """Percentage change of each measure's mean (and of G); ``None`` for a measure that is
+        round-off before and after (below ``NEGLIGIBLE_MEASURE`` of the largest measure), whose
+        percentage would be noise."""
+        keys = (*MEASURES, "G")
+        top = max((abs(d[k]) for d in (self.measures_before, self.measures_after) for k in keys),
+                  default=0.0)
+        floor = NEGLIGIBLE_MEASURE * top
+        return {k: None if max(abs(self.measures_before[k]), abs(self.measures_after[k])) <= floor
+                else percent_change(self.measures_before[k], self.measures_after[k])
+                for k in keys}
 
     def mean_of_sample_changes(self) -> dict[str, float]:
         """Mean over the samples of the per-sample % change of each load magnitude — the
@@ -90,7 +103,9 @@ class BalanceResult:
         """Rows (quantity, before, after, change %) for the CLI."""
         ch = self.changes()
         rows = [[f"{MEASURE_TITLES.get(k, 'objective G')} ({k})", f"{self.measures_before[k]:.6g}",
-                 f"{self.measures_after[k]:.6g}", f"{ch[k]:+.3f}"] for k in (*MEASURES, "G")]
+                 f"{self.measures_after[k]:.6g}",
+                 "n/a (round-off)" if ch[k] is None else f"{ch[k]:+.3f}"]
+                for k in (*MEASURES, "G")]
         for link, m0 in self.link_mass_before.items():
             m1 = self.link_mass_after[link]
             rows.append([f"mass of {link} (kg)", f"{m0:.6g}", f"{m1:.6g}",
@@ -121,26 +136,39 @@ class BalanceResult:
         return rows
 
     def write_tables(self, folder: str) -> list[str]:
-        """CSV files: one per per-sample load and the mass properties; returns the paths."""
+        """CSV files: one per per-sample load and the mass properties, each written atomically;
+        returns the paths. ``folder`` is created if missing; an existing file is refused."""
         import csv
+        import io
         from pathlib import Path
 
+        from screwkit.io.results import write_atomic
+
         out = Path(folder)
-        out.mkdir(parents=True, exist_ok=True)
+        if out.exists() and not out.is_dir():
+            raise BalancingError(f"--tables needs a folder: {out} is an existing file; give a "
+                                 "folder name (it is created if missing)")
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise BalancingError(f"cannot create the tables folder {out}: {exc.strerror}") from exc
+
+        def csv_text(header: list[list[str]], rows: list[list[Any]]) -> str:
+            buf = io.StringIO()
+            w = csv.writer(buf)
+            w.writerows(header)
+            w.writerows(rows)
+            return buf.getvalue()
+
         paths = []
         for key, title, unit in SAMPLE_LOADS:
             p = out / f"balance_{key}.csv"
-            with p.open("w", newline="") as fh:
-                w = csv.writer(fh)
-                w.writerow([f"# {title} ({unit}); input in rad"])
-                w.writerow(["input", "before", "after"])
-                w.writerows(self.per_sample_table(key))
+            write_atomic(p, csv_text([[f"# {title} ({unit}); input in rad"],
+                                      ["input", "before", "after"]], self.per_sample_table(key)))
             paths.append(str(p))
         p = out / "balance_mass_properties.csv"
-        with p.open("w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(["link", "quantity", "before", "after"])
-            w.writerows(self.mass_properties_table())
+        write_atomic(p, csv_text([["link", "quantity", "before", "after"]],
+                                 self.mass_properties_table()))
         paths.append(str(p))
         return paths
 

@@ -143,6 +143,23 @@ def blocks_from_table(spec: Any, table: BalancingTable) -> list[VariableBlock]:
     return blocks
 
 
+def _check_assembles(spec: Any, mode_motion: Any) -> None:
+    """Balancing needs the whole cycle: name, in the spec's units, the inputs where the mode
+    does not assemble and say which [motion] keys to change."""
+    ok = np.asarray(mode_motion.assembles) & ~np.asarray(mode_motion.singular)
+    if ok.all():
+        return
+    x = np.asarray(spec.inputs, dtype=float).reshape(len(ok), -1)[:, 0]
+    bad = np.degrees(x[~ok]) if spec.input_is_angle else x[~ok]
+    unit = "deg" if spec.input_is_angle else "m"
+    shown = ", ".join(f"{v:.6g}" for v in bad[:8]) + (" …" if bad.size > 8 else "")
+    raise BalancingError(
+        f"{spec.path}: [motion] mode {spec.mode} does not assemble (or is singular) at "
+        f"{int(bad.size)} of {ok.size} inputs ({shown} {unit}); balancing needs loads over the "
+        "whole sweep. Change [motion] start/stop/step to a range where the mode assembles, choose "
+        "another [motion] mode, or change the dimensions so that the linkage turns fully")
+
+
 def balance_from_spec(spec: Any, *, mode_motion: Any | None = None) -> BalanceResult:
     """Run the balancing described by a loaded spec's ``[balancing]`` table (kinematics of
     ``[motion]``, assembly mode ``[motion].mode``). ``mode_motion`` skips the kinematics."""
@@ -156,6 +173,7 @@ def balance_from_spec(spec: Any, *, mode_motion: Any | None = None) -> BalanceRe
             mode_motion = spec_mode_motion(lk, spec.inputs, spec.speed, spec.acceleration, spec.mode)
         except ValueError as exc:
             raise BalancingError(f"{spec.path}: [motion.mode]: {exc}") from exc
+    _check_assembles(spec, mode_motion)
     nt = table.normalisation
     speed = spec.speed if nt.speed is None else _si(spec, nt.speed, "angular_velocity",
                                                     "normalisation.speed")
@@ -168,8 +186,10 @@ def balance_from_spec(spec: Any, *, mode_motion: Any | None = None) -> BalanceRe
             spec, nt.bearing_length, "length", "normalisation.bearing_length"))
     gravity = None
     if table.gravity:
-        gravity = np.array([0.0, 0.0, -(spec.gravity_magnitude or 9.80665)])
-    setup = prepare(lk, mode_motion, blocks, speed=speed, gravity=gravity, normalisation=norm)
+        gravity = (spec.gravity_magnitude or 9.80665) * np.asarray(spec.gravity_direction,
+                                                                   dtype=float)
+    setup = prepare(lk, mode_motion, blocks, speed=speed, gravity=gravity, normalisation=norm,
+                    inputs=spec.inputs)
     result = solve_setup(setup, table.weights)
     if table.bound is not None:
         from screwkit.balancing.sdp import redistribution_bound

@@ -272,6 +272,19 @@ def _overlay_lines(docs: list[dict[str, Any]]) -> None:
             highlight=False)
 
 
+def plot_path(plot: Path) -> Path:
+    """The PNG file ``--plot`` writes: ``.png`` added when the name has no suffix; its folder must
+    exist and the name must not be a folder (checked before the solve)."""
+    path = plot if plot.suffix else plot.with_name(plot.name + ".png")
+    if path.is_dir():
+        raise ValueError(f"--plot {plot}: {path} is a folder; give a file name, e.g. "
+                         f"{path / 'synthesis.png'}")
+    folder = path.parent
+    if not folder.is_dir():
+        raise ValueError(f"--plot {plot}: folder {folder} does not exist; create it first")
+    return path
+
+
 def register(app: typer.Typer) -> None:
     """Add the ``synthesize`` command to ``app``."""
 
@@ -290,6 +303,9 @@ def register(app: typer.Typer) -> None:
         from screwkit.io.spec import load_spec
         from screwkit.synthesis.config import synthesis_from_spec
 
+        if plot is not None:
+            asked = plot
+            plot = _guard(lambda: plot_path(asked))
         s = _guard(lambda: load_spec(spec))
         problem, table = _guard(lambda: synthesis_from_spec(s))
 
@@ -310,7 +326,8 @@ def register(app: typer.Typer) -> None:
         if output is not None:
             _guard(lambda: write_atomic(output, text + "\n"))
         if plot is not None:
-            _guard(lambda: _plot_overlay(docs, problem, plot) if overlay else _plot(results, plot))
+            png = plot
+            _guard(lambda: _plot_overlay(docs, problem, png) if overlay else _plot(results, png))
         if as_json:
             sys.stdout.write(text + "\n")
         else:

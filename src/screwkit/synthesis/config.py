@@ -209,6 +209,7 @@ class _Parsed:
     start: dict[str, float]
     target: ScrewTarget
     length_scale: float
+    show: Callable[[float, str], str]
 
 
 def synthesis_from_spec(spec: MechanismSpec
@@ -301,7 +302,16 @@ def _parse(spec: MechanismSpec) -> _Parsed:
         raise _fail(path, "rotation", str(exc)) from None
     scale = (length_unit if table.length_scale is None
              else si(table.length_scale, "length", "length_scale"))
-    return _Parsed(table, si, start, target, scale)
+
+    def show(value: float, kind: str) -> str:
+        """An SI value in the spec's unit of ``kind`` (and in SI when that differs)."""
+        si_unit = "m" if kind == "length" else "rad"
+        unit = units.get(kind)
+        if unit is None or unit == si_unit:
+            return f"{float(value):.6g} {si_unit}"
+        return f"{float(value) / si(1.0, kind, 'units'):.6g} {unit} ({float(value):.6g} {si_unit})"
+
+    return _Parsed(table, si, start, target, scale, show)
 
 
 def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, SynthesisTable]:
@@ -337,6 +347,14 @@ def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, Synthe
     bounds = {}
     for name, (lo, hi) in table.bounds.items():
         bounds[name] = (si(lo, _kind(name), f"bounds.{name}"), si(hi, _kind(name), f"bounds.{name}"))
+    for name, (lo, hi) in bounds.items():
+        value = start.get(name, lo)
+        if lo < hi and not lo <= value <= hi:
+            k = _kind(name)
+            raise _fail(path, f"bounds.{name}", f"the start of {name}, {parsed.show(value, k)}, is "
+                        f"outside its bounds [{parsed.show(lo, k)}, {parsed.show(hi, k)}]: move "
+                        "the start ([dimensions] or [synthesis.start]) inside them or widen the "
+                        "bounds")
     scale = parsed.length_scale
     try:
         problem = RSRCSynthesisProblem(
@@ -375,6 +393,9 @@ def overlay_problem_from_spec(spec: MechanismSpec) -> tuple[OverlayProblem, Synt
     d3_range = None
     if ov.d3_range is not None:
         lo, hi = (si(v, "length", "overlay.d3_range") for v in ov.d3_range)
+        if not 0 < lo < hi:
+            raise _fail(path, "overlay.d3_range", "need 0 < lower < upper, got "
+                        f"[{parsed.show(lo, 'length')}, {parsed.show(hi, 'length')}]")
         d3_range = (lo, hi)
     senses = {"ccw": (1,), "cw": (-1,), "both": (1, -1)}[table.output_direction]
     try:

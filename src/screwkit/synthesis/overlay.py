@@ -300,7 +300,8 @@ def fit_overlay_circles(*, d1: float, d2: float, lambda0: float, theta01: float,
                          "points: give more rotation design points")
     lo, hi = d3_range if d3_range is not None else (0.05 * d1, 20.0 * d1)
     if not 0 < lo < hi:
-        raise ValueError(f"d3_range must be 0 < lower < upper, got ({lo!r}, {hi!r})")
+        raise ValueError(f"d3_range must be 0 < lower < upper, got ({float(lo):.6g} m, "
+                         f"{float(hi):.6g} m)")
     starts = _grid_starts(geo, lo, hi, n_starts)
     lower = np.full(geo.n_free, -np.inf)
     upper = np.full(geo.n_free, np.inf)

@@ -152,8 +152,10 @@ class RSRCSynthesisProblem:
             fixed = {n: float(self.start[n]) for n in ("delta0",) if n not in self.unknowns}
             if "delta0" in self.unknowns or abs(math.sin(fixed.get("delta0", 0.0))) > 1e-12:
                 raise ValueError("parameters of constraint (eqs. 5.13-5.21) hold for delta0 = 0 "
-                                 "only: make delta0 a constant 0, or use the equality-"
-                                 "constrained solver")
+                                 "only: make delta0 a constant 0, or drop the [synthesis."
+                                 "constraint] table and impose the dwell/range as equations "
+                                 "with the Python function screwkit.synthesis.equality."
+                                 "synthesize_equality_constrained (not reachable from the CLI)")
             if "lambda0" in self.unknowns and abs(math.sin(float(self.start["lambda0"]))) < 1e-9:
                 raise ValueError("lambda0 = 0 (plane) cannot be an unknown with parameters of "
                                  "constraint: the plane case re-references the fixed link")

@@ -271,6 +271,30 @@ def _bounds(problem: RSRCSynthesisProblem) -> tuple[FloatArray, FloatArray]:
     return lo, hi
 
 
+def _show(name: str, value: float) -> str:
+    """A value of unknown ``name`` as a plain number with its SI unit (angles also in deg)."""
+    if name in LENGTH_NAMES:
+        return f"{float(value):.6g} m"
+    if not math.isfinite(value):
+        return f"{float(value)}"
+    return f"{float(value):.6g} rad ({math.degrees(value):.6g} deg)"
+
+
+def _check_start(problem: RSRCSynthesisProblem, x0: FloatArray, lo: FloatArray,
+                 hi: FloatArray) -> None:
+    """The start must lie within the bounds (a crank or coupler length strictly above 0)."""
+    outside = (x0 < lo) | (x0 > hi) | ((x0 == lo) & np.isfinite(lo) & (lo == 0.0))
+    if outside.any():
+        k = int(np.flatnonzero(outside)[0])
+        name = problem.unknowns[k]
+        if name not in problem.bounds:
+            raise SynthesisError(f"start value of {name} = {_show(name, x0[k])} must be > 0 (a "
+                                 "crank or coupler length); give it a positive start")
+        raise SynthesisError(f"start value of {name} = {_show(name, x0[k])} is outside its "
+                             f"bounds [{_show(name, lo[k])}, {_show(name, hi[k])}]; move the "
+                             "start inside them or widen the bounds")
+
+
 def synthesize(problem: RSRCSynthesisProblem, *, inversion: int | None = None,
                gtol: float = 1e-14, xtol: float = 1e-15) -> SynthesisResult:
     """Minimise E = E_phi + E_S / L^2 from the problem's start on one assembly mode.
@@ -292,11 +316,7 @@ def synthesize(problem: RSRCSynthesisProblem, *, inversion: int | None = None,
     label = label or 1
     x0 = problem.start_vector()
     lo, hi = _bounds(problem)
-    outside = (x0 < lo) | (x0 > hi) | ((x0 == lo) & np.isfinite(lo) & (lo == 0.0))
-    if outside.any():
-        k = int(np.flatnonzero(outside)[0])
-        raise SynthesisError(f"start value of {problem.unknowns[k]} = {x0[k]!r} is outside its "
-                             f"bounds ({lo[k]!r}, {hi[k]!r})")
+    _check_start(problem, x0, lo, hi)
     t_start = time.perf_counter()
     deadline = t_start + problem.time_limit
     try:
@@ -403,6 +423,13 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
                 if n in problem.start) or problem.length_scale
     results: list[SynthesisResult] = []
     lo, hi = _bounds(problem)
+    _check_start(problem, x0, lo, hi)
+    reasons: dict[str, int] = {}  # distinct reasons a start/mode gave no result, with counts
+
+    def fail(reason: str) -> None:
+        reasons[reason] = reasons.get(reason, 0) + 1
+
+    tried = 0
     for k in range(n_starts):
         remaining = total_limit - (time.perf_counter() - t0)
         if remaining <= 0:
@@ -424,6 +451,7 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
         start = dict(problem.start)
         start.update({n: float(v) for n, v in zip(problem.unknowns, x, strict=True)})
         sub = replace(problem, start=start, time_limit=min(problem.time_limit, remaining))
+        tried += 1
         labels = [problem.inversion] if problem.inversion is not None else [1, 2, 3, 4]
         if problem.construction is not None:
             labels = [1]
@@ -431,19 +459,32 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
             try:
                 dims = dimensions_of({n: np.array([v]) for n, v in start.items()})
                 pos = rsrc_positions(dims, np.array([start["theta01"]]))
+                wanted = labels
                 labels = [lb for lb in labels if lb is not None and pos.assembles[0, lb - 1]]
-            except ValueError:
+                if not labels:
+                    fail("the start does not assemble at theta01 (theta = 0) on "
+                         + ("any mode" if len(wanted) > 1 else f"mode {wanted[0]}"))
+            except ValueError as exc:
                 labels = []
+                fail(f"the start is not a valid mechanism: {exc}")
         for lb in labels:
             try:
                 res = synthesize(sub, inversion=lb)
-            except (SynthesisError, ValueError):
+            except (SynthesisError, ValueError) as exc:
+                fail(str(exc))
                 continue
             if not math.isfinite(res.objective):
+                fail("the solve ended with a non-finite error measure")
                 continue
             results.append(res)
     if not results:
-        raise SynthesisError("no start assembled on any mode: widen the spread or change the start")
+        shown = "; ".join(f"{r} ({n}x)" if n > 1 else r for r, n in list(reasons.items())[:5])
+        more = f"; and {len(reasons) - 5} other reason(s)" if len(reasons) > 5 else ""
+        advice = ("widen the spread ([synthesis.multistart] spread), use more starts or change "
+                  "the start" if tried > 1 else "change the start ([dimensions] or "
+                  "[synthesis.start]) or the assembly mode")
+        raise SynthesisError(f"no start gave a solution ({tried} start(s) tried): "
+                             f"{shown or 'the time limit ran out'}{more}. {advice.capitalize()}")
     results.sort(key=lambda r: (not r.range_check.ok, r.objective))
     best: list[SynthesisResult] = []
     for r in results:

@@ -9,6 +9,7 @@ metres.  Each component is optional and has its own design points (Example 2 use
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
@@ -66,6 +67,13 @@ def library_function(name: str, **parameters: float) -> DesiredFunction:
     if factory is None:
         raise ValueError(f"unknown desired function {name!r}; choose one of {sorted(LIBRARY)} or "
                          "give an expression")
+    for pname, value in parameters.items():
+        if not np.isfinite(float(value)):
+            raise ValueError(f"desired function {name!r}: parameter {pname} must be finite, got "
+                             f"{float(value)}")
+    if "span" in parameters and not float(parameters["span"]) > 0.0:
+        raise ValueError(f"desired function {name!r}: span must be > 0 (the input rotation over "
+                         f"which the function runs), got {float(parameters['span'])}")
     try:
         return factory(**{k: float(v) for k, v in parameters.items()})
     except TypeError as exc:
@@ -85,7 +93,20 @@ def data_function(theta: ArrayLike, values: ArrayLike) -> DesiredFunction:
     if np.any(np.diff(t[order]) == 0.0):
         raise ValueError("data: theta values must be distinct")
     ts, vs = t[order], v[order]
-    return lambda x: np.interp(x, ts, vs)
+
+    def interpolate(x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=np.float64)
+        outside = (x < ts[0]) | (x > ts[-1])
+        if np.any(outside):
+            shown = ", ".join(f"{math.degrees(float(v)):.6g}" for v in np.unique(x[outside])[:8])
+            raise ValueError(
+                f"data: design point(s) theta = {shown} deg lie outside the data's range "
+                f"[{math.degrees(float(ts[0])):.6g}, {math.degrees(float(ts[-1])):.6g}] deg; the "
+                "data would be held constant there. Extend the data or move the design points")
+        return np.interp(x, ts, vs)
+
+    interpolate.theta_range = (float(ts[0]), float(ts[-1]))  # type: ignore[attr-defined]
+    return interpolate
 
 
 def expression_function(text: str, *, angle_unit: float, value_unit: float,
@@ -93,6 +114,22 @@ def expression_function(text: str, *, angle_unit: float, value_unit: float,
     """A safe user expression in the spec's units: theta [angle_unit] -> value [value_unit]."""
     expr = parse_expression(text, parameters)
     return lambda t: expr(np.asarray(t) / angle_unit) * value_unit
+
+
+def _check_finite(name: str, fn: DesiredFunction, theta: FloatArray) -> None:
+    """The desired ``name`` must be finite at theta = 0 (the reference, eq. 5.1) and at every
+    design point; numpy's warnings are silenced, the error names the points."""
+    pts = np.concatenate([[0.0], theta])
+    with np.errstate(all="ignore"):
+        values = np.asarray(fn(pts), dtype=np.float64).reshape(-1)
+    if values.shape != pts.shape:
+        raise ValueError(f"the desired {name} must give one value per design point")
+    bad = ~np.isfinite(values)
+    if bad.any():
+        shown = ", ".join(f"{math.degrees(float(t)):.6g}" for t in np.unique(pts[bad])[:8])
+        raise ValueError(f"the desired {name} is not finite at theta = {shown} deg (theta = 0 is "
+                         "the reference the target is measured from): change the function, its "
+                         "parameters or the design points")
 
 
 @dataclass(frozen=True)
@@ -129,6 +166,10 @@ class ScrewTarget:
             raise ValueError("a rotation is prescribed but it has no design points")
         if self.translation is not None and self.theta_translation.size == 0:
             raise ValueError("a translation is prescribed but it has no design points")
+        for name, fn, pts in (("rotation", self.rotation, self.theta_rotation),
+                              ("translation", self.translation, self.theta_translation)):
+            if fn is not None:
+                _check_finite(name, fn, pts)
 
     @property
     def theta_all(self) -> FloatArray:
