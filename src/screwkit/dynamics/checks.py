@@ -175,16 +175,16 @@ def valid_samples(
     if not allow_partial and not valid.all():
         bad = np.nonzero(~valid)[0]
         singular = np.nonzero(mode.singular & mode.assembles)[0]
-        shown = ", ".join(
-            f"#{i} {dict(zip(linkage.inputs, np.round(inputs[i], 6).tolist(), strict=True))}"
-            for i in bad[:8]
-        )
+        from screwkit.kinematics.motion import format_inputs
+
+        shown = "; ".join(f"#{i} ({format_inputs(linkage, inputs[i])})" for i in bad[:8])
         more = f" and {bad.size - 8} more" if bad.size > 8 else ""
         what = "is singular at" if singular.size == bad.size else "does not assemble (or is singular) at"
         raise NonAssemblingMotionError(
             f"{linkage.name}: the mode {what} {bad.size} of {valid.size} samples: {shown}{more}. "
-            "Restrict the sweep to where the mode assembles, pick another mode, or pass "
-            "allow_partial=True to get NaN there (None in as_dict())."
+            "Restrict the sweep (the spec's [motion] start/stop/step) to where the mode assembles "
+            "or pick another mode; from Python, allow_partial=True gives NaN there (None in "
+            "as_dict())."
         )
     return valid
 
