@@ -117,7 +117,7 @@ def test_user_errors_exit_2_with_a_message(tmp_path, text, fragment):
     assert r.exit_code == 2
     assert "Traceback" not in r.output
     assert fragment in r.output.replace("\n", " ")
-    assert str(p.name) in r.output.replace("\n", "") or "does not close" in r.output
+    assert str(p.name) in r.output or "does not close" in r.output
 
 
 def test_failed_run_leaves_no_output_file(tmp_path):

@@ -150,7 +150,7 @@ def test_plot_name_gets_png_and_folder_checked_first(tmp_path):
     r = CliRunner().invoke(app, ["synthesize", str(spec), "--plot", str(out)])
     assert r.exit_code == 0, r.output
     assert (tmp_path / "out.png").is_file() and not out.exists()
-    assert f"wrote {out}.png" in r.output.replace("\n", "")
+    assert f"wrote {out}.png" in r.output
     missing = tmp_path / "nowhere" / "p.png"
     bad = _spec(tmp_path, "[synthesis]\nunknowns = [\"nonsense\"]\n" + ROT, "bad.toml")
     r = CliRunner().invoke(app, ["synthesize", str(bad), "--plot", str(missing)])

@@ -12,10 +12,12 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-console = Console()
+# soft_wrap: a message is one line whatever the width (paths stay whole for grep and copy-paste);
+# only tables are fitted to the width
+console = Console(soft_wrap=True)
 if not console.is_terminal:
     console.width = max(console.width, 160)  # files and pipes get the full tables
-err_console = Console(stderr=True)
+err_console = Console(stderr=True, soft_wrap=True)
 
 T = TypeVar("T")
 
