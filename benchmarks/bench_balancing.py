@@ -31,10 +31,11 @@ def _best(fn: Any, repeat: int = 7) -> float:
 def run() -> list[dict[str, Any]]:
     from screwkit.balancing.balance import prepare, solve_setup
     from screwkit.balancing.qp import solve_qp
-    from screwkit.balancing.spec import balance_from_spec, balancing_table, blocks_from_table
+    from screwkit.io.balancing_table import balancing_table, blocks_from_table
     from screwkit.io.spec import load_spec
     from screwkit.kinematics.cssp_motion import cssp_mode_motion
-    from screwkit.kinematics.motion import motion
+    from screwkit.kinematics.generic_motion import generic_motion as motion
+    from screwkit.pipeline import balance_from_spec
 
     out: list[dict[str, Any]] = []
     spec = load_spec(EXAMPLE)

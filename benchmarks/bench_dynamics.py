@@ -220,7 +220,7 @@ def _check_fused(lk: Any, omega: float, gravity: list[float]) -> float:
 
 # ---------------------------------------------------------------------------------------------
 def _generic_kinematics(lk: Any, omega: float) -> float:
-    from screwkit.kinematics.motion import motion
+    from screwkit.kinematics.generic_motion import generic_motion as motion
 
     base = 72
     theta = np.linspace(0.0, 2 * np.pi, base, endpoint=False)

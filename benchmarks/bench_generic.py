@@ -7,8 +7,8 @@ import time
 
 import numpy as np
 
-from screwkit.kinematics.analysis import analyze
-from screwkit.kinematics.motion import motion
+from analysis_helpers import analyze
+from screwkit.kinematics.generic_motion import generic_motion as motion
 from screwkit.model.families import rsrc, rssr
 
 

@@ -25,7 +25,7 @@ OVERLAY = Path(__file__).resolve().parents[1] / "examples" / "bagci_example{}_ov
 
 def _problem() -> Any:
     from screwkit.io.spec import load_spec
-    from screwkit.synthesis.config import problem_from_spec
+    from screwkit.io.synthesis_table import problem_from_spec
 
     problem, _ = problem_from_spec(load_spec(EXAMPLE))
     return problem
@@ -72,7 +72,7 @@ def run() -> list[dict[str, Any]]:
     rows = []
     for example in (8, 9):
         from screwkit.io.spec import load_spec
-        from screwkit.synthesis.config import overlay_problem_from_spec
+        from screwkit.io.synthesis_table import overlay_problem_from_spec
         from screwkit.synthesis.overlay_route import synthesize_overlay
 
         overlay, _ = overlay_problem_from_spec(load_spec(str(OVERLAY).format(example)))

@@ -13,7 +13,7 @@ EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "rahman_cssp_balanc
 @cache
 def _rahman() -> tuple:
     from screwkit.io.spec import load_spec
-    from screwkit.kinematics.motion import motion
+    from screwkit.kinematics.generic_motion import generic_motion as motion
 
     spec = load_spec(EXAMPLE)
     m = motion(spec.linkage, spec.inputs, spec.speed, spec.acceleration)

@@ -7,13 +7,13 @@ import json
 
 import numpy as np
 import pytest
-from conftest import EXAMPLE
 
+from conftest import EXAMPLE
 from screwkit.balancing import balance, point_mass_variables
 from screwkit.balancing.measures import MEASURES, load_rows
-from screwkit.balancing.spec import balance_from_spec
 from screwkit.dynamics import inverse_dynamics, regressor
 from screwkit.model.linkage import Link
+from screwkit.pipeline import balance_from_spec
 
 
 @pytest.fixture(scope="module")

@@ -9,11 +9,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import EXAMPLE
 
+from conftest import EXAMPLE
 from screwkit.balancing import BalancingError
-from screwkit.balancing.spec import balance_from_spec
 from screwkit.io.spec import load_spec
+from screwkit.pipeline import balance_from_spec
 
 FOURBAR = Path(__file__).resolve().parents[2] / "examples" / "fourbar_dynamics.toml"
 RAHMAN = EXAMPLE.read_text()

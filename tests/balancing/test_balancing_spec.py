@@ -3,33 +3,36 @@
 from __future__ import annotations
 
 import pytest
-from conftest import EXAMPLE
 
+from conftest import EXAMPLE
 from screwkit.balancing import BalancingError
-from screwkit.balancing.spec import balance_from_spec, balancing_table, blocks_from_table
+from screwkit.io.balancing_table import balancing_table, blocks_from_table
 from screwkit.io.spec import load_spec
+from screwkit.pipeline import balance_from_spec
 
 BASE = EXAMPLE.read_text().split("[balancing]")[0]
 
 
 def _spec(tmp_path, table: str):
+    """Load a spec; its [balancing] table is validated at load (BalancingConfigError, which is a
+    BalancingError and a SpecError)."""
     p = tmp_path / "s.toml"
     p.write_text(BASE + table)
     return load_spec(p)
 
 
 def test_link_with_no_variables(tmp_path):
-    s = _spec(tmp_path, "[balancing.links.crank]\nvariables = []\n")
     with pytest.raises(BalancingError, match=r"\[balancing.links.crank\] has no variables"):
+        s = _spec(tmp_path, "[balancing.links.crank]\nvariables = []\n")
         blocks_from_table(s, balancing_table(s))
 
 
 def test_unknown_key_and_unknown_link(tmp_path):
-    s = _spec(tmp_path, "[balancing]\nweigths = { F = 1 }\n")
     with pytest.raises(BalancingError, match=r"\[balancing.weigths\] unknown key"):
+        s = _spec(tmp_path, "[balancing]\nweigths = { F = 1 }\n")
         balancing_table(s)
-    s = _spec(tmp_path, "[balancing.links.crnak]\nmax_decrease = 0.1\n")
     with pytest.raises(BalancingError, match="no moving link named 'crnak'"):
+        s = _spec(tmp_path, "[balancing.links.crnak]\nmax_decrease = 0.1\n")
         blocks_from_table(s, balancing_table(s))
 
 
@@ -44,6 +47,6 @@ def test_all_zero_weights_and_no_table(tmp_path, rahman):
 
 
 def test_bad_sum_rule(tmp_path):
-    s = _spec(tmp_path, "[balancing.links.rod]\npair_sum = \"less\"\n")
     with pytest.raises(BalancingError, match="pair_sum"):
+        s = _spec(tmp_path, "[balancing.links.rod]\npair_sum = \"less\"\n")
         balancing_table(s)

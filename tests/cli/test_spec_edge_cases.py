@@ -96,8 +96,8 @@ def test_limits_refuse_the_cssp_with_a_message():
 
 
 def test_generic_modes_do_not_depend_on_the_step_and_match_analyze():
-    from screwkit.kinematics.analysis import analyze, mode_motion
-    from screwkit.kinematics.named import seed_variables
+    from analysis_helpers import analyze, mode_motion
+    from screwkit.kinematics.registry import seed_variables
 
     spec = load_spec(EXAMPLES / "rsrc_fig7_dynamics.toml")
     first = []

@@ -13,7 +13,8 @@ from functools import cache
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from screwkit.kinematics.motion import ModeMotion, Motion, motion
+from screwkit.kinematics.generic_motion import generic_motion as motion
+from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.model.families import cssp, fourbar, rccc, rsrc, rssr
 from screwkit.model.linkage import Link, Linkage
 from screwkit.model.mass import MassProperties

@@ -18,7 +18,7 @@ import pytest
 from screwkit.dynamics import inverse_dynamics
 from screwkit.io.spec import load_spec
 from screwkit.kinematics.cssp_motion import cssp_mode_motion
-from screwkit.kinematics.motion import motion
+from screwkit.kinematics.generic_motion import generic_motion as motion
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "rahman_cssp.toml"
 

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from analysis_helpers import analyze
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.analysis import analyze
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 

@@ -6,8 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from screwkit.kinematics.cssp import CSSPDimensions, cssp_motion
-from screwkit.kinematics.motion import motion
-from screwkit.kinematics.named import seed_variables
+from screwkit.kinematics.generic_motion import generic_motion as motion
+from screwkit.kinematics.registry import seed_variables
 from screwkit.model.families import cssp
 
 deg = np.radians

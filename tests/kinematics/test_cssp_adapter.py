@@ -20,7 +20,8 @@ from screwkit.dual import ScrewMatrix
 from screwkit.dynamics import inverse_dynamics
 from screwkit.kinematics.cssp import CSSPAssemblyError
 from screwkit.kinematics.cssp_motion import NotACSSPError, cssp_dimensions, cssp_mode_motion
-from screwkit.kinematics.motion import ModeMotion, motion
+from screwkit.kinematics.generic_motion import generic_motion as motion
+from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.families import cssp, fourbar
 from screwkit.model.linkage import Link, Linkage
 from screwkit.model.mass import MassProperties

@@ -6,7 +6,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from screwkit.kinematics.motion import AssemblyError, motion
+from screwkit.kinematics.generic_motion import generic_motion as motion
+from screwkit.kinematics.motion import AssemblyError
 from screwkit.kinematics.solve import find_assemblies
 from screwkit.model.families import cssp, fourbar, rccc, rsrc, rsrc_seed_variables, rssr
 
@@ -184,7 +185,7 @@ def test_bad_input_shapes():
 
 
 def test_too_many_samples_for_the_generic_solver_is_refused_up_front():
-    from screwkit.kinematics.motion import MAX_GENERIC_SAMPLES
+    from screwkit.kinematics.generic_motion import MAX_GENERIC_SAMPLES
 
     with pytest.raises(ValueError, match="too many for the generic solver"):
         motion(fourbar(3.0, 1.0, 3.0, 2.5), np.linspace(0, 1, MAX_GENERIC_SAMPLES + 1))

@@ -4,8 +4,8 @@ universal joints close, and their rates are derivatives of their positions."""
 import numpy as np
 import pytest
 
+from screwkit.kinematics.generic_motion import generic_motion as motion
 from screwkit.kinematics.loop import closure_twist, forward
-from screwkit.kinematics.motion import motion
 from screwkit.model import Joint, Linkage
 
 deg = np.radians

@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 from screwkit.cli.synthesize_cmd import register
 from screwkit.io.spec import load_spec
-from screwkit.synthesis.config import SynthesisConfigError, problem_from_spec
+from screwkit.io.synthesis_table import SynthesisConfigError, problem_from_spec
 from screwkit.synthesis.overlay import overlay_fit
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"

@@ -15,13 +15,13 @@ from typer.testing import CliRunner
 
 from screwkit.cli.synthesize_cmd import register
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.quartic import wrap_angle
-from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
-from screwkit.synthesis.config import (
+from screwkit.io.synthesis_table import (
     SynthesisConfigError,
     overlay_problem_from_spec,
     problem_from_spec,
 )
+from screwkit.kinematics.quartic import wrap_angle
+from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
 from screwkit.synthesis.overlay import (
     OverlayDwell,
     ellipse_curvature_radius,

@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 
 from screwkit.cli.synthesize_cmd import register
 from screwkit.io.spec import load_spec
-from screwkit.synthesis.config import SynthesisConfigError, synthesis_from_spec
+from screwkit.io.synthesis_table import SynthesisConfigError, synthesis_from_spec
 from screwkit.synthesis.problem import (
     ConstraintConstruction,
     ConstraintPoint,

@@ -38,7 +38,7 @@ DATA = ROOT / "tests" / "data" / "bagci1969"
 EXAMPLES = ROOT / "examples"
 
 from screwkit.io.spec import load_spec  # noqa: E402
-from screwkit.synthesis.config import overlay_problem_from_spec, problem_from_spec  # noqa: E402
+from screwkit.io.synthesis_table import overlay_problem_from_spec, problem_from_spec  # noqa: E402
 from screwkit.synthesis.equality import (  # noqa: E402
     RangeConstraint,
     synthesize_equality_constrained,

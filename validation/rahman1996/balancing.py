@@ -25,9 +25,10 @@ import numpy as np
 
 from screwkit.balancing import balance, point_mass_variables
 from screwkit.balancing.measures import MEASURES
-from screwkit.balancing.spec import balance_from_spec, balancing_table
+from screwkit.io.balancing_table import balancing_table
 from screwkit.io.spec import load_spec
 from screwkit.kinematics.cssp_motion import cssp_mode_motion
+from screwkit.pipeline import balance_from_spec
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]

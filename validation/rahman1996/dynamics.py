@@ -37,7 +37,8 @@ from screwkit.dynamics import Dynamics, inverse_dynamics  # noqa: E402
 from screwkit.dynamics.checks import check_link_masses  # noqa: E402
 from screwkit.io.spec import load_spec  # noqa: E402
 from screwkit.kinematics.cssp_motion import cssp_mode_motion  # noqa: E402
-from screwkit.kinematics.motion import ModeMotion, motion  # noqa: E402
+from screwkit.kinematics.generic_motion import generic_motion as motion  # noqa: E402
+from screwkit.kinematics.motion import ModeMotion  # noqa: E402
 from screwkit.model.linkage import Linkage  # noqa: E402
 
 UREG = pint.UnitRegistry()

@@ -4,8 +4,8 @@ optimum is. JSON via :meth:`BalanceResult.as_dict`; plots via :mod:`screwkit.bal
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -16,6 +16,10 @@ from screwkit.balancing.problem import NonUniqueDirection, QuadraticObjective
 from screwkit.balancing.variables import DesignVariables
 from screwkit.dynamics import Dynamics
 from screwkit.model.mass import MassProperties
+
+if TYPE_CHECKING:  # the SDP bound and the Pareto sweep are built on top of BalanceResult
+    from screwkit.balancing.pareto import ParetoFront
+    from screwkit.balancing.sdp import RedistributionBound
 
 Array = NDArray[np.float64]
 
@@ -65,8 +69,10 @@ class BalanceResult:
     dynamics_before: Dynamics
     dynamics_after: Dynamics
     notes: list[str]
-    #: optional extras filled by balance_from_spec: the SDP bound and the Pareto front
-    extras: dict[str, Any] = field(default_factory=dict)
+    #: the bound over every physically consistent redistribution (SDP), when asked for
+    redistribution_bound: RedistributionBound | None = None
+    #: the Pareto sweep over some measures' weights, when asked for
+    pareto: ParetoFront | None = None
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -201,5 +207,20 @@ class BalanceResult:
                        "after": self.per_sample_after[k].tolist()} for k, _, _ in SAMPLE_LOADS},
             },
             "notes": list(self.notes),
-            **{k: v for k, v in self.extras.items() if not k.startswith("_")},
+            **self._extra_documents(),
         }
+
+    def _extra_documents(self) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        b = self.redistribution_bound
+        if b is not None:
+            out["redistribution_bound"] = {
+                "measures_before": b.measures_before, "measures_after": b.measures_after,
+                "mass_properties": {k: {"mass": v.mass, "com": v.com.tolist(),
+                                        "inertia": v.inertia.tolist()}
+                                    for k, v in b.mass_properties_after.items()}}
+        f = self.pareto
+        if f is not None:
+            out["pareto"] = {"measures": list(f.names), "weights": f.weights.tolist(),
+                             "values": f.measures.tolist(), "efficient": f.efficient.tolist()}
+        return out

@@ -32,15 +32,15 @@ def register(app: typer.Typer) -> None:
         from rich.markup import escape
         from rich.table import Table
 
-        from screwkit.balancing.spec import balance_from_spec
         from screwkit.cli.common import console
         from screwkit.cli.common import emit as _emit
         from screwkit.cli.common import guard as _guard
         from screwkit.io.spec import load_spec
+        from screwkit.pipeline import Pipeline
 
         _guard(lambda: _check_folders({"--tables": tables, "--plots": plots}))
         s = _guard(lambda: load_spec(spec))
-        res = _guard(lambda: balance_from_spec(s))
+        res = _guard(lambda: Pipeline(s).balance())
         doc: dict[str, Any] = res.as_dict()
         written: list[str] = []
         if tables is not None:
@@ -49,11 +49,12 @@ def register(app: typer.Typer) -> None:
             from screwkit.balancing.plots import write_plots
 
             written += _guard(lambda: write_plots(res, plots))
-            if "_pareto_front" in res.extras:
+            front = res.pareto
+            if front is not None:
                 from screwkit.balancing.plots import write_pareto_plot
 
                 written.append(_guard(lambda: write_pareto_plot(
-                    res.extras["_pareto_front"], Path(plots) / "balance_pareto.png")))
+                    front, Path(plots) / "balance_pareto.png")))
 
         def table() -> None:
             console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)

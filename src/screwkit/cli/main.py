@@ -58,12 +58,14 @@ def analyze(
     plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of every variable and its rates over the input, and the coupler curve projections.")] = None,
 ) -> None:
     """Positions, velocities and accelerations of every joint variable in every assembly mode."""
+    from screwkit.io.documents import analysis_document
     from screwkit.io.spec import load_spec
-    from screwkit.kinematics.analysis import analyze as run
+    from screwkit.pipeline import Pipeline
 
     s = _guard(lambda: load_spec(spec))
-    _, doc = _guard(lambda: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point, method))
-    doc["mechanism"] = s.name
+    pipe = Pipeline(s, method=method)
+    motion = _guard(lambda: pipe.motion)
+    doc = analysis_document(motion, name=s.name, coupler_point=s.coupler_point)
     if plot is not None:
         from screwkit.report.plots import plot_analysis
 
@@ -110,10 +112,10 @@ def limits(
 ) -> None:
     """Limit positions of the output rotation and translation over a full turn, and the order of the instantaneous dwell at each rotation limit (Bagci App. D)."""
     from screwkit.io.spec import load_spec
-    from screwkit.kinematics.analysis import limits as run
+    from screwkit.pipeline import Pipeline
 
     s = _guard(lambda: load_spec(spec))
-    doc = _guard(lambda: run(s.linkage, dwell_tolerance, at=[float(np.radians(x)) for x in at or []]))
+    doc = _guard(lambda: Pipeline(s).limits(dwell_tolerance, at=[float(np.radians(x)) for x in at or []]).as_dict())
 
     def table() -> None:
         console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
@@ -146,10 +148,10 @@ def mobility(
 ) -> None:
     """Mobility by formula (each term shown) and from the loop's screw Jacobian at a sample configuration: redundant constraints and undetermined (passive) motions named by joint."""
     from screwkit.io.spec import load_spec
-    from screwkit.kinematics.mobility_check import linkage_mobility
+    from screwkit.pipeline import Pipeline
 
     s = _guard(lambda: load_spec(spec))
-    doc = _guard(lambda: linkage_mobility(s.linkage, s.inputs))
+    doc = _guard(lambda: Pipeline(s).mobility().as_dict())
 
     def table() -> None:
         console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
@@ -169,9 +171,10 @@ def dynamics(
 ) -> None:
     """Shaking force and moment, every joint reaction and the actuator efforts over the cycle, with the RMS and peak of each (one assembly mode: motion.mode in the spec)."""
     from screwkit.io.spec import load_spec
+    from screwkit.pipeline import Pipeline
 
     s = _guard(lambda: load_spec(spec))
-    doc = _guard(lambda: _dynamics_doc(s, gravity))
+    doc = _guard(lambda: dynamics_job(Pipeline(s), gravity))
 
     def table() -> None:
         console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
@@ -192,33 +195,15 @@ def dynamics(
     _emit(doc, as_json, output, table)
 
 
-def _dynamics_doc(s: Any, gravity: bool) -> dict[str, Any]:
-    from screwkit.dynamics import inverse_dynamics
-    from screwkit.kinematics.analysis import mode_motion
+def dynamics_job(pipe: Any, gravity: bool) -> dict[str, Any]:
+    """The dynamics document of a pipeline's spec (``[motion] mode``; null loads, with a note,
+    where the mode does not assemble)."""
+    from screwkit.io.documents import dynamics_document
 
-    lk = s.linkage
-    missing = [link.name for link in lk.links if link.mass is None]
-    if missing:
-        raise ValueError(f"{s.path}: dynamics needs mass properties for every link; add [links.{missing[0]}] "
-                         f"(missing: {missing}; see docs/spec-format.md)")
-    mm = mode_motion(lk, s.inputs, s.speed, s.acceleration, s.mode)
-    g = None
-    if gravity:
-        g = (s.gravity_magnitude or 9.80665) * s.gravity_direction
-    ok = np.asarray(mm.assembles) & ~np.asarray(mm.singular)
-    partial = not ok.all()
-    dyn = inverse_dynamics(lk, mm, gravity=g, inputs=s.inputs, allow_partial=partial)
-    doc = dyn.as_dict()
-    if partial:
-        bad = np.degrees(s.inputs[~ok]) if s.input_is_angle else s.inputs[~ok]
-        unit = "deg" if s.input_is_angle else "m"
-        doc["note"] = (f"mode {s.mode} does not assemble (or is singular) at {int((~ok).sum())} of "
-                       f"{len(ok)} inputs ({', '.join(f'{x:.6g}' for x in bad[:8])}"
-                       f"{' …' if len(bad) > 8 else ''} {unit}): the loads there are null")
-    doc["mode"] = s.mode
-    doc["summary"] = dyn.summary()
-    doc["indeterminacy"] = dyn.indeterminacy.describe()
-    return doc
+    dyn = pipe.dynamics(gravity)
+    problem = pipe.not_assembling(pipe.mode())
+    note = None if problem is None else f"{problem}: the loads there are null"
+    return dynamics_document(dyn, mode=pipe.spec.mode, note=note)
 
 
 @app.command()
@@ -228,10 +213,10 @@ def demo(
     plots: Annotated[bool, typer.Option("--plots/--no-plots", help="Also write a PNG per example.")] = True,
 ) -> None:
     """Run the main job on every bundled example: validate, analyse, write the results."""
+    from screwkit.io.documents import analysis_document, synthesis_document
     from screwkit.io.results import dumps, write_atomic
     from screwkit.io.spec import load_spec
-    from screwkit.kinematics.analysis import analyze as run
-    from screwkit.kinematics.mobility_check import linkage_mobility
+    from screwkit.pipeline import Pipeline
 
     files = sorted(examples.glob("*.toml"))
     if not files:
@@ -244,31 +229,28 @@ def demo(
     for f in files:
         spec = _guard(lambda f=f: load_spec(f))  # type: ignore[misc]
         console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
-        _, doc = _guard(lambda s=spec: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point))  # type: ignore[misc]
-        doc["mechanism"] = spec.name
+        pipe = Pipeline(spec)
+        motion = _guard(lambda p=pipe: p.motion)  # type: ignore[misc]
+        doc = analysis_document(motion, name=spec.name, coupler_point=spec.coupler_point)
         out = output_dir / f"{f.stem}.analysis.json"
         write_atomic(out, dumps(doc) + "\n")
         if plots:
             from screwkit.report.plots import plot_analysis
 
             _guard(lambda d=doc, f=f: plot_analysis(d, output_dir / f"{f.stem}.analysis.png"))  # type: ignore[misc]
-        mob = _guard(lambda s=spec: linkage_mobility(s.linkage, s.inputs))  # type: ignore[misc]
+        mob = _guard(lambda p=pipe: p.mobility().as_dict())  # type: ignore[misc]
         write_atomic(output_dir / f"{f.stem}.mobility.json", dumps(mob) + "\n")
         jobs = ["analysis", "mobility"]
         if all(link.mass is not None for link in spec.linkage.links):
-            dyn = _guard(lambda s=spec: _dynamics_doc(s, False))  # type: ignore[misc]
+            dyn = _guard(lambda p=pipe: dynamics_job(p, False))  # type: ignore[misc]
             write_atomic(output_dir / f"{f.stem}.dynamics.json", dumps(dyn) + "\n")
             jobs.append("dynamics")
-        if spec.raw.balancing is not None:
-            from screwkit.balancing.spec import balance_from_spec
-
-            bal = _guard(lambda s=spec: balance_from_spec(s))  # type: ignore[misc]
+        if spec.balancing is not None:
+            bal = _guard(lambda p=pipe: p.balance())  # type: ignore[misc]
             write_atomic(output_dir / f"{f.stem}.balance.json", dumps(bal.as_dict()) + "\n")
             jobs.append("balance")
-        if spec.raw.synthesis is not None:
-            from screwkit.cli.synthesize_cmd import synthesis_document
-
-            syn = _guard(lambda s=spec: synthesis_document(s))  # type: ignore[misc]
+        if spec.synthesis is not None:
+            syn = _guard(lambda p=pipe: synthesis_document(p.synthesize(), p.spec.path))  # type: ignore[misc]
             write_atomic(output_dir / f"{f.stem}.synthesis.json", dumps(syn) + "\n")
             jobs.append("synthesis")
         res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)

@@ -18,38 +18,8 @@ from rich.table import Table
 from screwkit.cli.common import console, err_console
 from screwkit.cli.common import guard as _guard
 
-__all__ = ["overlay_document", "register", "result_document", "synthesis_document"]
+__all__ = ["register", "synthesis_document"]
 
-
-
-def result_document(result: Any) -> dict[str, Any]:
-    """A `SynthesisResult` as a JSON-able dict (SI units, radians)."""
-    rc = result.range_check
-    return {
-        "dimensions": dict(result.dimensions),
-        "mode": result.inversion,
-        "mode_sign": result.mode_sign,
-        "objective": result.objective,
-        "E_phi": result.E_phi,
-        "E_S": result.E_S,
-        "length_scale": result.length_scale,
-        "rmse": result.rmse,
-        "rmse_phi": result.rmse_phi,
-        "rmse_S": result.rmse_S,
-        "max_dev_phi": result.max_dev_phi,
-        "max_dev_S": result.max_dev_S,
-        "gradient_norm": result.gradient_norm,
-        "relative_gradient": result.relative_gradient,
-        "iterations": result.iterations,
-        "evaluations": result.evaluations,
-        "time": result.time,
-        "status": result.status,
-        "message": result.message,
-        "range_check": {"ok": rc.ok, "gaps": [list(g) for g in rc.gaps],
-                        "branch_mismatch": list(rc.branch_mismatch),
-                        "min_transmission": rc.min_transmission, "message": rc.message},
-        "rows": result.rows,
-    }
 
 
 def _plot(results: list[Any], path: Path) -> None:
@@ -122,69 +92,12 @@ def _tables(name: str, results: list[Any], scale_unit: str) -> None:
                       f"whole range {'ok' if other.range_check.ok else 'NOT ok'}", highlight=False)
 
 
-def overlay_document(outcome: Any) -> dict[str, Any]:
-    """An `OverlayOutcome` as a JSON-able dict: the least-squares document shape (the analysed
-    mechanism's errors and rows) plus ``method`` and the ``overlay`` keys."""
-    doc = result_document(outcome.result)
-    c = outcome.circle
-    doc["method"] = "overlay"
-    doc["overlay"] = {
-        "output_direction": "ccw" if outcome.output_direction > 0 else "cw",
-        "centre": list(c.centre),
-        "d3": c.d3,
-        "phi01": c.phi01,
-        "d2_chosen": outcome.d2_chosen,
-        "d2": c.d2,
-        "d2_refined": c.d2 != outcome.d2_chosen,
-        "circle_residual": [float(v) for v in c.circle_residual],
-        "max_circle_miss": outcome.max_circle_miss,
-        "fit_status": c.status,
-        "dwell_curvature_radii": list(outcome.dwell_curvature_radii),
-    }
-    return doc
-
-
-def _run(problem: Any, table: Any, starts: int | None) -> tuple[list[Any], list[dict[str, Any]]]:
-    """Solve by the table's method: (SynthesisResults best first, their JSON documents)."""
-    import dataclasses
-
-    from screwkit.synthesis.overlay_route import OverlayProblem, synthesize_overlay
-    from screwkit.synthesis.solve import synthesize as solve_one
-    from screwkit.synthesis.solve import synthesize_multistart
-
-    if isinstance(problem, OverlayProblem):
-        if starts is not None:
-            problem = dataclasses.replace(problem, n_starts=starts)
-        outcomes = synthesize_overlay(problem)
-        return [o.result for o in outcomes], [overlay_document(o) for o in outcomes]
-    ms = table.multistart
-    n_starts = starts if starts is not None else (ms.starts if ms is not None else 1)
-    if n_starts == 1 and not (problem.inversion is None and problem.construction is None):
-        results = [solve_one(problem)]
-    else:
-        results = synthesize_multistart(problem, n_starts=n_starts, seed=ms.seed if ms else 0,
-                                        keep=ms.keep if ms else 3, spread=ms.spread if ms else 0.5)
-    docs = [result_document(r) for r in results]
-    for d in docs:
-        d["method"] = "least_squares"
-    return results, docs
-
-
-def _document(docs: list[dict[str, Any]], spec_path: Any) -> dict[str, Any]:
-    doc = dict(docs[0])
-    doc["alternatives"] = docs[1:]
-    doc["spec"] = str(spec_path)
-    return doc
-
-
 def synthesis_document(s: Any, starts: int | None = None) -> dict[str, Any]:
-    """Run the synthesis of a loaded spec (its ``[synthesis]`` table, either method) and return
-    the JSON-able document of the best result with the alternatives (used by ``demo``)."""
-    from screwkit.synthesis.config import synthesis_from_spec
+    """Run the synthesis of a loaded spec and return its JSON document (kept for scripts)."""
+    from screwkit.io.documents import synthesis_document as document
+    from screwkit.pipeline import Pipeline
 
-    problem, table = synthesis_from_spec(s)
-    _, docs = _run(problem, table, starts)
-    return _document(docs, s.path)
+    return document(Pipeline(s).synthesize(starts), s.path)
 
 
 def _plot_overlay(docs: list[dict[str, Any]], problem: Any, path: Path) -> None:
@@ -299,29 +212,34 @@ def register(app: typer.Typer) -> None:
         """Optimise the mechanism's dimensions to generate a desired screw displacement
         (Bagci 1969 Ch. V: least squares with exact derivatives, dwell and range constraints;
         or the overlay technique of §5.4 with [synthesis] method = "overlay")."""
+        from screwkit.io.documents import synthesis_document as document
         from screwkit.io.results import dumps, write_atomic
         from screwkit.io.spec import load_spec
-        from screwkit.synthesis.config import synthesis_from_spec
+        from screwkit.pipeline import Pipeline
 
         if plot is not None:
             asked = plot
             plot = _guard(lambda: plot_path(asked))
         s = _guard(lambda: load_spec(spec))
-        problem, table = _guard(lambda: synthesis_from_spec(s))
+        pipe = Pipeline(s)
+        config = _guard(lambda: pipe.synthesis_config())
+        problem = config.problem
 
-        def run() -> tuple[list[Any], list[dict[str, Any]]]:
-            return _run(problem, table, starts)
+        def run() -> Any:
+            return pipe.synthesize(starts)
 
         if as_json or not sys.stderr.isatty():
-            results, docs = _guard(run)
+            outcome = _guard(run)
         else:
             with Progress(TextColumn("synthesising"), BarColumn(), TimeElapsedColumn(),
                           console=err_console, transient=True) as progress:
                 task = progress.add_task("run", total=None)
-                results, docs = _guard(run)
+                outcome = _guard(run)
                 progress.update(task, completed=1, total=1)
-        doc = _document(docs, spec)
-        overlay = table.method == "overlay"
+        results = outcome.results
+        doc = document(outcome, spec)
+        docs = [doc, *doc["alternatives"]]
+        overlay = config.method == "overlay"
         text = dumps(doc)
         if output is not None:
             _guard(lambda: write_atomic(output, text + "\n"))
@@ -331,9 +249,7 @@ def register(app: typer.Typer) -> None:
         if as_json:
             sys.stdout.write(text + "\n")
         else:
-            unit = s.units.get("length", "m")
-            _tables(s.name, results, f"1 {unit}" if table.length_scale is None
-                    else str(table.length_scale))
+            _tables(s.name, results, config.length_unit)
             if overlay:
                 _overlay_lines(docs)
             if output is not None:

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from screwkit.dynamics import soa
 from screwkit.dynamics.loop_statics import StaticsStructure
-from screwkit.dynamics.result import Array, Dynamics, Indeterminacy
+from screwkit.dynamics.result import Array, Dynamics, Indeterminacy, Reaction
 from screwkit.dynamics.screws import _cross
 from screwkit.model.linkage import Linkage
 
@@ -123,13 +123,10 @@ class Outputs:
 def as_dynamics(linkage: Linkage, joint_centres: Array, s: Setup, out: Outputs) -> Dynamics:
     """Filled outputs → a :class:`Dynamics`."""
     reactions = {
-        j.name: {"force": out.reaction_force[:, k], "moment": out.reaction_moment[:, k]}
+        j.name: Reaction(out.reaction_force[:, k], out.reaction_moment[:, k],
+                         joint_centres[:, k])
         for k, j in enumerate(linkage.joints)
     }
-    directions = s.structure.indeterminate_directions.copy()
-    # moment of each self-stress direction about the world origin
-    directions[:, 3:] += _cross(np.broadcast_to(s.reference, directions[:, :3].shape),
-                                directions[:, :3])
     return Dynamics(
         input_names=tuple(linkage.inputs),
         inputs=s.inputs,
@@ -140,12 +137,18 @@ def as_dynamics(linkage: Linkage, joint_centres: Array, s: Setup, out: Outputs) 
         reactions=reactions,
         joint_centres=joint_centres,
         efforts=out.efforts,
-        indeterminacy=Indeterminacy(
-            count=s.structure.indeterminate_count,
-            directions=directions,
-            idle_freedoms=s.structure.idle_count,
-        ),
+        indeterminacy=indeterminacy(s),
         residual=out.residual,
         residual_scale=out.scale,
         gravity=s.gravity,
     )
+
+
+def indeterminacy(s: Setup) -> Indeterminacy:
+    """What the joints leave undetermined (:class:`Indeterminacy`), self-stress directions
+    with their moments about the world origin."""
+    directions = s.structure.indeterminate_directions.copy()
+    directions[:, 3:] += _cross(np.broadcast_to(s.reference, directions[:, :3].shape),
+                                directions[:, :3])
+    return Indeterminacy(count=s.structure.indeterminate_count, directions=directions,
+                         idle_freedoms=s.structure.idle_count)

@@ -35,6 +35,7 @@ from screwkit.dynamics.blocks import (
     Setup,
     as_dynamics,
     blocks,
+    indeterminacy,
     joint_scale,
 )
 from screwkit.dynamics.checks import (
@@ -53,9 +54,9 @@ from screwkit.dynamics.loop_statics import (
     solve_loop_statics,
     statics_structure,
 )
-from screwkit.dynamics.result import Array, Dynamics
+from screwkit.dynamics.result import Array, Dynamics, Indeterminacy
 from screwkit.dynamics.screws import _cross, freedom_screws
-from screwkit.kinematics.motion import ModeMotion
+from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 
@@ -223,9 +224,25 @@ def _generic_block(
     out.scale = joint_scale(out.reaction_force, out.reaction_moment, linkage.length_scale)
 
 
+def resolve_mode(linkage: Linkage | Motion, mode: ModeMotion | int,
+                 inputs: ArrayLike | None) -> tuple[Linkage, ModeMotion, ArrayLike | None]:
+    """(linkage, mode_motion, inputs) from either calling form of :func:`inverse_dynamics`:
+    a Motion and a mode index, or a linkage and one mode's ModeMotion."""
+    if isinstance(linkage, Motion):
+        if not isinstance(mode, int | np.integer) or isinstance(mode, bool):
+            raise DynamicsInputError(f"with a Motion, give the assembly mode as an index "
+                                     f"0…{len(linkage.modes) - 1}; got {mode!r}")
+        return linkage.linkage, linkage.mode(int(mode)), (linkage.inputs if inputs is None
+                                                           else inputs)
+    if not isinstance(mode, ModeMotion):
+        raise DynamicsInputError("with a linkage, give one mode's ModeMotion (motion.mode(k)); "
+                                 "or pass the Motion itself: inverse_dynamics(motion, k)")
+    return linkage, mode, inputs
+
+
 def inverse_dynamics(
-    linkage: Linkage,
-    mode_motion: ModeMotion,
+    linkage: Linkage | Motion,
+    mode_motion: ModeMotion | int = 0,
     gravity: ArrayLike | None = None,
     moment_point: ArrayLike | None = None,
     *,
@@ -235,15 +252,22 @@ def inverse_dynamics(
     closed_form: bool = True,
     block_size: int = BLOCK_SAMPLES,
 ) -> Dynamics:
-    """Shaking force and moment, joint reactions and driven efforts of one assembly mode.
+    """Shaking force and moment, joint reactions and driven efforts of one assembly mode, over
+    the cycle, in SI units (N, N·m; world frame).
+
+    ``inverse_dynamics(motion, mode=0, gravity=…)`` takes a solved
+    :class:`~screwkit.kinematics.motion.Motion` (:func:`screwkit.solve_motion`) and one of its
+    modes; ``inverse_dynamics(linkage, mode_motion, …)`` takes a linkage and one
+    :class:`~screwkit.kinematics.motion.ModeMotion` — e.g. the same motion with other mass
+    properties (``linkage.with_links(...)``).
 
     Parameters
     ----------
     linkage:
-        the loop; every moving link needs ``mass`` (a MassProperties in its body frame).
+        a :class:`Motion`, or the loop; every moving link needs ``mass`` (a MassProperties in its
+        body frame).
     mode_motion:
-        one mode of :func:`screwkit.kinematics.motion.motion` (``motion(...).modes[k]``) or of
-        a closed form (e.g. :func:`screwkit.kinematics.cssp_motion.cssp_mode_motion`).
+        the mode index (with a Motion), or one mode's :class:`ModeMotion` (with a linkage).
     gravity:
         gravitational acceleration, world frame (m/s²), e.g. ``(0, 0, -9.80665)``; none if
         omitted.
@@ -269,6 +293,7 @@ def inverse_dynamics(
     block by block into preallocated outputs; see docs/dynamics.md for the conventions and how
     indeterminate components are reported.
     """
+    linkage, mode_motion, inputs = resolve_mode(linkage, mode_motion, inputs)
     if not isinstance(block_size, int | np.integer) or block_size < 1:
         raise DynamicsInputError(f"block_size must be a positive integer, got {block_size!r}")
     masses = check_link_masses(linkage)
@@ -338,6 +363,8 @@ class Regressor:
     {"force", "moment"}: (N, 3, P)}, ``efforts`` {freedom: (N, P)}, ``residual`` (N, m_p, P)
     (the idle-freedom generalised force, a vector). ``constant`` holds the π-independent part
     (external loads) with the same keys and a last axis of length 1; zero without external loads.
+    ``indeterminacy`` says which reaction components the joints leave undetermined and how many
+    idle passive freedoms (an S–S rod's spin) the loads can act along (``residual``).
     """
 
     parameter_names: tuple[str, ...]
@@ -347,6 +374,7 @@ class Regressor:
     efforts: Mapping[str, Array]
     residual: Array
     constant: Mapping[str, Any]
+    indeterminacy: Indeterminacy
     _linkage: Linkage
     _mode: ModeMotion
     _setup: Setup
@@ -422,6 +450,7 @@ def regressor(
         efforts=loads["efforts"],
         residual=loads["residual"],
         constant=const,
+        indeterminacy=indeterminacy(s),
         _linkage=linkage,
         _mode=mode_motion,
         _setup=s,

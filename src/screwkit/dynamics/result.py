@@ -21,6 +21,23 @@ Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
+class Reaction:
+    """The load one joint transmits over the cycle: ``force`` and ``moment`` (N, 3) exerted on
+    the distal link by the proximal link (on the moving link by the ground for the two ground
+    joints), world frame, moment about the joint centre ``point`` (N, 3), the point of
+    application. ``reaction["force"]`` reads a field by name."""
+
+    force: Array
+    moment: Array
+    point: Array
+
+    def __getitem__(self, key: str) -> Array:
+        if key not in ("force", "moment", "point"):
+            raise KeyError(f"a reaction has 'force', 'moment' and 'point'; got {key!r}")
+        return getattr(self, key)  # type: ignore[no-any-return]
+
+
+@dataclass(frozen=True)
 class Indeterminacy:
     """What the rigid-body joint model leaves undetermined, generic over the mode.
 
@@ -78,7 +95,8 @@ class Dynamics:
     shaking_force, shaking_moment:
         (N, 3) what the moving links exert on the ground; moment about ``moment_point``.
     reactions:
-        ``{joint: {"force": (N, 3), "moment": (N, 3)}}``, moment about the joint centre.
+        ``{joint: Reaction}``: force and moment (N, 3), moment about the joint centre
+        ``Reaction.point`` (N, 3).
     efforts:
         ``{driven freedom: (N,)}``: torque (N·m) of a driven rotation, force (N) of a driven
         translation, exerted by the proximal link on the distal link along the freedom.
@@ -95,7 +113,7 @@ class Dynamics:
     shaking_force: Array
     shaking_moment: Array
     moment_point: Array
-    reactions: Mapping[str, Mapping[str, Array]]
+    reactions: Mapping[str, Reaction]
     joint_centres: Array
     efforts: Mapping[str, Array]
     indeterminacy: Indeterminacy
@@ -115,8 +133,8 @@ class Dynamics:
             "shaking_moment": _stats(self.shaking_moment, self.valid),
         }
         for name, r in self.reactions.items():
-            out[f"{name}.force"] = _stats(r["force"], self.valid)
-            out[f"{name}.moment"] = _stats(r["moment"], self.valid)
+            out[f"{name}.force"] = _stats(r.force, self.valid)
+            out[f"{name}.moment"] = _stats(r.moment, self.valid)
         for name, e in self.efforts.items():
             out[f"effort {name}"] = _stats(e, self.valid)
         out["relative_residual"] = _stats(self.relative_residual, self.valid)
@@ -135,7 +153,8 @@ class Dynamics:
             "shaking_force": _listify(self.shaking_force, v),
             "shaking_moment": _listify(self.shaking_moment, v),
             "reactions": {
-                name: {"force": _listify(r["force"], v), "moment": _listify(r["moment"], v)}
+                name: {"force": _listify(r.force, v), "moment": _listify(r.moment, v),
+                       "point": _listify(r.point, v)}
                 for name, r in self.reactions.items()
             },
             "efforts": {name: _listify(e, v) for name, e in self.efforts.items()},

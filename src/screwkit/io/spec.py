@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import tomllib
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from pydantic import (
@@ -23,30 +23,16 @@ from pydantic import (
     field_validator,
 )
 
+from screwkit.io.errors import SpecError
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
+from screwkit.kinematics.registry import family, require
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
+if TYPE_CHECKING:
+    from screwkit.balancing.config import BalancingConfig
+    from screwkit.synthesis.config import SynthesisConfig
+
 Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
-
-
-class SpecError(ValueError):
-    """A spec file that cannot be used; the message says where and how to fix it."""
-
-
-FAMILY_DIMENSIONS: dict[str, dict[str, str]] = {
-    "RSRC": {"d1": "length", "d2": "length", "d3": "length", "a": "length", "b": "length",
-             "e": "length", "delta0": "angle", "lambda0": "angle"},
-    "CSSP": {"a1": "length", "a2": "length", "a4": "length", "alpha4": "angle", "s1": "length"},
-    "4R": {"a": "length", "d1": "length", "d2": "length", "d3": "length"},
-    "RSSR": {"d1": "length", "d2": "length", "d3": "length", "a": "length", "b": "length",
-             "lambda0": "angle", "output_offset": "length"},
-    "RCCC": {"a1": "length", "a2": "length", "a3": "length", "a4": "length", "alpha1": "angle",
-             "alpha2": "angle", "alpha3": "angle", "alpha4": "angle", "input_offset": "length"},
-}
-OPTIONAL_DIMENSIONS = {"CSSP": {"s1"}, "RSSR": {"output_offset"}, "RCCC": {"input_offset"}}
-FAMILY_ALIASES = {"rsrc": "RSRC", "cssp": "CSSP", "4r": "4R", "fourbar": "4R", "rssr": "RSSR",
-                  "rccc": "RCCC", "loop": "LOOP"}
-INPUT_KIND = {"RSRC": "angle", "CSSP": "angle", "4R": "angle", "RSSR": "angle", "RCCC": "angle"}
 
 
 class _Strict(BaseModel):
@@ -62,10 +48,7 @@ class MechanismTable(_Strict):
     @field_validator("family")
     @classmethod
     def _family(cls, v: str) -> str:
-        key = FAMILY_ALIASES.get(v.lower())
-        if key is None:
-            raise ValueError(f"unknown family {v!r}; use one of RSRC, CSSP, 4R, RSSR, RCCC, LOOP")
-        return key
+        return family(v).name
 
 
 class MotionTable(_Strict):
@@ -116,8 +99,18 @@ class SpecFile(_Strict):
     synthesis: dict[str, Any] | None = None
 
 
-class MechanismSpec:
-    """A validated spec file, converted to SI. Build the model with :meth:`linkage`."""
+class Spec:
+    """A validated spec file, converted to SI units (docs/spec-format.md).
+
+    Attributes: ``path``, ``name``, ``family``, ``source``, ``units`` (the ``[units]`` table),
+    ``dimensions`` (SI), ``inputs`` (N,) input samples (rad or m), ``speed`` and
+    ``acceleration`` of the input, ``mode`` (the assembly mode dynamics and balancing use),
+    ``gravity_magnitude``, ``gravity_direction``, ``coupler_point``; the property ``linkage`` is
+    the mechanism model (a :class:`~screwkit.model.Linkage`, built once at load); ``balancing``
+    and ``synthesis`` are the ``[balancing]`` and ``[synthesis]`` tables as typed configs
+    (:class:`~screwkit.balancing.config.BalancingConfig`,
+    :class:`~screwkit.synthesis.config.SynthesisConfig`), or ``None``.
+    """
 
     def __init__(self, raw: SpecFile, path: str) -> None:
         self.raw = raw
@@ -136,11 +129,11 @@ class MechanismSpec:
                 self._fail(f"units.{kind}", str(exc))
         self.dimensions = self._dimensions()
         self.inputs = self._input_samples()
-        self.speed = self._si(raw.motion.speed, self._rate_kind(), "motion.speed")
-        self.acceleration = self._si(raw.motion.acceleration, self._rate_kind(2), "motion.acceleration")
+        self.speed = self.quantity(raw.motion.speed, self._rate_kind(), "motion.speed")
+        self.acceleration = self.quantity(raw.motion.acceleration, self._rate_kind(2), "motion.acceleration")
         self.mode = raw.motion.mode
         self.gravity_magnitude = (
-            None if raw.gravity is None else self._si(raw.gravity, "acceleration", "gravity")
+            None if raw.gravity is None else self.quantity(raw.gravity, "acceleration", "gravity")
         )
         if self.gravity_magnitude is not None and not self.gravity_magnitude > 0:
             self._fail("gravity", f"gravity must be a positive acceleration (it turns weights into "
@@ -151,13 +144,25 @@ class MechanismSpec:
         self.gravity_direction = gd / np.linalg.norm(gd)
         self.coupler_point: tuple[float, float, float] | None = None
         if raw.coupler_point is not None:
-            if self.family != "RSRC":
-                self._fail("coupler_point", f"coupler points are defined for the RSRC (Bagci App. C); this is a {self.family}")
+            try:
+                require(family(self.family), "coupler_point")
+            except ValueError as exc:
+                self._fail("coupler_point", str(exc))
             cp = raw.coupler_point
-            self.coupler_point = (self._si(cp.f, "length", "coupler_point.f"),
-                                  self._si(cp.g, "length", "coupler_point.g"),
-                                  self._si(cp.h, "length", "coupler_point.h"))
+            self.coupler_point = (self.quantity(cp.f, "length", "coupler_point.f"),
+                                  self.quantity(cp.g, "length", "coupler_point.g"),
+                                  self.quantity(cp.h, "length", "coupler_point.h"))
         self._linkage = self._build()
+        self.balancing: BalancingConfig | None = None
+        self.synthesis: SynthesisConfig | None = None
+        if raw.balancing is not None:
+            from screwkit.io.balancing_table import balancing_config
+
+            self.balancing = balancing_config(self)
+        if raw.synthesis is not None:
+            from screwkit.io.synthesis_table import synthesis_config
+
+            self.synthesis = synthesis_config(self)
 
     # --- helpers ---------------------------------------------------------------------------
     def _fail(self, key: str, message: str) -> None:
@@ -166,7 +171,9 @@ class MechanismSpec:
     def _default_unit(self, kind: str) -> str | None:
         return self.units.get(kind)
 
-    def _si(self, value: Any, kind: str, key: str) -> float:
+    def quantity(self, value: Any, kind: str, key: str) -> float:
+        """``value`` (a number in the spec's ``[units]`` for ``kind``, or a string with its
+        unit) in SI units; a :class:`SpecError` naming ``key`` if it cannot be."""
         try:
             return to_si(value, kind, self._default_unit(kind))
         except UnitError as exc:
@@ -188,14 +195,15 @@ class MechanismSpec:
             if self.raw.dimensions:
                 self._fail("dimensions", "a LOOP family takes its geometry from [[joints]]; remove [dimensions]")
             return {}
-        wanted = FAMILY_DIMENSIONS[self.family]
+        fam = family(self.family)
+        wanted = fam.dimensions
         unknown = sorted(set(self.raw.dimensions) - set(wanted))
         if unknown:
             self._fail("dimensions", f"unknown key(s) {unknown} for a {self.family}; expected {sorted(wanted)}")
-        missing = sorted(set(wanted) - set(self.raw.dimensions) - OPTIONAL_DIMENSIONS.get(self.family, set()))
+        missing = sorted(set(wanted) - set(self.raw.dimensions) - set(fam.optional))
         if missing:
             self._fail("dimensions", f"missing {missing} for a {self.family} (e.g. d1 = \"2.0 in\")")
-        return {k: self._si(v, wanted[k], f"dimensions.{k}") for k, v in self.raw.dimensions.items()}
+        return {k: self.quantity(v, wanted[k], f"dimensions.{k}") for k, v in self.raw.dimensions.items()}
 
     def _input_samples(self) -> np.ndarray:
         m = self.raw.motion
@@ -205,9 +213,9 @@ class MechanismSpec:
             if missing:
                 self._fail("motion", f"the input is a translation: give {missing} as lengths "
                                      f"(e.g. start = \"0 mm\", stop = \"50 mm\", step = \"1 mm\")")
-        start = self._si(m.start, kind, "motion.start")
-        stop = self._si(m.stop, kind, "motion.stop")
-        step = self._si(m.step, kind, "motion.step")
+        start = self.quantity(m.start, kind, "motion.start")
+        stop = self.quantity(m.stop, kind, "motion.stop")
+        step = self.quantity(m.step, kind, "motion.step")
         if step <= 0:
             self._fail("motion.step", f"the step must be positive; got {m.step!r}")
         if stop < start:
@@ -240,11 +248,11 @@ class MechanismSpec:
             key = f"links.{name}"
             if (t.mass is None) == (t.weight is None):
                 self._fail(key, "give exactly one of mass (e.g. \"0.86 kg\") or weight (e.g. \"1.9 lbf\")")
-            mass = (self._si(t.mass, "mass", key + ".mass") if t.mass is not None
-                    else self._si(t.weight, "force", key + ".weight") / g)
+            mass = (self.quantity(t.mass, "mass", key + ".mass") if t.mass is not None
+                    else self.quantity(t.weight, "force", key + ".weight") / g)
             if len(t.com) != 3:
                 self._fail(key + ".com", f"give 3 coordinates; got {len(t.com)}")
-            com = [self._si(v, "length", f"{key}.com") for v in t.com]
+            com = [self.quantity(v, "length", f"{key}.com") for v in t.com]
             if t.inertia is None:
                 self._fail(key + ".inertia", "give the principal moments [Ixx, Iyy, Izz] or a 3×3 tensor about the CoM")
             inertia = t.inertia
@@ -253,10 +261,10 @@ class MechanismSpec:
                     if len(inertia) != 3 or any(not isinstance(r, list) or len(r) != 3 for r in inertia):
                         self._fail(key + ".inertia", "a full inertia tensor is 3 rows of 3 numbers "
                                    "(about the CoM, link axes); or give the 3 principal moments")
-                    I = np.array([[self._si(v, "inertia", f"{key}.inertia") for v in row] for row in inertia])  # type: ignore[union-attr]
+                    I = np.array([[self.quantity(v, "inertia", f"{key}.inertia") for v in row] for row in inertia])  # type: ignore[union-attr]
                     props = MassProperties(mass, np.array(com), I)
                 else:
-                    moments = [self._si(v, "inertia", f"{key}.inertia") for v in inertia]  # type: ignore[union-attr]
+                    moments = [self.quantity(v, "inertia", f"{key}.inertia") for v in inertia]  # type: ignore[union-attr]
                     if len(moments) != 3:
                         self._fail(key + ".inertia", f"give 3 principal moments; got {len(moments)}")
                     props = MassProperties.from_principal(mass, np.array(com), np.array(moments), t.principal_axes)
@@ -268,25 +276,11 @@ class MechanismSpec:
         return out
 
     def _build(self) -> Linkage:
-        from screwkit.model import families
-
-        d = self.dimensions
+        fam = family(self.family)
         try:
-            if self.family == "RSRC":
-                lk = families.rsrc(**d)
-            elif self.family == "CSSP":
-                lk = families.cssp(d["a1"], d["a2"], d["a4"], d["alpha4"], d.get("s1", 0.0))
-            elif self.family == "4R":
-                lk = families.fourbar(d["a"], d["d1"], d["d2"], d["d3"])
-            elif self.family == "RSSR":
-                lk = families.rssr(d["d1"], d["d2"], d["d3"], d["a"], d["b"], d["lambda0"], d.get("output_offset", 0.0))
-            elif self.family == "RCCC":
-                lk = families.rccc((d["a1"], d["a2"], d["a3"], d["a4"]),
-                                   (d["alpha1"], d["alpha2"], d["alpha3"], d["alpha4"]), d.get("input_offset", 0.0))
-            else:
-                lk = self._loop()
+            lk = fam.linkage(**self.dimensions) if fam.build is not None else self._loop()
         except LinkageError as exc:
-            self._fail("dimensions" if self.family != "LOOP" else "joints", str(exc))
+            self._fail("dimensions" if fam.build is not None else "joints", str(exc))
         if self.raw.links:
             lk = lk.with_links(self._masses([link.name for link in lk.links]))
         return lk
@@ -304,12 +298,12 @@ class MechanismSpec:
                 self._fail(f"{key}.offset", "a C joint has no constant offset (both its rotation "
                                            "and its translation are variables); remove offset")
             try:
-                joints.append(Joint(j.name, j.kind, self._si(j.offset, off_kind, key + ".offset"),
-                                    self._si(j.pitch, "length", key + ".pitch")))
+                joints.append(Joint(j.name, j.kind, self.quantity(j.offset, off_kind, key + ".offset"),
+                                    self.quantity(j.pitch, "length", key + ".pitch")))
             except ValueError as exc:
                 self._fail(key, str(exc))
-            lengths.append(self._si(j.length, "length", key + ".length"))
-            twists.append(self._si(j.twist, "angle", key + ".twist"))
+            lengths.append(self.quantity(j.length, "length", key + ".length"))
+            twists.append(self.quantity(j.twist, "angle", key + ".twist"))
             if j.input:
                 inputs.append(f"{j.name}.{joints[-1].freedoms[0]}")
         if len(inputs) != 1:
@@ -319,6 +313,7 @@ class MechanismSpec:
     # --- public ------------------------------------------------------------------------------
     @property
     def linkage(self) -> Linkage:
+        """The mechanism model (read only; built once when the spec is loaded)."""
         return self._linkage
 
     def describe(self) -> str:
@@ -350,8 +345,13 @@ def _format_validation(path: str, exc: ValidationError) -> str:
     return "\n".join(lines)
 
 
-def load_spec(path: str | Path) -> MechanismSpec:
-    """Read and validate a spec file; raises :class:`SpecError` with a specific message."""
+MechanismSpec = Spec  # the name used before the front door
+
+
+def load_spec(path: str | Path) -> Spec:
+    """Read and validate a spec file (TOML with units; docs/spec-format.md) into a :class:`Spec`
+    in SI units, with its mechanism model and its ``[balancing]``/``[synthesis]`` tables parsed;
+    raises :class:`SpecError` naming the file, the key and a fix."""
     p = Path(path)
     if not p.is_file():
         raise SpecError(f"{p}: no such spec file")
@@ -365,4 +365,4 @@ def load_spec(path: str | Path) -> MechanismSpec:
         raw = SpecFile.model_validate(data)
     except ValidationError as exc:
         raise SpecError(_format_validation(str(p), exc)) from exc
-    return MechanismSpec(raw, str(p))
+    return Spec(raw, str(p))

@@ -4,22 +4,8 @@ Each returns a general :class:`~screwkit.model.Linkage`, so the generic solver, 
 mobility work on it; the closed forms of :mod:`screwkit.kinematics` are registered per family
 and checked against the generic solver in the tests.
 
-RSRC (Bagci 1969, Fig. 5 as rebuilt in the reference spec §3.1)::
-
-        Z                      output (C) axis u3 = (cos λ0, 0, −sin λ0) through O3 = (b, a, 0)
-        |   sphere O1          output crank d3 ⟂ u3, turned φ0 about u3, slides S along −u3
-        |  /  coupler d2 ── R axis (skew δ0 to u3, offset e) ── output crank d3
-        | / d1 (θ0 from +Y about +X)
-        O──────────── Y        fixed link a along +Y, input crank plane X = 0, offset b along X
-       /
-      X  (input R axis)
-
-CSSP (Rahman 1996 §1): crank a1 about z1 with offset s1 (C joint; s1 constant or a second
-input), rod a2 between two balls, slider on the axis k4 = (0, sin α4, cos α4) at distance a4
-from z1 — Hartenberg–Denavit form M1 L2 L3 M4 = I.
-
-Planar 4R (Bagci's special case): frame a (input pivot → output pivot), crank d1, coupler d2,
-rocker d3; the world x axis is the line of centres.
+The parameter sketch of each family is a module constant (``RSRC_SKETCH`` …), shown by
+``docs/families.md`` and the family registry.
 """
 
 from __future__ import annotations
@@ -29,6 +15,31 @@ import numpy as np
 from screwkit.dual import ScrewMatrix
 from screwkit.model.joints import Joint
 from screwkit.model.linkage import Link, Linkage, LinkageError
+
+RSRC_SKETCH = """RSRC (Bagci 1969, Fig. 5 as rebuilt in the reference spec §3.1):
+
+        Z                      output (C) axis u3 = (cos λ0, 0, −sin λ0) through O3 = (b, a, 0)
+        |   sphere O1          output crank d3 ⟂ u3, turned φ0 about u3, slides S along −u3
+        |  /  coupler d2 ── R axis (skew δ0 to u3, offset e) ── output crank d3
+        | / d1 (θ0 from +Y about +X)
+        O──────────── Y        fixed link a along +Y, input crank plane X = 0, offset b along X
+       /
+      X  (input R axis)"""
+
+CSSP_SKETCH = """CSSP (Rahman 1996 §1): crank a1 about z1 with offset s1 (C joint; s1 constant or a
+second input), rod a2 between two balls, slider on the axis k4 = (0, sin α4, cos α4) at distance
+a4 from z1 — Hartenberg–Denavit form M1 L2 L3 M4 = I."""
+
+FOURBAR_SKETCH = """Planar 4R (Bagci's special case): frame a (input pivot → output pivot), crank d1,
+coupler d2, rocker d3; the world x axis is the line of centres, θ0 and φ0 are measured from it."""
+
+RSSR_SKETCH = """RSSR: the RSRC's frame geometry with ball joints at both coupler ends: input axis X,
+output R axis u3 = (cos λ0, 0, −sin λ0) through (b, a, 0), crank d1, coupler d2 between the ball
+centres, output crank d3 whose ball lies output_offset along u3 from the crank plane."""
+
+RCCC_SKETCH = """RCCC (Bagci App. B, Fig. 29c): input R then three C joints, Hartenberg–Denavit links
+a1…a4 with twists α1…α4; input_offset is the input joint's constant offset along its axis."""
+
 
 # columns e2, e3, e1: a frame whose z axis is the x axis of the frame it is expressed in
 _P = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])

@@ -1,4 +1,5 @@
-"""The seeds' variable names read off a general :class:`~screwkit.kinematics.motion.ModeMotion`.
+"""The seeds' variable names read off any :class:`~screwkit.kinematics.motion.ModeMotion` (the
+generic solver's included); the family registry maps each family to its function.
 
 RSRC (Bagci 1969 §3.1): θ0, φ0, S, χ0. CSSP (Rahman 1996 §1.2): θ1, s4, θ2, η2 with the rod
 direction u = (cη2 c(θ1+θ2), cη2 s(θ1+θ2), −sη2). Planar 4R (Bagci's special case): θ0 and φ0
@@ -17,25 +18,21 @@ from screwkit.model.linkage import Linkage
 Named = dict[str, Array]
 
 
-def seed_variables(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]:
-    """(variables, velocities, accelerations) under the seed's names for the linkage's family;
-    empty dicts for a general loop."""
-    fam = linkage.family
-    if fam == "RSRC":
-        return (rsrc_seed_variables(mode.variables), rsrc_seed_variables(mode.velocities),
-                rsrc_seed_variables(mode.accelerations))
-    if fam == "RSSR":
-        def pick(d: dict[str, Array]) -> Named:
-            return {"theta0": d["input.theta"], "phi0": -d["output.theta"]}
-        return pick(mode.variables), pick(mode.velocities), pick(mode.accelerations)
-    if fam == "4R":
-        return _fourbar(mode)
-    if fam == "CSSP":
-        return _cssp(linkage, mode)
-    return {}, {}, {}
+def rsrc_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]:
+    """θ0, φ0, S, χ0 of an RSRC mode (Bagci 1969 §3.1) from its joint variables."""
+    return (rsrc_seed_variables(mode.variables), rsrc_seed_variables(mode.velocities),
+            rsrc_seed_variables(mode.accelerations))
 
 
-def _fourbar(mode: ModeMotion) -> tuple[Named, Named, Named]:
+def rssr_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]:
+    """θ0 and φ0 of an RSSR mode, measured as for the RSRC."""
+    def pick(d: dict[str, Array]) -> Named:
+        return {"theta0": d["input.theta"], "phi0": -d["output.theta"]}
+    return pick(mode.variables), pick(mode.velocities), pick(mode.accelerations)
+
+
+def fourbar_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]:
+    """θ0, φ0 (from the line of centres) and χ0 of a planar 4R mode (Bagci's plane case)."""
     c = mode.joint_centres
     crank = c[:, 1] - c[:, 0]
     rocker = c[:, 2] - c[:, 3]
@@ -46,12 +43,18 @@ def _fourbar(mode: ModeMotion) -> tuple[Named, Named, Named]:
     ph[ok] = np.unwrap(ph[ok])
     w = mode.link_angular_velocity
     a = mode.link_angular_acceleration
-    return ({"theta0": th, "phi0": ph},
-            {"theta0": w[:, 0, 2], "phi0": w[:, 2, 2]},
-            {"theta0": a[:, 0, 2], "phi0": a[:, 2, 2]})
+    # Bagci's χ0 of the plane case is the coupler–rocker joint angle turned by π, in (−π, π]
+    rocker_pin = next(j.name for j in linkage.joints[2:3])
+    chi = np.pi - np.mod(np.pi - (mode.variables[f"{rocker_pin}.theta"] + np.pi), 2 * np.pi)
+    return ({"theta0": th, "phi0": ph, "chi0": chi},
+            {"theta0": w[:, 0, 2], "phi0": w[:, 2, 2],
+             "chi0": mode.velocities[f"{rocker_pin}.theta"]},
+            {"theta0": a[:, 0, 2], "phi0": a[:, 2, 2],
+             "chi0": mode.accelerations[f"{rocker_pin}.theta"]})
 
 
-def _cssp(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]:
+def cssp_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]:
+    """θ1, s4, θ2, η2 of a CSSP mode (Rahman 1996 §1.2) from its rod direction and rates."""
     a2 = linkage.parameters["a2"]
     c = mode.joint_centres
     u = (c[:, 2] - c[:, 1]) / a2

@@ -1,0 +1,200 @@
+"""The ``[balancing]`` table of a spec file: validated with pydantic and turned, once, into a typed
+:class:`~screwkit.balancing.config.BalancingConfig` in SI units (docs/balancing.md, "Spec file").
+
+Lengths and masses take the spec's units (``[units]``) or explicit unit strings. Every error
+names the file and the key (:class:`BalancingConfigError`, a SpecError and a BalancingError)."""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from screwkit.balancing.config import BalancingConfig, NormalisationConfig
+from screwkit.balancing.errors import BalancingError
+from screwkit.balancing.measures import MEASURES
+from screwkit.balancing.variables import (
+    POINT_MASS_NAMES,
+    VariableBlock,
+    counterweight_variables,
+    point_mass_variables,
+)
+from screwkit.io.errors import SpecError
+
+Value = float | int | str
+
+
+class BalancingConfigError(SpecError, BalancingError):
+    """A ``[balancing]`` table that cannot be used; the message names the file and the key."""
+SumRule = Literal["equal", "at_most", "free"]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class LinkVariablesTable(_Strict):
+    variables: list[str] = Field(default_factory=lambda: list(POINT_MASS_NAMES))
+    split: list[float] | None = None
+    max_decrease: float = 0.05
+    max_increase: float | None = None
+    pair_sum: SumRule = "equal"
+    link_mass: SumRule = "free"
+
+
+class CounterweightTable(_Strict):
+    name: str
+    link: str
+    mass_max: Value
+    mass_min: Value = 0.0
+    at: list[Value] | None = None
+    box_min: list[Value] | None = None
+    box_max: list[Value] | None = None
+
+
+class NormalisationTable(_Strict):
+    mass: Value | None = None
+    length: Value | None = None
+    speed: Value | None = None
+    bearing_length: Value | None = None
+
+
+class EllipsoidTable(_Strict):
+    centre: list[Value]
+    semi_axes: list[Value]
+
+
+class BoundTable(_Strict):
+    ellipsoids: dict[str, EllipsoidTable]
+
+
+class ParetoTable(_Strict):
+    measures: list[str] = Field(default_factory=lambda: ["F", "T", "T0"])
+    divisions: int = 4
+
+
+class BalancingTable(_Strict):
+    weights: dict[str, float] = Field(default_factory=lambda: {k: 1.0 for k in MEASURES})
+    gravity: bool = False
+    links: dict[str, LinkVariablesTable] = Field(default_factory=dict)
+    counterweights: list[CounterweightTable] = Field(default_factory=list)
+    normalisation: NormalisationTable = Field(default_factory=NormalisationTable)  # type: ignore[arg-type]
+    bound: BoundTable | None = None
+    pareto: ParetoTable | None = None
+
+
+def balancing_table(spec: Any) -> BalancingTable:
+    """The validated ``[balancing]`` table of a spec (messages name the file and the key)."""
+    raw = spec.raw.balancing
+    if raw is None:
+        raise BalancingConfigError(f"{spec.path}: no [balancing] table; see docs/balancing.md")
+    try:
+        return BalancingTable.model_validate(raw)
+    except ValidationError as exc:
+        lines = [f"{spec.path}: the [balancing] table is not valid:"]
+        for err in exc.errors():
+            loc = ".".join(str(p) for p in err["loc"])
+            msg = ("unknown key (see docs/balancing.md)" if err["type"] == "extra_forbidden"
+                   else err["msg"])
+            lines.append(f"  [balancing.{loc}] {msg}")
+        raise BalancingConfigError("\n".join(lines)) from exc
+
+
+def _si(spec: Any, value: Any, kind: str, key: str) -> float:
+    return float(spec.quantity(value, kind, f"balancing.{key}"))
+
+
+def _link_blocks(spec: Any, table: BalancingTable) -> list[VariableBlock]:
+    lk = spec.linkage
+    names = [link.name for link in lk.links]
+    blocks: list[VariableBlock] = []
+    for link, t in table.links.items():
+        if link not in names:
+            raise BalancingConfigError(f"{spec.path}: [balancing.links.{link}] no moving link "
+                                       f"named {link!r}; the links are {names}")
+        if not t.variables:
+            raise BalancingConfigError(f"{spec.path}: [balancing.links.{link}] has no variables; "
+                                       f"list some of {list(POINT_MASS_NAMES)} or remove the table")
+        try:
+            blocks.append(point_mass_variables(
+                lk, link, split=t.split, max_decrease=t.max_decrease,
+                max_increase=t.max_increase, pair_sum=t.pair_sum, link_mass=t.link_mass,
+                variables=t.variables))
+        except BalancingError as exc:
+            raise BalancingConfigError(f"{spec.path}: [balancing.links.{link}] {exc}") from exc
+    return blocks
+
+
+def _counterweight_blocks(spec: Any, table: BalancingTable) -> list[VariableBlock]:
+    lk = spec.linkage
+    blocks: list[VariableBlock] = []
+    for k, cw in enumerate(table.counterweights):
+        key = f"counterweights[{k}]"
+        if (cw.at is None) == (cw.box_min is None or cw.box_max is None):
+            raise BalancingConfigError(f"{spec.path}: [balancing.{key}] give either at = [x, y, z] "
+                                       "or both box_min and box_max")
+        m_max = _si(spec, cw.mass_max, "mass", key + ".mass_max")
+        m_min = _si(spec, cw.mass_min, "mass", key + ".mass_min")
+        try:
+            if cw.at is not None:
+                at = [_si(spec, v, "length", key + ".at") for v in cw.at]
+                blocks.append(counterweight_variables(lk, cw.link, cw.name, mass_max=m_max,
+                                                      mass_min=m_min, at=at))
+            else:
+                lo = [_si(spec, v, "length", key + ".box_min") for v in cw.box_min or []]
+                hi = [_si(spec, v, "length", key + ".box_max") for v in cw.box_max or []]
+                blocks.append(counterweight_variables(lk, cw.link, cw.name, mass_max=m_max,
+                                                      mass_min=m_min, box=(lo, hi)))
+        except BalancingError as exc:
+            raise BalancingConfigError(f"{spec.path}: [balancing.{key}] {exc}") from exc
+    return blocks
+
+
+def blocks_from_table(spec: Any, table: BalancingTable) -> list[VariableBlock]:
+    """The design variables of a ``[balancing]`` table (point masses, then counterweights)."""
+    blocks = _link_blocks(spec, table) + _counterweight_blocks(spec, table)
+    if not blocks:
+        raise BalancingConfigError(f"{spec.path}: [balancing] has no design variables; add "
+                                   "[balancing.links.<link>] or [[balancing.counterweights]]")
+    return blocks
+
+
+def _bound(spec: Any, table: BalancingTable) -> dict[str, tuple[list[float], list[float]]] | None:
+    if table.bound is None:
+        return None
+    ell = {}
+    for link, e in table.bound.ellipsoids.items():
+        key = f"bound.ellipsoids.{link}"
+        if len(e.centre) != 3 or len(e.semi_axes) != 3:
+            raise BalancingConfigError(f"{spec.path}: [balancing.{key}] centre and semi_axes "
+                                       "need 3 values each")
+        ell[link] = ([_si(spec, v, "length", key) for v in e.centre],
+                     [_si(spec, v, "length", key) for v in e.semi_axes])
+    return ell
+
+
+def balancing_config(spec: Any) -> BalancingConfig:
+    """The ``[balancing]`` table of a loaded spec as a typed, SI :class:`BalancingConfig`."""
+    table = balancing_table(spec)
+    nt = table.normalisation
+
+    def optional(value: Any, kind: str, key: str) -> float | None:
+        return None if value is None else _si(spec, value, kind, f"normalisation.{key}")
+
+    norm = NormalisationConfig(
+        mass=optional(nt.mass, "mass", "mass"), length=optional(nt.length, "length", "length"),
+        speed=optional(nt.speed, "angular_velocity", "speed"),
+        bearing_length=optional(nt.bearing_length, "length", "bearing_length"))
+    pareto = None
+    if table.pareto is not None:
+        measures, divisions = table.pareto.measures, table.pareto.divisions
+        if any(k not in MEASURES for k in measures) or len(measures) < 2:
+            raise BalancingConfigError(f"{spec.path}: [balancing.pareto.measures] must be at "
+                                       f"least two of {list(MEASURES)}; got {list(measures)}")
+        if divisions < 1:
+            raise BalancingConfigError(f"{spec.path}: [balancing.pareto.divisions] must be >= 1; "
+                                       f"got {divisions}")
+        pareto = (tuple(table.pareto.measures), table.pareto.divisions)
+    return BalancingConfig(blocks=tuple(blocks_from_table(spec, table)),
+                           weights=dict(table.weights), gravity=table.gravity,
+                           normalisation=norm, bound=_bound(spec, table), pareto=pareto)

@@ -1,0 +1,144 @@
+"""JSON documents of every job's result (SI units; docs/cli.md): the analysis of a
+:class:`~screwkit.kinematics.motion.Motion`, the dynamics of one mode, the synthesis results.
+Built here, in the io layer, from typed results — the CLI and the reports only format them."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from screwkit.dynamics import Dynamics
+from screwkit.kinematics.coupler_curves import coupler_point_path
+from screwkit.kinematics.motion import Motion
+from screwkit.synthesis.config import SynthesisRun
+
+ANALYSIS_UNITS = {"length": "m", "angle": "rad", "time": "s",
+                  "velocities": "d/dt of each variable (rad/s or m/s)",
+                  "accelerations": "d2/dt2 of each variable (rad/s^2 or m/s^2)"}
+
+
+def _constant_or_list(values: np.ndarray) -> float | list[float]:
+    v = np.asarray(values, dtype=float)
+    return float(v[0]) if np.all(v == v[0]) else v.tolist()
+
+
+def analysis_document(motion: Motion, *, name: str | None = None,
+                      coupler_point: tuple[float, float, float] | None = None,
+                      coupler_link: int = 1) -> dict[str, Any]:
+    """The analysis document of ``screwkit analyze`` (docs/cli.md): every mode with every
+    variable (joint freedoms and the seed's names), rates, accelerations, events, the closure
+    residual and, when asked, the coupler point's path (on link ``coupler_link``)."""
+    lk = motion.linkage
+    modes: list[dict[str, Any]] = []
+    for md in motion.modes:
+        entry: dict[str, Any] = {
+            "mode": md.index,
+            "label": md.label,
+            "assembles": md.assembles,
+            "singular": md.singular,
+            "events": list(md.events),
+            "variables": md.variables,
+            "velocities": md.velocities,
+            "accelerations": md.accelerations,
+            "closure_residual": md.closure_residual,
+        }
+        if coupler_point is not None:
+            p = coupler_point_path(md, coupler_point, coupler_link)
+            entry["coupler_point"] = {"x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
+        modes.append(entry)
+    doc: dict[str, Any] = {
+        "method": motion.method,
+        "solver": motion.solver,
+        "mechanism": name or lk.name,
+        "family": lk.family or "LOOP",
+        "units": ANALYSIS_UNITS,
+        "input_name": lk.inputs[0],
+        "input": motion.inputs[:, 0] if motion.inputs.shape[1] == 1 else motion.inputs,
+        "input_speed": _constant_or_list(motion.input_rates[:, 0]),
+        "input_acceleration": _constant_or_list(motion.input_accelerations[:, 0]),
+        "parameters": dict(lk.parameters),
+        "modes": modes,
+    }
+    if motion.notes:
+        doc["method_note"] = "; ".join(motion.notes)
+    return doc
+
+
+def dynamics_document(dyn: Dynamics, *, mode: int, note: str | None = None) -> dict[str, Any]:
+    """The document of ``screwkit dynamics``: the loads (:meth:`Dynamics.as_dict`), the mode,
+    the RMS/peak summary, what is indeterminate, and a note on non-assembling samples."""
+    doc = dyn.as_dict()
+    if note is not None:
+        doc["note"] = note
+    doc["mode"] = mode
+    doc["gravity_on"] = bool(np.any(dyn.gravity != 0))
+    doc["summary"] = dyn.summary()
+    doc["indeterminacy"] = dyn.indeterminacy.describe()
+    return doc
+
+
+def result_document(result: Any) -> dict[str, Any]:
+    """A `SynthesisResult` as a JSON-able dict (SI units, radians)."""
+    rc = result.range_check
+    return {
+        "dimensions": dict(result.dimensions),
+        "mode": result.inversion,
+        "mode_sign": result.mode_sign,
+        "objective": result.objective,
+        "E_phi": result.E_phi,
+        "E_S": result.E_S,
+        "length_scale": result.length_scale,
+        "rmse": result.rmse,
+        "rmse_phi": result.rmse_phi,
+        "rmse_S": result.rmse_S,
+        "max_dev_phi": result.max_dev_phi,
+        "max_dev_S": result.max_dev_S,
+        "gradient_norm": result.gradient_norm,
+        "relative_gradient": result.relative_gradient,
+        "iterations": result.iterations,
+        "evaluations": result.evaluations,
+        "time": result.time,
+        "status": result.status,
+        "message": result.message,
+        "range_check": {"ok": rc.ok, "gaps": [list(g) for g in rc.gaps],
+                        "branch_mismatch": list(rc.branch_mismatch),
+                        "min_transmission": rc.min_transmission, "message": rc.message},
+        "rows": result.rows,
+    }
+
+
+def overlay_document(outcome: Any) -> dict[str, Any]:
+    """An `OverlayOutcome` as a JSON-able dict: the least-squares document shape (the analysed
+    mechanism's errors and rows) plus ``method`` and the ``overlay`` keys."""
+    doc = result_document(outcome.result)
+    c = outcome.circle
+    doc["method"] = "overlay"
+    doc["overlay"] = {
+        "output_direction": "ccw" if outcome.output_direction > 0 else "cw",
+        "centre": list(c.centre),
+        "d3": c.d3,
+        "phi01": c.phi01,
+        "d2_chosen": outcome.d2_chosen,
+        "d2": c.d2,
+        "d2_refined": c.d2 != outcome.d2_chosen,
+        "circle_residual": [float(v) for v in c.circle_residual],
+        "max_circle_miss": outcome.max_circle_miss,
+        "fit_status": c.status,
+        "dwell_curvature_radii": list(outcome.dwell_curvature_radii),
+    }
+    return doc
+
+
+def synthesis_document(run: SynthesisRun, spec_path: Any) -> dict[str, Any]:
+    """The document of ``screwkit synthesize``: the best result with the alternatives."""
+    if run.overlay is not None:
+        docs = [overlay_document(o) for o in run.overlay]
+    else:
+        docs = [result_document(r) for r in run.results]
+        for d in docs:
+            d["method"] = "least_squares"
+    doc = dict(docs[0])
+    doc["alternatives"] = docs[1:]
+    doc["spec"] = str(spec_path)
+    return doc

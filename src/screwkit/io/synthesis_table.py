@@ -1,0 +1,428 @@
+"""The ``[synthesis]`` table of a spec file: validated with pydantic and turned, once, into a typed
+:class:`~screwkit.synthesis.config.SynthesisConfig` (the problem of its route, SI units).
+
+Keys are documented in docs/synthesis.md.  Numbers take the spec's ``[units]`` (angles usually
+in degrees, lengths in the spec's length unit); strings with units ("1 in", "80 deg") work too.
+The start of the unknowns is the spec's ``[dimensions]`` table, overridden by
+``[synthesis.start]`` (which also holds theta01 and the starts of free q1, q2).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from screwkit.io.errors import SpecError
+from screwkit.io.units import UnitError, to_si
+from screwkit.kinematics.registry import require
+from screwkit.synthesis.config import Multistart, SynthesisConfig
+from screwkit.synthesis.overlay import OverlayDwell
+from screwkit.synthesis.overlay_route import OverlayProblem
+from screwkit.synthesis.problem import (
+    ANGLE_NAMES,
+    DIMENSION_NAMES,
+    ConstraintConstruction,
+    ConstraintPoint,
+    RSRCSynthesisProblem,
+)
+from screwkit.synthesis.targets import (
+    LIBRARY,
+    DesiredFunction,
+    ScrewTarget,
+    data_function,
+    expression_function,
+    library_function,
+)
+
+if TYPE_CHECKING:
+    from screwkit.io.spec import MechanismSpec
+
+__all__ = ["MultistartTable", "OverlayTable", "SynthesisConfigError", "SynthesisTable",
+           "overlay_problem_from_spec", "problem_from_spec", "synthesis_config",
+           "synthesis_from_spec"]
+
+Value = float | int | str
+
+
+class SynthesisConfigError(SpecError):
+    """A ``[synthesis]`` table that cannot be used; the message names the key."""
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class RangeTable(_Strict):
+    start: Value
+    stop: Value
+    step: Value
+
+
+class DataTable(_Strict):
+    theta: list[Value]
+    value: list[Value]
+
+
+class ComponentTable(_Strict):
+    """One component of the desired screw: a library function, an expression, or data."""
+
+    function: str | None = None
+    parameters: dict[str, Value] = Field(default_factory=dict)
+    expression: str | None = None
+    data: DataTable | None = None
+    design_points: list[Value] | RangeTable | None = None
+
+    @model_validator(mode="after")
+    def _one_source(self) -> ComponentTable:
+        given = [k for k in ("function", "expression", "data") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError("give exactly one of function, expression or data "
+                             f"(got {given or 'none'})")
+        if self.function is not None and self.function not in LIBRARY:
+            raise ValueError(f"unknown function {self.function!r}; choose one of {sorted(LIBRARY)}")
+        if self.design_points is None and self.data is None:
+            raise ValueError("design_points are needed (a list, or {start, stop, step})")
+        return self
+
+
+class PointTable(_Strict):
+    theta: Value
+    q: Value = "dwell"
+    other_tangency: bool = False
+
+
+class ConstraintsTable(_Strict):
+    method: Literal["parameters"] = "parameters"
+    points: list[PointTable]
+    rotation_between: Value | None = None
+
+    @model_validator(mode="after")
+    def _two(self) -> ConstraintsTable:
+        if len(self.points) != 2:
+            raise ValueError(f"parameters of constraint need exactly 2 points, got "
+                             f"{len(self.points)}")
+        return self
+
+
+class MultistartTable(_Strict):
+    starts: int = Field(20, ge=1, le=10000)
+    seed: int = 0
+    keep: int = Field(3, ge=1, le=100)
+    spread: float = Field(0.5, gt=0.0, le=3.0)
+
+
+class DwellTable(_Strict):
+    theta: Value
+    tangency: Literal["interior", "exterior"] = "interior"
+
+
+class OverlayTable(_Strict):
+    """``[synthesis.overlay]``: options of the overlay technique (§5.4)."""
+
+    dwells: list[DwellTable] = Field(default_factory=list)
+    keep: int = Field(3, ge=1, le=100)
+    starts: int = Field(12, ge=1, le=1000)
+    d3_range: list[Value] | None = None
+
+    @model_validator(mode="after")
+    def _check(self) -> OverlayTable:
+        if len(self.dwells) > 2:
+            raise ValueError(f"at most two dwells can be placed on the overlay, got "
+                             f"{len(self.dwells)} (two fix the output circle already)")
+        if self.d3_range is not None and len(self.d3_range) != 2:
+            raise ValueError("d3_range must be [lower, upper]")
+        return self
+
+
+OVERLAY_UNKNOWNS = ({"d3", "a", "b"}, {"d2", "d3", "a", "b"})
+
+
+class SynthesisTable(_Strict):
+    method: Literal["least_squares", "overlay"] = "least_squares"
+    unknowns: list[str] | None = None
+    inversion: int | Literal["all"] = "all"
+    input_direction: Literal["ccw", "cw"] = "ccw"
+    output_direction: Literal["ccw", "cw", "both"] = "ccw"
+    length_scale: Value | None = None
+    max_iterations: int = Field(1000, ge=1, le=1_000_000)
+    time_limit: float = Field(10.0, gt=0.0, le=3600.0)
+    start: dict[str, Value] = Field(default_factory=dict)
+    bounds: dict[str, list[Value]] = Field(default_factory=dict)
+    rotation: ComponentTable | None = None
+    translation: ComponentTable | None = None
+    constraints: ConstraintsTable | None = None
+    multistart: MultistartTable | None = None
+    overlay: OverlayTable | None = None
+
+    @model_validator(mode="after")
+    def _check(self) -> SynthesisTable:
+        if isinstance(self.inversion, int) and self.inversion not in (1, 2, 3, 4):
+            raise ValueError("inversion must be 1, 2, 3, 4 or \"all\"")
+        if self.rotation is None and self.translation is None:
+            raise ValueError("give a rotation and/or a translation to generate")
+        if self.method == "overlay":
+            return self._check_overlay()
+        if self.unknowns is None:
+            raise ValueError("unknowns: give the names to solve for (method = \"least_squares\")")
+        if self.overlay is not None:
+            raise ValueError("[synthesis.overlay] belongs to method = \"overlay\"; set method "
+                             "or remove the table")
+        if self.output_direction == "both":
+            raise ValueError("output_direction = \"both\" is for method = \"overlay\"; the "
+                             "least-squares route solves one sense (\"ccw\" or \"cw\")")
+        for name, pair in self.bounds.items():
+            if len(pair) != 2:
+                raise ValueError(f"bounds.{name} must be [lower, upper]")
+        return self
+
+    def _check_overlay(self) -> SynthesisTable:
+        if self.rotation is None:
+            raise ValueError("the overlay technique fits the output rotation: give "
+                             "[synthesis.rotation] (the translation is only evaluated)")
+        unused = [k for k in ("constraints", "multistart") if getattr(self, k) is not None]
+        unused += ["bounds"] if self.bounds else []
+        unused += ["inversion"] if self.inversion != "all" else []
+        if unused:
+            raise ValueError(f"{unused} not used by method = \"overlay\" (it finds the output "
+                             "circle and the assembly mode from the overlay; dwells go in "
+                             "[synthesis.overlay] dwells)")
+        if self.unknowns is not None and set(self.unknowns) not in OVERLAY_UNKNOWNS:
+            raise ValueError(f"unknowns of the overlay are [\"d3\", \"a\", \"b\"] or, to refine "
+                             f"the coupler too, [\"d2\", \"d3\", \"a\", \"b\"]; got {self.unknowns}")
+        return self
+
+
+def _fail(path: str, key: str, message: str) -> SynthesisConfigError:
+    return SynthesisConfigError(f"{path}: [synthesis.{key}] {message}")
+
+
+def _kind(name: str) -> str:
+    return "angle" if name in ANGLE_NAMES else "length"
+
+
+@dataclass(frozen=True)
+class _Parsed:
+    """The parts of a ``[synthesis]`` table that both routes share (SI units)."""
+
+    table: SynthesisTable
+    si: Callable[[Any, str, str], float]
+    start: dict[str, float]
+    target: ScrewTarget
+    length_scale: float
+    show: Callable[[float, str], str]
+
+
+def synthesis_from_spec(spec: MechanismSpec
+                        ) -> tuple[RSRCSynthesisProblem | OverlayProblem, SynthesisTable]:
+    """The problem of either route, as the ``[synthesis]`` table's ``method`` asks."""
+    if isinstance(spec.raw.synthesis, dict) and spec.raw.synthesis.get("method") == "overlay":
+        return overlay_problem_from_spec(spec)
+    return problem_from_spec(spec)
+
+
+def _parse(spec: MechanismSpec) -> _Parsed:
+    path = spec.path
+    try:
+        require(spec.linkage, "synthesize")
+    except ValueError as exc:
+        raise SynthesisConfigError(f"{path}: [synthesis] {exc}") from None
+    raw: dict[str, Any] | None = spec.raw.synthesis
+    if raw is None:
+        raise SynthesisConfigError(f"{path}: no [synthesis] table; see docs/synthesis.md")
+    try:
+        table = SynthesisTable.model_validate(raw)
+    except ValidationError as exc:
+        lines = [f"{path}: the [synthesis] table is not valid:"]
+        for err in exc.errors():
+            loc = ".".join(str(p) for p in err["loc"])
+            msg = ("unknown key (see docs/synthesis.md)" if err["type"] == "extra_forbidden"
+                   else err["msg"])
+            lines.append(f"  [synthesis.{loc}] {msg}")
+        raise SynthesisConfigError("\n".join(lines)) from None
+    units = spec.units
+
+    def si(value: Any, kind: str, key: str) -> float:
+        try:
+            return to_si(value, kind, units.get(kind))
+        except UnitError as exc:
+            raise _fail(path, key, str(exc)) from None
+
+    angle_unit = si(1.0, "angle", "units")
+    length_unit = si(1.0, "length", "units")
+    start: dict[str, float] = dict(spec.dimensions)
+    for name, value in table.start.items():
+        if name not in (*DIMENSION_NAMES, "q1", "q2"):
+            raise _fail(path, f"start.{name}", f"unknown name; use {list(DIMENSION_NAMES)}, q1, q2")
+        start[name] = si(value, _kind(name), f"start.{name}")
+    if "theta01" not in start:
+        raise _fail(path, "start.theta01", "give the start (or value) of theta01, the input "
+                    "angle at which the desired screw starts")
+
+    def component(tab: ComponentTable, kind: str, key: str) -> tuple[DesiredFunction, np.ndarray]:
+        unit = angle_unit if kind == "angle" else length_unit
+        pts: np.ndarray | None = None
+        if tab.design_points is not None:
+            dp = tab.design_points
+            if isinstance(dp, RangeTable):
+                a, b, h = (si(v, "angle", f"{key}.design_points") for v in (dp.start, dp.stop,
+                                                                             dp.step))
+                if h <= 0 or b < a:
+                    raise _fail(path, f"{key}.design_points", "need step > 0 and stop >= start")
+                pts = a + h * np.arange(int(np.floor((b - a) / h + 1e-9)) + 1)
+            else:
+                pts = np.array([si(v, "angle", f"{key}.design_points") for v in dp])
+        try:
+            if tab.function is not None:
+                params = {}
+                for pname, pval in tab.parameters.items():
+                    pkind = {"amplitude": kind, "span": "angle"}.get(pname, "dimensionless")
+                    params[pname] = si(pval, pkind, f"{key}.parameters.{pname}")
+                fn = library_function(tab.function, **params)
+            elif tab.expression is not None:
+                fn = expression_function(tab.expression, angle_unit=angle_unit, value_unit=unit,
+                                         parameters={k: float(si(v, "dimensionless", key))
+                                                     for k, v in tab.parameters.items()})
+            else:
+                assert tab.data is not None
+                th = [si(v, "angle", f"{key}.data.theta") for v in tab.data.theta]
+                val = [si(v, kind, f"{key}.data.value") for v in tab.data.value]
+                fn = data_function(th, val)
+                if pts is None:
+                    pts = np.array(th)
+        except ValueError as exc:
+            raise _fail(path, key, str(exc)) from None
+        assert pts is not None
+        return fn, pts
+
+    rot = component(table.rotation, "angle", "rotation") if table.rotation else None
+    tra = component(table.translation, "length", "translation") if table.translation else None
+    try:
+        target = ScrewTarget(rot[0] if rot else None, rot[1] if rot else np.zeros(0),
+                             tra[0] if tra else None, tra[1] if tra else np.zeros(0))
+    except ValueError as exc:
+        raise _fail(path, "rotation", str(exc)) from None
+    scale = (length_unit if table.length_scale is None
+             else si(table.length_scale, "length", "length_scale"))
+
+    def show(value: float, kind: str) -> str:
+        """An SI value in the spec's unit of ``kind`` (and in SI when that differs)."""
+        si_unit = "m" if kind == "length" else "rad"
+        unit = units.get(kind)
+        if unit is None or unit == si_unit:
+            return f"{float(value):.6g} {si_unit}"
+        return f"{float(value) / si(1.0, kind, 'units'):.6g} {unit} ({float(value):.6g} {si_unit})"
+
+    return _Parsed(table, si, start, target, scale, show)
+
+
+def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, SynthesisTable]:
+    """Validate ``spec.raw.synthesis`` and build the least-squares problem (SI units inside)."""
+    parsed = _parse(spec)
+    table, si, start, target = parsed.table, parsed.si, parsed.start, parsed.target
+    path = spec.path
+    if table.method != "least_squares":
+        raise SynthesisConfigError(f"{path}: [synthesis] method = {table.method!r}: use "
+                                   "overlay_problem_from_spec (screwkit synthesize does)")
+    assert table.unknowns is not None
+    construction = None
+    if table.constraints is not None:
+        pts_c = []
+        for i, pt in enumerate(table.constraints.points, start=1):
+            theta = si(pt.theta, "angle", f"constraints.points[{i}].theta")
+            if isinstance(pt.q, str) and pt.q in ("dwell", "free"):
+                kind_q = pt.q
+                value = start.get(f"q{i}", 0.0)
+                if kind_q == "free" and f"q{i}" not in start:
+                    raise _fail(path, f"start.q{i}", f"q{i} is free: give its start value")
+            else:
+                kind_q = "fixed"
+                value = si(pt.q, "angle", f"constraints.points[{i}].q")
+            pts_c.append(ConstraintPoint(theta, kind_q, value, pt.other_tangency))  # type: ignore[arg-type]
+        between = (None if table.constraints.rotation_between is None
+                   else si(table.constraints.rotation_between, "angle",
+                           "constraints.rotation_between"))
+        try:
+            construction = ConstraintConstruction(pts_c[0], pts_c[1], between)
+        except ValueError as exc:
+            raise _fail(path, "constraints", str(exc)) from None
+    bounds = {}
+    for name, (lo, hi) in table.bounds.items():
+        bounds[name] = (si(lo, _kind(name), f"bounds.{name}"), si(hi, _kind(name), f"bounds.{name}"))
+    for name, (lo, hi) in bounds.items():
+        value = start.get(name, lo)
+        if lo < hi and not lo <= value <= hi:
+            k = _kind(name)
+            raise _fail(path, f"bounds.{name}", f"the start of {name}, {parsed.show(value, k)}, is "
+                        f"outside its bounds [{parsed.show(lo, k)}, {parsed.show(hi, k)}]: move "
+                        "the start ([dimensions] or [synthesis.start]) inside them or widen the "
+                        "bounds")
+    scale = parsed.length_scale
+    try:
+        problem = RSRCSynthesisProblem(
+            target=target, start=start, unknowns=tuple(table.unknowns), bounds=bounds,
+            inversion=None if table.inversion == "all" else int(table.inversion),
+            input_direction=1 if table.input_direction == "ccw" else -1,
+            output_direction=1 if table.output_direction == "ccw" else -1,
+            length_scale=scale, construction=construction,
+            max_iterations=table.max_iterations, time_limit=table.time_limit)
+    except ValueError as exc:
+        raise SynthesisConfigError(f"{path}: [synthesis] {exc}") from None
+    return problem, table
+
+
+def overlay_problem_from_spec(spec: MechanismSpec) -> tuple[OverlayProblem, SynthesisTable]:
+    """Validate a ``[synthesis]`` table with ``method = "overlay"`` and build the overlay problem
+    (Bagci 1969, §5.4).  d1, d2, lambda0, delta0 (must be 0) and e come from ``[dimensions]`` /
+    ``[synthesis.start]``, theta01 from ``[synthesis.start]``; d3, a, b are found."""
+    parsed = _parse(spec)
+    table, si, start = parsed.table, parsed.si, parsed.start
+    path = spec.path
+    if table.method != "overlay":
+        raise SynthesisConfigError(f"{path}: [synthesis] method is {table.method!r}, not "
+                                   "\"overlay\"")
+    if abs(math.sin(start.get("delta0", 0.0))) > 1e-12:
+        raise _fail(path, "start.delta0", "the overlay technique needs delta0 = 0 (the coupler "
+                    "ellipse is then a circle of radius d2, Bagci §5.4); use method = "
+                    "\"least_squares\" for delta0 != 0")
+    for name in ("d1", "d2", "lambda0"):
+        if name not in start:
+            raise _fail(path, f"start.{name}", f"the overlay needs {name} (in [dimensions] or "
+                        "[synthesis.start])")
+    ov = table.overlay if table.overlay is not None else OverlayTable.model_validate({})
+    dwells = tuple(OverlayDwell(si(d.theta, "angle", f"overlay.dwells[{i}].theta"), d.tangency)
+                   for i, d in enumerate(ov.dwells, start=1))
+    d3_range = None
+    if ov.d3_range is not None:
+        lo, hi = (si(v, "length", "overlay.d3_range") for v in ov.d3_range)
+        if not 0 < lo < hi:
+            raise _fail(path, "overlay.d3_range", "need 0 < lower < upper, got "
+                        f"[{parsed.show(lo, 'length')}, {parsed.show(hi, 'length')}]")
+        d3_range = (lo, hi)
+    senses = {"ccw": (1,), "cw": (-1,), "both": (1, -1)}[table.output_direction]
+    try:
+        problem = OverlayProblem(
+            target=parsed.target, d1=start["d1"], d2=start["d2"], lambda0=start["lambda0"],
+            theta01=start["theta01"], e=start.get("e", 0.0),
+            input_direction=1 if table.input_direction == "ccw" else -1,
+            output_directions=senses, dwells=dwells,
+            refine_d2=table.unknowns is not None and "d2" in table.unknowns, keep=ov.keep,
+            n_starts=ov.starts, d3_range=d3_range, length_scale=parsed.length_scale,
+            max_iterations=table.max_iterations, time_limit=table.time_limit)
+    except ValueError as exc:
+        raise SynthesisConfigError(f"{path}: [synthesis] {exc}") from None
+    return problem, table
+
+
+def synthesis_config(spec: MechanismSpec) -> SynthesisConfig:
+    """The ``[synthesis]`` table of a loaded spec as a typed :class:`SynthesisConfig`."""
+    problem, table = synthesis_from_spec(spec)
+    ms = table.multistart
+    multistart = None if ms is None else Multistart(ms.starts, ms.seed, ms.keep, ms.spread)
+    unit = spec.units.get("length", "m")
+    length_unit = f"1 {unit}" if table.length_scale is None else str(table.length_scale)
+    return SynthesisConfig(problem, multistart, length_unit)

@@ -1,0 +1,182 @@
+"""Closed forms as solvers of a :class:`~screwkit.kinematics.motion.Motion`: the RSRC quartic, the
+planar 4R and the CSSP quadratic, each returning the same type, fields and mode numbering as the
+generic loop solver (:func:`~screwkit.kinematics.solve_motion.solve_motion` dispatches here
+through the family registry).
+
+Each adapter turns the closed form's branches into joint configurations of the family's
+:class:`~screwkit.model.Linkage` and hands them to
+:func:`~screwkit.kinematics.mode_frames.mode_from_configuration`, so link frames, twists and every
+joint rate follow from the same rate equations as for any loop; the seed's own variables and their
+closed-form rates are added under the seed's names (an independent check of the rate equations:
+the tests compare both).
+
+Mode numbering (docs/conventions.md): the closed form's branches that assemble somewhere over the
+sweep, in the closed form's order — RSRC/4R: the columns of :func:`rsrc_motion` (branches
+labelled by Bagci's root order at the first sample); CSSP: the root s4 = −b + √(b² − c)
+(Rahman's branch) first, then the other root.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics.loop import Array, Configuration, close_spherical_joint, layout
+from screwkit.kinematics.mode_frames import mode_from_configuration
+from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion, format_inputs
+from screwkit.model.linkage import Linkage
+
+RSRC_SOLVER = "RSRC closed form: quartic in tan(φ0/2) (Bagci 1969 eqs. 3.59–3.82)"
+FOURBAR_SOLVER = "planar 4R closed form: Bagci's RSRC with δ0 = λ0 = b = e = 0 (§3.4)"
+CSSP_SOLVER = "CSSP closed form: quadratic in s4 (Rahman 1996 §1.2)"
+
+
+def _with_seed(mode: ModeMotion, index: int, label: str, seed: tuple[dict[str, Array], ...],
+               singular: NDArray[np.bool_] | None = None) -> ModeMotion:
+    """``mode`` with the seed's variables added (NaN outside the mask) and its index; samples
+    the closed form finds singular (e.g. a locked RSRC) lose their rates too."""
+    ok = mode.assembles
+    tables = []
+    for general, named in zip((mode.variables, mode.velocities, mode.accelerations), seed,
+                              strict=True):
+        merged = {k: np.where(ok, np.asarray(v, dtype=float), np.nan) for k, v in named.items()}
+        merged.update(general)
+        tables.append(merged)
+    sing = mode.singular if singular is None else (mode.singular | singular)
+    for v in [*tables[1].values(), *tables[2].values(), mode.link_angular_velocity,
+              mode.link_origin_velocity, mode.link_angular_acceleration,
+              mode.link_origin_acceleration]:
+        v[sing] = np.nan
+    return replace(mode, variables=tables[0], velocities=tables[1], accelerations=tables[2],
+                   singular=sing, index=index, label=label)
+
+
+def _no_modes(linkage: Linkage, X: Array) -> AssemblyError:
+    return AssemblyError(
+        f"{linkage.name}: the loop does not close at any of the {len(X)} inputs "
+        f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
+        "check the dimensions")
+
+
+def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
+    """Every assembly mode of Bagci's RSRC (or its planar 4R case) from the quartic; the
+    branches of :func:`~screwkit.kinematics.rsrc.rsrc_motion` become modes."""
+    from screwkit.kinematics.rsrc import RSRCDimensions, RSRCPositions, rsrc_motion, rsrc_rates
+
+    planar = linkage.family == "4R"
+    p = dict(linkage.parameters)
+    if planar:
+        dims = RSRCDimensions(d1=p["d1"], d2=p["d2"], d3=p["d3"], a=p["a"], b=0.0, e=0.0,
+                              delta0=0.0, lambda0=0.0)
+    else:
+        dims = RSRCDimensions(**p)
+    theta = X[:, 0]
+    mot = rsrc_motion(dims, theta)
+    pos = RSRCPositions(mot.theta0, mot.phi0, mot.chi0, mot.S, mot.assembles, dims.special_case)
+    rates = rsrc_rates(dims, pos, Xd[:, 0], Xdd[:, 0])
+    lay = layout(linkage)
+    modes: list[ModeMotion] = []
+    for j in range(mot.phi0.shape[1]):
+        ok = mot.assembles[:, j]
+        if not ok.any():
+            continue
+        phi = np.where(ok, mot.phi0[:, j], 0.0)
+        chi = np.where(ok, mot.chi0[:, j], 0.0)
+        s = np.where(ok, mot.S[:, j], 0.0)
+        events = [f"{e.kind} assembling at input [{e.theta0!r}] (limit position or dead centre)"
+                  for e in mot.events if e.branch == j]
+        if planar:
+            conf = _fourbar_configuration(p, theta, phi)
+        else:
+            scalars = np.zeros((len(theta), lay.n_scalar))
+            for name, values in (("input.theta", theta), ("coupler_R.theta", chi),
+                                 ("output_C.theta", -phi), ("output_C.s", s)):
+                scalars[:, lay.scalar_col[lay.names.index(name)]] = values
+            conf = close_spherical_joint(linkage, scalars, lay)
+        md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd, events)
+        seed_v = {"theta0": theta, "phi0": mot.phi0[:, j], "chi0": mot.chi0[:, j]}
+        seed_d = {"theta0": Xd[:, 0], "phi0": rates.phi0_dot[:, j], "chi0": rates.chi0_dot[:, j]}
+        seed_dd = {"theta0": Xdd[:, 0], "phi0": rates.phi0_ddot[:, j],
+                   "chi0": rates.chi0_ddot[:, j]}
+        if not planar:
+            seed_v["S"], seed_d["S"], seed_dd["S"] = mot.S[:, j], rates.S_dot[:, j], rates.S_ddot[:, j]
+        modes.append(_with_seed(md, len(modes), f"branch {len(modes)} (root order at the first "
+                                f"sample: label {int(np.max(mot.inversion_label[ok, j][:1]))})",
+                                (seed_v, seed_d, seed_dd), singular=ok & ~rates.valid[:, j]))
+    if not modes:
+        raise _no_modes(linkage, X)
+    return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed",
+                  solver=FOURBAR_SOLVER if planar else RSRC_SOLVER)
+
+
+def _fourbar_configuration(p: dict[str, float], theta: Array, phi: Array) -> Configuration:
+    """Joint angles of :func:`~screwkit.model.families.fourbar` from θ0 and φ0 (both measured
+    from the line of centres): crank pin c1 = d1(cos θ0, sin θ0), rocker pin
+    c2 = (a, 0) + d3(cos φ0, sin φ0), coupler direction γ = ∠(c2 − c1); the relative angles are
+    θ0, γ − θ0, φ0 + π − γ and −φ0 (they sum to 2π with the frame link's half turn)."""
+    c1 = p["d1"] * np.stack([np.cos(theta), np.sin(theta)], -1)
+    c2 = np.stack([p["a"] + p["d3"] * np.cos(phi), p["d3"] * np.sin(phi)], -1)
+    gamma = np.arctan2(c2[:, 1] - c1[:, 1], c2[:, 0] - c1[:, 0])
+    scalars = np.stack([theta, gamma - theta, phi + np.pi - gamma, -phi], -1)
+    return Configuration(scalars, np.zeros((len(theta), 0, 3, 3)))
+
+
+def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
+    """Both roots of Rahman's quadratic in s4 (§1.2) as modes, from the fused closed form
+    (:func:`~screwkit.kinematics.cssp_motion.cssp_mode_motion`), with the seed's angles θ2, η2
+    (rod) and θ3, η3 (slider ball) and their exact rates. The two roots stay separate: they meet
+    only at a branch point, where the mode stops."""
+    from screwkit.kinematics.cssp import CSSPDimensions, cssp_motion
+    from screwkit.kinematics.cssp_motion import cssp_mode_motion
+
+    p = dict(linkage.parameters)
+    dims = CSSPDimensions(p["a1"], p["a2"], p["a4"], p["alpha4"], p.get("s1", 0.0))
+    theta = X[:, 0]
+    names = ("s4", "theta2", "eta2", "theta3", "eta3")
+    modes: list[ModeMotion] = []
+    for root, label in ((1, "s4 = -b + sqrt(b^2 - c)"), (-1, "s4 = -b - sqrt(b^2 - c)")):
+        driven = len(linkage.inputs) == 2  # the crank offset s1 is a second input
+        md = cssp_mode_motion(linkage, theta, Xd[:, 0], Xdd[:, 0], mode=root, allow_partial=True,
+                              s1=X[:, 1] if driven else None, s1_dot=Xd[:, 1] if driven else 0.0,
+                              s1_ddot=Xdd[:, 1] if driven else 0.0)
+        ok = np.asarray(md.assembles)
+        if not ok.any():
+            continue
+        # the seed's angles with their closed-form rates (for a fixed crank offset; with a
+        # driven one the registry's names from the link frames are used)
+        cf = None if driven else cssp_motion(dims, theta, Xd[:, 0], Xdd[:, 0], mode=root,
+                                             allow_partial=True)
+        seed_v: dict[str, Array] = {"theta1": theta}
+        seed_d: dict[str, Array] = {"theta1": Xd[:, 0]}
+        seed_dd: dict[str, Array] = {"theta1": Xdd[:, 0]}
+        if cf is not None:
+            for n in names:
+                seed_v[n] = getattr(cf, n)
+                seed_d[n] = getattr(cf, f"{n}_dot")
+                seed_dd[n] = getattr(cf, f"{n}_ddot")
+            for key in ("theta2", "eta2", "theta3", "eta3"):
+                seed_v[key] = unwrap_runs(np.where(ok, seed_v[key], np.nan), ok)
+        stops = np.nonzero(ok[:-1] & ~ok[1:])[0]
+        starts = np.nonzero(~ok[:-1] & ok[1:])[0] + 1
+        events = [f"stops assembling after input [{theta[i]!r}] (branch point before "
+                  f"[{theta[i + 1]!r}])" for i in stops]
+        events += [f"starts assembling at input [{theta[i]!r}]" for i in starts]
+        md = replace(md, events=events)
+        modes.append(_with_seed(md, len(modes), label, (seed_v, seed_d, seed_dd)))
+    if not modes:
+        raise _no_modes(linkage, X)
+    return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=CSSP_SOLVER)
+
+
+def unwrap_runs(angle: Array, ok: NDArray[np.bool_]) -> Array:
+    """Continuous angles along each run of assembling samples, each run starting in (−π, π]."""
+    out = np.array(angle, dtype=float)
+    idx = np.flatnonzero(ok & np.isfinite(out))
+    if idx.size == 0:
+        return out
+    for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1):
+        values = np.unwrap(out[run])
+        out[run] = values - 2 * np.pi * np.round(values[0] / (2 * np.pi))
+    return out

@@ -1,0 +1,121 @@
+"""``solve_motion``: the one entry point of the kinematics — every assembly mode of a loop over
+an input sweep, with velocities and accelerations, from a family's closed form or the generic
+loop solver, as one :class:`~screwkit.kinematics.motion.Motion`."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from screwkit.kinematics.generic_motion import generic_motion
+from screwkit.kinematics.loop import Array
+from screwkit.kinematics.motion import ModeMotion, Motion, as_input_array
+from screwkit.kinematics.registry import family_of, seed_variables
+from screwkit.model.linkage import Linkage
+
+METHODS = ("auto", "closed", "generic")
+
+
+def solve_motion(
+    linkage: Linkage,
+    inputs: ArrayLike,
+    *,
+    rates: ArrayLike = 1.0,
+    accelerations: ArrayLike = 0.0,
+    method: str = "auto",
+    starts: int = 48,
+    seed: int = 0,
+) -> Motion:
+    """Positions, velocities and accelerations of every freedom and link of ``linkage`` over an
+    input sweep, in every assembly mode.
+
+    Parameters
+    ----------
+    linkage:
+        the loop (read only).
+    inputs:
+        (N,) input values for a one-input loop, or (N, n_inputs): radians for a rotation,
+        metres for a translation.
+    rates, accelerations:
+        the inputs' first and second time derivatives (rad/s, rad/s² or m/s, m/s²): a scalar
+        for all samples or one value per sample.
+    method:
+        ``"closed"`` the family's closed form (RSRC quartic, Bagci 1969 eqs. 3.59–3.82; the planar
+        4R as its δ0 = λ0 = b = e = 0 case; the CSSP quadratic in s4, Rahman 1996 §1.2);
+        ``"generic"`` the generic loop solver (any loop; docs/kinematics.md); ``"auto"`` the
+        closed form where the family has one and the sweep has at least 2 samples.
+    starts, seed:
+        random starts per sample and their seed, for the generic solver's root search.
+
+    Both methods give the same fields and the same mode numbering (docs/conventions.md,
+    "Assembly modes"): generic modes are numbered as the closed form's where a family has one.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be 'auto', 'closed' or 'generic'; got {method!r}")
+    X = as_input_array(linkage, inputs, "inputs")
+    Xd = np.array(np.broadcast_to(as_input_array(linkage, rates, "rates"), X.shape))
+    Xdd = np.array(np.broadcast_to(as_input_array(linkage, accelerations, "accelerations"),
+                                   X.shape))
+    fam = family_of(linkage)
+    closed = fam.closed_form if X.shape[0] >= 2 else None
+    if method == "closed" and closed is None:
+        with_closed = ", ".join(f.name for f in _families_with_closed_forms())
+        raise ValueError(
+            f"no closed form for a {fam.name} with {X.shape[0]} input sample(s) (closed forms: "
+            f"{with_closed}, with at least 2 input samples); use method 'generic'")
+    if method in ("auto", "closed") and closed is not None:
+        return closed(linkage, X, Xd, Xdd)
+    motion = generic_motion(linkage, X, Xd, Xdd, starts=starts, seed=seed)
+    modes = tuple(_with_seed_names(linkage, md) for md in motion.modes)
+    notes = motion.notes
+    if fam.closed_form is not None and closed is not None:
+        modes = _numbered_as(modes, closed(linkage, X, Xd, Xdd).modes, linkage.length_scale)
+    elif fam.closed_form is not None and method == "auto":
+        notes += ("one input sample: the generic solver was used (the closed form tracks "
+                  "branches over at least 2 samples)",)
+    return replace(motion, modes=modes, notes=notes)
+
+
+def _families_with_closed_forms() -> list:  # type: ignore[type-arg]
+    from screwkit.kinematics.registry import FAMILIES
+
+    return [f for f in FAMILIES.values() if f.closed_form is not None]
+
+
+def _with_seed_names(linkage: Linkage, mode: ModeMotion) -> ModeMotion:
+    """A generic mode with the seed's variable names added (from its joint variables)."""
+    named = seed_variables(linkage, mode)
+    tables = tuple({**n, **general} for n, general in
+                   zip(named, (mode.variables, mode.velocities, mode.accelerations), strict=True))
+    return replace(mode, variables=tables[0], velocities=tables[1], accelerations=tables[2])
+
+
+def _agreement(a: ModeMotion, b: ModeMotion, length: float) -> int:
+    """Samples where two modes are the same configuration (joint centres within 1e-6 of the
+    length scale)."""
+    both = a.assembles & b.assembles
+    if not both.any():
+        return 0
+    d = np.max(np.abs(a.joint_centres[both] - b.joint_centres[both]), axis=(1, 2))
+    return int(np.sum(d < 1e-6 * length))
+
+
+def _numbered_as(modes: tuple[ModeMotion, ...], reference: tuple[ModeMotion, ...],
+                 length: float) -> tuple[ModeMotion, ...]:
+    """Generic ``modes`` renumbered as the closed form's ``reference`` modes: mode k is the
+    generic branch that is the same configuration as closed-form mode k over most samples.
+    Where the closed form continues a branch past a limit position the generic solver may start
+    a new one; such extra branches, and any without a counterpart, follow in their own order."""
+    score: Array = np.array([[_agreement(g, r, length) for r in reference] for g in modes]
+                            ).reshape(len(modes), len(reference))
+    order: list[int] = []
+    for k in range(len(reference)):
+        candidates = [g for g in np.argsort(-score[:, k], kind="stable")
+                      if score[g, k] > 0 and int(g) not in order
+                      and int(np.argmax(score[g])) == k]
+        if candidates:
+            order.append(int(candidates[0]))
+    order += [g for g in range(len(modes)) if g not in order]
+    return tuple(replace(modes[g], index=k) for k, g in enumerate(order))

@@ -1,0 +1,128 @@
+"""One pipeline from a spec file to every job's result: spec → :class:`Motion` (solved once) →
+dynamics → balancing; and the spec's synthesis, limits and mobility. The CLI, ``demo`` and the
+report all go through a :class:`Pipeline`, so the motion of a spec is solved exactly once per
+run, whichever jobs run on it (docs/architecture.md)."""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import numpy as np
+
+from screwkit.balancing.config import BalancingConfig, balance_with_config
+from screwkit.balancing.errors import BalancingError
+from screwkit.balancing.result import BalanceResult
+from screwkit.constants import STANDARD_GRAVITY
+from screwkit.dynamics import Dynamics, inverse_dynamics
+from screwkit.io.errors import SpecError
+from screwkit.io.spec import Spec
+from screwkit.kinematics.limit_positions import LimitPositions, limit_positions
+from screwkit.kinematics.loop_mobility import LinkageMobility, mobility
+from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
+from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.synthesis.config import SynthesisConfig, SynthesisRun, run_synthesis
+
+
+class Pipeline:
+    """The jobs of one spec, sharing one solved motion.
+
+    ``method`` chooses the solver (``"auto"``, ``"closed"``, ``"generic"``; see
+    :func:`~screwkit.kinematics.solve_motion.solve_motion`)."""
+
+    def __init__(self, spec: Spec, *, method: str = "auto") -> None:
+        self.spec = spec
+        self.method = method
+
+    @cached_property
+    def motion(self) -> Motion:
+        """Every assembly mode over the spec's ``[motion]`` sweep (solved on first use only)."""
+        s = self.spec
+        return solve_motion(s.linkage, s.inputs, rates=s.speed, accelerations=s.acceleration,
+                            method=self.method)
+
+    @property
+    def gravity_vector(self) -> np.ndarray:
+        """The spec's gravity (magnitude along ``gravity_direction``), m/s²."""
+        g = self.spec.gravity_magnitude or STANDARD_GRAVITY
+        return np.asarray(g * self.spec.gravity_direction, dtype=float)
+
+    def mode(self) -> ModeMotion:
+        """The assembly mode of ``[motion] mode`` (what dynamics and balancing use)."""
+        try:
+            return self.motion.mode(self.spec.mode)
+        except AssemblyError as exc:
+            raise SpecError(f"{self.spec.path}: [motion.mode] {exc}") from None
+
+    def not_assembling(self, mode: ModeMotion) -> str | None:
+        """A sentence naming, in the spec's units, the inputs where ``mode`` does not assemble
+        or is singular; None if it assembles everywhere."""
+        ok = np.asarray(mode.assembles) & ~np.asarray(mode.singular)
+        if ok.all():
+            return None
+        s = self.spec
+        x = np.asarray(s.inputs, dtype=float).reshape(len(ok), -1)[:, 0]
+        bad = np.degrees(x[~ok]) if s.input_is_angle else x[~ok]
+        unit = "deg" if s.input_is_angle else "m"
+        shown = ", ".join(f"{v:.6g}" for v in bad[:8]) + (" …" if bad.size > 8 else "")
+        return (f"mode {s.mode} does not assemble (or is singular) at {int(bad.size)} of "
+                f"{ok.size} inputs ({shown} {unit})")
+
+    def dynamics(self, gravity: bool = False) -> Dynamics:
+        """Shaking force and moment, joint reactions and input efforts of ``[motion] mode``
+        (loads are null where the mode does not assemble)."""
+        s = self.spec
+        missing = [link.name for link in s.linkage.links if link.mass is None]
+        if missing:
+            raise SpecError(f"{s.path}: dynamics needs mass properties for every link; add "
+                            f"[links.{missing[0]}] (missing: {missing}; see docs/spec-format.md)")
+        mode = self.mode()
+        partial = self.not_assembling(mode) is not None
+        return inverse_dynamics(s.linkage, mode, self.gravity_vector if gravity else None,
+                                inputs=s.inputs, allow_partial=partial)
+
+    def balancing_config(self) -> BalancingConfig:
+        if self.spec.balancing is None:
+            raise BalancingError(f"{self.spec.path}: no [balancing] table; see docs/balancing.md")
+        return self.spec.balancing
+
+    def balance(self, mode: ModeMotion | None = None) -> BalanceResult:
+        """The spec's ``[balancing]`` run on ``[motion] mode`` (or on ``mode`` if given)."""
+        s = self.spec
+        config = self.balancing_config()
+        if mode is None:
+            try:
+                mode = self.mode()
+            except SpecError as exc:
+                raise BalancingError(str(exc)) from None
+        problem = self.not_assembling(mode)
+        if problem is not None:
+            raise BalancingError(
+                f"{s.path}: [motion] {problem}; balancing needs loads over the whole sweep. "
+                "Change [motion] start/stop/step to a range where the mode assembles, choose "
+                "another [motion] mode, or change the dimensions so that the linkage turns fully")
+        return balance_with_config(s.linkage, mode, config, speed=s.speed,
+                                   gravity=self.gravity_vector, inputs=s.inputs)
+
+    def synthesis_config(self) -> SynthesisConfig:
+        if self.spec.synthesis is None:
+            raise SpecError(f"{self.spec.path}: no [synthesis] table; see docs/synthesis.md")
+        return self.spec.synthesis
+
+    def synthesize(self, starts: int | None = None) -> SynthesisRun:
+        """The spec's ``[synthesis]`` run (either route), best result first."""
+        return run_synthesis(self.synthesis_config(), starts=starts)
+
+    def limits(self, dwell_tolerance: float = 1e-6, at: list[float] | None = None
+               ) -> LimitPositions:
+        """Limit positions and dwell orders (Bagci App. D); ``at`` in radians."""
+        return limit_positions(self.spec.linkage, dwell_tolerance, at=at)
+
+    def mobility(self) -> LinkageMobility:
+        """Formula and Jacobian mobility at the first input where the loop assembles."""
+        return mobility(self.spec.linkage, self.spec.inputs)
+
+
+def balance_from_spec(spec: Spec, *, mode_motion: ModeMotion | None = None) -> BalanceResult:
+    """Run the balancing of a loaded spec's ``[balancing]`` table on ``[motion] mode`` (or on
+    ``mode_motion``, which skips the kinematics)."""
+    return Pipeline(spec).balance(mode_motion)
