@@ -12,6 +12,7 @@ import pytest
 
 from conftest import EXAMPLE
 from screwkit.balancing import BalancingError
+from screwkit.io.balance_tables import write_balance_tables
 from screwkit.io.spec import load_spec
 from screwkit.pipeline import balance_from_spec
 
@@ -106,8 +107,8 @@ def test_tables_on_an_existing_file(tmp_path):
     assert afile.read_text() == "keep me"
     res = balance_from_spec(load_spec(spec))
     with pytest.raises(BalancingError, match="needs a folder"):
-        res.write_tables(str(afile))
-    paths = res.write_tables(str(tmp_path / "new" / "tables"))
+        write_balance_tables(res, str(afile))
+    paths = write_balance_tables(res, str(tmp_path / "new" / "tables"))
     assert len(paths) == 7 and all(Path(p).is_file() for p in paths)
     assert not list((tmp_path / "new" / "tables").glob(".*"))  # no temporary files left
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -27,9 +28,12 @@ from screwkit.balancing.problem import (
 from screwkit.balancing.result import BalanceResult
 from screwkit.balancing.variables import DesignVariables, VariableBlock, assemble
 from screwkit.dynamics import Dynamics, Regressor, regressor
-from screwkit.kinematics.motion import ModeMotion
+from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
+
+if TYPE_CHECKING:
+    from screwkit.balancing.config import BalancingConfig
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,6 +86,7 @@ def _rod_description(linkage: Linkage, mode: ModeMotion, k: int) -> str:
     """Transverse principal moments and CoM offset of S–S link k about the line of its ball
     centres (at the first assembled sample), for the error message."""
     mp = linkage.links[k].mass
+    assert mp is not None  # only links with mass properties are described
     i = int(np.flatnonzero(mode.assembles & ~mode.singular)[0])
     R, o = mode.link_rotation[i, k], mode.link_origin[i, k]
     c0, c1 = mode.joint_centres[i, k], mode.joint_centres[i, (k + 1) % len(linkage.joints)]
@@ -103,7 +108,7 @@ def _check_idle_spin(linkage: Linkage, mode: ModeMotion, reg: Regressor,
     an S–S rod must be axisymmetric about the line of its ball centres, CoM on that line, for
     its idle spin to carry no load). Otherwise the consistency equalities cannot hold and the
     QP would only report "infeasible constraints"."""
-    if reg.residual.size == 0 or reg._setup.structure.idle_count == 0:
+    if reg.residual.size == 0 or reg.indeterminacy.idle_freedoms == 0:
         return
     dyn = reg.apply(variables.physical_parameters(variables.original))
     worst = float(np.max(dyn.relative_residual, initial=0.0))
@@ -173,7 +178,7 @@ def solve_setup(setup: BalancingSetup, weights: Mapping[str, float]) -> BalanceR
             "the optimum is not unique: the Hessian is singular and the loads do not change "
             f"along {len(opt.directions)} direction(s) of the variables; the member nearest to "
             "the original design (least relative change) is returned")
-    indeterminate = setup.regressor._setup.structure.indeterminate_count
+    indeterminate = setup.regressor.indeterminacy.count
     if indeterminate and (w["R"] > 0 or w["M"] > 0):
         notes.append(
             f"{indeterminate} reaction component(s) are statically indeterminate (overconstrained "
@@ -203,23 +208,54 @@ def solve_setup(setup: BalancingSetup, weights: Mapping[str, float]) -> BalanceR
 
 
 def balance(
-    linkage: Linkage,
-    mode: ModeMotion,
-    blocks: Sequence[VariableBlock],
-    weights: Mapping[str, float],
+    linkage: Linkage | Motion,
+    mode: ModeMotion | int,
+    blocks: Sequence[VariableBlock] | BalancingConfig,
+    weights: Mapping[str, float] | None = None,
     *,
-    speed: float,
+    speed: float | None = None,
     gravity: ArrayLike | None = None,
     normalisation: Normalisation | None = None,
     inputs: ArrayLike | None = None,
 ) -> BalanceResult:
-    """Optimum balancing of one assembly mode (Rahman 1996 ch. 4, corrected; docs/balancing.md).
+    """Optimum balancing of one assembly mode (Rahman 1996 ch. 4, corrected; docs/balancing.md):
+    the design variables that minimise the weighted mean squares of the shaking force and
+    moment, bearing forces and moments and input torque over the cycle (a convex QP).
+
+    ``balance(motion, k, blocks, weights)`` balances mode ``k`` of a solved
+    :class:`~screwkit.kinematics.motion.Motion` (speed ω from its input rates);
+    ``balance(linkage, mode_motion, blocks, weights, speed=ω)`` one mode's
+    :class:`~screwkit.kinematics.motion.ModeMotion` of ``linkage``.
 
     ``blocks`` — design variables (:func:`~screwkit.balancing.variables.point_mass_variables`,
-    :func:`~screwkit.balancing.variables.counterweight_variables`); ``weights`` — W by measure
-    name (``F``, ``T``, ``R``, ``M``, ``T0``); ``speed`` — the input speed ω for the seed's
-    normalisation (or give ``normalisation``).
+    :func:`~screwkit.balancing.variables.counterweight_variables`), or a whole
+    :class:`~screwkit.balancing.config.BalancingConfig` (then ``weights`` come from it);
+    ``weights`` — W by measure name (``F``, ``T``, ``R``, ``M``, ``T0``); ``speed`` — the input
+    speed ω (rad/s) of the seed's normalisation (or give ``normalisation``); ``gravity`` — the
+    gravitational acceleration vector (m/s²), or none.
     """
+    from screwkit.balancing.config import BalancingConfig, balance_with_config
+
+    if isinstance(linkage, Motion):
+        motion = linkage
+        linkage, mode = motion.linkage, motion.mode(int(mode))  # type: ignore[arg-type]
+        inputs = motion.inputs if inputs is None else inputs
+        if speed is None:
+            rates = motion.input_rates[:, 0]
+            if not np.all(rates == rates[0]) and normalisation is None:
+                raise BalancingError("the input speed varies over the motion: give speed= (the "
+                                     "ω of the normalisation) or a normalisation")
+            speed = float(rates[0])
+    if not isinstance(mode, ModeMotion):
+        raise BalancingError("with a linkage, give one mode's ModeMotion (motion.mode(k)); or "
+                             "pass the Motion itself: balance(motion, k, ...)")
+    if speed is None:
+        raise BalancingError("give speed= (the input speed ω, rad/s, of the normalisation)")
+    if isinstance(blocks, BalancingConfig):
+        return balance_with_config(linkage, mode, blocks, speed=speed, gravity=gravity,
+                                   inputs=inputs)
+    if weights is None:
+        raise BalancingError("give the weights by measure name, e.g. {'F': 1.0, 'T0': 0.5}")
     setup = prepare(linkage, mode, blocks, speed=speed, gravity=gravity,
                     normalisation=normalisation, inputs=inputs)
     return solve_setup(setup, weights)

@@ -104,7 +104,7 @@ def consistency_constraints(reg: Regressor, variables: DesignVariables) -> list[
     joints would have to carry a moment they cannot. For Rahman's rod this ties the two
     transverse pair masses, x6 = x7 (SPEC §8.3)."""
     R = reg.residual  # (N, m_p, P)
-    if R.size == 0 or reg._setup.structure.idle_count == 0:
+    if R.size == 0 or reg.indeterminacy.idle_freedoms == 0:
         return []
     Rx = (R @ variables.basis).reshape(-1, variables.basis.shape[1]) * variables.scale
     r0 = (R @ variables.pi_fixed + reg.constant["residual"][..., 0]).reshape(-1)

@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.measures import MEASURE_TITLES, MEASURES, Normalisation
 from screwkit.balancing.problem import NonUniqueDirection, QuadraticObjective
 from screwkit.balancing.variables import DesignVariables
@@ -140,43 +139,6 @@ class BalanceResult:
                 rows.append([link, f"{lab} about CoM (kg*m^2)", float(mp0.inertia[i, j]),
                              float(mp1.inertia[i, j])])
         return rows
-
-    def write_tables(self, folder: str) -> list[str]:
-        """CSV files: one per per-sample load and the mass properties, each written atomically;
-        returns the paths. ``folder`` is created if missing; an existing file is refused."""
-        import csv
-        import io
-        from pathlib import Path
-
-        from screwkit.io.results import write_atomic
-
-        out = Path(folder)
-        if out.exists() and not out.is_dir():
-            raise BalancingError(f"--tables needs a folder: {out} is an existing file; give a "
-                                 "folder name (it is created if missing)")
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise BalancingError(f"cannot create the tables folder {out}: {exc.strerror}") from exc
-
-        def csv_text(header: list[list[str]], rows: list[list[Any]]) -> str:
-            buf = io.StringIO()
-            w = csv.writer(buf)
-            w.writerows(header)
-            w.writerows(rows)
-            return buf.getvalue()
-
-        paths = []
-        for key, title, unit in SAMPLE_LOADS:
-            p = out / f"balance_{key}.csv"
-            write_atomic(p, csv_text([[f"# {title} ({unit}); input in rad"],
-                                      ["input", "before", "after"]], self.per_sample_table(key)))
-            paths.append(str(p))
-        p = out / "balance_mass_properties.csv"
-        write_atomic(p, csv_text([["link", "quantity", "before", "after"]],
-                                 self.mass_properties_table()))
-        paths.append(str(p))
-        return paths
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-able (docs/balancing.md documents every key)."""

@@ -35,6 +35,7 @@ def register(app: typer.Typer) -> None:
         from screwkit.cli.common import console
         from screwkit.cli.common import emit as _emit
         from screwkit.cli.common import guard as _guard
+        from screwkit.io.balance_tables import write_balance_tables
         from screwkit.io.spec import load_spec
         from screwkit.pipeline import Pipeline
 
@@ -44,7 +45,7 @@ def register(app: typer.Typer) -> None:
         doc: dict[str, Any] = res.as_dict()
         written: list[str] = []
         if tables is not None:
-            written += _guard(lambda: res.write_tables(str(tables)))
+            written += _guard(lambda: write_balance_tables(res, str(tables)))
         if plots is not None:
             from screwkit.balancing.plots import write_plots
 

@@ -33,6 +33,7 @@ import numpy as np
 
 from screwkit.dynamics import soa
 from screwkit.dynamics.soa import Array, Vec
+from screwkit.kinematics.cssp_motion import NotACSSPError, cssp_dimensions
 from screwkit.model.linkage import Linkage
 
 _KINDS = (("R", "C"), ("S",), ("S",), ("P",))
@@ -58,13 +59,15 @@ class CSSPBlockLoads:
 
 
 def cssp_statics_for(linkage: Linkage) -> CSSPStatics | None:
-    """The closed form applies to a CSSP (family ``"CSSP"``, joints R|C, S, S, P) whose driven
-    freedoms are exactly the crank joint's; ``None`` otherwise (the generic solve is used)."""
+    """The closed form applies to a CSSP built by :func:`screwkit.model.families.cssp` (joints
+    R|C, S, S, P; :func:`~screwkit.kinematics.cssp_motion.cssp_dimensions` accepts it) whose
+    driven freedoms are exactly the crank joint's; ``None`` otherwise (the generic solve is
+    used)."""
+    try:
+        cssp_dimensions(linkage)
+    except NotACSSPError:
+        return None
     joints = linkage.joints
-    if (linkage.family or "").upper() != "CSSP" or len(joints) != 4:
-        return None
-    if not all(j.kind in kinds for j, kinds in zip(joints, _KINDS, strict=True)):
-        return None
     crank = joints[0]
     freedoms = [f"{crank.name}.theta"] + ([f"{crank.name}.s"] if crank.kind == "C" else [])
     if sorted(linkage.inputs) != sorted(freedoms):

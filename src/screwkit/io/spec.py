@@ -23,6 +23,7 @@ from pydantic import (
     field_validator,
 )
 
+from screwkit.constants import STANDARD_GRAVITY
 from screwkit.io.errors import SpecError
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
 from screwkit.kinematics.registry import family, require
@@ -181,7 +182,8 @@ class Spec:
         raise AssertionError  # unreachable
 
     def _rate_kind(self, order: int = 1) -> str:
-        base = "angle" if self.family != "LOOP" or self._loop_input_is_angle() else "length"
+        base = ("angle" if family(self.family).build is not None or self._loop_input_is_angle()
+                else "length")
         if base == "angle":
             return "angular_velocity" if order == 1 else "angular_acceleration"
         return "velocity" if order == 1 else "acceleration"
@@ -191,7 +193,7 @@ class Spec:
         return not ins or ins[0].kind != "P"
 
     def _dimensions(self) -> dict[str, float]:
-        if self.family == "LOOP":
+        if family(self.family).build is None:  # a joint list (LOOP)
             if self.raw.dimensions:
                 self._fail("dimensions", "a LOOP family takes its geometry from [[joints]]; remove [dimensions]")
             return {}
@@ -237,7 +239,7 @@ class Spec:
         unknown = sorted(set(self.raw.links) - set(link_names))
         if unknown:
             self._fail("links", f"no link named {unknown} in a {self.family}; links are {link_names}")
-        g = self.gravity_magnitude if self.gravity_magnitude is not None else 9.80665
+        g = self.gravity_magnitude if self.gravity_magnitude is not None else STANDARD_GRAVITY
         # (gravity > 0 is checked at load)
         out = []
         for name in link_names:

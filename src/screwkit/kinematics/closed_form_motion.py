@@ -19,6 +19,7 @@ labelled by Bagci's root order at the first sample); CSSP: the root s4 = −b + 
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,6 +28,9 @@ from screwkit.kinematics.loop import Array, Configuration, close_spherical_joint
 from screwkit.kinematics.mode_frames import mode_from_configuration
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion, format_inputs
 from screwkit.model.linkage import Linkage
+
+if TYPE_CHECKING:
+    from screwkit.kinematics.rsrc import RSRCDimensions
 
 RSRC_SOLVER = "RSRC closed form: quartic in tan(φ0/2) (Bagci 1969 eqs. 3.59–3.82)"
 FOURBAR_SOLVER = "planar 4R closed form: Bagci's RSRC with δ0 = λ0 = b = e = 0 (§3.4)"
@@ -60,18 +64,26 @@ def _no_modes(linkage: Linkage, X: Array) -> AssemblyError:
         "check the dimensions")
 
 
+def rsrc_dimensions(linkage: Linkage) -> tuple[RSRCDimensions, bool]:
+    """Bagci's RSRC dimensions of a linkage built by :func:`~screwkit.model.families.rsrc` or
+    :func:`~screwkit.model.families.fourbar` (the plane case δ0 = λ0 = b = e = 0), and whether
+    it is the planar 4R (four R joints)."""
+    from screwkit.kinematics.rsrc import RSRCDimensions
+
+    p = dict(linkage.parameters)
+    if all(j.kind == "R" for j in linkage.joints):
+        return RSRCDimensions(d1=p["d1"], d2=p["d2"], d3=p["d3"], a=p["a"], b=0.0, e=0.0,
+                              delta0=0.0, lambda0=0.0), True
+    return RSRCDimensions(**p), False
+
+
 def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
     """Every assembly mode of Bagci's RSRC (or its planar 4R case) from the quartic; the
     branches of :func:`~screwkit.kinematics.rsrc.rsrc_motion` become modes."""
-    from screwkit.kinematics.rsrc import RSRCDimensions, RSRCPositions, rsrc_motion, rsrc_rates
+    from screwkit.kinematics.rsrc import RSRCPositions, rsrc_motion, rsrc_rates
 
-    planar = linkage.family == "4R"
+    dims, planar = rsrc_dimensions(linkage)
     p = dict(linkage.parameters)
-    if planar:
-        dims = RSRCDimensions(d1=p["d1"], d2=p["d2"], d3=p["d3"], a=p["a"], b=0.0, e=0.0,
-                              delta0=0.0, lambda0=0.0)
-    else:
-        dims = RSRCDimensions(**p)
     theta = X[:, 0]
     mot = rsrc_motion(dims, theta)
     pos = RSRCPositions(mot.theta0, mot.phi0, mot.chi0, mot.S, mot.assembles, dims.special_case)

@@ -163,7 +163,7 @@ def _slider_and_rod(
     }
 
 
-def _elevation_azimuth(
+def elevation_azimuth(
     v: Array, v_dot: Array, v_ddot: Array
 ) -> tuple[BoolArray, Array, Array, Array, Array, Array, Array]:
     """Elevation E = atan2(v_z, ρ) and azimuth A = atan2(v_y, v_x) of a unit vector v(t),
@@ -476,10 +476,10 @@ def _solve(
         core[key] = np.where(mask, value, np.nan)
 
     u, ud, udd = core["rod_direction"], core["rod_direction_dot"], core["rod_direction_ddot"]
-    rod_ok, elev, e_d, e_dd, phi, phi_d, phi_dd = _elevation_azimuth(u, ud, udd)
+    rod_ok, elev, e_d, e_dd, phi, phi_d, phi_dd = elevation_azimuth(u, ud, udd)
     sa, ca = np.sin(dims.alpha4), np.cos(dims.alpha4)
     to_slider = np.array([[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]])  # X(α4) = R_{4←1}
-    slider_ok, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = _elevation_azimuth(
+    slider_ok, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = elevation_azimuth(
         u @ to_slider.T, ud @ to_slider.T, udd @ to_slider.T
     )
     rod_ok &= assembles

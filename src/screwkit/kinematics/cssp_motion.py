@@ -67,8 +67,7 @@ def cssp_dimensions(linkage: Linkage) -> CSSPDimensions:
     (read from ``linkage.parameters``); raises :class:`NotACSSPError` for any other linkage."""
     kinds = tuple(j.kind for j in linkage.joints)
     ok = (
-        linkage.family == "CSSP"
-        and len(kinds) == 4
+        len(kinds) == 4
         and all(k in allowed for k, allowed in zip(kinds, _JOINTS, strict=True))
         and all(key in linkage.parameters for key in ("a1", "a2", "a4", "alpha4", "s1"))
     )
@@ -77,7 +76,7 @@ def cssp_dimensions(linkage: Linkage) -> CSSPDimensions:
             f"cssp_mode_motion needs a CSSP built by screwkit.model.families.cssp (joints "
             f"R|C, S, S, P and parameters a1, a2, a4, alpha4, s1); got {linkage.name!r} "
             f"(family {linkage.family!r}, joints {''.join(kinds)}). Use "
-            "screwkit.kinematics.motion.motion for other loops."
+            "screwkit.solve_motion for other loops."
         )
     p = linkage.parameters
     return CSSPDimensions(p["a1"], p["a2"], p["a4"], p["alpha4"], p["s1"])

@@ -74,8 +74,8 @@ def limit_positions(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: 
     translation limits by the corrected eq. D.3; dwell order = number of vanishing consecutive
     derivatives dᵏφ0/dθ0ᵏ, k = 1…max_order, within ``dwell_tolerance`` rad/radᵏ). ``at``: input
     angles (rad) where the dwell order of every inversion is wanted too."""
+    from screwkit.kinematics.closed_form_motion import rsrc_dimensions
     from screwkit.kinematics.rsrc import (
-        RSRCDimensions,
         rsrc_dwell_order,
         rsrc_positions,
         rsrc_rotation_limits,
@@ -85,10 +85,7 @@ def limit_positions(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: 
     fam = require(linkage, "limits")
     if not dwell_tolerance > 0:
         raise ValueError(f"the dwell tolerance must be positive; got {dwell_tolerance}")
-    p = dict(linkage.parameters)
-    planar = fam.name == "4R"
-    dims = (RSRCDimensions(d1=p["d1"], d2=p["d2"], d3=p["d3"], a=p["a"], b=0.0, e=0.0,
-                           delta0=0.0, lambda0=0.0) if planar else RSRCDimensions(**p))
+    dims, planar = rsrc_dimensions(linkage)
     out: list[LimitPosition] = []
     rot = rsrc_rotation_limits(dims)
     if rot:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from screwkit.kinematics.cssp import elevation_azimuth
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.families import rsrc_seed_variables
@@ -54,7 +55,9 @@ def fourbar_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Nam
 
 
 def cssp_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]:
-    """θ1, s4, θ2, η2 of a CSSP mode (Rahman 1996 §1.2) from its rod direction and rates."""
+    """θ1, s4, θ2, η2, θ3, η3 of a CSSP mode (Rahman 1996 §1.2) from its rod direction u and
+    its rates: the rod's azimuth θ1 + θ2 and elevation −η2 in the crank frame, and u's elevation
+    θ3 and azimuth η3 in the slider frame X(α4)·u (reference SPEC §1.1)."""
     a2 = linkage.parameters["a2"]
     c = mode.joint_centres
     u = (c[:, 2] - c[:, 1]) / a2
@@ -62,24 +65,23 @@ def cssp_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]
     al = mode.link_angular_acceleration[:, 1]
     ud = np.cross(w, u)
     udd = np.cross(al, u) + np.cross(w, ud)
-    th1 = mode.variables["crank.theta"]
-    th1d = mode.velocities["crank.theta"]
-    th1dd = mode.accelerations["crank.theta"]
-    r2 = u[:, 0] ** 2 + u[:, 1] ** 2
-    cross_xy = u[:, 0] * ud[:, 1] - u[:, 1] * ud[:, 0]
-    psi = np.arctan2(u[:, 1], u[:, 0])
-    ok = mode.assembles
+    crank = linkage.joints[0].name
+    slider = linkage.joints[-1].name
+    th1 = mode.variables[f"{crank}.theta"]
+    th1d = mode.velocities[f"{crank}.theta"]
+    th1dd = mode.accelerations[f"{crank}.theta"]
+    _, elev, e_d, e_dd, psi, psi_d, psi_dd = elevation_azimuth(u, ud, udd)
+    ok = mode.assembles & np.isfinite(psi)
     psi[ok] = np.unwrap(psi[ok])
-    psid = cross_xy / r2
-    psidd = (u[:, 0] * udd[:, 1] - u[:, 1] * udd[:, 0]) / r2 - 2 * cross_xy * (
-        u[:, 0] * ud[:, 0] + u[:, 1] * ud[:, 1]) / r2**2
-    wz = -u[:, 2]
-    root = np.sqrt(1 - wz**2)
-    eta = np.arcsin(wz)
-    etad = -ud[:, 2] / root
-    etadd = -udd[:, 2] / root + wz * (ud[:, 2] ** 2) / root**3
-    s4 = mode.variables["slider.s"]
-    return ({"theta1": th1, "s4": s4, "theta2": psi - th1, "eta2": eta},
-            {"theta1": th1d, "s4": mode.velocities["slider.s"], "theta2": psid - th1d, "eta2": etad},
-            {"theta1": th1dd, "s4": mode.accelerations["slider.s"], "theta2": psidd - th1dd,
-             "eta2": etadd})
+    sa, ca = np.sin(linkage.parameters["alpha4"]), np.cos(linkage.parameters["alpha4"])
+    to_slider = np.array([[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]])  # X(α4)
+    _, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = elevation_azimuth(
+        u @ to_slider.T, ud @ to_slider.T, udd @ to_slider.T)
+    ok3 = mode.assembles & np.isfinite(eta3)
+    eta3[ok3] = np.unwrap(eta3[ok3])
+    return ({"theta1": th1, "s4": mode.variables[f"{slider}.s"], "theta2": psi - th1,
+             "eta2": -elev, "theta3": th3, "eta3": eta3},
+            {"theta1": th1d, "s4": mode.velocities[f"{slider}.s"], "theta2": psi_d - th1d,
+             "eta2": -e_d, "theta3": th3_d, "eta3": eta3_d},
+            {"theta1": th1dd, "s4": mode.accelerations[f"{slider}.s"], "theta2": psi_dd - th1dd,
+             "eta2": -e_dd, "theta3": th3_dd, "eta3": eta3_dd})

@@ -22,6 +22,7 @@ import numpy as np
 
 from screwkit.dual import ScrewMatrix
 from screwkit.model.joints import Joint
+from screwkit.model.mass import MassProperties
 
 
 class LinkageError(ValueError):
@@ -34,7 +35,7 @@ class Link:
     link's body frame; ``None`` when no dynamics is asked for."""
 
     name: str
-    mass: Any = None
+    mass: MassProperties | None = None
 
 
 @dataclass(frozen=True, eq=False)

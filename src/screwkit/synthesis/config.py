@@ -48,9 +48,17 @@ class SynthesisRun:
 
 def run_synthesis(config: SynthesisConfig | RSRCSynthesisProblem | OverlayProblem, *,
                   starts: int | None = None, seed: int | None = None) -> SynthesisRun:
-    """Solve a synthesis by its route. ``starts`` overrides the number of starts (multistart of
-    the least-squares route, or the overlay's circle-fit starts); ``seed`` the multistart's random
-    seed. One start with a given inversion (or parameters of constraint) is a single solve."""
+    """Dimensional synthesis of an RSRC (or its plane 4R case) for a desired screw displacement
+    ψ_d(θ) + ε S_d(θ) (Bagci 1969 ch. V): least squares with exact derivatives (Programs B and C,
+    dwell and range constraints by the parameters of constraint, eqs. 5.13–5.21), or the overlay
+    technique (§5.4). Dimensions in SI units (m) and radians; results best first.
+
+    ``config``: a :class:`SynthesisConfig` (``spec.synthesis``) or a bare problem
+    (:class:`~screwkit.synthesis.problem.RSRCSynthesisProblem`,
+    :class:`~screwkit.synthesis.overlay_route.OverlayProblem`). ``starts`` overrides the number
+    of starts (multistart of the least-squares route, or the overlay's circle-fit starts);
+    ``seed`` the multistart's random seed. One start with a given inversion (or parameters of
+    constraint) is a single solve."""
     if not isinstance(config, SynthesisConfig):
         config = SynthesisConfig(config)
     problem = config.problem
