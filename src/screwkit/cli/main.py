@@ -226,6 +226,7 @@ def demo(
     examples: Annotated[Path, typer.Argument(help="Folder of spec files.")] = Path("examples"),
     output_dir: Annotated[Path, typer.Option("--output-dir", help="Where results are written.")] = Path("out"),
     plots: Annotated[bool, typer.Option("--plots/--no-plots", help="Also write a PNG per example.")] = True,
+    write_reports: Annotated[bool, typer.Option("--reports/--no-reports", help="Also write each example's animated HTML report (<example>.html).")] = True,
 ) -> None:
     """Run the main job on every bundled example: validate, analyse, write the results and an animated HTML report per example (out/index.html links them)."""
     from screwkit.io.results import dumps, write_atomic
@@ -271,12 +272,13 @@ def demo(
             syn = _guard(lambda s=spec: synthesis_document(s))  # type: ignore[misc]
             write_atomic(output_dir / f"{f.stem}.synthesis.json", dumps(syn) + "\n")
             jobs.append("synthesis")
-        from screwkit.cli.report_cmd import write_spec_report
+        if write_reports:
+            from screwkit.cli.report_cmd import write_spec_report
 
-        bal_doc = bal.as_dict() if "balance" in jobs else None
-        syn_doc = syn if "synthesis" in jobs else None
-        _guard(lambda s=spec, f=f, b=bal_doc, y=syn_doc: write_spec_report(  # type: ignore[misc]
-            s, output_dir / f"{f.stem}.html", balance_doc=b, synthesis_doc=y))
+            bal_doc = bal.as_dict() if "balance" in jobs else None
+            syn_doc = syn if "synthesis" in jobs else None
+            _guard(lambda s=spec, f=f, b=bal_doc, y=syn_doc: write_spec_report(  # type: ignore[misc]
+                s, output_dir / f"{f.stem}.html", balance_doc=b, synthesis_doc=y))
         res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)
         asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])
         t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", ", ".join(jobs))
@@ -297,7 +299,7 @@ def demo(
         entries.append({
             "name": f.stem, "family": spec.family, "description": spec.describe(),
             "jobs": [(j, f"{f.stem}.{j}.json") for j in jobs], "summary": summary,
-            "picture": f"{f.stem}.analysis.png" if plots else None, "report": f"{f.stem}.html",
+            "picture": f"{f.stem}.analysis.png" if plots else None, "report": f"{f.stem}.html" if write_reports else None,
         })
     console.print(t)
     from screwkit.report.html import write_index

@@ -143,7 +143,7 @@ def render_still(scene: dict[str, Any], path: str | Path, *, mode: int = 0, fram
 
 
 def render_animation(scene: dict[str, Any], path: str | Path, *, mode: int = 0,
-                     fps: float | None = None, dpi: int = 80) -> None:
+                     fps: int | None = None, dpi: int = 80) -> None:
     """The whole cycle of one mode as an animation: ``.gif`` (Pillow, always there with
     matplotlib) or ``.mp4`` (needs ffmpeg on the PATH)."""
     _check(scene, mode)

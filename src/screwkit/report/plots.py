@@ -81,7 +81,7 @@ def continuous_rotation_vectors(rv: np.ndarray) -> np.ndarray:
     return out
 
 
-def _flat_axis(ax: Any, ys: list[np.ndarray]) -> None:
+def flatten_constant_axis(ax: Any, ys: list[np.ndarray]) -> None:
     """No offset notation, and a curve that is constant to round-off is shown as a flat line
     (a constant rate was drawn as noise on a 1e-10 axis offset by 6.283185307)."""
     ax.ticklabel_format(axis="y", useOffset=False, style="plain")
@@ -141,7 +141,7 @@ def plot_analysis(doc: dict[str, Any], path: str | Path) -> None:
             ax.set_title(f"{name}{label} ({unit}{per})")
             ax.set_xlabel(f"{doc['input_name']} (deg)")
             ax.grid(True, alpha=0.3)
-            _flat_axis(ax, ys)
+            flatten_constant_axis(ax, ys)
         axes[r, 0].legend(fontsize=8)
     if has_cp:
         for c, (i, j) in enumerate((("x", "y"), ("x", "z"), ("y", "z"))):

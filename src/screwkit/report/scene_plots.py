@@ -48,7 +48,8 @@ def _series(name: str, y: Any, mode: int | None = None, x: Any = None,
 
 
 def _variable_names(modes: list[Any], inputs: tuple[str, ...],
-                    seeds: list[tuple[dict[str, Array], ...]] | None) -> list[str]:
+                    seeds: list[tuple[dict[str, Array], dict[str, Array], dict[str, Array]]] | None,
+                    ) -> list[str]:
     if seeds and seeds[0][0]:
         source = [s[0] for s in seeds]
     else:
@@ -66,7 +67,7 @@ def _variable_names(modes: list[Any], inputs: tuple[str, ...],
 
 def kinematic_plots(modes: list[Any], x: Array, input_name: str, kind: str,
                     units: dict[str, Any], inputs: tuple[str, ...],
-                    seeds: list[tuple[dict[str, Array], ...]] | None = None,
+                    seeds: list[tuple[dict[str, Array], dict[str, Array], dict[str, Array]]] | None = None,
                     ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Each output variable, its rate and its acceleration against the input, one series per
     assembly mode (joint variables; the seed's names instead when ``seeds`` is given)."""
