@@ -134,7 +134,7 @@ class ViewerApp {
     const mode = this.scene.modes[this.mode];
     const ok = this.view.setFrame(i);
     this.slider.value = String(i);
-    this.readout.textContent = `${this.inputText(i)}   (frame ${i + 1} of ${this.N}, ${mode.label})`;
+    this.readout.textContent = `${this.inputText(i)}   (frame ${i} of 0…${this.N - 1}, ${mode.label})`;
     if (!ok) {
       this.status.textContent = `${mode.label} does not assemble at ${this.inputText(i)}: nothing is drawn here.`;
       this.status.className = 'sk-status sk-warn';

@@ -369,7 +369,7 @@ export class MechanismView {
   }
 
   setView(name) {
-    const d = 2.2 * this.size;
+    const d = 1.75 * this.size;
     const dirs = { front: [0, -1, 0], side: [1, 0, 0], top: [0, -1e-3, 1], iso: [1, -1, 0.8] };
     const v = new THREE.Vector3(...(dirs[name] || dirs.iso)).normalize().multiplyScalar(d);
     this.camera.position.copy(this.centre).add(v);

@@ -8,8 +8,9 @@ canvas; the JSON is written with ``<``, ``>``, ``&`` and the JavaScript line sep
 ``\\uXXXX`` escapes, so no ``</script>`` can close its tag early.
 
 Size: joint centres and the input values are kept as float64 (what is drawn matches the
-solver to the last bit), every other array as float32, both base64-encoded: a four-bar with
-two modes over 360 frames and full dynamics is about 1.6 MB, the viewer bundle ~0.8 MB of it.
+solver to the last bit), every other array as float32, both base64-encoded: an RSRC with two
+modes over 360 frames and full dynamics is about 1.3 MB (four modes, 1.5 MB), the viewer
+bundle 0.8 MB of it.
 """
 
 from __future__ import annotations
