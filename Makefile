@@ -4,7 +4,15 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test bench
+.PHONY: demo test bench viewer
+
+# The browser tests (tests/report) drive Debian's chromium; install it when it is missing.
+CHROMIUM := /usr/bin/chromium
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+$(CHROMIUM):
+	$(SUDO) apt-get update -q
+	DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -q chromium
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -23,8 +31,8 @@ demo: $(STAMP)
 		$(BIN)/python validation/$$v.py > out/validation/$$(echo $$v | tr / _).md || exit 1; \
 	done
 
-## Lint, type-check and run the whole test suite.
-test: $(STAMP)
+## Lint, type-check and run the whole test suite (installs Debian's chromium if missing).
+test: $(STAMP) $(CHROMIUM)
 	$(BIN)/ruff check src tests validation benchmarks
 	$(BIN)/mypy
 	$(BIN)/python -m pytest
@@ -33,3 +41,8 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[dev,bench]"
 	$(BIN)/python benchmarks/run.py
+
+## Rebuild the report viewer bundle (three.js + Chart.js) from viewer/ with npm; the built
+## file is committed, so only front-end changes need this.
+viewer:
+	cd viewer && npm ci --no-audit --no-fund && npm run build

@@ -160,7 +160,9 @@ def test_spec_error_is_a_value_error():
 
 
 def test_demo_runs_every_example(tmp_path):
-    r = runner.invoke(app, ["demo", str(EXAMPLES), "--output-dir", str(tmp_path), "--no-plots"])
+    # (the HTML reports are tested in tests/report on a few examples: --no-reports here)
+    r = runner.invoke(app, ["demo", str(EXAMPLES), "--output-dir", str(tmp_path), "--no-plots",
+                            "--no-reports"])
     assert r.exit_code == 0, r.output
     written = sorted(tmp_path.glob("*.analysis.json"))
     assert len(written) == len(list(EXAMPLES.glob("*.toml")))

@@ -73,7 +73,7 @@ def analyze(
 
     def table() -> None:
         console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
-        console.print(f"method: {doc['method']}; angles in degrees, lengths in metres, rates per second (SI)")
+        console.print(f"method: {doc['method']}; angles in deg (rates deg/s, deg/s²), lengths in m (m/s, m/s²)")
         if "method_note" in doc:
             console.print(f"[yellow]note:[/] {escape(doc['method_note'])}", highlight=False)
         for mode in doc["modes"]:
@@ -89,8 +89,8 @@ def analyze(
                 row = [f"{np.degrees(x):8.3f}" if s.input_is_angle else f"{x:.6g}"]
                 for n in names:
                     ang = not (n in ("S", "s4") or n.endswith(".s"))
-                    row += [_fmt(mode["variables"][n][i], ang), _fmt(mode["velocities"][n][i], False),
-                            _fmt(mode["accelerations"][n][i], False)]
+                    row += [_fmt(mode["variables"][n][i], ang), _fmt(mode["velocities"][n][i], ang),
+                            _fmt(mode["accelerations"][n][i], ang)]
                 t.add_row(*row)
             console.print(t)
             for ev in mode["events"]:
@@ -211,8 +211,9 @@ def demo(
     examples: Annotated[Path, typer.Argument(help="Folder of spec files.")] = Path("examples"),
     output_dir: Annotated[Path, typer.Option("--output-dir", help="Where results are written.")] = Path("out"),
     plots: Annotated[bool, typer.Option("--plots/--no-plots", help="Also write a PNG per example.")] = True,
+    write_reports: Annotated[bool, typer.Option("--reports/--no-reports", help="Also write each example's animated HTML report (<example>.html).")] = True,
 ) -> None:
-    """Run the main job on every bundled example: validate, analyse, write the results."""
+    """Run the main job on every bundled example: validate, analyse, write the results and an animated HTML report per example (out/index.html links them)."""
     from screwkit.io.documents import analysis_document, synthesis_document
     from screwkit.io.results import dumps, write_atomic
     from screwkit.io.spec import load_spec
@@ -253,6 +254,13 @@ def demo(
             syn = _guard(lambda p=pipe: synthesis_document(p.synthesize(), p.spec.path))  # type: ignore[misc]
             write_atomic(output_dir / f"{f.stem}.synthesis.json", dumps(syn) + "\n")
             jobs.append("synthesis")
+        if write_reports:
+            from screwkit.report.spec_report import write_spec_report
+
+            bal_doc = bal.as_dict() if "balance" in jobs else None
+            syn_doc = syn if "synthesis" in jobs else None
+            _guard(lambda p=pipe, f=f, b=bal_doc, y=syn_doc: write_spec_report(  # type: ignore[misc]
+                p, output_dir / f"{f.stem}.html", balance_doc=b, synthesis_doc=y))
         res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)
         asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])
         t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", ", ".join(jobs))
@@ -273,7 +281,7 @@ def demo(
         entries.append({
             "name": f.stem, "family": spec.family, "description": spec.describe(),
             "jobs": [(j, f"{f.stem}.{j}.json") for j in jobs], "summary": summary,
-            "picture": f"{f.stem}.analysis.png" if plots else None,
+            "picture": f"{f.stem}.analysis.png" if plots else None, "report": f"{f.stem}.html" if write_reports else None,
         })
     console.print(t)
     from screwkit.report.html import write_index
@@ -286,10 +294,12 @@ def demo(
 
 def _register_subcommands() -> None:
     from screwkit.cli.balance_cmd import register as register_balance
+    from screwkit.cli.report_cmd import register as register_report
     from screwkit.cli.synthesize_cmd import register as register_synthesize
 
     register_synthesize(app)
     register_balance(app)
+    register_report(app)
 
 
 _register_subcommands()

@@ -21,7 +21,7 @@ def _is_angle(name: str) -> bool:
     return name in ANGLE_NAMES or name not in LENGTH_NAMES
 
 
-def _pyplot() -> Any:
+def pyplot() -> Any:
     try:
         import matplotlib
 
@@ -53,10 +53,69 @@ def save_figure(fig: Any, path: str | Path) -> None:
             os.unlink(tmp)
 
 
+def continuous_rotation_vectors(rv: np.ndarray) -> np.ndarray:
+    """Rotation vectors (N, 3) made continuous along the sweep. ``as_rotvec`` keeps |r| ≤ π,
+    so a rotation passing through π jumps to the antipodal vector (−(2π − |r|) r̂, the same
+    rotation); here each sample keeps the axis sign of the one before and the angle is
+    unwrapped, which gives back a smooth curve (|r| may then exceed π). NaN rows (samples that
+    do not assemble) are kept and restart the chain."""
+    out = np.array(rv, dtype=float)
+    ok = np.isfinite(out).all(axis=1)
+    angle = np.linalg.norm(out, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        axis = out / angle[:, None]
+    tiny = ~(angle > 1e-9)
+    start = 0
+    for stop in [*np.nonzero(~ok)[0].tolist(), len(out)]:  # runs between non-assembling samples
+        run = np.arange(start, stop)
+        start = stop + 1
+        if run.size < 2:
+            continue
+        a, th = axis[run], angle[run]
+        dots = np.einsum("ij,ij->i", a[1:], a[:-1])
+        flip = np.where((dots < 0) & ~tiny[run][1:] & ~tiny[run][:-1], -1.0, 1.0)
+        sign = np.concatenate([[1.0], np.cumprod(flip)])
+        th_signed = np.unwrap(sign * th, period=2 * np.pi)
+        a = a * sign[:, None]
+        out[run] = np.where(tiny[run][:, None], out[run], a * th_signed[:, None])
+    return out
+
+
+def flatten_constant_axis(ax: Any, ys: list[np.ndarray]) -> None:
+    """No offset notation, and a curve that is constant to round-off is shown as a flat line
+    (a constant rate was drawn as noise on a 1e-10 axis offset by 6.283185307)."""
+    ax.ticklabel_format(axis="y", useOffset=False, style="plain")
+    finite = np.concatenate([y[np.isfinite(y)] for y in ys]) if ys else np.array([])
+    if finite.size == 0:
+        return
+    lo, hi = float(finite.min()), float(finite.max())
+    scale = max(abs(lo), abs(hi), 1.0)
+    if hi - lo <= 1e-9 * scale:
+        mid = 0.5 * (lo + hi)
+        half = max(0.05 * abs(mid), 1e-3)
+        ax.set_ylim(mid - half, mid + half)
+
+
+def _smoothed(mode: dict[str, Any], key: str) -> dict[str, np.ndarray]:
+    """A mode's table with every spherical joint's rotation vector made continuous."""
+    table = {k: np.asarray(v, dtype=float) for k, v in mode[key].items()}
+    if key != "variables":
+        return table
+    for name in [k for k in table if k.endswith(".rx")]:
+        joint = name[:-3]
+        parts = [f"{joint}.r{a}" for a in "xyz"]
+        if all(p in table for p in parts):
+            rv = continuous_rotation_vectors(np.stack([table[p] for p in parts], axis=1))
+            for a, p in enumerate(parts):
+                table[p] = rv[:, a]
+    return table
+
+
 def plot_analysis(doc: dict[str, Any], path: str | Path) -> None:
     """One row per seed variable (position, velocity, acceleration columns), one line per
-    assembly mode; plus the coupler curve projections when the document has a coupler point."""
-    plt = _pyplot()
+    assembly mode; plus the coupler curve projections when the document has a coupler point.
+    Angles and their rates share one unit (deg, deg/s, deg/s²); lengths are in m."""
+    plt = pyplot()
     x = np.degrees(np.asarray(doc["input"], dtype=float))
     modes = doc["modes"]
     names = [n for n in modes[0]["variables"] if "." not in n and n not in ("theta0", "theta1")]
@@ -65,20 +124,24 @@ def plot_analysis(doc: dict[str, Any], path: str | Path) -> None:
     has_cp = any("coupler_point" in m for m in modes)
     rows = len(names) + (1 if has_cp else 0)
     fig, axes = plt.subplots(rows, 3, figsize=(13, 2.8 * rows), squeeze=False)
+    tables = [{key: _smoothed(m, key) for key in ("variables", "velocities", "accelerations")}
+              for m in modes]
     for r, name in enumerate(names):
         angle = _is_angle(name)
         for c, (key, label) in enumerate((("variables", ""), ("velocities", "'"), ("accelerations", "''"))):
             ax = axes[r, c]
-            for m in modes:
-                y = np.asarray(m[key][name], dtype=float)
-                if angle and key == "variables":
-                    y = np.degrees(y)
+            ys = []
+            for m, t in zip(modes, tables, strict=True):
+                y = t[key][name]
+                y = np.degrees(y) if angle else y
+                ys.append(y)
                 ax.plot(x, y, label=f"mode {m['mode']}")
-            unit = "deg" if angle and key == "variables" else ("rad" if angle else "m")
+            unit = "deg" if angle else "m"
             per = {"variables": "", "velocities": "/s", "accelerations": "/s²"}[key]
             ax.set_title(f"{name}{label} ({unit}{per})")
             ax.set_xlabel(f"{doc['input_name']} (deg)")
             ax.grid(True, alpha=0.3)
+            flatten_constant_axis(ax, ys)
         axes[r, 0].legend(fontsize=8)
     if has_cp:
         for c, (i, j) in enumerate((("x", "y"), ("x", "z"), ("y", "z"))):

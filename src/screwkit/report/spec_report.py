@@ -1,0 +1,68 @@
+"""The report of a spec: its pipeline's motion (solved once), and the dynamics, balancing and
+synthesis the spec asks for, as one scene (:mod:`screwkit.report.scene`) and one
+self-contained HTML file (:mod:`screwkit.report.viewer`; docs/report.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from screwkit.io.spec import Spec
+from screwkit.kinematics.motion import ModeMotion
+from screwkit.pipeline import Pipeline
+
+Named = dict[str, Any]
+
+
+def seed_tables(mode: ModeMotion) -> tuple[Named, Named, Named]:
+    """A mode's variables, rates and accelerations under the seed's names only (no joint
+    freedoms ``<joint>.<freedom>``), for the plots."""
+    def seeds(table: Named) -> Named:
+        return {k: v for k, v in table.items() if "." not in k}
+
+    return seeds(mode.variables), seeds(mode.velocities), seeds(mode.accelerations)
+
+
+def spec_scene(spec: Spec | Pipeline, *, gravity: bool = False,
+               dynamics_doc: dict[str, Any] | None = None,
+               balance_doc: dict[str, Any] | None = None,
+               synthesis_doc: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The report scene of a loaded spec (or of a pipeline, whose motion is reused): every
+    mode's motion and, when the spec has them, the dynamics of ``[motion] mode`` (masses),
+    balancing (``[balancing]``) and synthesis (``[synthesis]``) — computed here unless their
+    documents are given."""
+    from screwkit.io.documents import synthesis_document
+    from screwkit.report.scene import scene_from_motion
+
+    pipe = spec if isinstance(spec, Pipeline) else Pipeline(spec)
+    s = pipe.spec
+    m = pipe.motion
+    notes = []
+    dyn_mode = None
+    if all(link.mass is not None for link in s.linkage.links):
+        if dynamics_doc is None:
+            dynamics_doc = pipe.dynamics(gravity).as_dict()
+        dyn_mode = s.mode
+        notes.append(f"Dynamics and balancing are of [motion] mode = {s.mode} of the spec.")
+    else:
+        dynamics_doc = None
+    if balance_doc is None and s.balancing is not None:
+        balance_doc = pipe.balance().as_dict()
+    if synthesis_doc is None and s.synthesis is not None:
+        synthesis_doc = synthesis_document(pipe.synthesize(), s.path)
+    text = Path(s.path).read_text(encoding="utf-8")
+    return scene_from_motion(s, m, dynamics_doc=dynamics_doc, dynamics_mode=dyn_mode,
+                             balance_doc=balance_doc, synthesis_doc=synthesis_doc,
+                             spec_text=text, seed_variables=[seed_tables(md) for md in m.modes],
+                             solver=[m.solver] if m.solver else None, notes=notes)
+
+
+def write_spec_report(spec: Spec | Pipeline, path: str | Path, **docs: Any) -> dict[str, Any]:
+    """Write the HTML report of a loaded spec (or pipeline) to ``path`` atomically; returns its
+    scene. ``docs``: ``gravity``, ``dynamics_doc``, ``balance_doc``, ``synthesis_doc``."""
+    from screwkit.io.results import write_atomic
+    from screwkit.report.viewer import render_report_html
+
+    scene = spec_scene(spec, **docs)
+    write_atomic(path, render_report_html(scene))
+    return scene
