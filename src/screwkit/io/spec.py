@@ -7,7 +7,6 @@ Every error names the file, the key, what is wrong and what would be right
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 from typing import Any, Literal
 
@@ -16,6 +15,7 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    StrictBool,
     StrictFloat,
     StrictInt,
     StrictStr,
@@ -23,10 +23,12 @@ from pydantic import (
     field_validator,
 )
 
+from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
 Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
+Number = StrictFloat | StrictInt
 
 
 class SpecError(ValueError):
@@ -74,8 +76,8 @@ class MotionTable(_Strict):
     step: Value = 10.0
     speed: Value = Field(1.0, description="input speed (angular velocity for a crank)")
     acceleration: Value = 0.0
-    periodic: bool | None = Field(None, description="drop the stop sample when it repeats the start")
-    mode: int = Field(0, ge=0, description="assembly mode used by dynamics and balancing")
+    periodic: StrictBool | None = Field(None, description="drop the stop sample when it repeats the start")
+    mode: StrictInt = Field(0, ge=0, le=10_000, description="assembly mode used by dynamics and balancing")
 
 
 class JointTable(_Strict):
@@ -85,7 +87,7 @@ class JointTable(_Strict):
     twist: Value = 0.0
     offset: Value = 0.0
     pitch: Value = 0.0
-    input: bool = False
+    input: StrictBool = False
 
 
 class LinkMassTable(_Strict):
@@ -93,7 +95,7 @@ class LinkMassTable(_Strict):
     weight: Value | None = None
     com: list[Value] = Field(default_factory=lambda: [0.0, 0.0, 0.0])  # type: ignore[arg-type]
     inertia: list[Value] | list[list[Value]] | None = None
-    principal_axes: list[list[float]] | None = None
+    principal_axes: list[list[Number]] | None = None
 
 
 class CouplerPointTable(_Strict):
@@ -111,7 +113,7 @@ class SpecFile(_Strict):
     links: dict[str, LinkMassTable] = Field(default_factory=dict)
     coupler_point: CouplerPointTable | None = None
     gravity: Value | None = None
-    gravity_direction: list[float] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
+    gravity_direction: list[Number] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
     balancing: dict[str, Any] | None = None
     synthesis: dict[str, Any] | None = None
 
@@ -339,28 +341,31 @@ class MechanismSpec:
         return self._rate_kind() == "angular_velocity"
 
 
+#: validation errors listed in one message (the rest are counted)
+MAX_LISTED_ERRORS = 12
+
+
 def _format_validation(path: str, exc: ValidationError) -> str:
     lines = [f"{path}: the spec file is not valid:"]
-    for err in exc.errors():
-        loc = ".".join(str(p) for p in err["loc"])
+    errors = exc.errors()
+    for err in errors[:MAX_LISTED_ERRORS]:
+        loc = ".".join(str(p) for p in err["loc"])[:120]
         msg = err["msg"]
         if err["type"] == "extra_forbidden":
             msg = "unknown key (check the spelling; see docs/spec-format.md)"
         lines.append(f"  [{loc}] {msg}")
+    if len(errors) > MAX_LISTED_ERRORS:
+        lines.append(f"  … and {len(errors) - MAX_LISTED_ERRORS} more")
     return "\n".join(lines)
 
 
 def load_spec(path: str | Path) -> MechanismSpec:
     """Read and validate a spec file; raises :class:`SpecError` with a specific message."""
     p = Path(path)
-    if not p.is_file():
-        raise SpecError(f"{p}: no such spec file")
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(f"{p}: not valid TOML: {exc}") from exc
-    except UnicodeDecodeError as exc:
-        raise SpecError(f"{p}: not a text file ({exc})") from exc
+        data = read_toml(p)  # size, encoding, nesting and string-length checks
+    except SpecFileError as exc:
+        raise SpecError(str(exc)) from None
     try:
         raw = SpecFile.model_validate(data)
     except ValidationError as exc:
