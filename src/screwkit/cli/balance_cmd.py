@@ -9,14 +9,6 @@ from typing import Annotated, Any
 import typer
 
 
-def _check_folders(options: dict[str, Path | None]) -> None:
-    """Output folders must not be existing files (checked before the solve)."""
-    for opt, folder in options.items():
-        if folder is not None and folder.exists() and not folder.is_dir():
-            raise ValueError(f"{opt} needs a folder: {folder} is an existing file; give a folder "
-                             "name (it is created if missing)")
-
-
 def register(app: typer.Typer) -> None:
     """Add the ``balance`` command to ``app``."""
 
@@ -33,12 +25,12 @@ def register(app: typer.Typer) -> None:
         from rich.table import Table
 
         from screwkit.balancing.spec import balance_from_spec
-        from screwkit.cli.common import console
+        from screwkit.cli.common import check_paths, console
         from screwkit.cli.common import emit as _emit
         from screwkit.cli.common import guard as _guard
         from screwkit.io.spec import load_spec
 
-        _guard(lambda: _check_folders({"--tables": tables, "--plots": plots}))
+        check_paths([spec], {"--output": output}, {"--tables": tables, "--plots": plots})
         s = _guard(lambda: load_spec(spec))
         res = _guard(lambda: balance_from_spec(s))
         doc: dict[str, Any] = res.as_dict()
@@ -81,4 +73,4 @@ def register(app: typer.Typer) -> None:
             for p in written:
                 console.print(f"wrote {escape(p)}", highlight=False)
 
-        _emit(doc, as_json, output, table)
+        _emit(doc, as_json, output, table, [spec])

@@ -13,7 +13,16 @@ from rich.markup import escape
 from rich.table import Table
 
 from screwkit import __version__
-from screwkit.cli.common import JsonOpt, OutputOpt, console, emit, guard
+from screwkit.cli.common import (
+    JsonOpt,
+    OutputOpt,
+    attempt,
+    check_paths,
+    console,
+    emit,
+    err_console,
+    guard,
+)
 
 app = typer.Typer(
     name="screwkit",
@@ -38,9 +47,16 @@ def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML)
     """Load and validate spec files and say what each describes."""
     from screwkit.io.spec import load_spec
 
-    for path in specs:
-        spec = _guard(lambda p=path: load_spec(p))  # type: ignore[misc]
-        console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+    failed = 0
+    for path in specs:  # every file is reported, good or bad
+        ok, spec = attempt(lambda p=path: load_spec(p))  # type: ignore[misc]
+        if ok and spec is not None:
+            console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+        else:
+            failed += 1
+    if failed:
+        err_console.print(f"{failed} of {len(specs)} spec file(s) failed", highlight=False)
+        raise typer.Exit(2)
 
 
 def _fmt(x: float | None, angle: bool) -> str:
@@ -61,6 +77,7 @@ def analyze(
     from screwkit.io.spec import load_spec
     from screwkit.kinematics.analysis import analyze as run
 
+    check_paths([spec], {"--output": output, "--plot": plot})
     s = _guard(lambda: load_spec(spec))
     _, doc = _guard(lambda: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point, method))
     doc["mechanism"] = s.name
@@ -97,7 +114,7 @@ def analyze(
             if missing:
                 console.print(f"  • does not assemble at {missing} of {len(doc['input'])} inputs", highlight=False)
 
-    _emit(doc, as_json, output, table)
+    _emit(doc, as_json, output, table, [spec])
 
 
 @app.command()
@@ -112,6 +129,7 @@ def limits(
     from screwkit.io.spec import load_spec
     from screwkit.kinematics.analysis import limits as run
 
+    check_paths([spec], {"--output": output})
     s = _guard(lambda: load_spec(spec))
     doc = _guard(lambda: run(s.linkage, dwell_tolerance, at=[float(np.radians(x)) for x in at or []]))
 
@@ -135,7 +153,7 @@ def limits(
                            ", ".join(f"{x:.3g}" for x in d["derivatives"]))
             console.print(t2)
 
-    _emit(doc, as_json, output, table)
+    _emit(doc, as_json, output, table, [spec])
 
 
 @app.command()
@@ -148,6 +166,7 @@ def mobility(
     from screwkit.io.spec import load_spec
     from screwkit.kinematics.mobility_check import linkage_mobility
 
+    check_paths([spec], {"--output": output})
     s = _guard(lambda: load_spec(spec))
     doc = _guard(lambda: linkage_mobility(s.linkage, s.inputs))
 
@@ -157,7 +176,7 @@ def mobility(
             console.print(escape(str(line)), highlight=False)
             console.print()
 
-    _emit(doc, as_json, output, table)
+    _emit(doc, as_json, output, table, [spec])
 
 
 @app.command()
@@ -170,6 +189,7 @@ def dynamics(
     """Shaking force and moment, every joint reaction and the actuator efforts over the cycle, with the RMS and peak of each (one assembly mode: motion.mode in the spec)."""
     from screwkit.io.spec import load_spec
 
+    check_paths([spec], {"--output": output})
     s = _guard(lambda: load_spec(spec))
     doc = _guard(lambda: _dynamics_doc(s, gravity))
 
@@ -189,7 +209,7 @@ def dynamics(
                     t.add_row(f"{name} {sub}", f"{st2['rms']:.6g}", f"{st2['peak']:.6g}")
         console.print(t)
 
-    _emit(doc, as_json, output, table)
+    _emit(doc, as_json, output, table, [spec])
 
 
 def _dynamics_doc(s: Any, gravity: bool) -> dict[str, Any]:
@@ -236,7 +256,12 @@ def demo(
     files = sorted(examples.glob("*.toml"))
     if not files:
         _guard(lambda: (_ for _ in ()).throw(ValueError(f"no spec files (*.toml) in {examples}")))
-    output_dir.mkdir(parents=True, exist_ok=True)
+    from screwkit.io.outputs import make_output_folder
+
+    _guard(lambda: make_output_folder(output_dir, "--output-dir"))
+
+    def write(path: Path, result: Any) -> None:
+        _guard(lambda: write_atomic(path, dumps(result) + "\n", files))
     t = Table(title=f"screwkit demo: {len(files)} examples")
     for col in ("example", "family", "samples", "modes", "assembling", "max closure residual", "jobs"):
         t.add_column(col)
@@ -247,29 +272,29 @@ def demo(
         _, doc = _guard(lambda s=spec: run(s.linkage, s.inputs, s.speed, s.acceleration, s.coupler_point))  # type: ignore[misc]
         doc["mechanism"] = spec.name
         out = output_dir / f"{f.stem}.analysis.json"
-        write_atomic(out, dumps(doc) + "\n")
+        write(out, doc)
         if plots:
             from screwkit.report.plots import plot_analysis
 
             _guard(lambda d=doc, f=f: plot_analysis(d, output_dir / f"{f.stem}.analysis.png"))  # type: ignore[misc]
         mob = _guard(lambda s=spec: linkage_mobility(s.linkage, s.inputs))  # type: ignore[misc]
-        write_atomic(output_dir / f"{f.stem}.mobility.json", dumps(mob) + "\n")
+        write(output_dir / f"{f.stem}.mobility.json", mob)
         jobs = ["analysis", "mobility"]
         if all(link.mass is not None for link in spec.linkage.links):
             dyn = _guard(lambda s=spec: _dynamics_doc(s, False))  # type: ignore[misc]
-            write_atomic(output_dir / f"{f.stem}.dynamics.json", dumps(dyn) + "\n")
+            write(output_dir / f"{f.stem}.dynamics.json", dyn)
             jobs.append("dynamics")
         if spec.raw.balancing is not None:
             from screwkit.balancing.spec import balance_from_spec
 
             bal = _guard(lambda s=spec: balance_from_spec(s))  # type: ignore[misc]
-            write_atomic(output_dir / f"{f.stem}.balance.json", dumps(bal.as_dict()) + "\n")
+            write(output_dir / f"{f.stem}.balance.json", bal.as_dict())
             jobs.append("balance")
         if spec.raw.synthesis is not None:
             from screwkit.cli.synthesize_cmd import synthesis_document
 
             syn = _guard(lambda s=spec: synthesis_document(s))  # type: ignore[misc]
-            write_atomic(output_dir / f"{f.stem}.synthesis.json", dumps(syn) + "\n")
+            write(output_dir / f"{f.stem}.synthesis.json", syn)
             jobs.append("synthesis")
         res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)
         asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])

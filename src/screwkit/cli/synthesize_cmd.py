@@ -17,6 +17,7 @@ from rich.table import Table
 
 from screwkit.cli.common import console, err_console
 from screwkit.cli.common import guard as _guard
+from screwkit.report.plots import save_figure
 
 __all__ = ["overlay_document", "register", "result_document", "synthesis_document"]
 
@@ -74,7 +75,7 @@ def _plot(results: list[Any], path: Path) -> None:
     axes[1].legend()
     fig.suptitle(f"synthesis: RMSE φ {math.degrees(best.rmse_phi):.4g}°, S {best.rmse_S:.3g} m")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path)
     plt.close(fig)
 
 
@@ -254,7 +255,7 @@ def _plot_overlay(docs: list[dict[str, Any]], problem: Any, path: Path) -> None:
         ax2.set_xlabel("input θ from θ01 (deg)")
         ax2.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path)
     plt.close(fig)
 
 
@@ -306,6 +307,9 @@ def register(app: typer.Typer) -> None:
         if plot is not None:
             asked = plot
             plot = _guard(lambda: plot_path(asked))
+        from screwkit.cli.common import check_paths
+
+        check_paths([spec], {"--output": output, "--plot": plot})
         s = _guard(lambda: load_spec(spec))
         problem, table = _guard(lambda: synthesis_from_spec(s))
 
@@ -324,7 +328,7 @@ def register(app: typer.Typer) -> None:
         overlay = table.method == "overlay"
         text = dumps(doc)
         if output is not None:
-            _guard(lambda: write_atomic(output, text + "\n"))
+            _guard(lambda: write_atomic(output, text + "\n", [spec], "--output"))
         if plot is not None:
             png = plot
             _guard(lambda: _plot_overlay(docs, problem, png) if overlay else _plot(results, png))

@@ -353,6 +353,8 @@ def _format_validation(path: str, exc: ValidationError) -> str:
         msg = err["msg"]
         if err["type"] == "extra_forbidden":
             msg = "unknown key (check the spelling; see docs/spec-format.md)"
+        elif err["type"] == "bool_type":
+            msg = "write true or false (TOML booleans, without quotes)"
         lines.append(f"  [{loc}] {msg}")
     if len(errors) > MAX_LISTED_ERRORS:
         lines.append(f"  … and {len(errors) - MAX_LISTED_ERRORS} more")

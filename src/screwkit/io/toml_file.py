@@ -64,11 +64,11 @@ def read_bytes(path: Path) -> bytes:
     except OSError as exc:
         raise SpecFileError(f"{path}: cannot read it ({exc.strerror})") from None
     if stat.S_ISDIR(st.st_mode):
-        raise SpecFileError(f"{path}: is a folder, not a spec file; give a .toml file")
+        raise SpecFileError(f"{path}: this is a folder, not a spec file; give a .toml file")
     if not stat.S_ISREG(st.st_mode):
-        raise SpecFileError(f"{path}: is {_file_kind(st.st_mode)}, not a spec file")
+        raise SpecFileError(f"{path}: this is {_file_kind(st.st_mode)}, not a spec file")
     if st.st_size > MAX_SPEC_BYTES:
-        raise SpecFileError(f"{path}: is {st.st_size} bytes; a spec file is at most "
+        raise SpecFileError(f"{path}: the file has {st.st_size} bytes; a spec file is at most "
                             f"{MAX_SPEC_BYTES} bytes (1 MB; see docs/reliability.md)")
     try:
         with open(path, "rb") as fh:
@@ -76,7 +76,7 @@ def read_bytes(path: Path) -> bytes:
     except OSError as exc:
         raise SpecFileError(f"{path}: cannot read it ({exc.strerror})") from None
     if len(data) > MAX_SPEC_BYTES:  # it grew after the stat
-        raise SpecFileError(f"{path}: is over {MAX_SPEC_BYTES} bytes; a spec file is at most "
+        raise SpecFileError(f"{path}: the file has over {MAX_SPEC_BYTES} bytes; a spec file is at most "
                             "1 MB")
     return data
 
@@ -85,7 +85,7 @@ def decode_text(path: Path, data: bytes) -> str:
     """UTF-8 text of ``data`` (a leading UTF-8 byte-order mark dropped); binary data, UTF-16 and
     other encodings are refused with a sentence saying so."""
     if not data.strip():
-        raise SpecFileError(f"{path}: is empty; a spec file needs at least a [mechanism] table "
+        raise SpecFileError(f"{path}: the file is empty; a spec file needs at least a [mechanism] table "
                             "with family = \"...\" (see docs/spec-format.md)")
     if data.startswith(_UTF16_BOMS):
         raise SpecFileError(f"{path}: starts with a UTF-16 byte-order mark; save it as UTF-8")
@@ -93,12 +93,12 @@ def decode_text(path: Path, data: bytes) -> str:
         data = data[len(_UTF8_BOM):]  # a UTF-8 byte-order mark carries no meaning: drop it
     nul = data.find(b"\x00")
     if nul >= 0:
-        raise SpecFileError(f"{path}: is not a text file (binary data: a NUL byte at offset "
+        raise SpecFileError(f"{path}: not a text file (binary data: a NUL byte at offset "
                             f"{nul}); a spec file is UTF-8 TOML text")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise SpecFileError(f"{path}: is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
+        raise SpecFileError(f"{path}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
                             f"{exc.start}); save it as UTF-8") from None
 
 

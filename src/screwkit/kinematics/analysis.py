@@ -207,6 +207,7 @@ def limits(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: int = 5,
     the order of its instantaneous dwell (Bagci 1969, App. D: rotation limits Q4 = 0, eq. D.1;
     translation limits by the corrected eq. D.3; dwell order = number of vanishing consecutive
     derivatives dᵏφ0/dθ0ᵏ, k = 1…max_order, within ``dwell_tolerance`` rad/radᵏ)."""
+    from screwkit.kinematics.assembly_range import assembling_intervals, describe_intervals
     from screwkit.kinematics.rsrc import (
         RSRCDimensions,
         rsrc_dwell_order,
@@ -227,6 +228,11 @@ def limits(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: int = 5,
                            delta0=0.0, lambda0=0.0) if planar else RSRCDimensions(**p))
     out: list[dict[str, Any]] = []
     rot = rsrc_rotation_limits(dims)
+    runs = assembling_intervals(dims)
+    if not runs and not rot:
+        raise ValueError(f"{linkage.name}: the mechanism does not assemble at any input angle "
+                         "(scanned every 0.25° over a full turn), so it has no limit positions; "
+                         "check the dimensions (docs/kinematics.md)")
     if rot:
         order, deriv = rsrc_dwell_order(dims, np.array([r.theta0 for r in rot]),
                                         np.array([r.phi0 for r in rot]), tol=dwell_tolerance,
@@ -246,6 +252,11 @@ def limits(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: int = 5,
 
         th = np.asarray(at, dtype=float)
         pos = rsrc_positions(dims, th)
+        nowhere = ~np.asarray(pos.assembles).any(axis=1)
+        if nowhere.any():
+            shown = ", ".join(f"{np.degrees(t):.6g}°" for t in th[nowhere][:8])
+            raise ValueError(f"{linkage.name}: the mechanism does not assemble at the input "
+                             f"angle(s) {shown} asked for; it assembles {describe_intervals(runs)}")
         for j in range(pos.phi0.shape[1]):
             ok = pos.assembles[:, j]
             if not ok.any():
