@@ -20,7 +20,7 @@ def assembling_intervals(dims: RSRCDimensions, samples: int = SCAN_SAMPLES) -> l
     interval shorter than one step can be missed, which the limit positions then reveal)."""
     theta = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
     with np.errstate(all="ignore"):
-        ok: np.ndarray = np.asarray(rsrc_positions(dims, theta).assembles).any(axis=1)
+        ok = np.asarray(np.asarray(rsrc_positions(dims, theta).assembles).any(axis=1), dtype=bool)
     if not ok.any():
         return []
     if ok.all():
