@@ -9,6 +9,17 @@ from typing import Annotated, Any
 import typer
 
 
+def direction_range(d: Any) -> str:
+    """"range -0.05 … 0.1, relative units", with "unbounded" or "could not determine" for an
+    end the linear programs did not give."""
+    def end(value: float | None, side: str) -> str:
+        if value is not None:
+            return f"{value:.3g}"
+        return "could not determine" if f"could not determine {side}" in d.extent else (
+            "unbounded")
+    return f"range {end(d.low, 'below')} … {end(d.high, 'above')}, relative units"
+
+
 def register(app: typer.Typer) -> None:
     """Add the ``balance`` command to ``app``."""
 
@@ -55,10 +66,11 @@ def register(app: typer.Typer) -> None:
             for row in res.summary_table():
                 t.add_row(*row)
             console.print(t)
-            console.print(f"unique optimum: {res.unique}", highlight=False)
+            verdict = "could not determine" if res.unique is None else str(res.unique)
+            console.print(f"unique optimum: {verdict}", highlight=False)
             for d in res.directions:
-                console.print(escape(f"  free direction {d.direction} (range {d.low:.3g} … "
-                                     f"{d.high:.3g}, relative units)"), highlight=False)
+                console.print(escape(f"  free direction {d.direction} ({direction_range(d)})"),
+                              highlight=False)
             bound = doc.get("redistribution_bound")
             if bound:
                 console.print(f"bound over all consistent redistributions (SDP): G = "
