@@ -119,7 +119,14 @@ def optimal_set(Q: Array, q: Array, first: QPSolution, Ae: Array, be: Array, Al:
     n = Q.shape[0]
     z_star = first.x
     H = 0.5 * (Q + Q.T)
-    strong = strongly_active(z_star, H, q, Al, bl, first.multipliers_le)
+    # rows of unit length: the LP solver drops coefficients below ~1e-9 as zeros, and a
+    # variable scaled by a tiny original value (1e-12 kg) would give such rows
+    norms = np.linalg.norm(Al, axis=1).clip(1e-300) if len(bl) else np.ones(0)
+    Al, bl = Al / norms[:, None], bl / norms
+    mu = first.multipliers_le * norms
+    enorms = np.linalg.norm(Ae, axis=1).clip(1e-300) if len(be) else np.ones(0)
+    Ae = Ae / enorms[:, None]
+    strong = strongly_active(z_star, H, q, Al, bl, mu)
     Z = null_space(np.vstack([Ae, Al[strong]]).reshape(-1, n), n)
     if Z.shape[1] == 0:
         return OptimalSet(z_star, [], True, [])
@@ -131,6 +138,8 @@ def optimal_set(Q: Array, q: Array, first: QPSolution, Ae: Array, be: Array, Al:
     # the set in coordinates c: Al N c ≤ r; r ≥ 0 keeps c = 0 (z*) a member despite round-off
     AN = Al @ N
     r = np.maximum(bl - Al @ z_star, 0.0)
+    moving = np.linalg.norm(AN, axis=1) > 1e-12 if len(r) else np.zeros(0, dtype=bool)
+    AN, r = AN[moving], r[moving]  # rows N cannot move along hold for every c (r ≥ 0)
     z = _nearest_member(z_star, N, AN, r, z0)
     directions: list[NonUniqueDirection] = []
     failures: list[str] = []

@@ -8,11 +8,12 @@ from __future__ import annotations
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError
 
 from screwkit.balancing.balance import prepare, solve_setup
 from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.measures import MEASURES, default_normalisation
+from screwkit.balancing.problem import check_weights
 from screwkit.balancing.result import BalanceResult
 from screwkit.balancing.variables import (
     POINT_MASS_NAMES,
@@ -71,7 +72,7 @@ class ParetoTable(_Strict):
 
 class BalancingTable(_Strict):
     weights: dict[str, float] = Field(default_factory=lambda: {k: 1.0 for k in MEASURES})
-    gravity: bool = False
+    gravity: StrictBool = False
     links: dict[str, LinkVariablesTable] = Field(default_factory=dict)
     counterweights: list[CounterweightTable] = Field(default_factory=list)
     normalisation: NormalisationTable = Field(default_factory=NormalisationTable)  # type: ignore[arg-type]
@@ -91,7 +92,7 @@ def balancing_table(spec: Any) -> BalancingTable:
         for err in exc.errors():
             loc = ".".join(str(p) for p in err["loc"])
             msg = ("unknown key (see docs/balancing.md)" if err["type"] == "extra_forbidden"
-                   else err["msg"])
+                   else str(err["msg"]).removeprefix("Value error, "))
             lines.append(f"  [balancing.{loc}] {msg}")
         raise BalancingError("\n".join(lines)) from exc
 
@@ -166,6 +167,10 @@ def balance_from_spec(spec: Any, *, mode_motion: Any | None = None) -> BalanceRe
     from screwkit.kinematics.analysis import mode_motion as spec_mode_motion
 
     table = balancing_table(spec)
+    try:
+        check_weights(table.weights)  # before any dynamics: a bad weight is named at once
+    except BalancingError as exc:
+        raise BalancingError(f"{spec.path}: [balancing.weights] {exc}") from None
     blocks = blocks_from_table(spec, table)
     lk = spec.linkage
     if mode_motion is None:

@@ -276,7 +276,7 @@ def _overlay_lines(docs: list[dict[str, Any]]) -> None:
 def plot_path(plot: Path) -> Path:
     """The PNG file ``--plot`` writes: ``.png`` added when the name has no suffix; its folder must
     exist and the name must not be a folder (checked before the solve)."""
-    path = plot if plot.suffix else plot.with_name(plot.name + ".png")
+    path = plot if plot.suffix or plot.is_dir() else plot.with_name(plot.name + ".png")
     if path.is_dir():
         raise ValueError(f"--plot {plot}: {path} is a folder; give a file name, e.g. "
                          f"{path / 'synthesis.png'}")

@@ -25,6 +25,7 @@ from pydantic import (
 
 from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
+from screwkit.io.validation import validation_lines
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
 Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
@@ -341,24 +342,8 @@ class MechanismSpec:
         return self._rate_kind() == "angular_velocity"
 
 
-#: validation errors listed in one message (the rest are counted)
-MAX_LISTED_ERRORS = 12
-
-
 def _format_validation(path: str, exc: ValidationError) -> str:
-    lines = [f"{path}: the spec file is not valid:"]
-    errors = exc.errors()
-    for err in errors[:MAX_LISTED_ERRORS]:
-        loc = ".".join(str(p) for p in err["loc"])[:120]
-        msg = err["msg"]
-        if err["type"] == "extra_forbidden":
-            msg = "unknown key (check the spelling; see docs/spec-format.md)"
-        elif err["type"] == "bool_type":
-            msg = "write true or false (TOML booleans, without quotes)"
-        lines.append(f"  [{loc}] {msg}")
-    if len(errors) > MAX_LISTED_ERRORS:
-        lines.append(f"  … and {len(errors) - MAX_LISTED_ERRORS} more")
-    return "\n".join(lines)
+    return "\n".join([f"{path}: the spec file is not valid:", *validation_lines(exc)])
 
 
 def load_spec(path: str | Path) -> MechanismSpec:

@@ -256,7 +256,8 @@ def limits(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: int = 5,
         if nowhere.any():
             shown = ", ".join(f"{np.degrees(t):.6g}°" for t in th[nowhere][:8])
             raise ValueError(f"{linkage.name}: the mechanism does not assemble at the input "
-                             f"angle(s) {shown} asked for; it assembles {describe_intervals(runs)}")
+                             f"angle(s) {shown} asked for; it assembles {describe_intervals(runs)} "
+                             "(sampled every 0.25°)")
         for j in range(pos.phi0.shape[1]):
             ok = pos.assembles[:, j]
             if not ok.any():

@@ -35,11 +35,14 @@ def assembling_intervals(dims: RSRCDimensions, samples: int = SCAN_SAMPLES) -> l
 
 
 def describe_intervals(runs: list[tuple[float, float]]) -> str:
-    """``"θ0 from 12.5° to 80.25°, from 200° to 260°"`` (degrees, as the CLI prints inputs)."""
+    """``"for θ0 from 12.5° to 80.25°, from 200° through 0° to 20°"`` (degrees, as the CLI
+    prints inputs; the ends are the scan's outermost assembling samples)."""
     if not runs:
         return "at no input angle"
     if runs == [(0.0, 2 * math.pi)]:
         return "at every input angle"
-    parts = [f"from {math.degrees(a):.6g}° to {math.degrees(b):.6g}°" for a, b in runs[:6]]
+    parts = [f"from {math.degrees(a):.6g}° to {math.degrees(b):.6g}°" if b < 2 * math.pi else
+             f"from {math.degrees(a):.6g}° through 0° to {math.degrees(b - 2 * math.pi):.6g}°"
+             for a, b in runs[:6]]
     more = f" and {len(runs) - 6} more intervals" if len(runs) > 6 else ""
     return "for θ0 " + ", ".join(parts) + more

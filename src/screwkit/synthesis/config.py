@@ -14,7 +14,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    ValidationError,
+    model_validator,
+)
 
 from screwkit.io.units import UnitError, to_si
 from screwkit.synthesis.overlay import OverlayDwell
@@ -88,7 +95,7 @@ class ComponentTable(_Strict):
 class PointTable(_Strict):
     theta: Value
     q: Value = "dwell"
-    other_tangency: bool = False
+    other_tangency: StrictBool = False
 
 
 class ConstraintsTable(_Strict):
@@ -235,7 +242,7 @@ def _parse(spec: MechanismSpec) -> _Parsed:
         for err in exc.errors():
             loc = ".".join(str(p) for p in err["loc"])
             msg = ("unknown key (see docs/synthesis.md)" if err["type"] == "extra_forbidden"
-                   else err["msg"])
+                   else str(err["msg"]).removeprefix("Value error, "))
             lines.append(f"  [synthesis.{loc}] {msg}")
         raise SynthesisConfigError("\n".join(lines)) from None
     units = spec.units
@@ -288,6 +295,8 @@ def _parse(spec: MechanismSpec) -> _Parsed:
                 fn = data_function(th, val)
                 if pts is None:
                     pts = np.array(th)
+        except SynthesisConfigError:
+            raise  # already names its key
         except ValueError as exc:
             raise _fail(path, key, str(exc)) from None
         assert pts is not None
