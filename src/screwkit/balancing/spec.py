@@ -93,7 +93,7 @@ def balancing_table(spec: Any) -> BalancingTable:
             loc = ".".join(str(p) for p in err["loc"])
             msg = ("unknown key (see docs/balancing.md)" if err["type"] == "extra_forbidden"
                    else str(err["msg"]).removeprefix("Value error, "))
-            lines.append(f"  [balancing.{loc}] {msg}")
+            lines.append(f"  [balancing{'.' + loc if loc else ''}] {msg}")
         raise BalancingError("\n".join(lines)) from exc
 
 

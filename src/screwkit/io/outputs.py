@@ -87,13 +87,12 @@ def check_output_folder(folder: str | Path, option: str) -> Path:
     p = Path(folder)
     try:
         st = os.stat(p)
-    except FileNotFoundError:
-        parent = p.parent
+    except (FileNotFoundError, NotADirectoryError):
         if os.path.lexists(p):
             raise OutputPathError(f"{option} {p}: is a dangling symbolic link") from None
-        if not parent.is_dir() and not _creatable(parent):
-            raise OutputPathError(f"{option} {p}: cannot create it (the path above it is not "
-                                  "a folder)") from None
+        if not _creatable(p.parent):
+            raise OutputPathError(f"{option} {p}: cannot create it (a path above it is a file, "
+                                  "not a folder)") from None
         return p
     except OSError as exc:
         raise OutputPathError(f"{option} {p}: {exc.strerror}") from None

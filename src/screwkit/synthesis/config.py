@@ -243,7 +243,7 @@ def _parse(spec: MechanismSpec) -> _Parsed:
             loc = ".".join(str(p) for p in err["loc"])
             msg = ("unknown key (see docs/synthesis.md)" if err["type"] == "extra_forbidden"
                    else str(err["msg"]).removeprefix("Value error, "))
-            lines.append(f"  [synthesis.{loc}] {msg}")
+            lines.append(f"  [synthesis{'.' + loc if loc else ''}] {msg}")
         raise SynthesisConfigError("\n".join(lines)) from None
     units = spec.units
 
