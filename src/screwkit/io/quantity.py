@@ -33,7 +33,9 @@ MAX_POWER = 4
 EXCERPT_CHARS = 40
 
 _NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
-_NAME = re.compile(r"[^\W\d]\w*")  # a letter or _ first (Unicode letters include µ, μ)
+# a letter or _ first (Unicode letters include µ, μ), then letters, digits or _ — but not the
+# superscript digits, which \w would take: "m²" is the name m with the power 2
+_NAME = re.compile(r"[^\W\d](?:(?![¹²³⁴⁵⁶⁷⁸⁹⁰])\w)*")
 _POWER = re.compile(r"(?:\^|\*\*)\s*([+-]?\d+)")
 _SUPERSCRIPTS = {"²": 2, "³": 3, "⁴": 4}
 _BLANK = re.compile(r"\s*")

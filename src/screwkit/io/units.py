@@ -123,10 +123,13 @@ def _factor(names: tuple[tuple[str, int], ...], kind: str) -> float:
         raise UnitError(f"its unit is {unit}") from exc
     except Exception as exc:  # offset units (degC) cannot be multiplied
         raise UnitError(f"the unit {unit} cannot be used here ({type(exc).__name__})") from exc
-    if kind == "angular_velocity" and any(
-            registry().Unit(ALIASES.get(n, n)) == registry().Unit("hertz") for n, _ in names):
-        raise UnitError("hertz")
     return factor
+
+
+def _has_hertz(names: tuple[tuple[str, int], ...]) -> bool:
+    """Whether a unit names hertz (1/s with no angle: ambiguous for an angular speed)."""
+    hertz = registry().Unit("hertz")
+    return any(_unit(((n, 1),)) == hertz for n, _ in names)
 
 
 def check_unit(unit: str, kind: str) -> None:
@@ -202,13 +205,12 @@ def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
     try:
         factor = _factor(names, kind)
     except UnitError as exc:
-        if str(exc) == "hertz":
-            raise UnitError(
-                f"{shown} is ambiguous for an angular speed (Hz is 1/s, with no angle): write "
-                f"revolutions as \"50 rev/s\" or \"3000 rpm\", or radians as \"314.16 rad/s\""
-            ) from None
         if str(exc).startswith("unknown unit"):
             raise UnitError(f"{exc} in {shown}; write e.g. {EXAMPLES[kind]}") from None
         raise UnitError(f"{shown} is not {_a(kind)} ({exc}); write e.g. "
                         f"{EXAMPLES[kind]}") from None
+    if kind == "angular_velocity" and _has_hertz(names):
+        raise UnitError(
+            f"{shown} is ambiguous for an angular speed (Hz is 1/s, with no angle): write "
+            f"revolutions as \"50 rev/s\" or \"3000 rpm\", or radians as \"314.16 rad/s\"")
     return check_magnitude(magnitude * factor, kind, shown)
