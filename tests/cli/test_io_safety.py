@@ -214,3 +214,23 @@ def test_json_is_strict():
         jsonable({"modes": [{"x": np.array([0.0, np.inf])}]})
     with pytest.raises(NonFiniteResultError, match="low"):
         dumps({"low": float("-inf")})
+
+
+def test_floating_point_errors_in_a_command_exit_2_instead_of_warning(capsys):
+    import typer
+
+    from screwkit.cli.common import guard
+
+    for bad in (lambda: np.array([1e308]) * 10, lambda: np.array([1.0]) / 0.0,
+                lambda: np.sqrt(np.array([-1.0]))):
+        with pytest.raises(typer.Exit) as exc:
+            guard(bad)
+        assert exc.value.exit_code == 2
+        assert "failed numerically" in capsys.readouterr().err
+
+
+    def expects_nan() -> float:
+        with np.errstate(invalid="ignore"):  # code that expects NaN says so and is left alone
+            return float(np.sqrt(np.array([-1.0]))[0])
+
+    assert np.isnan(guard(expects_nan))
