@@ -38,8 +38,8 @@ def test_unknown_key_and_unknown_link(tmp_path):
 
 def test_all_zero_weights_and_no_table(tmp_path, rahman):
     _, mode = rahman
-    s = _spec(tmp_path, "[balancing]\nweights = { F = 0, T = 0 }\n[balancing.links.rod]\n")
     with pytest.raises(BalancingError, match="all weights are zero"):
+        s = _spec(tmp_path, "[balancing]\nweights = { F = 0, T = 0 }\n[balancing.links.rod]\n")
         balance_from_spec(s, mode_motion=mode)
     s = _spec(tmp_path, "")
     with pytest.raises(BalancingError, match="no \\[balancing\\] table"):

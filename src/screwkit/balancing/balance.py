@@ -173,11 +173,16 @@ def solve_setup(setup: BalancingSetup, weights: Mapping[str, float]) -> BalanceR
     pi0, pi1 = v.physical_parameters(v.original), v.physical_parameters(opt.x)
     dyn0, dyn1 = setup.regressor.apply(pi0), setup.regressor.apply(pi1)
     notes = []
-    if not opt.unique:
+    if opt.unique is False:
         notes.append(
             "the optimum is not unique: the Hessian is singular and the loads do not change "
             f"along {len(opt.directions)} direction(s) of the variables; the member nearest to "
             "the original design (least relative change) is returned")
+    elif opt.unique is None:
+        notes.append(
+            "could not determine whether the optimum is unique: a linear program for the extent "
+            "of the optimal set failed (the optimum itself is checked by its KKT conditions); "
+            f"directions concerned: {len(opt.directions)}")
     indeterminate = setup.regressor.indeterminacy.count
     if indeterminate and (w["R"] > 0 or w["M"] > 0):
         notes.append(

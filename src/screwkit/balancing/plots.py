@@ -26,8 +26,9 @@ def _pyplot() -> Any:
 def write_plots(result: BalanceResult, folder: str | Path) -> list[str]:
     """One PNG per per-sample load, before and after, against the input in degrees."""
     plt = _pyplot()
-    out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
+    from screwkit.io.outputs import make_output_folder
+
+    out = make_output_folder(folder, "--plots")
     x = np.degrees(result.inputs)
     paths = []
     for key, title, unit in SAMPLE_LOADS:
@@ -40,7 +41,7 @@ def write_plots(result: BalanceResult, folder: str | Path) -> list[str]:
         ax.legend()
         fig.tight_layout()
         p = out / f"balance_{key}.png"
-        fig.savefig(p, dpi=110)
+        _save(fig, p)
         plt.close(fig)
         paths.append(str(p))
     return paths
@@ -61,6 +62,14 @@ def write_pareto_plot(front: Any, path: str | Path, x: str = "F", y: str = "T",
     ax.set_ylabel(y)
     ax.set_title("balancing trade-off (outlined: non-dominated)")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    _save(fig, Path(path))
     plt.close(fig)
     return str(path)
+
+
+def _save(fig: Any, path: Path) -> None:
+    """PNG through a temporary file and a rename (screwkit.io.outputs: no partial file)."""
+    from screwkit.io.outputs import atomic_path
+
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")

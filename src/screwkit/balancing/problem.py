@@ -5,8 +5,10 @@ G(x) = Σ_k W_k·measure_k(π(x)),  π(x) = π_fixed + B·x, so G = xᵀQx + 2q�
 Q = Σ_k W_k/N · Y_kᵀY_k (Y_k = load rows·B). The Hessian 2Q is often singular: in the seed's
 example the crank turns at constant speed about a principal axis, so its three pair masses act
 only through their sum (SPEC §4.4). Every optimum then has the same loads, and the optimal set
-is {x feasible : Q x = Q x*}; screwkit reports its directions and extent (by linear programs)
-and returns its member nearest to the original design (relative changes, least squares).
+is {x feasible : Q x = Q x*, gradient·(x − x*) = 0}; screwkit reports its directions and extent
+(screwkit.balancing.optimal_set: reduced-Hessian null space, then linear programs that are
+feasible whenever the optimum is) and returns its member nearest to the original design
+(relative changes, least squares).
 """
 
 from __future__ import annotations
@@ -19,14 +21,13 @@ from numpy.typing import NDArray
 
 from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.measures import MEASURES, LoadRows
+from screwkit.balancing.optimal_set import NonUniqueDirection, optimal_set
+from screwkit.balancing.optimal_set import canonical_basis as canonical_basis  # re-exported
 from screwkit.balancing.qp import QPSolution, solve_qp
 from screwkit.balancing.variables import DesignVariables, LinearConstraint
 from screwkit.dynamics import Regressor
 
 Array = NDArray[np.float64]
-
-#: eigenvalues of the scaled Hessian below this fraction of the largest count as zero
-NULL_RTOL = 1e-9
 
 
 def check_weights(weights: Mapping[str, float]) -> dict[str, float]:
@@ -44,16 +45,6 @@ def check_weights(weights: Mapping[str, float]) -> dict[str, float]:
         raise BalancingError("all weights are zero: the objective would be constant. Give at "
                              "least one of F, T, R, M, T0 a positive weight")
     return w
-
-
-@dataclass(frozen=True)
-class NonUniqueDirection:
-    """A direction (unit, in relative variable changes) along which the optimum may move
-    without changing any load, and how far: ``low ≤ t ≤ high`` about the returned member."""
-
-    direction: dict[str, float]
-    low: float
-    high: float
 
 
 @dataclass(frozen=True)
@@ -123,30 +114,6 @@ def consistency_constraints(reg: Regressor, variables: DesignVariables) -> list[
     return out
 
 
-def canonical_basis(basis: Array, tol: float = 1e-9) -> Array:
-    """A basis of the column space of ``basis`` (n, k) that depends only on the space: the reduced
-    row-echelon form of ``basisᵀ`` against the variable order (pivots chosen in column order),
-    each direction scaled to unit length with its leading (pivot) entry positive. Any orthonormal
-    basis an eigen-solver returns (which differs between machines) gives the same answer."""
-    A = np.array(basis, dtype=float).T  # (k, n) rows span the space
-    k, n = A.shape
-    row = 0
-    for j in range(n):
-        if row == k:
-            break
-        p = row + int(np.argmax(np.abs(A[row:, j])))
-        if abs(A[p, j]) <= tol:
-            continue
-        A[[row, p]] = A[[p, row]]
-        A[row] /= A[row, j]
-        others = np.arange(k) != row
-        A[others] -= np.outer(A[others, j], A[row])
-        row += 1
-    A = A[:row]
-    A[np.abs(A) <= tol * np.abs(A).max(initial=1.0)] = 0.0
-    return (A / np.linalg.norm(A, axis=1, keepdims=True)).T
-
-
 def _rows(cons: list[LinearConstraint], kind: str, n: int) -> tuple[Array, Array, list[str]]:
     sel = [c for c in cons if c.kind == kind]
     A = np.array([c.coefficients for c in sel]).reshape(-1, n)
@@ -177,7 +144,7 @@ class Optimum:
     multipliers of every constraint (for the KKT conditions)."""
 
     x: Array
-    unique: bool
+    unique: bool | None  # None: could not be determined (a linear program failed)
     directions: list[NonUniqueDirection]
     constraints: list[LinearConstraint]
     multipliers: Array  # one per constraint, stationarity 2Qx + 2q + Σ μ_i a_i = 0
@@ -189,8 +156,6 @@ def solve_balancing(objective: QuadraticObjective, variables: DesignVariables,
                     extra: list[LinearConstraint] | None = None) -> Optimum:
     """Minimise G over the design variables (scaled by their typical sizes); detect a singular
     Hessian and return the optimal member nearest to the original design."""
-    from scipy.optimize import linprog
-
     cons = list(variables.constraints) + list(extra or [])
     n = len(variables.names)
     S = variables.scale
@@ -200,47 +165,12 @@ def solve_balancing(objective: QuadraticObjective, variables: DesignVariables,
     Q = S[:, None] * objective.Q * S[None, :]
     q = S * objective.q
     first = solve_qp(Q, q, Ae, be, Al, bl, ne, nl)
-    z = first.x
-    lam, vec = np.linalg.eigh(0.5 * (Q + Q.T))
-    top = max(float(lam[-1]), 1e-300)
-    null = vec[:, lam <= NULL_RTOL * top]
-    rng = vec[:, lam > NULL_RTOL * top]
-    directions: list[NonUniqueDirection] = []
-    sol = first
-    if null.shape[1]:
-        band = 1e-9 * max(1.0, float(np.max(np.abs(z))))
-        Rz = rng.T @ z
-        A_opt = np.vstack([Al, rng.T, -rng.T])
-        b_opt = np.concatenate([bl, Rz + band, -Rz + band])
-        z0 = variables.original / S
-        # nearest optimal member to the original design (relative changes)
-        sol = solve_qp(np.eye(n), -z0, Ae, be, A_opt, b_opt, ne,
-                       [*nl, *(["optimal set"] * 2 * rng.shape[1])])
-        z = sol.x
-        # directions of the optimal set: a canonical basis of null(Q) within the equalities
-        basis = null
-        if len(be):
-            sub = Ae @ null
-            _, s, Vt = np.linalg.svd(sub) if sub.size else (None, np.zeros(0), np.eye(null.shape[1]))
-            rank = int(np.sum(s > 1e-9 * max(float(s.max()) if s.size else 0.0, 1e-300)))
-            basis = null @ Vt[rank:].T
-        basis = canonical_basis(basis)
-        for k in range(basis.shape[1]):
-            d = basis[:, k]
-            ends = []
-            for sign in (1.0, -1.0):
-                res = linprog(-sign * d, A_ub=A_opt if len(b_opt) else None,
-                              b_ub=b_opt if len(b_opt) else None,
-                              A_eq=Ae if len(be) else None, b_eq=be if len(be) else None,
-                              bounds=[(None, None)] * n, method="highs")
-                ends.append(sign * (-res.fun) - d @ z if res.status == 0 else sign * np.inf)
-            hi, lo = ends[0], ends[1]
-            if hi - lo > 1e-6:
-                dx = d * S
-                dx /= np.linalg.norm(d)
-                directions.append(NonUniqueDirection(
-                    {nm: float(v) for nm, v in zip(variables.names, d, strict=True)
-                     if abs(v) > 1e-9}, float(lo), float(hi)))
+    # uniqueness and the extent of the optimal set: reduced-Hessian null space over the
+    # variables the equalities and the strongly active bounds leave free, then LPs that are
+    # feasible whenever the optimum is (screwkit.balancing.optimal_set)
+    found = optimal_set(Q, q, first, Ae, be, Al, bl, variables.original / S,
+                        list(variables.names))
+    z = found.z
     z = _snap_to_active(z, Ae, be, Al, bl)
     x = z * S
     # multipliers of the original problem at x: stationarity of G (polished KKT, least squares)
@@ -253,5 +183,5 @@ def solve_balancing(objective: QuadraticObjective, variables: DesignVariables,
     mu = np.zeros(len(cons))
     if active.any():
         mu[active] = np.linalg.lstsq(A_all[active].T, -grad, rcond=None)[0]
-    return Optimum(x, not directions, directions, cons, mu,
+    return Optimum(x, found.unique, found.directions, cons, mu,
                    [c.name for c, a in zip(cons, active, strict=True) if a], first)

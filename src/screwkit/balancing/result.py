@@ -60,7 +60,7 @@ class BalanceResult:
     link_mass_after: dict[str, float]
     mass_properties_before: dict[str, MassProperties]
     mass_properties_after: dict[str, MassProperties]
-    unique: bool
+    unique: bool | None  # None: could not be determined (see notes)
     directions: list[NonUniqueDirection]
     active_constraints: list[str]
     multipliers: dict[str, float]
@@ -155,7 +155,8 @@ class BalanceResult:
                           "change_percent": self.link_mass_change()},
             "unique": self.unique,
             "non_unique_directions": [
-                {"direction": d.direction, "low": d.low, "high": d.high} for d in self.directions
+                {"direction": d.direction, "low": d.low, "high": d.high, "extent": d.extent}
+                for d in self.directions
             ],
             "active_constraints": list(self.active_constraints),
             "multipliers": dict(self.multipliers),

@@ -9,12 +9,15 @@ from typing import Annotated, Any
 import typer
 
 
-def _check_folders(options: dict[str, Path | None]) -> None:
-    """Output folders must not be existing files (checked before the solve)."""
-    for opt, folder in options.items():
-        if folder is not None and folder.exists() and not folder.is_dir():
-            raise ValueError(f"{opt} needs a folder: {folder} is an existing file; give a folder "
-                             "name (it is created if missing)")
+def direction_range(d: Any) -> str:
+    """"range -0.05 … 0.1, relative units", with "unbounded" or "could not determine" for an
+    end the linear programs did not give."""
+    def end(value: float | None, side: str) -> str:
+        if value is not None:
+            return f"{value:.3g}"
+        return "could not determine" if f"could not determine {side}" in d.extent else (
+            "unbounded")
+    return f"range {end(d.low, 'below')} … {end(d.high, 'above')}, relative units"
 
 
 def register(app: typer.Typer) -> None:
@@ -32,14 +35,14 @@ def register(app: typer.Typer) -> None:
         from rich.markup import escape
         from rich.table import Table
 
-        from screwkit.cli.common import console
+        from screwkit.cli.common import check_paths, console
         from screwkit.cli.common import emit as _emit
         from screwkit.cli.common import guard as _guard
         from screwkit.io.balance_tables import write_balance_tables
         from screwkit.io.spec import load_spec
         from screwkit.pipeline import Pipeline
 
-        _guard(lambda: _check_folders({"--tables": tables, "--plots": plots}))
+        check_paths([spec], {"--output": output}, {"--tables": tables, "--plots": plots})
         s = _guard(lambda: load_spec(spec))
         res = _guard(lambda: Pipeline(s).balance())
         doc: dict[str, Any] = res.as_dict()
@@ -65,10 +68,11 @@ def register(app: typer.Typer) -> None:
             for row in res.summary_table():
                 t.add_row(*row)
             console.print(t)
-            console.print(f"unique optimum: {res.unique}", highlight=False)
+            verdict = "could not determine" if res.unique is None else str(res.unique)
+            console.print(f"unique optimum: {verdict}", highlight=False)
             for d in res.directions:
-                console.print(escape(f"  free direction {d.direction} (range {d.low:.3g} … "
-                                     f"{d.high:.3g}, relative units)"), highlight=False)
+                console.print(escape(f"  free direction {d.direction} ({direction_range(d)})"),
+                              highlight=False)
             bound = doc.get("redistribution_bound")
             if bound:
                 console.print(f"bound over all consistent redistributions (SDP): G = "
@@ -83,4 +87,4 @@ def register(app: typer.Typer) -> None:
             for p in written:
                 console.print(f"wrote {escape(p)}", highlight=False)
 
-        _emit(doc, as_json, output, table)
+        _emit(doc, as_json, output, table, [spec])

@@ -13,7 +13,16 @@ from rich.markup import escape
 from rich.table import Table
 
 from screwkit import __version__
-from screwkit.cli.common import JsonOpt, OutputOpt, console, emit, guard
+from screwkit.cli.common import (
+    JsonOpt,
+    OutputOpt,
+    attempt,
+    check_paths,
+    console,
+    emit,
+    err_console,
+    guard,
+)
 
 app = typer.Typer(
     name="screwkit",
@@ -38,9 +47,16 @@ def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML)
     """Load and validate spec files and say what each describes."""
     from screwkit.io.spec import load_spec
 
-    for path in specs:
-        spec = _guard(lambda p=path: load_spec(p))  # type: ignore[misc]
-        console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+    failed = 0
+    for path in specs:  # every file is reported, good or bad
+        ok, spec = attempt(lambda p=path: load_spec(p))  # type: ignore[misc]
+        if ok and spec is not None:
+            console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+        else:
+            failed += 1
+    if failed:
+        err_console.print(f"{failed} of {len(specs)} spec file(s) failed", highlight=False)
+        raise typer.Exit(2)
 
 
 def _fmt(x: float | None, angle: bool) -> str:
@@ -62,6 +78,7 @@ def analyze(
     from screwkit.io.spec import load_spec
     from screwkit.pipeline import Pipeline
 
+    check_paths([spec], {"--output": output, "--plot": plot})
     s = _guard(lambda: load_spec(spec))
     pipe = Pipeline(s, method=method)
     motion = _guard(lambda: pipe.motion)
@@ -99,7 +116,7 @@ def analyze(
             if missing:
                 console.print(f"  • does not assemble at {missing} of {len(doc['input'])} inputs", highlight=False)
 
-    _emit(doc, as_json, output, table)
+    _emit(doc, as_json, output, table, [spec])
 
 
 @app.command()
@@ -114,6 +131,7 @@ def limits(
     from screwkit.io.spec import load_spec
     from screwkit.pipeline import Pipeline
 
+    check_paths([spec], {"--output": output})
     s = _guard(lambda: load_spec(spec))
     doc = _guard(lambda: Pipeline(s).limits(dwell_tolerance, at=[float(np.radians(x)) for x in at or []]).as_dict())
 
@@ -137,7 +155,7 @@ def limits(
                            ", ".join(f"{x:.3g}" for x in d["derivatives"]))
             console.print(t2)
 
-    _emit(doc, as_json, output, table)
+    _emit(doc, as_json, output, table, [spec])
 
 
 @app.command()
@@ -150,6 +168,7 @@ def mobility(
     from screwkit.io.spec import load_spec
     from screwkit.pipeline import Pipeline
 
+    check_paths([spec], {"--output": output})
     s = _guard(lambda: load_spec(spec))
     doc = _guard(lambda: Pipeline(s).mobility().as_dict())
 
@@ -159,7 +178,7 @@ def mobility(
             console.print(escape(str(line)), highlight=False)
             console.print()
 
-    _emit(doc, as_json, output, table)
+    _emit(doc, as_json, output, table, [spec])
 
 
 @app.command()
@@ -173,6 +192,7 @@ def dynamics(
     from screwkit.io.spec import load_spec
     from screwkit.pipeline import Pipeline
 
+    check_paths([spec], {"--output": output})
     s = _guard(lambda: load_spec(spec))
     doc = _guard(lambda: dynamics_job(Pipeline(s), gravity))
 
@@ -192,7 +212,7 @@ def dynamics(
                     t.add_row(f"{name} {sub}", f"{st2['rms']:.6g}", f"{st2['peak']:.6g}")
         console.print(t)
 
-    _emit(doc, as_json, output, table)
+    _emit(doc, as_json, output, table, [spec])
 
 
 def dynamics_job(pipe: Any, gravity: bool) -> dict[str, Any]:
@@ -222,7 +242,12 @@ def demo(
     files = sorted(examples.glob("*.toml"))
     if not files:
         _guard(lambda: (_ for _ in ()).throw(ValueError(f"no spec files (*.toml) in {examples}")))
-    output_dir.mkdir(parents=True, exist_ok=True)
+    from screwkit.io.outputs import make_output_folder
+
+    _guard(lambda: make_output_folder(output_dir, "--output-dir"))
+
+    def write(path: Path, result: Any) -> None:
+        _guard(lambda: write_atomic(path, dumps(result) + "\n", files))
     t = Table(title=f"screwkit demo: {len(files)} examples")
     for col in ("example", "family", "samples", "modes", "assembling", "max closure residual", "jobs"):
         t.add_column(col)
@@ -234,25 +259,25 @@ def demo(
         motion = _guard(lambda p=pipe: p.motion)  # type: ignore[misc]
         doc = analysis_document(motion, name=spec.name, coupler_point=spec.coupler_point)
         out = output_dir / f"{f.stem}.analysis.json"
-        write_atomic(out, dumps(doc) + "\n")
+        write(out, doc)
         if plots:
             from screwkit.report.plots import plot_analysis
 
             _guard(lambda d=doc, f=f: plot_analysis(d, output_dir / f"{f.stem}.analysis.png"))  # type: ignore[misc]
         mob = _guard(lambda p=pipe: p.mobility().as_dict())  # type: ignore[misc]
-        write_atomic(output_dir / f"{f.stem}.mobility.json", dumps(mob) + "\n")
+        write(output_dir / f"{f.stem}.mobility.json", mob)
         jobs = ["analysis", "mobility"]
         if all(link.mass is not None for link in spec.linkage.links):
             dyn = _guard(lambda p=pipe: dynamics_job(p, False))  # type: ignore[misc]
-            write_atomic(output_dir / f"{f.stem}.dynamics.json", dumps(dyn) + "\n")
+            write(output_dir / f"{f.stem}.dynamics.json", dyn)
             jobs.append("dynamics")
         if spec.balancing is not None:
             bal = _guard(lambda p=pipe: p.balance())  # type: ignore[misc]
-            write_atomic(output_dir / f"{f.stem}.balance.json", dumps(bal.as_dict()) + "\n")
+            write(output_dir / f"{f.stem}.balance.json", bal.as_dict())
             jobs.append("balance")
         if spec.synthesis is not None:
             syn = _guard(lambda p=pipe: synthesis_document(p.synthesize(), p.spec.path))  # type: ignore[misc]
-            write_atomic(output_dir / f"{f.stem}.synthesis.json", dumps(syn) + "\n")
+            write(output_dir / f"{f.stem}.synthesis.json", syn)
             jobs.append("synthesis")
         if write_reports:
             from screwkit.report.spec_report import write_spec_report

@@ -17,6 +17,7 @@ from rich.table import Table
 
 from screwkit.cli.common import console, err_console
 from screwkit.cli.common import guard as _guard
+from screwkit.report.plots import save_figure
 
 __all__ = ["register", "synthesis_document"]
 
@@ -44,7 +45,7 @@ def _plot(results: list[Any], path: Path) -> None:
     axes[1].legend()
     fig.suptitle(f"synthesis: RMSE φ {math.degrees(best.rmse_phi):.4g}°, S {best.rmse_S:.3g} m")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path)
     plt.close(fig)
 
 
@@ -167,7 +168,7 @@ def _plot_overlay(docs: list[dict[str, Any]], problem: Any, path: Path) -> None:
         ax2.set_xlabel("input θ from θ01 (deg)")
         ax2.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path)
     plt.close(fig)
 
 
@@ -188,7 +189,7 @@ def _overlay_lines(docs: list[dict[str, Any]]) -> None:
 def plot_path(plot: Path) -> Path:
     """The PNG file ``--plot`` writes: ``.png`` added when the name has no suffix; its folder must
     exist and the name must not be a folder (checked before the solve)."""
-    path = plot if plot.suffix else plot.with_name(plot.name + ".png")
+    path = plot if plot.suffix or plot.is_dir() else plot.with_name(plot.name + ".png")
     if path.is_dir():
         raise ValueError(f"--plot {plot}: {path} is a folder; give a file name, e.g. "
                          f"{path / 'synthesis.png'}")
@@ -220,6 +221,9 @@ def register(app: typer.Typer) -> None:
         if plot is not None:
             asked = plot
             plot = _guard(lambda: plot_path(asked))
+        from screwkit.cli.common import check_paths
+
+        check_paths([spec], {"--output": output, "--plot": plot})
         s = _guard(lambda: load_spec(spec))
         pipe = Pipeline(s)
         config = _guard(lambda: pipe.synthesis_config())
@@ -242,7 +246,7 @@ def register(app: typer.Typer) -> None:
         overlay = config.method == "overlay"
         text = dumps(doc)
         if output is not None:
-            _guard(lambda: write_atomic(output, text + "\n"))
+            _guard(lambda: write_atomic(output, text + "\n", [spec], "--output"))
         if plot is not None:
             png = plot
             _guard(lambda: _plot_overlay(docs, problem, png) if overlay else _plot(results, png))

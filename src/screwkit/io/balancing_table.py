@@ -8,11 +8,12 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError
 
 from screwkit.balancing.config import BalancingConfig, NormalisationConfig
 from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.measures import MEASURES
+from screwkit.balancing.problem import check_weights
 from screwkit.balancing.variables import (
     POINT_MASS_NAMES,
     VariableBlock,
@@ -75,7 +76,7 @@ class ParetoTable(_Strict):
 
 class BalancingTable(_Strict):
     weights: dict[str, float] = Field(default_factory=lambda: {k: 1.0 for k in MEASURES})
-    gravity: bool = False
+    gravity: StrictBool = False
     links: dict[str, LinkVariablesTable] = Field(default_factory=dict)
     counterweights: list[CounterweightTable] = Field(default_factory=list)
     normalisation: NormalisationTable = Field(default_factory=NormalisationTable)  # type: ignore[arg-type]
@@ -95,8 +96,8 @@ def balancing_table(spec: Any) -> BalancingTable:
         for err in exc.errors():
             loc = ".".join(str(p) for p in err["loc"])
             msg = ("unknown key (see docs/balancing.md)" if err["type"] == "extra_forbidden"
-                   else err["msg"])
-            lines.append(f"  [balancing.{loc}] {msg}")
+                   else str(err["msg"]).removeprefix("Value error, "))
+            lines.append(f"  [balancing{'.' + loc if loc else ''}] {msg}")
         raise BalancingConfigError("\n".join(lines)) from exc
 
 
@@ -176,6 +177,10 @@ def _bound(spec: Any, table: BalancingTable) -> dict[str, tuple[list[float], lis
 def balancing_config(spec: Any) -> BalancingConfig:
     """The ``[balancing]`` table of a loaded spec as a typed, SI :class:`BalancingConfig`."""
     table = balancing_table(spec)
+    try:
+        check_weights(table.weights)  # a bad weight is named at load, before any dynamics
+    except BalancingError as exc:
+        raise BalancingConfigError(f"{spec.path}: [balancing.weights] {exc}") from None
     nt = table.normalisation
 
     def optional(value: Any, kind: str, key: str) -> float | None:

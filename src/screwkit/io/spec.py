@@ -7,7 +7,6 @@ Every error names the file, the key, what is wrong and what would be right
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -16,6 +15,7 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    StrictBool,
     StrictFloat,
     StrictInt,
     StrictStr,
@@ -25,7 +25,9 @@ from pydantic import (
 
 from screwkit.constants import STANDARD_GRAVITY
 from screwkit.io.errors import SpecError
+from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
+from screwkit.io.validation import validation_lines
 from screwkit.kinematics.registry import family, require
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
@@ -34,6 +36,7 @@ if TYPE_CHECKING:
     from screwkit.synthesis.config import SynthesisConfig
 
 Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
+Number = StrictFloat | StrictInt
 
 
 class _Strict(BaseModel):
@@ -58,8 +61,8 @@ class MotionTable(_Strict):
     step: Value = 10.0
     speed: Value = Field(1.0, description="input speed (angular velocity for a crank)")
     acceleration: Value = 0.0
-    periodic: bool | None = Field(None, description="drop the stop sample when it repeats the start")
-    mode: int = Field(0, ge=0, description="assembly mode used by dynamics and balancing")
+    periodic: StrictBool | None = Field(None, description="drop the stop sample when it repeats the start")
+    mode: StrictInt = Field(0, ge=0, le=10_000, description="assembly mode used by dynamics and balancing")
 
 
 class JointTable(_Strict):
@@ -69,7 +72,7 @@ class JointTable(_Strict):
     twist: Value = 0.0
     offset: Value = 0.0
     pitch: Value = 0.0
-    input: bool = False
+    input: StrictBool = False
 
 
 class LinkMassTable(_Strict):
@@ -77,7 +80,7 @@ class LinkMassTable(_Strict):
     weight: Value | None = None
     com: list[Value] = Field(default_factory=lambda: [0.0, 0.0, 0.0])  # type: ignore[arg-type]
     inertia: list[Value] | list[list[Value]] | None = None
-    principal_axes: list[list[float]] | None = None
+    principal_axes: list[list[Number]] | None = None
 
 
 class CouplerPointTable(_Strict):
@@ -95,7 +98,7 @@ class SpecFile(_Strict):
     links: dict[str, LinkMassTable] = Field(default_factory=dict)
     coupler_point: CouplerPointTable | None = None
     gravity: Value | None = None
-    gravity_direction: list[float] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
+    gravity_direction: list[Number] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
     balancing: dict[str, Any] | None = None
     synthesis: dict[str, Any] | None = None
 
@@ -337,14 +340,7 @@ class Spec:
 
 
 def _format_validation(path: str, exc: ValidationError) -> str:
-    lines = [f"{path}: the spec file is not valid:"]
-    for err in exc.errors():
-        loc = ".".join(str(p) for p in err["loc"])
-        msg = err["msg"]
-        if err["type"] == "extra_forbidden":
-            msg = "unknown key (check the spelling; see docs/spec-format.md)"
-        lines.append(f"  [{loc}] {msg}")
-    return "\n".join(lines)
+    return "\n".join([f"{path}: the spec file is not valid:", *validation_lines(exc)])
 
 
 MechanismSpec = Spec  # the name used before the front door
@@ -355,14 +351,10 @@ def load_spec(path: str | Path) -> Spec:
     in SI units, with its mechanism model and its ``[balancing]``/``[synthesis]`` tables parsed;
     raises :class:`SpecError` naming the file, the key and a fix."""
     p = Path(path)
-    if not p.is_file():
-        raise SpecError(f"{p}: no such spec file")
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(f"{p}: not valid TOML: {exc}") from exc
-    except UnicodeDecodeError as exc:
-        raise SpecError(f"{p}: not a text file ({exc})") from exc
+        data = read_toml(p)  # size, encoding, nesting and string-length checks
+    except SpecFileError as exc:
+        raise SpecError(str(exc)) from None
     try:
         raw = SpecFile.model_validate(data)
     except ValidationError as exc:

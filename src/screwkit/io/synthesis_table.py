@@ -15,7 +15,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    ValidationError,
+    model_validator,
+)
 
 from screwkit.io.errors import SpecError
 from screwkit.io.units import UnitError, to_si
@@ -93,7 +100,7 @@ class ComponentTable(_Strict):
 class PointTable(_Strict):
     theta: Value
     q: Value = "dwell"
-    other_tangency: bool = False
+    other_tangency: StrictBool = False
 
 
 class ConstraintsTable(_Strict):
@@ -241,8 +248,8 @@ def _parse(spec: MechanismSpec) -> _Parsed:
         for err in exc.errors():
             loc = ".".join(str(p) for p in err["loc"])
             msg = ("unknown key (see docs/synthesis.md)" if err["type"] == "extra_forbidden"
-                   else err["msg"])
-            lines.append(f"  [synthesis.{loc}] {msg}")
+                   else str(err["msg"]).removeprefix("Value error, "))
+            lines.append(f"  [synthesis{'.' + loc if loc else ''}] {msg}")
         raise SynthesisConfigError("\n".join(lines)) from None
     units = spec.units
 
@@ -294,6 +301,8 @@ def _parse(spec: MechanismSpec) -> _Parsed:
                 fn = data_function(th, val)
                 if pts is None:
                     pts = np.array(th)
+        except SynthesisConfigError:
+            raise  # already names its key
         except ValueError as exc:
             raise _fail(path, key, str(exc)) from None
         assert pts is not None

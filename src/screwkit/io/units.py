@@ -1,11 +1,27 @@
-"""Unit handling at the boundary (pint). Inside the library everything is SI and radians."""
+"""Unit handling at the boundary. Inside the library everything is SI and radians.
+
+A value is read by the quantity grammar of :mod:`screwkit.io.quantity` (a number and unit
+names with small powers); pint only looks up each unit *name* and converts. After conversion a
+value must be finite and inside the engineering range of its kind (:data:`MAGNITUDE_LIMITS`,
+docs/reliability.md): a mass of 1e300 kg is a typing mistake, and letting it through turns into
+overflow deep inside the solvers.
+"""
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 from typing import Any
 
 import pint
+
+from screwkit.io.quantity import (
+    MAX_QUANTITY_CHARS,
+    QuantitySyntaxError,
+    excerpt,
+    parse_quantity,
+    parse_unit,
+)
 
 
 class UnitError(ValueError):
@@ -31,6 +47,31 @@ KIND_UNITS = {
     "dimensionless": "",
 }
 
+#: SI unit of each kind as printed in messages
+SI_SYMBOL = {"length": "m", "angle": "rad", "angular_velocity": "rad/s",
+             "angular_acceleration": "rad/s^2", "velocity": "m/s", "acceleration": "m/s^2",
+             "mass": "kg", "force": "N", "inertia": "kg*m^2", "dimensionless": ""}
+
+#: (largest |value|, smallest non-zero |value|) accepted per kind, in SI. Zero is always
+#: accepted here (a zero offset, a massless link, a resting input); rules that need a positive
+#: value (a step, gravity) are checked where the value is used. The ranges cover every machine
+#: from a MEMS linkage to a crane; docs/reliability.md says how to widen them.
+MAGNITUDE_LIMITS: dict[str, tuple[float, float]] = {
+    "length": (1e6, 1e-9),                  # 1000 km … 1 nm
+    "angle": (1e5, 1e-12),                  # ~16 000 turns … 1e-12 rad
+    "angular_velocity": (1e6, 1e-12),       # ~9.5 million rpm
+    "angular_acceleration": (1e12, 1e-12),
+    "velocity": (1e6, 1e-12),               # 1000 km/s
+    "acceleration": (1e9, 1e-12),           # 1e8 g
+    "mass": (1e9, 1e-12),                   # a million tonnes … 1 ng
+    "force": (1e12, 1e-12),
+    "inertia": (1e15, 1e-27),               # kg·m²
+    "dimensionless": (1e12, 1e-300),
+}
+
+#: names pint does not define that spec files use, and what they mean
+ALIASES = {"rev": "revolution", "revs": "revolution"}
+
 EXAMPLES = {
     "length": '"2.0 in" or "50 mm"',
     "angle": '"250 deg" or "1.2 rad"',
@@ -45,68 +86,131 @@ EXAMPLES = {
 }
 
 
-def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
-    """Convert ``value`` (a number, or a string such as ``"2 in"``) to the SI unit of ``kind``.
+def _words(kind: str) -> str:
+    return kind.replace("_", " ")
 
-    A bare number takes ``default_unit`` (from the spec's ``[units]`` table), or SI if none.
-    """
+
+def _a(kind: str) -> str:
+    """The kind with its article: "a length", "an angle"."""
+    w = _words(kind)
+    return f"an {w}" if w[0] in "aeiou" else f"a {w}"
+
+
+@lru_cache(maxsize=512)
+def _unit(names: tuple[tuple[str, int], ...]) -> Any:
+    """The pint unit of parsed (name, power) pairs: each name is looked up on its own (a
+    single identifier, which pint resolves as a name, with prefixes and plurals)."""
     ureg = registry()
-    target = KIND_UNITS[kind]
-    if default_unit is not None:
-        check_unit(default_unit, kind)
-    if isinstance(value, bool):
-        raise UnitError(f"expected a {kind.replace('_', ' ')}, e.g. {EXAMPLES[kind]}; got {value!r}")
-    if isinstance(value, int | float):
-        if default_unit is None or kind == "dimensionless":
-            return _finite(float(value), value, kind)
-        q = ureg.Quantity(float(value), default_unit)
-    elif isinstance(value, str):
+    unit = ureg.Unit("")
+    for name, power in names:
         try:
-            q = ureg.Quantity(value)
-        except Exception as exc:  # pint raises several types for unreadable text
-            raise UnitError(
-                f"cannot read {value!r} as a {kind.replace('_', ' ')}; write e.g. {EXAMPLES[kind]}"
-            ) from exc
-        if not isinstance(q, pint.Quantity):
-            q = ureg.Quantity(float(q), default_unit or target or "")
-        elif q.unitless and default_unit and kind != "dimensionless":
-            # a number written as text ("2"): the default unit applies. A unit the user wrote
-            # ("1.2 rad" under angle = "deg") is kept, even if pint calls it dimensionless.
-            q = ureg.Quantity(float(q.magnitude), default_unit)
-        if kind == "angular_velocity" and "hertz" in str(q.units):
-            raise UnitError(
-                f"{value!r} is ambiguous for an angular speed (Hz is 1/s, with no angle): write "
-                f"revolutions as \"50 rev/s\" or \"3000 rpm\", or radians as \"314.16 rad/s\""
-            )
-    else:
-        raise UnitError(f"expected a {kind.replace('_', ' ')}, e.g. {EXAMPLES[kind]}; got {value!r}")
+            one = ureg.Unit(ALIASES.get(name, name))
+        except Exception as exc:  # UndefinedUnitError and friends
+            raise UnitError(f"unknown unit {excerpt(name)}") from exc
+        unit = unit * one**power
+    return unit
+
+
+@lru_cache(maxsize=512)
+def _factor(names: tuple[tuple[str, int], ...], kind: str) -> float:
+    """SI value of one of the unit; raises :class:`UnitError` for the wrong kind."""
+    unit = _unit(names)
+    target = KIND_UNITS[kind]
     try:
-        out = float(q.to(target).magnitude) if target else float(q.to("").magnitude)
+        q = registry().Quantity(1.0, unit)
+        factor = float(q.to(target).magnitude) if target else float(q.to("").magnitude)
     except pint.DimensionalityError as exc:
-        raise UnitError(
-            f"{value!r} is not a {kind.replace('_', ' ')} (its unit is {q.units}); "
-            f"write e.g. {EXAMPLES[kind]}"
-        ) from exc
-    return _finite(out, value, kind)
+        raise UnitError(f"its unit is {unit}") from exc
+    except Exception as exc:  # offset units (degC) cannot be multiplied
+        raise UnitError(f"the unit {unit} cannot be used here ({type(exc).__name__})") from exc
+    return factor
 
 
-def _finite(out: float, value: Any, kind: str) -> float:
-    if out != out or out in (float("inf"), float("-inf")):
-        raise UnitError(f"{value!r} is not a finite {kind.replace('_', ' ')}")
-    return out
+def _has_hertz(names: tuple[tuple[str, int], ...]) -> bool:
+    """Whether a unit names hertz (1/s with no angle: ambiguous for an angular speed)."""
+    hertz = registry().Unit("hertz")
+    return any(_unit(((n, 1),)) == hertz for n, _ in names)
 
 
 def check_unit(unit: str, kind: str) -> None:
-    """Raise :class:`UnitError` unless ``unit`` is a unit pint knows and of the right kind."""
-    ureg = registry()
+    """Raise :class:`UnitError` unless ``unit`` is a unit expression of the right kind."""
+    if not isinstance(unit, str):
+        raise UnitError(f"a unit is a string such as \"in\" or \"deg\"; got {unit!r}")
     try:
-        q = ureg.Quantity(1.0, unit)
-    except Exception as exc:  # UndefinedUnitError and friends
-        raise UnitError(f"unknown unit {unit!r} for {kind.replace('_', ' ')}; write e.g. "
+        names = parse_unit(unit) if len(unit) <= MAX_QUANTITY_CHARS else None
+    except QuantitySyntaxError as exc:
+        raise UnitError(f"cannot read the unit {excerpt(unit)}: {exc}; write e.g. "
                         f"{EXAMPLES[kind]}") from exc
-    target = KIND_UNITS[kind]
+    if names is None:
+        raise UnitError(f"the unit {excerpt(unit)} is longer than {MAX_QUANTITY_CHARS} characters")
     try:
-        q.to(target) if target else q.to("")
-    except pint.DimensionalityError as exc:
-        raise UnitError(f"{unit!r} is not a unit of {kind.replace('_', ' ')}; write e.g. "
+        _unit(names)
+    except UnitError as exc:
+        raise UnitError(f"unknown unit {excerpt(unit)} for {_words(kind)}; write e.g. "
                         f"{EXAMPLES[kind]}") from exc
+    try:
+        _factor(names, kind)
+    except UnitError as exc:
+        raise UnitError(f"{excerpt(unit)} is not a unit of {_words(kind)}; write e.g. "
+                        f"{EXAMPLES[kind]}") from exc
+
+
+def check_magnitude(value_si: float, kind: str, shown: str) -> float:
+    """``value_si`` if it is finite and inside :data:`MAGNITUDE_LIMITS` for ``kind``; otherwise
+    a :class:`UnitError` that shows the value as ``shown``."""
+    unit = SI_SYMBOL[kind]
+    if not math.isfinite(value_si):
+        raise UnitError(f"{shown} is not a finite {_words(kind)} (it overflows in SI)")
+    high, low = MAGNITUDE_LIMITS[kind]
+    size = abs(value_si)
+    if size > high or 0.0 < size < low:
+        raise UnitError(
+            f"{shown} is {value_si:.3g} {unit} in SI, outside the range accepted for "
+            f"{_a(kind)} (0, or {low:g} to {high:g} {unit} in magnitude); check the "
+            "number and its unit (the limits and how to change them: docs/reliability.md)")
+    return value_si
+
+
+def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
+    """Convert ``value`` (a number, or a string such as ``"2 in"``) to the SI unit of ``kind``.
+
+    A bare number (or a string holding only a number) takes ``default_unit`` (from the spec's
+    ``[units]`` table), or SI if none. A unit written in the value wins over the default.
+    """
+    if default_unit is not None:
+        check_unit(default_unit, kind)
+    if isinstance(value, bool) or not isinstance(value, int | float | str):
+        raise UnitError(f"expected {_a(kind)}, e.g. {EXAMPLES[kind]}; got "
+                        f"{excerpt(repr(value)) if not isinstance(value, bool) else value!r}")
+    shown = excerpt(str(value)) if isinstance(value, str) else repr(value)
+    if isinstance(value, str):
+        try:
+            parsed = parse_quantity(value)
+        except QuantitySyntaxError as exc:
+            raise UnitError(f"cannot read {shown} as {_a(kind)}: {exc}; write e.g. "
+                            f"{EXAMPLES[kind]}") from None
+        magnitude, names = parsed.magnitude, parsed.units
+    else:
+        try:
+            magnitude = float(value)
+        except OverflowError:
+            raise UnitError(f"{excerpt(repr(value))} is too large for {_a(kind)}") from None
+        names = ()
+        if not math.isfinite(magnitude):
+            raise UnitError(f"{shown} is not a finite number")
+    if not names and kind != "dimensionless" and default_unit is not None:
+        names = parse_unit(default_unit)
+    if not names:
+        return check_magnitude(magnitude, kind, shown)
+    try:
+        factor = _factor(names, kind)
+    except UnitError as exc:
+        if str(exc).startswith("unknown unit"):
+            raise UnitError(f"{exc} in {shown}; write e.g. {EXAMPLES[kind]}") from None
+        raise UnitError(f"{shown} is not {_a(kind)} ({exc}); write e.g. "
+                        f"{EXAMPLES[kind]}") from None
+    if kind == "angular_velocity" and _has_hertz(names):
+        raise UnitError(
+            f"{shown} is ambiguous for an angular speed (Hz is 1/s, with no angle): write "
+            f"revolutions as \"50 rev/s\" or \"3000 rpm\", or radians as \"314.16 rad/s\"")
+    return check_magnitude(magnitude * factor, kind, shown)

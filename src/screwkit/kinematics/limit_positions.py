@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.kinematics.motion import AssemblyError
 from screwkit.kinematics.registry import require
 from screwkit.model.linkage import Linkage
 
@@ -74,6 +75,7 @@ def limit_positions(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: 
     translation limits by the corrected eq. D.3; dwell order = number of vanishing consecutive
     derivatives dᵏφ0/dθ0ᵏ, k = 1…max_order, within ``dwell_tolerance`` rad/radᵏ). ``at``: input
     angles (rad) where the dwell order of every inversion is wanted too."""
+    from screwkit.kinematics.assembly_range import assembling_intervals, describe_intervals
     from screwkit.kinematics.closed_form_motion import rsrc_dimensions
     from screwkit.kinematics.rsrc import (
         rsrc_dwell_order,
@@ -88,6 +90,11 @@ def limit_positions(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: 
     dims, planar = rsrc_dimensions(linkage)
     out: list[LimitPosition] = []
     rot = rsrc_rotation_limits(dims)
+    runs = assembling_intervals(dims)
+    if not runs and not rot:
+        raise AssemblyError(f"{linkage.name}: the mechanism does not assemble at any input angle "
+                            "(scanned every 0.25° over a full turn), so it has no limit positions; "
+                            "check the dimensions (docs/kinematics.md)")
     if rot:
         order, deriv = rsrc_dwell_order(dims, np.array([r.theta0 for r in rot]),
                                         np.array([r.phi0 for r in rot]), tol=dwell_tolerance,
@@ -104,6 +111,12 @@ def limit_positions(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: 
     if at:
         th = np.asarray(at, dtype=float)
         pos = rsrc_positions(dims, th)
+        nowhere = ~np.asarray(pos.assembles).any(axis=1)
+        if nowhere.any():
+            shown = ", ".join(f"{np.degrees(t):.6g}°" for t in th[nowhere][:8])
+            raise AssemblyError(f"{linkage.name}: the mechanism does not assemble at the input "
+                                f"angle(s) {shown} asked for; it assembles "
+                                f"{describe_intervals(runs)} (sampled every 0.25°)")
         for j in range(pos.phi0.shape[1]):
             ok = pos.assembles[:, j]
             if not ok.any():

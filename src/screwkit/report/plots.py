@@ -3,8 +3,6 @@ assembly mode, and the coupler curve in Bagci's three projections (App. C: X–Y
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -34,23 +32,15 @@ def pyplot() -> Any:
     return plt
 
 
-def save_figure(fig: Any, path: str | Path) -> None:
-    """Save through a temporary file and a rename (no half-written picture on error)."""
+def save_figure(fig: Any, path: str | Path, inputs: Any = (), option: str | None = None) -> None:
+    """Save through a temporary file and a rename (no half-written picture on error; links,
+    FIFOs, folders and the command's inputs are refused: screwkit.io.outputs)."""
+    from screwkit.io.outputs import atomic_path
+
     p = Path(path)
-    if not p.parent.exists():
-        raise ValueError(f"cannot write {p}: folder {p.parent} does not exist")
-    suffix = p.suffix or ".png"
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}.", suffix=suffix, dir=str(p.parent))
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=110, bbox_inches="tight")
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, p)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    fmt = p.suffix[1:].lower() or "png"
+    with atomic_path(p, inputs, option) as tmp:
+        fig.savefig(tmp, dpi=110, bbox_inches="tight", format=fmt)
 
 
 def continuous_rotation_vectors(rv: np.ndarray) -> np.ndarray:

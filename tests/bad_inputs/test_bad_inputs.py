@@ -1,0 +1,193 @@
+"""The bad-input corpus (cases.toml + specs/): every command line runs in-process under a time
+bound and must exit with the expected status and a message holding the expected fragment,
+with no traceback, no numpy warning, no file left behind and no change to any file but its
+declared outputs. Two cases run as real processes: an output FIFO (which would block an
+``open``) and Ctrl-C in the middle of a run. Add a case by adding a spec file and a
+``[[case]]`` entry; no code is needed (docs/reliability.md)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import select
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import threading
+import time
+import tomllib
+import warnings
+from pathlib import Path
+from typing import Any
+
+import pytest
+from typer.testing import CliRunner
+
+from screwkit.cli.main import app
+
+HERE = Path(__file__).resolve().parent
+SPECS = HERE / "specs"
+CASES: list[dict[str, Any]] = tomllib.loads((HERE / "cases.toml").read_text())["case"]
+#: seconds one case may take before it counts as a hang
+TIMEOUT = 30.0
+
+
+def _make(folder: Path, name: str, how: str) -> None:
+    """Create the special file ``name`` in ``folder`` (kinds listed in cases.toml)."""
+    p = folder / name
+    p.parent.mkdir(parents=True, exist_ok=True)
+    kind, _, arg = how.partition(":")
+    if kind == "empty":
+        p.write_bytes(b"")
+    elif kind == "text":
+        p.write_text(arg, encoding="utf-8")
+    elif kind == "text-latin1":
+        p.write_bytes(arg.encode("latin-1"))
+    elif kind == "binary":
+        p.write_bytes(bytes(range(256)) * 4)
+    elif kind == "big":
+        p.write_bytes(b"# " + b"x" * 1_100_000 + b"\n")
+    elif kind == "dir":
+        p.mkdir()
+    elif kind == "fifo":
+        os.mkfifo(p)
+    elif kind == "symlink":
+        os.symlink(arg, p)
+    elif kind == "hardlink":
+        os.link(folder / arg, p)
+    elif kind == "copy":
+        shutil.copyfile(SPECS / arg, p)
+    elif kind == "bom":
+        p.write_bytes(b"\xef\xbb\xbf" + (SPECS / arg).read_bytes())
+    elif kind == "utf16":
+        p.write_bytes((SPECS / arg).read_text().encode("utf-16"))
+    else:  # pragma: no cover - a mistake in cases.toml
+        raise ValueError(f"unknown make kind {how!r}")
+
+
+def _snapshot(folder: Path) -> dict[str, tuple[str, str]]:
+    """Every entry under ``folder``: (kind, content hash or link target); FIFOs are not read."""
+    out: dict[str, tuple[str, str]] = {}
+    for root, dirs, files in os.walk(folder):
+        for name in dirs + files:
+            p = Path(root) / name
+            mode = os.lstat(p).st_mode
+            rel = str(p.relative_to(folder))
+            if stat.S_ISLNK(mode):
+                out[rel] = ("link", os.readlink(p))
+            elif stat.S_ISREG(mode):
+                out[rel] = ("file", hashlib.sha256(p.read_bytes()).hexdigest())
+            else:
+                out[rel] = ("dir" if stat.S_ISDIR(mode) else "special", "")
+    return out
+
+
+def _invoke(args: list[str], timeout: float) -> tuple[Any, list[str]]:
+    """Run the CLI in a thread; fail on a hang. Returns (result, warnings raised)."""
+    box: dict[str, Any] = {}
+
+    def run() -> None:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            box["result"] = CliRunner().invoke(app, args)
+        box["warnings"] = [f"{w.category.__name__}: {w.message}" for w in caught]
+
+    worker = threading.Thread(target=run, daemon=True)
+    worker.start()
+    worker.join(timeout)
+    if worker.is_alive():
+        pytest.fail(f"hang: still running after {timeout} s: screwkit {' '.join(args)}")
+    return box["result"], box["warnings"]
+
+
+def _flat(text: str) -> str:
+    return " ".join(text.split())
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c["name"] for c in CASES])
+def test_bad_input(case: dict[str, Any], tmp_path: Path) -> None:
+    for name in case.get("files", []):
+        shutil.copyfile(SPECS / name, tmp_path / name)
+    for name, how in case.get("make", {}).items():
+        _make(tmp_path, name, how)
+    args = [a.replace("{d}", str(tmp_path)) for a in case["args"]]
+    before = _snapshot(tmp_path)
+    started = time.perf_counter()
+    result, caught = _invoke(args, case.get("timeout", TIMEOUT))
+    took = time.perf_counter() - started
+    output = result.output
+    where = f"screwkit {' '.join(args)} ({took:.1f} s)\n{output}"
+    if result.exception is not None and not isinstance(result.exception, SystemExit):
+        import traceback
+
+        tb = "".join(traceback.format_exception(result.exception))
+        pytest.fail(f"uncaught exception from {where}\n{tb}")
+    assert "Traceback" not in output, where
+    assert not caught, f"warnings {caught} from {where}"
+    assert "RuntimeWarning" not in output, where
+    assert result.exit_code == case["status"], where
+    assert _flat(case["message"]) in _flat(output), where
+    after = _snapshot(tmp_path)
+    allowed = set(case.get("outputs", []))
+    changed = sorted(k for k in before if k not in allowed and after.get(k) != before[k])
+    assert not changed, f"changed or removed {changed}: {where}"
+    new = sorted(set(after) - set(before) - allowed)
+    assert not new, f"left behind {new}: {where}"
+
+
+def test_the_corpus_is_big_enough_and_every_spec_is_used() -> None:
+    assert len(CASES) >= 60
+    used = {n for c in CASES for n in c.get("files", [])}
+    used |= {how.partition(":")[2] for c in CASES for how in c.get("make", {}).values()}
+    assert {p.name for p in SPECS.glob("*.toml")} <= used
+
+
+def _screwkit(args: list[str], **kw: Any) -> subprocess.Popen[str]:
+    return subprocess.Popen([sys.executable, "-m", "screwkit.cli.main", *args], text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, **kw)
+
+
+def test_an_output_fifo_is_refused_without_blocking(tmp_path: Path) -> None:
+    shutil.copyfile(SPECS / "rsrc.toml", tmp_path / "rsrc.toml")
+    os.mkfifo(tmp_path / "out.json")
+    proc = _screwkit(["analyze", str(tmp_path / "rsrc.toml"), "-o", str(tmp_path / "out.json")])
+    try:
+        out, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        pytest.fail("screwkit blocked on an output FIFO")
+    assert proc.returncode == 2 and "FIFO" in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.json", "rsrc.toml"]
+
+
+def test_ctrl_c_leaves_no_file_and_no_traceback(tmp_path: Path) -> None:
+    # a run of a minute or more (generic solver, 0.05° steps), interrupted once it is under way:
+    # the process says when its imports are done, and the signal comes a second later
+    spec = (SPECS / "rsrc.toml").read_text().replace('step = "10 deg"', 'step = "0.05 deg"')
+    (tmp_path / "long.toml").write_text(spec)
+    out = tmp_path / "out.json"
+    start = ("import sys; from screwkit.cli.main import app; "
+             "print('ready', file=sys.stderr, flush=True); app()")
+    proc = subprocess.Popen(
+        [sys.executable, "-c", start, "analyze", str(tmp_path / "long.toml"), "--method",
+         "generic", "--json", "-o", str(out)],
+        text=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    assert proc.stderr is not None
+    ready, _, _ = select.select([proc.stderr], [], [], 60)
+    assert ready and proc.stderr.readline().strip() == "ready"
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    try:
+        _, stderr = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        pytest.fail("screwkit did not stop on Ctrl-C")
+    assert "Traceback" not in stderr, stderr
+    if proc.returncode == 0:  # it finished first: the file is whole
+        json.loads(out.read_text())
+    else:  # typer exits with 130 (128 + SIGINT) and says nothing
+        assert proc.returncode in (1, 130) and not out.exists(), (proc.returncode, stderr)
+    assert sorted(p.name for p in tmp_path.iterdir()) in (["long.toml"], ["long.toml", "out.json"])
