@@ -355,8 +355,15 @@ def load_spec(path: str | Path) -> Spec:
         data = read_toml(p)  # size, encoding, nesting and string-length checks
     except SpecFileError as exc:
         raise SpecError(str(exc)) from None
+    return spec_from_data(data, p)
+
+
+def spec_from_data(data: dict[str, Any], path: str | Path) -> Spec:
+    """A :class:`Spec` from the parsed TOML tables of a spec file (what :func:`load_spec` reads
+    from ``path``), validated exactly as :func:`load_spec` does; ``path`` names the file in
+    messages. Design sweeps use it to load a spec whose values were replaced."""
     try:
         raw = SpecFile.model_validate(data)
     except ValidationError as exc:
-        raise SpecError(_format_validation(str(p), exc)) from exc
-    return Spec(raw, str(p))
+        raise SpecError(_format_validation(str(path), exc)) from exc
+    return Spec(raw, str(path))

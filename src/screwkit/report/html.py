@@ -17,6 +17,21 @@ code{background:#f6f6f6;padding:0 .2em}
 """
 
 
+def _sweep_sections(output_dir: Path) -> list[str]:
+    """The design sweeps whose pictures (``screwkit sweep --plot``) lie in ``output_dir``."""
+    from screwkit.report.sweep_pictures import sweep_pictures
+
+    pictures = sweep_pictures(output_dir)
+    if not pictures:
+        return []
+    parts = ["<h2 id='sweeps'>Design sweeps</h2>",
+             "<p class='muted'>Made by <code>screwkit sweep</code> (docs/sweeps.md).</p>"]
+    for p in pictures:
+        parts.append(f"<h3>{html.escape(p['title'])}</h3><p>{html.escape(p['description'])}</p>"
+                     f"<img src='{html.escape(p['file'])}' alt='{html.escape(p['title'])}'>")
+    return parts
+
+
 def write_index(output_dir: Path, entries: list[dict[str, Any]], reports: list[Path] | None = None) -> Path:
     """Write ``output_dir/index.html``. Each entry: name, description, family, jobs (list of
     (job, file name)), summary (list of (label, value)), picture (file name or None), report
@@ -44,6 +59,7 @@ def write_index(output_dir: Path, entries: list[dict[str, Any]], reports: list[P
             label = f"{r.parent.name}/{r.name}"
             parts.append(f"<li><a href='{html.escape(r.as_posix())}'>{html.escape(label)}</a></li>")
         parts.append("</ul>")
+    parts.extend(_sweep_sections(output_dir))
     for e in entries:
         parts.append(f"<h2 id='{html.escape(e['name'])}'>{html.escape(e['name'])}</h2>")
         parts.append(f"<p>{html.escape(e['description'])}</p>")

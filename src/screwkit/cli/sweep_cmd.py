@@ -1,0 +1,151 @@
+"""``screwkit sweep SPEC --vary KEY=START:STOP:COUNT … --job JOB --output FILE``: one job on
+every design of a grid or Latin-hypercube sample, one row per design, on Dask
+(docs/sweeps.md). Registered on the main app by ``register(app)``; it parses options and
+formats, the work is in :mod:`screwkit.sweep`."""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.markup import escape
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    ProgressColumn,
+    TextColumn,
+    TimeRemainingColumn,
+)
+from rich.table import Table
+from rich.text import Text
+
+from screwkit.cli.common import check_paths, console, err_console, guard
+
+SchedulerOpt = Annotated[str | None, typer.Option(
+    "--scheduler", help="Run on an existing Dask scheduler (tcp://HOST:PORT) and its workers "
+                        "instead of an embedded cluster; default: $SCREWKIT_SCHEDULER.")]
+WorkersOpt = Annotated[int | None, typer.Option(
+    "--workers", min=0, max=1024, help="Worker processes of the embedded cluster (default: one "
+                                       "per core; 0: run in this process without Dask).")]
+
+
+class _Rate(ProgressColumn):
+    """Designs per second over this run (resumed designs not counted)."""
+
+    def __init__(self, state: dict[str, float]) -> None:
+        super().__init__()
+        self.state = state
+
+    def render(self, task: Any) -> Text:
+        elapsed = time.perf_counter() - self.state["t0"]
+        rate = self.state["computed"] / elapsed if elapsed > 0 else 0.0
+        return Text(f"{rate:.3g} designs/s", style="progress.data.speed")
+
+
+@contextmanager
+def progress_bar(label: str, unit: str = "designs") -> Iterator[Callable[[int, int, int], None]]:
+    """A progress callback (done, total, computed now) drawing on stderr when it is a
+    terminal (designs done, rate, ETA); silent otherwise."""
+    state = {"t0": time.perf_counter(), "computed": 0.0}
+    if not err_console.is_terminal:
+        yield lambda done, total, computed: None
+        return
+    with Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TextColumn(unit),
+                  _Rate(state), TextColumn("ETA"), TimeRemainingColumn(),
+                  console=err_console, transient=True) as bar:
+        task = bar.add_task(label, total=None)
+
+        def update(done: int, total: int, computed: int) -> None:
+            state["computed"] = computed
+            bar.update(task, completed=done, total=total)
+
+        yield update
+
+
+def interrupted(folder: Path, done: int | None = None) -> None:
+    """Ctrl-C: say what is kept and how to continue; exit 130."""
+    err_console.print(f"[yellow]interrupted:[/] no table written; the finished designs are "
+                      f"kept in {escape(str(folder))} — run the same command with --resume to "
+                      "continue", highlight=False)
+    raise typer.Exit(130)
+
+
+def _summary(result: Any, output: Path, plot: Path | None) -> None:
+    rows = result.rows
+    n = len(rows)
+    t = Table(title=f"sweep: {n} designs")
+    for col in ("computed", "resumed", "ok", "failed", "internal errors", "time (s)",
+                "per design (ms)", "engine"):
+        t.add_column(col, justify="right")
+    per = 1000 * result.seconds / result.computed if result.computed else float("nan")
+    t.add_row(str(result.computed), str(result.resumed), str(n - result.failed - result.errors),
+              str(result.failed), str(result.errors), f"{result.seconds:.2f}", f"{per:.3g}",
+              escape(result.engine))
+    console.print(t)
+    reasons = Counter(r["reason"] for r in rows if r["status"] != "ok")
+    for reason, count in reasons.most_common(5):
+        console.print(f"  • {count} × {escape(reason)}", highlight=False)
+    console.print(f"wrote {escape(str(output))}", highlight=False)
+    if plot is not None:
+        console.print(f"wrote {escape(str(plot))}", highlight=False)
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``sweep`` command to ``app``."""
+
+    @app.command()
+    def sweep(
+        spec: Annotated[Path, typer.Argument(help="Spec file (TOML): the nominal design.")],
+        vary: Annotated[list[str], typer.Option("--vary", help="KEY=START:STOP:COUNT (grid), KEY=START:STOP (with --sample lhs:N) or KEY=V1,V2,…; KEY is a dotted path into the spec (dimensions.d2 or d2, links.coupler.mass, motion.speed …); numbers in the spec's units unless written with theirs (d2=4in:5in:11). Repeatable.")],
+        output: Annotated[Path, typer.Option("--output", "-o", help="The table: .parquet (needs pyarrow) or .csv; written atomically when every design is done.")],
+        job: Annotated[str, typer.Option("--job", help="analyze, limits, mobility, dynamics, balance or synthesize.")] = "analyze",
+        sample: Annotated[str | None, typer.Option("--sample", help="grid (default) or lhs:N (N designs by Latin hypercube over the KEY=START:STOP box).")] = None,
+        seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of --sample lhs:N (the same seed gives the same designs).")] = 0,
+        plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG: a line over one key, a heat map over two (grid), a scatter matrix otherwise.")] = None,
+        plot_column: Annotated[str | None, typer.Option("--plot-column", help="The column the picture shows (default: the job's headline, e.g. shaking_force.rms).")] = None,
+        resume: Annotated[bool, typer.Option("--resume", help="Continue an interrupted run of the same sweep from its checkpoint of finished designs.")] = False,
+        scheduler: SchedulerOpt = None,
+        workers: WorkersOpt = None,
+        batch: Annotated[int | None, typer.Option("--batch-size", min=1, max=100000, help="Designs per task (default: about four tasks per worker, at most 64).")] = None,
+        method: Annotated[str, typer.Option("--method", help="Kinematics: auto, closed or generic (as analyze).")] = "auto",
+        gravity: Annotated[bool, typer.Option("--gravity/--no-gravity", help="dynamics: include the spec's gravity.")] = False,
+        dwell_tolerance: Annotated[float, typer.Option("--dwell-tol", help="limits/analyze: dwell tolerance (as limits).")] = 1e-6,
+        starts: Annotated[int | None, typer.Option("--starts", min=1, max=10000, help="synthesize: starts of each design's multistart.")] = None,
+    ) -> None:
+        """Run one job on every design of a grid or Latin-hypercube sample of spec values, on Dask (an embedded cluster, or --scheduler); one row per design in a Parquet or CSV table."""
+        from screwkit.sweep.checkpoint import checkpoint_folder
+        from screwkit.sweep.engine import EngineConfig
+        from screwkit.sweep.jobs import JobOptions
+        from screwkit.sweep.run import define_sweep, run_sweep
+        from screwkit.sweep.table import table_format
+
+        check_paths([spec], {"--output": output, "--plot": plot})
+        guard(lambda: table_format(output))
+        options = JobOptions(method=method, gravity=gravity, dwell_tolerance=dwell_tolerance,
+                             starts=starts)
+        definition = guard(lambda: define_sweep(spec, vary, job, sample=sample, seed=seed,
+                                                options=options))
+        config = EngineConfig(scheduler, workers)
+        try:
+            with progress_bar("sweep") as update:
+                result = guard(lambda: run_sweep(definition, output, config, resume=resume,
+                                                 batch=batch, progress=update))
+        except KeyboardInterrupt:
+            interrupted(checkpoint_folder(output))
+        if plot is not None:
+            from screwkit.sweep.plots import default_column, plot_sweep
+
+            column = plot_column or default_column(job, result.rows)
+            guard(lambda: plot_sweep(result.rows, definition.metadata(), plot, column, [spec]))
+        _summary(result, output, plot)
+        if result.errors:
+            err_console.print(f"[bold red]error:[/] {result.errors} design(s) hit an internal "
+                              "error (status 'error' in the table); please report it",
+                              highlight=False)
+            raise typer.Exit(1)
