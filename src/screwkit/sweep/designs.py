@@ -2,7 +2,7 @@
 (docs/sweeps.md, "Designs").
 
 ``--vary KEY=START:STOP:COUNT`` gives COUNT equally spaced values from START to STOP (both
-included), ``--vary KEY=V1,V2,…`` a list; a grid takes every combination (the first ``--vary``
+included), ``--vary KEY=V1,V2,…`` a list (one value fixes the key); a grid takes every combination (the first ``--vary``
 varies slowest, the last fastest). ``--sample lhs:N`` draws N designs by Latin hypercube
 sampling over the ``KEY=START:STOP`` box (McKay, Beckman & Conover 1979; scipy.stats.qmc) with a
 reproducible seed. Numbers carry the unit written with them (``d2=4in:5in:11``) or the spec's
@@ -67,7 +67,7 @@ def parse_vary(text: str) -> VaryText:
         raise DesignError(f"{where}: write KEY=START:STOP:COUNT (e.g. dimensions.d2=4in:5in:11), "
                           "KEY=START:STOP with --sample lhs:N, or KEY=V1,V2,V3")
     key = key.strip()
-    if "," in rest:
+    if "," in rest or ":" not in rest:
         values, unit = _numbers(rest.split(","), where)
         return VaryText(key, values=tuple(values), unit=unit)
     parts = rest.split(":")

@@ -45,7 +45,7 @@ def evaluate_design(task: SweepTask, values: np.ndarray) -> Row:
     """The row of one design (``values`` in the keys' units) without its index and varied
     values: status, reason, where it assembles, and the job's columns."""
     overrides = [(k.path, k.toml_value(v)) for k, v in zip(task.keys, values, strict=True)]
-    row: Row = {"status": STATUS_OK, "reason": ""}
+    row: Row = {"status": STATUS_OK, "reason": None}
     try:
         with np.errstate(over="raise", divide="raise", invalid="raise"):
             spec = spec_from_data(with_values(task.data, overrides), task.path)

@@ -65,8 +65,7 @@ def _heat(fig: Any, ax: Any, x: np.ndarray, y: np.ndarray, z: np.ndarray, labels
 
     xs, ys = np.unique(x), np.unique(y)
     grid = z.reshape(xs.size, ys.size).T  # the first key varies slowest
-    cmap = matplotlib.colormaps["viridis"].copy()
-    cmap.set_bad("lightgrey")
+    cmap = matplotlib.colormaps["viridis"].with_extremes(bad="lightgrey")
     mesh = ax.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(grid), cmap=cmap,
                          shading="flat")
     fig.colorbar(mesh, ax=ax, label=column)

@@ -2,7 +2,7 @@
 Parquet (pyarrow) or CSV by the output's extension, atomically (docs/sweeps.md, "The table").
 
 Columns: ``design``, the varied keys (``dimensions.d2 [in]``: in the sweep's units), ``status``
-(``ok``, ``failed``, ``error``), ``reason``, where the design assembles, then the job's columns
+(``ok``, ``failed``, ``error``), ``reason`` (null when ok), where the design assembles, then the job's columns
 in SI units. A column's type follows its values (booleans, whole numbers, numbers, text); a
 value a design does not have is null (an empty CSV field). The columns are the union over all
 rows in the order they first appear by design number, so the table does not depend on how the
