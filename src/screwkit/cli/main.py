@@ -322,11 +322,13 @@ def _register_subcommands() -> None:
     from screwkit.cli.report_cmd import register as register_report
     from screwkit.cli.sweep_cmd import register as register_sweep
     from screwkit.cli.synthesize_cmd import register as register_synthesize
+    from screwkit.cli.tolerance_cmd import register as register_tolerance
 
     register_synthesize(app)
     register_balance(app)
     register_report(app)
     register_sweep(app)
+    register_tolerance(app)
 
 
 _register_subcommands()

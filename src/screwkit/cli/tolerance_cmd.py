@@ -1,0 +1,134 @@
+"""``screwkit tolerance SPEC --tol d2=±0.05mm …``: first-order sensitivities of every output
+over the cycle, worst-case and RSS stack-ups, and a Monte Carlo check on the sweep engine
+(docs/sweeps.md). Registered on the main app by ``register(app)``; the work is in
+:mod:`screwkit.sweep.tolerance` and :mod:`screwkit.sweep.monte_carlo`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+from rich.markup import escape
+from rich.table import Table
+
+from screwkit.cli.common import JsonOpt, OutputOpt, check_paths, console, emit, err_console, guard
+from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, progress_bar
+
+
+def _is_angle(freedom: str) -> bool:
+    return not freedom.endswith(".s")
+
+
+def _show(value: float, angle: bool) -> str:
+    return f"{np.degrees(value):.5g}" if angle else f"{value:.5g}"
+
+
+def _tables(doc: dict[str, Any], description: str) -> None:
+    console.print(f"[bold]{escape(description)}[/]", highlight=False)
+    console.print(f"assembly mode {doc['mode']}; {doc['convention']}; angles in deg, lengths "
+                  "in m", highlight=False)
+    t = Table(title="stack-ups: the largest deviation over the cycle")
+    for col in ("output", "worst case ±", "RSS ±", "at input", "dominant tolerance"):
+        t.add_column(col, justify="right")
+    for row in doc["summary"]:
+        angle = _is_angle(doc["outputs"][row["output"]]["joint_freedom"])
+        t.add_row(row["output"], _show(row["max_worst_case"], angle), _show(row["max_rss"], angle),
+                  f"{np.degrees(row['at_input']):.4g} deg", row["dominant"])
+    console.print(t)
+    mc = doc["monte_carlo"]
+    if mc is None:
+        return
+    if not mc["points_compared"]:
+        console.print("[yellow]Monte Carlo:[/] no point to compare (the outputs do not depend "
+                      "on these tolerances)")
+        return
+    lo, hi = mc["std_ratio_range"]
+    verdict = "[green]agrees[/]" if mc["agree"] else "[yellow]does NOT agree[/]"
+    console.print(
+        f"Monte Carlo ({mc['samples']} designs, seed {mc['seed']}, {mc['failed_designs']} "
+        f"failed): σ_MC/σ_first-order {lo:.4f}…{hi:.4f}; first-order σ inside the 95% "
+        f"interval at {mc['inside_95_percent_interval']} of {mc['points_compared']} points, "
+        f"inside the Bonferroni-corrected interval at {mc['inside_bonferroni_interval']}; "
+        f"first-order prediction error ≤ {mc['max_prediction_error_over_sigma']:.3g} σ — "
+        f"the first-order result {verdict}", highlight=False)
+
+
+def _plot(doc: dict[str, Any], path: Path, inputs: list[Path]) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from screwkit.io.outputs import atomic_path
+
+    outs = list(doc["outputs"])
+    fig, axes = plt.subplots(len(outs), 1, figsize=(7, 2.6 * len(outs)), sharex=True,
+                             squeeze=False)
+    x = np.degrees(np.asarray(doc["input"], dtype=float))
+    for ax, name in zip(axes[:, 0], outs, strict=True):
+        o = doc["outputs"][name]
+        scale = np.degrees(1.0) if _is_angle(o["joint_freedom"]) else 1.0
+        wc, rss = np.asarray(o["worst_case"]) * scale, np.asarray(o["rss"]) * scale
+        ax.fill_between(x, -wc, wc, color="tab:orange", alpha=0.25, label="worst case")
+        ax.plot(x, rss, "-", color="tab:blue", label="RSS (3σ)")
+        ax.plot(x, -rss, "-", color="tab:blue")
+        if doc["monte_carlo"] is not None:
+            sd = 3 * np.asarray(doc["monte_carlo"]["std"][name], dtype=float) * scale
+            ax.plot(x, sd, ".", color="k", ms=3, label="Monte Carlo 3σ")
+        ax.set_ylabel(f"Δ{name} ({'deg' if scale != 1.0 else 'm'})")
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    axes[-1, 0].set_xlabel("input (deg)")
+    fig.suptitle(f"{doc['mechanism']}: tolerance stack-up", fontsize=10)
+    with atomic_path(path, inputs, "--plot") as tmp:
+        fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
+    plt.close(fig)
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``tolerance`` command to ``app``."""
+
+    @app.command()
+    def tolerance(
+        spec: Annotated[Path, typer.Argument(help="Spec file (TOML): the nominal design.")],
+        tol: Annotated[list[str], typer.Option("--tol", help="KEY=±T: a tolerance (±3σ) on a spec value, with a unit or in the spec's units (d2=±0.05mm, delta0=+-0.1deg, joints[1].length=±0.01). Repeatable.")],
+        monte_carlo: Annotated[int, typer.Option("--monte-carlo", min=0, max=1_000_000, help="Monte Carlo designs checking the first-order result on the sweep engine (0: none).")] = 1000,
+        seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the Monte Carlo draw.")] = 0,
+        as_json: JsonOpt = False,
+        output: OutputOpt = None,
+        plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of the stack-ups over the cycle.")] = None,
+        scheduler: SchedulerOpt = None,
+        workers: WorkersOpt = None,
+    ) -> None:
+        """First-order sensitivities of every output over the cycle to toleranced spec values (exact, from the loop's screw Jacobian), worst-case and RSS stack-ups, and a Monte Carlo check on the sweep engine."""
+        from screwkit.pipeline import Pipeline
+        from screwkit.sweep.engine import EngineConfig, start_engine
+        from screwkit.sweep.monte_carlo import compare, run_monte_carlo
+        from screwkit.sweep.run import read_spec_tables
+        from screwkit.sweep.tolerance import first_order, make_tolerances, tolerance_document
+
+        check_paths([spec], {"--output": output, "--plot": plot})
+        data, s = guard(lambda: read_spec_tables(spec))
+        tolerances = guard(lambda: make_tolerances(data, s, tol))
+        pipe = Pipeline(s)
+        fo = guard(lambda: first_order(data, s, str(spec), tolerances, pipe))
+        mc = None
+        if monte_carlo:
+            try:
+                with progress_bar("Monte Carlo") as update, \
+                        guard(lambda: start_engine(EngineConfig(scheduler, workers))) as engine:
+                    deviations = guard(lambda: run_monte_carlo(
+                        engine, data, str(spec), tolerances, pipe.mode(), fo, monte_carlo,
+                        seed, update))
+            except KeyboardInterrupt:
+                err_console.print("[yellow]interrupted:[/] nothing written")
+                raise typer.Exit(130) from None
+            mc = compare(fo, tolerances, deviations, seed)
+        doc = tolerance_document(spec, s, tolerances, fo, mc)
+        if plot is not None:
+            guard(lambda: _plot(doc, plot, [spec]))
+        emit(doc, as_json, output, lambda: _tables(doc, s.describe()), [spec])
+        if plot is not None and not as_json:
+            console.print(f"wrote {plot}")
