@@ -8,7 +8,7 @@ from __future__ import annotations
 import time
 from collections import Counter
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -66,6 +66,16 @@ def progress_bar(label: str, unit: str = "designs") -> Iterator[Callable[[int, i
             bar.update(task, completed=done, total=total)
 
         yield update
+
+
+@contextmanager
+def engine_for(scheduler: str | None, workers: int | None) -> Iterator[Any]:
+    """The running engine (:func:`screwkit.sweep.engine.start_engine`), stopped on exit; one
+    that cannot start (no Dask, no scheduler) is a user error (exit 2)."""
+    from screwkit.sweep.engine import EngineConfig, start_engine
+
+    with ExitStack() as stack:
+        yield guard(lambda: stack.enter_context(start_engine(EngineConfig(scheduler, workers))))
 
 
 def interrupted(folder: Path, done: int | None = None) -> None:

@@ -17,6 +17,7 @@ from rich.table import Table
 
 from screwkit.cli.common import console, err_console
 from screwkit.cli.common import guard as _guard
+from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for, progress_bar
 from screwkit.report.plots import save_figure
 
 __all__ = ["register", "synthesis_document"]
@@ -199,6 +200,26 @@ def plot_path(plot: Path) -> Path:
     return path
 
 
+def global_synthesis(config: Any, starts: int, scheduler: str | None, workers: int | None,
+                     serial: Any) -> Any:
+    """``--starts N``: the multistart's starts on the sweep engine (the same results as the
+    serial run for the same seed); in this process when Dask is not installed."""
+    import importlib.util
+
+    from screwkit.sweep.multistart import synthesize_on_engine
+
+    if importlib.util.find_spec("distributed") is None and scheduler is None and not workers:
+        err_console.print("[yellow]note:[/] Dask (pip install 'screwkit[sweep]') is not "
+                          "installed; the starts run in this process", highlight=False)
+        return _guard(serial)
+    try:
+        with progress_bar("starts", "starts") as update, engine_for(scheduler, workers) as engine:
+            return _guard(lambda: synthesize_on_engine(config, starts, engine, update))
+    except KeyboardInterrupt:
+        err_console.print("[yellow]interrupted:[/] nothing written")
+        raise typer.Exit(130) from None
+
+
 def register(app: typer.Typer) -> None:
     """Add the ``synthesize`` command to ``app``."""
 
@@ -208,7 +229,9 @@ def register(app: typer.Typer) -> None:
         as_json: Annotated[bool, typer.Option("--json", help="Print one JSON document (SI units) instead of tables.")] = False,
         output: Annotated[Path | None, typer.Option("--output", "-o", help="Write the JSON document to this file (atomically).")] = None,
         plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of desired vs generated.")] = None,
-        starts: Annotated[int | None, typer.Option("--starts", help="Multi-start: number of starts (overrides [synthesis.multistart], or [synthesis.overlay] starts).", min=1, max=10000)] = None,
+        starts: Annotated[int | None, typer.Option("--starts", help="Multi-start: number of starts (overrides [synthesis.multistart], or [synthesis.overlay] starts); the least-squares starts run on the sweep engine (docs/sweeps.md).", min=1, max=10000)] = None,
+        scheduler: SchedulerOpt = None,
+        workers: WorkersOpt = None,
     ) -> None:
         """Optimise the mechanism's dimensions to generate a desired screw displacement
         (Bagci 1969 Ch. V: least squares with exact derivatives, dwell and range constraints;
@@ -232,7 +255,9 @@ def register(app: typer.Typer) -> None:
         def run() -> Any:
             return pipe.synthesize(starts)
 
-        if as_json or not sys.stderr.isatty():
+        if starts is not None and starts > 1 and config.method == "least_squares":
+            outcome = global_synthesis(config, starts, scheduler, workers, run)
+        elif as_json or not sys.stderr.isatty():
             outcome = _guard(run)
         else:
             with Progress(TextColumn("synthesising"), BarColumn(), TimeElapsedColumn(),

@@ -14,7 +14,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from screwkit.cli.common import JsonOpt, OutputOpt, check_paths, console, emit, err_console, guard
-from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, progress_bar
+from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for, progress_bar
 
 
 def _is_angle(freedom: str) -> bool:
@@ -104,7 +104,6 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """First-order sensitivities of every output over the cycle to toleranced spec values (exact, from the loop's screw Jacobian), worst-case and RSS stack-ups, and a Monte Carlo check on the sweep engine."""
         from screwkit.pipeline import Pipeline
-        from screwkit.sweep.engine import EngineConfig, start_engine
         from screwkit.sweep.monte_carlo import compare, run_monte_carlo
         from screwkit.sweep.run import read_spec_tables
         from screwkit.sweep.tolerance import first_order, make_tolerances, tolerance_document
@@ -118,7 +117,7 @@ def register(app: typer.Typer) -> None:
         if monte_carlo:
             try:
                 with progress_bar("Monte Carlo") as update, \
-                        guard(lambda: start_engine(EngineConfig(scheduler, workers))) as engine:
+                        engine_for(scheduler, workers) as engine:
                     deviations = guard(lambda: run_monte_carlo(
                         engine, data, str(spec), tolerances, pipe.mode(), fo, monte_carlo,
                         seed, update))

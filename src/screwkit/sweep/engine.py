@@ -28,6 +28,10 @@ class EngineError(ValueError):
     """The engine cannot start (Dask missing, a scheduler that does not answer …)."""
 
 
+class DaskMissingError(EngineError):
+    """Dask (the optional extra ``screwkit[sweep]``) is not installed."""
+
+
 @dataclass(frozen=True)
 class EngineConfig:
     """Where work runs: ``scheduler`` address (``None``: ``SCREWKIT_SCHEDULER`` or an embedded
@@ -53,7 +57,7 @@ def _dask() -> Any:
     try:
         import distributed
     except ImportError:
-        raise EngineError("this command runs on Dask, an optional extra: install it with "
+        raise DaskMissingError("this command runs on Dask, an optional extra: install it with "
                           "pip install 'screwkit[sweep]' (or run it in this process with "
                           "--workers 0)") from None
     return distributed

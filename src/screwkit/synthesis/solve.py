@@ -23,8 +23,8 @@ from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
 from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled, ResidualModel, dimensions_of
 
-__all__ = ["RangeCheck", "evaluate_design", "SynthesisError", "SynthesisResult", "check_range", "synthesize",
-           "synthesize_multistart"]
+__all__ = ["RangeCheck", "evaluate_design", "SynthesisError", "SynthesisResult", "best_distinct",
+           "check_range", "multistart_starts", "solve_start", "synthesize", "synthesize_multistart"]
 
 FloatArray = NDArray[np.float64]
 Status = Literal["converged", "iteration limit", "time limit", "not solved"]
@@ -401,43 +401,24 @@ def _distinct(a: SynthesisResult, b: SynthesisResult, scale: float) -> bool:
     return False
 
 
-def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, seed: int = 0,
-                          keep: int = 3, spread: float = 0.5,
-                          time_limit: float | None = None) -> list[SynthesisResult]:
-    """Multi-start over random starts and every assembly mode; the best ``keep`` distinct results.
-
-    Starts: the problem's own start, then random ones: each unknown length multiplied by
-    exp(U(-spread, spread)) (plus a shift of spread * L for signed lengths), each angle shifted by
-    U(-spread, spread) rad.  For every start each inversion label 1..4 that assembles at
-    theta = 0 is solved (the problem's ``inversion`` when it is set).  Results that fail the
-    whole-range check are kept but ranked after those that pass.  ``time_limit`` bounds the whole
-    run (seconds; default n_starts * problem.time_limit).
-    """
-    if n_starts < 1 or keep < 1:
+def multistart_starts(problem: RSRCSynthesisProblem, n_starts: int, seed: int,
+                      spread: float) -> tuple[list[dict[str, float]], float]:
+    """The starts of a multistart, in order, and its length scale (see
+    `synthesize_multistart`): the problem's own start, then ``n_starts - 1`` random ones drawn
+    from ``numpy.random.default_rng(seed)``. The same seed gives the same starts, so the starts
+    can be solved anywhere (one process or a cluster) with the same results."""
+    if n_starts < 1:
         raise ValueError("n_starts and keep must be >= 1")
     rng = np.random.default_rng(seed)
-    total_limit = time_limit if time_limit is not None else n_starts * problem.time_limit
-    t0 = time.perf_counter()
     x0 = problem.start_vector()
     scale = max(abs(problem.start.get(n, 0.0)) for n in ("d1", "d2", "d3", "a", "b", "e")
                 if n in problem.start) or problem.length_scale
-    results: list[SynthesisResult] = []
     lo, hi = _bounds(problem)
     _check_start(problem, x0, lo, hi)
-    reasons: dict[str, int] = {}  # distinct reasons a start/mode gave no result, with counts
-
-    def fail(reason: str) -> None:
-        reasons[reason] = reasons.get(reason, 0) + 1
-
-    tried = 0
+    starts = []
     for k in range(n_starts):
-        remaining = total_limit - (time.perf_counter() - t0)
-        if remaining <= 0:
-            break
-        if k == 0:
-            x = x0.copy()
-        else:
-            x = x0.copy()
+        x = x0.copy()
+        if k > 0:
             for j, name in enumerate(problem.unknowns):
                 u = rng.uniform(-spread, spread)
                 if name in ("d1", "d2", "d3"):
@@ -450,49 +431,101 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
                         np.where(np.isfinite(hi), hi - 1e-9 * scale, hi))
         start = dict(problem.start)
         start.update({n: float(v) for n, v in zip(problem.unknowns, x, strict=True)})
-        sub = replace(problem, start=start, time_limit=min(problem.time_limit, remaining))
-        tried += 1
-        labels = [problem.inversion] if problem.inversion is not None else [1, 2, 3, 4]
-        if problem.construction is not None:
-            labels = [1]
-        else:
-            try:
-                dims = dimensions_of({n: np.array([v]) for n, v in start.items()})
-                pos = rsrc_positions(dims, np.array([start["theta01"]]))
-                wanted = labels
-                labels = [lb for lb in labels if lb is not None and pos.assembles[0, lb - 1]]
-                if not labels:
-                    fail("the start does not assemble at theta01 (theta = 0) on "
-                         + ("any mode" if len(wanted) > 1 else f"mode {wanted[0]}"))
-            except ValueError as exc:
-                labels = []
-                fail(f"the start is not a valid mechanism: {exc}")
-        for lb in labels:
-            try:
-                res = synthesize(sub, inversion=lb)
-            except (SynthesisError, ValueError) as exc:
-                fail(str(exc))
-                continue
-            if not math.isfinite(res.objective):
-                fail("the solve ended with a non-finite error measure")
-                continue
-            results.append(res)
+        starts.append(start)
+    return starts, scale
+
+
+def solve_start(problem: RSRCSynthesisProblem, start: dict[str, float],
+                time_limit: float | None = None) -> tuple[list[SynthesisResult], list[str]]:
+    """One start of a multistart solved on every assembly mode that assembles there (the
+    problem's ``inversion`` when set): its results and the reasons a mode gave none."""
+    sub = replace(problem, start=start, time_limit=min(problem.time_limit, time_limit)
+                  if time_limit is not None else problem.time_limit)
+    reasons: list[str] = []
+    labels = [problem.inversion] if problem.inversion is not None else [1, 2, 3, 4]
+    if problem.construction is not None:
+        labels = [1]
+    else:
+        try:
+            dims = dimensions_of({n: np.array([v]) for n, v in start.items()})
+            pos = rsrc_positions(dims, np.array([start["theta01"]]))
+            wanted = labels
+            labels = [lb for lb in labels if lb is not None and pos.assembles[0, lb - 1]]
+            if not labels:
+                reasons.append("the start does not assemble at theta01 (theta = 0) on "
+                               + ("any mode" if len(wanted) > 1 else f"mode {wanted[0]}"))
+        except ValueError as exc:
+            labels = []
+            reasons.append(f"the start is not a valid mechanism: {exc}")
+    results = []
+    for lb in labels:
+        try:
+            res = synthesize(sub, inversion=lb)
+        except (SynthesisError, ValueError) as exc:
+            reasons.append(str(exc))
+            continue
+        if not math.isfinite(res.objective):
+            reasons.append("the solve ended with a non-finite error measure")
+            continue
+        results.append(res)
+    return results, reasons
+
+
+def best_distinct(results: list[SynthesisResult], reasons: list[str], tried: int, keep: int,
+                  scale: float) -> list[SynthesisResult]:
+    """The best ``keep`` distinct results of a multistart (whole-range check first, then E),
+    or a `SynthesisError` naming why no start gave one (``reasons`` in start order)."""
     if not results:
-        shown = "; ".join(f"{r} ({n}x)" if n > 1 else r for r, n in list(reasons.items())[:5])
-        more = f"; and {len(reasons) - 5} other reason(s)" if len(reasons) > 5 else ""
+        counts: dict[str, int] = {}
+        for why in reasons:
+            counts[why] = counts.get(why, 0) + 1
+        shown = "; ".join(f"{w} ({n}x)" if n > 1 else w for w, n in list(counts.items())[:5])
+        more = f"; and {len(counts) - 5} other reason(s)" if len(counts) > 5 else ""
         advice = ("widen the spread ([synthesis.multistart] spread), use more starts or change "
                   "the start" if tried > 1 else "change the start ([dimensions] or "
                   "[synthesis.start]) or the assembly mode")
         raise SynthesisError(f"no start gave a solution ({tried} start(s) tried): "
                              f"{shown or 'the time limit ran out'}{more}. {advice.capitalize()}")
-    results.sort(key=lambda r: (not r.range_check.ok, r.objective))
+    ranked = sorted(results, key=lambda r: (not r.range_check.ok, r.objective))
     best: list[SynthesisResult] = []
-    for r in results:
+    for r in ranked:
         if all(_distinct(r, b, scale) for b in best):
             best.append(r)
         if len(best) == keep:
             break
     return best
+
+
+def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, seed: int = 0,
+                          keep: int = 3, spread: float = 0.5,
+                          time_limit: float | None = None) -> list[SynthesisResult]:
+    """Multi-start over random starts and every assembly mode; the best ``keep`` distinct results.
+
+    Starts: the problem's own start, then random ones: each unknown length multiplied by
+    exp(U(-spread, spread)) (plus a shift of spread * L for signed lengths), each angle shifted by
+    U(-spread, spread) rad.  For every start each inversion label 1..4 that assembles at
+    theta = 0 is solved (the problem's ``inversion`` when it is set).  Results that fail the
+    whole-range check are kept but ranked after those that pass.  ``time_limit`` bounds the whole
+    run (seconds; default n_starts * problem.time_limit).  `multistart_starts`, `solve_start`
+    and `best_distinct` are its parts, for running the starts elsewhere (screwkit.sweep).
+    """
+    if n_starts < 1 or keep < 1:
+        raise ValueError("n_starts and keep must be >= 1")
+    total_limit = time_limit if time_limit is not None else n_starts * problem.time_limit
+    t0 = time.perf_counter()
+    starts, scale = multistart_starts(problem, n_starts, seed, spread)
+    results: list[SynthesisResult] = []
+    reasons: list[str] = []
+    tried = 0
+    for start in starts:
+        remaining = total_limit - (time.perf_counter() - t0)
+        if remaining <= 0:
+            break
+        tried += 1
+        found, why = solve_start(problem, start, remaining)
+        results += found
+        reasons += why
+    return best_distinct(results, reasons, tried, keep, scale)
 
 
 def dimensions_as_mechanism(result: SynthesisResult) -> RSRCDimensions:
