@@ -22,8 +22,12 @@ $(STAMP): pyproject.toml
 
 VALIDATION := bagci1969/analysis_tables bagci1969/synthesis rahman1996/kinematics rahman1996/dynamics rahman1996/balancing
 
-## Run the main job on every bundled example and reproduce both seed systems' reports (writes out/).
+## One small design sweep (its heat map goes into out/index.html), the main job on every bundled
+## example, and both seed systems' reports (writes out/).
 demo: $(STAMP)
+	mkdir -p out
+	$(BIN)/screwkit sweep examples/rsrc_fig7_dynamics.toml --vary d2=4:5:9 --vary e=0.5:1.5:5 \
+		--job dynamics --output out/sweep_rsrc_dynamics.parquet --plot out/sweep_rsrc_dynamics.png
 	$(BIN)/screwkit demo examples --output-dir out
 	mkdir -p out/validation
 	@for v in $(VALIDATION); do \
