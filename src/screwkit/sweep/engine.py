@@ -125,9 +125,10 @@ def start_engine(config: EngineConfig) -> Iterator[Engine]:
     n = config.workers if config.workers is not None else machine_cores()
     if n < 0:
         raise EngineError(f"--workers must be 0 (in this process) or more; got {n}")
+    # on this machine only; the scheduler's HTTP server on a free port (8787 may be taken)
     cluster = distributed.LocalCluster(
-        n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-        silence_logs=logging.ERROR)
+        n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+        dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
     try:
         client = distributed.Client(cluster, set_as_default=False)
         try:
