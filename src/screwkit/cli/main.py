@@ -320,11 +320,13 @@ def demo(
 def _register_subcommands() -> None:
     from screwkit.cli.balance_cmd import register as register_balance
     from screwkit.cli.report_cmd import register as register_report
+    from screwkit.cli.simulate_cmd import register as register_simulate
     from screwkit.cli.synthesize_cmd import register as register_synthesize
 
     register_synthesize(app)
     register_balance(app)
     register_report(app)
+    register_simulate(app)
 
 
 _register_subcommands()
