@@ -319,6 +319,7 @@ def demo(
 
 def _register_subcommands() -> None:
     from screwkit.cli.balance_cmd import register as register_balance
+    from screwkit.cli.mjcf_cmd import register as register_mjcf
     from screwkit.cli.report_cmd import register as register_report
     from screwkit.cli.simulate_cmd import register as register_simulate
     from screwkit.cli.synthesize_cmd import register as register_synthesize
@@ -327,6 +328,7 @@ def _register_subcommands() -> None:
     register_balance(app)
     register_report(app)
     register_simulate(app)
+    register_mjcf(app)
 
 
 _register_subcommands()

@@ -172,12 +172,12 @@ def _load(spec: Any, t: LoadTable | None) -> LoadConfig | None:
         _fail(spec, "load.freedom", f"the load acts on the output, a freedom of the last joint "
                                     f"(the one to the ground): {lk.joints[-1].freedom_names()}")
     translation = freedom.endswith(".s")
-    if (t.force if translation else t.torque) is None and t.damping is None:
-        _fail(spec, "load", f"give {'force' if translation else 'torque'} and/or damping")
     wrong = "torque" if translation else "force"
     if getattr(t, wrong) is not None:
         what, right = ("a translation", "force") if translation else ("a rotation", "torque")
         _fail(spec, f"load.{wrong}", f"{freedom!r} is {what}: give {right}")
+    if (t.force if translation else t.torque) is None and t.damping is None:
+        _fail(spec, "load", f"give {'force' if translation else 'torque'} and/or damping")
     constant = 0.0
     if translation and t.force is not None:
         constant = _si(spec, t.force, "force", "load.force")
