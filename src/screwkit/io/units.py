@@ -15,6 +15,7 @@ from typing import Any
 
 import pint
 
+from screwkit.errors import InputError
 from screwkit.io.quantity import (
     MAX_QUANTITY_CHARS,
     QuantitySyntaxError,
@@ -24,7 +25,7 @@ from screwkit.io.quantity import (
 )
 
 
-class UnitError(ValueError):
+class UnitError(InputError):
     """A quantity that cannot be read or has the wrong kind of unit."""
 
 
