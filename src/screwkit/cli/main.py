@@ -285,6 +285,10 @@ def demo(
             syn = _guard(lambda p=pipe: synthesis_document(p.synthesize(), p.spec.path))  # type: ignore[misc]
             write(output_dir / f"{f.stem}.synthesis.json", syn)
             jobs.append("synthesis")
+        if spec.drive is not None:
+            sim = _guard(lambda p=pipe: p.simulate().as_dict(loads=False))  # type: ignore[misc]
+            write(output_dir / f"{f.stem}.simulation.json", sim)
+            jobs.append("simulation")
         if write_reports:
             from screwkit.report.spec_report import write_spec_report
 
@@ -307,6 +311,10 @@ def demo(
         if "balance" in jobs:
             g = bal.as_dict()["measures"]
             summary.append(("balancing objective G before → after", f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
+        if "simulation" in jobs:
+            last = sim["cycles"][-1] if sim.get("cycles") else {}
+            summary.append(("simulated speed fluctuation (last cycle)",
+                            f"{last.get('fluctuation', float('nan')):.4g}"))
         if "synthesis" in jobs:
             summary.append(("synthesis RMSE (φ rad, S m)", f"{syn.get('rmse_phi')} , {syn.get('rmse_S')}"))
         entries.append({
