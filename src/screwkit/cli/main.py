@@ -36,7 +36,13 @@ _emit = emit
 
 
 @app.callback(invoke_without_command=True)
-def main(version: Annotated[bool, typer.Option("--version", help="Print the version.")] = False) -> None:
+def main(
+    version: Annotated[bool, typer.Option("--version", help="Print the version.")] = False,
+    max_memory: Annotated[str | None, typer.Option("--max-memory", help="Refuse work estimated to need more memory than this (e.g. 16GB; default: half the machine's memory, at most 16 GiB; also SCREWKIT_MAX_MEMORY).")] = None,
+) -> None:
+    from screwkit.budget import set_memory_limit
+
+    _guard(lambda: set_memory_limit(max_memory))  # None: the default (or SCREWKIT_MAX_MEMORY)
     if version:
         console.print(f"screwkit {__version__}")
         raise typer.Exit(0)
@@ -279,6 +285,10 @@ def demo(
             syn = _guard(lambda p=pipe: synthesis_document(p.synthesize(), p.spec.path))  # type: ignore[misc]
             write(output_dir / f"{f.stem}.synthesis.json", syn)
             jobs.append("synthesis")
+        if spec.drive is not None:
+            sim = _guard(lambda p=pipe: p.simulate().as_dict(loads=False))  # type: ignore[misc]
+            write(output_dir / f"{f.stem}.simulation.json", sim)
+            jobs.append("simulation")
         if write_reports:
             from screwkit.report.spec_report import write_spec_report
 
@@ -301,6 +311,10 @@ def demo(
         if "balance" in jobs:
             g = bal.as_dict()["measures"]
             summary.append(("balancing objective G before → after", f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
+        if "simulation" in jobs:
+            last = sim["cycles"][-1] if sim.get("cycles") else {}
+            summary.append(("simulated speed fluctuation (last cycle)",
+                            f"{last.get('fluctuation', float('nan')):.4g}"))
         if "synthesis" in jobs:
             summary.append(("synthesis RMSE (φ rad, S m)", f"{syn.get('rmse_phi')} , {syn.get('rmse_S')}"))
         entries.append({
@@ -319,7 +333,9 @@ def demo(
 
 def _register_subcommands() -> None:
     from screwkit.cli.balance_cmd import register as register_balance
+    from screwkit.cli.mjcf_cmd import register as register_mjcf
     from screwkit.cli.report_cmd import register as register_report
+    from screwkit.cli.simulate_cmd import register as register_simulate
     from screwkit.cli.sweep_cmd import register as register_sweep
     from screwkit.cli.synthesize_cmd import register as register_synthesize
     from screwkit.cli.tolerance_cmd import register as register_tolerance
@@ -327,6 +343,8 @@ def _register_subcommands() -> None:
     register_synthesize(app)
     register_balance(app)
     register_report(app)
+    register_simulate(app)
+    register_mjcf(app)
     register_sweep(app)
     register_tolerance(app)
 
