@@ -106,11 +106,6 @@ class DesignSet:
         return [(k.path, k.toml_value(v)) for k, v in zip(self.keys, self.values[index],
                                                             strict=True)]
 
-    def row_values(self, index: int) -> dict[str, float | int]:
-        """The varied values of design ``index`` as table columns."""
-        return {k.column: (int(v) if k.kind == "integer" else float(v))
-                for k, v in zip(self.keys, self.values[index], strict=True)}
-
     def fingerprint(self) -> str:
         """A hash of the keys, units and every value (part of a sweep's checkpoint key)."""
         h = hashlib.sha256(json.dumps([[k.text, k.unit, k.written_unit] for k in self.keys])
@@ -126,7 +121,7 @@ def _keys(data: dict[str, Any], spec: Spec, varies: list[VaryText]) -> list[Spec
         try:
             keys.append(spec_key(data, spec, v.key, v.unit))
         except SpecKeyError as exc:
-            raise DesignError(f"--vary {v.key}: {exc}") from None
+            raise DesignError(f"--vary {exc}") from None
     texts = [k.text for k in keys]
     repeated = sorted({t for t in texts if texts.count(t) > 1})
     if repeated:

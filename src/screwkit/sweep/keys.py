@@ -74,24 +74,24 @@ def resolve_key(data: dict[str, Any], spec: Spec, text: str) -> tuple[Segment, .
         if isinstance(seg, int):
             if not isinstance(node, list) or seg >= len(node):
                 size = len(node) if isinstance(node, list) else 0
-                raise SpecKeyError(f"key {key_text(path)}: {key_text(path[:depth])} has no item "
+                raise SpecKeyError(f"{key_text(path)}: {key_text(path[:depth])} has no item "
                                 f"[{seg}] (it has {size})")
             node = node[seg]
         else:
             if not isinstance(node, dict) or seg not in node:
-                raise SpecKeyError(f"key {key_text(path)}: the spec has no table [{where}]; a "
+                raise SpecKeyError(f"{key_text(path)}: the spec has no table [{where}]; a "
                                 "sweep replaces values of the spec, so give that table in the "
                                 "spec first")
             node = node[seg]
     last = path[-1]
     if isinstance(last, int):
         if not isinstance(node, list) or last >= len(node):
-            raise SpecKeyError(f"key {key_text(path)}: {key_text(path[:-1])} is not a list with an "
+            raise SpecKeyError(f"{key_text(path)}: {key_text(path[:-1])} is not a list with an "
                             f"item [{last}]")
     elif not isinstance(node, dict):
-        raise SpecKeyError(f"key {key_text(path)}: {key_text(path[:-1])} is not a table")
+        raise SpecKeyError(f"{key_text(path)}: {key_text(path[:-1])} is not a table")
     elif last not in node and not _may_add(path, spec):
-        raise SpecKeyError(f"key {key_text(path)}: the spec has no value there; give it in the "
+        raise SpecKeyError(f"{key_text(path)}: the spec has no value there; give it in the "
                         "spec first (a sweep varies values the spec has, or optional "
                         "dimensions and [motion] values)")
     return path

@@ -102,7 +102,7 @@ def make_tolerances(data: dict[str, Any], spec: Spec, texts: list[str]) -> list[
         try:
             key = spec_key(data, spec, name, None)
         except SpecKeyError as exc:
-            raise ToleranceError(f"--tol {name}: {exc}") from None
+            raise ToleranceError(f"--tol {exc}") from None
         if unit is not None and key.kind is not None:
             from screwkit.io.units import UnitError, to_si
 
