@@ -98,7 +98,7 @@ def test_a_scheduler_that_does_not_answer_is_a_clear_error():
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]  # nothing listens there once closed
     with pytest.raises(EngineError, match="cannot reach the Dask scheduler"), \
-            start_engine(EngineConfig(scheduler=f"tcp://127.0.0.1:{port}")):
+            start_engine(EngineConfig(scheduler=f"tcp://127.0.0.1:{port}", connect_timeout=2)):
         pass
 
 

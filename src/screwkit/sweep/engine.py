@@ -40,6 +40,7 @@ class EngineConfig:
 
     scheduler: str | None = None
     workers: int | None = None
+    connect_timeout: float = 10.0  # seconds to reach an existing scheduler
 
     def address(self) -> str | None:
         return self.scheduler or os.environ.get(SCHEDULER_ENV) or None
@@ -112,7 +113,8 @@ def start_engine(config: EngineConfig) -> Iterator[Engine]:
     address = config.address()
     if address is not None:
         try:
-            client = distributed.Client(address, timeout="10s", set_as_default=False)
+            client = distributed.Client(address, timeout=f"{config.connect_timeout}s",
+                                        set_as_default=False)
         except (OSError, TimeoutError) as exc:
             raise EngineError(f"cannot reach the Dask scheduler at {address} ({exc}); start "
                               "one with 'dask scheduler' and workers with 'dask worker "
