@@ -77,5 +77,7 @@ def run() -> list[dict[str, Any]]:
          "note": "36 input samples, 3 moving links"},
         {"name": "cost per design in one process", "value": 1000 * serial, "unit": "ms",
          "note": "--workers 0: spec validation + motion + dynamics + row"},
+        {"name": "machine load (1-minute average) at the end", "value": os.getloadavg()[0],
+         "unit": "", "note": f"{machine_cores()} cores: above that, other processes take a share"},
     ]
     return rows
