@@ -91,7 +91,7 @@ def _summary(result: Any, output: Path, plot: Path | None) -> None:
     n = len(rows)
     t = Table(title=f"sweep: {n} designs")
     for col in ("computed", "resumed", "ok", "failed", "internal errors", "time (s)",
-                "per design (ms)", "engine"):
+                "ms per design, all in", "engine"):
         t.add_column(col, justify="right")
     per = 1000 * result.seconds / result.computed if result.computed else float("nan")
     t.add_row(str(result.computed), str(result.resumed), str(n - result.failed - result.errors),
