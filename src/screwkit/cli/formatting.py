@@ -80,8 +80,8 @@ def print_columns(console: Console, title: str, columns: Sequence[TextColumn], *
     for k, group in enumerate(groups):
         shown = list(range(key)) + group
         t_title = title if k == 0 else f"{title} (continued: columns {group[0] + 1}–{n})"
-        t = Table(title=Text(t_title), box=box.SIMPLE_HEAD, title_justify="left",
-                  padding=(0, 1), collapse_padding=False, pad_edge=True)
+        t = Table(title=Text(t_title), box=box.HEAVY_HEAD, title_justify="left",
+                  padding=(0, 1))
         for i in shown:
             c = columns[i]
             t.add_column(Text(c.header), justify=c.justify,  # type: ignore[arg-type]
