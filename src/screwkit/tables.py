@@ -144,12 +144,16 @@ class ResultTable:
                units: UnitChoice | None = None) -> None:
         """CSV: one header line with units, then one line per row; empty cells where a value is
         missing (NaN; ``null`` in the JSON); flags as ``true``/``false``. Numbers are written to
-        full precision (shortest text that reads back as the same double)."""
+        full precision (the shortest text that reads back as the same double); with pyarrow
+        installed the rows are formatted by its C++ writer (big tables)."""
+        conv = self.converted(units)
+        headers = [header(n, label) for n, label, _ in conv]
+        columns = [v for _, _, v in conv]
         if isinstance(path, str | os.PathLike):
             with open(path, "w", encoding="utf-8", newline="") as fh:
-                self.to_csv(fh, units)
+                write_csv_text(fh, headers, columns)
             return
-        write_csv_text(path, self.headers(units), [v for _, _, v in self.converted(units)])
+        write_csv_text(path, headers, columns)
 
     def csv_text(self, units: UnitChoice | None = None) -> str:
         buf = io.StringIO()
@@ -168,7 +172,9 @@ class ResultTable:
                            "units": {n: label for n, label, _ in conv}})
         table = pa.Table.from_arrays(arrays, names=[header(n, lb) for n, lb, _ in conv])
         table = table.replace_schema_metadata({"screwkit": meta})
-        pq.write_table(table, str(path), compression="snappy")
+        # no dictionary encoding: measured floats rarely repeat, and building the dictionaries
+        # took 10x the rest of the write (benchmarks/bench_outputs.py)
+        pq.write_table(table, str(path), compression="snappy", use_dictionary=False)
 
     def to_npz(self, path: str | os.PathLike[str] | IO[bytes],
                units: UnitChoice | None = None) -> None:
@@ -207,8 +213,14 @@ def write_csv_text(fh: IO[str], headers: Sequence[str], columns: Sequence[NDArra
     import csv
 
     csv.writer(fh, lineterminator="\n").writerow(headers)
-    if not columns:
+    if not columns or not len(columns[0]):
         return
+    if len(columns[0]) * len(columns) > 20_000:
+        try:
+            fh.write(_arrow_csv_rows(columns))
+            return
+        except ImportError:
+            pass
     texts = [_text(c) for c in columns]
     block = 50_000
     n = len(texts[0])
@@ -216,6 +228,20 @@ def write_csv_text(fh: IO[str], headers: Sequence[str], columns: Sequence[NDArra
         rows = zip(*(t[start:start + block] for t in texts), strict=True)
         fh.write("\n".join(map(",".join, rows)))
         fh.write("\n")
+
+
+def _arrow_csv_rows(columns: Sequence[NDArray[Any]]) -> str:
+    """The rows as CSV text by pyarrow's writer (shortest round-trip numbers, empty for NaN,
+    true/false), without a header."""
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+
+    arrays = [pa.array(v, from_pandas=True) if v.dtype.kind == "f" else pa.array(v)
+              for v in columns]
+    table = pa.Table.from_arrays(arrays, names=[f"c{k}" for k in range(len(arrays))])
+    sink = io.BytesIO()
+    pacsv.write_csv(table, sink, pacsv.WriteOptions(include_header=False))
+    return sink.getvalue().decode("utf-8")
 
 
 def _optional(module: str, what: str) -> Any:

@@ -15,7 +15,6 @@ from rich.markup import escape
 from screwkit.cli.common import console
 from screwkit.cli.common import guard as _guard
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
-from screwkit.report.plots import save_figure
 
 __all__ = ["register", "synthesis_document"]
 
@@ -51,6 +50,8 @@ def _plot(results: list[Any], path: Path, du: Any) -> None:
     fig.suptitle(f"synthesis: RMSE φ {du.show('angle', best.rmse_phi):.4g} {a}, "
                  f"S {du.show('length', best.rmse_S):.3g} {lu}")
     fig.tight_layout()
+    from screwkit.report.plots import save_figure
+
     save_figure(fig, path)
     plt.close(fig)
 
@@ -179,6 +180,8 @@ def _plot_overlay(docs: list[dict[str, Any]], problem: Any, path: Path, du: Any)
         ax2.set_xlabel(f"input θ from θ01 ({au})")
         ax2.legend()
     fig.tight_layout()
+    from screwkit.report.plots import save_figure
+
     save_figure(fig, path)
     plt.close(fig)
 
