@@ -143,7 +143,7 @@ def test_analyze_tables_and_plot_in_the_spec_units(tmp_path, monkeypatch):
     monkeypatch.setattr(plots, "save_figure", lambda fig, path, *a, **k: figures.append(fig))
     _run("analyze", spec, "--plot", tmp_path / "a.png")
     titles = [ax.get_title() for ax in figures[0].axes]
-    assert "phi0' (deg/s)" in titles and "S (mm)" in titles
+    assert "phi0' (deg/s)" in titles and "phi0'' (deg/s²)" in titles and "S (mm)" in titles
     doc = json.loads(_run("analyze", spec, "--json"))
     ax = next(a for a in figures[0].axes if a.get_title() == "S (mm)")
     y = ax.get_lines()[0].get_ydata()
@@ -290,3 +290,42 @@ def test_result_types_have_tables_and_dataframes(tmp_path):
     path = tmp_path / "bal.csv"
     res.to_csv(path)
     assert path.read_text().startswith("input [rad],G_before,G_after,shaking_force_before [N]")
+
+
+def test_progress_bar_counts_on_a_terminal_and_is_silent_otherwise(monkeypatch):
+    from rich.console import Console
+
+    import screwkit.cli.common as common
+    from screwkit.cli.progress import progress_bar
+
+    quiet = io.StringIO()
+    monkeypatch.setattr(common, "err_console", Console(file=quiet, force_terminal=False))
+    with progress_bar("starts", total=3) as advance:
+        for k in range(3):
+            advance(k + 1, 3)
+    assert quiet.getvalue() == ""
+    loud = io.StringIO()
+    monkeypatch.setattr(common, "err_console", Console(file=loud, force_terminal=True, width=100))
+    with progress_bar("starts", total=3) as advance:
+        for k in range(3):
+            advance(k + 1, 3)
+    assert "3/3" in loud.getvalue() and "starts" in loud.getvalue()
+
+
+def test_long_calls_report_progress():
+    import screwkit as sk
+    from screwkit.balancing.balance import prepare
+    from screwkit.balancing.pareto import pareto_front
+    from screwkit.balancing.variables import point_mass_variables
+
+    spec = sk.load_spec(EXAMPLES / "bagci_example1_synthesis.toml")
+    calls: list[tuple[int, int]] = []
+    sk.synthesize(spec.synthesis, starts=3, progress=lambda d, t: calls.append((d, t)))
+    assert calls == [(1, 3), (2, 3), (3, 3)]
+    bal = sk.load_spec(EXAMPLES / "rahman_cssp_balance.toml")
+    mode = sk.Pipeline(bal).mode()
+    setup = prepare(bal.linkage, mode, [point_mass_variables(bal.linkage, "rod")],
+                    speed=bal.speed)
+    calls.clear()
+    front = pareto_front(setup, ("F", "T"), divisions=2, progress=lambda d, t: calls.append((d, t)))
+    assert calls == [(1, 3), (2, 3), (3, 3)] and front.measures.shape == (3, 2)

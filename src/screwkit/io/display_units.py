@@ -45,7 +45,12 @@ class DisplayUnits:
         return SI_LABELS.get(kind, ""), 1.0
 
     def label(self, kind: str) -> str:
+        """The unit as text (ASCII, as in CSV headers): ``deg/s^2``, ``N*m``."""
         return self.unit_of(kind)[0]
+
+    def pretty(self, kind: str) -> str:
+        """The unit for plots and terminals: ``deg/s²``, ``N·m``."""
+        return pretty_unit(self.label(kind))
 
     def show(self, kind: str, si: Any) -> Any:
         """SI value(s) of ``kind`` (a number or an array) in the display unit."""
@@ -68,6 +73,14 @@ class DisplayUnits:
     @property
     def is_si(self) -> bool:
         return all(math.isclose(f, 1.0, rel_tol=1e-15) for f in self.factors.values())
+
+
+def pretty_unit(text: str) -> str:
+    """``kg*m^2`` → ``kg·m²``: powers as superscripts, products with a middle dot."""
+    for power, sup in (("^-1", "⁻¹"), ("^-2", "⁻²"), ("**2", "²"), ("**3", "³"), ("^2", "²"),
+                       ("^3", "³"), ("^4", "⁴")):
+        text = text.replace(power, sup)
+    return text.replace("*", "·")
 
 
 def parse_unit_overrides(items: Iterable[str]) -> dict[str, str]:

@@ -29,6 +29,7 @@ def write_plots(result: BalanceResult, folder: str | Path, units: Any = None) ->
     :class:`~screwkit.io.display_units.DisplayUnits`), by default the input in degrees and the
     loads in SI."""
     from screwkit.balancing.result_table import LOAD_KINDS
+    from screwkit.io.display_units import pretty_unit
     from screwkit.io.outputs import make_output_folder
     from screwkit.tables import SI_LABELS
 
@@ -50,7 +51,7 @@ def write_plots(result: BalanceResult, folder: str | Path, units: Any = None) ->
         ax.plot(x, result.per_sample_before[key] / factor, "o-", ms=3, label="before")
         ax.plot(x, result.per_sample_after[key] / factor, "s--", ms=3, label="after")
         ax.set_xlabel(f"input ({x_label})")
-        ax.set_ylabel(f"{title} ({label or '1'})")
+        ax.set_ylabel(f"{title} ({pretty_unit(label) or '1'})")
         ax.grid(True, alpha=0.3)
         ax.legend()
         fig.tight_layout()
