@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -122,6 +123,14 @@ class Pipeline:
                ) -> LimitPositions:
         """Limit positions and dwell orders (Bagci App. D); ``at`` in radians."""
         return limit_positions(self.spec.linkage, dwell_tolerance, at=at)
+
+    def simulate(self, fluctuation: float | None = None, cycles: int | None = None) -> Any:
+        """The spec's ``[drive]`` run forward in time (docs/simulation.md): a
+        :class:`~screwkit.simulation.spec_run.SpecSimulation`; with ``fluctuation`` the
+        flywheel is first sized for that coefficient of speed fluctuation."""
+        from screwkit.simulation.spec_run import simulate_spec
+
+        return simulate_spec(self.spec, fluctuation=fluctuation, cycles=cycles)
 
     def mobility(self) -> LinkageMobility:
         """Formula and Jacobian mobility at the first input where the loop assembles."""

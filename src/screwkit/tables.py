@@ -30,6 +30,7 @@ SI_LABELS: dict[str, str] = {
     "length": "m", "angle": "rad", "time": "s", "mass": "kg", "force": "N", "moment": "N*m",
     "inertia": "kg*m^2", "velocity": "m/s", "acceleration": "m/s^2",
     "angular_velocity": "rad/s", "angular_acceleration": "rad/s^2", "mass_moment": "kg*m",
+    "energy": "J",
     "ratio": "", "percent": "%", "flag": "", "index": "", "text": "",
 }
 #: kinds whose values are never converted

@@ -44,7 +44,7 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
     mob = guard(lambda: pipe.mobility().as_dict())
     write(output_dir / f"{f.stem}.mobility.json", mob)
     jobs = ["analysis", "mobility"]
-    dyn = bal = syn = None
+    dyn = bal = syn = sim = None
     if all(link.mass is not None for link in spec.linkage.links):
         dyn = guard(lambda: dynamics_job(pipe, False))
         write(output_dir / f"{f.stem}.dynamics.json", dyn)
@@ -57,6 +57,10 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
         syn = guard(lambda: synthesis_document(pipe.synthesize(), pipe.spec.path))
         write(output_dir / f"{f.stem}.synthesis.json", syn)
         jobs.append("synthesis")
+    if spec.drive is not None:
+        sim = guard(lambda: pipe.simulate().as_dict(loads=False))
+        write(output_dir / f"{f.stem}.simulation.json", sim)
+        jobs.append("simulation")
     if reports:
         from screwkit.report.spec_report import write_spec_report
 
@@ -82,6 +86,10 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
         g = bal["measures"]
         summary.append(("balancing objective G before → after",
                         f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
+    if sim is not None:
+        last = sim["cycles"][-1] if sim.get("cycles") else {}
+        summary.append(("simulated speed fluctuation (last cycle)",
+                        f"{last.get('fluctuation', float('nan')):.4g}"))
     if syn is not None:
         summary.append(("synthesis RMSE (φ rad, S m)",
                         f"{syn.get('rmse_phi')} , {syn.get('rmse_S')}"))

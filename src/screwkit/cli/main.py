@@ -14,7 +14,7 @@ from typing import Annotated
 import typer
 
 from screwkit import __version__
-from screwkit.cli.common import attempt, console, err_console
+from screwkit.cli.common import attempt, console, err_console, guard
 
 app = typer.Typer(
     name="screwkit",
@@ -26,7 +26,13 @@ app = typer.Typer(
 
 
 @app.callback(invoke_without_command=True)
-def main(version: Annotated[bool, typer.Option("--version", help="Print the version.")] = False) -> None:
+def main(
+    version: Annotated[bool, typer.Option("--version", help="Print the version.")] = False,
+    max_memory: Annotated[str | None, typer.Option("--max-memory", help="Refuse work estimated to need more memory than this (e.g. 16GB; default: half the machine's memory, at most 16 GiB; also SCREWKIT_MAX_MEMORY).")] = None,
+) -> None:
+    from screwkit.budget import set_memory_limit
+
+    guard(lambda: set_memory_limit(max_memory))  # None: the default (or SCREWKIT_MAX_MEMORY)
     if version:
         console.print(f"screwkit {__version__}")
         raise typer.Exit(0)
@@ -57,7 +63,9 @@ def _register_subcommands() -> None:
     from screwkit.cli.demo_cmd import register as register_demo
     from screwkit.cli.dynamics_cmd import register as register_dynamics
     from screwkit.cli.limits_cmd import register as register_limits
+    from screwkit.cli.mjcf_cmd import register as register_mjcf
     from screwkit.cli.report_cmd import register as register_report
+    from screwkit.cli.simulate_cmd import register as register_simulate
     from screwkit.cli.synthesize_cmd import register as register_synthesize
 
     register_analyze(app)
@@ -67,6 +75,8 @@ def _register_subcommands() -> None:
     register_synthesize(app)
     register_balance(app)
     register_report(app)
+    register_simulate(app)
+    register_mjcf(app)
 
 
 _register_subcommands()

@@ -114,6 +114,8 @@ def display_units(spec_units: Mapping[str, str] | None = None, *, system: str = 
                         "or si")
     base = {k: v for k, v in (spec_units or {}).items()
             if system == "spec" and k in KIND_UNITS and k != "dimensionless"}
+    if "torque" in base and "moment" not in base:  # [units] torque (the drive's) is a moment
+        base["moment"] = base["torque"]
     base.update(overrides or {})
     length = base.get("length", "m")
     angle = base.get("angle", "rad")

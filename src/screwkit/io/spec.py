@@ -34,6 +34,7 @@ from screwkit.model.linkage import Link, Linkage, LinkageError
 if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
     from screwkit.io.display_units import DisplayUnits
+    from screwkit.io.drive_table import DriveConfig
     from screwkit.synthesis.config import SynthesisConfig
 
 Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
@@ -102,6 +103,7 @@ class SpecFile(_Strict):
     gravity_direction: list[Number] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
     balancing: dict[str, Any] | None = None
     synthesis: dict[str, Any] | None = None
+    drive: dict[str, Any] | None = None
 
 
 class Spec:
@@ -114,7 +116,8 @@ class Spec:
     the mechanism model (a :class:`~screwkit.model.Linkage`, built once at load); ``balancing``
     and ``synthesis`` are the ``[balancing]`` and ``[synthesis]`` tables as typed configs
     (:class:`~screwkit.balancing.config.BalancingConfig`,
-    :class:`~screwkit.synthesis.config.SynthesisConfig`), or ``None``.
+    :class:`~screwkit.synthesis.config.SynthesisConfig`), or ``None``; ``drive`` the ``[drive]``
+    table of ``screwkit simulate`` (:class:`~screwkit.io.drive_table.DriveConfig`), or ``None``.
     """
 
     def __init__(self, raw: SpecFile, path: str) -> None:
@@ -168,6 +171,11 @@ class Spec:
             from screwkit.io.synthesis_table import synthesis_config
 
             self.synthesis = synthesis_config(self)
+        self.drive: DriveConfig | None = None
+        if raw.drive is not None:
+            from screwkit.io.drive_table import drive_config
+
+            self.drive = drive_config(self)
 
     # --- helpers ---------------------------------------------------------------------------
     def _fail(self, key: str, message: str) -> None:

@@ -13,6 +13,7 @@ import math
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
+from screwkit.errors import InputError
 from screwkit.io.quantity import (
     MAX_QUANTITY_CHARS,
     QuantitySyntaxError,
@@ -25,7 +26,7 @@ if TYPE_CHECKING:
     import pint
 
 
-class UnitError(ValueError):
+class UnitError(InputError):
     """A quantity that cannot be read or has the wrong kind of unit."""
 
 
@@ -49,9 +50,12 @@ KIND_UNITS = {
     "mass": "kg",
     "force": "N",
     "inertia": "kg*m**2",
+    "torque": "N*m",
+    "time": "s",
+    "rotational_damping": "N*m*s/rad",
+    "translational_damping": "N*s/m",
     "moment": "N*m",
     "mass_moment": "kg*m",
-    "time": "s",
     "dimensionless": "",
 }
 
@@ -60,7 +64,9 @@ KIND_DIMENSIONS: dict[str, tuple[int, int, int]] = {
     "length": (1, 0, 0), "angle": (0, 0, 0), "angular_velocity": (0, 0, -1),
     "angular_acceleration": (0, 0, -2), "velocity": (1, 0, -1), "acceleration": (1, 0, -2),
     "mass": (0, 1, 0), "force": (1, 1, -2), "inertia": (2, 1, 0), "moment": (2, 1, -2),
-    "mass_moment": (1, 1, 0), "time": (0, 0, 1), "dimensionless": (0, 0, 0),
+    "torque": (2, 1, -2), "mass_moment": (1, 1, 0), "time": (0, 0, 1),
+    "rotational_damping": (2, 1, -1), "translational_damping": (0, 1, -1),
+    "dimensionless": (0, 0, 0),
 }
 
 _INCH = 0.0254
@@ -111,14 +117,16 @@ def common_unit_factor(names: tuple[tuple[str, int], ...], kind: str) -> float |
         factor *= entry[0] ** power
         for k in range(3):
             dims[k] += entry[1][k] * power
-    return factor if tuple(dims) == KIND_DIMENSIONS[kind] else None
+    return factor if tuple(dims) == KIND_DIMENSIONS.get(kind) else None
 
 
 #: SI unit of each kind as printed in messages
 SI_SYMBOL = {"length": "m", "angle": "rad", "angular_velocity": "rad/s",
              "angular_acceleration": "rad/s^2", "velocity": "m/s", "acceleration": "m/s^2",
-             "mass": "kg", "force": "N", "inertia": "kg*m^2", "moment": "N*m",
-             "mass_moment": "kg*m", "time": "s", "dimensionless": ""}
+             "mass": "kg", "force": "N", "inertia": "kg*m^2", "torque": "N*m", "time": "s",
+             "rotational_damping": "N*m*s/rad", "translational_damping": "N*s/m",
+             "moment": "N*m", "mass_moment": "kg*m",
+             "dimensionless": ""}
 
 #: (largest |value|, smallest non-zero |value|) accepted per kind, in SI. Zero is always
 #: accepted here (a zero offset, a massless link, a resting input); rules that need a positive
@@ -134,9 +142,12 @@ MAGNITUDE_LIMITS: dict[str, tuple[float, float]] = {
     "mass": (1e9, 1e-12),                   # a million tonnes … 1 ng
     "force": (1e12, 1e-12),
     "inertia": (1e15, 1e-27),               # kg·m²
+    "torque": (1e12, 1e-12),                # N·m
+    "time": (1e7, 1e-12),                   # ~4 months … 1 ps
+    "rotational_damping": (1e12, 1e-15),    # N·m·s/rad
+    "translational_damping": (1e12, 1e-15),  # N·s/m
     "moment": (1e15, 1e-15),
     "mass_moment": (1e12, 1e-15),
-    "time": (1e9, 1e-12),
     "dimensionless": (1e12, 1e-300),
 }
 
@@ -153,9 +164,12 @@ EXAMPLES = {
     "mass": '"0.86 kg"',
     "force": '"1.9 lbf"',
     "inertia": '"2.05e-4 lbf*s^2*in" or "1e-3 kg*m^2"',
+    "torque": '"5 N*m" or "40 lbf*in"',
+    "time": '"2 s" or "150 ms"',
+    "rotational_damping": '"0.01 N*m*s/rad"',
+    "translational_damping": '"5 N*s/m"',
     "moment": '"N*m" or "lbf*in"',
     "mass_moment": '"kg*m" or "kg*mm"',
-    "time": '"s" or "ms"',
     "dimensionless": "a plain number",
 }
 

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError
 from screwkit.kinematics.cssp import (
     _GIMBAL_TOL,
     SEED_ASSEMBLY_MODE,
@@ -57,7 +58,7 @@ Array = NDArray[np.float64]
 _JOINTS = (("R", "C"), ("S",), ("S",), ("P",))
 
 
-class NotACSSPError(ValueError):
+class NotACSSPError(InputError):
     """The linkage given to :func:`cssp_mode_motion` is not a CSSP of the family constructor."""
 
 
