@@ -329,3 +329,17 @@ def test_long_calls_report_progress():
     calls.clear()
     front = pareto_front(setup, ("F", "T"), divisions=2, progress=lambda d, t: calls.append((d, t)))
     assert calls == [(1, 3), (2, 3), (3, 3)] and front.measures.shape == (3, 2)
+
+
+def test_simulate_csv_in_spec_units(tmp_path):
+    spec = EXAMPLES / "rahman_cssp_drive.toml"
+    doc = json.loads(_run("simulate", spec, "--cycles", "2", "--json"))
+    _run("simulate", spec, "--cycles", "2", "--unit", "angular_velocity=rpm",
+         "--csv", tmp_path / "s.csv")
+    t = _read_csv(tmp_path / "s.csv")
+    s = doc["samples"]
+    _same(t["time [s]"], s["time"])
+    _same(t["angle [deg]"], s["angle"], DEG)
+    _same(t["speed [rpm]"], s["speed"], 2 * math.pi / 60)
+    _same(t["motor_torque [N*m]"], s["motor_torque"])
+    assert "crank.point_z [in]" in t and "kinetic_energy [J]" in t

@@ -50,4 +50,11 @@ def test_common_units_need_no_pint_registry():
         d = q.dimensionality
         assert (d.get("[length]", 0), d.get("[mass]", 0), d.get("[time]", 0)) == dims, name
         assert set(d) <= {"[length]", "[mass]", "[time]"}, name
-        assert abs(q.magnitude - factor) <= 1e-15 * abs(factor), name
+        assert q.magnitude == factor, name  # the same double: results do not move by an ulp
+    from screwkit.io.quantity import parse_unit
+    from screwkit.io.units import _factor, common_unit_factor
+
+    for unit, kind in (("lbf*s^2*in", "inertia"), ("kg*mm^2", "inertia"), ("in/s^2",
+                       "acceleration"), ("lbf*in", "moment"), ("rev/min", "angular_velocity")):
+        names = parse_unit(unit)
+        assert common_unit_factor(names, kind) == _factor(names, kind), unit

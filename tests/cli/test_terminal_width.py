@@ -79,9 +79,13 @@ def test_every_command_fits_80_columns_in_a_long_working_directory(tmp_path):
         "report": ["report", str(ex / "bagci_example3_4r.toml"), "-o", str(folder / "r.html")],
         "demo": ["demo", str(demo), "--output-dir", str(folder / "out"), "--no-plots",
                  "--no-reports"],
+        "simulate": ["simulate", str(ex / "rahman_cssp_drive.toml"), "--cycles", "3"],
+        "export-mjcf": ["export-mjcf", str(ex / "rahman_cssp.toml"), "-o", str(folder / "m.xml")],
     }
     errors = {f"{name} error": [name, missing] for name in
-              ("analyze", "limits", "mobility", "dynamics", "balance", "synthesize", "report")}
+              ("analyze", "limits", "mobility", "dynamics", "balance", "synthesize", "report",
+               "simulate")}
+    errors["export-mjcf error"] = ["export-mjcf", missing, "-o", str(folder / "x.xml")]
     env = {**os.environ, "COLUMNS": "80"}
     r = subprocess.run([sys.executable, "-c", DRIVER, json.dumps({**runs, **errors})],
                        capture_output=True, text=True, cwd=folder, env=env, timeout=600)
@@ -91,7 +95,8 @@ def test_every_command_fits_80_columns_in_a_long_working_directory(tmp_path):
         res = results[name]
         assert res["code"] == 0, (name, res)
         table_lines = [line for line in res["stdout"].splitlines() if BOX & set(line)]
-        assert table_lines or name in ("validate", "mobility", "analyze -o", "report"), name
+        assert table_lines or name in ("validate", "mobility", "analyze -o", "report",
+                                       "export-mjcf"), name
         wide = [line for line in table_lines if len(line) > 80]
         assert not wide, f"{name}: table lines over 80 columns:\n" + "\n".join(wide)
     assert f"wrote {folder / 'a.csv'} (" in results["analyze -o"]["stdout"]

@@ -70,7 +70,7 @@ KIND_DIMENSIONS: dict[str, tuple[int, int, int]] = {
 }
 
 _INCH = 0.0254
-_POUND = 0.45359237
+_POUND = 0.4535923700000001  # pint's double for 0.45359237 kg (from 7000 grains): the same bits
 _G0 = 9.80665
 _TURN = 2.0 * math.pi
 _LENGTH, _MASS, _TIME, _NONE = (1, 0, 0), (0, 1, 0), (0, 0, 1), (0, 0, 0)
