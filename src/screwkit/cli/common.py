@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import TypeVar
+from typing import NoReturn, TypeVar
 
 import typer
 from rich.console import Console
@@ -51,6 +51,12 @@ def guard(fn: Callable[[], T]) -> T:
     except user_errors() as exc:
         err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
         raise typer.Exit(2) from None
+
+
+def user_error(message: str) -> NoReturn:
+    """Print ``message`` as a user error (one line) and exit with status 2."""
+    err_console.print(f"[bold red]error:[/] {escape(message)}", highlight=False)
+    raise typer.Exit(2)
 
 
 def attempt(fn: Callable[[], T]) -> tuple[bool, T | None]:

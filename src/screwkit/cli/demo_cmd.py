@@ -113,14 +113,14 @@ def register(app: typer.Typer) -> None:
         write_reports: Annotated[bool, typer.Option("--reports/--no-reports", help="Also write each example's animated HTML report (<example>.html).")] = True,
     ) -> None:
         """Run the main job on every bundled example: validate, analyse, write the results (JSON in SI, CSV and plots in each spec's units) and an animated HTML report per example (out/index.html links them)."""
-        from screwkit.cli.common import console, guard
+        from screwkit.cli.common import console, guard, user_error
         from screwkit.cli.formatting import TextColumn, print_columns
         from screwkit.cli.progress import progress_bar
         from screwkit.io.outputs import make_output_folder
 
         files = sorted(examples.glob("*.toml"))
         if not files:
-            guard(lambda: (_ for _ in ()).throw(ValueError(f"no spec files (*.toml) in {examples}")))
+            user_error(f"no spec files (*.toml) in {examples}")
         guard(lambda: make_output_folder(output_dir, "--output-dir"))
         rows: list[list[str]] = []
         entries: list[dict[str, Any]] = []

@@ -23,7 +23,7 @@ from typing import Annotated, Any
 
 import typer
 
-from screwkit.cli.common import check_paths, console, err_console, guard
+from screwkit.cli.common import check_paths, console, err_console, guard, user_error
 
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print the JSON document (SI units) instead of tables.")]
 OutputOpt = Annotated[Path | None, typer.Option("--output", "-o", help="Write the result to this file (atomically) and print one line; the format by extension: .json (the SI document), .csv, .parquet, .npz (the per-sample table in the display units).")]
@@ -70,8 +70,7 @@ class Outputs:
         fmt = None if output is None else guard(lambda: output_format(output, "--output",
                                                                        formats))
         if units not in SYSTEMS:
-            guard(lambda: (_ for _ in ()).throw(ValueError(
-                f"--units {units}: choose spec (the spec's [units], the default) or si")))
+            user_error(f"--units {units}: choose spec (the spec's [units], the default) or si")
         overrides = guard(lambda: parse_unit_overrides(unit or []))
         return cls(list(inputs), as_json, output, fmt, csv, full, units, overrides)
 

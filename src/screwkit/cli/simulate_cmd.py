@@ -88,7 +88,7 @@ def register(app: typer.Typer) -> None:
         flywheel: Annotated[str | None, typer.Option("--flywheel", help="Flywheel inertia on the input shaft, e.g. \"0.02 kg*m^2\" (overrides [drive] flywheel).")] = None,
     ) -> None:
         """Forward dynamics of the machine: motor, flywheel and load of the [drive] table; speed fluctuation, motor torque, energy per cycle and every load; --fluctuation sizes the flywheel."""
-        from screwkit.cli.common import guard
+        from screwkit.cli.common import guard, user_error
         from screwkit.cli.outputs import Outputs
         from screwkit.io.spec import load_spec
         from screwkit.io.units import to_si
@@ -98,8 +98,7 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, files={"--plot": plot})
         if plot is not None and plot.suffix.lower() not in (".png", ".svg", ".pdf"):
-            guard(lambda: (_ for _ in ()).throw(ValueError(
-                f"--plot {plot}: give a file ending in .png, .svg or .pdf")))
+            user_error(f"--plot {plot}: give a file ending in .png, .svg or .pdf")
         fw = None if flywheel is None else guard(
             lambda: to_si(flywheel, "inertia", "kg*m**2"))
         s = guard(lambda: load_spec(spec))
