@@ -8,10 +8,8 @@ its ``run() -> list[dict]`` (keys: name, value, unit, target, note) and prints a
 
 from __future__ import annotations
 
-import importlib.util
 import sys
 from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 from rich.console import Console
@@ -33,15 +31,6 @@ def discover(names: list[str]) -> list[Path]:
             raise SystemExit(f"no benchmark {stem!r}; available: {', '.join(available) or 'none'}")
         chosen.append(available[stem])
     return chosen
-
-
-def load(path: Path) -> ModuleType:
-    spec = importlib.util.spec_from_file_location(path.stem, path)
-    if spec is None or spec.loader is None:
-        raise SystemExit(f"cannot import {path}")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 CHILD = """
