@@ -5,7 +5,6 @@ formats, the work is in :mod:`screwkit.sweep`."""
 
 from __future__ import annotations
 
-import time
 from collections import Counter
 from collections.abc import Callable, Iterator
 from contextlib import ExitStack, contextmanager
@@ -14,16 +13,7 @@ from typing import Annotated, Any
 
 import typer
 from rich.markup import escape
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    ProgressColumn,
-    TextColumn,
-    TimeRemainingColumn,
-)
 from rich.table import Table
-from rich.text import Text
 
 from screwkit.cli.common import check_paths, console, err_console, guard
 
@@ -35,37 +25,16 @@ WorkersOpt = Annotated[int | None, typer.Option(
                                        "per core; 0: run in this process without Dask).")]
 
 
-class _Rate(ProgressColumn):
-    """Designs per second over this run (resumed designs not counted)."""
-
-    def __init__(self, state: dict[str, float]) -> None:
-        super().__init__()
-        self.state = state
-
-    def render(self, task: Any) -> Text:
-        elapsed = time.perf_counter() - self.state["t0"]
-        rate = self.state["computed"] / elapsed if elapsed > 0 else 0.0
-        return Text(f"{rate:.3g} designs/s", style="progress.data.speed")
-
-
 @contextmanager
-def progress_bar(label: str, unit: str = "designs") -> Iterator[Callable[[int, int, int], None]]:
-    """A progress callback (done, total, computed now) drawing on stderr when it is a
-    terminal (designs done, rate, ETA); silent otherwise."""
-    state = {"t0": time.perf_counter(), "computed": 0.0}
-    if not err_console.is_terminal:
-        yield lambda done, total, computed: None
-        return
-    with Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TextColumn(unit),
-                  _Rate(state), TextColumn("ETA"), TimeRemainingColumn(),
-                  console=err_console, transient=True) as bar:
-        task = bar.add_task(label, total=None)
+def progress_bar(label: str, total: int | None = None
+                 ) -> Iterator[Callable[[int, int, int], None]]:
+    """The engine's progress callback (done, total, computed now) on the shared progress bar
+    (:mod:`screwkit.cli.progress`: count done, rate and ETA on stderr when it is a terminal,
+    silent otherwise)."""
+    from screwkit.cli.progress import progress_bar as shared_bar
 
-        def update(done: int, total: int, computed: int) -> None:
-            state["computed"] = computed
-            bar.update(task, completed=done, total=total)
-
-        yield update
+    with shared_bar(label, total) as advance:
+        yield lambda done, total, computed: advance(done, total)
 
 
 @contextmanager

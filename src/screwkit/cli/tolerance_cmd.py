@@ -13,7 +13,8 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from screwkit.cli.common import JsonOpt, OutputOpt, check_paths, console, emit, err_console, guard
+from screwkit.cli.common import console, err_console, guard
+from screwkit.cli.outputs import JsonOpt, OutputOpt, Outputs
 from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for, progress_bar
 
 
@@ -108,7 +109,8 @@ def register(app: typer.Typer) -> None:
         from screwkit.sweep.run import read_spec_tables
         from screwkit.sweep.tolerance import first_order, make_tolerances, tolerance_document
 
-        check_paths([spec], {"--output": output, "--plot": plot})
+        out = Outputs.prepare([spec], as_json=as_json, output=output, files={"--plot": plot},
+                              formats=("json",))
         data, s = guard(lambda: read_spec_tables(spec))
         tolerances = guard(lambda: make_tolerances(data, s, tol))
         pipe = Pipeline(s)
@@ -128,6 +130,5 @@ def register(app: typer.Typer) -> None:
         doc = tolerance_document(spec, s, tolerances, fo, mc)
         if plot is not None:
             guard(lambda: _plot(doc, plot, [spec]))
-        emit(doc, as_json, output, lambda: _tables(doc, s.describe()), [spec])
-        if plot is not None and not as_json:
-            console.print(f"wrote {plot}")
+            out.note_written(plot)
+        out.deliver(document=lambda: doc, table=None, show=lambda: _tables(doc, s.describe()))

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
@@ -499,7 +500,9 @@ def best_distinct(results: list[SynthesisResult], reasons: list[str], tried: int
 
 def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, seed: int = 0,
                           keep: int = 3, spread: float = 0.5,
-                          time_limit: float | None = None) -> list[SynthesisResult]:
+                          time_limit: float | None = None,
+                          progress: Callable[[int, int], None] | None = None
+                          ) -> list[SynthesisResult]:
     """Multi-start over random starts and every assembly mode; the best ``keep`` distinct results.
 
     Starts: the problem's own start, then random ones: each unknown length multiplied by
@@ -507,8 +510,9 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
     U(-spread, spread) rad.  For every start each inversion label 1..4 that assembles at
     theta = 0 is solved (the problem's ``inversion`` when it is set).  Results that fail the
     whole-range check are kept but ranked after those that pass.  ``time_limit`` bounds the whole
-    run (seconds; default n_starts * problem.time_limit).  `multistart_starts`, `solve_start`
-    and `best_distinct` are its parts, for running the starts elsewhere (screwkit.sweep).
+    run (seconds; default n_starts * problem.time_limit). ``progress(done, n_starts)`` is called
+    after each start.  `multistart_starts`, `solve_start` and `best_distinct` are its parts,
+    for running the starts elsewhere (screwkit.sweep).
     """
     if n_starts < 1 or keep < 1:
         raise ValueError("n_starts and keep must be >= 1")
@@ -526,6 +530,8 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
         found, why = solve_start(problem, start, remaining)
         results += found
         reasons += why
+        if progress is not None:
+            progress(tried, n_starts)
     return best_distinct(results, reasons, tried, keep, scale)
 
 
