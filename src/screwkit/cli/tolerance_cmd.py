@@ -5,10 +5,10 @@ over the cycle, worst-case and RSS stack-ups, and a Monte Carlo check on the swe
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Any
 
-import numpy as np
 import typer
 from rich.markup import escape
 from rich.table import Table
@@ -23,7 +23,7 @@ def _is_angle(freedom: str) -> bool:
 
 
 def _show(value: float, angle: bool) -> str:
-    return f"{np.degrees(value):.5g}" if angle else f"{value:.5g}"
+    return f"{math.degrees(value):.5g}" if angle else f"{value:.5g}"
 
 
 def _tables(doc: dict[str, Any], description: str) -> None:
@@ -36,7 +36,7 @@ def _tables(doc: dict[str, Any], description: str) -> None:
     for row in doc["summary"]:
         angle = _is_angle(doc["outputs"][row["output"]]["joint_freedom"])
         t.add_row(row["output"], _show(row["max_worst_case"], angle), _show(row["max_rss"], angle),
-                  f"{np.degrees(row['at_input']):.4g} deg", row["dominant"])
+                  f"{math.degrees(row['at_input']):.4g} deg", row["dominant"])
     console.print(t)
     mc = doc["monte_carlo"]
     if mc is None:
@@ -58,6 +58,7 @@ def _tables(doc: dict[str, Any], description: str) -> None:
 
 def _plot(doc: dict[str, Any], path: Path, inputs: list[Path]) -> None:
     import matplotlib
+    import numpy as np
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
