@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -29,10 +29,12 @@ from screwkit.kinematics.quartic import sin_cos
 from screwkit.kinematics.rsrc.dimensions import RSRCDimensions
 
 __all__ = [
+    "LoopEquation",
     "LoopTerms",
     "RSRCDimensionArrays",
     "closure_terms",
     "input_terms",
+    "loop_equation",
     "loop_residual",
     "loop_terms_at",
 ]
@@ -132,22 +134,53 @@ def loop_terms_at(
     return LoopTerms(st, ct, sp, cp, sc, cc, m0, n0, w1, w2)
 
 
+class LoopEquation(NamedTuple):
+    """The loop equation at given angles with every named term (§3.4, §3.5); each an array of the
+    broadcast shape of the dimensions and angles."""
+
+    m0: Value
+    n0: Value
+    w1: Value
+    w2: Value
+    #: M1 = N0 cos phi0 + M0 sin phi0 = dW2/dphi0
+    m1: Value
+    #: M2 = M0 cos phi0 - N0 sin phi0 = dW1/dphi0
+    m2: Value
+    #: G = (cos^2 delta0 (W1^2 - d2^2) + W2^2) / 2 (eq. 3.61, halved): zero on every assembly
+    residual: Value
+    #: Q5 = dG/dphi0 = W2 M1 + cos^2 delta0 W1 M2 (§3.5): zero at an input dead centre
+    slope: Value
+
+
+def loop_equation(dims: RSRCDimensionArrays, theta0: Value, phi0: Value) -> LoopEquation:
+    """The RSRC loop equation G(theta0, phi0) (Bagci 1969, eq. 3.61) and its terms, vectorised.
+
+    ``dims`` may hold one mechanism (floats) or a batch (arrays broadcasting against the angles,
+    real or complex: the synthesis differentiates through it by complex steps).  The angles are
+    in radians.  G is zero wherever the mechanism closes; Q5 = dG/dphi0 is the denominator of the
+    output rates (3.77).
+    """
+    m0, n0 = input_terms(dims, np.sin(theta0), np.cos(theta0))
+    sp, cp = np.sin(phi0), np.cos(phi0)
+    w1, w2 = closure_terms(dims, m0, n0, sp, cp)
+    m1 = n0 * cp + m0 * sp
+    m2 = m0 * cp - n0 * sp
+    c2 = dims.cos_delta0 * dims.cos_delta0
+    residual = 0.5 * (c2 * (w1 * w1 - dims.d2 * dims.d2) + w2 * w2)
+    slope = w2 * m1 + c2 * w1 * m2
+    return LoopEquation(m0, n0, w1, w2, m1, m2, residual, slope)
+
+
 def loop_residual(
     dims: RSRCDimensions, theta: FloatArray, phi: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
-    """Loop equation and its phi0-derivative at input angles ``theta`` and output angles ``phi``.
+    """The residual that vanishes on a branch and its phi0-derivative, at (theta0, phi0).
 
-    General delta0: G/2 = (cos^2 delta0 W1^2 + W2^2 - d2^2 cos^2 delta0)/2 (eq. 3.61), whose
-    phi0-derivative is Q5 (§3.5).  delta0 = +-pi/2: W2 (eq. 3.75), derivative M1.  Zero on every
-    assembly; used to re-solve or check a branch's phi0 by Newton's method.
+    General delta0: G and Q5 of `loop_equation`.  delta0 = +-pi/2, where cos delta0 = 0 leaves
+    G = W2^2 / 2 with a double zero: W2 itself (eq. 3.75) and its derivative M1.  Used to re-solve
+    or check a branch's phi0 by Newton's method.
     """
-    arrays = RSRCDimensionArrays.from_dimensions(dims)
-    sp, cp = np.sin(phi), np.cos(phi)
-    m0, n0 = input_terms(arrays, np.sin(theta), np.cos(theta))
-    w1, w2 = closure_terms(arrays, m0, n0, sp, cp)
-    m1 = n0 * cp + m0 * sp
+    eq = loop_equation(RSRCDimensionArrays.from_dimensions(dims), theta, phi)
     if dims.special_case == "delta0_half_pi":
-        return w2, m1
-    c2 = arrays.cos_delta0 * arrays.cos_delta0
-    m2 = m0 * cp - n0 * sp
-    return 0.5 * (c2 * w1 * w1 + w2 * w2 - c2 * dims.d2**2), w2 * m1 + c2 * w1 * m2
+        return eq.w2, eq.m1
+    return eq.residual, eq.slope
