@@ -1,5 +1,6 @@
 """Dual-number screw calculus: dual numbers, dual vectors (lines), 3×3 screw matrices, dual
-quaternions, screw parameters, dual Euler angles and conversions (docs/conventions.md)."""
+quaternions, screw parameters, dual Euler angles, conversions and the real spatial toolbox
+(`screwkit.dual.spatial`: skew, cross, elementary rotations, angle wrapping; docs/conventions.md)."""
 
 from screwkit.dual.checks import (
     check_rotation_matrix,
@@ -44,12 +45,23 @@ from screwkit.dual.number import (
     tan,
 )
 from screwkit.dual.quaternion import DualQuaternion
-from screwkit.dual.screw_matrix import ScrewMatrix, skew, vee
+from screwkit.dual.screw_matrix import ScrewMatrix
 from screwkit.dual.screw_parameters import (
     ScrewParameters,
     screw_matrix_about_line,
     screw_matrix_from_screw_parameters,
     screw_parameters_from_screw_matrix,
+)
+from screwkit.dual.spatial import (
+    cross,
+    elementary_rotation,
+    rot_x,
+    rot_y,
+    rot_z,
+    skew,
+    vee,
+    wrap_angle,
+    wrap_angle_near,
 )
 from screwkit.dual.vector import DualVector, common_normal, dual_angle
 
@@ -74,15 +86,20 @@ __all__ = [
     "check_vector3",
     "common_normal",
     "cos",
+    "cross",
     "dual_angle",
     "dual_euler_from_screw_matrix",
     "dual_quaternion_from_rigid_transform",
     "dual_quaternion_from_screw_matrix",
     "dual_quaternion_from_transform",
+    "elementary_rotation",
     "exp",
     "log",
     "rigid_transform_from_dual_quaternion",
     "rigid_transform_from_screw_matrix",
+    "rot_x",
+    "rot_y",
+    "rot_z",
     "rotation_from_screw_matrix",
     "screw_matrix_about_line",
     "screw_matrix_from_dual_euler",
@@ -99,4 +116,6 @@ __all__ = [
     "transform_from_dual_quaternion",
     "transform_from_screw_matrix",
     "vee",
+    "wrap_angle",
+    "wrap_angle_near",
 ]

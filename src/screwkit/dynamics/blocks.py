@@ -15,10 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.dual.spatial import cross
 from screwkit.dynamics import soa
 from screwkit.dynamics.loop_statics import StaticsStructure
 from screwkit.dynamics.result import Array, Dynamics, Indeterminacy, Reaction
-from screwkit.dynamics.screws import _cross
 from screwkit.model.linkage import Linkage
 
 BLOCK_SAMPLES = 16384
@@ -148,7 +148,7 @@ def indeterminacy(s: Setup) -> Indeterminacy:
     """What the joints leave undetermined (:class:`Indeterminacy`), self-stress directions
     with their moments about the world origin."""
     directions = s.structure.indeterminate_directions.copy()
-    directions[:, 3:] += _cross(np.broadcast_to(s.reference, directions[:, :3].shape),
+    directions[:, 3:] += cross(np.broadcast_to(s.reference, directions[:, :3].shape),
                                 directions[:, :3])
     return Indeterminacy(count=s.structure.indeterminate_count, directions=directions,
                          idle_freedoms=s.structure.idle_count)

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from screwkit.dual.spatial import cross
 from screwkit.dynamics.blocks import (
     BLOCK_SAMPLES,
     Outputs,
@@ -55,7 +56,7 @@ from screwkit.dynamics.loop_statics import (
     statics_structure,
 )
 from screwkit.dynamics.result import Array, Dynamics, Indeterminacy
-from screwkit.dynamics.screws import _cross, freedom_screws
+from screwkit.dynamics.screws import freedom_screws
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
@@ -140,7 +141,7 @@ def _external_wrenches(
     for l, (force, moment, point) in by_link.items():
         at = sub.link_origin[:, l] + sub.link_rotation[:, l] @ point - ref
         out[:, l, :3] = force
-        out[:, l, 3:] = moment + _cross(at, np.broadcast_to(force, at.shape))
+        out[:, l, 3:] = moment + cross(at, np.broadcast_to(force, at.shape))
     return out
 
 

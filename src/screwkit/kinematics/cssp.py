@@ -28,6 +28,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
 
 Array = NDArray[np.float64]
@@ -198,11 +199,6 @@ def elevation_azimuth(
         np.where(defined, a_dot, nan),
         np.where(defined, a_ddot, nan),
     )
-
-
-def _wrap(angle: Array) -> Array:
-    """Angle in (−π, π]."""
-    return -((-angle + np.pi) % (2 * np.pi) - np.pi)
 
 
 # --------------------------------------------------------------------------------------------
@@ -502,7 +498,7 @@ def _solve(
         "crank_pin": core["crank_pin"],
         "slider_ball": core["slider_ball"],
         "rod_direction": u,
-        "theta2": np.where(rod_ok, _wrap(phi - th), np.nan),
+        "theta2": np.where(rod_ok, wrap_angle(phi - th), np.nan),
         "eta2": -elev,
         "rod_angles_defined": rod_ok,
         "theta3": th3,

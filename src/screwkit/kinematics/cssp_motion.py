@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from screwkit.dual.spatial import rot_x
 from screwkit.errors import InputError
 from screwkit.kinematics.cssp import (
     _GIMBAL_TOL,
@@ -50,7 +51,7 @@ from screwkit.kinematics.cssp import (
     _check_mode,
     assembly_message,
 )
-from screwkit.kinematics.loop import Configuration, rot_x
+from screwkit.kinematics.loop import Configuration
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
 

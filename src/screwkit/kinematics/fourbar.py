@@ -26,6 +26,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.dual.spatial import wrap_angle_near
 from screwkit.kinematics.quartic import DEFAULT_DOUBLE_ROOT_TOL, sin_cos
 from screwkit.kinematics.rsrc.dimensions import RSRCDimensions, check_input_angles
 
@@ -130,12 +131,7 @@ class FourBarPositions:
     def coupler_angle(self) -> FloatArray:
         """(N, 2) absolute direction of the coupler from crank tip to rocker tip, phi0 - chi0,
         in (-pi, pi]."""
-        return _wrap(self.phi0 - self.chi0)
-
-
-def _wrap(angle: FloatArray) -> FloatArray:
-    """Wrap angles in (-3 pi, 3 pi] into (-pi, pi]."""
-    return angle - _TWO_PI * ((angle > math.pi).astype(np.float64) - (angle <= -math.pi))
+        return wrap_angle_near(self.phi0 - self.chi0)
 
 
 def _positions_block(

@@ -51,10 +51,6 @@ class PointMassSplitError(InputError):
     """A split of a link mass into Rahman's point masses that cannot reproduce its inertia."""
 
 
-def _skew(v: Array) -> Array:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
 def _point_inertia(mass: float, r: Array) -> Array:
     """Inertia tensor of a point mass at ``r`` about the origin: m(|r|²·1 − r rᵀ)."""
     return mass * (float(r @ r) * np.eye(3) - np.outer(r, r))

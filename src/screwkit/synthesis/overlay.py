@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
-from screwkit.kinematics.quartic import wrap_angle
+from screwkit.dual.spatial import wrap_angle
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
 
 __all__ = [

@@ -26,8 +26,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
-from screwkit.kinematics.quartic import wrap_angle
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
 from screwkit.kinematics.rsrc.loop_equation import RSRCDimensionArrays, loop_equation
 from screwkit.synthesis.problem import RSRCSynthesisProblem

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
 from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
@@ -119,7 +120,7 @@ def check_range(problem: RSRCSynthesisProblem, ev: Evaluation, n_samples: int = 
     inv = np.empty_like(order)
     inv[order] = np.arange(order.size)
     k0 = int(inv[int(np.flatnonzero(sweep == 0.0)[0])])
-    diff = np.abs(np.remainder(motion.phi0[k0] - ev.phi[0] + math.pi, 2 * math.pi) - math.pi)
+    diff = np.abs(wrap_angle(motion.phi0[k0] - ev.phi[0]))
     diff = np.where(motion.assembles[k0], diff, np.inf)
     branch = int(np.argmin(diff))
     ok_mask = motion.assembles[:, branch][inv]
@@ -240,8 +241,7 @@ def _result(problem: RSRCSynthesisProblem, model: ResidualModel, ev: Evaluation,
     # the program label (root ordering, Bagci's I8/I9) of the result's configuration at theta = 0
     pos = rsrc_positions(dimensions_of({k: np.array([v]) for k, v in ev.params.items()}),
                          ev.theta0[:1])
-    gap = np.where(pos.assembles[0], np.abs(np.remainder(pos.phi0[0] - ev.phi[0] + math.pi,
-                                                         2 * math.pi) - math.pi), np.inf)
+    gap = np.where(pos.assembles[0], np.abs(wrap_angle(pos.phi0[0] - ev.phi[0])), np.inf)
     label = int(np.argmin(gap)) + 1 if np.isfinite(gap).any() else label
     return SynthesisResult(
         dimensions=dims, inversion=label, mode_sign=model.sigma, objective=objective,

@@ -12,7 +12,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.kinematics.quartic import DEFAULT_DOUBLE_ROOT_TOL, wrap_angle
+from screwkit.dual.spatial import wrap_angle
+from screwkit.kinematics.quartic import DEFAULT_DOUBLE_ROOT_TOL
 from screwkit.kinematics.rsrc.dimensions import RSRCDimensions, check_input_angles
 from screwkit.kinematics.rsrc.positions import RSRCPositions, rsrc_positions
 from screwkit.kinematics.rsrc.rates import RSRCRates, rsrc_rates

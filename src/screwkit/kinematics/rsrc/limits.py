@@ -9,7 +9,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.quartic import wrap_angle
+from screwkit.dual.spatial import wrap_angle
 from screwkit.kinematics.rsrc.branches import rsrc_motion
 from screwkit.kinematics.rsrc.dimensions import RSRCDimensions
 from screwkit.kinematics.rsrc.loop_equation import (

@@ -41,11 +41,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.dual.spatial import wrap_angle
 from screwkit.kinematics.quartic import (
     DEFAULT_DOUBLE_ROOT_TOL,
     real_roots_of_trig_quadratic,
     sin_cos,
-    wrap_angle,
 )
 from screwkit.kinematics.rsrc.dimensions import RSRCDimensions, SpecialCase, check_input_angles
 from screwkit.kinematics.rsrc.loop_equation import (
