@@ -73,7 +73,7 @@ def run() -> list[dict[str, Any]]:
     for example in (8, 9):
         from screwkit.io.spec import load_spec
         from screwkit.io.synthesis_table import overlay_problem_from_spec
-        from screwkit.synthesis.overlay_route import synthesize_overlay
+        from screwkit.synthesis.overlay_synthesis import synthesize_overlay
 
         overlay, _ = overlay_problem_from_spec(load_spec(str(OVERLAY).format(example)))
         t_ov, outcomes = _best(lambda p=overlay: synthesize_overlay(p), repeat=3)

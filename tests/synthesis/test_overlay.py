@@ -29,7 +29,7 @@ from screwkit.synthesis.overlay import (
     fit_overlay_circles,
     mechanism_from_circle,
 )
-from screwkit.synthesis.overlay_route import OverlayOutcome, OverlayProblem, synthesize_overlay
+from screwkit.synthesis.overlay_synthesis import OverlayOutcome, OverlayProblem, synthesize_overlay
 from screwkit.synthesis.solve import SynthesisError
 from screwkit.synthesis.targets import ScrewTarget, data_function, library_function
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from screwkit.dual.spatial import cross, skew
-from screwkit.dynamics import soa
+from screwkit.dynamics import component_arrays as soa
 from screwkit.dynamics.screws import Array
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.mass import MassProperties
@@ -112,7 +112,7 @@ def inertia_wrenches_soa(
 ) -> list[tuple[soa.Vec, soa.Vec]]:
     """The direct form of the module docstring for one block of samples in structure-of-arrays
     form: per moving link, the applied force and moment about ``reference`` as component
-    tuples. Inputs are component rows (:func:`screwkit.dynamics.soa.rows`): ``rotation`` 9 per
+    tuples. Inputs are component rows (:func:`screwkit.dynamics.component_arrays.rows`): ``rotation`` 9 per
     link (R[3i + j]), the others 3 per link."""
     out = []
     g = soa.const(gravity)

@@ -154,7 +154,7 @@ class RSRCSynthesisProblem:
                 raise ValueError("parameters of constraint (eqs. 5.13-5.21) hold for delta0 = 0 "
                                  "only: make delta0 a constant 0, or drop the [synthesis."
                                  "constraint] table and impose the dwell/range as equations "
-                                 "with the Python function screwkit.synthesis.equality."
+                                 "with the Python function screwkit.synthesis.equality_constrained."
                                  "synthesize_equality_constrained (not reachable from the CLI)")
             if "lambda0" in self.unknowns and abs(math.sin(float(self.start["lambda0"]))) < 1e-9:
                 raise ValueError("lambda0 = 0 (plane) cannot be an unknown with parameters of "

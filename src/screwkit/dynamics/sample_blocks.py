@@ -3,7 +3,7 @@ blocks fill, and their assembly into a :class:`~screwkit.dynamics.result.Dynamic
 
 Samples are processed in blocks of :data:`BLOCK_SAMPLES`: the block's temporaries stay in the
 CPU caches and the peak memory is the (N, …) outputs plus one block, whatever N. The outputs
-are component-major (:func:`screwkit.dynamics.soa.component_major`): each component of a load
+are component-major (:func:`screwkit.dynamics.component_arrays.component_major`): each component of a load
 is contiguous over the samples, which the structure-of-arrays kernels write without transposing.
 """
 
@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual.spatial import cross
-from screwkit.dynamics import soa
+from screwkit.dynamics import component_arrays as soa
 from screwkit.dynamics.loop_statics import StaticsStructure
 from screwkit.dynamics.result import Array, Dynamics, Indeterminacy, Reaction
 from screwkit.model.linkage import Linkage
@@ -81,7 +81,7 @@ class Outputs:
 
     @classmethod
     def allocate(cls, linkage: Linkage, N: int, fill: bool) -> Outputs:
-        """Component-major (N, …) arrays (:func:`screwkit.dynamics.soa.component_major`), NaN
+        """Component-major (N, …) arrays (:func:`screwkit.dynamics.component_arrays.component_major`), NaN
         filled when some samples will not be computed."""
         def new(*shape: int) -> Array:
             out = soa.component_major(*shape)
