@@ -1,5 +1,6 @@
-"""Real spatial toolbox shared by every layer: skew matrices, cross products, elementary rotations
-and angle wrapping, batch-first over leading axes (docs/conventions.md, "Spatial toolbox").
+"""Real spatial toolbox shared by every layer: skew matrices, cross products, elementary rotations,
+angle wrapping and the elevation/azimuth of a moving unit vector, batch-first over leading axes
+(docs/conventions.md, "Spatial toolbox").
 
 Conventions: vectors have shape (..., 3), matrices (..., 3, 3); rotations are right-handed and
 active (``rot_z(a) @ x`` turns x by +a about z); wrapped angles lie in (-pi, pi], so +pi stays
@@ -14,8 +15,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "GIMBAL_TOL",
     "cross",
     "elementary_rotation",
+    "elevation_azimuth",
     "rot_x",
     "rot_y",
     "rot_z",
@@ -27,6 +30,11 @@ __all__ = [
 
 Array = NDArray[Any]
 FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+#: |cos| of an elevation (distance of a unit vector from the z axis) below which its azimuth and
+#: the angle rates are undefined (`elevation_azimuth`)
+GIMBAL_TOL = 1e-12
 
 
 def skew(v: ArrayLike) -> FloatArray:
@@ -115,3 +123,38 @@ def wrap_angle_near(angle: FloatArray) -> FloatArray:
     """
     two_pi = 2.0 * np.pi
     return angle - two_pi * ((angle > np.pi).astype(np.float64) - (angle <= -np.pi))
+
+
+def elevation_azimuth(
+    v: FloatArray, v_dot: FloatArray, v_ddot: FloatArray
+) -> tuple[BoolArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Elevation E = atan2(v_z, ρ) and azimuth A = atan2(v_y, v_x) of a unit vector v(t),
+    ρ = √(v_x² + v_y²) = cos E, with exact rates:
+        Ė = v̇_z/ρ,  Ë = (v̈_z + v_z Ė²)/ρ,
+        Ȧ = (v_x v̇_y − v_y v̇_x)/ρ²,  Ä = (v_x v̈_y − v_y v̈_x)/ρ² − 2 Ȧ (v_x v̇_x + v_y v̇_y)/ρ².
+    Where ρ ≈ 0 (v along z) A is undefined: those samples are flagged False and their rates NaN.
+    """
+    vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
+    rho2 = vx**2 + vy**2
+    rho = np.sqrt(rho2)
+    defined = rho > GIMBAL_TOL
+    elevation = np.arctan2(vz, rho)
+    azimuth = np.where(defined, np.arctan2(vy, vx), np.nan)
+    safe_rho = np.where(defined, rho, 1.0)
+    safe_rho2 = safe_rho**2
+    e_dot = v_dot[..., 2] / safe_rho
+    e_ddot = (v_ddot[..., 2] + vz * e_dot**2) / safe_rho
+    a_dot = (vx * v_dot[..., 1] - vy * v_dot[..., 0]) / safe_rho2
+    a_ddot = (vx * v_ddot[..., 1] - vy * v_ddot[..., 0]) / safe_rho2 - 2 * a_dot * (
+        vx * v_dot[..., 0] + vy * v_dot[..., 1]
+    ) / safe_rho2
+    nan = np.nan
+    return (
+        defined,
+        elevation,
+        np.where(defined, e_dot, nan),
+        np.where(defined, e_ddot, nan),
+        azimuth,
+        np.where(defined, a_dot, nan),
+        np.where(defined, a_ddot, nan),
+    )

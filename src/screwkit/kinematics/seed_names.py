@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from screwkit.kinematics.cssp import elevation_azimuth
+from screwkit.dual.spatial import elevation_azimuth
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.families import rsrc_seed_variables

@@ -186,6 +186,19 @@ class RSRCSynthesisProblem:
     def start_vector(self) -> NDArray[np.float64]:
         return np.array([float(self.start[n]) for n in self.unknowns])
 
+    def bound_vectors(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(lower, upper) bounds of the unknown vector, SI: ``bounds`` where given, otherwise
+        d1, d2, d3 >= 0 (a crank, coupler or output-crank length, as `RSRCDimensions` requires)
+        and no bound on the other unknowns."""
+        lo = np.full(len(self.unknowns), -np.inf)
+        hi = np.full(len(self.unknowns), np.inf)
+        for k, name in enumerate(self.unknowns):
+            if name in self.bounds:
+                lo[k], hi[k] = self.bounds[name]
+            elif name in ("d1", "d2", "d3"):
+                lo[k] = 0.0
+        return lo, hi
+
     def rotation_between(self) -> float:
         assert self.construction is not None
         c = self.construction
