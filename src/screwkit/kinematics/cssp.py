@@ -28,7 +28,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.dual.spatial import elevation_azimuth, wrap_angle
+from screwkit.dual.spatial import elevation_azimuth, rot_x, wrap_angle
 from screwkit.errors import InputError
 
 Array = NDArray[np.float64]
@@ -404,8 +404,7 @@ def _rod_and_slider_angles(
     η2 = −elevation of u (rod), θ3, η3 the azimuth and elevation of u seen in the slider frame
     {4} = X(α4), with their rates when ``need_rates``, and the rod frame {3} = Z(θ1 + θ2) Y(η2)."""
     rod_ok, elev, e_d, e_dd, phi, phi_d, phi_dd = elevation_azimuth(u, ud, udd)
-    sa, ca = np.sin(dims.alpha4), np.cos(dims.alpha4)
-    to_slider = np.array([[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]])  # X(α4) = R_{4←1}
+    to_slider = rot_x(dims.alpha4)  # X(α4) = R_{4←1}
     slider_ok, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = elevation_azimuth(
         u @ to_slider.T, ud @ to_slider.T, udd @ to_slider.T
     )
