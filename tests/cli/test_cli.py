@@ -220,6 +220,11 @@ def test_limits_refuse_a_family_without_the_theory():
     assert r.exit_code == 2 and "RSRC" in r.output
 
 
+def test_limits_refuse_the_cssp_with_a_message():
+    r = runner.invoke(app, ["limits", str(EXAMPLES / "rahman_cssp.toml")])
+    assert r.exit_code == 2 and "RSRC and the planar 4R" in r.output.replace("\n", " ")
+
+
 def test_analyze_plot_writes_a_png(tmp_path):
     png = tmp_path / "fig7.png"
     r = runner.invoke(app, ["analyze", str(EXAMPLES / "bagci_fig7_rsrc.toml"), "--plot", str(png)])

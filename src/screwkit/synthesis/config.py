@@ -9,7 +9,7 @@ import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from screwkit.synthesis.overlay_route import OverlayOutcome, OverlayProblem, synthesize_overlay
+from screwkit.synthesis.overlay_synthesis import OverlayOutcome, OverlayProblem, synthesize_overlay
 from screwkit.synthesis.problem import RSRCSynthesisProblem
 from screwkit.synthesis.solve import SynthesisResult, synthesize, synthesize_multistart
 
@@ -57,7 +57,7 @@ def run_synthesis(config: SynthesisConfig | RSRCSynthesisProblem | OverlayProble
 
     ``config``: a :class:`SynthesisConfig` (``spec.synthesis``) or a bare problem
     (:class:`~screwkit.synthesis.problem.RSRCSynthesisProblem`,
-    :class:`~screwkit.synthesis.overlay_route.OverlayProblem`). ``starts`` overrides the number
+    :class:`~screwkit.synthesis.overlay_synthesis.OverlayProblem`). ``starts`` overrides the number
     of starts (multistart of the least-squares route, or the overlay's circle-fit starts);
     ``seed`` the multistart's random seed. One start with a given inversion (or parameters of
     constraint) is a single solve. ``progress(done, total)`` is called after each start of a
