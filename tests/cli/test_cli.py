@@ -211,9 +211,14 @@ def test_limits_reproduce_bagci_fig9_and_fig10_dwells():
     assert {d["inversion_label"]: d["dwell_order"] for d in doc["dwells_at"]}[2] == 2
 
 
-def test_limits_refuse_a_family_without_the_theory():
-    r = runner.invoke(app, ["limits", str(EXAMPLES / "rssr_spatial.toml")])
-    assert r.exit_code == 2 and "RSRC" in r.output
+def test_limits_of_a_loop_without_a_closed_form_take_the_generic_route():
+    r = runner.invoke(app, ["limits", str(EXAMPLES / "rssr_spatial.toml"), "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    assert doc["method"] == "generic" and doc["outputs"] == ["phi0"]
+    assert len(doc["limits"]) == 4 and all(lim["dwell_order"] == 1 for lim in doc["limits"])
+    r = runner.invoke(app, ["limits", str(EXAMPLES / "rssr_spatial.toml"), "--method", "closed"])
+    assert r.exit_code == 2 and "no closed-form limits" in r.output
 
 
 def test_analyze_plot_writes_a_png(tmp_path):

@@ -59,6 +59,32 @@ def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML)
         raise typer.Exit(2)
 
 
+def transmission_lines(entry: dict[str, Any] | None, input_is_angle: bool) -> list[str]:
+    """One line per transmission measure of a mode: the minimum index of each output, the worst
+    transmission angle, each ball joint's cone limit, with the input where it occurs."""
+    if not entry:
+        return []
+    summary = entry["summary"]
+
+    def where(x: float | None) -> str:
+        if x is None:
+            return "—"
+        return f"{np.degrees(x):.4g} deg" if input_is_angle else f"{x:.6g} m"
+
+    lines = []
+    for name, st in summary["index"].items():
+        if st["value"] is not None:
+            lines.append(f"transmission index of {name}: min {st['value']:.4f} at input {where(st['at'])}")
+    if "angle" in summary and summary["angle"]["value"] is not None:
+        st = summary["angle"]
+        lines.append(f"transmission angle: worst {np.degrees(st['value']):.4f} deg from a dead "
+                     f"centre at input {where(st['at'])}")
+    for joint, st in summary["cone_limit"].items():
+        lines.append(f"ball joint {joint}: cone limit {np.degrees(st['value']):.4f} deg (at input "
+                     f"{where(st['at'])})")
+    return lines
+
+
 def _fmt(x: float | None, angle: bool) -> str:
     if x is None or x != x:
         return "—"
@@ -73,16 +99,15 @@ def analyze(
     method: Annotated[str, typer.Option("--method", help="auto (closed form where the family has one), closed, or generic (any loop; every joint variable).")] = "auto",
     plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of every variable and its rates over the input, and the coupler curve projections.")] = None,
 ) -> None:
-    """Positions, velocities and accelerations of every joint variable in every assembly mode."""
-    from screwkit.io.documents import analysis_document
+    """Positions, velocities and accelerations of every joint variable in every assembly mode, the coupler curves of the spec's coupler points and the transmission quality over the cycle."""
     from screwkit.io.spec import load_spec
     from screwkit.pipeline import Pipeline
 
     check_paths([spec], {"--output": output, "--plot": plot})
     s = _guard(lambda: load_spec(spec))
     pipe = Pipeline(s, method=method)
-    motion = _guard(lambda: pipe.motion)
-    doc = analysis_document(motion, name=s.name, coupler_point=s.coupler_point)
+    _guard(lambda: pipe.motion)
+    doc = _guard(pipe.analysis)
     if plot is not None:
         from screwkit.report.plots import plot_analysis
 
@@ -102,58 +127,76 @@ def analyze(
                 t.add_column(n, justify="right")
                 t.add_column(f"{n}'", justify="right")
                 t.add_column(f"{n}''", justify="right")
+            points = mode.get("coupler_points", {})
+            for p in points:
+                for ax in "xyz":
+                    t.add_column(f"{p} {ax} (m)", justify="right")
             for i, x in enumerate(doc["input"]):
                 row = [f"{np.degrees(x):8.3f}" if s.input_is_angle else f"{x:.6g}"]
                 for n in names:
                     ang = not (n in ("S", "s4") or n.endswith(".s"))
                     row += [_fmt(mode["variables"][n][i], ang), _fmt(mode["velocities"][n][i], ang),
                             _fmt(mode["accelerations"][n][i], ang)]
+                for p in points.values():
+                    row += [_fmt(p[ax][i], False) for ax in "xyz"]
                 t.add_row(*row)
             console.print(t)
+            for line in transmission_lines(mode.get("transmission"), s.input_is_angle):
+                console.print(f"  • {escape(line)}", highlight=False)
             for ev in mode["events"]:
                 console.print(f"  • {escape(ev)}", highlight=False)
             missing = int((~np.asarray(mode["assembles"])).sum())
             if missing:
                 console.print(f"  • does not assemble at {missing} of {len(doc['input'])} inputs", highlight=False)
+        if "note" in doc.get("transmission", {}):
+            console.print(f"[yellow]transmission:[/] {escape(doc['transmission']['note'])}", highlight=False)
 
     _emit(doc, as_json, output, table, [spec])
 
 
 @app.command()
 def limits(
-    spec: Annotated[Path, typer.Argument(help="Spec file (TOML) of an RSRC or a planar 4R.")],
+    spec: Annotated[Path, typer.Argument(help="Spec file (TOML).")],
     as_json: JsonOpt = False,
     output: OutputOpt = None,
-    dwell_tolerance: Annotated[float, typer.Option("--dwell-tol", help="A derivative dᵏφ0/dθ0ᵏ counts as vanishing below this (rad/radᵏ). Printed dimensions hold a designed dwell only to ~1e-4.")] = 1e-6,
-    at: Annotated[list[float] | None, typer.Option("--at", help="Also give the dwell order at this input angle (degrees); repeatable.")] = None,
+    variable: Annotated[str | None, typer.Option("--output-variable", "--var", help="The output variable: a joint freedom (e.g. output.theta) or a seed name (phi0, S, s4 …); default the loop's outputs (or [limits] output).")] = None,
+    method: Annotated[str | None, typer.Option("--method", help="auto (Bagci's App. D closed form for the RSRC/4R φ0 and S, else generic), closed, or generic (any loop, over the [motion] sweep).")] = None,
+    dwell_tolerance: Annotated[float | None, typer.Option("--dwell-tol", help="A derivative dᵏy/dxᵏ counts as vanishing below this (output unit / input unitᵏ; default 1e-6 or [limits]). Printed dimensions hold a designed dwell only to ~1e-4.")] = None,
+    at: Annotated[list[float] | None, typer.Option("--at", help="Also give the dwell order at this input (degrees, or m for a translation input); repeatable.")] = None,
 ) -> None:
-    """Limit positions of the output rotation and translation over a full turn, and the order of the instantaneous dwell at each rotation limit (Bagci App. D)."""
+    """Limit positions of the output variables (d output/d input = 0) and the order of the instantaneous dwell at each (Bagci App. D for the RSRC and 4R; the generic route for any loop)."""
     from screwkit.io.spec import load_spec
     from screwkit.pipeline import Pipeline
 
     check_paths([spec], {"--output": output})
     s = _guard(lambda: load_spec(spec))
-    doc = _guard(lambda: Pipeline(s).limits(dwell_tolerance, at=[float(np.radians(x)) for x in at or []]).as_dict())
+    where = None if at is None else [float(np.radians(x)) if s.input_is_angle else float(x) for x in at]
+    doc = _guard(lambda: Pipeline(s).limits(dwell_tolerance, where, output=variable, method=method).as_dict())
 
     def table() -> None:
         console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
-        t = Table(title=f"limit positions (dwell tolerance {dwell_tolerance:g})")
-        for col in ("kind", "branch", "θ0 (deg)", "φ0 (deg)", "S (m)", "2nd derivative", "dwell order"):
+        console.print(f"method: {doc['method']}; derivatives: {escape(doc['derivatives'])}", highlight=False)
+        t = Table(title=f"limit positions (dwell tolerance {doc['dwell_tolerance']:g})")
+        inp = "input (deg)" if s.input_is_angle else "input (m)"
+        for col in ("output", "kind", "mode" if doc["method"] == "generic" else "branch", inp, "value", "2nd derivative", "dwell order"):
             t.add_column(col, justify="right")
         for lim in doc["limits"]:
-            t.add_row(lim["kind"], str(lim["branch"]), f"{np.degrees(lim['theta0']):.4f}",
-                      f"{np.degrees(lim['phi0']):.4f}", "—" if lim["S"] is None else f"{lim['S']:.6g}",
-                      f"{lim['second_derivative']:.4g}", str(lim.get("dwell_order", "—")))
+            ang = lim["kind"] == "rotation"
+            t.add_row(lim["output"], lim["kind"], str(lim.get("mode", lim.get("branch"))),
+                      _fmt(lim["input"], s.input_is_angle), _fmt(lim["value"], ang) + (" deg" if ang else " m"),
+                      f"{lim['second_derivative']:.4g}", "—" if lim["dwell_order"] is None else str(lim["dwell_order"]))
         console.print(t)
         if doc["dwells_at"]:
             t2 = Table(title="dwell order at given inputs")
-            for col in ("θ0 (deg)", "inversion", "φ0 (deg)", "dwell order", "dφ0/dθ0 … (rad/radᵏ)"):
+            for col in ("output", inp, "mode", "value", "dwell order", "dᵏy/dxᵏ, k = 1 …"):
                 t2.add_column(col, justify="right")
             for d in doc["dwells_at"]:
-                t2.add_row(f"{np.degrees(d['theta0']):.4f}", str(d["inversion_label"]),
-                           f"{np.degrees(d['phi0']):.4f}", str(d["dwell_order"]),
-                           ", ".join(f"{x:.3g}" for x in d["derivatives"]))
+                ang = not (d["output"] in ("S", "s4") or d["output"].endswith(".s"))
+                t2.add_row(d["output"], _fmt(d["input"], s.input_is_angle), str(d.get("mode", d.get("inversion_label"))),
+                           _fmt(d["value"], ang), str(d["dwell_order"]), ", ".join(f"{x:.3g}" for x in d["derivatives"]))
             console.print(t2)
+        for note in doc["notes"]:
+            console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
 
     _emit(doc, as_json, output, table, [spec])
 
@@ -234,7 +277,7 @@ def demo(
     write_reports: Annotated[bool, typer.Option("--reports/--no-reports", help="Also write each example's animated HTML report (<example>.html).")] = True,
 ) -> None:
     """Run the main job on every bundled example: validate, analyse, write the results and an animated HTML report per example (out/index.html links them)."""
-    from screwkit.io.documents import analysis_document, synthesis_document
+    from screwkit.io.documents import synthesis_document
     from screwkit.io.results import dumps, write_atomic
     from screwkit.io.spec import load_spec
     from screwkit.pipeline import Pipeline
@@ -256,8 +299,8 @@ def demo(
         spec = _guard(lambda f=f: load_spec(f))  # type: ignore[misc]
         console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
         pipe = Pipeline(spec)
-        motion = _guard(lambda p=pipe: p.motion)  # type: ignore[misc]
-        doc = analysis_document(motion, name=spec.name, coupler_point=spec.coupler_point)
+        _guard(lambda p=pipe: p.motion)  # type: ignore[misc]
+        doc = _guard(pipe.analysis)
         out = output_dir / f"{f.stem}.analysis.json"
         write(out, doc)
         if plots:
@@ -267,6 +310,10 @@ def demo(
         mob = _guard(lambda p=pipe: p.mobility().as_dict())  # type: ignore[misc]
         write(output_dir / f"{f.stem}.mobility.json", mob)
         jobs = ["analysis", "mobility"]
+        if spec.limits is not None:
+            lim = _guard(lambda p=pipe: p.limits().as_dict())  # type: ignore[misc]
+            write(output_dir / f"{f.stem}.limits.json", lim)
+            jobs.append("limits")
         if all(link.mass is not None for link in spec.linkage.links):
             dyn = _guard(lambda p=pipe: dynamics_job(p, False))  # type: ignore[misc]
             write(output_dir / f"{f.stem}.dynamics.json", dyn)
@@ -295,6 +342,13 @@ def demo(
             ("max loop-closure residual", f"{res:.1e}"),
             ("mobility (formula / Jacobian)", f"{mob['formula']['mobility']} / {mob['numeric']['mobility']}"),
         ]
+        for m in doc["modes"]:
+            for line in transmission_lines(m.get("transmission"), spec.input_is_angle):
+                summary.append((f"mode {m['mode']}", line))
+        if "limits" in jobs:
+            summary.append(("limit positions (output: input, dwell order)", "; ".join(
+                f"{x['output']} {_fmt(x['input'], spec.input_is_angle)}, {x['dwell_order']}"
+                for x in lim["limits"]) or "none"))
         if "dynamics" in jobs:
             sf = dyn["summary"]["shaking_force"]
             summary.append(("shaking force RMS / peak (N)", f"{sf['rms']:.6g} / {sf['peak']:.6g}"))

@@ -33,6 +33,8 @@ from screwkit.model.linkage import Link, Linkage, LinkageError
 
 if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
+    from screwkit.kinematics.coupler_curves import CouplerPoint
+    from screwkit.kinematics.limit_positions import LimitsConfig
     from screwkit.synthesis.config import SynthesisConfig
 
 Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
@@ -84,9 +86,19 @@ class LinkMassTable(_Strict):
 
 
 class CouplerPointTable(_Strict):
+    name: StrictStr | None = Field(None, max_length=80)
+    link: StrictStr | None = Field(None, description="moving link (default: the family's coupler)")
     f: Value = 0.0
     g: Value = 0.0
     h: Value = 0.0
+
+
+class LimitsTable(_Strict):
+    output: StrictStr | None = None
+    dwell_tolerance: Number = 1e-6
+    max_order: StrictInt = Field(5, ge=1, le=10)
+    at: list[Value] = Field(default_factory=list, max_length=1000)
+    method: Literal["auto", "closed", "generic"] = "auto"
 
 
 class SpecFile(_Strict):
@@ -97,6 +109,8 @@ class SpecFile(_Strict):
     motion: MotionTable = Field(default_factory=MotionTable)  # type: ignore[arg-type]
     links: dict[str, LinkMassTable] = Field(default_factory=dict)
     coupler_point: CouplerPointTable | None = None
+    coupler_points: list[CouplerPointTable] = Field(default_factory=list, max_length=100)
+    limits: LimitsTable | None = None
     gravity: Value | None = None
     gravity_direction: list[Number] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
     balancing: dict[str, Any] | None = None
@@ -109,11 +123,15 @@ class Spec:
     Attributes: ``path``, ``name``, ``family``, ``source``, ``units`` (the ``[units]`` table),
     ``dimensions`` (SI), ``inputs`` (N,) input samples (rad or m), ``speed`` and
     ``acceleration`` of the input, ``mode`` (the assembly mode dynamics and balancing use),
-    ``gravity_magnitude``, ``gravity_direction``, ``coupler_point``; the property ``linkage`` is
-    the mechanism model (a :class:`~screwkit.model.Linkage`, built once at load); ``balancing``
-    and ``synthesis`` are the ``[balancing]`` and ``[synthesis]`` tables as typed configs
+    ``gravity_magnitude``, ``gravity_direction``, ``coupler_points`` (every
+    :class:`~screwkit.kinematics.coupler_curves.CouplerPoint` of ``[coupler_point]`` and
+    ``[[coupler_points]]``), ``coupler_point`` (the ``[coupler_point]`` table's (f, g, h), m);
+    the property ``linkage`` is the mechanism model (a :class:`~screwkit.model.Linkage`, built
+    once at load); ``balancing``, ``synthesis`` and ``limits`` are the ``[balancing]``,
+    ``[synthesis]`` and ``[limits]`` tables as typed configs
     (:class:`~screwkit.balancing.config.BalancingConfig`,
-    :class:`~screwkit.synthesis.config.SynthesisConfig`), or ``None``.
+    :class:`~screwkit.synthesis.config.SynthesisConfig`,
+    :class:`~screwkit.kinematics.limit_positions.LimitsConfig`), or ``None``.
     """
 
     def __init__(self, raw: SpecFile, path: str) -> None:
@@ -146,17 +164,12 @@ class Spec:
         if gd.shape != (3,) or not np.all(np.isfinite(gd)) or np.linalg.norm(gd) == 0:
             self._fail("gravity_direction", f"give a non-zero world vector [x, y, z]; got {raw.gravity_direction}")
         self.gravity_direction = gd / np.linalg.norm(gd)
-        self.coupler_point: tuple[float, float, float] | None = None
-        if raw.coupler_point is not None:
-            try:
-                require(family(self.family), "coupler_point")
-            except ValueError as exc:
-                self._fail("coupler_point", str(exc))
-            cp = raw.coupler_point
-            self.coupler_point = (self.quantity(cp.f, "length", "coupler_point.f"),
-                                  self.quantity(cp.g, "length", "coupler_point.g"),
-                                  self.quantity(cp.h, "length", "coupler_point.h"))
         self._linkage = self._build()
+        self.coupler_point: tuple[float, float, float] | None = None
+        self.coupler_points = self._coupler_points()
+        if raw.coupler_point is not None:
+            self.coupler_point = self.coupler_points[0].point
+        self.limits = self._limits()
         self.balancing: BalancingConfig | None = None
         self.synthesis: SynthesisConfig | None = None
         if raw.balancing is not None:
@@ -169,6 +182,54 @@ class Spec:
             self.synthesis = synthesis_config(self)
 
     # --- helpers ---------------------------------------------------------------------------
+    def _coupler_points(self) -> list[CouplerPoint]:
+        """``[coupler_point]`` and ``[[coupler_points]]`` as coupler points of the linkage."""
+        from screwkit.kinematics.coupler_curves import coupler_point
+        from screwkit.kinematics.registry import coupler_link_index
+
+        tables = [("coupler_point", self.raw.coupler_point, "coupler point")] if (
+            self.raw.coupler_point is not None) else []
+        tables += [(f"coupler_points[{k}]", t, f"point {k + 1}")
+                   for k, t in enumerate(self.raw.coupler_points)]
+        out: list[CouplerPoint] = []
+        for key, t, default in tables:
+            assert t is not None
+            try:
+                require(family(self.family), "coupler_point")
+            except ValueError as exc:
+                self._fail(key, str(exc))
+            xyz = [self.quantity(getattr(t, c), "length", f"{key}.{c}") for c in "fgh"]
+            name = t.name or default
+            if any(p.name == name for p in out):
+                self._fail(f"{key}.name", f"the name {name!r} is used twice; give each point "
+                                          "its own name")
+            try:
+                coupler_link_index(self._linkage, t.link)
+            except ValueError as exc:
+                self._fail(f"{key}.link", str(exc))
+            try:
+                out.append(coupler_point(self._linkage, xyz, t.link, name))
+            except ValueError as exc:
+                self._fail(key, str(exc))
+        return out
+
+    def _limits(self) -> LimitsConfig | None:
+        """``[limits]`` as a :class:`LimitsConfig`, checked against the loop (the output names
+        a variable it has; the closed form is there when asked for)."""
+        from screwkit.kinematics.limit_positions import LimitsConfig, check_limits_config
+
+        t = self.raw.limits
+        if t is None:
+            return None
+        kind = "angle" if self.input_is_angle else "length"
+        at = tuple(self.quantity(v, kind, "limits.at") for v in t.at)
+        config = LimitsConfig(t.output, float(t.dwell_tolerance), t.max_order, at, t.method)
+        try:
+            check_limits_config(self._linkage, config)
+        except ValueError as exc:
+            self._fail("limits", str(exc))
+        return config
+
     def _fail(self, key: str, message: str) -> None:
         raise SpecError(f"{self.path}: [{key}] {message}")
 
