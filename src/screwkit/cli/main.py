@@ -120,7 +120,8 @@ def analyze(
             console.print(f"[yellow]note:[/] {escape(doc['method_note'])}", highlight=False)
         for mode in doc["modes"]:
             names = [n for n in mode["variables"] if "." not in n and n not in ("theta0", "theta1")]
-            names = names or [n for n in mode["variables"] if n != doc["input_name"]][:4]
+            names = names or [n for n in mode["variables"]
+                              if n != doc["input_name"] and n in mode["velocities"]][:4]
             t = Table(title=f"assembly mode {mode['mode']}", show_lines=False)
             t.add_column("input (deg)" if s.input_is_angle else "input (m)", justify="right")
             for n in names:

@@ -38,8 +38,10 @@ def _plot(results: list[Any], path: Path) -> None:
     axes[0].plot(th, np.degrees([r["psi_g0"] for r in rows]), "x-", label="generated ψ_g0")
     axes[0].set_ylabel("output rotation (deg)")
     axes[0].legend()
-    axes[1].plot(th, [r["S_d"] for r in rows], "o", label="desired S_d")
-    axes[1].plot(th, [r["S_g"] for r in rows], "x-", label="generated S_g")
+    axes[1].plot(th, [np.nan if r["S_d"] is None else r["S_d"] for r in rows], "o",
+                 label="desired S_d")
+    axes[1].plot(th, [np.nan if r["S_g"] is None else r["S_g"] for r in rows], "x-",
+                 label="generated S_g")
     axes[1].set_ylabel("output translation (m)")
     axes[1].set_xlabel("input θ from θ01 (deg)")
     axes[1].legend()
@@ -49,7 +51,12 @@ def _plot(results: list[Any], path: Path) -> None:
     plt.close(fig)
 
 
-def _tables(name: str, results: list[Any], scale_unit: str) -> None:
+def _num(value: float | None, fmt: str) -> str:
+    return "—" if value is None or value != value else format(value, fmt)
+
+
+def _tables(name: str, results: list[Any], config: Any) -> None:
+    scale_unit = config.length_unit
     best = results[0]
     console.print(f"[bold]{escape(name)}[/]: synthesis ({best.status}; {best.iterations} "
                   f"iterations, {best.evaluations} evaluations, {best.time:.3f} s)",
@@ -60,11 +67,16 @@ def _tables(name: str, results: list[Any], scale_unit: str) -> None:
     t.add_column("name")
     t.add_column("value", justify="right")
     for k, v in best.dimensions.items():
-        angle = k in ("delta0", "lambda0", "theta01", "q1", "q2")
+        angle = k in config.angles
         t.add_row(k, f"{math.degrees(v):.6f}" if angle else f"{v:.6g}")
     console.print(t)
+    rot, tra = config.outputs
+    mode = (f"assembly mode {best.inversion} (sign of Q5 {best.mode_sign:+.0f})"
+            if config.route == "closed" else
+            f"assembly mode {best.inversion} (generic route: the loop's screw Jacobian; outputs "
+            f"{', '.join(o for o in (rot, tra) if o)})")
     console.print(
-        f"assembly mode {best.inversion} (sign of Q5 {best.mode_sign:+.0f}); "
+        f"{mode}; "
         f"E = E_phi + E_S/L² = {best.objective:.6g} with L = {best.length_scale:g} m "
         f"({scale_unit}); E_phi = {best.E_phi:.6g} rad², E_S = {best.E_S:.6g} m²", highlight=False)
     console.print(
@@ -84,9 +96,9 @@ def _tables(name: str, results: list[Any], scale_unit: str) -> None:
                    f"{d(r['psi_g0']):.5f}",
                    "—" if r["psi_d0"] != r["psi_d0"] else f"{d(r['psi_d0']):.5f}",
                    "—" if r["psi_d0"] != r["psi_d0"] else f"{d(r['psi_d0'] - r['psi_g0']):.5f}",
-                   f"{r['S']:.6g}", f"{r['S_g']:.6g}",
-                   "—" if s_d != s_d else f"{s_d:.6g}",
-                   "—" if s_d != s_d else f"{s_d - r['S_g']:.3g}")
+                   _num(r["S"], ".6g"), _num(r["S_g"], ".6g"),
+                   _num(s_d, ".6g"),
+                   "—" if s_d != s_d or r["S_g"] is None else f"{s_d - r['S_g']:.3g}")
     console.print(rt)
     for k, other in enumerate(results[1:], start=2):
         console.print(f"alternative {k}: mode {other.inversion}, E = {other.objective:.6g}, "
@@ -253,7 +265,7 @@ def register(app: typer.Typer) -> None:
         if as_json:
             sys.stdout.write(text + "\n")
         else:
-            _tables(s.name, results, config.length_unit)
+            _tables(s.name, results, config)
             if overlay:
                 _overlay_lines(docs)
             if output is not None:

@@ -97,13 +97,17 @@ def close_loop(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
     rows, cols = _scales(linkage, lay)
     pidx = _passive(linkage, lay)
     m = len(lay.names)
+    last = np.full(conf.size, np.inf)
     for _ in range(max_iter):
         fr = forward(linkage, conf, lay)
         xi = closure_twist(fr.closure_R, fr.closure_p)
         err = np.max(np.abs(xi * rows), axis=-1)
-        todo = np.isfinite(err) & (err > 0.1 * CLOSED_TOL)
+        # done: closed to rounding (a Newton step no longer halves the error once it is small)
+        todo = np.isfinite(err) & (err > 0.1 * CLOSED_TOL) & ~((err <= CLOSED_TOL)
+                                                               & (err > 0.5 * last))
         if not todo.any():
-            break
+            return conf, err <= CLOSED_TOL
+        last = err
         delta = np.zeros((conf.size, m))
         delta[:, pidx] = -_solve_passive(fr.screws, xi, rows, cols, pidx)
         delta[~todo] = 0.0

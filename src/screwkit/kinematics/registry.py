@@ -22,6 +22,8 @@ from screwkit.kinematics import seed_names
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.model import families as constructors
+from screwkit.model import geometry as geometries
+from screwkit.model.geometry import LoopGeometry
 from screwkit.model.linkage import Linkage
 
 Named = dict[str, Array]
@@ -71,6 +73,12 @@ class Family:
     coupler_link: str | None = None
     #: Bagci's App. D closed form of the limits of ``outputs`` (None: the generic route)
     closed_limits: ClosedLimits | None = None
+    #: the loop's constant geometry from its dimensions, complex-safe (model/geometry.py): the
+    #: generic synthesis route differentiates the loop closure through it
+    geometry: Callable[..., LoopGeometry] | None = None
+    #: Bagci's closed-form synthesis (Programs B/C, the overlay) as the RSRC with these
+    #: dimensions held (the 4R: b = e = δ0 = λ0 = 0); None: the generic route only
+    closed_synthesis: Mapping[str, float] | None = None
 
     def linkage(self, **dimensions: float) -> Linkage:
         """The family's loop from its dimensions (SI units, radians)."""
@@ -119,7 +127,8 @@ FAMILIES: dict[str, Family] = {
             aliases=("rsrc",), sketch=constructors.RSRC_SKETCH,
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output_C.theta", -1.0),
                            "S": ("output_C.s", 1.0), "chi0": ("coupler_R.theta", 1.0)},
-            outputs=("phi0", "S"), coupler_link="coupler", closed_limits=_rsrc_limits),
+            outputs=("phi0", "S"), coupler_link="coupler", closed_limits=_rsrc_limits,
+            geometry=geometries.rsrc_geometry, closed_synthesis={}),
         Family(
             "4R", "the planar 4R", "planar four-bar (Bagci's special case of the RSRC)",
             {"a": _LENGTH, "d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH},
@@ -128,14 +137,16 @@ FAMILIES: dict[str, Family] = {
             aliases=("4r", "fourbar"), sketch=constructors.FOURBAR_SKETCH,
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output.theta", -1.0),
                            "chi0": ("rocker_pin.theta", 1.0)},
-            outputs=("phi0",), coupler_link="coupler", closed_limits=_rsrc_limits),
+            outputs=("phi0",), coupler_link="coupler", closed_limits=_rsrc_limits,
+            geometry=geometries.fourbar_geometry,
+            closed_synthesis={"b": 0.0, "e": 0.0, "delta0": 0.0, "lambda0": 0.0}),
         Family(
             "CSSP", "the CSSP", "Rahman's generalised slider-crank (C-S-S-P)",
             {"a1": _LENGTH, "a2": _LENGTH, "a4": _LENGTH, "alpha4": _ANGLE, "s1": _LENGTH},
             optional={"s1": 0.0}, build=_cssp, closed_form=_cssp_closed,
             seed_names=seed_names.cssp_names, aliases=("cssp",), sketch=constructors.CSSP_SKETCH,
             seed_freedoms={"theta1": ("crank.theta", 1.0), "s4": ("slider.s", 1.0)},
-            outputs=("s4",), coupler_link="rod"),
+            outputs=("s4",), coupler_link="rod", geometry=geometries.cssp_geometry),
         Family(
             "RSSR", "the RSSR", "spatial R-S-S-R crank-rocker (generic solver)",
             {"d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH, "a": _LENGTH, "b": _LENGTH,
@@ -144,13 +155,14 @@ FAMILIES: dict[str, Family] = {
             seed_names=seed_names.rssr_names, aliases=("rssr",),
             sketch=constructors.RSSR_SKETCH,
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output.theta", -1.0)},
-            outputs=("phi0",), coupler_link="coupler"),
+            outputs=("phi0",), coupler_link="coupler", geometry=geometries.rssr_geometry),
         Family(
             "RCCC", "the RCCC", "R-C-C-C loop in Hartenberg-Denavit form (generic solver)",
             {"a1": _LENGTH, "a2": _LENGTH, "a3": _LENGTH, "a4": _LENGTH, "alpha1": _ANGLE,
              "alpha2": _ANGLE, "alpha3": _ANGLE, "alpha4": _ANGLE, "input_offset": _LENGTH},
             optional={"input_offset": 0.0}, build=_rccc, aliases=("rccc",),
-            sketch=constructors.RCCC_SKETCH, outputs=("C4.theta", "C4.s"), coupler_link="link2"),
+            sketch=constructors.RCCC_SKETCH, outputs=("C4.theta", "C4.s"), coupler_link="link2",
+            geometry=geometries.rccc_geometry),
         Family(
             "LOOP", "a joint-list loop", "any single loop given as a joint list (generic solver)", {},
             aliases=("loop",),

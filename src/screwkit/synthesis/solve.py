@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field, replace
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,8 +23,8 @@ from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
 from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled, ResidualModel, dimensions_of
 
-__all__ = ["RangeCheck", "evaluate_design", "SynthesisError", "SynthesisResult", "check_range", "synthesize",
-           "synthesize_multistart"]
+__all__ = ["RangeCheck", "evaluate_design", "SynthesisError", "SynthesisResult", "check_range",
+           "fit_notes", "synthesize", "synthesize_multistart"]
 
 FloatArray = NDArray[np.float64]
 Status = Literal["converged", "iteration limit", "time limit", "not solved"]
@@ -156,7 +156,7 @@ def check_range(problem: RSRCSynthesisProblem, ev: Evaluation, n_samples: int = 
     return RangeCheck(ok, tuple(gaps), tuple(mismatch), trans, msg)
 
 
-def _fit_notes(problem: RSRCSynthesisProblem, psi_d: FloatArray, s_d: FloatArray,
+def fit_notes(problem: Any, psi_d: FloatArray, s_d: FloatArray,
                r_phi: FloatArray, r_s: FloatArray, check: RangeCheck, status: Status) -> list[str]:
     """Plain-language notes for the result message: a limit that was hit, a target the result
     does not follow (a maximum deviation above 10 % of the desired range of that component),
@@ -234,7 +234,7 @@ def _result(problem: RSRCSynthesisProblem, model: ResidualModel, ev: Evaluation,
             "S_d": float(s_all[i]),
         })
     check = check_range(problem, ev)
-    message = "; ".join(m for m in (message, *_fit_notes(problem, psi_all, s_all, r_phi, r_s,
+    message = "; ".join(m for m in (message, *fit_notes(problem, psi_all, s_all, r_phi, r_s,
                                                           check, status)) if m)
     # the program label (root ordering, Bagci's I8/I9) of the result's configuration at theta = 0
     pos = rsrc_positions(dimensions_of({k: np.array([v]) for k, v in ev.params.items()}),
