@@ -394,6 +394,24 @@ class Spec:
             span = f"{self.inputs[0]:.6g}…{self.inputs[-1]:.6g} m"
         return f"{self.name}: {self.family} ({joints}) {dims}; {n} input samples {span}{src}"
 
+    def jobs(self) -> list[str]:
+        """The jobs this spec asks for, each checked at load against what its family offers
+        (the registry's capabilities): what ``screwkit demo`` runs on it."""
+        from screwkit.kinematics.limit_positions import uses_closed_form
+
+        out = ["analyze" + (f" ({len(self.coupler_points)} coupler point(s))"
+                            if self.coupler_points else ""), "mobility"]
+        if all(link.mass is not None for link in self._linkage.links):
+            out.append("dynamics")
+        if self.balancing is not None:
+            out.append("balance")
+        if self.synthesis is not None:
+            out.append(f"synthesize ({self.synthesis.route} route)")
+        if self.limits is not None:
+            closed = uses_closed_form(self._linkage, self.limits.output, self.limits.method)
+            out.append(f"limits ({'closed' if closed else 'generic'} route)")
+        return out
+
     @property
     def input_is_angle(self) -> bool:
         """Whether the driven freedom is a rotation (else a translation, in metres)."""
