@@ -140,10 +140,10 @@ if TYPE_CHECKING:
     from screwkit.kinematics.coupler_curves import coupler_point_path
     from screwkit.kinematics.limit_positions import limit_positions
     from screwkit.kinematics.loop_mobility import mobility
-    from screwkit.kinematics.transmission import transmission
     from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
     from screwkit.kinematics.registry import family
     from screwkit.kinematics.solve_motion import solve_motion
+    from screwkit.kinematics.transmission import transmission
     from screwkit.model.families import cssp, fourbar, rccc, rsrc, rssr
     from screwkit.model.joints import Joint
     from screwkit.model.linkage import Link, Linkage

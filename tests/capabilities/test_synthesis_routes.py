@@ -185,7 +185,7 @@ def _edited(base: str, tmp_path: Path, old: str, new: str) -> Path:
     ("rssr_synthesis.toml", "mode = 0", 'mode = 0\nsolver = "closed"', "solver",
      "synthesised by the generic route"),
     ("rssr_synthesis.toml", "mode = 0", 'mode = 0\nmethod = "overlay"', "method",
-     "defined for the RSRC and the 4R only"),
+     "overlay syntheses are computed for the RSRC (Bagci §5.4); this is a RSSR"),
     ("rssr_synthesis.toml", "mode = 0", "inversion = 2", "inversion",
      "numbers assembly modes as analyze does"),
     ("rssr_synthesis.toml", "[synthesis.rotation]",
@@ -197,7 +197,7 @@ def _edited(base: str, tmp_path: Path, old: str, new: str) -> Path:
     ("bagci_example3_4r_synthesis.toml", "[synthesis.rotation]", "[synthesis.translation]",
      "translation", "generates no translation"),
     ("bagci_example3_4r_synthesis.toml", "[synthesis]", '[synthesis]\nmethod = "overlay"',
-     "method", "not offered for a 4R"),
+     "method", "this is a 4R: it turns the plane mechanism"),
 ])
 def test_what_a_route_cannot_do_is_refused_at_load_with_the_key(tmp_path, base, old, new, key,
                                                                   why):

@@ -138,9 +138,9 @@ def loop_problem_from_spec(spec: MechanismSpec) -> tuple[LoopSynthesisProblem, S
     for name, (lo, hi) in table.bounds.items():
         if name not in names:
             raise key_error(path, f"bounds.{name}", "not a dimension of this loop")
-        bounds[name] = (si(lo, names[name], f"bounds.{name}"), si(hi, names[name],
-                                                                  f"bounds.{name}"))
-        if lo < hi and not bounds[name][0] <= start.get(name, bounds[name][0]) <= bounds[name][1]:
+        bounds[name] = low, high = (si(lo, names[name], f"bounds.{name}"),
+                                    si(hi, names[name], f"bounds.{name}"))
+        if low < high and not low <= start.get(name, low) <= high:
             raise key_error(path, f"bounds.{name}", f"the start of {name} is outside its bounds: "
                             "move the start ([dimensions] or [synthesis.start]) or the bounds")
     try:

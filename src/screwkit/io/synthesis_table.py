@@ -269,23 +269,18 @@ def synthesis_route(spec: MechanismSpec) -> str:
     raw = spec.raw.synthesis if isinstance(spec.raw.synthesis, dict) else {}
     solver, method = raw.get("solver", "auto"), raw.get("method", "least_squares")
     fam = family_of(spec.linkage)
-    closed = fam.closed_synthesis is not None
-    if solver == "closed" and not closed:
-        raise key_error(spec.path, "solver", f"Bagci's closed-form synthesis (Programs B and C, "
-                        f"the overlay) is for the RSRC and its plane case, the 4R; a {fam.name} "
-                        "is synthesised by the generic route (solver = \"generic\" or \"auto\")")
+    closed = "closed_synthesis" in fam.capabilities
+    for key, capability, asked in (("solver", "closed_synthesis", solver == "closed"),
+                                   ("method", "overlay", method == "overlay")):
+        if asked:
+            try:
+                require(spec.linkage, capability)
+            except ValueError as exc:
+                raise key_error(spec.path, key, str(exc)) from None
     route = "closed" if solver == "closed" or (solver != "generic" and closed) else "generic"
     if route == "generic" and method == "overlay":
-        raise key_error(spec.path, "method", "the overlay technique (Bagci §5.4) draws the RSRC's "
-                        "coupler circles about its input-crank ellipse; it is defined for the "
-                        f"RSRC and the 4R only, not for a {fam.name} or the generic route: use "
-                        "method = \"least_squares\"")
-    if route == "closed" and method == "overlay" and fam.closed_synthesis:
-        raise key_error(spec.path, "method", f"the overlay technique is not offered for a "
-                        f"{fam.name} spec: it turns the plane mechanism to put the output pivot on "
-                        "the line of centres (Program C L6248-L6262), which the 4R's own "
-                        "parameters do not carry; state the mechanism as an RSRC with lambda0 = "
-                        "delta0 = b = e = 0, or use method = \"least_squares\"")
+        raise key_error(spec.path, "method", "the overlay technique (Bagci §5.4) belongs to the "
+                        "closed route; use method = \"least_squares\" with solver = \"generic\"")
     validated_table(spec)
     return route
 

@@ -42,7 +42,14 @@ CAPABILITIES = {
     "coupler_point": ("coupler points", "Bagci App. C; docs/kinematics.md"),
     "transmission": ("transmission angles and indices", "docs/kinematics.md"),
     "synthesize": ("dimensional syntheses", "Bagci ch. IV-V; docs/synthesis.md"),
+    "closed_synthesis": ("closed-form syntheses (Programs B and C, the overlay)",
+                         "Bagci ch. V"),
+    "overlay": ("overlay syntheses", "Bagci §5.4"),
 }
+_NOT_CLOSED = ("it has no closed-form synthesis; it is synthesised by the generic route "
+               "(solver = \"generic\" or \"auto\", docs/synthesis.md)")
+_NOT_OVERLAY = ("the overlay draws Bagci's RSRC coupler circles about its input-crank ellipse, "
+                "which this loop does not have; use method = \"least_squares\"")
 _EVERY_LOOP = frozenset({"analyze", "mobility", "dynamics", "balance", "limits",
                          "coupler_point", "transmission", "synthesize"})
 
@@ -125,6 +132,7 @@ FAMILIES: dict[str, Family] = {
              "e": _LENGTH, "delta0": _ANGLE, "lambda0": _ANGLE},
             build=constructors.rsrc, closed_form=_rsrc_closed, seed_names=seed_names.rsrc_names,
             aliases=("rsrc",), sketch=constructors.RSRC_SKETCH,
+            capabilities=_EVERY_LOOP | {"closed_synthesis", "overlay"},
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output_C.theta", -1.0),
                            "S": ("output_C.s", 1.0), "chi0": ("coupler_R.theta", 1.0)},
             outputs=("phi0", "S"), coupler_link="coupler", closed_limits=_rsrc_limits,
@@ -135,6 +143,11 @@ FAMILIES: dict[str, Family] = {
             build=constructors.fourbar, closed_form=_rsrc_closed,
             seed_names=seed_names.fourbar_names,
             aliases=("4r", "fourbar"), sketch=constructors.FOURBAR_SKETCH,
+            capabilities=_EVERY_LOOP | {"closed_synthesis"},
+            why_not={"overlay": "it turns the plane mechanism to put the output pivot on the "
+                                "line of centres (Program C L6248-L6262), which the 4R's own "
+                                "parameters do not carry; state it as an RSRC with lambda0 = "
+                                "delta0 = b = e = 0, or use method = \"least_squares\""},
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output.theta", -1.0),
                            "chi0": ("rocker_pin.theta", 1.0)},
             outputs=("phi0",), coupler_link="coupler", closed_limits=_rsrc_limits,
@@ -145,6 +158,7 @@ FAMILIES: dict[str, Family] = {
             {"a1": _LENGTH, "a2": _LENGTH, "a4": _LENGTH, "alpha4": _ANGLE, "s1": _LENGTH},
             optional={"s1": 0.0}, build=_cssp, closed_form=_cssp_closed,
             seed_names=seed_names.cssp_names, aliases=("cssp",), sketch=constructors.CSSP_SKETCH,
+            why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             seed_freedoms={"theta1": ("crank.theta", 1.0), "s4": ("slider.s", 1.0)},
             outputs=("s4",), coupler_link="rod", geometry=geometries.cssp_geometry),
         Family(
@@ -153,6 +167,7 @@ FAMILIES: dict[str, Family] = {
              "lambda0": _ANGLE, "output_offset": _LENGTH},
             optional={"output_offset": 0.0}, build=constructors.rssr,
             seed_names=seed_names.rssr_names, aliases=("rssr",),
+            why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch=constructors.RSSR_SKETCH,
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output.theta", -1.0)},
             outputs=("phi0",), coupler_link="coupler", geometry=geometries.rssr_geometry),
@@ -161,11 +176,13 @@ FAMILIES: dict[str, Family] = {
             {"a1": _LENGTH, "a2": _LENGTH, "a3": _LENGTH, "a4": _LENGTH, "alpha1": _ANGLE,
              "alpha2": _ANGLE, "alpha3": _ANGLE, "alpha4": _ANGLE, "input_offset": _LENGTH},
             optional={"input_offset": 0.0}, build=_rccc, aliases=("rccc",),
+            why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch=constructors.RCCC_SKETCH, outputs=("C4.theta", "C4.s"), coupler_link="link2",
             geometry=geometries.rccc_geometry),
         Family(
             "LOOP", "a joint-list loop", "any single loop given as a joint list (generic solver)", {},
             aliases=("loop",),
+            why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch="[[joints]]: name, kind (R P C H U S), length, twist, offset, pitch, input "
                    "(Hartenberg-Denavit, Rahman eq. 2.2)"),
     )

@@ -95,7 +95,7 @@ class SynthesisResult:
     status: Status
     message: str
     length_scale: float
-    rows: list[dict[str, float]]
+    rows: list[dict[str, float | None]]
     range_check: RangeCheck
     evaluation: Evaluation = field(repr=False)
 
@@ -222,7 +222,7 @@ def _result(problem: RSRCSynthesisProblem, model: ResidualModel, ev: Evaluation,
             dims[name] = math.remainder(dims[name], 2 * math.pi)
         elif name in ("theta01", "q1", "q2"):
             dims[name] = dims[name] % (2 * math.pi)
-    rows = []
+    rows: list[dict[str, float | None]] = []
     psi_all = problem.target.desired_rotation(ev.theta)
     s_all = problem.target.desired_translation(ev.theta)
     for i, th in enumerate(ev.theta):
