@@ -15,6 +15,7 @@ from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.result import BalanceResult
 from screwkit.constants import STANDARD_GRAVITY
 from screwkit.dynamics import Dynamics, inverse_dynamics
+from screwkit.errors import ScrewkitError
 from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec
 from screwkit.kinematics.coupler_curves import coupler_curves
@@ -144,7 +145,7 @@ class Pipeline:
 
         try:
             tr, note = self.transmission(), None
-        except ValueError as exc:
+        except ScrewkitError as exc:
             tr, note = None, str(exc)
         return analysis_document(self.motion, name=self.spec.name,
                                  coupler_points=self.spec.coupler_points, transmission=tr,
@@ -158,6 +159,14 @@ class Pipeline:
     def coupler_curves(self) -> list[dict[str, Array]]:
         """Per mode, the world path (N, 3) of every coupler point of the spec, by name."""
         return coupler_curves(self.motion, self.spec.coupler_points)
+
+    def simulate(self, fluctuation: float | None = None, cycles: int | None = None) -> Any:
+        """The spec's ``[drive]`` run forward in time (docs/simulation.md): a
+        :class:`~screwkit.simulation.spec_run.SpecSimulation`; with ``fluctuation`` the
+        flywheel is first sized for that coefficient of speed fluctuation."""
+        from screwkit.simulation.spec_run import simulate_spec
+
+        return simulate_spec(self.spec, fluctuation=fluctuation, cycles=cycles)
 
     def mobility(self) -> LinkageMobility:
         """Formula and Jacobian mobility at the first input where the loop assembles."""

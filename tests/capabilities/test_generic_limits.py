@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import screwkit as sk
+from screwkit.errors import UnknownNameError
 from screwkit.io.spec import load_spec
 from screwkit.kinematics.limit_positions import limit_positions
 from screwkit.model.joints import Joint
@@ -98,7 +99,7 @@ def test_a_loop_without_an_output_joint_says_why():
                                          ["b.theta"])
     with pytest.raises(ValueError, match="not one of the two joints on the ground"):
         limit_positions(lk)
-    with pytest.raises(ValueError, match="no output variable 'phi0'"):
+    with pytest.raises(UnknownNameError, match="no output variable 'phi0'"):
         limit_positions(lk, output="phi0")
 
 

@@ -29,12 +29,9 @@ OutputOpt = Annotated[Path | None, typer.Option("--output", "-o", help="Write th
 def user_errors() -> tuple[type[BaseException], ...]:
     """Exceptions that mean the user's input is wrong (every one is a ValueError subclass or a
     missing file); anything else is a bug and keeps its traceback."""
-    from screwkit.io.spec import SpecError
-    from screwkit.io.units import UnitError
-    from screwkit.kinematics.motion import AssemblyError
-    from screwkit.model.linkage import LinkageError
+    from screwkit.errors import ScrewkitError
 
-    return (SpecError, UnitError, AssemblyError, LinkageError, ValueError, OSError)
+    return (ScrewkitError, ValueError, OSError)
 
 
 def guard(fn: Callable[[], T]) -> T:

@@ -36,7 +36,13 @@ _emit = emit
 
 
 @app.callback(invoke_without_command=True)
-def main(version: Annotated[bool, typer.Option("--version", help="Print the version.")] = False) -> None:
+def main(
+    version: Annotated[bool, typer.Option("--version", help="Print the version.")] = False,
+    max_memory: Annotated[str | None, typer.Option("--max-memory", help="Refuse work estimated to need more memory than this (e.g. 16GB; default: half the machine's memory, at most 16 GiB; also SCREWKIT_MAX_MEMORY).")] = None,
+) -> None:
+    from screwkit.budget import set_memory_limit
+
+    _guard(lambda: set_memory_limit(max_memory))  # None: the default (or SCREWKIT_MAX_MEMORY)
     if version:
         console.print(f"screwkit {__version__}")
         raise typer.Exit(0)
@@ -328,6 +334,10 @@ def demo(
             syn = _guard(lambda p=pipe: synthesis_document(p.synthesize(), p.spec.path))  # type: ignore[misc]
             write(output_dir / f"{f.stem}.synthesis.json", syn)
             jobs.append("synthesis")
+        if spec.drive is not None:
+            sim = _guard(lambda p=pipe: p.simulate().as_dict(loads=False))  # type: ignore[misc]
+            write(output_dir / f"{f.stem}.simulation.json", sim)
+            jobs.append("simulation")
         if write_reports:
             from screwkit.report.spec_report import write_spec_report
 
@@ -338,27 +348,11 @@ def demo(
         res = max((np.nanmax(np.asarray(m["closure_residual"], dtype=float)) for m in doc["modes"]), default=np.nan)
         asm = ", ".join(str(int(np.sum(m["assembles"]))) for m in doc["modes"])
         t.add_row(f.stem, spec.family, str(len(spec.inputs)), str(len(doc["modes"])), asm, f"{res:.1e}", ", ".join(jobs))
-        summary: list[tuple[str, Any]] = [
-            ("input samples", len(spec.inputs)), ("analysis method", doc["method"]),
-            ("assembly modes (samples assembling)", f"{len(doc['modes'])} ({asm})"),
-            ("max loop-closure residual", f"{res:.1e}"),
-            ("mobility (formula / Jacobian)", f"{mob['formula']['mobility']} / {mob['numeric']['mobility']}"),
-        ]
-        for m in doc["modes"]:
-            for line in transmission_lines(m.get("transmission"), spec.input_is_angle):
-                summary.append((f"mode {m['mode']}", line))
-        if "limits" in jobs:
-            summary.append(("limit positions (output: input, dwell order)", "; ".join(
-                f"{x['output']} {_fmt(x['input'], spec.input_is_angle)}, {x['dwell_order']}"
-                for x in lim["limits"]) or "none"))
-        if "dynamics" in jobs:
-            sf = dyn["summary"]["shaking_force"]
-            summary.append(("shaking force RMS / peak (N)", f"{sf['rms']:.6g} / {sf['peak']:.6g}"))
-        if "balance" in jobs:
-            g = bal.as_dict()["measures"]
-            summary.append(("balancing objective G before → after", f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
-        if "synthesis" in jobs:
-            summary.append(("synthesis RMSE (φ rad, S m)", f"{syn.get('rmse_phi')} , {syn.get('rmse_S')}"))
+        summary = _demo_summary(spec, doc, mob, asm, res, {
+            "limits": lim if "limits" in jobs else None, "dynamics": dyn if "dynamics" in jobs
+            else None, "balance": bal.as_dict() if "balance" in jobs else None,
+            "simulation": sim if "simulation" in jobs else None,
+            "synthesis": syn if "synthesis" in jobs else None})
         entries.append({
             "name": f.stem, "family": spec.family, "description": spec.describe(),
             "jobs": [(j, f"{f.stem}.{j}.json") for j in jobs], "summary": summary,
@@ -373,14 +367,50 @@ def demo(
     console.print(f"wrote {index}")
 
 
+def _demo_summary(spec: Any, doc: dict[str, Any], mob: dict[str, Any], asm: str, res: float,
+                  done: dict[str, Any]) -> list[tuple[str, Any]]:
+    """The lines of an example's entry in the demo's index: the analysis (with transmission),
+    mobility and one line per other job that ran (``done``: job -> its document or None)."""
+    summary: list[tuple[str, Any]] = [
+        ("input samples", len(spec.inputs)), ("analysis method", doc["method"]),
+        ("assembly modes (samples assembling)", f"{len(doc['modes'])} ({asm})"),
+        ("max loop-closure residual", f"{res:.1e}"),
+        ("mobility (formula / Jacobian)", f"{mob['formula']['mobility']} / {mob['numeric']['mobility']}"),
+    ]
+    for m in doc["modes"]:
+        for line in transmission_lines(m.get("transmission"), spec.input_is_angle):
+            summary.append((f"mode {m['mode']}", line))
+    if (lim := done.get("limits")) is not None:
+        summary.append(("limit positions (output: input, dwell order)", "; ".join(
+            f"{x['output']} {_fmt(x['input'], spec.input_is_angle)}, {x['dwell_order']}"
+            for x in lim["limits"]) or "none"))
+    if (dyn := done.get("dynamics")) is not None:
+        sf = dyn["summary"]["shaking_force"]
+        summary.append(("shaking force RMS / peak (N)", f"{sf['rms']:.6g} / {sf['peak']:.6g}"))
+    if (bal := done.get("balance")) is not None:
+        g = bal["measures"]
+        summary.append(("balancing objective G before → after", f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
+    if (sim := done.get("simulation")) is not None:
+        last = sim["cycles"][-1] if sim.get("cycles") else {}
+        summary.append(("simulated speed fluctuation (last cycle)",
+                        f"{last.get('fluctuation', float('nan')):.4g}"))
+    if (syn := done.get("synthesis")) is not None:
+        summary.append(("synthesis RMSE (φ rad, S m)", f"{syn.get('rmse_phi')} , {syn.get('rmse_S')}"))
+    return summary
+
+
 def _register_subcommands() -> None:
     from screwkit.cli.balance_cmd import register as register_balance
+    from screwkit.cli.mjcf_cmd import register as register_mjcf
     from screwkit.cli.report_cmd import register as register_report
+    from screwkit.cli.simulate_cmd import register as register_simulate
     from screwkit.cli.synthesize_cmd import register as register_synthesize
 
     register_synthesize(app)
     register_balance(app)
     register_report(app)
+    register_simulate(app)
+    register_mjcf(app)
 
 
 _register_subcommands()

@@ -12,14 +12,20 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError, InputTypeError
+
 Array = NDArray[np.float64]
 
 
-def _as_array(x: ArrayLike) -> Array:
-    return np.asarray(x, dtype=np.result_type(np.asarray(x).dtype, np.float64))
+def _as_array(x: ArrayLike, part: str = "value") -> Array:
+    a = np.asarray(x)
+    if a.dtype.kind not in "biufc":  # bool, integers, floats, complex (complex-step derivatives)
+        raise InputTypeError(f"a dual number's {part} part must be numbers (float or complex "
+                             f"arrays); got {type(x).__name__} of dtype {a.dtype}")
+    return np.asarray(a, dtype=np.result_type(a.dtype, np.float64))
 
 
-class DualDivisionError(ValueError, ZeroDivisionError):
+class DualDivisionError(InputError, ZeroDivisionError):
     """Division by a dual number with zero real part (a pure dual number εb)."""
 
 
@@ -40,8 +46,8 @@ class Dual:
     __array_ufunc__ = None
 
     def __init__(self, real: ArrayLike, dual: ArrayLike = 0.0) -> None:
-        r = _as_array(real)
-        d = _as_array(dual)
+        r = _as_array(real, "real")
+        d = _as_array(dual, "dual")
         r, d = np.broadcast_arrays(r, d)
         object.__setattr__(self, "real", np.array(r))
         object.__setattr__(self, "dual", np.array(d))

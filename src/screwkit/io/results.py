@@ -10,13 +10,14 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.io.outputs import write_text_atomic
 
 SI_UNITS = {"length": "m", "angle": "rad", "time": "s", "mass": "kg", "force": "N",
             "moment": "N*m", "velocity": "per s (m/s or rad/s)", "acceleration": "per s^2"}
 
 
-class NonFiniteResultError(ValueError):
+class NonFiniteResultError(InputError):
     """A result holding an infinite value (never written: strict JSON has no Infinity)."""
 
 

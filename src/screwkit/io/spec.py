@@ -24,6 +24,7 @@ from pydantic import (
 )
 
 from screwkit.constants import STANDARD_GRAVITY
+from screwkit.errors import ScrewkitError
 from screwkit.io.errors import SpecError
 from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
@@ -33,6 +34,7 @@ from screwkit.model.linkage import Link, Linkage, LinkageError
 
 if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
+    from screwkit.io.drive_table import DriveConfig
     from screwkit.kinematics.coupler_curves import CouplerPoint
     from screwkit.kinematics.limit_positions import LimitsConfig
     from screwkit.synthesis.config import SynthesisConfig
@@ -115,6 +117,7 @@ class SpecFile(_Strict):
     gravity_direction: list[Number] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
     balancing: dict[str, Any] | None = None
     synthesis: dict[str, Any] | None = None
+    drive: dict[str, Any] | None = None
 
 
 class Spec:
@@ -131,7 +134,9 @@ class Spec:
     ``[synthesis]`` and ``[limits]`` tables as typed configs
     (:class:`~screwkit.balancing.config.BalancingConfig`,
     :class:`~screwkit.synthesis.config.SynthesisConfig`,
-    :class:`~screwkit.kinematics.limit_positions.LimitsConfig`), or ``None``.
+    :class:`~screwkit.kinematics.limit_positions.LimitsConfig`), or ``None``; ``drive`` the
+    ``[drive]`` table of ``screwkit simulate`` (:class:`~screwkit.io.drive_table.DriveConfig`),
+    or ``None``.
     """
 
     def __init__(self, raw: SpecFile, path: str) -> None:
@@ -180,6 +185,11 @@ class Spec:
             from screwkit.io.synthesis_table import synthesis_config
 
             self.synthesis = synthesis_config(self)
+        self.drive: DriveConfig | None = None
+        if raw.drive is not None:
+            from screwkit.io.drive_table import drive_config
+
+            self.drive = drive_config(self)
 
     # --- helpers ---------------------------------------------------------------------------
     def _coupler_points(self) -> list[CouplerPoint]:
@@ -205,7 +215,7 @@ class Spec:
                                           "its own name")
             try:
                 coupler_link_index(self._linkage, t.link)
-            except ValueError as exc:
+            except ScrewkitError as exc:
                 self._fail(f"{key}.link", str(exc))
             try:
                 out.append(coupler_point(self._linkage, xyz, t.link, name))
@@ -226,7 +236,7 @@ class Spec:
         config = LimitsConfig(t.output, float(t.dwell_tolerance), t.max_order, at, t.method)
         try:
             check_limits_config(self._linkage, config)
-        except ValueError as exc:
+        except ScrewkitError as exc:
             self._fail("limits", str(exc))
         return config
 
@@ -410,6 +420,8 @@ class Spec:
         if self.limits is not None:
             closed = uses_closed_form(self._linkage, self.limits.output, self.limits.method)
             out.append(f"limits ({'closed' if closed else 'generic'} route)")
+        if self.drive is not None:
+            out.append("simulate")
         return out
 
     @property

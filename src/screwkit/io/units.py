@@ -15,6 +15,7 @@ from typing import Any
 
 import pint
 
+from screwkit.errors import InputError
 from screwkit.io.quantity import (
     MAX_QUANTITY_CHARS,
     QuantitySyntaxError,
@@ -24,7 +25,7 @@ from screwkit.io.quantity import (
 )
 
 
-class UnitError(ValueError):
+class UnitError(InputError):
     """A quantity that cannot be read or has the wrong kind of unit."""
 
 
@@ -44,13 +45,19 @@ KIND_UNITS = {
     "mass": "kg",
     "force": "N",
     "inertia": "kg*m**2",
+    "torque": "N*m",
+    "time": "s",
+    "rotational_damping": "N*m*s/rad",
+    "translational_damping": "N*s/m",
     "dimensionless": "",
 }
 
 #: SI unit of each kind as printed in messages
 SI_SYMBOL = {"length": "m", "angle": "rad", "angular_velocity": "rad/s",
              "angular_acceleration": "rad/s^2", "velocity": "m/s", "acceleration": "m/s^2",
-             "mass": "kg", "force": "N", "inertia": "kg*m^2", "dimensionless": ""}
+             "mass": "kg", "force": "N", "inertia": "kg*m^2", "torque": "N*m", "time": "s",
+             "rotational_damping": "N*m*s/rad", "translational_damping": "N*s/m",
+             "dimensionless": ""}
 
 #: (largest |value|, smallest non-zero |value|) accepted per kind, in SI. Zero is always
 #: accepted here (a zero offset, a massless link, a resting input); rules that need a positive
@@ -66,6 +73,10 @@ MAGNITUDE_LIMITS: dict[str, tuple[float, float]] = {
     "mass": (1e9, 1e-12),                   # a million tonnes … 1 ng
     "force": (1e12, 1e-12),
     "inertia": (1e15, 1e-27),               # kg·m²
+    "torque": (1e12, 1e-12),                # N·m
+    "time": (1e7, 1e-12),                   # ~4 months … 1 ps
+    "rotational_damping": (1e12, 1e-15),    # N·m·s/rad
+    "translational_damping": (1e12, 1e-15),  # N·s/m
     "dimensionless": (1e12, 1e-300),
 }
 
@@ -82,6 +93,10 @@ EXAMPLES = {
     "mass": '"0.86 kg"',
     "force": '"1.9 lbf"',
     "inertia": '"2.05e-4 lbf*s^2*in" or "1e-3 kg*m^2"',
+    "torque": '"5 N*m" or "40 lbf*in"',
+    "time": '"2 s" or "150 ms"',
+    "rotational_damping": '"0.01 N*m*s/rad"',
+    "translational_damping": '"5 N*s/m"',
     "dimensionless": "a plain number",
 }
 

@@ -57,11 +57,13 @@ def _with_seed(mode: ModeMotion, index: int, label: str, seed: tuple[dict[str, A
                    singular=sing, index=index, label=label)
 
 
-def _no_modes(linkage: Linkage, X: Array) -> AssemblyError:
+def _no_modes(linkage: Linkage, X: Array, where: str) -> AssemblyError:
+    """The loop closes at none of the inputs: say where over a full turn it does, if anywhere."""
     return AssemblyError(
         f"{linkage.name}: the loop does not close at any of the {len(X)} inputs "
-        f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
-        "check the dimensions")
+        f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); it "
+        f"assembles {where}" + ("; check the dimensions" if where.startswith("at no") else
+                                "; change [motion] start/stop to a range where it does"))
 
 
 def rsrc_dimensions(linkage: Linkage) -> tuple[RSRCDimensions, bool]:
@@ -118,7 +120,9 @@ def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
                                 f"sample: label {int(np.max(mot.inversion_label[ok, j][:1]))})",
                                 (seed_v, seed_d, seed_dd), singular=ok & ~rates.valid[:, j]))
     if not modes:
-        raise _no_modes(linkage, X)
+        from screwkit.kinematics.assembly_range import assembling_intervals, describe_intervals
+
+        raise _no_modes(linkage, X, describe_intervals(assembling_intervals(dims)))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed",
                   solver=FOURBAR_SOLVER if planar else RSRC_SOLVER)
 
@@ -178,7 +182,11 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         md = replace(md, events=events)
         modes.append(_with_seed(md, len(modes), label, (seed_v, seed_d, seed_dd)))
     if not modes:
-        raise _no_modes(linkage, X)
+        from screwkit.kinematics.assembly_range import describe_intervals
+        from screwkit.kinematics.cssp import assembly_intervals
+
+        raise _no_modes(linkage, X, describe_intervals(
+            [(a % (2 * np.pi), a % (2 * np.pi) + (b - a)) for a, b in assembly_intervals(dims)]))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=CSSP_SOLVER)
 
 

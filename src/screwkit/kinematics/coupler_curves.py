@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from screwkit.errors import InputError
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.kinematics.registry import coupler_link_index
@@ -54,7 +55,7 @@ def coupler_point(linkage: Linkage, point: ArrayLike, link: str | None = None,
     has no defined path (module docstring)."""
     p = np.asarray(point, dtype=float)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise ValueError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
+        raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
     k = coupler_link_index(linkage, link)
     axis = idle_axis(linkage, k)
     if axis is not None:
@@ -62,7 +63,7 @@ def coupler_point(linkage: Linkage, point: ArrayLike, link: str | None = None,
         if off > 1e-9 * linkage.length_scale:
             j1, j2 = linkage.joints[k].name, linkage.joints[k + 1].name
             along = float(p @ axis)
-            raise ValueError(
+            raise InputError(
                 f"{linkage.name}: the {linkage.links[k].name} lies between the ball joints {j1} "
                 f"and {j2}, so it turns freely about the line of their centres and only points on "
                 f"that line have a defined path; this point is {off:.6g} m off it (the nearest "
@@ -77,10 +78,10 @@ def coupler_point_path(mode: ModeMotion, point: ArrayLike, link: int = 1) -> Arr
     the joint motion), over one mode; NaN where the mode does not assemble."""
     p = np.asarray(point, dtype=float)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise ValueError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
+        raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
     n_links = mode.link_rotation.shape[1]
     if not 0 <= link < n_links:
-        raise ValueError(f"link index {link} out of range: the loop has {n_links} moving links")
+        raise InputError(f"link index {link} out of range: the loop has {n_links} moving links")
     R = mode.link_rotation[:, link]
     return np.asarray(mode.link_origin[:, link] + np.einsum("nij,j->ni", R, p))
 

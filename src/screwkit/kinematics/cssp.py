@@ -28,6 +28,8 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError
+
 Array = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 AnyArray = NDArray[Any]  # real, or complex for complex-step differentiation
@@ -41,7 +43,7 @@ SEED_ASSEMBLY_MODE: AssemblyMode = 1
 _GIMBAL_TOL = 1e-12
 
 
-class CSSPAssemblyError(ValueError):
+class CSSPAssemblyError(InputError):
     """The CSSP does not assemble (b² < c) or sits on a branch point (b² = c) at some inputs."""
 
     def __init__(self, message: str, assembles: BoolArray) -> None:

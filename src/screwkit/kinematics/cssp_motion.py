@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from screwkit.errors import InputError
 from screwkit.kinematics.cssp import (
     _GIMBAL_TOL,
     SEED_ASSEMBLY_MODE,
@@ -58,7 +59,7 @@ Array = NDArray[np.float64]
 _JOINTS = (("R", "C"), ("S",), ("S",), ("P",))
 
 
-class NotACSSPError(ValueError):
+class NotACSSPError(InputError):
     """The linkage given to :func:`cssp_mode_motion` is not a CSSP of the family constructor."""
 
 

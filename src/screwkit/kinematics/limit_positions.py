@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.kinematics.generic_limits import generic_limit_positions
 from screwkit.kinematics.limit_results import DwellAt, LimitPosition, LimitPositions
 from screwkit.kinematics.motion import Motion
@@ -38,17 +39,17 @@ def check_limits_config(linkage: Linkage, config: LimitsConfig) -> None:
     """A ValueError naming what ``config`` asks that the loop cannot give."""
     require(linkage, "limits")
     if not 1 <= int(config.max_order) <= 10:
-        raise ValueError(f"max_order must be 1 … 10; got {config.max_order}")
+        raise InputError(f"max_order must be 1 … 10; got {config.max_order}")
     if not config.dwell_tolerance > 0:
-        raise ValueError(f"dwell_tolerance must be positive; got {config.dwell_tolerance}")
+        raise InputError(f"dwell_tolerance must be positive; got {config.dwell_tolerance}")
     if config.method not in METHODS:
-        raise ValueError(f"method must be 'auto', 'closed' or 'generic'; got {config.method!r}")
+        raise InputError(f"method must be 'auto', 'closed' or 'generic'; got {config.method!r}")
     outputs = (config.output,) if config.output is not None else default_outputs(linkage)
     for name in outputs:
         output_freedom(linkage, name)
     if config.method == "closed" and not uses_closed_form(linkage, config.output, "closed"):
         fam = family_of(linkage)
-        raise ValueError(f"no closed-form limits of {', '.join(outputs)} for a {fam.name} "
+        raise InputError(f"no closed-form limits of {', '.join(outputs)} for a {fam.name} "
                          "(Bagci's App. D covers the RSRC's φ0 and S and the 4R's φ0); use "
                          "method = \"generic\" or \"auto\"")
 

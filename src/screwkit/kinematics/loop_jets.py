@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from screwkit.errors import InputError
 from screwkit.kinematics.loop import (
     Array,
     Configuration,
@@ -259,7 +260,7 @@ def taylor_jets(linkage: Linkage, conf: Configuration, order: int,
     """Taylor coefficients to ``order`` of every freedom along the branch through each closed
     configuration of ``conf``, w.r.t. the first input (module docstring)."""
     if not 1 <= order <= 12:
-        raise ValueError(f"order must be 1 … 12; got {order}")
+        raise InputError(f"order must be 1 … 12; got {order}")
     lay = lay or layout(linkage)
     rows, cols = _scales(linkage, lay)
     pidx = _passive(linkage, lay)

@@ -18,6 +18,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from screwkit.errors import CapabilityError, InputError, UnknownNameError
 from screwkit.kinematics import seed_names
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion
@@ -90,7 +91,8 @@ class Family:
     def linkage(self, **dimensions: float) -> Linkage:
         """The family's loop from its dimensions (SI units, radians)."""
         if self.build is None:
-            raise ValueError(f"a {self.name} is built from its joint list, not from dimensions")
+            raise CapabilityError(f"a {self.name} is built from its joint list, not from "
+                                  "dimensions")
         return self.build(**{**self.optional, **dimensions})
 
 
@@ -194,7 +196,7 @@ def family(name: str) -> Family:
     """The family called ``name`` (case-insensitive; ``fourbar`` is the 4R)."""
     key = _ALIASES.get(str(name).lower())
     if key is None:
-        raise ValueError(f"unknown family {name!r}; use one of {', '.join(FAMILIES)}")
+        raise InputError(f"unknown family {name!r}; use one of {', '.join(FAMILIES)}")
     return FAMILIES[key]
 
 
@@ -213,7 +215,7 @@ def require(linkage_or_family: Linkage | Family, capability: str) -> Family:
         listed = (" and ".join(offered) if len(offered) < 3
                   else ", ".join(offered[:-1]) + " and " + offered[-1])
         why = fam.why_not.get(capability)
-        raise ValueError(f"{what} are computed for {listed or 'no family yet'} ({source}); this "
+        raise CapabilityError(f"{what} are computed for {listed or 'no family yet'} ({source}); this "
                          f"is a {fam.name}" + (f": {why}" if why else ""))
     return fam
 
@@ -229,7 +231,7 @@ def seed_variables(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Na
 def output_joint(linkage: Linkage) -> int:
     """The index of the loop's output joint: the joint on the ground (the last or the first
     joint; the ground link closes the loop between them) that is not the input joint. A
-    ValueError says why when the input is not on the ground (then no joint is the output)."""
+    CapabilityError says why when the input is not on the ground (then no joint is the output)."""
     n = len(linkage.joints)
     driven = {name.split(".")[0] for name in linkage.inputs}
     first, last = linkage.joints[0].name, linkage.joints[n - 1].name
@@ -237,7 +239,7 @@ def output_joint(linkage: Linkage) -> int:
         return n - 1
     if last in driven and first not in driven:
         return 0
-    raise ValueError(
+    raise CapabilityError(
         f"{linkage.name}: the input joint ({', '.join(sorted(driven))}) is not one of the two "
         f"joints on the ground ({first}, {last}), so the loop has no output joint to take limits, "
         "transmission or synthesis of; name the output variable (e.g. --output <joint>.theta)")
@@ -251,7 +253,7 @@ def default_outputs(linkage: Linkage) -> tuple[str, ...]:
         return fam.outputs
     joint = linkage.joints[output_joint(linkage)]
     if joint.kind == "S":
-        raise ValueError(f"{linkage.name}: the output joint {joint.name!r} is a ball joint, whose "
+        raise CapabilityError(f"{linkage.name}: the output joint {joint.name!r} is a ball joint, whose "
                          "rotation has no scalar variable; name the output variable")
     return tuple(joint.freedom_names())
 
@@ -259,14 +261,14 @@ def default_outputs(linkage: Linkage) -> tuple[str, ...]:
 def output_freedom(linkage: Linkage, name: str) -> tuple[str, float]:
     """The joint freedom and sign of an output variable ``name``: a scalar freedom
     ``"<joint>.<freedom>"`` is itself (sign +1); a seed name of the family is its freedom times
-    a sign (RSRC ``phi0`` = −``output_C.theta``). A ValueError lists the names that work."""
+    a sign (RSRC ``phi0`` = −``output_C.theta``). An UnknownNameError lists the names that work."""
     fam = family_of(linkage)
     scalar = [f for j in linkage.joints if j.kind != "S" for f in j.freedom_names()]
     if name in scalar:
         return name, 1.0
     if name in fam.seed_freedoms:
         return fam.seed_freedoms[name]
-    raise ValueError(f"{linkage.name}: no output variable {name!r}; use a joint freedom "
+    raise UnknownNameError(f"{linkage.name}: no output variable {name!r}; use a joint freedom "
                      f"({', '.join(scalar)})"
                      + (f" or one of the seed's names {', '.join(fam.seed_freedoms)}"
                         if fam.seed_freedoms else ""))
@@ -279,7 +281,7 @@ def coupler_link_index(linkage: Linkage, name: str | None = None) -> int:
     names = [link.name for link in linkage.links]
     if name is not None:
         if name not in names:
-            raise ValueError(f"{linkage.name}: no moving link called {name!r}; the links are "
+            raise UnknownNameError(f"{linkage.name}: no moving link called {name!r}; the links are "
                              f"{', '.join(names)}")
         return names.index(name)
     fam = family_of(linkage)
@@ -288,6 +290,6 @@ def coupler_link_index(linkage: Linkage, name: str | None = None) -> int:
     floating = list(range(1, len(names) - 1))
     if len(floating) == 1:
         return floating[0]
-    raise ValueError(f"{linkage.name}: a joint list of {len(linkage.joints)} joints has "
+    raise InputError(f"{linkage.name}: a joint list of {len(linkage.joints)} joints has "
                      f"{len(floating) or 'no'} moving link(s) off the ground, so it has no one "
                      f"coupler; name the link (link = \"...\", one of {', '.join(names)})")

@@ -9,6 +9,8 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import ArrayLike
 
+from screwkit.budget import check_memory
+from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.generic_motion import generic_motion
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion, as_input_array
@@ -53,8 +55,10 @@ def solve_motion(
     "Assembly modes"): generic modes are numbered as the closed form's where a family has one.
     """
     if method not in METHODS:
-        raise ValueError(f"method must be 'auto', 'closed' or 'generic'; got {method!r}")
+        raise InputError(f"method must be 'auto', 'closed' or 'generic'; got {method!r}")
     X = as_input_array(linkage, inputs, "inputs")
+    check_memory(motion_bytes(linkage, X.shape[0]), f"a motion of {X.shape[0]} samples",
+                 "use fewer input samples (a larger [motion] step or a shorter range)")
     Xd = np.array(np.broadcast_to(as_input_array(linkage, rates, "rates"), X.shape))
     Xdd = np.array(np.broadcast_to(as_input_array(linkage, accelerations, "accelerations"),
                                    X.shape))
@@ -62,7 +66,7 @@ def solve_motion(
     closed = fam.closed_form if X.shape[0] >= 2 else None
     if method == "closed" and closed is None:
         with_closed = ", ".join(f.name for f in _families_with_closed_forms())
-        raise ValueError(
+        raise CapabilityError(
             f"no closed form for a {fam.name} with {X.shape[0]} input sample(s) (closed forms: "
             f"{with_closed}, with at least 2 input samples); use method 'generic'")
     if method in ("auto", "closed") and closed is not None:
@@ -76,6 +80,20 @@ def solve_motion(
         notes += ("one input sample: the generic solver was used (the closed form tracks "
                   "branches over at least 2 samples)",)
     return replace(motion, modes=modes, notes=notes)
+
+
+#: assembly modes assumed when estimating memory (the RSRC quartic has at most 4)
+MODES_ESTIMATE = 4
+
+
+def motion_bytes(linkage: Linkage, samples: int, modes: int = MODES_ESTIMATE) -> float:
+    """About how many bytes a Motion of ``samples`` samples takes, with the solver's temporaries
+    (about three times the result): per mode and sample, every link frame and its twists and
+    accelerations, joint centres and axes, and three tables of every variable."""
+    n, links = len(linkage.joints), len(linkage.links)
+    freedoms = sum(j.dof for j in linkage.joints)
+    per_sample = 24 * links + 6 * n + 4 * (freedoms + 8) + 9 * n
+    return 3.0 * 8 * per_sample * modes * samples
 
 
 def _families_with_closed_forms() -> list:  # type: ignore[type-arg]

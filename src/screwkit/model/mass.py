@@ -29,6 +29,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError
+
 Array = NDArray[np.float64]
 
 STANDARD_GRAVITY = 9.80665
@@ -41,11 +43,11 @@ CONSISTENCY_RTOL = 1e-9
 N_INERTIAL_PARAMETERS = 10
 
 
-class PhysicalConsistencyError(ValueError):
+class PhysicalConsistencyError(InputError):
     """Mass properties that no real body can have (negative mass, non-PSD inertia, …)."""
 
 
-class PointMassSplitError(ValueError):
+class PointMassSplitError(InputError):
     """A split of a link mass into Rahman's point masses that cannot reproduce its inertia."""
 
 

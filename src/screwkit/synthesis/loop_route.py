@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import InputError
 from screwkit.kinematics.loop import (
     Array,
     Configuration,
@@ -84,34 +85,34 @@ class LoopSynthesisProblem:
     def __post_init__(self) -> None:
         allowed = set(self.kinds) | {"theta01"}
         if not self.unknowns or len(set(self.unknowns)) != len(self.unknowns):
-            raise ValueError(f"unknowns must be distinct and not empty, got {self.unknowns!r}")
+            raise InputError(f"unknowns must be distinct and not empty, got {self.unknowns!r}")
         bad = [u for u in self.unknowns if u not in allowed]
         if bad:
-            raise ValueError(f"unknown(s) {bad} cannot be solved for; choose among "
+            raise InputError(f"unknown(s) {bad} cannot be solved for; choose among "
                              f"{sorted(allowed)}")
         missing = sorted(allowed - set(self.start))
         if missing:
-            raise ValueError(f"start/constants lack {missing}: give a value for every dimension")
+            raise InputError(f"start/constants lack {missing}: give a value for every dimension")
         for name, value in self.start.items():
             if not math.isfinite(float(value)):
-                raise ValueError(f"start value of {name} must be finite, got {value!r}")
+                raise InputError(f"start value of {name} must be finite, got {value!r}")
         for name, (lo, hi) in self.bounds.items():
             if name not in self.unknowns:
-                raise ValueError(f"bounds given for {name!r}, which is not an unknown")
+                raise InputError(f"bounds given for {name!r}, which is not an unknown")
             if not lo < hi:
-                raise ValueError(f"bounds of {name}: lower {lo!r} must be below upper {hi!r}")
+                raise InputError(f"bounds of {name}: lower {lo!r} must be below upper {hi!r}")
         if self.target.rotation is not None and self.rotation_output is None:
-            raise ValueError(f"a {self.family} has no rotation output to generate the target "
+            raise InputError(f"a {self.family} has no rotation output to generate the target "
                              "rotation")
         if self.target.translation is not None and self.translation_output is None:
-            raise ValueError(f"a {self.family}'s output has no translation, so it cannot "
+            raise InputError(f"a {self.family}'s output has no translation, so it cannot "
                              "generate a desired translation; prescribe the rotation only")
         if self.input_direction not in (1, -1) or self.output_direction not in (1, -1):
-            raise ValueError("input_direction and output_direction must be +1 or -1")
+            raise InputError("input_direction and output_direction must be +1 or -1")
         if not (self.length_scale > 0.0 and math.isfinite(self.length_scale)):
-            raise ValueError(f"length_scale must be a positive length, got {self.length_scale!r}")
+            raise InputError(f"length_scale must be a positive length, got {self.length_scale!r}")
         if self.mode is not None and self.mode < 0:
-            raise ValueError(f"mode must be an assembly mode index ≥ 0, got {self.mode}")
+            raise InputError(f"mode must be an assembly mode index ≥ 0, got {self.mode}")
 
     def dimensions(self, x: Array) -> dict[str, float]:
         """Every dimension and theta01 at the unknown vector ``x``."""

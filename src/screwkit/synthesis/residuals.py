@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import InputError
 from screwkit.kinematics.quartic import wrap_angle
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
 from screwkit.synthesis.problem import RSRCSynthesisProblem
@@ -37,7 +38,7 @@ Array = NDArray[Any]
 _STEP = 1e-30  # complex step: exact first derivatives to rounding, any step this small works
 
 
-class NotAssembled(ValueError):
+class NotAssembled(InputError):
     """The mechanism does not close (or locks) at a design point on the chosen mode."""
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
 from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled, ResidualModel, dimensions_of
@@ -30,7 +31,7 @@ FloatArray = NDArray[np.float64]
 Status = Literal["converged", "iteration limit", "time limit", "not solved"]
 
 
-class SynthesisError(ValueError):
+class SynthesisError(InputError):
     """A synthesis that cannot start or has no solution; the message says why."""
 
 
