@@ -160,7 +160,8 @@ def _index(w: Array, twist: Array, joint_point: Array, joint_axis: Array | None,
                      / denom)
     P = p0 + t[:, None] * fhat
     vel = v0 + np.cross(om, P) + pitch[:, None] * om
-    ti = np.abs(np.einsum("ni,ni->n", fhat, vel)) / np.linalg.norm(vel, axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):  # P on the output axis: no index (NaN)
+        ti = np.abs(np.einsum("ni,ni->n", fhat, vel)) / np.linalg.norm(vel, axis=-1)
     mhat = m / np.maximum(np.linalg.norm(m, axis=-1, keepdims=True), 1e-300)
     on = np.linalg.norm(om, axis=-1)
     by_couple = np.where(on > 0, np.abs(np.einsum("ni,ni->n", mhat, om)) / np.where(on > 0, on, 1),
