@@ -107,3 +107,16 @@ def test_closed_route_only_for_what_app_d_covers():
     s = load_spec(f"{EXAMPLES}/rssr_spatial.toml")
     with pytest.raises(ValueError, match="no closed-form limits"):
         limit_positions(s.linkage, method="closed")
+
+
+def test_a_limit_across_the_end_of_a_full_turn_is_found():
+    """Example 3's 4R has a limit at θ0 = 7.37°: with the sweep 10° … 360° it lies between the
+    last sample and the first one turned by 360° (the mode comes back to itself)."""
+    s = load_spec(f"{EXAMPLES}/bagci_example3_4r.toml")
+    closed = limit_positions(s.linkage, method="closed")
+    sweep = np.radians(np.arange(10.0, 361.0, 10.0))
+    generic = limit_positions(sk.solve_motion(s.linkage, sweep), method="generic")
+    assert len(generic.limits) == len(closed.limits) == 2
+    for lim in closed.limits:
+        assert min(_gap(g.input, lim.input) for g in generic.limits) < 1e-10
+    assert all(sweep[0] <= g.input < sweep[0] + 2 * math.pi for g in generic.limits)

@@ -316,7 +316,7 @@ def follow(linkage: Linkage, conf: Configuration, x_from: Array, x_to: Array, *,
         q = guess.scalars.copy()
         q[:, col] = x_from + (x_to - x_from) * (s / n_steps)
         closed, good = close_loop(linkage, Configuration(q, guess.spherical), lay)
-        moved = np.abs(closed.scalars - guess.scalars)
+        moved = np.abs(closed.scalars - q)  # the correction (q: the prediction at the input)
         scale = np.array([cols[f] for f in range(len(lay.names)) if lay.scalar_col[f] >= 0])
         shift = np.max(moved / scale[None, :], axis=-1) if moved.size else np.zeros(conf.size)
         good &= shift <= 1e-2 + 0.1 * np.abs(h) / (cols[f_in])
