@@ -196,7 +196,8 @@ def limits(
         console.print(t)
         if doc["dwells_at"]:
             t2 = Table(title="dwell order at given inputs")
-            for col in ("output", inp, "mode", "value", "dwell order", "dᵏy/dxᵏ, k = 1 …"):
+            for col in ("output", inp, "mode" if doc["method"] == "generic" else "inversion",
+                        "value", "dwell order", "dᵏy/dxᵏ, k = 1 …"):
                 t2.add_column(col, justify="right")
             for d in doc["dwells_at"]:
                 ang = not (d["output"] in ("S", "s4") or d["output"].endswith(".s"))
