@@ -5,6 +5,7 @@ run, whichever jobs run on it (docs/architecture.md)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cached_property
 from typing import Any
 
@@ -31,6 +32,7 @@ from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.kinematics.transmission import Transmission, transmission
 from screwkit.synthesis.config import SynthesisConfig, SynthesisRun, run_synthesis
+from screwkit.tables import ResultTable
 
 
 class Pipeline:
@@ -95,8 +97,10 @@ class Pipeline:
             raise BalancingError(f"{self.spec.path}: no [balancing] table; see docs/balancing.md")
         return self.spec.balancing
 
-    def balance(self, mode: ModeMotion | None = None) -> BalanceResult:
-        """The spec's ``[balancing]`` run on ``[motion] mode`` (or on ``mode`` if given)."""
+    def balance(self, mode: ModeMotion | None = None,
+                progress: Callable[[int, int], None] | None = None) -> BalanceResult:
+        """The spec's ``[balancing]`` run on ``[motion] mode`` (or on ``mode`` if given);
+        ``progress(done, total)`` follows a Pareto sweep."""
         s = self.spec
         config = self.balancing_config()
         if mode is None:
@@ -111,16 +115,19 @@ class Pipeline:
                 "Change [motion] start/stop/step to a range where the mode assembles, choose "
                 "another [motion] mode, or change the dimensions so that the linkage turns fully")
         return balance_with_config(s.linkage, mode, config, speed=s.speed,
-                                   gravity=self.gravity_vector, inputs=s.inputs)
+                                   gravity=self.gravity_vector, inputs=s.inputs,
+                                   progress=progress)
 
     def synthesis_config(self) -> SynthesisConfig:
         if self.spec.synthesis is None:
             raise SpecError(f"{self.spec.path}: no [synthesis] table; see docs/synthesis.md")
         return self.spec.synthesis
 
-    def synthesize(self, starts: int | None = None) -> SynthesisRun:
-        """The spec's ``[synthesis]`` run (either route), best result first."""
-        return run_synthesis(self.synthesis_config(), starts=starts)
+    def synthesize(self, starts: int | None = None,
+                   progress: Callable[[int, int], None] | None = None) -> SynthesisRun:
+        """The spec's ``[synthesis]`` run (either route), best result first;
+        ``progress(done, total)`` follows a multistart."""
+        return run_synthesis(self.synthesis_config(), starts=starts, progress=progress)
 
     def limits(self, dwell_tolerance: float | None = None, at: list[float] | None = None, *,
                output: str | None = None, method: str | None = None,
@@ -150,6 +157,15 @@ class Pipeline:
         return analysis_document(self.motion, name=self.spec.name,
                                  coupler_points=self.spec.coupler_points, transmission=tr,
                                  transmission_note=note)
+
+    def analysis_table(self) -> ResultTable:
+        """The motion as a column table (``Motion.table``) with the spec's coupler points and
+        the transmission quality (where the loop has one)."""
+        try:
+            tr = self.transmission()
+        except ScrewkitError:
+            tr = None
+        return self.motion.table(coupler_points=self.spec.coupler_points, transmission=tr)
 
     def transmission(self) -> Transmission:
         """Transmission index, angle and ball-joint cone angles over every mode (a ValueError

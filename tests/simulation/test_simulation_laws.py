@@ -139,7 +139,7 @@ def test_cli_simulate_json_csv_and_sizing(tmp_path):
     assert abs(doc["flywheel_sizing"]["achieved_fluctuation"] / 0.05 - 1) < 2e-3
     assert doc["shaft_torque_check"] < 1e-9
     rows = (tmp_path / "s.csv").read_text().splitlines()
-    assert len(rows) == 1 + 3 * 36 and rows[0].startswith("time [s],angle [rad]")
+    assert len(rows) == 1 + 3 * 36 and rows[0].startswith("time [s],angle [deg]")  # the spec's units
 
 
 @pytest.mark.parametrize(("table", "message"), [

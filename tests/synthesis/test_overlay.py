@@ -236,7 +236,7 @@ def test_cli_overlay_json_and_plot(tmp_path: Path) -> None:
     r = runner.invoke(app, ["synthesize", str(EXAMPLES / "bagci_example9_overlay.toml"), "--json",
                             "--plot", str(png)])
     assert r.exit_code == 0, r.output
-    doc = json.loads(r.output)
+    doc = json.loads(r.stdout)  # the document alone on stdout ("wrote …" goes to stderr)
     for key in ("dimensions", "mode", "E_phi", "E_S", "rmse", "rmse_phi", "rows", "status",
                 "range_check", "alternatives"):
         assert key in doc

@@ -34,6 +34,7 @@ from screwkit.model.linkage import Link, Linkage, LinkageError
 
 if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
+    from screwkit.io.display_units import DisplayUnits
     from screwkit.io.drive_table import DriveConfig
     from screwkit.kinematics.coupler_curves import CouplerPoint
     from screwkit.kinematics.limit_positions import LimitsConfig
@@ -392,16 +393,29 @@ class Spec:
         """The mechanism model (read only; built once when the spec is loaded)."""
         return self._linkage
 
-    def describe(self) -> str:
+    def display_units(self, system: str = "spec", overrides: dict[str, str] | None = None
+                      ) -> DisplayUnits:
+        """The units tables, CSV and plots show this spec's results in: its ``[units]``
+        (``system="spec"``) or SI (``"si"``), with per-kind ``overrides``
+        (:func:`screwkit.io.display_units.display_units`)."""
+        from screwkit.io.display_units import display_units
+
+        return display_units(self.units, system=system, overrides=overrides)
+
+    def describe(self, units: DisplayUnits | None = None) -> str:
+        """One line: name, family, dimensions and input span in ``units`` (default: the
+        spec's own [units])."""
+        du = units if units is not None else self.display_units()
         lk = self._linkage
-        dims = ", ".join(f"{k}={v:.6g}" for k, v in self.dimensions.items())
+        kinds = family(self.family).dimensions
+        dims = ", ".join(f"{k}={du.show(kinds[k], v):.6g} {du.label(kinds[k])}"
+                         for k, v in self.dimensions.items())
         n = len(self.inputs)
         joints = "".join(j.kind for j in lk.joints)
         src = f" — source: {self.source}" if self.source else ""
-        if self.input_is_angle:
-            span = f"{np.degrees(self.inputs[0]):.6g}…{np.degrees(self.inputs[-1]):.6g} deg"
-        else:
-            span = f"{self.inputs[0]:.6g}…{self.inputs[-1]:.6g} m"
+        kind = "angle" if self.input_is_angle else "length"
+        span = (f"{du.show(kind, self.inputs[0]):.6g}…{du.show(kind, self.inputs[-1]):.6g} "
+                f"{du.label(kind)}")
         return f"{self.name}: {self.family} ({joints}) {dims}; {n} input samples {span}{src}"
 
     def jobs(self) -> list[str]:

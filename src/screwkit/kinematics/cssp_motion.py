@@ -38,7 +38,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation
 
 from screwkit.errors import InputError
 from screwkit.kinematics.cssp import (
@@ -499,6 +498,7 @@ def cssp_mode_motion(
     if joint_rotations:
         safe = np.where(ok[:, None, None], 1.0, 0.0)
         eye = np.where(ok[:, None, None], 0.0, 1.0) * np.eye(3)
+        from scipy.spatial.transform import Rotation  # on first use (start-up time)
         pin_rv = Rotation.from_matrix(np.nan_to_num(pin_rel) * safe + eye).as_rotvec()
         ball_rv = Rotation.from_matrix(np.nan_to_num(ball_rel) * safe + eye).as_rotvec()
     for name, r, rv in ((pin, 0, pin_rv if joint_rotations else None),

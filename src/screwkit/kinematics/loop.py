@@ -18,7 +18,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 from screwkit.model.linkage import Linkage
 
@@ -204,6 +203,7 @@ def closure_twist(R: Array, p: Array) -> Array:
     """The twist ξ (ω; v) with exp(ξ) = G = (R, p): the exact SE(3) logarithm, batched.
 
     Its norm is the loop-closure error; Newton drives it to zero."""
+    from scipy.spatial.transform import Rotation  # on first use (start-up time)
     w = Rotation.from_matrix(R).as_rotvec()
     th = np.linalg.norm(w, axis=-1)
     W = _skew(w)
@@ -231,6 +231,8 @@ def _skew(v: Array) -> Array:
 def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configuration:
     """Move a configuration by freedom increments ``delta`` (N, m): scalars add, spherical
     joints turn by exp([δ]) about their own moving axes (R ← R·exp([δ]))."""
+    from scipy.spatial.transform import Rotation  # on first use (start-up time)
+
     q = conf.scalars.copy()
     sph = conf.spherical.copy()
     cols = np.array(lay.scalar_col)

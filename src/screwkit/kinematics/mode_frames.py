@@ -18,7 +18,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 from screwkit.kinematics.loop import (
     Array,
@@ -146,6 +145,8 @@ def _variable_tables(linkage: Linkage, lay: Layout, conf: Configuration, mask: N
             variables[name] = values
         velocities[name] = qd[:, f]
         accelerations[name] = qdd[:, f]
+    from scipy.spatial.transform import Rotation  # on first use (start-up time)
+
     for i, sidx in lay.spherical_of_joint.items():
         rv = Rotation.from_matrix(conf.spherical[:, sidx]).as_rotvec()
         jn = linkage.joints[i].name

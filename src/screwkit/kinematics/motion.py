@@ -11,6 +11,7 @@ mask.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -18,6 +19,9 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.errors import InputError, InputTypeError, UnknownNameError
 from screwkit.kinematics.loop import Array, Configuration
 from screwkit.model.linkage import Linkage
+
+if TYPE_CHECKING:
+    from screwkit.tables import ResultTable, UnitChoice
 
 
 class AssemblyError(InputError):
@@ -121,6 +125,26 @@ class Motion:
             raise UnknownNameError(f"{self.linkage.name}: no variable {name!r} in mode {mode}; "
                                    f"the variables are {sorted(table)}")
         return table[name]
+
+    def table(self, coupler_point: Any = None, coupler_link: int = 1, *,
+              coupler_points: Any = (), transmission: Any = None) -> ResultTable:
+        """One row per input sample and mode, one column per variable, rate and acceleration
+        (SI; :mod:`screwkit.kinematics.motion_table`), with the coupler points' paths and the
+        transmission quality when given."""
+        from screwkit.kinematics.motion_table import motion_table
+
+        return motion_table(self, coupler_point, coupler_link, coupler_points=coupler_points,
+                            transmission=transmission)
+
+    def to_dataframe(self, units: UnitChoice | None = None) -> Any:
+        """:meth:`table` as a pandas DataFrame, headers with units (``phi0 [rad]``; pass
+        ``units=spec.display_units()`` for the spec's units). Needs pandas."""
+        return self.table().to_dataframe(units)
+
+    def to_csv(self, path: Any, units: UnitChoice | None = None) -> None:
+        """:meth:`table` as CSV (header ``phi0 [rad]``; empty cells where a mode does not
+        assemble)."""
+        self.table().to_csv(path, units)
 
 
 def as_input_array(linkage: Linkage, values: ArrayLike, name: str) -> Array:

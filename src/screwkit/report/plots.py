@@ -8,16 +8,6 @@ from typing import Any
 
 import numpy as np
 
-ANGLE_NAMES = {"phi0", "chi0", "theta2", "eta2", "theta3", "eta3", "theta0", "theta1"}
-LENGTH_NAMES = {"S", "s4"}
-
-
-def _is_angle(name: str) -> bool:
-    """Seed names by list; joint freedoms by kind (``.s`` is a translation, the rest angles)."""
-    if "." in name:
-        return not name.endswith(".s")
-    return name in ANGLE_NAMES or name not in LENGTH_NAMES
-
 
 def pyplot() -> Any:
     try:
@@ -101,17 +91,25 @@ def _smoothed(mode: dict[str, Any], key: str) -> dict[str, np.ndarray]:
     return table
 
 
-def plot_analysis(doc: dict[str, Any], path: str | Path) -> None:
+def plot_analysis(doc: dict[str, Any], path: str | Path, units: Any = None) -> None:
     """One row per seed variable (position, velocity, acceleration columns), one line per
     assembly mode; plus the coupler curve projections when the document has a coupler point.
-    Angles and their rates share one unit (deg, deg/s, deg/s²); lengths are in m."""
+    In ``units`` (a :class:`~screwkit.io.display_units.DisplayUnits`, e.g. the spec's; default
+    deg and m): angles and their rates share the angle unit (deg, deg/s, deg/s²), lengths and
+    theirs the length unit."""
+    from screwkit.io.display_units import display_units
+    from screwkit.kinematics.motion_table import ACCELERATION_KIND, RATE_KIND, variable_kind
+
+    du = units if units is not None else display_units({"angle": "deg"})
     plt = pyplot()
-    x = np.degrees(np.asarray(doc["input"], dtype=float))
+    input_kind = variable_kind(doc["input_name"])
+    x = du.show(input_kind, np.asarray(doc["input"], dtype=float))
     modes = doc["modes"]
     names = [n for n in modes[0]["variables"] if "." not in n and n not in ("theta0", "theta1")]
     if not names:
         names = [n for n in modes[0]["variables"] if n != doc["input_name"]][:3]
     curves = [_curves(m) for m in modes]
+    periodic = _full_turn(np.degrees(np.asarray(doc["input"], dtype=float)))
     has_cp = any(curves)
     has_tr = any("transmission" in m for m in modes)
     rows = len(names) + (1 if has_cp else 0) + (1 if has_cp or has_tr else 0)
@@ -119,26 +117,26 @@ def plot_analysis(doc: dict[str, Any], path: str | Path) -> None:
     tables = [{key: _smoothed(m, key) for key in ("variables", "velocities", "accelerations")}
               for m in modes]
     for r, name in enumerate(names):
-        angle = _is_angle(name)
+        base = variable_kind(name)
+        kinds = {"variables": base, "velocities": RATE_KIND[base],
+                 "accelerations": ACCELERATION_KIND[base]}
         for c, (key, label) in enumerate((("variables", ""), ("velocities", "'"), ("accelerations", "''"))):
             ax = axes[r, c]
             ys = []
             for m, t in zip(modes, tables, strict=True):
-                y = t[key][name]
-                y = np.degrees(y) if angle else y
+                y = du.show(kinds[key], t[key][name])
                 ys.append(y)
                 ax.plot(x, y, label=f"mode {m['mode']}")
-            unit = "deg" if angle else "m"
-            per = {"variables": "", "velocities": "/s", "accelerations": "/s²"}[key]
-            ax.set_title(f"{name}{label} ({unit}{per})")
-            ax.set_xlabel(f"{doc['input_name']} (deg)")
+            ax.set_title(f"{name}{label} ({du.pretty(kinds[key])})")
+            ax.set_xlabel(f"{doc['input_name']} ({du.pretty(input_kind)})")
             ax.grid(True, alpha=0.3)
             flatten_constant_axis(ax, ys)
         axes[r, 0].legend(fontsize=8)
     if has_cp:
-        _coupler_projections(axes[len(names)], modes, curves, x)
+        _coupler_projections(axes[len(names)], modes, curves, du, periodic)
     if has_cp or has_tr:
-        _last_row(fig, axes[-1], rows, modes, curves, x, doc["input_name"])
+        _last_row(fig, axes[-1], modes, curves, x, du, periodic,
+                  f"{doc['input_name']} ({du.pretty(input_kind)})")
     fig.suptitle(f"{doc['mechanism']} — {doc.get('method', '')} analysis", fontsize=12)
     fig.tight_layout()
     try:
@@ -154,28 +152,30 @@ def _curves(mode: dict[str, Any]) -> dict[str, dict[str, Any]]:
     return {"coupler point": mode["coupler_point"]} if "coupler_point" in mode else {}
 
 
-def _closed(x_deg: np.ndarray, *arrays: np.ndarray) -> list[np.ndarray]:
+def _closed(periodic: bool, *arrays: Any) -> list[np.ndarray]:
     """The arrays with their first sample appended when the sweep is a full turn."""
     arrs = [np.asarray(a, dtype=float) for a in arrays]
-    return [np.append(a, a[0]) for a in arrs] if _full_turn(x_deg) else arrs
+    return [np.append(a, a[0]) for a in arrs] if periodic else arrs
 
 
 def _coupler_projections(row: Any, modes: list[dict[str, Any]], curves: list[dict[str, Any]],
-                         x: np.ndarray) -> None:
+                         du: Any, periodic: bool) -> None:
     for c, (i, j) in enumerate((("x", "y"), ("x", "z"), ("y", "z"))):
         ax = row[c]
         for m, cv in zip(modes, curves, strict=True):
             for name, cp in cv.items():
-                xi, yj = _closed(x, cp[i], cp[j])
+                xi, yj = _closed(periodic, du.show("length", np.asarray(cp[i], dtype=float)),
+                                 du.show("length", np.asarray(cp[j], dtype=float)))
                 ax.plot(xi, yj, label=f"{name}, mode {m['mode']}")
-        ax.set_title(f"coupler curves, {i.upper()}–{j.upper()} projection (m)")
+        ax.set_title(f"coupler curves, {i.upper()}–{j.upper()} projection "
+                     f"({du.pretty('length')})")
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, alpha=0.3)
     row[0].legend(fontsize=7)
 
 
-def _last_row(fig: Any, row: Any, rows: int, modes: list[dict[str, Any]],
-              curves: list[dict[str, Any]], x: np.ndarray, input_name: str) -> None:
+def _last_row(fig: Any, row: Any, modes: list[dict[str, Any]], curves: list[dict[str, Any]],
+              x: np.ndarray, du: Any, periodic: bool, x_label: str) -> None:
     """The coupler curves in 3-D, the transmission index and the transmission angle (planar
     loops) or the ball-joint cone angles, over the input."""
     if any(curves):
@@ -184,29 +184,33 @@ def _last_row(fig: Any, row: Any, rows: int, modes: list[dict[str, Any]],
         ax3 = fig.add_subplot(pos, projection="3d")
         for m, cv in zip(modes, curves, strict=True):
             for name, cp in cv.items():
-                ax3.plot(*_closed(x, cp["x"], cp["y"], cp["z"]), label=f"{name}, mode {m['mode']}")
-        ax3.set_title("coupler curves in 3-D (m)")
+                ax3.plot(*_closed(periodic, *(du.show("length", np.asarray(cp[k], dtype=float))
+                                              for k in "xyz")), label=f"{name}, mode {m['mode']}")
+        ax3.set_title(f"coupler curves in 3-D ({du.pretty('length')})")
     else:
         row[0].axis("off")
     tr = [(m["mode"], m["transmission"]) for m in modes if "transmission" in m]
-    for col, (title, unit) in ((1, ("transmission index", "")), (2, ("", "deg"))):
+    for col in (1, 2):
         ax = row[col]
         if not tr:
             ax.axis("off")
             continue
+        title = "transmission index"
         for k, t in tr:
             if col == 1:
                 for name, ti in t["index"].items():
                     ax.plot(x, np.asarray(ti, dtype=float), label=f"{name}, mode {k}")
             elif "angle" in t:
-                title = "transmission angle μ"
-                ax.plot(x, np.degrees(np.asarray(t["angle"], dtype=float)), label=f"mode {k}")
+                title = f"transmission angle μ ({du.pretty('angle')})"
+                ax.plot(x, du.show("angle", np.asarray(t["angle"], dtype=float)),
+                        label=f"mode {k}")
             else:
-                title = "ball-joint cone angles"
+                title = f"ball-joint cone angles ({du.pretty('angle')})"
                 for joint, a in t["cone_angle"].items():
-                    ax.plot(x, np.degrees(np.asarray(a, dtype=float)), label=f"{joint}, mode {k}")
-        ax.set_title(f"{title} ({unit})" if unit else title)
-        ax.set_xlabel(f"{input_name} (deg)")
+                    ax.plot(x, du.show("angle", np.asarray(a, dtype=float)),
+                            label=f"{joint}, mode {k}")
+        ax.set_title(title)
+        ax.set_xlabel(x_label)
         ax.grid(True, alpha=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7)

@@ -1,14 +1,14 @@
-"""The samples of a simulation as one CSV table (SI units, one row per reported sample): the
-motion, the torques, the energy, and every load of the loop from the inverse dynamics."""
+"""The samples of a simulation as one table (one row per reported sample): the motion, the
+torques, the energy, and every load of the loop from the inverse dynamics — a
+:class:`~screwkit.tables.ResultTable`, written by ``screwkit simulate --csv``/``-o`` in the
+display units like every other command's table."""
 
 from __future__ import annotations
 
-import io
-
 import numpy as np
 
-from screwkit.simulation.reduced import Array
 from screwkit.simulation.result import Simulation
+from screwkit.tables import Column, ResultTable, vector_columns
 
 #: sample columns and their units
 SAMPLE_COLUMNS = (("time", "s"), ("angle", "rad"), ("cycle_angle", "rad"), ("speed", "rad/s"),
@@ -17,31 +17,30 @@ SAMPLE_COLUMNS = (("time", "s"), ("angle", "rad"), ("cycle_angle", "rad"), ("spe
                   ("gravity_torque", "N*m"), ("kinetic_energy", "J"))
 
 
-def simulation_columns(sim: Simulation) -> tuple[list[str], Array]:
-    """Column names (``name [unit]``) and values (M, C) of :func:`simulation_csv`."""
+def simulation_table(sim: Simulation) -> ResultTable:
+    """The reported samples (:data:`SAMPLE_COLUMNS`) as a :class:`~screwkit.tables.ResultTable`
+    (each column with its quantity kind, so that ``screwkit simulate --csv`` and ``-o`` show it
+    in the display units like every other command): time, angles, speed, acceleration,
+    torques, kinetic energy, then the shaft torque, the shaking force and moment and every
+    joint reaction with its point of application."""
     s = sim.samples
-    names = [f"{k} [{u}]" for k, u in SAMPLE_COLUMNS]
-    cols = [s[k] for k, _ in SAMPLE_COLUMNS]
+    load = getattr(sim.eom.drive, "load", None)
+    output_kind = ("force" if load is not None and load.freedom.rsplit(".", 1)[-1] == "s"
+                   else "moment")
+    kinds = {"time": "time", "angle": "angle", "cycle_angle": "angle",
+             "speed": "angular_velocity", "acceleration": "angular_acceleration",
+             "motor_torque": "moment", "output_force": output_kind, "load_torque": "moment",
+             "gravity_torque": "moment", "kinetic_energy": "energy"}
+    cols = [Column(k, kinds[k], np.asarray(s[k])) for k, _ in SAMPLE_COLUMNS]
     if sim.run.cycles:
         dyn = sim.loads
         for name, e in dyn.efforts.items():
-            names.append(f"shaft_torque {name} [N*m]")
-            cols.append(e)
-        for key, arr, unit in (("shaking_force", dyn.shaking_force, "N"),
-                               ("shaking_moment", dyn.shaking_moment, "N*m")):
-            names += [f"{key}_{a} [{unit}]" for a in "xyz"]
-            cols += list(arr.T)
+            kind = "force" if name.rsplit(".", 1)[-1] == "s" else "moment"
+            cols.append(Column(f"{name}.shaft_torque", kind, e))
+        cols += vector_columns("shaking_force", "force", dyn.shaking_force)
+        cols += vector_columns("shaking_moment", "moment", dyn.shaking_moment)
         for joint, r in dyn.reactions.items():
-            names += [f"{joint}_force_{a} [N]" for a in "xyz"]
-            names += [f"{joint}_moment_{a} [N*m]" for a in "xyz"]
-            cols += list(r.force.T) + list(r.moment.T)
-    return names, np.stack(cols, axis=1) if cols else np.zeros((0, 0))
-
-
-def simulation_csv(sim: Simulation) -> str:
-    """The CSV text (header line, then one row per sample, ``%.17g``)."""
-    names, values = simulation_columns(sim)
-    buf = io.StringIO()
-    buf.write(",".join(names) + "\n")
-    np.savetxt(buf, values, delimiter=",", fmt="%.17g")
-    return buf.getvalue()
+            cols += vector_columns(f"{joint}.force", "force", r.force)
+            cols += vector_columns(f"{joint}.moment", "moment", r.moment)
+            cols += vector_columns(f"{joint}.point", "length", r.point)
+    return ResultTable(tuple(cols), "simulation: one row per reported sample")

@@ -8,6 +8,7 @@ Jacobian, :mod:`screwkit.synthesis.loop_route`); one start or a multistart."""
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from screwkit.synthesis.loop_route import LoopSynthesisProblem
@@ -75,7 +76,8 @@ def _reported(run: SynthesisRun, names: tuple[str, ...] | None) -> SynthesisRun:
 
 
 def run_synthesis(config: SynthesisConfig | Problem, *, starts: int | None = None,
-                  seed: int | None = None) -> SynthesisRun:
+                  seed: int | None = None,
+                  progress: Callable[[int, int], None] | None = None) -> SynthesisRun:
     """Dimensional synthesis of an RSRC (or its plane 4R case) for a desired screw displacement
     ψ_d(θ) + ε S_d(θ) (Bagci 1969 ch. V): least squares with exact derivatives (Programs B and C,
     dwell and range constraints by the parameters of constraint, eqs. 5.13–5.21), or the overlay
@@ -86,7 +88,8 @@ def run_synthesis(config: SynthesisConfig | Problem, *, starts: int | None = Non
     :class:`~screwkit.synthesis.overlay_route.OverlayProblem`). ``starts`` overrides the number
     of starts (multistart of the least-squares route, or the overlay's circle-fit starts);
     ``seed`` the multistart's random seed. One start with a given inversion (or parameters of
-    constraint) is a single solve."""
+    constraint) is a single solve. ``progress(done, total)`` is called after each start of a
+    multistart."""
     if not isinstance(config, SynthesisConfig):
         config = SynthesisConfig(config)
     problem = config.problem
@@ -102,10 +105,10 @@ def run_synthesis(config: SynthesisConfig | Problem, *, starts: int | None = Non
         if n_starts == 1 and problem.mode is not None:
             return _reported(SynthesisRun([synthesize_loop(problem)]), config.dimensions)
         return _reported(SynthesisRun(synthesize_loop_multistart(
-            problem, n_starts=n_starts, seed=seed, keep=ms.keep, spread=ms.spread)),
-            config.dimensions)
+            problem, n_starts=n_starts, seed=seed, keep=ms.keep, spread=ms.spread,
+            progress=progress)), config.dimensions)
     if n_starts == 1 and not (problem.inversion is None and problem.construction is None):
         return _reported(SynthesisRun([synthesize(problem)]), config.dimensions)
     return _reported(SynthesisRun(synthesize_multistart(
-        problem, n_starts=n_starts, seed=seed, keep=ms.keep, spread=ms.spread)),
-        config.dimensions)
+        problem, n_starts=n_starts, seed=seed, keep=ms.keep, spread=ms.spread,
+        progress=progress)), config.dimensions)

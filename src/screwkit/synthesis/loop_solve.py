@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -240,11 +241,12 @@ def _modes(problem: LoopSynthesisProblem) -> list[int]:
 
 
 def synthesize_loop_multistart(problem: LoopSynthesisProblem, *, n_starts: int = 20,
-                               seed: int = 0, keep: int = 3, spread: float = 0.5
+                               seed: int = 0, keep: int = 3, spread: float = 0.5,
+                               progress: Callable[[int, int], None] | None = None
                                ) -> list[SynthesisResult]:
     """Random starts (lengths × e^U(−spread, spread), angles + U(−spread, spread) rad) × every
     assembly mode that assembles at every design point; the best ``keep`` distinct results,
-    those that run the whole range first."""
+    those that run the whole range first. ``progress(done, n_starts)`` after each start."""
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
     x0 = problem.start_vector()
@@ -272,6 +274,8 @@ def synthesize_loop_multistart(problem: LoopSynthesisProblem, *, n_starts: int =
                 results.append(synthesize_loop(replace(sub, mode=m)))
             except (SynthesisError, ValueError) as exc:
                 reasons[str(exc)] = reasons.get(str(exc), 0) + 1
+        if progress is not None:
+            progress(k + 1, n_starts)
     if not results:
         shown = "; ".join(f"{r} ({n}x)" if n > 1 else r for r, n in list(reasons.items())[:5])
         raise SynthesisError(f"no start gave a solution ({n_starts} start(s) tried): {shown}. "

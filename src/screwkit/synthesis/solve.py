@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
@@ -404,7 +405,9 @@ def _distinct(a: SynthesisResult, b: SynthesisResult, scale: float) -> bool:
 
 def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, seed: int = 0,
                           keep: int = 3, spread: float = 0.5,
-                          time_limit: float | None = None) -> list[SynthesisResult]:
+                          time_limit: float | None = None,
+                          progress: Callable[[int, int], None] | None = None
+                          ) -> list[SynthesisResult]:
     """Multi-start over random starts and every assembly mode; the best ``keep`` distinct results.
 
     Starts: the problem's own start, then random ones: each unknown length multiplied by
@@ -412,7 +415,8 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
     U(-spread, spread) rad.  For every start each inversion label 1..4 that assembles at
     theta = 0 is solved (the problem's ``inversion`` when it is set).  Results that fail the
     whole-range check are kept but ranked after those that pass.  ``time_limit`` bounds the whole
-    run (seconds; default n_starts * problem.time_limit).
+    run (seconds; default n_starts * problem.time_limit). ``progress(done, n_starts)`` is called
+    after each start.
     """
     if n_starts < 1 or keep < 1:
         raise ValueError("n_starts and keep must be >= 1")
@@ -478,6 +482,8 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
                 fail("the solve ended with a non-finite error measure")
                 continue
             results.append(res)
+        if progress is not None:
+            progress(k + 1, n_starts)
     if not results:
         shown = "; ".join(f"{r} ({n}x)" if n > 1 else r for r, n in list(reasons.items())[:5])
         more = f"; and {len(reasons) - 5} other reason(s)" if len(reasons) > 5 else ""
