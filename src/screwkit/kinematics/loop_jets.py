@@ -30,7 +30,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 from screwkit.errors import InputError
 from screwkit.kinematics.loop import (
@@ -70,6 +69,7 @@ def _solve_passive(J: Array, rhs: Array, rows: Array, cols: Array, pidx: list[in
 
 def _increment(conf: Configuration, delta: Array, lay: Layout) -> Configuration:
     """Scalars add; spherical joints turn by exp([δ]) about their own moving axes."""
+    from scipy.spatial.transform import Rotation  # on first use: start-up stays light
     q = conf.scalars.copy()
     sph = conf.spherical.copy()
     cols = np.array(lay.scalar_col)

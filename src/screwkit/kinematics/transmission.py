@@ -42,7 +42,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import nnls
 
 from screwkit.kinematics.loop import Array, forward, layout
 from screwkit.kinematics.motion import ModeMotion, Motion
@@ -173,6 +172,8 @@ def smallest_cone(directions: Array) -> tuple[Array, float]:
     """The axis (3,) and half-angle (rad) of the smallest cone containing unit ``directions``
     (K, 3): the axis is the normalised minimum-norm point of their convex hull (that point
     maximises the smallest a·v_i over unit a), found as a non-negative least-squares problem."""
+    from scipy.optimize import nnls  # on first use: start-up stays light
+
     V = directions[np.isfinite(directions).all(axis=1)]
     if V.shape[0] == 0:
         return np.full(3, np.nan), float("nan")

@@ -13,7 +13,6 @@ from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import least_squares
 
 from screwkit.kinematics.loop import forward
 from screwkit.kinematics.transmission import transmission
@@ -205,6 +204,8 @@ def synthesize_loop(problem: LoopSynthesisProblem, *, mode: int | None = None,
             ev = model.evaluate(x)
         assert ev.jacobian is not None
         return ev.jacobian
+
+    from scipy.optimize import least_squares  # on first use: start-up stays light
 
     status: Status = "converged"
     message = ""
