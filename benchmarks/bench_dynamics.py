@@ -38,11 +38,13 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.constants import STANDARD_GRAVITY
+
 SAMPLES = 1_000_000
 REPEATS = 3
 BLOCK = 16_384  # samples per block of the prototype kernel
 INCH = 0.0254
-GRAVITY = [0.0, 0.0, -9.80665]
+GRAVITY = [0.0, 0.0, -STANDARD_GRAVITY]
 
 
 def _best_time(fn: Callable[[], Any], repeats: int = REPEATS) -> float:

@@ -1,5 +1,6 @@
 """Dual-number screw calculus: dual numbers, dual vectors (lines), 3×3 screw matrices, dual
-quaternions, screw parameters, dual Euler angles and conversions (docs/conventions.md).
+quaternions, screw parameters, dual Euler angles, conversions and the real spatial toolbox
+(`screwkit.dual.spatial`: skew, cross, elementary rotations, angle wrapping; docs/conventions.md).
 
 Names are imported from their modules on first use, so that ``from screwkit.dual import
 ScrewMatrix`` does not load every module (start-up time of the command line)."""
@@ -50,12 +51,19 @@ _EXPORTS: dict[str, str] = {
     'screw_matrix_from_transform': 'screwkit.dual.conversions',
     'screw_parameters_from_screw_matrix': 'screwkit.dual.screw_parameters',
     'sin': 'screwkit.dual.number',
-    'skew': 'screwkit.dual.screw_matrix',
+    'skew': 'screwkit.dual.spatial',
+    'cross': 'screwkit.dual.spatial',
+    'elementary_rotation': 'screwkit.dual.spatial',
+    'rot_x': 'screwkit.dual.spatial',
+    'rot_y': 'screwkit.dual.spatial',
+    'rot_z': 'screwkit.dual.spatial',
+    'wrap_angle': 'screwkit.dual.spatial',
+    'wrap_angle_near': 'screwkit.dual.spatial',
     'sqrt': 'screwkit.dual.number',
     'tan': 'screwkit.dual.number',
     'transform_from_dual_quaternion': 'screwkit.dual.conversions',
     'transform_from_screw_matrix': 'screwkit.dual.conversions',
-    'vee': 'screwkit.dual.screw_matrix',
+    'vee': 'screwkit.dual.spatial',
 }
 
 
@@ -116,12 +124,23 @@ if TYPE_CHECKING:
         tan,
     )
     from screwkit.dual.quaternion import DualQuaternion
-    from screwkit.dual.screw_matrix import ScrewMatrix, skew, vee
+    from screwkit.dual.screw_matrix import ScrewMatrix
     from screwkit.dual.screw_parameters import (
         ScrewParameters,
         screw_matrix_about_line,
         screw_matrix_from_screw_parameters,
         screw_parameters_from_screw_matrix,
+    )
+    from screwkit.dual.spatial import (
+        cross,
+        elementary_rotation,
+        rot_x,
+        rot_y,
+        rot_z,
+        skew,
+        vee,
+        wrap_angle,
+        wrap_angle_near,
     )
     from screwkit.dual.vector import DualVector, common_normal, dual_angle
 
@@ -146,15 +165,20 @@ __all__ = [
     "check_vector3",
     "common_normal",
     "cos",
+    "cross",
     "dual_angle",
     "dual_euler_from_screw_matrix",
     "dual_quaternion_from_rigid_transform",
     "dual_quaternion_from_screw_matrix",
     "dual_quaternion_from_transform",
+    "elementary_rotation",
     "exp",
     "log",
     "rigid_transform_from_dual_quaternion",
     "rigid_transform_from_screw_matrix",
+    "rot_x",
+    "rot_y",
+    "rot_z",
     "rotation_from_screw_matrix",
     "screw_matrix_about_line",
     "screw_matrix_from_dual_euler",
@@ -171,4 +195,6 @@ __all__ = [
     "transform_from_dual_quaternion",
     "transform_from_screw_matrix",
     "vee",
+    "wrap_angle",
+    "wrap_angle_near",
 ]

@@ -154,7 +154,9 @@ class Dual:
 
 
 # --- functions: f(a + εb) = f(a) + ε b f'(a) (Bagci A.31) ----------------------------------
-def _index_text(mask: NDArray[Any]) -> str:
+def batch_index_text(mask: NDArray[Any]) -> str:
+    """' at batch index (i, j)' naming the first True entry of ``mask``, for error messages
+    (empty for a scalar mask)."""
     if mask.ndim == 0:
         return ""
     return f" at batch index {tuple(int(i) for i in np.argwhere(mask)[0])}"
@@ -166,7 +168,7 @@ def sqrt(x: Dual | ArrayLike) -> Dual:
     bad = x.real <= 0
     if np.any(bad):
         raise ValueError(
-            f"dual sqrt needs a positive real part; got {x.real[bad].min():.3g}{_index_text(bad)}"
+            f"dual sqrt needs a positive real part; got {x.real[bad].min():.3g}{batch_index_text(bad)}"
         )
     r = np.sqrt(x.real)
     return Dual(r, x.dual / (2.0 * r))
@@ -200,7 +202,7 @@ def atan2(y: Dual | ArrayLike, x: Dual | ArrayLike) -> Dual:
     bad = r2 == 0
     if np.any(bad):
         raise ValueError(
-            f"dual atan2 is undefined where both real parts are zero{_index_text(bad)}"
+            f"dual atan2 is undefined where both real parts are zero{batch_index_text(bad)}"
         )
     return Dual(np.arctan2(y.real, x.real), (x.real * y.dual - y.real * x.dual) / r2)
 
@@ -210,7 +212,7 @@ def asin(x: Dual | ArrayLike) -> Dual:
     x = Dual.coerce(x)
     bad = np.abs(x.real) >= 1
     if np.any(bad):
-        raise ValueError(f"dual asin needs |real part| < 1{_index_text(bad)}")
+        raise ValueError(f"dual asin needs |real part| < 1{batch_index_text(bad)}")
     return Dual(np.arcsin(x.real), x.dual / np.sqrt(1.0 - x.real**2))
 
 
@@ -219,7 +221,7 @@ def acos(x: Dual | ArrayLike) -> Dual:
     x = Dual.coerce(x)
     bad = np.abs(x.real) >= 1
     if np.any(bad):
-        raise ValueError(f"dual acos needs |real part| < 1{_index_text(bad)}")
+        raise ValueError(f"dual acos needs |real part| < 1{batch_index_text(bad)}")
     return Dual(np.arccos(x.real), -x.dual / np.sqrt(1.0 - x.real**2))
 
 
@@ -242,6 +244,6 @@ def log(x: Dual | ArrayLike) -> Dual:
     bad = x.real <= 0
     if np.any(bad):
         raise ValueError(
-            f"dual log needs a positive real part; got {x.real[bad].min():.3g}{_index_text(bad)}"
+            f"dual log needs a positive real part; got {x.real[bad].min():.3g}{batch_index_text(bad)}"
         )
     return Dual(np.log(x.real), x.dual / x.real)

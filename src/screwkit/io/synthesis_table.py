@@ -30,7 +30,7 @@ from screwkit.kinematics.registry import family_of, require
 from screwkit.synthesis.config import Multistart, Problem, SynthesisConfig
 from screwkit.synthesis.loop_route import LoopSynthesisProblem
 from screwkit.synthesis.overlay import OverlayDwell
-from screwkit.synthesis.overlay_route import OverlayProblem
+from screwkit.synthesis.overlay_synthesis import OverlayProblem
 from screwkit.synthesis.problem import (
     ANGLE_NAMES,
     DIMENSION_NAMES,

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.dual.spatial import rot_y, rot_z, skew
 from screwkit.model.linkage import Linkage
 
 Array = NDArray[np.float64]
@@ -77,24 +78,6 @@ def layout(linkage: Linkage) -> Layout:
                 scalar_col.append(col)
                 col += 1
     return Layout(tuple(names), tuple(joint_of), tuple(scalar_col), sph, tuple(is_tr), col, len(sph))
-
-
-def rot_z(angle: Array) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    z, o = np.zeros_like(c), np.ones_like(c)
-    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
-
-
-def rot_y(angle: Array) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    z, o = np.zeros_like(c), np.ones_like(c)
-    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
-
-
-def rot_x(angle: Array) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    z, o = np.zeros_like(c), np.ones_like(c)
-    return np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2)
 
 
 @dataclass(frozen=True)
@@ -206,7 +189,7 @@ def closure_twist(R: Array, p: Array) -> Array:
     from scipy.spatial.transform import Rotation  # on first use (start-up time)
     w = Rotation.from_matrix(R).as_rotvec()
     th = np.linalg.norm(w, axis=-1)
-    W = _skew(w)
+    W = skew(w)
     small = th < 1e-6
     ths = np.where(small, 1.0, th)
     # V^{-1} = I - W/2 + (1/θ²)(1 - (θ/2) cot(θ/2)) W²
@@ -214,18 +197,6 @@ def closure_twist(R: Array, p: Array) -> Array:
     Vinv = np.eye(3) - 0.5 * W + coef[..., None, None] * (W @ W)
     v = np.einsum("...ij,...j->...i", Vinv, p)
     return np.concatenate([w, v], -1)
-
-
-def _skew(v: Array) -> Array:
-    z = np.zeros_like(v[..., 0])
-    return np.stack(
-        [
-            np.stack([z, -v[..., 2], v[..., 1]], -1),
-            np.stack([v[..., 2], z, -v[..., 0]], -1),
-            np.stack([-v[..., 1], v[..., 0], z], -1),
-        ],
-        -2,
-    )
 
 
 def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configuration:

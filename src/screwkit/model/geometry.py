@@ -32,6 +32,7 @@ class LoopGeometry:
     offsets: tuple[Any, ...]
 
 
+# complex-safe elementary rotations (screwkit.dual.spatial's are float-only by design)
 def _ry(a: Any) -> Any:
     c, s = np.cos(a), np.sin(a)
     z, o = 0 * c, 0 * c + 1

@@ -29,12 +29,10 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.constants import STANDARD_GRAVITY
 from screwkit.errors import InputError
 
 Array = NDArray[np.float64]
-
-STANDARD_GRAVITY = 9.80665
-"""Standard acceleration of gravity g₀ in m/s² (CGPM 1901), the default for weights."""
 
 #: relative tolerance for symmetry, definiteness and triangle checks (round-off of frame changes)
 CONSISTENCY_RTOL = 1e-9
@@ -49,10 +47,6 @@ class PhysicalConsistencyError(InputError):
 
 class PointMassSplitError(InputError):
     """A split of a link mass into Rahman's point masses that cannot reproduce its inertia."""
-
-
-def _skew(v: Array) -> Array:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
 def _point_inertia(mass: float, r: Array) -> Array:

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.dual.spatial import cross
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.model.linkage import Linkage
@@ -54,10 +55,6 @@ class SimulationError(ValueError):
     """A simulation that cannot run as asked; the message says why and how to fix it."""
 
 
-def _cross(a: Array, b: Array) -> Array:
-    return np.cross(a, b)
-
-
 def _masses(linkage: Linkage) -> list[MassProperties]:
     missing = [link.name for link in linkage.links if link.mass is None]
     if missing:
@@ -74,8 +71,8 @@ def link_kinematics(linkage: Linkage, mode: ModeMotion) -> tuple[Array, Array, A
     R = mode.link_rotation
     rc = np.einsum("nlij,lj->nli", R, com)
     w, al = mode.link_angular_velocity, mode.link_angular_acceleration
-    v_c = mode.link_origin_velocity + _cross(w, rc)
-    a_c = mode.link_origin_acceleration + _cross(al, rc) + _cross(w, _cross(w, rc))
+    v_c = mode.link_origin_velocity + cross(w, rc)
+    a_c = mode.link_origin_acceleration + cross(al, rc) + cross(w, cross(w, rc))
     return w, v_c, al, a_c
 
 

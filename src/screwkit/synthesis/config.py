@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 from screwkit.synthesis.loop_route import LoopSynthesisProblem
 from screwkit.synthesis.loop_solve import synthesize_loop, synthesize_loop_multistart
-from screwkit.synthesis.overlay_route import OverlayOutcome, OverlayProblem, synthesize_overlay
+from screwkit.synthesis.overlay_synthesis import OverlayOutcome, OverlayProblem, synthesize_overlay
 from screwkit.synthesis.problem import RSRCSynthesisProblem
 from screwkit.synthesis.solve import SynthesisResult, synthesize, synthesize_multistart
 
@@ -85,7 +85,7 @@ def run_synthesis(config: SynthesisConfig | Problem, *, starts: int | None = Non
 
     ``config``: a :class:`SynthesisConfig` (``spec.synthesis``) or a bare problem
     (:class:`~screwkit.synthesis.problem.RSRCSynthesisProblem`,
-    :class:`~screwkit.synthesis.overlay_route.OverlayProblem`). ``starts`` overrides the number
+    :class:`~screwkit.synthesis.overlay_synthesis.OverlayProblem`). ``starts`` overrides the number
     of starts (multistart of the least-squares route, or the overlay's circle-fit starts);
     ``seed`` the multistart's random seed. One start with a given inversion (or parameters of
     constraint) is a single solve. ``progress(done, total)`` is called after each start of a

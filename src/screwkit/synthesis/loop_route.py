@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.dual.spatial import vee, wrap_angle
 from screwkit.errors import InputError
 from screwkit.kinematics.loop import (
     Array,
@@ -42,7 +43,6 @@ from screwkit.kinematics.loop import (
     layout,
 )
 from screwkit.kinematics.loop_jets import close_loop
-from screwkit.kinematics.quartic import wrap_angle
 from screwkit.kinematics.registry import output_freedom
 from screwkit.model.geometry import LoopGeometry
 from screwkit.model.linkage import Linkage, LinkageError
@@ -128,11 +128,6 @@ class LoopSynthesisProblem:
         return self.length_scale if self.kinds.get(name) == "length" else 1.0
 
 
-def _vee(W: Array) -> Array:
-    return np.stack([W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0],
-                     W[..., 1, 0] - W[..., 0, 1]], -1) / 2.0
-
-
 def closure_sensitivities(linkage: Linkage, fr: LoopFrames, geometry: Callable[
         [Mapping[str, Any]], LoopGeometry], dims: Mapping[str, float],
         names: tuple[str, ...]) -> Array:
@@ -151,7 +146,7 @@ def closure_sensitivities(linkage: Linkage, fr: LoopFrames, geometry: Callable[
             td = np.imag(np.asarray(geo.translations[k], dtype=complex)) / _STEP
             if not (Rd.any() or td.any()):
                 continue
-            w = _vee(Rd @ R.T)
+            w = vee(0.5 * (Rd @ R.T - R @ Rd.T))  # dR/dp·Rᵀ is skew
             v = td - np.cross(w, t)
             AR, Ap = fr.after_R[:, k], fr.after_p[:, k]
             wg = AR @ w
