@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from screwkit.sweep.engine import Engine, batch_size, batches
-from screwkit.synthesis.config import Multistart, SynthesisConfig, SynthesisRun, run_synthesis
+from screwkit.synthesis.config import SynthesisConfig, SynthesisRun, run_synthesis
 from screwkit.synthesis.problem import RSRCSynthesisProblem
 from screwkit.synthesis.solve import (
     SynthesisResult,
@@ -66,14 +66,22 @@ def distributed_multistart(problem: RSRCSynthesisProblem, engine: Engine, *, n_s
 def synthesize_on_engine(config: SynthesisConfig, starts: int, engine: Engine,
                          progress: Callable[[int, int, int], None] | None = None
                          ) -> SynthesisRun:
-    """``run_synthesis(config, starts=starts)`` with the least-squares multistart on
-    ``engine``; the overlay route and a single solve run in this process as before."""
-    problem = config.problem
-    if not isinstance(problem, RSRCSynthesisProblem):
-        return run_synthesis(config, starts=starts)
-    ms = config.multistart or Multistart(starts=1)
-    if starts == 1 and not (problem.inversion is None and problem.construction is None):
-        return run_synthesis(config, starts=starts)
-    return SynthesisRun(distributed_multistart(problem, engine, n_starts=starts, seed=ms.seed,
-                                               keep=ms.keep, spread=ms.spread,
-                                               progress=progress))
+    """``run_synthesis(config, starts=starts)`` with the least-squares multistart's starts on
+    ``engine``; the other routes (overlay, generic loop) and a single solve run as
+    ``run_synthesis`` runs them."""
+
+    def on_engine(problem: RSRCSynthesisProblem, *, n_starts: int, seed: int, keep: int,
+                  spread: float, progress: Callable[[int, int], None] | None = None
+                  ) -> list[SynthesisResult]:
+        def advance(done: int, total: int, _: int) -> None:
+            if progress is not None:
+                progress(done, total)
+
+        return distributed_multistart(problem, engine, n_starts=n_starts, seed=seed, keep=keep,
+                                      spread=spread, progress=advance)
+
+    def two(done: int, total: int) -> None:
+        if progress is not None:
+            progress(done, total, done)
+
+    return run_synthesis(config, starts=starts, progress=two, multistart=on_engine)
