@@ -10,6 +10,7 @@ from sweep_helpers import EXAMPLES, runner
 from screwkit.cli.main import app
 from screwkit.io.documents import result_document
 from screwkit.io.spec import load_spec
+from screwkit.pipeline import Pipeline
 from screwkit.sweep.engine import EngineConfig, start_engine
 from screwkit.sweep.multistart import distributed_multistart
 from screwkit.synthesis.solve import synthesize_multistart
@@ -35,8 +36,7 @@ def test_synthesize_starts_on_the_embedded_cluster_equals_the_serial_run():
     r = runner.invoke(app, ["synthesize", str(SPEC), "--starts", "4", "--workers", "2", "--json"])
     assert r.exit_code == 0, r.output
     doc = json.loads(r.stdout)
-    problem = load_spec(SPEC).synthesis.problem
-    serial = synthesize_multistart(problem, n_starts=4, seed=0, keep=3)
+    serial = Pipeline(load_spec(SPEC)).synthesize(4).results  # the serial run
     docs = [doc, *doc["alternatives"]]
     assert len(docs) == len(serial)
     for got, want in zip(docs, serial, strict=True):
