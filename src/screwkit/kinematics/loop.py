@@ -243,6 +243,23 @@ def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configura
     return Configuration(q, sph)
 
 
+def configuration_difference(a: Configuration, b: Configuration, lay: Layout) -> Array:
+    """Freedom increments (N, m) taking ``b`` to ``a``: scalar differences (angles wrapped to
+    (−π, π]) and, for a spherical joint, the rotation vector of R_bᵀR_a (its own axes)."""
+    out = np.zeros((a.size, len(lay.names)))
+    cols = np.array(lay.scalar_col)
+    scal = np.nonzero(cols >= 0)[0]
+    d = a.scalars[:, cols[scal]] - b.scalars[:, cols[scal]]
+    turn = ~np.array(lay.is_translation)[scal]
+    d[:, turn] = np.pi - np.mod(np.pi - d[:, turn], 2 * np.pi)
+    out[:, scal] = d
+    for j, k in lay.spherical_of_joint.items():
+        idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
+        rel = np.swapaxes(b.spherical[:, k], -1, -2) @ a.spherical[:, k]
+        out[:, idx] = Rotation.from_matrix(rel).as_rotvec()
+    return out
+
+
 def lie_bracket(a: Array, b: Array) -> Array:
     """[a, b] of twists (ω; v): (ωa × ωb; ωa × vb − ωb × va)."""
     wa, va = a[..., :3], a[..., 3:]

@@ -109,6 +109,66 @@ def newton(
     return NewtonResult(Configuration(q, sph), res, ok, it)
 
 
+@dataclass(frozen=True)
+class Correction:
+    """The corrector's verdict on a batch of predicted configurations (:func:`correct`)."""
+
+    conf: Configuration
+    converged: NDArray[np.bool_]
+    first_step: Array  # (N,) scaled size of the first Newton step
+    contraction: Array  # (N,) second step / first step (0 when the first step was tiny)
+    moved: Array  # (N,) scaled size of all the steps together
+
+
+def correct(linkage: Linkage, conf: Configuration, lay: Layout, max_iter: int = 7,
+            tol: float = CLOSURE_TOL) -> Correction:
+    """Newton corrector of a continuation step (inputs held): minimum-norm Gauss–Newton steps
+    over the passive freedoms, vectorised over the batch, without damping, reporting what a
+    step-size control needs — the first step, the contraction of the second and the whole
+    move (Deuflhard's contraction test: a prediction inside the branch's basin of quadratic
+    convergence contracts fast; a jump towards another branch does not)."""
+    L = linkage.length_scale
+    rows, cols = _scales(lay, L)
+    pidx = np.array([k for k, n in enumerate(lay.names) if n not in linkage.inputs])
+    N = conf.size
+    q = conf.scalars.copy()
+    sph = conf.spherical.copy()
+    first = np.zeros(N)
+    second = np.zeros(N)
+    total = np.zeros((N, len(pidx)))
+    done = np.zeros(N, dtype=bool)
+    todo = np.arange(N)
+    for it in range(max_iter + 1):
+        fr = forward(linkage, Configuration(q[todo], sph[todo]), lay)
+        xi = closure_twist(fr.closure_R, fr.closure_p) * rows
+        r = np.max(np.abs(xi), axis=-1)
+        fine = r <= tol
+        done[todo[fine]] = True
+        keep = ~fine & np.isfinite(r)
+        if it == max_iter or not keep.any():
+            break
+        todo, xi = todo[keep], xi[keep]
+        J = fr.screws[keep][:, :, pidx] * rows[:, None] * cols[pidx][None, :]
+        JJt = J @ np.swapaxes(J, -1, -2)
+        mu = 1e-13 * np.maximum(np.trace(JJt, axis1=-2, axis2=-1), 1e-300)
+        y = np.linalg.solve(JJt + mu[:, None, None] * np.eye(6), xi[..., None])[..., 0]
+        step = -np.einsum("nji,nj->ni", J, y)
+        size = np.linalg.norm(step, axis=-1)
+        if it == 0:
+            first[todo] = size
+        elif it == 1:
+            second[todo] = size
+        total[todo] += step
+        delta = np.zeros((len(todo), len(lay.names)))
+        delta[:, pidx] = step * cols[pidx]
+        moved = apply_increment(Configuration(q[todo], sph[todo]), delta, lay)
+        q[todo] = moved.scalars
+        sph[todo] = moved.spherical
+    contraction = np.where(first > 1e-12, second / np.maximum(first, 1e-300), 0.0)
+    return Correction(Configuration(q, sph), done, first, contraction,
+                      np.linalg.norm(total, axis=-1))
+
+
 def random_configurations(linkage: Linkage, count: int, rng: np.random.Generator, lay: Layout | None = None) -> Configuration:
     """``count`` random starting configurations: angles uniform in (−π, π], translations
     uniform within ± the length scale, spherical joints uniformly random rotations."""
@@ -150,6 +210,7 @@ class Assemblies:
     conf: Configuration
     found: NDArray[np.bool_]
     signature: Array  # (N, K, d)
+    radius: Array  # (N, K) signature distance within which another root is the same one
 
 
 def find_assemblies(
@@ -173,6 +234,7 @@ def find_assemblies(
                           np.concatenate([p.conf.spherical for p in parts])),
             np.concatenate([p.found for p in parts]),
             np.concatenate([p.signature for p in parts]),
+            np.concatenate([p.radius for p in parts]),
         )
     lay = layout(linkage)
     N = values.shape[0]
@@ -206,4 +268,4 @@ def find_assemblies(
     flat = (np.arange(N)[:, None] * starts + order).ravel()
     conf = res.conf.take(flat)
     sig_k = np.take_along_axis(sig, order[..., None], axis=1)
-    return Assemblies(conf, found, sig_k)
+    return Assemblies(conf, found, sig_k, np.take_along_axis(radius, order, axis=1))
