@@ -267,22 +267,30 @@ def lie_bracket(a: Array, b: Array) -> Array:
     return np.concatenate([np.cross(wa, wb), np.cross(wa, vb) - np.cross(wb, va)], -1)
 
 
-def close_spherical_joint(linkage: Linkage, scalars: Array, lay: Layout | None = None) -> Configuration:
-    """The configuration of a loop with exactly one spherical joint whose scalar freedoms are
-    known (e.g. from a closed form): the ball joint's rotation is what closes the loop.
+def close_spherical_joint(linkage: Linkage, scalars: Array, lay: Layout | None = None,
+                          spherical: Array | None = None, joint: int | None = None,
+                          ) -> Configuration:
+    """The configuration of a loop whose scalar freedoms and all spherical joints but one are
+    known (e.g. from a closed form): the remaining ball joint's rotation is what closes the loop.
 
-    With the ball at rest (R = I) the loop product is G₀ = P·Q′ (P up to the ball's frame); the
-    closing rotation is the conjugate R = R_Pᵀ R_G₀ᵀ R_P, exact wherever the scalars close the
-    loop's translation (which is what a closed form guarantees; the closure residual checks it).
+    ``spherical`` (N, n_S, 3, 3) holds the known rotations (default: identity; the loop's only
+    ball when ``joint`` is None); ``joint`` is the index of the ball to close. With that ball at
+    rest (R = I) the loop product is G₀ = P·Q′ (P up to the ball's frame); the closing rotation
+    is the conjugate R = R_Pᵀ R_G₀ᵀ R_P, exact wherever the known freedoms close the loop's
+    translation (which is what a closed form guarantees; the closure residual checks it).
     """
     lay = lay or layout(linkage)
-    if lay.n_spherical != 1:
-        raise ValueError(f"{linkage.name}: close_spherical_joint needs exactly one spherical joint; "
-                         f"this loop has {lay.n_spherical}")
+    if joint is None:
+        if lay.n_spherical != 1:
+            raise ValueError(f"{linkage.name}: close_spherical_joint needs exactly one spherical "
+                             f"joint or the joint to close; this loop has {lay.n_spherical}")
+        joint = next(iter(lay.spherical_of_joint))
     N = scalars.shape[0]
-    at_rest = Configuration(scalars, np.broadcast_to(np.eye(3), (N, 1, 3, 3)).copy())
-    fr = forward(linkage, at_rest, lay)
-    k = next(iter(lay.spherical_of_joint))
-    RP = fr.before_R[:, k]
-    R = np.einsum("nji,nkj,nkl->nil", RP, fr.closure_R, RP)
-    return Configuration(scalars, R[:, None])
+    rot = (np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)) if spherical is None
+           else spherical).copy()
+    k = lay.spherical_of_joint[joint]
+    rot[:, k] = np.eye(3)
+    fr = forward(linkage, Configuration(scalars, rot), lay)
+    RP = fr.before_R[:, joint]
+    rot[:, k] = np.einsum("nji,nkj,nkl->nil", RP, fr.closure_R, RP)
+    return Configuration(scalars, rot)

@@ -52,11 +52,21 @@ class Family:
     optional: Mapping[str, float] = field(default_factory=dict)  # name -> default (SI)
     build: Callable[..., Linkage] | None = None  # keyword dimensions (SI) -> Linkage
     closed_form: ClosedForm | None = None
+    #: whether the closed form solves a given loop of the family (None: every loop)
+    closed_form_applies: Callable[[Linkage], bool] | None = None
     seed_names: SeedNames | None = None
     capabilities: frozenset[str] = _EVERY_LOOP
     aliases: tuple[str, ...] = ()
     sketch: str = ""
     why_not: Mapping[str, str] = field(default_factory=dict)  # capability -> reason it is missing
+
+    def closed_form_for(self, linkage: Linkage) -> ClosedForm | None:
+        """The closed form that solves ``linkage``, or None (then the generic solver does)."""
+        if self.closed_form is None:
+            return None
+        if self.closed_form_applies is not None and not self.closed_form_applies(linkage):
+            return None
+        return self.closed_form
 
     def linkage(self, **dimensions: float) -> Linkage:
         """The family's loop from its dimensions (SI units, radians)."""
@@ -75,6 +85,24 @@ def _cssp_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
     from screwkit.kinematics.closed_form_motion import cssp_closed_motion
 
     return cssp_closed_motion(linkage, X, Xd, Xdd)
+
+
+def _rssr_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
+    from screwkit.kinematics.closed_form_motion import rssr_closed_motion
+
+    return rssr_closed_motion(linkage, X, Xd, Xdd)
+
+
+def _rccc_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
+    from screwkit.kinematics.closed_form_motion import rccc_closed_motion
+
+    return rccc_closed_motion(linkage, X, Xd, Xdd)
+
+
+def _is_rccc(linkage: Linkage) -> bool:
+    from screwkit.kinematics.rccc import rccc_applies
+
+    return rccc_applies(linkage)
 
 
 def _cssp(a1: float, a2: float, a4: float, alpha4: float, s1: float = 0.0) -> Linkage:
@@ -115,21 +143,24 @@ FAMILIES: dict[str, Family] = {
             why_not={"limits": "the CSSP's output is a slider; its limits are where the quadratic's "
                                "discriminant vanishes (reported as branch events by analyze)"}),
         Family(
-            "RSSR", "the RSSR", "spatial R-S-S-R crank-rocker (generic solver)",
+            "RSSR", "the RSSR", "spatial R-S-S-R crank-rocker (closed form A cos φ0 + B sin φ0 = K)",
             {"d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH, "a": _LENGTH, "b": _LENGTH,
              "lambda0": _ANGLE, "output_offset": _LENGTH},
-            optional={"output_offset": 0.0}, build=constructors.rssr,
+            optional={"output_offset": 0.0}, build=constructors.rssr, closed_form=_rssr_closed,
             seed_names=seed_names.rssr_names, aliases=("rssr",),
             sketch=constructors.RSSR_SKETCH),
         Family(
-            "RCCC", "the RCCC", "R-C-C-C loop in Hartenberg-Denavit form (generic solver)",
+            "RCCC", "the RCCC", "R-C-C-C loop in Hartenberg-Denavit form (closed form: the dual "
+            "input-output equation)",
             {"a1": _LENGTH, "a2": _LENGTH, "a3": _LENGTH, "a4": _LENGTH, "alpha1": _ANGLE,
              "alpha2": _ANGLE, "alpha3": _ANGLE, "alpha4": _ANGLE, "input_offset": _LENGTH},
-            optional={"input_offset": 0.0}, build=_rccc, aliases=("rccc",),
+            optional={"input_offset": 0.0}, build=_rccc, closed_form=_rccc_closed,
+            closed_form_applies=_is_rccc, aliases=("rccc",),
             sketch=constructors.RCCC_SKETCH),
         Family(
-            "LOOP", "a joint-list loop", "any single loop given as a joint list (generic solver)", {},
-            aliases=("loop",),
+            "LOOP", "a joint-list loop", "any single loop given as a joint list (generic solver; "
+            "the RCCC closed form for an R C C C list driven at its R joint)", {},
+            closed_form=_rccc_closed, closed_form_applies=_is_rccc, aliases=("loop",),
             sketch="[[joints]]: name, kind (R P C H U S), length, twist, offset, pitch, input "
                    "(Hartenberg-Denavit, Rahman eq. 2.2)"),
     )

@@ -59,7 +59,7 @@ def solve_motion(
     Xdd = np.array(np.broadcast_to(as_input_array(linkage, accelerations, "accelerations"),
                                    X.shape))
     fam = family_of(linkage)
-    closed = fam.closed_form if X.shape[0] >= 2 else None
+    closed = fam.closed_form_for(linkage) if X.shape[0] >= 2 else None
     if method == "closed" and closed is None:
         with_closed = ", ".join(f.name for f in _families_with_closed_forms())
         raise ValueError(
@@ -70,9 +70,9 @@ def solve_motion(
     motion = generic_motion(linkage, X, Xd, Xdd, starts=starts, seed=seed)
     modes = tuple(_with_seed_names(linkage, md) for md in motion.modes)
     notes = motion.notes
-    if fam.closed_form is not None and closed is not None:
+    if closed is not None:
         modes = _numbered_as(modes, closed(linkage, X, Xd, Xdd).modes, linkage.length_scale)
-    elif fam.closed_form is not None and method == "auto":
+    elif fam.closed_form_for(linkage) is not None and method == "auto":
         notes += ("one input sample: the generic solver was used (the closed form tracks "
                   "branches over at least 2 samples)",)
     return replace(motion, modes=modes, notes=notes)
