@@ -13,9 +13,11 @@ fronts and samples). A corrected sample is accepted when Newton converged and co
 from a prediction close to the result (Deuflhard's test: a jump towards another branch does
 not); a chunk is accepted up to its first rejected sample and the next chunk doubles or shrinks
 accordingly. When even the next sample is rejected the front sub-steps between samples with
-halving steps; when the step falls below 2⁻¹² of the sample spacing the branch ends there — a
+steps cut by four; when the step falls below 2⁻⁸ of the sample spacing the branch ends there — a
 limit position or dead centre lies between the two samples (it *stops*, or going backwards it
-*starts assembling*).
+*starts assembling*). Near a fold the passive Jacobian's smallest singular value falls as the
+square root of the distance to it, σ² ∝ x* − x: where a step fails and the σ measured at the
+front's last two points extrapolates to zero before the next sample, the branch ends at once.
 """
 
 from __future__ import annotations
@@ -35,13 +37,14 @@ from screwkit.kinematics.loop import (
     forward,
 )
 from screwkit.kinematics.rates import rate_equations, solve_rates
-from screwkit.kinematics.solve import correct, set_inputs
+from screwkit.kinematics.solve import correct, set_inputs, signature
 from screwkit.model.linkage import Linkage
 
-MIN_SUBSTEP = 2.0 ** -12  # of the sample spacing: a front that cannot advance further ends
+MIN_SUBSTEP = 2.0 ** -8  # of the sample spacing: a front that cannot advance further ends
+FOLD_SIGMA = 0.2  # σ_min/σ_max of J_p below which a failed step may be a fold ahead
 MAX_CHUNK = 2048  # samples predicted at once by one front
 MAX_SPAN = 0.5  # rad (or length scale) the inputs may move over one chunk
-FIRST_STEP = 0.2  # largest first Newton step, relative to the predicted step
+FIRST_STEP = 0.2  # largest Newton correction, relative to the predicted step
 CONTRACTION = 0.5  # largest ratio of the second Newton step to the first
 
 
@@ -72,6 +75,8 @@ class _Front:
     prev_t: float = 0.0
     chunk: int = 2
     substep: float = 0.0  # 0: chunk mode; else the sub-step (a fraction of the spacing)
+    sigma: tuple[float, float] = (np.inf, np.nan)  # σ ratio of J_p at the front, and where
+    sigma_before: tuple[float, float] = (np.inf, np.nan)
 
 
 def input_at(X: Array, t: Array) -> Array:
@@ -82,11 +87,12 @@ def input_at(X: Array, t: Array) -> Array:
     return np.asarray(X[i0] + frac * (X[i1] - X[i0]))
 
 
-def taylor(linkage: Linkage, lay: Layout, conf: Configuration) -> tuple[Array, Array]:
+def taylor(linkage: Linkage, lay: Layout, conf: Configuration) -> tuple[Array, Array, Array]:
     """First and second derivatives of every freedom with respect to the inputs, q_X (B, m,
     n_in) and q_XX (B, m, n_in, n_in), at each configuration; where the rate equations are
     singular, their minimum-norm solution (on a continuum: the least motion that follows the
-    input; elsewhere the acceptance test judges the prediction)."""
+    input; elsewhere the acceptance test judges the prediction). Also returns the σ ratio of
+    the passive Jacobian (B,)."""
     B, n_in = conf.size, len(linkage.inputs)
     m = len(lay.names)
     eq = rate_equations(linkage, lay, forward(linkage, conf, lay))
@@ -103,7 +109,7 @@ def taylor(linkage: Linkage, lay: Layout, conf: Configuration) -> tuple[Array, A
             both = solve_rates(linkage, lay, eq, np.broadcast_to(eye[i] + eye[j], (B, n_in)),
                                zero, True)
             Q2[:, :, i, j] = Q2[:, :, j, i] = 0.5 * (both.qdd - Q2[:, :, i, i] - Q2[:, :, j, j])
-    return Q1, Q2
+    return Q1, Q2, eq.sigma_ratio
 
 
 class Tracker:
@@ -115,6 +121,7 @@ class Tracker:
         self.linkage, self.lay, self.X = linkage, lay, X
         self.N = X.shape[0]
         self.tracks: list[Track] = []
+        self._met: dict[int, bool] = {}
         self.progress = progress
         L = linkage.length_scale
         self.col_scale = np.array([1.0 / L if t else 1.0 for t in lay.is_translation])
@@ -135,6 +142,7 @@ class Tracker:
             tr.mask[sample] = True
             self.tracks.append(tr)
             ids.append(len(self.tracks) - 1)
+            self._met[ids[-1]] = False
             if self.progress is not None:
                 self.progress(1)
         return ids
@@ -142,16 +150,41 @@ class Tracker:
     def follow(self, ids: list[int]) -> None:
         """Follow the given (seeded) tracks forwards and backwards to their ends."""
         fronts = []
-        for i in ids:
+        if not ids:
+            return
+        seeds = Configuration(np.stack([self.tracks[i].scalars[self.tracks[i].seed] for i in ids]),
+                              np.stack([self.tracks[i].spherical[self.tracks[i].seed]
+                                        for i in ids]))
+        sigma = rate_equations(self.linkage, self.lay,
+                               forward(self.linkage, seeds, self.lay)).sigma_ratio
+        for r, i in enumerate(ids):
             tr = self.tracks[i]
-            row = Configuration(tr.scalars[tr.seed:tr.seed + 1], tr.spherical[tr.seed:tr.seed + 1])
+            row = seeds.take(np.array([r]))
             for direction in (1, -1):
                 if 0 <= tr.seed + direction < self.N:
-                    fronts.append(_Front(i, direction, float(tr.seed), row))
+                    # a seed near a fold starts with sub-steps: its Taylor series is short there
+                    fronts.append(_Front(i, direction, float(tr.seed), row,
+                                         substep=0.25 if sigma[r] < FOLD_SIGMA else 0.0))
         while fronts:
             fronts = self._wave(fronts)
 
     # ---------------------------------------------------------------------------------------
+
+    def _position(self, t: float) -> float:
+        """Input distance along the sweep at position ``t``."""
+        k = min(int(np.floor(t)), self.N - 2) if self.N > 1 else 0
+        return float(self.span[k] + (t - k) * (self.span[min(k + 1, self.N - 1)] - self.span[k]))
+
+    def _fold_ahead(self, f: _Front) -> bool:
+        """Whether σ² of the front's last two points extrapolates to zero before the next
+        sample (a fold of the branch in the input lies there)."""
+        (s1, x1), (s0, x0) = f.sigma, f.sigma_before
+        if not (s1 < FOLD_SIGMA and s0 > s1 and np.isfinite(x0)) or x0 == x1:
+            return False
+        fold = x1 + s1**2 * (x1 - x0) / (s0**2 - s1**2)
+        nxt = np.floor(f.t) + 1 if f.direction > 0 else np.ceil(f.t) - 1
+        return bool(abs(fold - x1) <= abs(self._position(float(np.clip(nxt, 0, self.N - 1)))
+                                          - x1))
 
     def _targets(self, fr: _Front) -> Array:
         if fr.substep:
@@ -172,7 +205,11 @@ class Tracker:
         lay, X = self.lay, self.X
         here = Configuration(np.concatenate([f.conf.scalars for f in fronts]),
                              np.concatenate([f.conf.spherical for f in fronts]))
-        Q1, Q2 = taylor(self.linkage, lay, here)
+        Q1, Q2, sigma = taylor(self.linkage, lay, here)
+        for f, sg in zip(fronts, sigma.tolist(), strict=True):
+            at = self._position(f.t)
+            if at != f.sigma[1]:
+                f.sigma_before, f.sigma = f.sigma, (sg, at)
         t_front = np.array([f.t for f in fronts])
         d = input_at(X, t) - input_at(X, t_front)[owner]
         delta = (np.einsum("tmi,ti->tm", Q1[owner], d)
@@ -199,9 +236,8 @@ class Tracker:
                              np.concatenate([f.conf.spherical for f in fronts])).take(owner)
         step = np.linalg.norm(configuration_difference(pred, here, self.lay) * self.col_scale,
                               axis=1)
-        res = correct(self.linkage, pred, self.lay)
-        ok = (res.converged & (res.first_step <= FIRST_STEP * step + 1e-9)
-              & (res.contraction <= CONTRACTION) & (res.moved <= 2 * FIRST_STEP * step + 1e-9))
+        res = correct(self.linkage, pred, self.lay, FIRST_STEP * step + 1e-9, CONTRACTION)
+        ok = res.accepted
         alive = []
         start = 0
         for k, f in enumerate(fronts):
@@ -226,6 +262,8 @@ class Tracker:
             tr.mask[idx] = True
             if self.progress is not None and len(idx):
                 self.progress(len(idx))
+            if len(self.tracks) > 1 and self._joins_another(f.track, idx, conf.take(whole)):
+                return False
             last = len(t) - 1
             if len(t) > 1:
                 f.prev, f.prev_t = conf.take(np.array([last - 1])), float(t[last - 1])
@@ -236,17 +274,42 @@ class Tracker:
                 if f.t == round(f.t):
                     f.substep, f.chunk = 0.0, 1
                 else:
-                    f.substep = min(2 * f.substep, 0.5)
+                    f.substep = min(4 * f.substep, 0.5)
             else:
                 f.chunk = min(2 * f.chunk, MAX_CHUNK) if full else max(len(t), 1)
+        elif self._fold_ahead(f):
+            return self._end(f)
         elif f.substep:
-            f.substep /= 2
+            f.substep /= 4
             if f.substep < MIN_SUBSTEP:
                 return self._end(f)
         else:
-            f.substep = 0.5
+            f.substep = 0.25
         at_end = f.t == round(f.t) and not (0 <= round(f.t) + f.direction < self.N)
         return not at_end
+
+    def _joins_another(self, track: int, idx: NDArray[np.intp], conf: Configuration) -> bool:
+        """Whether the newly reached samples ``idx`` of ``track`` are, at two of them or more,
+        the configurations another track already holds: the front has run onto a known branch
+        (a seed found again next to where a branch ended) and stops there; the two tracks are
+        merged afterwards. Branches that cross meet at one sample only."""
+        if len(idx) < 2:
+            idx, conf = idx[-1:], conf.take(np.arange(len(idx))[-1:])
+        others = [k for k, tr in enumerate(self.tracks) if k != track and tr.mask[idx].any()]
+        if not others or len(idx) == 0:
+            return False
+        mine = signature(self.linkage, conf, self.lay)
+        for k in others:
+            tr = self.tracks[k]
+            held = np.nonzero(tr.mask[idx])[0]
+            theirs = signature(self.linkage, Configuration(tr.scalars[idx[held]],
+                                                           tr.spherical[idx[held]]), self.lay)
+            same = np.max(np.abs(mine[held] - theirs), axis=1) < 1e-6
+            if same.sum() >= min(2, len(idx)) and (same.sum() >= 2 or self._met[track]):
+                return True
+            if same.any():
+                self._met[track] = True
+        return False
 
     def _end(self, f: _Front) -> bool:
         tr = self.tracks[f.track]

@@ -4,9 +4,9 @@ Assembly modes are continuous branches (``../shared/DESIGN.md``), found by conti
 (:mod:`screwkit.kinematics.continuation`), not by a root search at every sample:
 
 1. a global root search (:func:`~screwkit.kinematics.solve.find_assemblies`, Newton from many
-   random starts) runs at the first sample and, as a safety net, at a coarse stride of
-   *anchor* samples (every :data:`ANCHOR_SPAN` rad of input, or that fraction of the length
-   scale for a sliding input);
+   random starts) runs at the first sample and, as a safety net with half as many starts, at
+   a coarse stride of *anchor* samples (every :data:`ANCHOR_SPAN` rad of input, or that
+   fraction of the length scale for a sliding input);
 2. every root not on a known branch seeds a new branch, which is followed forwards and
    backwards to where it ends (so a mode born after the first sample is found over all of its
    life, not from the anchor that found it);
@@ -41,12 +41,12 @@ from screwkit.kinematics.motion import (
     as_input_array,
     format_inputs,
 )
-from screwkit.kinematics.solve import find_assemblies, signature
+from screwkit.kinematics.solve import Assemblies, find_assemblies, signature
 from screwkit.model.linkage import Linkage
 
 #: input movement between two anchor samples of the safety-net root search (rad; × the length
 #: scale for a sliding input)
-ANCHOR_SPAN = np.radians(10.0)
+ANCHOR_SPAN = np.radians(15.0)
 #: a sweep at least this long shows a progress bar on a terminal (when no callback is given)
 PROGRESS_SAMPLES = 50_000
 SAME_ROOT = 1e-6  # signature distance (length-scale units) of two copies of one configuration
@@ -147,42 +147,80 @@ def _signatures(linkage: Linkage, lay: Layout, tr: Track, samples: NDArray[np.in
     return signature(linkage, conf, lay)
 
 
-def _new_roots(linkage: Linkage, lay: Layout, tracker: Tracker, sample: int,
-               conf: Configuration, sig: Array, radius: Array) -> NDArray[np.intp]:
-    """The roots (rows of ``conf`` at ``sample``) on no known branch."""
-    new = np.ones(conf.size, dtype=bool)
-    for tr in tracker.tracks:
-        if tr.mask[sample]:
-            own = _signatures(linkage, lay, tr, np.array([sample]))[0]
-            new &= np.max(np.abs(sig - own), axis=1) >= np.maximum(radius, SAME_ROOT)
-    return np.nonzero(new)[0]
+def _new_seeds(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray[np.intp],
+               asm: Assemblies, first_only: bool = False,
+               ) -> list[tuple[int, int, Configuration]]:
+    """The roots of a root search at ``samples`` that are on no known branch, per row of the
+    search (its index, its sample and the roots); of
+    the roots on a continuum (a motion free with the input fixed) one, and none where a known
+    branch is on a continuum already (:mod:`screwkit.kinematics.degenerate`)."""
+    K = asm.found.shape[1]
+    known = [(tr, tr.mask[samples]) for tr in tracker.tracks]
+    known_sig = [_signatures(linkage, lay, tr, samples[m]) if m.any() else None
+                 for tr, m in known]
+    out = []
+    for r, s in enumerate(samples.tolist()):
+        found = np.nonzero(asm.found[r])[0]
+        if found.size == 0:
+            continue
+        sig, radius = asm.signature[r][found], asm.radius[r][found]
+        new = np.ones(found.size, dtype=bool)
+        here = []
+        for (tr, m), ks in zip(known, known_sig, strict=True):
+            if ks is not None and m[r]:
+                own = ks[int(np.sum(m[:r]))]
+                new &= np.max(np.abs(sig - own), axis=1) >= np.maximum(radius, SAME_ROOT)
+                here.append(tr)
+        if not new.any():
+            continue
+        conf = asm.conf.take(r * K + found[new])
+        seen = Configuration(np.stack([tr.scalars[s] for tr in here]),
+                             np.stack([tr.spherical[s] for tr in here])) if here \
+            else conf.take(np.array([], dtype=int))
+        keep = seeds_off_continua(linkage, lay, seen, conf)
+        if keep.any():
+            out.append((r, s, conf.take(np.nonzero(keep)[0])))
+            if first_only:
+                break
+    return out
+
+
+def _root_search(linkage: Linkage, X: Array, samples: NDArray[np.intp], starts: int,
+                 seed: int) -> tuple[NDArray[np.intp], Assemblies]:
+    """Every root at ``samples`` by Newton from random starts, in one vectorised search:
+    ``starts`` at the first sample of the sweep, half as many at the others (the safety net:
+    there the known branches are found again by most starts, and a branch missed at one
+    sample is found at the next). Returns the sample of each row of the search and the
+    search."""
+    half = max(starts // 2, 8)
+    lead = int(samples[0] == 0) * max(starts // half - 1, 0)  # extra copies of sample 0
+    rows = np.concatenate([np.zeros(lead, dtype=np.intp), samples])
+    return rows, find_assemblies(linkage, X[rows], starts=half, seed=seed)
 
 
 def _seed_from(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray[np.intp],
                X: Array, starts: int, seed: int) -> bool:
-    """Root search at ``samples``; follow every root on no known branch (sample by sample, so
-    that a branch found at one sample is not seeded again at the next). True if any was new."""
+    """Root search at ``samples`` (vectorised over them); then, in the order of the samples,
+    follow the roots on no known branch at the first sample that has some, and look again at
+    the later samples — so a branch found at one sample is not seeded again at the next. True
+    if any root was new."""
     if samples.size == 0:
         return False
-    asm = find_assemblies(linkage, X[samples], starts=starts, seed=seed)
+    samples, asm = _root_search(linkage, X, samples, starts, seed)
     K = asm.found.shape[1]
+    remaining = np.nonzero(asm.found.any(axis=1))[0]
     found_new = False
-    for r, s in enumerate(samples.tolist()):
-        rows = r * K + np.nonzero(asm.found[r])[0]
-        if rows.size == 0:
-            continue
-        conf = asm.conf.take(rows)
-        new = _new_roots(linkage, lay, tracker, s, conf, asm.signature[r][asm.found[r]],
-                         asm.radius[r][asm.found[r]])
-        if new.size:
-            known = [k for k, tr in enumerate(tracker.tracks) if tr.mask[s]]
-            here = Configuration(np.stack([tracker.tracks[k].scalars[s] for k in known]),
-                                 np.stack([tracker.tracks[k].spherical[s] for k in known])
-                                 ) if known else conf.take(np.array([], dtype=int))
-            new = new[seeds_off_continua(linkage, lay, here, conf.take(new))]
-        if new.size:
-            found_new = True
-            tracker.follow(tracker.add_seeds(s, conf.take(new)))
+    while remaining.size:
+        rows = (remaining[:, None] * K + np.arange(K)).ravel()
+        sub = Assemblies(asm.conf.take(rows), asm.found[remaining], asm.signature[remaining],
+                         asm.radius[remaining])
+        seeds = _new_seeds(linkage, lay, tracker, samples[remaining], sub, first_only=True)
+        if not seeds:
+            break
+        row, sample, conf = seeds[0]
+        tracker.follow(tracker.add_seeds(sample, conf))
+        found_new = True
+        remaining = remaining[row + 1:]
     return found_new
 
 
@@ -215,24 +253,30 @@ def _all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: in
 
 
 def _merge_duplicates(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
-    """Tracks that are the same configuration wherever both hold are one branch."""
+    """Tracks that are the same configuration wherever both hold are one branch; a track that
+    shares another's configuration at some samples only has jumped onto it there (near a fold
+    both branches are close) and loses those samples. (Two branches that cross share one
+    singular configuration; that sample is kept by both.)"""
     out: list[Track] = []
     for tr in tracks:
         for kept in out:
             both = np.nonzero(kept.mask & tr.mask)[0]
             if both.size == 0:
                 continue
-            probe = both[np.linspace(0, both.size - 1, min(both.size, 16)).astype(int)]
-            d = np.max(np.abs(_signatures(linkage, lay, kept, probe)
-                              - _signatures(linkage, lay, tr, probe)), axis=1)
-            if np.all(d < 1e-5):
+            d = np.max(np.abs(_signatures(linkage, lay, kept, both)
+                              - _signatures(linkage, lay, tr, both)), axis=1)
+            same = d < 1e-5
+            if same.all():
                 extra = tr.mask & ~kept.mask
                 kept.scalars[extra] = tr.scalars[extra]
                 kept.spherical[extra] = tr.spherical[extra]
                 kept.mask |= tr.mask
                 break
+            if same.sum() > 1:
+                tr.mask[both[same]] = False
         else:
-            out.append(tr)
+            if tr.mask.any():
+                out.append(tr)
     return out
 
 

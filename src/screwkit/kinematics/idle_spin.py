@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.loop import Array, Configuration, Layout, LoopFrames, forward
+from screwkit.kinematics.loop import Array, Configuration, Layout, LoopFrames, cross, forward
 from screwkit.kinematics.rates import RateEquations, rate_equations, solve_rates
 from screwkit.model.linkage import Linkage
 
@@ -50,21 +50,21 @@ def _dot(a: Array, b: Array) -> Array:
 
 def minimal_rotation_apply(a: Array, b: Array, v: Array) -> Array:
     """M v for the least rotation M taking unit ``a`` to unit ``b`` (rows; a ≠ −b)."""
-    k = np.cross(a, b)
+    k = cross(a, b)
     c = _dot(a, b)
-    return np.asarray(c[:, None] * v + np.cross(k, v)
+    return np.asarray(c[:, None] * v + cross(k, v)
                       + (_dot(k, v) / (1.0 + c))[:, None] * k)
 
 
 def signed_angle(a: Array, b: Array, axis: Array) -> Array:
     """Angle turning ``a`` into ``b`` about ``axis`` (all (N, 3); a, b ⟂ axis)."""
-    return np.asarray(np.arctan2(_dot(axis, np.cross(a, b)), _dot(a, b)))
+    return np.asarray(np.arctan2(_dot(axis, cross(a, b)), _dot(a, b)))
 
 
 def geodesic_spin_correction(u0: Array, u1: Array, u1_dot: Array, u1_ddot: Array) -> Array:
     """c = −∫₀¹ f dt of the module docstring for steps from ``u0`` to ``u1``, with the
     derivatives of u along the step at its end (per unit of the step parameter)."""
-    k = np.cross(u0, u1)
+    k = cross(u0, u1)
     den = 1.0 + _dot(u0, u1)
     f1 = _dot(k, u1_dot) / den
     f1_dot = _dot(k, u1_ddot) / den - f1 * _dot(u0, u1_dot) / den
@@ -127,8 +127,8 @@ def hold_idle_spin(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDA
         along = solve_rates(linkage, lay, eq, steps, np.zeros_like(X))
         w, al = along.link_V[:, i, :3], along.link_A[:, i, :3]
         u = eq.rod_axes[:, r]
-        u_dot = np.cross(w, u)
-        u_ddot = np.cross(al, u) + np.cross(w, u_dot)
+        u_dot = cross(w, u)
+        u_ddot = cross(al, u) + cross(w, u_dot)
         rod = fr.after_R[:, i]
         first = int(np.argmax(mask))
         u_body = rod[first].T @ u[first]

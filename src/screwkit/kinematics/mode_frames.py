@@ -24,6 +24,7 @@ from screwkit.kinematics.loop import (
     Configuration,
     Layout,
     closure_twist,
+    cross,
     forward,
 )
 from screwkit.kinematics.motion import ModeMotion
@@ -85,8 +86,8 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
     w, v0 = link_V[:, :nl, :3], link_V[:, :nl, 3:]
     al, a0 = link_A[:, :nl, :3], link_A[:, :nl, 3:]
     p_g = fr.after_p[:, :nl]
-    v_o = v0 + np.cross(w, p_g)
-    a_o = a0 + np.cross(al, p_g) + np.cross(w, v_o)
+    v_o = v0 + cross(w, p_g)
+    a_o = a0 + cross(al, p_g) + cross(w, v_o)
 
     def world(x: Array) -> Array:
         return np.einsum("ij,n...j->n...i", bR, x)

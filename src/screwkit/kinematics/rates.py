@@ -130,7 +130,7 @@ def rate_equations(linkage: Linkage, lay: Layout, fr: LoopFrames,
     """The scaled rate equations at every sample of ``fr`` (samples outside ``mask`` are
     treated as singular and give NaN)."""
     N, _, m = fr.screws.shape
-    L = linkage.length_scale
+    L = lay.length_scale
     names = list(lay.names)
     in_idx = [names.index(n) for n in linkage.inputs]
     p_idx = [k for k in range(m) if k not in in_idx]

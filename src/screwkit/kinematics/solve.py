@@ -63,7 +63,7 @@ def newton(
     minimum-norm Gauss–Newton step, also where J has fewer independent rows than 6 (a planar
     loop seen in space)."""
     lay = lay or layout(linkage)
-    L = linkage.length_scale
+    L = lay.length_scale
     rows, cols = _scales(lay, L)
     passive = np.array([n not in linkage.inputs for n in lay.names])
     pidx = np.nonzero(passive)[0]
@@ -114,32 +114,33 @@ class Correction:
     """The corrector's verdict on a batch of predicted configurations (:func:`correct`)."""
 
     conf: Configuration
-    converged: NDArray[np.bool_]
-    first_step: Array  # (N,) scaled size of the first Newton step
-    contraction: Array  # (N,) second step / first step (0 when the first step was tiny)
-    moved: Array  # (N,) scaled size of all the steps together
+    accepted: NDArray[np.bool_]  # converged and passed the contraction test
 
 
-def correct(linkage: Linkage, conf: Configuration, lay: Layout, max_iter: int = 7,
-            tol: float = CLOSURE_TOL) -> Correction:
+def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
+            contraction: float = 0.5, max_iter: int = 7, tol: float = CLOSURE_TOL,
+            ) -> Correction:
     """Newton corrector of a continuation step (inputs held): minimum-norm Gauss–Newton steps
-    over the passive freedoms, vectorised over the batch, without damping, reporting what a
-    step-size control needs — the first step, the contraction of the second and the whole
-    move (Deuflhard's contraction test: a prediction inside the branch's basin of quadratic
-    convergence contracts fast; a jump towards another branch does not)."""
-    L = linkage.length_scale
+    over the passive freedoms, vectorised over the batch, without damping.
+
+    A prediction is accepted when Newton converges to ``tol`` within ``max_iter`` steps, its
+    first step stays within ``reach`` (N,) (scaled freedoms), all its steps together within
+    1.5 ``reach``, and the
+    second step is at most ``contraction`` times the first — Deuflhard's contraction test: a
+    prediction inside the branch's basin of quadratic convergence contracts fast, a jump
+    towards another branch does not. Predictions that fail a test are dropped at once."""
+    L = lay.length_scale
     rows, cols = _scales(lay, L)
     pidx = np.array([k for k, n in enumerate(lay.names) if n not in linkage.inputs])
     N = conf.size
     q = conf.scalars.copy()
     sph = conf.spherical.copy()
     first = np.zeros(N)
-    second = np.zeros(N)
     total = np.zeros((N, len(pidx)))
     done = np.zeros(N, dtype=bool)
     todo = np.arange(N)
     for it in range(max_iter + 1):
-        fr = forward(linkage, Configuration(q[todo], sph[todo]), lay)
+        fr = forward(linkage, Configuration(q[todo], sph[todo]), lay, frames=False)
         xi = closure_twist(fr.closure_R, fr.closure_p) * rows
         r = np.max(np.abs(xi), axis=-1)
         fine = r <= tol
@@ -154,26 +155,31 @@ def correct(linkage: Linkage, conf: Configuration, lay: Layout, max_iter: int = 
         y = np.linalg.solve(JJt + mu[:, None, None] * np.eye(6), xi[..., None])[..., 0]
         step = -np.einsum("nji,nj->ni", J, y)
         size = np.linalg.norm(step, axis=-1)
+        total[todo] += step
         if it == 0:
             first[todo] = size
-        elif it == 1:
-            second[todo] = size
-        total[todo] += step
+            hopeful = size <= reach[todo]
+        else:
+            hopeful = np.linalg.norm(total[todo], axis=-1) <= 1.5 * reach[todo]
+            if it == 1:
+                hopeful &= size <= contraction * np.maximum(first[todo], 1e-12)
+        if not hopeful.all():
+            todo, step = todo[hopeful], step[hopeful]
+            if todo.size == 0:
+                break
         delta = np.zeros((len(todo), len(lay.names)))
         delta[:, pidx] = step * cols[pidx]
         moved = apply_increment(Configuration(q[todo], sph[todo]), delta, lay)
         q[todo] = moved.scalars
         sph[todo] = moved.spherical
-    contraction = np.where(first > 1e-12, second / np.maximum(first, 1e-300), 0.0)
-    return Correction(Configuration(q, sph), done, first, contraction,
-                      np.linalg.norm(total, axis=-1))
+    return Correction(Configuration(q, sph), done)
 
 
 def random_configurations(linkage: Linkage, count: int, rng: np.random.Generator, lay: Layout | None = None) -> Configuration:
     """``count`` random starting configurations: angles uniform in (−π, π], translations
     uniform within ± the length scale, spherical joints uniformly random rotations."""
     lay = lay or layout(linkage)
-    L = linkage.length_scale
+    L = lay.length_scale
     q = np.empty((count, lay.n_scalar))
     for f in range(len(lay.names)):
         c = lay.scalar_col[f]
@@ -193,8 +199,9 @@ def signature(linkage: Linkage, conf: Configuration, lay: Layout | None = None) 
     """A vector per sample that identifies an assembly up to passive freedoms: every joint
     centre (divided by the length scale) and every non-spherical joint axis, in the ground
     frame. Two configurations with the same signature are the same assembly."""
+    lay = lay or layout(linkage)
     fr = forward(linkage, conf, lay)
-    L = linkage.length_scale
+    L = lay.length_scale
     parts = [fr.centres.reshape(conf.size, -1) / L]
     ax = [fr.axes[:, i] for i, j in enumerate(linkage.joints) if j.kind != "S"]
     if ax:
@@ -241,14 +248,14 @@ def find_assemblies(
     rng = np.random.default_rng(seed)
     conf0 = random_configurations(linkage, N * starts, rng, lay)
     conf0 = set_inputs(conf0, lay, linkage.inputs, np.repeat(values, starts, axis=0))
-    res = newton(linkage, conf0, max_iter=80, lay=lay)
+    res = newton(linkage, conf0, max_iter=50, lay=lay)
     fr = forward(linkage, res.conf, lay)
     sig = signature(linkage, res.conf, lay).reshape(N, starts, -1)
     ok = res.converged.reshape(N, starts)
     # Near a double root (a limit position) the closure error grows only quadratically with
     # the distance from the root, so Newton's roots scatter by ~√tolerance: merge within that
     # wider radius where the passive Jacobian is near-singular.
-    rows, cols = _scales(lay, linkage.length_scale)
+    rows, cols = _scales(lay, lay.length_scale)
     pidx = [k for k, n in enumerate(lay.names) if n not in linkage.inputs]
     Jp = fr.screws[:, :, pidx] * rows[None, :, None] * cols[pidx][None, None, :]
     sv = np.linalg.svd(Jp, compute_uv=False)
