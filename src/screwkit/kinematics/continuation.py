@@ -13,8 +13,10 @@ fronts and samples). A corrected sample is accepted when Newton converged and co
 from a prediction close to the result (Deuflhard's test: a jump towards another branch does
 not); a chunk is accepted up to its first rejected sample and the next chunk doubles or shrinks
 accordingly. When even the next sample is rejected the front sub-steps between samples with
-steps cut by four; when the step falls below 2⁻⁸ of the sample spacing the branch ends there — a
-limit position or dead centre lies between the two samples (it *stops*, or going backwards it
+steps cut by four; when the step falls below 2⁻⁸ of the sample spacing it tries once to step
+over the next sample to the one after (branches that cross — a bifurcation — are passed that
+way, the crossing sample closed by Newton alone), and if that fails too the branch ends there:
+a limit position or dead centre lies between the two samples (it *stops*, or going backwards it
 *starts assembling*). Near a fold the passive Jacobian's smallest singular value falls as the
 square root of the distance to it, σ² ∝ x* − x: where a step fails and the σ measured at the
 front's last two points extrapolates to zero before the next sample, the branch ends at once.
@@ -77,6 +79,8 @@ class _Front:
     substep: float = 0.0  # 0: chunk mode; else the sub-step (a fraction of the spacing)
     sigma: tuple[float, float] = (np.inf, np.nan)  # σ ratio of J_p at the front, and where
     sigma_before: tuple[float, float] = (np.inf, np.nan)
+    jump: bool = False  # this wave steps over a singular sample to the one after it
+    jumped: bool = False  # a jump was tried since the front last advanced normally
 
 
 def input_at(X: Array, t: Array) -> Array:
@@ -187,6 +191,9 @@ class Tracker:
                                           - x1))
 
     def _targets(self, fr: _Front) -> Array:
+        if fr.jump:
+            near = np.floor(fr.t) + 1 if fr.direction > 0 else np.ceil(fr.t) - 1
+            return np.array([near, near + fr.direction])
         if fr.substep:
             nxt = np.floor(fr.t) + 1 if fr.direction > 0 else np.ceil(fr.t) - 1
             t = fr.t + fr.direction * fr.substep
@@ -236,7 +243,13 @@ class Tracker:
                              np.concatenate([f.conf.spherical for f in fronts])).take(owner)
         step = np.linalg.norm(configuration_difference(pred, here, self.lay) * self.col_scale,
                               axis=1)
-        res = correct(self.linkage, pred, self.lay, FIRST_STEP * step + 1e-9, CONTRACTION)
+        # a jump's near target is the singular sample itself: Newton converges there only
+        # linearly; it is accepted if it converges and the sample after it passes the test
+        near = np.zeros(len(t), dtype=bool)
+        near[np.cumsum([len(tg) for tg in targets]) - 2] = [f.jump for f in fronts]
+        reach = np.where(near, np.inf, FIRST_STEP * step + 1e-9)
+        res = correct(self.linkage, pred, self.lay, reach, np.where(near, 1.0, CONTRACTION),
+                      max_iter=40 if near.any() else 7)
         ok = res.accepted
         alive = []
         start = 0
@@ -246,6 +259,16 @@ class Tracker:
             start += n
             acc = ok[sl]
             p = n if acc.all() else int(np.argmin(acc))
+            if f.jump:
+                f.jump = False
+                if not acc[1]:
+                    if not self._end(f):
+                        continue
+                keep = np.nonzero(acc)[0]
+                if self._advance(f, targets[k][keep], res.conf.take(sl.start + keep),
+                                 full=False):
+                    alive.append(f)
+                continue
             if self._advance(f, targets[k][:p], res.conf.take(np.arange(sl.start, sl.start + p)),
                              full=p == n):
                 alive.append(f)
@@ -277,12 +300,13 @@ class Tracker:
                     f.substep = min(4 * f.substep, 0.5)
             else:
                 f.chunk = min(2 * f.chunk, MAX_CHUNK) if full else max(len(t), 1)
+                f.jumped = False
         elif self._fold_ahead(f):
-            return self._end(f)
+            return self._jump_or_end(f)
         elif f.substep:
             f.substep /= 4
             if f.substep < MIN_SUBSTEP:
-                return self._end(f)
+                return self._jump_or_end(f)
         else:
             f.substep = 0.25
         at_end = f.t == round(f.t) and not (0 <= round(f.t) + f.direction < self.N)
@@ -310,6 +334,17 @@ class Tracker:
             if same.any():
                 self._met[track] = True
         return False
+
+    def _jump_or_end(self, f: _Front) -> bool:
+        """A front that cannot reach the next sample may be at a bifurcation (branches that
+        cross), which it can step over: try once to land on the sample after the next (the
+        next being the singular one); if that fails too, the branch ends (a fold)."""
+        near = np.floor(f.t) + 1 if f.direction > 0 else np.ceil(f.t) - 1
+        if f.jumped or not (0 <= near + f.direction < self.N):
+            return self._end(f)
+        f.jump = f.jumped = True
+        f.substep = 0.0
+        return True
 
     def _end(self, f: _Front) -> bool:
         tr = self.tracks[f.track]

@@ -14,17 +14,18 @@ Frames (those of :func:`screwkit.model.families.cssp` and :func:`screwkit.kinema
 * crank: rotation Z(θ1), origin on z1 at the crank offset s1 (joint 1's frame after its motion;
   x along the crank);
 * rod: origin at the crank pin D1, x along the rod u = (P − D1)/a2 (the pin S joint's child
-  frame). A two-ball rod's spin angle about u is not fixed by the loop; this adapter uses
-  Rahman's frame {3}, R = Z(θ1 + θ2)·Y(η2) (SPEC §1.1, L2), so y lies in the plane of z1;
+  frame). A two-ball rod's spin angle about u is not fixed by the loop; it is the zero-spin
+  frame along the branch, the generic solver's convention (:mod:`screwkit.kinematics.idle_spin`),
+  so that its rotation differentiates to its ω: Rahman's frame {3}, R = Z(θ1 + θ2)·Y(η2)
+  (SPEC §1.1, L2), turned about u by the sweep's ``rod_turn`` φ
+  (:mod:`screwkit.kinematics.cssp_rod_pose`);
 * slider: origin at the ball centre P, constant rotation X(−(α4 + π/2)) (the loop closes the
   slider's rotation with the ball joint).
 
 Rates follow the generic solver's rule for an S–S link: zero absolute spin, ω_rod·u = 0, so
-ω_rod = u × u̇ and α_rod = u × ü (Rahman 1996 §1.2). As in the generic solver, the rod's
-rotation is therefore not the time integral of its angular velocity (the spin angle is a free
-choice, the spin rate is zero); only quantities that do not depend on the spin angle are
-physical — the CoM kinematics of a rod whose CoM is on its axis, ω, α, the joint centres and the
-loads of an axisymmetric rod (docs/dynamics.md, "idle passive freedoms").
+ω_rod = u × u̇ and α_rod = u × ü (Rahman 1996 §1.2), and the rod's pose is the frame that spin
+rule carries along the branch (path dependent: after a full turn of the crank it comes back
+turned about u by the holonomy). The fused inverse dynamics reads the same block rows.
 
 Spherical-joint rates use the generic solver's convention: the three freedoms ``<joint>.wx|wy|wz``
 are the relative angular velocity in the child frame, and their "accelerations" the time
@@ -94,7 +95,7 @@ def _component_major(n: int, *shape: int) -> tuple[Array, Array]:
     return storage, np.moveaxis(storage, -1, 0)
 
 
-def _closed_form_block(
+def cssp_closed_form_block(
     dims: CSSPDimensions, mode: int, ct: Array, st: Array, w: Any, wd: Any, s1: Any, s1d: Any,
     s1dd: Any, disc: Array,
 ) -> dict[str, Any]:
@@ -148,6 +149,18 @@ def _combine(coefficients: Array, values: tuple[Any, Any, Any]) -> Any:
         term = v if c == 1.0 else (-v if c == -1.0 else c * v)
         total = term if type(total) is float and total == 0.0 else total + term
     return total
+
+
+def rahman_rod_axes(u: tuple[Any, Any, Any]) -> tuple[tuple[Any, Any, Any], tuple[Any, Any, Any]]:
+    """y3 and z3 of Rahman's rod frame {3} = Z(θ1 + θ2)·Y(η2) with x3 = u:
+    y3 = (−u_y, u_x, 0)/ρ, z3 = u × y3 (SPEC §1.1; y3 = (0, 1, 0) where u is vertical)."""
+    rho2 = u[0] * u[0] + u[1] * u[1]
+    defined = rho2 > _GIMBAL_TOL**2
+    inv_rho = 1.0 / np.sqrt(np.where(defined, rho2, 1.0))
+    y3 = (np.where(defined, -u[1] * inv_rho, 0.0), np.where(defined, u[0] * inv_rho, 1.0),
+          np.zeros_like(rho2))
+    z3 = (-u[2] * y3[1], u[2] * y3[0], u[0] * y3[1] - u[1] * y3[0])
+    return y3, z3
 
 
 def _dot3(a: tuple[Any, Any, Any], b: tuple[Any, Any, Any]) -> Any:
@@ -223,15 +236,15 @@ def cssp_block_rows(
     w, wd = sw.block("theta1_dot", sel), sw.block("theta1_ddot", sel)
     s1 = sw.block("s1", sel)
     s1d, s1dd = sw.block("s1_dot", sel), sw.block("s1_ddot", sel)
-    k = _closed_form_block(dims, sw.mode, ct, st, w, wd, s1, s1d, s1dd, sw.discriminant[sel])
+    k = cssp_closed_form_block(dims, sw.mode, ct, st, w, wd, s1, s1d, s1dd,
+                               sw.discriminant[sel])
     u, ud, udd = k["u"], k["u_dot"], k["u_ddot"]
-    # Rahman's rod frame {3} = Z(θ1 + θ2)·Y(η2): x3 = u, y3 = (−u_y, u_x, 0)/ρ, z3 = u × y3
-    rho2 = u[0] * u[0] + u[1] * u[1]
-    defined = rho2 > _GIMBAL_TOL**2
-    inv_rho = 1.0 / np.sqrt(np.where(defined, rho2, 1.0))
-    y3 = (np.where(defined, -u[1] * inv_rho, 0.0), np.where(defined, u[0] * inv_rho, 1.0))
-    z3 = (-u[2] * y3[1], u[2] * y3[0], u[0] * y3[1] - u[1] * y3[0])
-    rod = ((u[0], y3[0], z3[0]), (u[1], y3[1], z3[1]), (u[2], 0.0, z3[2]))
+    y3, z3 = rahman_rod_axes(u)
+    # the zero-spin frame: {3} turned about u by the sweep's rod turn φ (module docstring)
+    c, s = np.cos(sw.rod_turn[sel]), np.sin(sw.rod_turn[sel])
+    y3, z3 = (tuple(c * y + s * z for y, z in zip(y3, z3, strict=True)),
+              tuple(c * z - s * y for y, z in zip(y3, z3, strict=True)))
+    rod = ((u[0], y3[0], z3[0]), (u[1], y3[1], z3[1]), (u[2], y3[2], z3[2]))
     w_rod = _cross3(u, ud)
     al_rod = _cross3(u, udd)
     slider_R = rot_x(np.array(-(dims.alpha4 + np.pi / 2)))
@@ -280,8 +293,7 @@ def _ball_joint_block(loop: dict[str, Any], REL_st: Array, RATE_st: Array, sl: s
     for j in range(3):
         REL_st[0, 0, j, sl] = ct * rod[0][j] + st * rod[1][j]
         REL_st[0, 1, j, sl] = ct * rod[1][j] - st * rod[0][j]
-        if j != 1:  # rod[2][1] = y3_z = 0
-            REL_st[0, 2, j, sl] = rod[2][j]
+        REL_st[0, 2, j, sl] = rod[2][j]
         for i in range(3):
             REL_st[1, i, j, sl] = _combine(slider_R[:, j], (rod[0][i], rod[1][i], rod[2][i]))
     rel_w = (w_rod[0], w_rod[1], w_rod[2] - w)
@@ -326,6 +338,7 @@ class CSSPSweep:
     given: dict[str, float | Array]
     discriminant: Array
     assembles: NDArray[np.bool_]
+    rod_turn: Array  # (N,) φ turning Rahman's rod frame {3} about u to the zero-spin frame
 
     def block(self, name: str, sel: slice | NDArray[np.intp]) -> float | Array:
         """An input over some samples (a float if it is constant)."""
@@ -405,7 +418,10 @@ def cssp_sweep(
             raise CSSPAssemblyError(msg + " Pass allow_partial=True to get NaN there instead.",
                                     ok)
         disc = np.where(ok, disc, 1.0)
-    return CSSPSweep(dims, mode, driven_offset, n, th, ct, st, given, disc, ok)
+    from screwkit.kinematics.cssp_rod_pose import rod_turn
+
+    turn = rod_turn(dims, mode, th, ct, st, given, disc, ok)
+    return CSSPSweep(dims, mode, driven_offset, n, th, ct, st, given, disc, ok, turn)
 
 
 def cssp_mode_motion(

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.continuation import Track, Tracker
 from screwkit.kinematics.degenerate import seeds_off_continua
-from screwkit.kinematics.loop import Array, Configuration, Layout, layout
+from screwkit.kinematics.loop import Array, Configuration, Layout, forward, layout
 from screwkit.kinematics.mode_frames import mode_from_configuration
 from screwkit.kinematics.motion import (
     AssemblyError,
@@ -41,6 +41,7 @@ from screwkit.kinematics.motion import (
     as_input_array,
     format_inputs,
 )
+from screwkit.kinematics.rates import rate_equations
 from screwkit.kinematics.solve import Assemblies, find_assemblies, signature
 from screwkit.model.linkage import Linkage
 
@@ -248,7 +249,7 @@ def _all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: in
         searched |= set(todo.tolist())
         if not _seed_from(linkage, lay, tracker, todo, X, starts, seed + 1 + round_):
             break
-    tracks = _merge_duplicates(linkage, lay, tracker.tracks)
+    tracks = _attach_turning_points(linkage, lay, _merge_duplicates(linkage, lay, tracker.tracks))
     return sorted(tracks, key=lambda tr: _order_key(linkage, lay, tr))
 
 
@@ -277,6 +278,30 @@ def _merge_duplicates(linkage: Linkage, lay: Layout, tracks: list[Track]) -> lis
         else:
             if tr.mask.any():
                 out.append(tr)
+    return out
+
+
+def _attach_turning_points(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
+    """A one-sample track at a singular configuration next to where other branches end is
+    the turning point where they meet (a sample exactly at a dead centre, found by the root
+    search there): it becomes the last sample of each of those branches, as the closed forms
+    report it."""
+    out = []
+    for tr in tracks:
+        held = np.nonzero(tr.mask)[0]
+        if held.size != 1:
+            out.append(tr)
+            continue
+        s = int(held[0])
+        ends = [o for o in tracks if o is not tr and not o.mask[s] and (
+            (s > 0 and o.mask[s - 1]) or (s + 1 < len(o.mask) and o.mask[s + 1]))]
+        conf = Configuration(tr.scalars[held], tr.spherical[held])
+        singular = rate_equations(linkage, lay, forward(linkage, conf, lay)).rank_deficient[0]
+        if not ends or not singular:
+            out.append(tr)
+            continue
+        for o in ends:
+            o.scalars[s], o.spherical[s], o.mask[s] = tr.scalars[s], tr.spherical[s], True
     return out
 
 

@@ -110,13 +110,34 @@ def transported_spin(u: Array, u_dot: Array, u_ddot: Array, frame_x: Array, star
     return np.where(runs, phi, 0.0)
 
 
+def zero_spin_angle(u: Array, u_dot: Array, u_ddot: Array, rod: Array, before: Array,
+                    mask: NDArray[np.bool_], exact: NDArray[np.bool_]) -> Array:
+    """The turn φ (N,) about its axis that makes a rod's frame ``rod`` (N, 3, 3) the zero-spin
+    frame of the module docstring: ``u`` its axes, ``u_dot``/``u_ddot`` their derivatives
+    along the step arriving at each sample, ``before`` the frame of its proximal ball joint
+    before the joint's motion (the rod's rest frame), ``mask`` where it holds, ``exact``
+    where the derivatives are known. The turned frame is Rot(u, φ)·rod."""
+    N = u.shape[0]
+    first = int(np.argmax(mask))
+    u_body = rod[first].T @ u[first]
+    e_body = _perpendicular(u_body)
+    frame_x = rod @ e_body
+    # wanted frame at a run's start: the proximal ball is a pure swing from rest
+    u_in_before = np.einsum("nji,nj->ni", before, u)
+    swing_x = minimal_rotation_apply(np.broadcast_to(u_body, (N, 3)), u_in_before,
+                                     np.broadcast_to(e_body, (N, 3)))
+    start_x = np.einsum("nij,nj->ni", before, swing_x)
+    continues = np.zeros(N, dtype=bool)
+    continues[1:] = mask[1:] & mask[:-1]
+    return transported_spin(u, u_dot, u_ddot, frame_x, start_x, mask, continues, exact)
+
+
 def hold_idle_spin(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArray[np.bool_],
                    X: Array, fr: LoopFrames, eq: RateEquations) -> Configuration:
     """``conf`` with every S–S rod turned about its axis to the zero-spin frame (module
     docstring); the loop stays closed (the turn is about the line of the two ball centres)."""
     if not eq.spin_links or not mask.any():
         return conf
-    N = conf.size
     steps = np.zeros_like(X)
     steps[1:] = X[1:] - X[:-1]
     sph = conf.spherical.copy()
@@ -129,23 +150,11 @@ def hold_idle_spin(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDA
         u = eq.rod_axes[:, r]
         u_dot = cross(w, u)
         u_ddot = cross(al, u) + cross(w, u_dot)
-        rod = fr.after_R[:, i]
-        first = int(np.argmax(mask))
-        u_body = rod[first].T @ u[first]
-        e_body = _perpendicular(u_body)
-        frame_x = rod @ e_body
-        # wanted frame at a run's start: the proximal ball is a pure swing from rest
         B = fr.before_R[:, i]
-        u_in_B = np.einsum("nji,nj->ni", B, u)
-        swing_x = minimal_rotation_apply(np.broadcast_to(u_body, (N, 3)), u_in_B,
-                                         np.broadcast_to(e_body, (N, 3)))
-        start_x = np.einsum("nij,nj->ni", B, swing_x)
-        continues = np.zeros(N, dtype=bool)
-        continues[1:] = mask[1:] & mask[:-1]
         exact = np.asarray(np.isfinite(along.qd).all(axis=1))
-        phi = transported_spin(u, u_dot, u_ddot, frame_x, start_x, mask, continues, exact)
+        phi = zero_spin_angle(u, u_dot, u_ddot, fr.after_R[:, i], B, mask, exact)
         k1, k2 = lay.spherical_of_joint[i], lay.spherical_of_joint[i + 1]
-        sph[:, k1] = axis_rotation(u_in_B, phi) @ sph[:, k1]
+        sph[:, k1] = axis_rotation(np.einsum("nji,nj->ni", B, u), phi) @ sph[:, k1]
         B2 = fr.before_R[:, i + 1]
         sph[:, k2] = axis_rotation(np.einsum("nji,nj->ni", B2, u), -phi) @ sph[:, k2]
     return Configuration(conf.scalars, sph)

@@ -30,6 +30,7 @@ from screwkit.kinematics.loop import (
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.kinematics.rates import RESIDUAL_TOL, rate_equations, solve_rates
 from screwkit.kinematics.singularities import classify, singular_events
+from screwkit.kinematics.solve import newton
 from screwkit.model.linkage import Linkage
 
 
@@ -75,6 +76,12 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
     eq = rate_equations(linkage, lay, fr, mask)
     if eq.spin_links:
         conf = hold_idle_spin(linkage, lay, conf, mask, X, fr, eq)
+        # the turns about the rods' axes leave round-off in the closure: one Newton step
+        # (minimum-norm, so it does not turn the rods back) restores it
+        polished = newton(linkage, conf, max_iter=2, tol=1e-15, lay=lay).conf
+        conf = Configuration(np.where(mask[:, None], polished.scalars, conf.scalars),
+                             np.where(mask[:, None, None, None], polished.spherical,
+                                      conf.spherical))
         fr = forward(linkage, conf, lay)
         eq = rate_equations(linkage, lay, fr, mask)
     rates = solve_rates(linkage, lay, eq, Xd, Xdd)

@@ -24,6 +24,7 @@ from screwkit.kinematics.loop import (
 from screwkit.model.linkage import Linkage
 
 CLOSURE_TOL = 1e-11  # residual (radians, and lengths / length scale) accepted as closed
+POLISHED = 1e-15  # the corrector stops early below this (round-off)
 
 
 @dataclass(frozen=True)
@@ -118,7 +119,7 @@ class Correction:
 
 
 def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
-            contraction: float = 0.5, max_iter: int = 7, tol: float = CLOSURE_TOL,
+            contraction: float | Array = 0.5, max_iter: int = 7, tol: float = CLOSURE_TOL,
             ) -> Correction:
     """Newton corrector of a continuation step (inputs held): minimum-norm Gauss–Newton steps
     over the passive freedoms, vectorised over the batch, without damping.
@@ -126,7 +127,8 @@ def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
     A prediction is accepted when Newton converges to ``tol`` within ``max_iter`` steps, its
     first step stays within ``reach`` (N,) (scaled freedoms), all its steps together within
     1.5 ``reach``, and the
-    second step is at most ``contraction`` times the first — Deuflhard's contraction test: a
+    second step is at most ``contraction`` (a number or one per prediction) times the first
+    — Deuflhard's contraction test: a
     prediction inside the branch's basin of quadratic convergence contracts fast, a jump
     towards another branch does not. Predictions that fail a test are dropped at once."""
     L = lay.length_scale
@@ -135,19 +137,25 @@ def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
     N = conf.size
     q = conf.scalars.copy()
     sph = conf.spherical.copy()
+    limit = np.broadcast_to(np.asarray(contraction, dtype=float), (N,))
     first = np.zeros(N)
     total = np.zeros((N, len(pidx)))
     done = np.zeros(N, dtype=bool)
+    last = np.full(N, np.inf)
     todo = np.arange(N)
     for it in range(max_iter + 1):
         fr = forward(linkage, Configuration(q[todo], sph[todo]), lay, frames=False)
         xi = closure_twist(fr.closure_R, fr.closure_p) * rows
         r = np.max(np.abs(xi), axis=-1)
-        fine = r <= tol
-        done[todo[fine]] = True
+        # within tolerance, one more (quadratically converging) step polishes to round-off;
+        # stop when that no longer gains a digit
+        fine = (r <= POLISHED) | ((r <= tol) & (r > 0.1 * last[todo]))
+        last[todo] = r
+        done[todo[r <= tol]] = True
         keep = ~fine & np.isfinite(r)
         if it == max_iter or not keep.any():
             break
+        done[todo[keep]] = False  # a polishing step must succeed too
         todo, xi = todo[keep], xi[keep]
         J = fr.screws[keep][:, :, pidx] * rows[:, None] * cols[pidx][None, :]
         JJt = J @ np.swapaxes(J, -1, -2)
@@ -162,7 +170,7 @@ def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
         else:
             hopeful = np.linalg.norm(total[todo], axis=-1) <= 1.5 * reach[todo]
             if it == 1:
-                hopeful &= size <= contraction * np.maximum(first[todo], 1e-12)
+                hopeful &= size <= limit[todo] * np.maximum(first[todo], 1e-12)
         if not hopeful.all():
             todo, step = todo[hopeful], step[hopeful]
             if todo.size == 0:
