@@ -32,7 +32,7 @@ from screwkit.kinematics.loop import (
     forward,
     layout,
 )
-from screwkit.kinematics.mode_frames import mode_from_configuration, start_in_half_open
+from screwkit.kinematics.mode_frames import mode_from_configuration, unwrap_runs
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion, format_inputs
 from screwkit.model.linkage import Linkage
 
@@ -191,17 +191,6 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     if not modes:
         raise _no_modes(linkage, X)
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=CSSP_SOLVER)
-
-
-def unwrap_runs(angle: Array, ok: NDArray[np.bool_]) -> Array:
-    """Continuous angles along each run of assembling samples, each run starting in (−π, π]."""
-    out = np.array(angle, dtype=float)
-    idx = np.flatnonzero(ok & np.isfinite(out))
-    if idx.size == 0:
-        return out
-    for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1):
-        out[run] = start_in_half_open(np.unwrap(out[run]))
-    return out
 
 
 def _branch_events(theta: Array, ok: NDArray[np.bool_]) -> list[str]:

@@ -45,7 +45,7 @@ from screwkit.model.linkage import Linkage
 MIN_SUBSTEP = 2.0 ** -8  # of the sample spacing: a front that cannot advance further ends
 FOLD_SIGMA = 0.2  # σ_min/σ_max of J_p below which a failed step may be a fold ahead
 MAX_CHUNK = 2048  # samples predicted at once by one front
-MAX_SPAN = 0.5  # rad (or length scale) the inputs may move over one chunk
+MAX_SPAN = 1.5  # rad (or length scale) the inputs may move over one chunk
 FIRST_STEP = 0.2  # largest Newton correction, relative to the predicted step
 CONTRACTION = 0.5  # largest ratio of the second Newton step to the first
 
@@ -75,7 +75,7 @@ class _Front:
     conf: Configuration  # one row
     prev: Configuration | None = None
     prev_t: float = 0.0
-    chunk: int = 2
+    chunk: int = 4
     substep: float = 0.0  # 0: chunk mode; else the sub-step (a fraction of the spacing)
     sigma: tuple[float, float] = (np.inf, np.nan)  # σ ratio of J_p at the front, and where
     sigma_before: tuple[float, float] = (np.inf, np.nan)

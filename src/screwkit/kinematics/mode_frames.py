@@ -39,6 +39,17 @@ def start_in_half_open(run: Array) -> Array:
     return np.asarray(run - 2 * np.pi * np.ceil((run[0] - np.pi) / (2 * np.pi)))
 
 
+def unwrap_runs(angle: Array, ok: NDArray[np.bool_]) -> Array:
+    """Continuous angles along each run of assembling samples, each run starting in (−π, π]."""
+    out = np.array(angle, dtype=float)
+    idx = np.flatnonzero(ok & np.isfinite(out))
+    if idx.size == 0:
+        return out
+    for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1):
+        out[run] = start_in_half_open(np.unwrap(out[run]))
+    return out
+
+
 def _variable_tables(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArray[np.bool_],
                      X: Array, qd: Array, qdd: Array) -> tuple[dict[str, Array], ...]:
     variables: dict[str, Array] = {}
@@ -51,8 +62,9 @@ def _variable_tables(linkage: Linkage, lay: Layout, conf: Configuration, mask: N
             if name in linkage.inputs:
                 values = X[:, linkage.inputs.index(name)].copy()  # exactly as given
             elif not lay.is_translation[f] and mask.any():
-                # continuous along the branch, starting in (−π, π] (as the closed forms do)
-                values[mask] = start_in_half_open(np.unwrap(values[mask]))
+                # continuous along each run of the branch, starting in (−π, π] (as the closed
+                # forms do)
+                values = unwrap_runs(values, mask)
             variables[name] = values
         velocities[name] = qd[:, f]
         accelerations[name] = qdd[:, f]
