@@ -289,9 +289,20 @@ def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configura
     q[:, cols[scal]] += delta[:, np.nonzero(scal)[0]]
     for j, k in lay.spherical_of_joint.items():
         idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
-        d = delta[:, idx]
-        sph[:, k] = sph[:, k] @ Rotation.from_rotvec(d).as_matrix()
+        sph[:, k] = sph[:, k] @ rotation_matrix(delta[:, idx])
     return Configuration(q, sph)
+
+
+def rotation_matrix(w: Array) -> Array:
+    """exp([w]×) of rotation vectors w (N, 3) by Rodrigues' formula (series near zero)."""
+    th2 = np.einsum("ni,ni->n", w, w)
+    th = np.sqrt(th2)
+    small = th2 < 1e-8
+    safe = np.where(small, 1.0, th)
+    a = np.where(small, 1.0 - th2 / 6.0, np.sin(safe) / safe)
+    b = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(safe)) / np.where(small, 1.0, th2))
+    K = _skew(w)
+    return np.asarray(np.eye(3) + a[:, None, None] * K + b[:, None, None] * (K @ K))
 
 
 def configuration_difference(a: Configuration, b: Configuration, lay: Layout) -> Array:
@@ -307,7 +318,19 @@ def configuration_difference(a: Configuration, b: Configuration, lay: Layout) ->
     for j, k in lay.spherical_of_joint.items():
         idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
         rel = np.swapaxes(b.spherical[:, k], -1, -2) @ a.spherical[:, k]
-        out[:, idx] = Rotation.from_matrix(rel).as_rotvec()
+        out[:, idx] = rotation_vector(rel)
+    return out
+
+
+def closure_error(R: Array, p: Array) -> Array:
+    """A first-order closure twist (½ vee(R − Rᵀ); p): equal to :func:`closure_twist` up to
+    second order near closure, with the same derivative there — the residual of a corrector
+    that starts close (a prediction), at a fraction of the cost of the exact logarithm."""
+    out = np.empty(p.shape[:-1] + (6,))
+    out[..., 0] = 0.5 * (R[..., 2, 1] - R[..., 1, 2])
+    out[..., 1] = 0.5 * (R[..., 0, 2] - R[..., 2, 0])
+    out[..., 2] = 0.5 * (R[..., 1, 0] - R[..., 0, 1])
+    out[..., 3:] = p
     return out
 
 

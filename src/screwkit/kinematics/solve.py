@@ -17,6 +17,7 @@ from screwkit.kinematics.loop import (
     Configuration,
     Layout,
     apply_increment,
+    closure_error,
     closure_twist,
     forward,
     layout,
@@ -145,7 +146,7 @@ def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
     todo = np.arange(N)
     for it in range(max_iter + 1):
         fr = forward(linkage, Configuration(q[todo], sph[todo]), lay, frames=False)
-        xi = closure_twist(fr.closure_R, fr.closure_p) * rows
+        xi = closure_error(fr.closure_R, fr.closure_p) * rows
         r = np.max(np.abs(xi), axis=-1)
         # within tolerance, one more (quadratically converging) step polishes to round-off;
         # stop when that no longer gains a digit
