@@ -49,11 +49,18 @@ def _dot(a: Array, b: Array) -> Array:
 
 
 def minimal_rotation_apply(a: Array, b: Array, v: Array) -> Array:
-    """M v for the least rotation M taking unit ``a`` to unit ``b`` (rows; a ≠ −b)."""
+    """M v for the least rotation M taking unit ``a`` to unit ``b`` (rows). Where b = −a every
+    half turn about an axis ⟂ a is least; the one about the axis ⟂ a nearest a coordinate
+    plane is taken."""
     k = cross(a, b)
     c = _dot(a, b)
-    return np.asarray(c[:, None] * v + cross(k, v)
-                      + (_dot(k, v) / (1.0 + c))[:, None] * k)
+    opposite = 1.0 + c < 1e-12
+    out = np.asarray(c[:, None] * v + cross(k, v)
+                     + (_dot(k, v) / np.where(opposite, 1.0, 1.0 + c))[:, None] * k)
+    for r in np.nonzero(opposite)[0]:
+        n = _perpendicular(a[r])
+        out[r] = 2.0 * (n @ v[r]) * n - v[r]
+    return out
 
 
 def signed_angle(a: Array, b: Array, axis: Array) -> Array:
