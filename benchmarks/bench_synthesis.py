@@ -43,7 +43,6 @@ def _best(fn: Any, repeat: int = 5) -> tuple[float, Any]:
 def _finite_difference_run(problem: Any) -> tuple[float, int]:
     """scipy least_squares, jac='2-point', same residuals / bounds / tolerances / x_scale."""
     from screwkit.synthesis.residuals import NotAssembled, ResidualModel
-    from screwkit.synthesis.solve import _bounds
 
     model = ResidualModel(problem)
     x0 = problem.start_vector()
@@ -55,7 +54,7 @@ def _finite_difference_run(problem: Any) -> tuple[float, int]:
         except (NotAssembled, ValueError):
             return np.full(model.n_residuals, big)
 
-    sol = least_squares(fun, x0, jac="2-point", bounds=_bounds(problem), method="trf",
+    sol = least_squares(fun, x0, jac="2-point", bounds=problem.bound_vectors(), method="trf",
                         x_scale="jac", max_nfev=20000, gtol=1e-14, xtol=1e-15, ftol=1e-15)
     return float(np.sum(sol.fun**2)), int(sol.nfev)
 
@@ -73,7 +72,7 @@ def run() -> list[dict[str, Any]]:
     for example in (8, 9):
         from screwkit.io.spec import load_spec
         from screwkit.io.synthesis_table import overlay_problem_from_spec
-        from screwkit.synthesis.overlay_route import synthesize_overlay
+        from screwkit.synthesis.overlay_synthesis import synthesize_overlay
 
         overlay, _ = overlay_problem_from_spec(load_spec(str(OVERLAY).format(example)))
         t_ov, outcomes = _best(lambda p=overlay: synthesize_overlay(p), repeat=3)

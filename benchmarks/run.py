@@ -1,5 +1,6 @@
-"""Benchmark runner (not tests): imports every ``benchmarks/bench_*.py``, calls its
-``run() -> list[dict]`` (keys: name, value, unit, target, note) and prints a rich table.
+"""Benchmark runner (not tests): runs every ``benchmarks/bench_*.py`` in a process of its own
+(so that what one benchmark loads — numba for pylinkage, Pinocchio — cannot slow another), calls
+its ``run() -> list[dict]`` (keys: name, value, unit, target, note) and prints a rich table.
 
     python benchmarks/run.py              # every benchmark
     python benchmarks/run.py dual         # only bench_dual.py (``bench_dual`` also works)
@@ -7,10 +8,8 @@
 
 from __future__ import annotations
 
-import importlib.util
 import sys
 from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 from rich.console import Console
@@ -34,13 +33,29 @@ def discover(names: list[str]) -> list[Path]:
     return chosen
 
 
-def load(path: Path) -> ModuleType:
-    spec = importlib.util.spec_from_file_location(path.stem, path)
-    if spec is None or spec.loader is None:
-        raise SystemExit(f"cannot import {path}")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+CHILD = """
+import importlib.util, json, math, sys
+spec = importlib.util.spec_from_file_location("bench", sys.argv[1])
+module = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(module)
+rows = module.run()
+for row in rows:
+    v = row.get("value")
+    if isinstance(v, float) and not math.isfinite(v):
+        row["value"] = None
+print(json.dumps(rows))
+"""
+
+
+def run_in_own_process(path: Path) -> list[dict[str, Any]]:
+    """``run()`` of one bench module in a fresh interpreter; its rows."""
+    import json
+    import subprocess
+
+    out = subprocess.run([sys.executable, "-c", CHILD, str(path)], check=True,
+                         capture_output=True, text=True)
+    rows: list[dict[str, Any]] = json.loads(out.stdout.strip().splitlines()[-1])
+    return rows
 
 
 def main(argv: list[str]) -> int:
@@ -49,7 +64,7 @@ def main(argv: list[str]) -> int:
     for column in ("module", "name", "value", "unit", "target", "note"):
         table.add_column(column, overflow="fold")
     for path in discover(argv):
-        rows: list[dict[str, Any]] = load(path).run()
+        rows = run_in_own_process(path)
         for row in rows:
             value = row.get("value")
             text = f"{value:.4g}" if isinstance(value, float) else str(value)

@@ -29,6 +29,8 @@ __version__ = "0.1.0"
 
 #: public name -> module that defines it
 _EXPORTS: dict[str, str] = {
+    # errors
+    "ScrewkitError": "screwkit.errors",
     # spec files
     "load_spec": "screwkit.io.spec",
     "Spec": "screwkit.io.spec",
@@ -72,6 +74,7 @@ _EXPORTS: dict[str, str] = {
 _ALIASES = {"synthesize": "run_synthesis"}
 
 __all__ = [
+    "ScrewkitError",
     "AssemblyError",
     "BalanceResult",
     "BalancingConfig",
@@ -133,6 +136,7 @@ if TYPE_CHECKING:
     from screwkit.dynamics.checks import ExternalLoad
     from screwkit.dynamics.inverse import inverse_dynamics, regressor
     from screwkit.dynamics.result import Dynamics
+    from screwkit.errors import ScrewkitError
     from screwkit.io.errors import SpecError
     from screwkit.io.spec import Spec, load_spec
     from screwkit.kinematics.coupler_curves import coupler_point_path

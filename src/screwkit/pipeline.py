@@ -5,7 +5,9 @@ run, whichever jobs run on it (docs/architecture.md)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -85,8 +87,10 @@ class Pipeline:
             raise BalancingError(f"{self.spec.path}: no [balancing] table; see docs/balancing.md")
         return self.spec.balancing
 
-    def balance(self, mode: ModeMotion | None = None) -> BalanceResult:
-        """The spec's ``[balancing]`` run on ``[motion] mode`` (or on ``mode`` if given)."""
+    def balance(self, mode: ModeMotion | None = None,
+                progress: Callable[[int, int], None] | None = None) -> BalanceResult:
+        """The spec's ``[balancing]`` run on ``[motion] mode`` (or on ``mode`` if given);
+        ``progress(done, total)`` follows a Pareto sweep."""
         s = self.spec
         config = self.balancing_config()
         if mode is None:
@@ -101,21 +105,32 @@ class Pipeline:
                 "Change [motion] start/stop/step to a range where the mode assembles, choose "
                 "another [motion] mode, or change the dimensions so that the linkage turns fully")
         return balance_with_config(s.linkage, mode, config, speed=s.speed,
-                                   gravity=self.gravity_vector, inputs=s.inputs)
+                                   gravity=self.gravity_vector, inputs=s.inputs,
+                                   progress=progress)
 
     def synthesis_config(self) -> SynthesisConfig:
         if self.spec.synthesis is None:
             raise SpecError(f"{self.spec.path}: no [synthesis] table; see docs/synthesis.md")
         return self.spec.synthesis
 
-    def synthesize(self, starts: int | None = None) -> SynthesisRun:
-        """The spec's ``[synthesis]`` run (either route), best result first."""
-        return run_synthesis(self.synthesis_config(), starts=starts)
+    def synthesize(self, starts: int | None = None,
+                   progress: Callable[[int, int], None] | None = None) -> SynthesisRun:
+        """The spec's ``[synthesis]`` run (either route), best result first;
+        ``progress(done, total)`` follows a multistart."""
+        return run_synthesis(self.synthesis_config(), starts=starts, progress=progress)
 
     def limits(self, dwell_tolerance: float = 1e-6, at: list[float] | None = None
                ) -> LimitPositions:
         """Limit positions and dwell orders (Bagci App. D); ``at`` in radians."""
         return limit_positions(self.spec.linkage, dwell_tolerance, at=at)
+
+    def simulate(self, fluctuation: float | None = None, cycles: int | None = None) -> Any:
+        """The spec's ``[drive]`` run forward in time (docs/simulation.md): a
+        :class:`~screwkit.simulation.spec_run.SpecSimulation`; with ``fluctuation`` the
+        flywheel is first sized for that coefficient of speed fluctuation."""
+        from screwkit.simulation.spec_run import simulate_spec
+
+        return simulate_spec(self.spec, fluctuation=fluctuation, cycles=cycles)
 
     def mobility(self) -> LinkageMobility:
         """Formula and Jacobian mobility at the first input where the loop assembles."""

@@ -16,17 +16,13 @@ import signal
 import stat
 import subprocess
 import sys
-import threading
 import time
 import tomllib
-import warnings
 from pathlib import Path
 from typing import Any
 
 import pytest
-from typer.testing import CliRunner
-
-from screwkit.cli.main import app
+from cli_runner import invoke_bounded
 
 HERE = Path(__file__).resolve().parent
 SPECS = HERE / "specs"
@@ -85,24 +81,6 @@ def _snapshot(folder: Path) -> dict[str, tuple[str, str]]:
     return out
 
 
-def _invoke(args: list[str], timeout: float) -> tuple[Any, list[str]]:
-    """Run the CLI in a thread; fail on a hang. Returns (result, warnings raised)."""
-    box: dict[str, Any] = {}
-
-    def run() -> None:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            box["result"] = CliRunner().invoke(app, args)
-        box["warnings"] = [f"{w.category.__name__}: {w.message}" for w in caught]
-
-    worker = threading.Thread(target=run, daemon=True)
-    worker.start()
-    worker.join(timeout)
-    if worker.is_alive():
-        pytest.fail(f"hang: still running after {timeout} s: screwkit {' '.join(args)}")
-    return box["result"], box["warnings"]
-
-
 def _flat(text: str) -> str:
     return " ".join(text.split())
 
@@ -116,7 +94,7 @@ def test_bad_input(case: dict[str, Any], tmp_path: Path) -> None:
     args = [a.replace("{d}", str(tmp_path)) for a in case["args"]]
     before = _snapshot(tmp_path)
     started = time.perf_counter()
-    result, caught = _invoke(args, case.get("timeout", TIMEOUT))
+    result, caught = invoke_bounded(args, case.get("timeout", TIMEOUT))
     took = time.perf_counter() - started
     output = result.output
     where = f"screwkit {' '.join(args)} ({took:.1f} s)\n{output}"

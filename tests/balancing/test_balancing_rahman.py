@@ -133,6 +133,6 @@ def test_cli_balance_json(tmp_path):
         register(app)
     r = CliRunner().invoke(app, ["balance", str(EXAMPLE), "--json", "--tables", str(tmp_path)])
     assert r.exit_code == 0, r.output
-    doc = json.loads(r.output[r.output.index("{"):])
+    doc = json.loads(r.stdout)  # the document alone on stdout; "wrote …" lines on stderr
     assert doc["measures"]["after"]["G"] < doc["measures"]["before"]["G"]
     assert (tmp_path / "balance_shaking_force.csv").is_file()

@@ -30,8 +30,12 @@ def test_analyze_json_shape_and_units(tmp_path):
         app, ["analyze", str(EXAMPLES / "bagci_fig7_rsrc.toml"), "--json", "-o", str(out)]
     )
     assert r.exit_code == 0, r.output
-    doc = json.loads(r.stdout)
-    assert doc == json.loads(out.read_text())
+    # -o writes the file and prints one line; --json alone prints the same document
+    assert r.stdout.strip().splitlines() == [r.stdout.strip()]
+    assert r.stdout.startswith(f"wrote {out} (JSON")
+    doc = json.loads(out.read_text())
+    printed = runner.invoke(app, ["analyze", str(EXAMPLES / "bagci_fig7_rsrc.toml"), "--json"])
+    assert json.loads(printed.stdout) == doc
     n = len(doc["input"])
     assert n == 36 and abs(doc["input"][1] - np.radians(10)) < 1e-12  # SI: radians
     assert len(doc["modes"]) == 2
@@ -214,6 +218,11 @@ def test_limits_reproduce_bagci_fig9_and_fig10_dwells():
 def test_limits_refuse_a_family_without_the_theory():
     r = runner.invoke(app, ["limits", str(EXAMPLES / "rssr_spatial.toml")])
     assert r.exit_code == 2 and "RSRC" in r.output
+
+
+def test_limits_refuse_the_cssp_with_a_message():
+    r = runner.invoke(app, ["limits", str(EXAMPLES / "rahman_cssp.toml")])
+    assert r.exit_code == 2 and "RSRC and the planar 4R" in r.output.replace("\n", " ")
 
 
 def test_analyze_plot_writes_a_png(tmp_path):

@@ -39,3 +39,70 @@ def test_written_file_message_keeps_its_path_whole(tmp_path):
                        text=True, cwd=folder, env=env, timeout=120)
     assert r.returncode == 0, r.stderr
     assert any(f"wrote {out}" in line for line in r.stdout.splitlines())
+
+
+BOX = set("│┃┏┓┗┛┡┩━─└┘┌┐╇╈┳┻╋┼├┤┬┴")
+DRIVER = r"""
+import json, sys
+from typer.testing import CliRunner
+from screwkit.cli.main import app
+runs = json.loads(sys.argv[1])
+out = {}
+for name, args in runs.items():
+    r = CliRunner().invoke(app, args)
+    out[name] = {"code": r.exit_code, "stdout": r.stdout, "stderr": r.stderr}
+print(json.dumps(out))
+"""
+
+
+def test_every_command_fits_80_columns_in_a_long_working_directory(tmp_path):
+    """COLUMNS=80 and a 150-character working directory: no table line is wider than 80
+    columns; every message that names a path names it whole, on one line."""
+    import json
+
+    folder = _long_folder(tmp_path)
+    ex = Path(__file__).parents[2] / "examples"
+    demo = folder / "ex"
+    demo.mkdir()
+    (demo / "fourbar.toml").write_text((ex / "fourbar_dynamics.toml").read_text())
+    missing = str(folder / "no_such_spec.toml")
+    runs = {
+        "validate": ["validate", str(ex / "rahman_cssp.toml")],
+        "analyze": ["analyze", str(ex / "rahman_cssp.toml"), "--method", "generic"],
+        "analyze -o": ["analyze", str(ex / "rssr_spatial.toml"), "-o", str(folder / "a.csv")],
+        "limits": ["limits", str(ex / "bagci_fig9_dwell.toml"), "--at", "90"],
+        "mobility": ["mobility", str(ex / "rccc_loop.toml")],
+        "dynamics": ["dynamics", str(ex / "rsrc_fig7_dynamics.toml"), "--csv",
+                     str(folder / "d.csv")],
+        "balance": ["balance", str(ex / "rahman_cssp_balance.toml")],
+        "synthesize": ["synthesize", str(ex / "bagci_example8_overlay.toml")],
+        "report": ["report", str(ex / "bagci_example3_4r.toml"), "-o", str(folder / "r.html")],
+        "demo": ["demo", str(demo), "--output-dir", str(folder / "out"), "--no-plots",
+                 "--no-reports"],
+        "simulate": ["simulate", str(ex / "rahman_cssp_drive.toml"), "--cycles", "3"],
+        "export-mjcf": ["export-mjcf", str(ex / "rahman_cssp.toml"), "-o", str(folder / "m.xml")],
+    }
+    errors = {f"{name} error": [name, missing] for name in
+              ("analyze", "limits", "mobility", "dynamics", "balance", "synthesize", "report",
+               "simulate")}
+    errors["export-mjcf error"] = ["export-mjcf", missing, "-o", str(folder / "x.xml")]
+    env = {**os.environ, "COLUMNS": "80"}
+    r = subprocess.run([sys.executable, "-c", DRIVER, json.dumps({**runs, **errors})],
+                       capture_output=True, text=True, cwd=folder, env=env, timeout=600)
+    assert r.returncode == 0, r.stderr
+    results = json.loads(r.stdout)
+    for name in runs:
+        res = results[name]
+        assert res["code"] == 0, (name, res)
+        table_lines = [line for line in res["stdout"].splitlines() if BOX & set(line)]
+        assert table_lines or name in ("validate", "mobility", "analyze -o", "report",
+                                       "export-mjcf"), name
+        wide = [line for line in table_lines if len(line) > 80]
+        assert not wide, f"{name}: table lines over 80 columns:\n" + "\n".join(wide)
+    assert f"wrote {folder / 'a.csv'} (" in results["analyze -o"]["stdout"]
+    assert f"wrote {folder / 'd.csv'}" in results["dynamics"]["stdout"].splitlines()
+    for name in errors:
+        res = results[name]
+        assert res["code"] == 2, (name, res)
+        assert any(missing in line for line in res["stderr"].splitlines()), (name, res)
+        assert "Traceback" not in res["stderr"]

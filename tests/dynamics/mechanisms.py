@@ -3,7 +3,8 @@
 Dimensions are drawn (fixed seeds) from ranges in which the input crank turns fully, so one
 assembly mode covers the whole 0–360° sweep; the S–S rods (RSSR coupler, CSSP rod) get
 axisymmetric line-mass inertia about their own axis (zero axial moment, CoM on the axis) — the
-rule under which their idle spin carries no load (docs/dynamics.md).
+rule under which their idle spin carries no load (docs/dynamics.md).  `assert_same_dynamics`
+compares two ``Dynamics`` field by field.
 """
 
 from __future__ import annotations
@@ -11,8 +12,10 @@ from __future__ import annotations
 from functools import cache
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
+from screwkit.dynamics import Dynamics
 from screwkit.kinematics.generic_motion import generic_motion as motion
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.model.families import cssp, fourbar, rccc, rsrc, rssr
@@ -139,3 +142,36 @@ def fine_sweep(linkage: Linkage, mode: ModeMotion, refine: int) -> tuple[np.ndar
     R = np.einsum("ij,nljk->nlik", bR, fr.after_R[:, :L])
     p = np.einsum("ij,nlj->nli", bR, fr.after_p[:, :L]) + bp
     return R, p
+
+
+AGREE = 1e-12  # of the largest joint load: both paths are exact, this is round-off
+
+
+def assert_same_dynamics(a: Dynamics, b: Dynamics, ell: float, tol: float = AGREE) -> None:
+    """Every field of two Dynamics equal, loads to ``tol`` of the largest joint load."""
+    scale = b.residual_scale
+    assert a.residual_scale == pytest.approx(scale, rel=tol)
+    force, moment = tol * scale, tol * scale * ell
+    np.testing.assert_array_equal(a.valid, b.valid)
+    np.testing.assert_array_equal(a.inputs, b.inputs)
+    assert a.input_names == b.input_names
+    np.testing.assert_array_equal(a.moment_point, b.moment_point)
+    np.testing.assert_array_equal(a.gravity, b.gravity)
+    np.testing.assert_array_equal(a.joint_centres, b.joint_centres)
+    np.testing.assert_allclose(a.shaking_force, b.shaking_force, rtol=0, atol=force)
+    np.testing.assert_allclose(a.shaking_moment, b.shaking_moment, rtol=0, atol=moment)
+    assert a.reactions.keys() == b.reactions.keys()
+    for joint in a.reactions:
+        np.testing.assert_allclose(a.reactions[joint]["force"], b.reactions[joint]["force"],
+                                   rtol=0, atol=force, err_msg=joint)
+        np.testing.assert_allclose(a.reactions[joint]["moment"], b.reactions[joint]["moment"],
+                                   rtol=0, atol=moment, err_msg=joint)
+    assert a.efforts.keys() == b.efforts.keys()
+    for name in a.efforts:
+        unit = moment if name.endswith(".theta") else force
+        np.testing.assert_allclose(a.efforts[name], b.efforts[name], rtol=0, atol=unit,
+                                   err_msg=name)
+    np.testing.assert_allclose(a.residual, b.residual, rtol=0, atol=force)
+    assert a.indeterminacy.count == b.indeterminacy.count
+    assert a.indeterminacy.idle_freedoms == b.indeterminacy.idle_freedoms
+    np.testing.assert_array_equal(a.indeterminacy.directions, b.indeterminacy.directions)

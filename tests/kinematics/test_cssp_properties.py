@@ -12,10 +12,10 @@ from hypothesis import strategies as st
 
 from screwkit.kinematics.cssp import (
     CSSPDimensions,
-    _slider_and_rod,
     assembly_discriminant,
     cssp_motion,
     cssp_positions,
+    slider_and_rod,
 )
 
 SETTINGS = settings(derandomize=True, max_examples=60, deadline=None)
@@ -107,7 +107,7 @@ def test_rates_equal_complex_step_derivatives(case: dict[str, Any]) -> None:
     s1 = np.full(n, dims.s1)
     t = 1j * H
     # along the path θ1(t) = θ1 + θ̇1 t + ½θ̈1 t², s1(t) likewise
-    stepped = _slider_and_rod(
+    stepped = slider_and_rod(
         dims,
         theta + w * t + 0.5 * wd * t**2,
         w + wd * t,

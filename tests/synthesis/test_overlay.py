@@ -14,13 +14,13 @@ import typer
 from typer.testing import CliRunner
 
 from screwkit.cli.synthesize_cmd import register
+from screwkit.dual.spatial import wrap_angle
 from screwkit.io.spec import load_spec
 from screwkit.io.synthesis_table import (
     SynthesisConfigError,
     overlay_problem_from_spec,
     problem_from_spec,
 )
-from screwkit.kinematics.quartic import wrap_angle
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
 from screwkit.synthesis.overlay import (
     OverlayDwell,
@@ -29,7 +29,7 @@ from screwkit.synthesis.overlay import (
     fit_overlay_circles,
     mechanism_from_circle,
 )
-from screwkit.synthesis.overlay_route import OverlayOutcome, OverlayProblem, synthesize_overlay
+from screwkit.synthesis.overlay_synthesis import OverlayOutcome, OverlayProblem, synthesize_overlay
 from screwkit.synthesis.solve import SynthesisError
 from screwkit.synthesis.targets import ScrewTarget, data_function, library_function
 
@@ -236,7 +236,7 @@ def test_cli_overlay_json_and_plot(tmp_path: Path) -> None:
     r = runner.invoke(app, ["synthesize", str(EXAMPLES / "bagci_example9_overlay.toml"), "--json",
                             "--plot", str(png)])
     assert r.exit_code == 0, r.output
-    doc = json.loads(r.output)
+    doc = json.loads(r.stdout)  # the document alone on stdout ("wrote …" goes to stderr)
     for key in ("dimensions", "mode", "E_phi", "E_S", "rmse", "rmse_phi", "rows", "status",
                 "range_check", "alternatives"):
         assert key in doc

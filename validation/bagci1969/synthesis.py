@@ -8,7 +8,7 @@ points (SPEC / PROGRAMS.md §6), so the test is: ours is a true local optimum (p
 ~ 0) and its E is no larger than the seed's.
 
 Examples 8 and 9 (graphical overlay, no numbers printed) are re-done from their spec files
-with `screwkit.synthesis.overlay_route.synthesize_overlay`; Example 5 by the overlay with two
+with `screwkit.synthesis.overlay_synthesis.synthesize_overlay`; Example 5 by the overlay with two
 dwells (it must be Program C's construction).  Also: the equality-constrained route against the
 parameters of constraint (Example 4), and the whole-range check of the printed Example 7
 mechanism (it does not assemble for theta0 ~ 299-318 deg).
@@ -39,12 +39,12 @@ EXAMPLES = ROOT / "examples"
 
 from screwkit.io.spec import load_spec  # noqa: E402
 from screwkit.io.synthesis_table import overlay_problem_from_spec, problem_from_spec  # noqa: E402
-from screwkit.synthesis.equality import (  # noqa: E402
+from screwkit.synthesis.equality_constrained import (  # noqa: E402
     RangeConstraint,
     synthesize_equality_constrained,
 )
 from screwkit.synthesis.overlay import OverlayDwell, ellipse_curvature_radius  # noqa: E402
-from screwkit.synthesis.overlay_route import (  # noqa: E402
+from screwkit.synthesis.overlay_synthesis import (  # noqa: E402
     OverlayOutcome,
     OverlayProblem,
     synthesize_overlay,
@@ -233,7 +233,7 @@ def report() -> str:
               "No numbers are printed in the seed (Figs. 25, 26). The overlay fit puts one output",
               "circle through the family of coupler circles (`screwkit.synthesis.overlay`); each",
               "circle's mechanism is re-analysed with the closed form on one branch",
-              "(`overlay_route.synthesize_overlay`, spec files examples/bagci_example{8,9}_overlay.toml).",
+              "(`overlay_synthesis.synthesize_overlay`, spec files examples/bagci_example{8,9}_overlay.toml).",
               "Lengths in inches; the RMSEs are those of the analysed mechanism.", ""]
     lines += _overlay_lines()
     lines += ["", "## Notes and deviations", "",

@@ -150,7 +150,7 @@ class ProgramAngle:
     velocity_ls_residual: float
 
 
-def _program_rates(q: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray, float]:
+def program_rates(q: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray, float]:
     """SPEC §1.4: least squares VM·q̇ = VV, then VM·q̈ = AV (θ̈1 = ṡ1 = s̈1 = 0). Unknown order
     (θ̇2, θ̇3, η̇2, η̇3, ṡ4)."""
     th2, et2, th3, _, _ = q
@@ -231,7 +231,7 @@ def seed_program_step1(
             x3 = mats["M1L2"][0][:, 0]  # rod axis x3 in {1}: first column of M1R·L2R
             pin = np.array([A1_IN * np.cos(theta1), A1_IN * np.sin(theta1), S1_IN])
             ball = np.array([-A4_IN, -q[4] * np.sin(alpha4), -q[4] * np.cos(alpha4)])
-            dot, ddot, ls_res = _program_rates(q, omega)
+            dot, ddot, ls_res = program_rates(q, omega)
             results.append(
                 ProgramAngle(
                     theta1_deg=float(th_deg),

@@ -150,7 +150,7 @@ def program_kinematics() -> tuple[list[AngleKinematics], list[AngleKinematics]]:
     for angles in kin.seed_program_step1():
         rows = []
         for p in angles:
-            dot, ddot, _ = kin._program_rates(p.q, OMEGA)
+            dot, ddot, _ = kin.program_rates(p.q, OMEGA)
             rows.append(AngleKinematics(np.radians(p.theta1_deg), p.q.copy(), dot, ddot))
         out.append(rows)
     return out[0], out[1]

@@ -5,7 +5,7 @@ one assembly mode (docs/balancing.md, "Spec file")."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -50,9 +50,10 @@ class BalancingConfig:
 
 def balance_with_config(linkage: Linkage, mode: ModeMotion, config: BalancingConfig, *,
                         speed: float, gravity: ArrayLike | None = None,
-                        inputs: ArrayLike | None = None) -> BalanceResult:
+                        inputs: ArrayLike | None = None,
+                        progress: Callable[[int, int], None] | None = None) -> BalanceResult:
     """Run ``config`` on one assembly mode: the QP for its weights, then the SDP bound and the
-    Pareto sweep when asked for. ``speed`` is the input speed ω of the motion (the default for
+    Pareto sweep when asked for (``progress(done, total)`` after each of its weightings). ``speed`` is the input speed ω of the motion (the default for
     the normalisation); ``gravity`` the gravitational acceleration vector (used when
     ``config.gravity``)."""
     nt = config.normalisation
@@ -73,5 +74,5 @@ def balance_with_config(linkage: Linkage, mode: ModeMotion, config: BalancingCon
     if config.pareto is not None:
         from screwkit.balancing.pareto import pareto_front
 
-        result = replace(result, pareto=pareto_front(setup, *config.pareto))
+        result = replace(result, pareto=pareto_front(setup, *config.pareto, progress=progress))
     return result

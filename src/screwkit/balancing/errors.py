@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+from screwkit.errors import InputError
 
-class BalancingError(ValueError):
+
+class BalancingError(InputError):
     """A balancing problem that cannot be set up or solved as asked."""
 
 

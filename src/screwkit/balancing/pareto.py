@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import itertools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,8 +48,10 @@ def non_dominated(values: Array, rtol: float = 1e-9) -> NDArray[np.bool_]:
 
 
 def pareto_front(setup: BalancingSetup, measures: Sequence[str] = ("F", "T", "T0"),
-                 divisions: int = 4) -> ParetoFront:
-    """Solve the balancing QP for every weight vector of a simplex grid over ``measures``."""
+                 divisions: int = 4,
+                 progress: Callable[[int, int], None] | None = None) -> ParetoFront:
+    """Solve the balancing QP for every weight vector of a simplex grid over ``measures``;
+    ``progress(done, total)`` is called after each weighting."""
     bad = [k for k in measures if k not in MEASURES]
     if bad or len(measures) < 2:
         raise BalancingError(f"pareto measures must be at least two of {list(MEASURES)}; "
@@ -58,9 +60,11 @@ def pareto_front(setup: BalancingSetup, measures: Sequence[str] = ("F", "T", "T0
         raise BalancingError(f"divisions must be >= 1; got {divisions}")
     grid = simplex_grid(len(measures), divisions)
     vals, designs = [], []
-    for w in grid:
+    for i, w in enumerate(grid):
         res = solve_setup(setup, dict(zip(measures, w, strict=True)))
         vals.append([res.measures_after[k] for k in measures])
         designs.append(res.after)
+        if progress is not None:
+            progress(i + 1, len(grid))
     values = np.array(vals)
     return ParetoFront(tuple(measures), grid, values, np.array(designs), non_dominated(values))

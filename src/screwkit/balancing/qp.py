@@ -42,7 +42,9 @@ class QPSolution:
     polished: bool
 
 
-def _clarabel():  # type: ignore[no-untyped-def]
+def load_clarabel():  # type: ignore[no-untyped-def]
+    """The ``clarabel`` module (interior-point QP/conic solver, Apache-2.0) used by the QP and
+    SDP balancing solves; MissingSolverError with the install command if it is missing."""
     try:
         import clarabel
     except ImportError as exc:  # pragma: no cover - clarabel is a hard dependency
@@ -71,7 +73,7 @@ def solve_qp(
     """Minimise xᵀQx + 2qᵀx under the linear constraints (module docstring)."""
     from scipy import sparse
 
-    clarabel = _clarabel()
+    clarabel = load_clarabel()
     n = Q.shape[0]
     Ae, be = _normalise_rows(np.asarray(A_eq, float).reshape(-1, n), np.asarray(b_eq, float))
     Al, bl = _normalise_rows(np.asarray(A_le, float).reshape(-1, n), np.asarray(b_le, float))

@@ -1,6 +1,6 @@
 """The result of a balancing run: the design before and after, the load measures, per-sample
 loads (like Rahman's Tables 5.2–5.7), new mass properties (like Table 5.1), and how unique the
-optimum is. JSON via :meth:`BalanceResult.as_dict`; plots via :mod:`screwkit.balancing.plots`."""
+optimum is. JSON via :meth:`BalanceResult.as_dict`; plots via :mod:`screwkit.report.balance_plots`."""
 
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ from screwkit.model.mass import MassProperties
 if TYPE_CHECKING:  # the SDP bound and the Pareto sweep are built on top of BalanceResult
     from screwkit.balancing.pareto import ParetoFront
     from screwkit.balancing.sdp import RedistributionBound
+    from screwkit.tables import ResultTable, UnitChoice
 
 Array = NDArray[np.float64]
 
@@ -139,6 +140,21 @@ class BalanceResult:
                 rows.append([link, f"{lab} about CoM (kg*m^2)", float(mp0.inertia[i, j]),
                              float(mp1.inertia[i, j])])
         return rows
+
+    def table(self) -> ResultTable:
+        """One row per input sample: every per-sample load before and after (SI;
+        :mod:`screwkit.balancing.result_table`)."""
+        from screwkit.balancing.result_table import balance_table
+
+        return balance_table(self)
+
+    def to_dataframe(self, units: UnitChoice | None = None) -> Any:
+        """:meth:`table` as a pandas DataFrame, headers with units (needs pandas)."""
+        return self.table().to_dataframe(units)
+
+    def to_csv(self, path: Any, units: UnitChoice | None = None) -> None:
+        """:meth:`table` as CSV (``shaking_force_before [N]`` …)."""
+        self.table().to_csv(path, units)
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-able (docs/balancing.md documents every key)."""

@@ -20,7 +20,7 @@ from screwkit.balancing.balance import BalancingSetup
 from screwkit.balancing.errors import BalancingError, SolverError
 from screwkit.balancing.measures import MEASURES
 from screwkit.balancing.problem import check_weights, consistency_constraints, quadratic_objective
-from screwkit.balancing.qp import _clarabel
+from screwkit.balancing.qp import load_clarabel
 from screwkit.balancing.variables import DesignVariables, LinearConstraint, VariableBlock
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 
@@ -82,7 +82,7 @@ def redistribution_bound(
     of the mass of the links in ``ellipsoids`` ({link: (centre, semi_axes)}, link frame, m)."""
     from scipy import sparse
 
-    clarabel = _clarabel()
+    clarabel = load_clarabel()
     w = check_weights(weights)
     lk = setup.linkage
     names = [link.name for link in lk.links]

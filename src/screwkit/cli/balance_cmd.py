@@ -1,5 +1,7 @@
 """``screwkit balance SPEC``: optimum balancing from a spec file's [balancing] table
-(docs/balancing.md). ``register(app)`` adds the command to the main Typer app."""
+(docs/balancing.md): the normalised measures (Rahman eq. 4.1), the RMS loads they stand for in
+N and N·m, the design variables with the bounds they press on, the link masses; ``--csv`` and
+``-o`` get the per-sample loads before and after. ``register(app)`` adds the command."""
 
 from __future__ import annotations
 
@@ -7,6 +9,8 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+
+from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 
 def direction_range(d: Any) -> str:
@@ -20,71 +24,141 @@ def direction_range(d: Any) -> str:
     return f"range {end(d.low, 'below')} … {end(d.high, 'above')}, relative units"
 
 
+def _change(b: float, a: float) -> str:
+    return "new" if b == 0 else f"{100.0 * (a - b) / b:+.3f}"
+
+
+def show_balance(spec: Any, res: Any, doc: dict[str, Any], units: Any,
+                 written: list[str]) -> None:
+    """The terminal view: measures, RMS loads, variables (bounds flagged), link masses."""
+    from rich.markup import escape
+
+    from screwkit.balancing.measures import MEASURE_TITLES, MEASURES
+    from screwkit.cli.common import console
+    from screwkit.cli.formatting import TextColumn, number, print_columns
+
+    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
+    gravity = "on" if res.dynamics_before.gravity_on else "off ([balancing] gravity = true adds it)"
+    console.print(f"assembly mode {spec.mode}; gravity {gravity}", highlight=False,
+                  markup=False)
+    keys = (*MEASURES, "G")
+    ch = res.changes()
+    print_columns(console, "load measures, normalised mean squares (Rahman eq. 4.1)", [
+        TextColumn("measure", [f"{MEASURE_TITLES.get(k, 'objective')} ({k})" for k in keys],
+                   "left"),
+        TextColumn("before", [number(res.measures_before[k]) for k in keys]),
+        TextColumn("after", [number(res.measures_after[k]) for k in keys]),
+        TextColumn("change %", ["n/a (round-off)" if ch[k] is None else f"{ch[k]:+.3f}"
+                                for k in keys])])
+    rms = doc["measures_rms"]
+    print_columns(console, "RMS loads over the cycle", [
+        TextColumn("load", [f"{MEASURE_TITLES[k]} ({k})" for k in MEASURES], "left"),
+        TextColumn("unit", [units.label(rms["kinds"][k]) for k in MEASURES], "left"),
+        TextColumn("before", [number(units.show(rms["kinds"][k], rms["before"][k]))
+                              for k in MEASURES]),
+        TextColumn("after", [number(units.show(rms["kinds"][k], rms["after"][k]))
+                             for k in MEASURES]),
+        TextColumn("change %", ["—" if rms["change_percent"][k] is None
+                                else f"{rms['change_percent'][k]:+.3f}" for k in MEASURES])])
+    bounds = {b["variable"]: b["bound"] for b in doc["active_bounds"]}
+    kinds = ["mass_moment" if n.rsplit(".", 1)[-1] in ("mx", "my", "mz") else "mass"
+             for n in res.names]
+    print_columns(console, "design variables", [
+        TextColumn("variable", list(res.names), "left"),
+        TextColumn("unit", [units.label(k) for k in kinds], "left"),
+        TextColumn("before", [number(units.show(k, b)) for k, b in zip(kinds, res.before,
+                                                                       strict=True)]),
+        TextColumn("after", [number(units.show(k, a)) for k, a in zip(kinds, res.after,
+                                                                      strict=True)]),
+        TextColumn("change %", [_change(b, a) for b, a in zip(res.before, res.after,
+                                                              strict=True)]),
+        TextColumn("bound", [f"at {bounds[n]}" if n in bounds else "" for n in res.names],
+                   "left")])
+    links = list(res.link_mass_before)
+    print_columns(console, f"link masses [{units.label('mass')}]", [
+        TextColumn("link", links, "left"),
+        TextColumn("before", [number(units.show("mass", res.link_mass_before[k]))
+                              for k in links]),
+        TextColumn("after", [number(units.show("mass", res.link_mass_after[k])) for k in links]),
+        TextColumn("change %", [_change(res.link_mass_before[k], res.link_mass_after[k])
+                                for k in links])])
+    if bounds:
+        console.print("active bounds: " + "; ".join(
+            escape(b["constraint"]) for b in doc["active_bounds"]), highlight=False)
+    verdict = "could not determine" if res.unique is None else str(res.unique)
+    console.print(f"unique optimum: {verdict}", highlight=False)
+    for d in res.directions:
+        console.print(escape(f"  free direction {d.direction} ({direction_range(d)})"),
+                      highlight=False)
+    bound = doc.get("redistribution_bound")
+    if bound:
+        console.print(f"bound over all consistent redistributions (SDP): G = "
+                      f"{bound['measures_after']['G']:.6g}", highlight=False)
+    if "pareto" in doc:
+        eff = sum(doc["pareto"]["efficient"])
+        console.print(f"Pareto sweep over {doc['pareto']['measures']}: "
+                      f"{len(doc['pareto']['values'])} weightings, {eff} non-dominated",
+                      highlight=False)
+    for note in res.notes:
+        console.print(escape(f"note: {note}"), highlight=False)
+    for p in written:
+        console.print(f"wrote {escape(p)}", highlight=False)
+
+
 def register(app: typer.Typer) -> None:
     """Add the ``balance`` command to ``app``."""
 
     @app.command()
     def balance(
         spec: Annotated[Path, typer.Argument(help="Spec file (TOML) with a [balancing] table.")],
-        as_json: Annotated[bool, typer.Option("--json", help="Print one JSON document (SI units) instead of tables.")] = False,
-        output: Annotated[Path | None, typer.Option("--output", "-o", help="Write the JSON document to this file (atomically).")] = None,
-        tables: Annotated[Path | None, typer.Option("--tables", help="Write per-sample CSV tables (before/after) into this folder.")] = None,
-        plots: Annotated[Path | None, typer.Option("--plots", help="Write PNG plots of each load over the cycle into this folder (needs matplotlib).")] = None,
+        as_json: JsonOpt = False,
+        output: OutputOpt = None,
+        csv: CsvOpt = None,
+        units: UnitsOpt = "spec",
+        unit: UnitOpt = None,
+        full: FullOpt = False,
+        tables: Annotated[Path | None, typer.Option("--tables", help="Write per-sample CSV tables (before/after, SI) and the mass properties into this folder.")] = None,
+        plots: Annotated[Path | None, typer.Option("--plots", help="Write PNG plots of each load over the cycle (display units) into this folder (needs matplotlib).")] = None,
     ) -> None:
         """Choose the links' point masses (and counterweights) that minimise the weighted load measures over the cycle; print the before/after summary."""
-        from rich.markup import escape
-        from rich.table import Table
-
-        from screwkit.cli.common import check_paths, console
-        from screwkit.cli.common import emit as _emit
-        from screwkit.cli.common import guard as _guard
+        from screwkit.cli.common import guard
+        from screwkit.cli.outputs import Outputs
+        from screwkit.cli.progress import progress_bar
         from screwkit.io.balance_tables import write_balance_tables
+        from screwkit.io.documents import balance_document
         from screwkit.io.spec import load_spec
         from screwkit.pipeline import Pipeline
 
-        check_paths([spec], {"--output": output}, {"--tables": tables, "--plots": plots})
-        s = _guard(lambda: load_spec(spec))
-        res = _guard(lambda: Pipeline(s).balance())
-        doc: dict[str, Any] = res.as_dict()
+        out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
+                              unit=unit, full=full,
+                              folders={"--tables": tables, "--plots": plots})
+        s = guard(lambda: load_spec(spec))
+        du = out.units_for(s.units)
+        pareto = s.balancing.pareto if s.balancing is not None else None
+        total = None if pareto is None else pareto_size(pareto)
+        with progress_bar("Pareto sweep", total, enabled=pareto is not None) as advance:
+            res = guard(lambda: Pipeline(s).balance(progress=advance))
+        doc = balance_document(res)
         written: list[str] = []
         if tables is not None:
-            written += _guard(lambda: write_balance_tables(res, str(tables)))
+            written += guard(lambda: write_balance_tables(res, str(tables)))
         if plots is not None:
-            from screwkit.balancing.plots import write_plots
+            from screwkit.report.balance_plots import write_pareto_plot, write_plots
 
-            written += _guard(lambda: write_plots(res, plots))
+            written += guard(lambda: write_plots(res, plots, units=du))
             front = res.pareto
             if front is not None:
-                from screwkit.balancing.plots import write_pareto_plot
-
-                written.append(_guard(lambda: write_pareto_plot(
+                written.append(guard(lambda: write_pareto_plot(
                     front, Path(plots) / "balance_pareto.png")))
+        for p in written:
+            out.note_written(p)
+        out.deliver(document=lambda: doc, table=res.table,
+                    show=lambda: show_balance(s, res, doc, du, []), units=du)
 
-        def table() -> None:
-            console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
-            t = Table(title="optimum balancing: before / after")
-            for col in ("quantity", "before", "after", "change %"):
-                t.add_column(col, justify="right")
-            for row in res.summary_table():
-                t.add_row(*row)
-            console.print(t)
-            verdict = "could not determine" if res.unique is None else str(res.unique)
-            console.print(f"unique optimum: {verdict}", highlight=False)
-            for d in res.directions:
-                console.print(escape(f"  free direction {d.direction} ({direction_range(d)})"),
-                              highlight=False)
-            bound = doc.get("redistribution_bound")
-            if bound:
-                console.print(f"bound over all consistent redistributions (SDP): G = "
-                              f"{bound['measures_after']['G']:.6g}", highlight=False)
-            if "pareto" in doc:
-                eff = sum(doc["pareto"]["efficient"])
-                console.print(f"Pareto sweep over {doc['pareto']['measures']}: "
-                              f"{len(doc['pareto']['values'])} weightings, {eff} non-dominated",
-                              highlight=False)
-            for note in res.notes:
-                console.print(escape(f"note: {note}"), highlight=False)
-            for p in written:
-                console.print(f"wrote {escape(p)}", highlight=False)
 
-        _emit(doc, as_json, output, table, [spec])
+def pareto_size(pareto: tuple[tuple[str, ...], int]) -> int:
+    """The number of weightings of a Pareto sweep over m measures with d divisions."""
+    from math import comb
+
+    measures, divisions = pareto
+    return comb(divisions + len(measures) - 1, len(measures) - 1)

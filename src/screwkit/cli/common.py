@@ -1,40 +1,33 @@
-"""What every ``screwkit`` subcommand shares: the consoles, the ``--json``/``--output`` options,
-and the rule that a user mistake exits with status 2 and a one-paragraph message."""
+"""What every ``screwkit`` subcommand shares: the consoles and the rule that a user mistake
+exits with status 2 and a one-paragraph message (the output options: :mod:`screwkit.cli.outputs`).
+
+Messages are never wrapped (``soft_wrap``): one message is one line whatever ``COLUMNS`` says
+and whether or not the output is a terminal, so paths stay whole for grep and copy-paste. Only
+tables are fitted to the width (:mod:`screwkit.cli.formatting`): the terminal's, or ``COLUMNS``,
+or 80 for a pipe or a file."""
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Annotated, Any, TypeVar
+from typing import NoReturn, TypeVar
 
-import numpy as np
 import typer
 from rich.console import Console
 from rich.markup import escape
 
-# soft_wrap: a message is one line whatever the width (paths stay whole for grep and copy-paste);
-# only tables are fitted to the width
 console = Console(soft_wrap=True)
-if not console.is_terminal:
-    console.width = max(console.width, 160)  # files and pipes get the full tables
 err_console = Console(stderr=True, soft_wrap=True)
 
 T = TypeVar("T")
-
-JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON document (SI units) instead of tables.")]
-OutputOpt = Annotated[Path | None, typer.Option("--output", "-o", help="Write the JSON document to this file (atomically).")]
 
 
 def user_errors() -> tuple[type[BaseException], ...]:
     """Exceptions that mean the user's input is wrong (every one is a ValueError subclass or a
     missing file); anything else is a bug and keeps its traceback."""
-    from screwkit.io.spec import SpecError
-    from screwkit.io.units import UnitError
-    from screwkit.kinematics.motion import AssemblyError
-    from screwkit.model.linkage import LinkageError
+    from screwkit.errors import ScrewkitError
 
-    return (SpecError, UnitError, AssemblyError, LinkageError, ValueError, OSError)
+    return (ScrewkitError, ValueError, OSError)
 
 
 def guard(fn: Callable[[], T]) -> T:
@@ -44,6 +37,8 @@ def guard(fn: Callable[[], T]) -> T:
     ``fn`` (code that expects them, e.g. at samples where a mechanism does not assemble, says
     so with its own ``np.errstate``): a warning printed halfway through a run would be a result
     that looks right but is not. They exit with status 2 and a sentence instead."""
+    import numpy as np
+
     try:
         with np.errstate(over="raise", divide="raise", invalid="raise"):
             return fn()
@@ -56,6 +51,12 @@ def guard(fn: Callable[[], T]) -> T:
     except user_errors() as exc:
         err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
         raise typer.Exit(2) from None
+
+
+def user_error(message: str) -> NoReturn:
+    """Print ``message`` as a user error (one line) and exit with status 2."""
+    err_console.print(f"[bold red]error:[/] {escape(message)}", highlight=False)
+    raise typer.Exit(2)
 
 
 def attempt(fn: Callable[[], T]) -> tuple[bool, T | None]:
@@ -74,19 +75,3 @@ def check_paths(inputs: Sequence[Path], files: Mapping[str, Path | None],
     from screwkit.io.outputs import check_outputs
 
     guard(lambda: check_outputs(inputs, files, folders))
-
-
-def emit(doc: dict[str, Any], as_json: bool, output: Path | None, table: Callable[[], None],
-         inputs: Sequence[Path] = ()) -> None:
-    """Write ``doc`` atomically to ``output`` if given; print it as JSON or as tables."""
-    from screwkit.io.results import dumps, write_atomic
-
-    text = guard(lambda: dumps(doc))
-    if output is not None:
-        guard(lambda: write_atomic(output, text + "\n", inputs, "--output"))
-    if as_json:
-        sys.stdout.write(text + "\n")
-    else:
-        table()
-        if output is not None:
-            console.print(f"wrote {output}")

@@ -6,24 +6,21 @@ the spec's ``[synthesis]`` table in docs/synthesis.md).  Registered on the main 
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 from rich.markup import escape
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-from rich.table import Table
 
-from screwkit.cli.common import console, err_console
+from screwkit.cli.common import console
 from screwkit.cli.common import guard as _guard
-from screwkit.report.plots import save_figure
+from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 __all__ = ["register", "synthesis_document"]
 
 
 
-def _plot(results: list[Any], path: Path) -> None:
+def _plot(results: list[Any], path: Path, du: Any) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -32,62 +29,72 @@ def _plot(results: list[Any], path: Path) -> None:
 
     best = results[0]
     rows = sorted(best.rows, key=lambda r: r["theta"])  # theta = 0 comes first in the result
-    th = np.degrees([r["theta"] for r in rows])
+    def ang(key: str) -> Any:
+        return du.show("angle", np.array([r[key] for r in rows], dtype=float))
+
+    def length(key: str) -> Any:
+        return du.show("length", np.array([r[key] for r in rows], dtype=float))
+
+    a, lu = du.label("angle"), du.label("length")
+    th = ang("theta")
     fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-    axes[0].plot(th, np.degrees([r["psi_d0"] for r in rows]), "o", label="desired ψ_d0")
-    axes[0].plot(th, np.degrees([r["psi_g0"] for r in rows]), "x-", label="generated ψ_g0")
-    axes[0].set_ylabel("output rotation (deg)")
+    axes[0].plot(th, ang("psi_d0"), "o", label="desired ψ_d0")
+    axes[0].plot(th, ang("psi_g0"), "x-", label="generated ψ_g0")
+    axes[0].set_ylabel(f"output rotation ({a})")
     axes[0].legend()
-    axes[1].plot(th, [r["S_d"] for r in rows], "o", label="desired S_d")
-    axes[1].plot(th, [r["S_g"] for r in rows], "x-", label="generated S_g")
-    axes[1].set_ylabel("output translation (m)")
-    axes[1].set_xlabel("input θ from θ01 (deg)")
+    axes[1].plot(th, length("S_d"), "o", label="desired S_d")
+    axes[1].plot(th, length("S_g"), "x-", label="generated S_g")
+    axes[1].set_ylabel(f"output translation ({lu})")
+    axes[1].set_xlabel(f"input θ from θ01 ({a})")
     axes[1].legend()
-    fig.suptitle(f"synthesis: RMSE φ {math.degrees(best.rmse_phi):.4g}°, S {best.rmse_S:.3g} m")
+    fig.suptitle(f"synthesis: RMSE φ {du.show('angle', best.rmse_phi):.4g} {a}, "
+                 f"S {du.show('length', best.rmse_S):.3g} {lu}")
     fig.tight_layout()
+    from screwkit.report.plots import save_figure
+
     save_figure(fig, path)
     plt.close(fig)
 
 
-def _tables(name: str, results: list[Any], scale_unit: str) -> None:
+def _tables(name: str, results: list[Any], doc: dict[str, Any], scale_unit: str, du: Any,
+            full: bool) -> None:
+    from screwkit.cli.formatting import (
+        TextColumn,
+        number,
+        print_columns,
+        print_long_table,
+        table_columns,
+    )
+    from screwkit.io.tables import synthesis_table
+
     best = results[0]
+    a, lu = du.label("angle"), du.label("length")
     console.print(f"[bold]{escape(name)}[/]: synthesis ({best.status}; {best.iterations} "
                   f"iterations, {best.evaluations} evaluations, {best.time:.3f} s)",
                   highlight=False)
     if best.message:
         console.print(f"  {escape(best.message)}", highlight=False)
-    t = Table(title="optimised dimensions (lengths in m, angles in deg)")
-    t.add_column("name")
-    t.add_column("value", justify="right")
-    for k, v in best.dimensions.items():
-        angle = k in ("delta0", "lambda0", "theta01", "q1", "q2")
-        t.add_row(k, f"{math.degrees(v):.6f}" if angle else f"{v:.6g}")
-    console.print(t)
+    kinds = ["angle" if k in ("delta0", "lambda0", "theta01", "q1", "q2") else "length"
+             for k in best.dimensions]
+    print_columns(console, "optimised dimensions", [
+        TextColumn("name", list(best.dimensions), "left"),
+        TextColumn("value", [number(du.show(k, v), 7) for k, v in
+                             zip(kinds, best.dimensions.values(), strict=True)]),
+        TextColumn("unit", [du.label(k) for k in kinds], "left")])
     console.print(
         f"assembly mode {best.inversion} (sign of Q5 {best.mode_sign:+.0f}); "
         f"E = E_phi + E_S/L² = {best.objective:.6g} with L = {best.length_scale:g} m "
         f"({scale_unit}); E_phi = {best.E_phi:.6g} rad², E_S = {best.E_S:.6g} m²", highlight=False)
     console.print(
-        f"RMSE {best.rmse:.6g}; RMSE_phi {best.rmse_phi:.6g} rad = "
-        f"{math.degrees(best.rmse_phi):.5g}°; RMSE_S {best.rmse_S:.6g} m; max deviation "
-        f"{math.degrees(best.max_dev_phi):.5g}° / {best.max_dev_S:.4g} m; |grad E| = "
-        f"{best.gradient_norm:.2g}", highlight=False)
+        f"RMSE {best.rmse:.6g}; RMSE_phi {du.show('angle', best.rmse_phi):.5g} {a}; RMSE_S "
+        f"{du.show('length', best.rmse_S):.6g} {lu}; max deviation "
+        f"{du.show('angle', best.max_dev_phi):.5g} {a} / {du.show('length', best.max_dev_S):.4g} "
+        f"{lu}; |grad E| = {best.gradient_norm:.2g}", highlight=False)
     console.print(f"whole range: {escape(best.range_check.message)}", highlight=False)
-    rt = Table(title="desired vs generated (as Bagci's Tables I-XII)")
-    for col in ("θ (deg)", "θ0 (deg)", "φ_g (deg)", "ψ_g0 (deg)", "ψ_d0 (deg)", "ψ_d0-ψ_g0",
-                "S (m)", "S_g (m)", "S_d (m)", "S_d-S_g"):
-        rt.add_column(col, justify="right")
-    for r in best.rows:
-        d = math.degrees
-        s_d = r["S_d"]
-        rt.add_row(f"{d(r['theta']):.3f}", f"{d(r['theta0']):.4f}", f"{d(r['phi_g']):.5f}",
-                   f"{d(r['psi_g0']):.5f}",
-                   "—" if r["psi_d0"] != r["psi_d0"] else f"{d(r['psi_d0']):.5f}",
-                   "—" if r["psi_d0"] != r["psi_d0"] else f"{d(r['psi_d0'] - r['psi_g0']):.5f}",
-                   f"{r['S']:.6g}", f"{r['S_g']:.6g}",
-                   "—" if s_d != s_d else f"{s_d:.6g}",
-                   "—" if s_d != s_d else f"{s_d - r['S_g']:.3g}")
-    console.print(rt)
+    t = synthesis_table(doc)
+    cols, values = table_columns(t, t.names, du)
+    print_long_table(console, "desired vs generated (as Bagci's Tables I-XII)", cols, values,
+                     full)
     for k, other in enumerate(results[1:], start=2):
         console.print(f"alternative {k}: mode {other.inversion}, E = {other.objective:.6g}, "
                       f"whole range {'ok' if other.range_check.ok else 'NOT ok'}", highlight=False)
@@ -101,7 +108,7 @@ def synthesis_document(s: Any, starts: int | None = None) -> dict[str, Any]:
     return document(Pipeline(s).synthesize(starts), s.path)
 
 
-def _plot_overlay(docs: list[dict[str, Any]], problem: Any, path: Path) -> None:
+def _plot_overlay(docs: list[dict[str, Any]], problem: Any, path: Path, du: Any) -> None:
     """The overlay plane (input-crank ellipse, coupler circles, fitted output circle, overlay
     radial lines) and desired vs generated rotation (and translation) of the best mechanism."""
     import matplotlib
@@ -119,10 +126,13 @@ def _plot_overlay(docs: list[dict[str, Any]], problem: Any, path: Path) -> None:
     theta = pr.target.theta_rotation
     psi = pr.target.desired_rotation(theta)
     th0 = pr.theta01 + pr.input_direction * theta
-    px, py = input_ellipse_point(pr.d1, pr.lambda0, th0)
-    ex, ey = input_ellipse_point(pr.d1, pr.lambda0, np.linspace(0, 2 * np.pi, 361))
-    cx, cy = ov["centre"]
-    d3, d2, phi01 = ov["d3"], ov["d2"], ov["phi01"]
+    k = 1.0 / du.unit_of("length")[1]  # the plane in the display length unit
+    lu, au = du.label("length"), du.label("angle")
+    px, py = (k * v for v in input_ellipse_point(pr.d1, pr.lambda0, th0))
+    ex, ey = (k * v for v in input_ellipse_point(pr.d1, pr.lambda0,
+                                                 np.linspace(0, 2 * np.pi, 361)))
+    cx, cy = (k * v for v in ov["centre"])
+    d3, d2, phi01 = k * ov["d3"], k * ov["d2"], ov["phi01"]
     tips = (cx + d3 * np.cos(phi01 + sense * psi), cy + d3 * np.sin(phi01 + sense * psi))
     ring = np.linspace(0, 2 * np.pi, 181)
     has_s = pr.target.translation is not None
@@ -141,33 +151,37 @@ def _plot_overlay(docs: list[dict[str, Any]], problem: Any, path: Path) -> None:
     ax.plot([cx], [cy], "+", color="tab:orange", ms=12)
     for dw in pr.dwells:
         t0 = pr.theta01 + pr.input_direction * dw.theta
-        pxd, pyd = input_ellipse_point(pr.d1, pr.lambda0, t0)
+        pxd, pyd = (k * v for v in input_ellipse_point(pr.d1, pr.lambda0, t0))
         nx, ny = ellipse_normal(pr.d1, pr.lambda0, t0, dw.tangency)
         ax.plot([pxd, pxd + 1.5 * d2 * nx], [pyd, pyd + 1.5 * d2 * ny], "--", color="tab:green",
                 label="dwell normal")
     ax.set_aspect("equal")
-    ax.set_title(f"overlay plane (m): {ov['output_direction']} output, "
-                 f"max circle miss {ov['max_circle_miss']:.3g} m")
+    ax.set_title(f"overlay plane ({lu}): {ov['output_direction']} output, "
+                 f"max circle miss {k * ov['max_circle_miss']:.3g} {lu}")
     ax.legend(fontsize=7, loc="best")
     rows = sorted(best["rows"], key=lambda r: r["theta"])  # theta = 0 comes first in the result
-    th = np.degrees([r["theta"] for r in rows])
+    def col(key: str, kind: str) -> Any:
+        return du.show(kind, np.array([np.nan if r[key] is None else r[key] for r in rows],
+                                      dtype=float))
+
+    th = col("theta", "angle")
     ax1 = fig.add_subplot(2 if has_s else 1, 2, 2)
-    ax1.plot(th, np.degrees([np.nan if r["psi_d0"] is None else r["psi_d0"] for r in rows]),
-             "o", label="desired ψ_d0")
-    ax1.plot(th, np.degrees([r["psi_g0"] for r in rows]), "x-", label="generated ψ_g0")
-    ax1.set_ylabel("output rotation (deg)")
-    ax1.set_xlabel("input θ from θ01 (deg)")
-    ax1.set_title(f"RMSE φ {math.degrees(best['rmse_phi']):.4g}°")
+    ax1.plot(th, col("psi_d0", "angle"), "o", label="desired ψ_d0")
+    ax1.plot(th, col("psi_g0", "angle"), "x-", label="generated ψ_g0")
+    ax1.set_ylabel(f"output rotation ({au})")
+    ax1.set_xlabel(f"input θ from θ01 ({au})")
+    ax1.set_title(f"RMSE φ {du.show('angle', best['rmse_phi']):.4g} {au}")
     ax1.legend()
     if has_s:
         ax2 = fig.add_subplot(2, 2, 4)
-        ax2.plot(th, [np.nan if r["S_d"] is None else r["S_d"] for r in rows], "o",
-                 label="desired S_d")
-        ax2.plot(th, [r["S_g"] for r in rows], "x-", label="generated S_g")
-        ax2.set_ylabel("output translation (m)")
-        ax2.set_xlabel("input θ from θ01 (deg)")
+        ax2.plot(th, col("S_d", "length"), "o", label="desired S_d")
+        ax2.plot(th, col("S_g", "length"), "x-", label="generated S_g")
+        ax2.set_ylabel(f"output translation ({lu})")
+        ax2.set_xlabel(f"input θ from θ01 ({au})")
         ax2.legend()
     fig.tight_layout()
+    from screwkit.report.plots import save_figure
+
     save_figure(fig, path)
     plt.close(fig)
 
@@ -205,58 +219,51 @@ def register(app: typer.Typer) -> None:
     @app.command()
     def synthesize(
         spec: Annotated[Path, typer.Argument(help="Spec file (TOML) with a [synthesis] table.")],
-        as_json: Annotated[bool, typer.Option("--json", help="Print one JSON document (SI units) instead of tables.")] = False,
-        output: Annotated[Path | None, typer.Option("--output", "-o", help="Write the JSON document to this file (atomically).")] = None,
-        plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of desired vs generated.")] = None,
+        as_json: JsonOpt = False,
+        output: OutputOpt = None,
+        csv: CsvOpt = None,
+        units: UnitsOpt = "spec",
+        unit: UnitOpt = None,
+        full: FullOpt = False,
+        plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of desired vs generated (display units).")] = None,
         starts: Annotated[int | None, typer.Option("--starts", help="Multi-start: number of starts (overrides [synthesis.multistart], or [synthesis.overlay] starts).", min=1, max=10000)] = None,
     ) -> None:
         """Optimise the mechanism's dimensions to generate a desired screw displacement
         (Bagci 1969 Ch. V: least squares with exact derivatives, dwell and range constraints;
         or the overlay technique of §5.4 with [synthesis] method = "overlay")."""
+        from screwkit.cli.outputs import Outputs
+        from screwkit.cli.progress import progress_bar
         from screwkit.io.documents import synthesis_document as document
-        from screwkit.io.results import dumps, write_atomic
         from screwkit.io.spec import load_spec
+        from screwkit.io.tables import synthesis_table
         from screwkit.pipeline import Pipeline
 
         if plot is not None:
             asked = plot
             plot = _guard(lambda: plot_path(asked))
-        from screwkit.cli.common import check_paths
-
-        check_paths([spec], {"--output": output, "--plot": plot})
+        out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
+                              unit=unit, full=full, files={"--plot": plot})
         s = _guard(lambda: load_spec(spec))
+        du = out.units_for(s.units)
         pipe = Pipeline(s)
         config = _guard(lambda: pipe.synthesis_config())
         problem = config.problem
-
-        def run() -> Any:
-            return pipe.synthesize(starts)
-
-        if as_json or not sys.stderr.isatty():
-            outcome = _guard(run)
-        else:
-            with Progress(TextColumn("synthesising"), BarColumn(), TimeElapsedColumn(),
-                          console=err_console, transient=True) as progress:
-                task = progress.add_task("run", total=None)
-                outcome = _guard(run)
-                progress.update(task, completed=1, total=1)
+        overlay = config.method == "overlay"
+        with progress_bar("synthesis starts", None) as advance:
+            outcome = _guard(lambda: pipe.synthesize(starts, progress=advance))
         results = outcome.results
         doc = document(outcome, spec)
         docs = [doc, *doc["alternatives"]]
-        overlay = config.method == "overlay"
-        text = dumps(doc)
-        if output is not None:
-            _guard(lambda: write_atomic(output, text + "\n", [spec], "--output"))
         if plot is not None:
             png = plot
-            _guard(lambda: _plot_overlay(docs, problem, png) if overlay else _plot(results, png))
-        if as_json:
-            sys.stdout.write(text + "\n")
-        else:
-            _tables(s.name, results, config.length_unit)
+            _guard(lambda: _plot_overlay(docs, problem, png, du) if overlay
+                   else _plot(results, png, du))
+            out.note_written(plot)
+
+        def show() -> None:
+            _tables(s.name, results, doc, config.length_unit, du, out.full)
             if overlay:
                 _overlay_lines(docs)
-            if output is not None:
-                console.print(f"wrote {output}")
-            if plot is not None:
-                console.print(f"wrote {plot}")
+
+        out.deliver(document=lambda: doc, table=lambda: synthesis_table(doc), show=show,
+                    units=du)

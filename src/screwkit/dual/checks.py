@@ -4,22 +4,14 @@ the offending shape or value, where it is in the batch and how to fix it (pytran
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.dual.number import Array
+from screwkit.dual.number import Array, batch_index_text
 
 #: Default tolerance on orthogonality / unit-norm checks. Values typed from printed tables
 #: (4–6 digits) fail tighter checks, so the default is loose; pass ``tol`` to tighten.
 DEFAULT_TOL = 1e-6
-
-
-def _first_bad(mask: Array | np.ndarray[Any, Any]) -> str:
-    """'at batch index (i, j)' for the first True entry of ``mask`` (empty string for scalars)."""
-    idx = tuple(int(i) for i in np.argwhere(mask)[0])
-    return f" at batch index {idx}" if idx else ""
 
 
 def check_finite(x: ArrayLike, name: str = "value") -> Array:
@@ -27,7 +19,7 @@ def check_finite(x: ArrayLike, name: str = "value") -> Array:
     a = np.asarray(x, dtype=float)
     bad = ~np.isfinite(a)
     if np.any(bad):
-        raise ValueError(f"{name} contains NaN or inf{_first_bad(bad)}; pass finite numbers")
+        raise ValueError(f"{name} contains NaN or inf{batch_index_text(bad)}; pass finite numbers")
     return a
 
 
@@ -54,7 +46,7 @@ def check_unit_vector(v: ArrayLike, name: str = "direction", tol: float = DEFAUL
     if np.any(bad):
         raise ValueError(
             f"{name} must be a unit vector: | |v| - 1 | = {err[bad].max():.3g} > {tol:g}"
-            f"{_first_bad(bad)}; normalise it first"
+            f"{batch_index_text(bad)}; normalise it first"
         )
     return a
 
@@ -68,14 +60,14 @@ def check_rotation_matrix(R: ArrayLike, name: str = "rotation", tol: float = DEF
     if np.any(bad):
         raise ValueError(
             f"{name} is not orthogonal: max |RᵀR − I| = {err[bad].max():.3g} > {tol:g}"
-            f"{_first_bad(bad)}; re-orthonormalise it (e.g. scipy Rotation.from_matrix) or "
+            f"{batch_index_text(bad)}; re-orthonormalise it (e.g. scipy Rotation.from_matrix) or "
             "loosen tol"
         )
     det = np.linalg.det(a)
     bad = det < 0
     if np.any(bad):
         raise ValueError(
-            f"{name} has det = {det[bad].min():.3g} < 0{_first_bad(bad)}: a reflection is not a "
+            f"{name} has det = {det[bad].min():.3g} < 0{batch_index_text(bad)}: a reflection is not a "
             "rotation; check the handedness of the frame"
         )
     return a
@@ -95,7 +87,7 @@ def check_screw_matrix_parts(
     if np.any(bad):
         raise ValueError(
             f"{name} dual part is not [d]×R: D·Rᵀ is not skew-symmetric (max |W + Wᵀ| = "
-            f"{err[bad].max():.3g}){_first_bad(bad)}; build it with "
+            f"{err[bad].max():.3g}){batch_index_text(bad)}; build it with "
             "ScrewMatrix.from_rotation_translation"
         )
     return R, D
@@ -109,7 +101,7 @@ def check_transform(T: ArrayLike, name: str = "transform", tol: float = DEFAULT_
     if np.any(bad):
         raise ValueError(
             f"{name} last row must be (0, 0, 0, 1); it is off by {bottom[bad].max():.3g}"
-            f"{_first_bad(bad)}"
+            f"{batch_index_text(bad)}"
         )
     check_rotation_matrix(a[..., :3, :3], f"rotation block of {name}", tol)
     return a
@@ -126,14 +118,14 @@ def check_unit_dual_quaternion(
     if np.any(bad):
         raise ValueError(
             f"{name} real part is not a unit quaternion: | |r| - 1 | = {nerr[bad].max():.3g}"
-            f"{_first_bad(bad)}; call .normalized()"
+            f"{batch_index_text(bad)}; call .normalized()"
         )
     derr = np.abs(np.sum(r * d, axis=-1))
     scale = np.maximum(1.0, np.linalg.norm(d, axis=-1))
     bad = derr > tol * scale
     if np.any(bad):
         raise ValueError(
-            f"{name} is not unit: real·dual = {derr[bad].max():.3g} ≠ 0{_first_bad(bad)}; "
+            f"{name} is not unit: real·dual = {derr[bad].max():.3g} ≠ 0{batch_index_text(bad)}; "
             "call .normalized()"
         )
     return r, d
@@ -152,7 +144,7 @@ def check_unit_line(
     if np.any(bad):
         raise ValueError(
             f"{name} is not a line: direction·moment = {err[bad].max():.3g} ≠ 0"
-            f"{_first_bad(bad)}; build it with DualVector.line(point, direction)"
+            f"{batch_index_text(bad)}; build it with DualVector.line(point, direction)"
         )
     return u, m
 

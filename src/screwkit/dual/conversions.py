@@ -9,14 +9,18 @@ screwkit's own types are not (call ``.check()`` on untrusted ScrewMatrix input).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.spatial.transform import RigidTransform, Rotation
 
 from screwkit.dual.checks import DEFAULT_TOL, check_rotation_matrix, check_transform, check_vector3
 from screwkit.dual.number import Array
 from screwkit.dual.quaternion import DualQuaternion
 from screwkit.dual.screw_matrix import ScrewMatrix
+
+if TYPE_CHECKING:  # scipy.spatial is imported on first use: it costs 0.3 s at start-up
+    from scipy.spatial.transform import RigidTransform, Rotation
 
 
 # --- 4×4 homogeneous transforms -------------------------------------------------------------
@@ -63,6 +67,8 @@ def screw_matrix_from_rotation(
     rotation: Rotation, translation: ArrayLike | None = None
 ) -> ScrewMatrix:
     """R + ε[d]×R from a scipy ``Rotation`` (any batch shape) and optional translations d."""
+    from scipy.spatial.transform import Rotation
+
     if not isinstance(rotation, Rotation):
         raise ValueError(
             f"expected a scipy.spatial.transform.Rotation; got {type(rotation).__name__}"
@@ -77,12 +83,16 @@ def screw_matrix_from_rotation(
 def rotation_from_screw_matrix(screw: ScrewMatrix, tol: float = DEFAULT_TOL) -> Rotation:
     """The scipy ``Rotation`` of the real part (checked to be a rotation; the translation is
     dropped)."""
+    from scipy.spatial.transform import Rotation
+
     R = check_rotation_matrix(screw.real, "real part of screw matrix", tol)
     return Rotation.from_matrix(R)
 
 
 def screw_matrix_from_rigid_transform(transform: RigidTransform) -> ScrewMatrix:
     """R + ε[d]×R from a scipy ``RigidTransform`` (any batch shape)."""
+    from scipy.spatial.transform import RigidTransform
+
     if not isinstance(transform, RigidTransform):
         raise ValueError(
             f"expected a scipy.spatial.transform.RigidTransform; got {type(transform).__name__}"
@@ -94,12 +104,16 @@ def screw_matrix_from_rigid_transform(transform: RigidTransform) -> ScrewMatrix:
 
 def rigid_transform_from_screw_matrix(screw: ScrewMatrix, tol: float = DEFAULT_TOL) -> RigidTransform:
     """A scipy ``RigidTransform`` with the same batch shape (real part checked)."""
+    from scipy.spatial.transform import RigidTransform
+
     check_rotation_matrix(screw.real, "real part of screw matrix", tol)
     return RigidTransform.from_matrix(transform_from_screw_matrix(screw))
 
 
 def dual_quaternion_from_rigid_transform(transform: RigidTransform) -> DualQuaternion:
     """From scipy's own dual quaternion (``as_dual_quat(scalar_first=True)``, same layout)."""
+    from scipy.spatial.transform import RigidTransform
+
     if not isinstance(transform, RigidTransform):
         raise ValueError(
             f"expected a scipy.spatial.transform.RigidTransform; got {type(transform).__name__}"
@@ -109,6 +123,8 @@ def dual_quaternion_from_rigid_transform(transform: RigidTransform) -> DualQuate
 
 def rigid_transform_from_dual_quaternion(dq: DualQuaternion) -> RigidTransform:
     """To a scipy ``RigidTransform`` via ``from_dual_quat(scalar_first=True)``."""
+    from scipy.spatial.transform import RigidTransform
+
     from screwkit.dual.checks import check_unit_dual_quaternion
 
     check_unit_dual_quaternion(dq.real, dq.dual)

@@ -24,17 +24,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from screwkit.dual.number import Array, Dual
+from screwkit.dual.number import Dual
 from screwkit.dual.screw_matrix import ScrewMatrix
+from screwkit.dual.spatial import wrap_angle
 
 #: sin θ0 below this counts as the degenerate case θ0 = 0 or π. Above it the general formulas
 #: are used; they reconstruct the displacement to rounding even for small sin θ0.
 DEFAULT_SINGULAR_TOL = 1e-12
-
-
-def _wrap(angle: Array) -> Array:
-    """Angle in (−π, π]."""
-    return np.pi - np.mod(np.pi - angle, 2.0 * np.pi)
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,7 +82,7 @@ def dual_euler_from_screw_matrix(
     psi0_s = np.where(near_zero, gamma - phi0_s, phi0_s - gamma)
     theta0 = np.where(singular, np.where(near_zero, 0.0, np.pi), theta0)
     phi0 = np.where(singular, phi0_s, phi0)
-    psi0 = _wrap(np.where(singular, psi0_s, psi0))
+    psi0 = wrap_angle(np.where(singular, psi0_s, psi0))
 
     cf, sf = np.cos(phi0), np.sin(phi0)
     theta1 = X * cf + Y * sf

@@ -12,14 +12,20 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError, InputTypeError
+
 Array = NDArray[np.float64]
 
 
-def _as_array(x: ArrayLike) -> Array:
-    return np.asarray(x, dtype=np.result_type(np.asarray(x).dtype, np.float64))
+def _as_array(x: ArrayLike, part: str = "value") -> Array:
+    a = np.asarray(x)
+    if a.dtype.kind not in "biufc":  # bool, integers, floats, complex (complex-step derivatives)
+        raise InputTypeError(f"a dual number's {part} part must be numbers (float or complex "
+                             f"arrays); got {type(x).__name__} of dtype {a.dtype}")
+    return np.asarray(a, dtype=np.result_type(a.dtype, np.float64))
 
 
-class DualDivisionError(ValueError, ZeroDivisionError):
+class DualDivisionError(InputError, ZeroDivisionError):
     """Division by a dual number with zero real part (a pure dual number εb)."""
 
 
@@ -40,8 +46,8 @@ class Dual:
     __array_ufunc__ = None
 
     def __init__(self, real: ArrayLike, dual: ArrayLike = 0.0) -> None:
-        r = _as_array(real)
-        d = _as_array(dual)
+        r = _as_array(real, "real")
+        d = _as_array(dual, "dual")
         r, d = np.broadcast_arrays(r, d)
         object.__setattr__(self, "real", np.array(r))
         object.__setattr__(self, "dual", np.array(d))
@@ -148,7 +154,9 @@ class Dual:
 
 
 # --- functions: f(a + εb) = f(a) + ε b f'(a) (Bagci A.31) ----------------------------------
-def _index_text(mask: NDArray[Any]) -> str:
+def batch_index_text(mask: NDArray[Any]) -> str:
+    """' at batch index (i, j)' naming the first True entry of ``mask``, for error messages
+    (empty for a scalar mask)."""
     if mask.ndim == 0:
         return ""
     return f" at batch index {tuple(int(i) for i in np.argwhere(mask)[0])}"
@@ -160,7 +168,7 @@ def sqrt(x: Dual | ArrayLike) -> Dual:
     bad = x.real <= 0
     if np.any(bad):
         raise ValueError(
-            f"dual sqrt needs a positive real part; got {x.real[bad].min():.3g}{_index_text(bad)}"
+            f"dual sqrt needs a positive real part; got {x.real[bad].min():.3g}{batch_index_text(bad)}"
         )
     r = np.sqrt(x.real)
     return Dual(r, x.dual / (2.0 * r))
@@ -194,7 +202,7 @@ def atan2(y: Dual | ArrayLike, x: Dual | ArrayLike) -> Dual:
     bad = r2 == 0
     if np.any(bad):
         raise ValueError(
-            f"dual atan2 is undefined where both real parts are zero{_index_text(bad)}"
+            f"dual atan2 is undefined where both real parts are zero{batch_index_text(bad)}"
         )
     return Dual(np.arctan2(y.real, x.real), (x.real * y.dual - y.real * x.dual) / r2)
 
@@ -204,7 +212,7 @@ def asin(x: Dual | ArrayLike) -> Dual:
     x = Dual.coerce(x)
     bad = np.abs(x.real) >= 1
     if np.any(bad):
-        raise ValueError(f"dual asin needs |real part| < 1{_index_text(bad)}")
+        raise ValueError(f"dual asin needs |real part| < 1{batch_index_text(bad)}")
     return Dual(np.arcsin(x.real), x.dual / np.sqrt(1.0 - x.real**2))
 
 
@@ -213,7 +221,7 @@ def acos(x: Dual | ArrayLike) -> Dual:
     x = Dual.coerce(x)
     bad = np.abs(x.real) >= 1
     if np.any(bad):
-        raise ValueError(f"dual acos needs |real part| < 1{_index_text(bad)}")
+        raise ValueError(f"dual acos needs |real part| < 1{batch_index_text(bad)}")
     return Dual(np.arccos(x.real), -x.dual / np.sqrt(1.0 - x.real**2))
 
 
@@ -236,6 +244,6 @@ def log(x: Dual | ArrayLike) -> Dual:
     bad = x.real <= 0
     if np.any(bad):
         raise ValueError(
-            f"dual log needs a positive real part; got {x.real[bad].min():.3g}{_index_text(bad)}"
+            f"dual log needs a positive real part; got {x.real[bad].min():.3g}{batch_index_text(bad)}"
         )
     return Dual(np.log(x.real), x.dual / x.real)

@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from screwkit.dual.number import Array
-from screwkit.dual.screw_matrix import skew
+from screwkit.dual.spatial import skew
 
 
 def rotation_from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> Array:

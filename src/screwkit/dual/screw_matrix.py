@@ -14,38 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from screwkit.dual.number import Array, Dual
-
-
-def skew(v: ArrayLike) -> Array:
-    """[v]×, the 3×3 skew matrix of ``v`` (shape (..., 3) → (..., 3, 3))."""
-    v = np.asarray(v, dtype=float)
-    z = np.zeros_like(v[..., 0])
-    return np.stack(
-        [
-            np.stack([z, -v[..., 2], v[..., 1]], axis=-1),
-            np.stack([v[..., 2], z, -v[..., 0]], axis=-1),
-            np.stack([-v[..., 1], v[..., 0], z], axis=-1),
-        ],
-        axis=-2,
-    )
-
-
-def vee(w: ArrayLike) -> Array:
-    """Axial vector (W32, W13, W21) of a skew matrix (shape (..., 3, 3) → (..., 3))."""
-    w = np.asarray(w, dtype=float)
-    return np.stack([w[..., 2, 1], w[..., 0, 2], w[..., 1, 0]], axis=-1)
-
-
-def _elementary(c: Array, s: Array, axis: int) -> Array:
-    one = np.ones_like(c)
-    zero = np.zeros_like(c)
-    if axis == 0:
-        rows = [[one, zero, zero], [zero, c, -s], [zero, s, c]]
-    elif axis == 1:
-        rows = [[c, zero, s], [zero, one, zero], [-s, zero, c]]
-    else:
-        rows = [[c, -s, zero], [s, c, zero], [zero, zero, one]]
-    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+from screwkit.dual.spatial import elementary_rotation, skew, vee
 
 
 @dataclass(frozen=True, eq=False)
@@ -131,7 +100,7 @@ class ScrewMatrix:
         about the axis and translation s along it (Bagci eqs. 2.6–2.11; Rahman A.2–A.9)."""
         a = Dual.coerce(angle)
         c, s = np.cos(a.real), np.sin(a.real)
-        R = _elementary(c, s, axis)
+        R = elementary_rotation(c, s, axis)
         # d/dθ of the elementary rotation is [e_axis]× R, so the dual part is s·[e]×R.
         e = np.zeros(3)
         e[axis] = 1.0

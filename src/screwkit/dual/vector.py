@@ -46,7 +46,7 @@ class DualVector:
         if np.any(n == 0):
             raise ValueError(
                 "a line needs a non-zero direction; got the zero vector"
-                + dn._index_text(n[..., 0] == 0)
+                + dn.batch_index_text(n[..., 0] == 0)
             )
         u = u / n
         return cls(u, np.cross(p, u))
@@ -181,7 +181,7 @@ def common_normal(a: DualVector, b: DualVector) -> DualVector:
     if np.any(coincident):
         raise ValueError(
             "the common normal of two coincident lines is undefined"
-            + dn._index_text(coincident)
+            + dn.batch_index_text(coincident)
         )
     safe_s = np.where(parallel, 1.0, s_real)
     n_skew = cr.real / safe_s[..., None]

@@ -5,14 +5,13 @@ See docs/dynamics.md for conventions and for how statically indeterminate compon
 passive freedoms are reported.
 """
 
-from screwkit.dynamics.blocks import BLOCK_SAMPLES
 from screwkit.dynamics.checks import (
     DynamicsInputError,
     ExternalLoad,
     MissingMassError,
     NonAssemblingMotionError,
 )
-from screwkit.dynamics.cssp_path import cssp_inverse_dynamics
+from screwkit.dynamics.cssp_fused_dynamics import cssp_inverse_dynamics
 from screwkit.dynamics.inertia import inertia_wrench_regressor, inertia_wrenches
 from screwkit.dynamics.inverse import (
     INERTIAL_PARAMETER_NAMES,
@@ -21,6 +20,7 @@ from screwkit.dynamics.inverse import (
     regressor,
 )
 from screwkit.dynamics.result import Dynamics, Indeterminacy
+from screwkit.dynamics.sample_blocks import BLOCK_SAMPLES
 from screwkit.dynamics.screws import FreedomScrews, freedom_screws
 
 __all__ = [

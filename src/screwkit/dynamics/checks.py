@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import (
@@ -23,7 +24,7 @@ from screwkit.model.mass import (
 Array = NDArray[np.float64]
 
 
-class DynamicsInputError(ValueError):
+class DynamicsInputError(InputError):
     """Inverse dynamics was given something it cannot use (missing masses, bad motion …)."""
 
 

@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from screwkit.dynamics import soa
-from screwkit.dynamics.soa import Array, Vec
+from screwkit.dynamics import component_arrays as soa
+from screwkit.dynamics.component_arrays import Array, Vec
 from screwkit.kinematics.cssp_motion import NotACSSPError, cssp_dimensions
 from screwkit.model.linkage import Linkage
 

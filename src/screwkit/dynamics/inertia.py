@@ -21,8 +21,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from screwkit.dynamics import soa
-from screwkit.dynamics.screws import Array, _cross
+from screwkit.dual.spatial import cross, skew
+from screwkit.dynamics import component_arrays as soa
+from screwkit.dynamics.screws import Array
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.mass import MassProperties
 
@@ -53,14 +54,14 @@ def inertia_wrenches(
     al = mode.link_angular_acceleration
     rc = _rotate(R, np.broadcast_to(com, R.shape[:-1]))
     p_c = mode.link_origin + rc - reference
-    a_c = mode.link_origin_acceleration + _cross(al, rc) + _cross(w, _cross(w, rc))
+    a_c = mode.link_origin_acceleration + cross(al, rc) + cross(w, cross(w, rc))
     force = m[:, None] * (gravity - a_c)
     w_b = _rotate_back(R, w)
     al_b = _rotate_back(R, al)
     iw = np.einsum("lij,...lj->...li", inertia, w_b)
     ia = np.einsum("lij,...lj->...li", inertia, al_b)
-    moment_c = -_rotate(R, ia + _cross(w_b, iw))
-    return np.concatenate([force, moment_c + _cross(p_c, force)], -1)
+    moment_c = -_rotate(R, ia + cross(w_b, iw))
+    return np.concatenate([force, moment_c + cross(p_c, force)], -1)
 
 
 def _inertia_operator(v: Array) -> Array:
@@ -77,14 +78,6 @@ def _inertia_operator(v: Array) -> Array:
     )
 
 
-def _skew(v: Array) -> Array:
-    x, y, z = v[..., 0], v[..., 1], v[..., 2]
-    o = np.zeros_like(x)
-    return np.stack(
-        [np.stack([o, -z, y], -1), np.stack([z, o, -x], -1), np.stack([-y, x, o], -1)], -2
-    )
-
-
 def inertia_wrench_regressor(mode: ModeMotion, gravity: Array, reference: Array) -> Array:
     """Regressor of the applied (inertia + weight) wrench of every moving link, (N, L, 6, 10):
     ``wrench[:, l] = Y[:, l] @ π_l`` with π_l the 10 inertial parameters of link l about its
@@ -96,14 +89,14 @@ def inertia_wrench_regressor(mode: ModeMotion, gravity: Array, reference: Array)
     shape = w_b.shape[:-1]
     k_force = np.zeros((*shape, 3, 10))
     k_moment = np.zeros((*shape, 3, 10))
-    w_x = _skew(w_b)
+    w_x = skew(w_b)
     k_force[..., 0] = a_b
-    k_force[..., 1:4] = _skew(al_b) + w_x @ w_x
-    k_moment[..., 1:4] = -_skew(a_b)
+    k_force[..., 1:4] = skew(al_b) + w_x @ w_x
+    k_moment[..., 1:4] = -skew(a_b)
     k_moment[..., 4:] = _inertia_operator(al_b) + w_x @ _inertia_operator(w_b)
     force = -np.einsum("...ij,...jk->...ik", R, k_force)
     moment_o = -np.einsum("...ij,...jk->...ik", R, k_moment)
-    arm = _skew(mode.link_origin - reference)
+    arm = skew(mode.link_origin - reference)
     return np.concatenate([force, moment_o + arm @ force], -2)
 
 
@@ -119,7 +112,7 @@ def inertia_wrenches_soa(
 ) -> list[tuple[soa.Vec, soa.Vec]]:
     """The direct form of the module docstring for one block of samples in structure-of-arrays
     form: per moving link, the applied force and moment about ``reference`` as component
-    tuples. Inputs are component rows (:func:`screwkit.dynamics.soa.rows`): ``rotation`` 9 per
+    tuples. Inputs are component rows (:func:`screwkit.dynamics.component_arrays.rows`): ``rotation`` 9 per
     link (R[3i + j]), the others 3 per link."""
     out = []
     g = soa.const(gravity)

@@ -8,9 +8,9 @@
 3. the joint wrenches and driven efforts from the link balances and the joints' "no work along a
    passive freedom" conditions (:mod:`screwkit.dynamics.loop_statics`).
 
-The samples go through these steps in blocks (:mod:`screwkit.dynamics.blocks`), written into
+The samples go through these steps in blocks (:mod:`screwkit.dynamics.sample_blocks`), written into
 preallocated outputs. For a family with a registered closed-form statics (the CSSP,
-:mod:`screwkit.dynamics.cssp_statics`, run by :mod:`screwkit.dynamics.cssp_path`), steps 2–3
+:mod:`screwkit.dynamics.cssp_statics`, run by :mod:`screwkit.dynamics.cssp_fused_dynamics`), steps 2–3
 are replaced by the closed form and step 1 runs in structure-of-arrays form: same results to
 round-off, several times faster.
 
@@ -28,16 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.dynamics.blocks import (
-    BLOCK_SAMPLES,
-    Outputs,
-    Selection,
-    Setup,
-    as_dynamics,
-    blocks,
-    indeterminacy,
-    joint_scale,
-)
+from screwkit.dual.spatial import cross
 from screwkit.dynamics.checks import (
     DynamicsInputError,
     ExternalLoad,
@@ -47,7 +38,7 @@ from screwkit.dynamics.checks import (
     finite_samples,
     valid_samples,
 )
-from screwkit.dynamics.cssp_path import cssp_mode_block
+from screwkit.dynamics.cssp_fused_dynamics import cssp_mode_block
 from screwkit.dynamics.cssp_statics import CSSPStatics, cssp_statics_for
 from screwkit.dynamics.inertia import inertia_wrench_regressor, inertia_wrenches
 from screwkit.dynamics.loop_statics import (
@@ -55,7 +46,17 @@ from screwkit.dynamics.loop_statics import (
     statics_structure,
 )
 from screwkit.dynamics.result import Array, Dynamics, Indeterminacy
-from screwkit.dynamics.screws import _cross, freedom_screws
+from screwkit.dynamics.sample_blocks import (
+    BLOCK_SAMPLES,
+    Outputs,
+    Selection,
+    Setup,
+    as_dynamics,
+    blocks,
+    indeterminacy,
+    joint_scale,
+)
+from screwkit.dynamics.screws import freedom_screws
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
@@ -140,7 +141,7 @@ def _external_wrenches(
     for l, (force, moment, point) in by_link.items():
         at = sub.link_origin[:, l] + sub.link_rotation[:, l] @ point - ref
         out[:, l, :3] = force
-        out[:, l, 3:] = moment + _cross(at, np.broadcast_to(force, at.shape))
+        out[:, l, 3:] = moment + cross(at, np.broadcast_to(force, at.shape))
     return out
 
 

@@ -12,10 +12,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from screwkit.tables import ResultTable, UnitChoice
 
 Array = NDArray[np.float64]
 
@@ -69,9 +72,9 @@ class Indeterminacy:
 
 
 def _listify(a: Array, valid: NDArray[np.bool_]) -> list[Any]:
-    out: list[Any] = []
-    for ok, row in zip(valid, a, strict=True):
-        out.append(np.asarray(row).tolist() if ok else None)
+    out: list[Any] = np.asarray(a).tolist()  # one C call; then None at the invalid samples
+    for i in np.flatnonzero(~np.asarray(valid, dtype=bool)).tolist():
+        out[i] = None
     return out
 
 
@@ -139,6 +142,26 @@ class Dynamics:
             out[f"effort {name}"] = _stats(e, self.valid)
         out["relative_residual"] = _stats(self.relative_residual, self.valid)
         return out
+
+    @property
+    def gravity_on(self) -> bool:
+        """Whether the loads include gravity (a non-zero ``gravity`` vector)."""
+        return bool(np.any(self.gravity != 0))
+
+    def table(self, mode: int | None = None) -> ResultTable:
+        """One row per sample: input, shaking force and moment, every reaction with its point
+        of application, efforts (SI; :mod:`screwkit.dynamics.result_table`)."""
+        from screwkit.dynamics.result_table import dynamics_table
+
+        return dynamics_table(self, mode)
+
+    def to_dataframe(self, units: UnitChoice | None = None) -> Any:
+        """:meth:`table` as a pandas DataFrame, headers with units (needs pandas)."""
+        return self.table().to_dataframe(units)
+
+    def to_csv(self, path: Any, units: UnitChoice | None = None) -> None:
+        """:meth:`table` as CSV (``shaking_force_x [N]`` …; empty cells where not valid)."""
+        self.table().to_csv(path, units)
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-able dictionary (SI units, lists, ``None`` where a sample is not valid)."""

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.loop import rot_z
+from screwkit.dual.spatial import cross, rot_z
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
 
@@ -55,19 +55,8 @@ class FreedomScrews:
     reference: Array
 
 
-def _cross(a: Array, b: Array) -> Array:
-    return np.stack(
-        [
-            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
-        ],
-        -1,
-    )
-
-
 def _line(axis: Array, arm: Array) -> Array:
-    return np.concatenate([axis, _cross(arm, axis)], -1)
+    return np.concatenate([axis, cross(arm, axis)], -1)
 
 
 def freedom_screws(

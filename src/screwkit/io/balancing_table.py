@@ -6,6 +6,7 @@ names the file and the key (:class:`BalancingConfigError`, a SpecError and a Bal
 
 from __future__ import annotations
 
+import math
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError
@@ -23,6 +24,10 @@ from screwkit.balancing.variables import (
 from screwkit.io.errors import SpecError
 
 Value = float | int | str
+
+
+#: most weightings a Pareto sweep may solve (each is one QP)
+MAX_PARETO_WEIGHTINGS = 10_000
 
 
 class BalancingConfigError(SpecError, BalancingError):
@@ -199,6 +204,13 @@ def balancing_config(spec: Any) -> BalancingConfig:
         if divisions < 1:
             raise BalancingConfigError(f"{spec.path}: [balancing.pareto.divisions] must be >= 1; "
                                        f"got {divisions}")
+        points = math.comb(divisions + len(measures) - 1, len(measures) - 1)
+        if points > MAX_PARETO_WEIGHTINGS:
+            raise BalancingConfigError(
+                f"{spec.path}: [balancing.pareto.divisions] = {divisions} over "
+                f"{len(measures)} measures makes {points:,} weightings (one QP each), over the "
+                f"limit of {MAX_PARETO_WEIGHTINGS:,}; use fewer divisions (e.g. 10 gives "
+                f"{math.comb(10 + len(measures) - 1, len(measures) - 1)})")
         pareto = (tuple(table.pareto.measures), table.pareto.divisions)
     return BalancingConfig(blocks=tuple(blocks_from_table(spec, table)),
                            weights=dict(table.weights), gravity=table.gravity,

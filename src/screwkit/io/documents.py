@@ -142,3 +142,53 @@ def synthesis_document(run: SynthesisRun, spec_path: Any) -> dict[str, Any]:
     doc["alternatives"] = docs[1:]
     doc["spec"] = str(spec_path)
     return doc
+
+
+#: each balancing measure's physical RMS: (kind, scale of the measure as a power of F0, ℓ, b)
+MEASURE_RMS = {"F": ("force", "F0"), "T": ("moment", "F0*l"), "R": ("force", "F0"),
+               "M": ("moment", "F0*b"), "T0": ("moment", "F0*l")}
+
+
+def measures_rms(result: Any) -> dict[str, Any]:
+    """Each normalised mean-square measure of a :class:`BalanceResult` as the RMS load it
+    stands for, in N or N·m (Rahman 1996 eqs. 4.1/4.2 undone: F = mean|F_sh|²/F0², so the RMS
+    shaking force is F0·√F; T and T0 scale by F0·ℓ, M by F0·b; R is the RMS over the samples of
+    the root-sum-square of the joint forces), before and after, with the change in percent.
+    A driven slide's T0 is a force (F0 scale)."""
+    norm = result.normalisation
+    slide = result.dynamics_before.input_names[0].rsplit(".", 1)[-1] == "s"
+    scale = {"F0": norm.force, "F0*l": norm.force * norm.length,
+             "F0*b": norm.force * norm.bearing_length}
+    out: dict[str, Any] = {"before": {}, "after": {}, "change_percent": {}, "kinds": {}}
+    for key, (kind, s) in MEASURE_RMS.items():
+        if key == "T0" and slide:
+            kind, s = "force", "F0"
+        b = scale[s] * float(np.sqrt(max(result.measures_before[key], 0.0)))
+        a = scale[s] * float(np.sqrt(max(result.measures_after[key], 0.0)))
+        out["before"][key], out["after"][key] = b, a
+        out["change_percent"][key] = None if b == 0 else 100.0 * (a - b) / b
+        out["kinds"][key] = kind
+    out["units"] = {k: "N" if v == "force" else "N*m" for k, v in out["kinds"].items()}
+    return out
+
+
+def active_bounds(result: Any) -> list[dict[str, str]]:
+    """The design variables at one of their bounds at the optimum (a point mass at its allowed
+    decrease, a counterweight at its mass limit): variable, which bound, the constraint."""
+    out = []
+    for c in result.active_constraints:
+        for name in result.names:
+            for op, side in ((" >= ", "lower"), (" <= ", "upper")):
+                if c.startswith(name + op):
+                    out.append({"variable": name, "bound": side, "constraint": c})
+    return out
+
+
+def balance_document(result: Any) -> dict[str, Any]:
+    """The document of ``screwkit balance``: :meth:`BalanceResult.as_dict` (docs/balancing.md)
+    with ``measures_rms`` (:func:`measures_rms`, N and N·m) and ``active_bounds``
+    (:func:`active_bounds`)."""
+    doc: dict[str, Any] = result.as_dict()
+    doc["measures_rms"] = measures_rms(result)
+    doc["active_bounds"] = active_bounds(result)
+    return doc

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from screwkit.errors import InputError
 
-class SpecError(ValueError):
+
+class SpecError(InputError):
     """A spec file that cannot be used; the message says where and how to fix it."""

@@ -16,8 +16,10 @@ from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 
+from screwkit.errors import InputError
 
-class OutputPathError(ValueError):
+
+class OutputPathError(InputError):
     """An output path that screwkit refuses to write; the message says why and what to do."""
 
 

@@ -23,6 +23,8 @@ import math
 import re
 from dataclasses import dataclass
 
+from screwkit.errors import InputError
+
 #: longest quantity string read (characters); a longer value is refused naming its key
 MAX_QUANTITY_CHARS = 200
 #: longest unit name (pint's longest ordinary names are ~30 characters)
@@ -41,7 +43,7 @@ _SUPERSCRIPTS = {"²": 2, "³": 3, "⁴": 4}
 _BLANK = re.compile(r"\s*")
 
 
-class QuantitySyntaxError(ValueError):
+class QuantitySyntaxError(InputError):
     """Text that is not a quantity of the grammar above; the message says what was expected."""
 
 

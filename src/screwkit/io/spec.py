@@ -33,6 +33,8 @@ from screwkit.model.linkage import Link, Linkage, LinkageError
 
 if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
+    from screwkit.io.display_units import DisplayUnits
+    from screwkit.io.drive_table import DriveConfig
     from screwkit.synthesis.config import SynthesisConfig
 
 Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
@@ -101,6 +103,7 @@ class SpecFile(_Strict):
     gravity_direction: list[Number] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
     balancing: dict[str, Any] | None = None
     synthesis: dict[str, Any] | None = None
+    drive: dict[str, Any] | None = None
 
 
 class Spec:
@@ -113,7 +116,8 @@ class Spec:
     the mechanism model (a :class:`~screwkit.model.Linkage`, built once at load); ``balancing``
     and ``synthesis`` are the ``[balancing]`` and ``[synthesis]`` tables as typed configs
     (:class:`~screwkit.balancing.config.BalancingConfig`,
-    :class:`~screwkit.synthesis.config.SynthesisConfig`), or ``None``.
+    :class:`~screwkit.synthesis.config.SynthesisConfig`), or ``None``; ``drive`` the ``[drive]``
+    table of ``screwkit simulate`` (:class:`~screwkit.io.drive_table.DriveConfig`), or ``None``.
     """
 
     def __init__(self, raw: SpecFile, path: str) -> None:
@@ -167,6 +171,11 @@ class Spec:
             from screwkit.io.synthesis_table import synthesis_config
 
             self.synthesis = synthesis_config(self)
+        self.drive: DriveConfig | None = None
+        if raw.drive is not None:
+            from screwkit.io.drive_table import drive_config
+
+            self.drive = drive_config(self)
 
     # --- helpers ---------------------------------------------------------------------------
     def _fail(self, key: str, message: str) -> None:
@@ -321,16 +330,29 @@ class Spec:
         """The mechanism model (read only; built once when the spec is loaded)."""
         return self._linkage
 
-    def describe(self) -> str:
+    def display_units(self, system: str = "spec", overrides: dict[str, str] | None = None
+                      ) -> DisplayUnits:
+        """The units tables, CSV and plots show this spec's results in: its ``[units]``
+        (``system="spec"``) or SI (``"si"``), with per-kind ``overrides``
+        (:func:`screwkit.io.display_units.display_units`)."""
+        from screwkit.io.display_units import display_units
+
+        return display_units(self.units, system=system, overrides=overrides)
+
+    def describe(self, units: DisplayUnits | None = None) -> str:
+        """One line: name, family, dimensions and input span in ``units`` (default: the
+        spec's own [units])."""
+        du = units if units is not None else self.display_units()
         lk = self._linkage
-        dims = ", ".join(f"{k}={v:.6g}" for k, v in self.dimensions.items())
+        kinds = family(self.family).dimensions
+        dims = ", ".join(f"{k}={du.show(kinds[k], v):.6g} {du.label(kinds[k])}"
+                         for k, v in self.dimensions.items())
         n = len(self.inputs)
         joints = "".join(j.kind for j in lk.joints)
         src = f" — source: {self.source}" if self.source else ""
-        if self.input_is_angle:
-            span = f"{np.degrees(self.inputs[0]):.6g}…{np.degrees(self.inputs[-1]):.6g} deg"
-        else:
-            span = f"{self.inputs[0]:.6g}…{self.inputs[-1]:.6g} m"
+        kind = "angle" if self.input_is_angle else "length"
+        span = (f"{du.show(kind, self.inputs[0]):.6g}…{du.show(kind, self.inputs[-1]):.6g} "
+                f"{du.label(kind)}")
         return f"{self.name}: {self.family} ({joints}) {dims}; {n} input samples {span}{src}"
 
     @property

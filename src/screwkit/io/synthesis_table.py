@@ -29,7 +29,7 @@ from screwkit.io.units import UnitError, to_si
 from screwkit.kinematics.registry import require
 from screwkit.synthesis.config import Multistart, SynthesisConfig
 from screwkit.synthesis.overlay import OverlayDwell
-from screwkit.synthesis.overlay_route import OverlayProblem
+from screwkit.synthesis.overlay_synthesis import OverlayProblem
 from screwkit.synthesis.problem import (
     ANGLE_NAMES,
     DIMENSION_NAMES,

@@ -18,6 +18,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
+from screwkit.errors import InputError
 from screwkit.io.quantity import excerpt
 
 #: largest spec file read (bytes); the biggest bundled example is under 4 kB
@@ -40,7 +41,7 @@ _TOKENS = re.compile(
 )
 
 
-class SpecFileError(ValueError):
+class SpecFileError(InputError):
     """A spec file that cannot be read as TOML; the message names the file."""
 
 

@@ -11,10 +11,9 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import pint
-
+from screwkit.errors import InputError
 from screwkit.io.quantity import (
     MAX_QUANTITY_CHARS,
     QuantitySyntaxError,
@@ -23,13 +22,20 @@ from screwkit.io.quantity import (
     parse_unit,
 )
 
+if TYPE_CHECKING:
+    import pint
 
-class UnitError(ValueError):
+
+class UnitError(InputError):
     """A quantity that cannot be read or has the wrong kind of unit."""
 
 
 @lru_cache(maxsize=1)
 def registry() -> pint.UnitRegistry[Any]:
+    """pint's registry, built on first use (0.2 s): the common units of :data:`COMMON_UNITS`
+    never need it."""
+    import pint
+
     ureg: pint.UnitRegistry[Any] = pint.UnitRegistry()
     return ureg
 
@@ -44,13 +50,83 @@ KIND_UNITS = {
     "mass": "kg",
     "force": "N",
     "inertia": "kg*m**2",
+    "torque": "N*m",
+    "time": "s",
+    "rotational_damping": "N*m*s/rad",
+    "translational_damping": "N*s/m",
+    "moment": "N*m",
+    "mass_moment": "kg*m",
     "dimensionless": "",
 }
+
+#: powers of (m, kg, s) of each kind; an angle is dimensionless, as in pint
+KIND_DIMENSIONS: dict[str, tuple[int, int, int]] = {
+    "length": (1, 0, 0), "angle": (0, 0, 0), "angular_velocity": (0, 0, -1),
+    "angular_acceleration": (0, 0, -2), "velocity": (1, 0, -1), "acceleration": (1, 0, -2),
+    "mass": (0, 1, 0), "force": (1, 1, -2), "inertia": (2, 1, 0), "moment": (2, 1, -2),
+    "torque": (2, 1, -2), "mass_moment": (1, 1, 0), "time": (0, 0, 1),
+    "rotational_damping": (2, 1, -1), "translational_damping": (0, 1, -1),
+    "dimensionless": (0, 0, 0),
+}
+
+_INCH = 0.0254
+_POUND = 0.4535923700000001  # pint's double for 0.45359237 kg (from 7000 grains): the same bits
+_G0 = 9.80665
+_TURN = 2.0 * math.pi
+_LENGTH, _MASS, _TIME, _NONE = (1, 0, 0), (0, 1, 0), (0, 0, 1), (0, 0, 0)
+
+#: the unit names most spec files use, read without building pint's registry (start-up time):
+#: name -> (SI value of one unit, powers of m, kg, s). The same definitions as pint's (tested
+#: against pint name by name); any other name goes to pint.
+COMMON_UNITS: dict[str, tuple[float, tuple[int, int, int]]] = {
+    **dict.fromkeys(("m", "meter", "metre", "meters", "metres"), (1.0, _LENGTH)),
+    **dict.fromkeys(("mm", "millimeter", "millimetre", "millimeters"), (1e-3, _LENGTH)),
+    **dict.fromkeys(("cm", "centimeter", "centimetre"), (1e-2, _LENGTH)),
+    **dict.fromkeys(("km", "kilometer", "kilometre"), (1e3, _LENGTH)),
+    **dict.fromkeys(("um", "µm", "μm", "micrometer"), (1e-6, _LENGTH)),
+    **dict.fromkeys(("in", "inch", "inches"), (_INCH, _LENGTH)),
+    **dict.fromkeys(("ft", "foot", "feet"), (12 * _INCH, _LENGTH)),
+    **dict.fromkeys(("rad", "radian", "radians"), (1.0, _NONE)),
+    **dict.fromkeys(("deg", "degree", "degrees"), (math.pi / 180.0, _NONE)),
+    **dict.fromkeys(("rev", "revs", "revolution", "revolutions", "turn"), (_TURN, _NONE)),
+    **dict.fromkeys(("s", "sec", "second", "seconds"), (1.0, _TIME)),
+    **dict.fromkeys(("ms", "millisecond"), (1e-3, _TIME)),
+    **dict.fromkeys(("min", "minute", "minutes"), (60.0, _TIME)),
+    **dict.fromkeys(("h", "hr", "hour", "hours"), (3600.0, _TIME)),
+    "rpm": (_TURN / 60.0, (0, 0, -1)),
+    **dict.fromkeys(("kg", "kilogram", "kilograms"), (1.0, _MASS)),
+    **dict.fromkeys(("g", "gram", "grams"), (1e-3, _MASS)),
+    **dict.fromkeys(("lb", "pound", "pounds"), (_POUND, _MASS)),
+    **dict.fromkeys(("N", "newton", "newtons"), (1.0, (1, 1, -2))),
+    "kN": (1e3, (1, 1, -2)),
+    "lbf": (_POUND * _G0, (1, 1, -2)),
+    "kgf": (_G0, (1, 1, -2)),
+}
+
+
+def common_unit_factor(names: tuple[tuple[str, int], ...], kind: str) -> float | None:
+    """SI value of one of the unit ``names`` if every name is in :data:`COMMON_UNITS` and the
+    powers make a unit of ``kind``; ``None`` otherwise (pint then decides, and words the
+    error)."""
+    factor = 1.0
+    dims = [0, 0, 0]
+    for name, power in names:
+        entry = COMMON_UNITS.get(name)
+        if entry is None:
+            return None
+        factor *= entry[0] ** power
+        for k in range(3):
+            dims[k] += entry[1][k] * power
+    return factor if tuple(dims) == KIND_DIMENSIONS.get(kind) else None
+
 
 #: SI unit of each kind as printed in messages
 SI_SYMBOL = {"length": "m", "angle": "rad", "angular_velocity": "rad/s",
              "angular_acceleration": "rad/s^2", "velocity": "m/s", "acceleration": "m/s^2",
-             "mass": "kg", "force": "N", "inertia": "kg*m^2", "dimensionless": ""}
+             "mass": "kg", "force": "N", "inertia": "kg*m^2", "torque": "N*m", "time": "s",
+             "rotational_damping": "N*m*s/rad", "translational_damping": "N*s/m",
+             "moment": "N*m", "mass_moment": "kg*m",
+             "dimensionless": ""}
 
 #: (largest |value|, smallest non-zero |value|) accepted per kind, in SI. Zero is always
 #: accepted here (a zero offset, a massless link, a resting input); rules that need a positive
@@ -66,6 +142,12 @@ MAGNITUDE_LIMITS: dict[str, tuple[float, float]] = {
     "mass": (1e9, 1e-12),                   # a million tonnes … 1 ng
     "force": (1e12, 1e-12),
     "inertia": (1e15, 1e-27),               # kg·m²
+    "torque": (1e12, 1e-12),                # N·m
+    "time": (1e7, 1e-12),                   # ~4 months … 1 ps
+    "rotational_damping": (1e12, 1e-15),    # N·m·s/rad
+    "translational_damping": (1e12, 1e-15),  # N·s/m
+    "moment": (1e15, 1e-15),
+    "mass_moment": (1e12, 1e-15),
     "dimensionless": (1e12, 1e-300),
 }
 
@@ -82,6 +164,12 @@ EXAMPLES = {
     "mass": '"0.86 kg"',
     "force": '"1.9 lbf"',
     "inertia": '"2.05e-4 lbf*s^2*in" or "1e-3 kg*m^2"',
+    "torque": '"5 N*m" or "40 lbf*in"',
+    "time": '"2 s" or "150 ms"',
+    "rotational_damping": '"0.01 N*m*s/rad"',
+    "translational_damping": '"5 N*s/m"',
+    "moment": '"N*m" or "lbf*in"',
+    "mass_moment": '"kg*m" or "kg*mm"',
     "dimensionless": "a plain number",
 }
 
@@ -114,6 +202,8 @@ def _unit(names: tuple[tuple[str, int], ...]) -> Any:
 @lru_cache(maxsize=512)
 def _factor(names: tuple[tuple[str, int], ...], kind: str) -> float:
     """SI value of one of the unit; raises :class:`UnitError` for the wrong kind."""
+    import pint
+
     unit = _unit(names)
     target = KIND_UNITS[kind]
     try:
@@ -143,6 +233,8 @@ def check_unit(unit: str, kind: str) -> None:
                         f"{EXAMPLES[kind]}") from exc
     if names is None:
         raise UnitError(f"the unit {excerpt(unit)} is longer than {MAX_QUANTITY_CHARS} characters")
+    if common_unit_factor(names, kind) is not None:
+        return
     try:
         _unit(names)
     except UnitError as exc:
@@ -202,6 +294,9 @@ def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
         names = parse_unit(default_unit)
     if not names:
         return check_magnitude(magnitude, kind, shown)
+    common = common_unit_factor(names, kind)
+    if common is not None:
+        return check_magnitude(magnitude * common, kind, shown)
     try:
         factor = _factor(names, kind)
     except UnitError as exc:
@@ -214,3 +309,12 @@ def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
             f"{shown} is ambiguous for an angular speed (Hz is 1/s, with no angle): write "
             f"revolutions as \"50 rev/s\" or \"3000 rpm\", or radians as \"314.16 rad/s\"")
     return check_magnitude(magnitude * factor, kind, shown)
+
+
+def unit_factor(unit: str, kind: str) -> float:
+    """The SI value of one ``unit`` of ``kind`` (``unit_factor("deg", "angle")`` is π/180);
+    a :class:`UnitError` for a unit that cannot be read or is of another kind."""
+    check_unit(unit, kind)
+    names = parse_unit(unit)
+    common = common_unit_factor(names, kind)
+    return common if common is not None else _factor(names, kind)

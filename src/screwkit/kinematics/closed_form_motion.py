@@ -19,6 +19,7 @@ input-output equation A cos x + B sin x = K first, then the one with −acos.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -68,11 +69,13 @@ def _with_seed(mode: ModeMotion, index: int, label: str, seed: tuple[dict[str, A
                    singular=sing, index=index, label=label)
 
 
-def _no_modes(linkage: Linkage, X: Array) -> AssemblyError:
+def _no_modes(linkage: Linkage, X: Array, where: str) -> AssemblyError:
+    """The loop closes at none of the inputs: say where over a full turn it does, if anywhere."""
     return AssemblyError(
         f"{linkage.name}: the loop does not close at any of the {len(X)} inputs "
-        f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
-        "check the dimensions")
+        f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); it "
+        f"assembles {where}" + ("; check the dimensions" if where.startswith("at no") else
+                                "; change [motion] start/stop to a range where it does"))
 
 
 def rsrc_dimensions(linkage: Linkage) -> tuple[RSRCDimensions, bool]:
@@ -129,7 +132,9 @@ def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
                                 f"sample: label {int(np.max(mot.inversion_label[ok, j][:1]))})",
                                 (seed_v, seed_d, seed_dd), singular=ok & ~rates.valid[:, j]))
     if not modes:
-        raise _no_modes(linkage, X)
+        from screwkit.kinematics.assembly_range import assembling_intervals, describe_intervals
+
+        raise _no_modes(linkage, X, describe_intervals(assembling_intervals(dims)))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed",
                   solver=FOURBAR_SOLVER if planar else RSRC_SOLVER)
 
@@ -189,7 +194,11 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         md = replace(md, events=events)
         modes.append(_with_seed(md, len(modes), label, (seed_v, seed_d, seed_dd)))
     if not modes:
-        raise _no_modes(linkage, X)
+        from screwkit.kinematics.assembly_range import describe_intervals
+        from screwkit.kinematics.cssp import assembly_intervals
+
+        raise _no_modes(linkage, X, describe_intervals(
+            [(a % (2 * np.pi), a % (2 * np.pi) + (b - a)) for a, b in assembly_intervals(dims)]))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=CSSP_SOLVER)
 
 
@@ -232,8 +241,21 @@ def rssr_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
                  "phi0": mot.ddphi[:, j] * Xd[:, 0] ** 2 + rate * Xdd[:, 0]})
         modes.append(_with_seed(md, len(modes), label, seed, singular=mot.dead_centre[:, j]))
     if not modes:
-        raise _no_modes(linkage, X)
+        raise _no_modes(linkage, X, _where_over_a_turn(
+            lambda th: np.asarray(rssr_motion(dims, th).assembles.any(axis=1))))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=RSSR_SOLVER)
+
+
+def _where_over_a_turn(assembles: Callable[[Array], NDArray[np.bool_]]) -> str:
+    """Where over a full input turn a closed form assembles, in words (0.25° scan)."""
+    from screwkit.kinematics.assembly_range import (
+        SCAN_SAMPLES,
+        describe_intervals,
+        runs_over_a_turn,
+    )
+
+    theta = np.linspace(0.0, 2 * np.pi, SCAN_SAMPLES, endpoint=False)
+    return describe_intervals(runs_over_a_turn(theta, np.asarray(assembles(theta))))
 
 
 def _two_ball_configuration(linkage: Linkage, scalars: Array, rod: Array) -> Configuration:
@@ -284,5 +306,6 @@ def rccc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         modes.append(_with_seed(md, len(modes), label, ({}, {}, {}),
                                 singular=mot.dead_centre[:, j]))
     if not modes:
-        raise _no_modes(linkage, X)
+        raise _no_modes(linkage, X, _where_over_a_turn(
+            lambda th: np.asarray(rccc_motion(dims, th).assembles.any(axis=1))))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=RCCC_SOLVER)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from screwkit.errors import InputError
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion
 
@@ -17,9 +18,9 @@ def coupler_point_path(mode: ModeMotion, point: ArrayLike, link: int = 1) -> Arr
     the joint motion), over one mode; NaN where the mode does not assemble."""
     p = np.asarray(point, dtype=float)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise ValueError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
+        raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
     n_links = mode.link_rotation.shape[1]
     if not 0 <= link < n_links:
-        raise ValueError(f"link index {link} out of range: the loop has {n_links} moving links")
+        raise InputError(f"link index {link} out of range: the loop has {n_links} moving links")
     R = mode.link_rotation[:, link]
     return np.asarray(mode.link_origin[:, link] + np.einsum("nij,j->ni", R, p))

@@ -28,6 +28,9 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.dual.spatial import elevation_azimuth, rot_x, wrap_angle
+from screwkit.errors import InputError
+
 Array = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 AnyArray = NDArray[Any]  # real, or complex for complex-step differentiation
@@ -37,11 +40,7 @@ AssemblyMode = Literal[1, -1]
 #: assembly mode of Rahman's FORTRAN program: s4 = −b + √(b² − c) (SPEC §1.2)
 SEED_ASSEMBLY_MODE: AssemblyMode = 1
 
-# |cos| of an elevation below which its azimuth (and the angle rates) are undefined
-_GIMBAL_TOL = 1e-12
-
-
-class CSSPAssemblyError(ValueError):
+class CSSPAssemblyError(InputError):
     """The CSSP does not assemble (b² < c) or sits on a branch point (b² = c) at some inputs."""
 
     def __init__(self, message: str, assembles: BoolArray) -> None:
@@ -104,7 +103,7 @@ def _quadratic_coefficients(
     return b, c
 
 
-def _slider_and_rod(
+def slider_and_rod(
     dims: CSSPDimensions,
     theta1: AnyArray,
     theta1_dot: AnyArray,
@@ -161,46 +160,6 @@ def _slider_and_rod(
         "rod_direction_dot": (ball_dot - pin_dot) / a2,
         "rod_direction_ddot": (ball_ddot - pin_ddot) / a2,
     }
-
-
-def elevation_azimuth(
-    v: Array, v_dot: Array, v_ddot: Array
-) -> tuple[BoolArray, Array, Array, Array, Array, Array, Array]:
-    """Elevation E = atan2(v_z, ρ) and azimuth A = atan2(v_y, v_x) of a unit vector v(t),
-    ρ = √(v_x² + v_y²) = cos E, with exact rates:
-        Ė = v̇_z/ρ,  Ë = (v̈_z + v_z Ė²)/ρ,
-        Ȧ = (v_x v̇_y − v_y v̇_x)/ρ²,  Ä = (v_x v̈_y − v_y v̈_x)/ρ² − 2 Ȧ (v_x v̇_x + v_y v̇_y)/ρ².
-    Where ρ ≈ 0 (v along z) A is undefined: those samples are flagged False and their rates NaN.
-    """
-    vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
-    rho2 = vx**2 + vy**2
-    rho = np.sqrt(rho2)
-    defined = rho > _GIMBAL_TOL
-    elevation = np.arctan2(vz, rho)
-    azimuth = np.where(defined, np.arctan2(vy, vx), np.nan)
-    safe_rho = np.where(defined, rho, 1.0)
-    safe_rho2 = safe_rho**2
-    e_dot = v_dot[..., 2] / safe_rho
-    e_ddot = (v_ddot[..., 2] + vz * e_dot**2) / safe_rho
-    a_dot = (vx * v_dot[..., 1] - vy * v_dot[..., 0]) / safe_rho2
-    a_ddot = (vx * v_ddot[..., 1] - vy * v_ddot[..., 0]) / safe_rho2 - 2 * a_dot * (
-        vx * v_dot[..., 0] + vy * v_dot[..., 1]
-    ) / safe_rho2
-    nan = np.nan
-    return (
-        defined,
-        elevation,
-        np.where(defined, e_dot, nan),
-        np.where(defined, e_ddot, nan),
-        azimuth,
-        np.where(defined, a_dot, nan),
-        np.where(defined, a_ddot, nan),
-    )
-
-
-def _wrap(angle: Array) -> Array:
-    """Angle in (−π, π]."""
-    return -((-angle + np.pi) % (2 * np.pi) - np.pi)
 
 
 # --------------------------------------------------------------------------------------------
@@ -402,7 +361,9 @@ class CSSPMotion(CSSPPositions):
 # --------------------------------------------------------------------------------------------
 # public solvers
 # --------------------------------------------------------------------------------------------
-def _as_samples(value: ArrayLike | None, n: int, name: str, default: float) -> Array:
+def as_sample_array(value: ArrayLike | None, n: int, name: str, default: float) -> Array:
+    """A per-sample input (``default`` if None, a scalar, or shape (n,)) as a finite (n,) array;
+    a ValueError names ``name`` and the offending shape or samples."""
     arr = np.asarray(default if value is None else value, dtype=float)
     if arr.ndim > 1:
         raise ValueError(
@@ -419,12 +380,62 @@ def _as_samples(value: ArrayLike | None, n: int, name: str, default: float) -> A
     return out
 
 
-def _check_mode(mode: int) -> int:
+def check_assembly_mode(mode: int) -> int:
+    """The assembly mode as an int, +1 (s4 = -b + sqrt(b^2 - c), Rahman's) or -1; else ValueError."""
     if mode not in (1, -1):
         raise ValueError(
             f"mode must be +1 (s4 = -b + sqrt(b^2 - c), Rahman's branch) or -1, got {mode!r}"
         )
     return int(mode)
+
+
+def _rod_and_slider_angles(
+    dims: CSSPDimensions,
+    th: Array,
+    w: Array,
+    wd: Array,
+    u: Array,
+    ud: Array,
+    udd: Array,
+    assembles: BoolArray,
+    need_rates: bool,
+) -> dict[str, object]:
+    """Rahman's joint angles from the rod direction u (SPEC §1.1, L2): θ2 = azimuth of u − θ1 and
+    η2 = −elevation of u (rod), θ3, η3 the azimuth and elevation of u seen in the slider frame
+    {4} = X(α4), with their rates when ``need_rates``, and the rod frame {3} = Z(θ1 + θ2) Y(η2)."""
+    rod_ok, elev, e_d, e_dd, phi, phi_d, phi_dd = elevation_azimuth(u, ud, udd)
+    to_slider = rot_x(dims.alpha4)  # X(α4) = R_{4←1}
+    slider_ok, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = elevation_azimuth(
+        u @ to_slider.T, ud @ to_slider.T, udd @ to_slider.T
+    )
+    rod_ok &= assembles
+    slider_ok &= assembles
+
+    # Rahman's rod frame {3}: R_{1←3} = Z(θ1 + θ2) Y(η2), x3 = u (SPEC §1.1, L2).
+    phi_frame = np.where(rod_ok, phi, 0.0)
+    y3 = np.stack([-np.sin(phi_frame), np.cos(phi_frame), np.zeros(th.shape[0])], axis=-1)
+    rod_frame = np.stack([u, y3, np.cross(u, y3)], axis=-1)
+    out: dict[str, object] = {
+        "theta2": np.where(rod_ok, wrap_angle(phi - th), np.nan),
+        "eta2": -elev,
+        "rod_angles_defined": rod_ok,
+        "theta3": th3,
+        "eta3": eta3,
+        "slider_angles_defined": slider_ok,
+        "rod_frame": rod_frame,
+    }
+    if need_rates:
+        out.update(
+            theta2_dot=phi_d - w,
+            theta2_ddot=phi_dd - wd,
+            eta2_dot=-e_d,
+            eta2_ddot=-e_dd,
+            theta3_dot=th3_d,
+            theta3_ddot=th3_dd,
+            eta3_dot=eta3_d,
+            eta3_ddot=eta3_dd,
+        )
+    return out
 
 
 def _solve(
@@ -439,17 +450,17 @@ def _solve(
     allow_partial: bool,
     need_rates: bool,
 ) -> dict[str, object]:
-    mode = _check_mode(mode)
+    mode = check_assembly_mode(mode)
     th = np.atleast_1d(np.asarray(theta1, dtype=float))
     if th.ndim != 1:
         raise ValueError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
     n = th.shape[0]
-    th = _as_samples(th, n, "theta1", 0.0)
-    w = _as_samples(theta1_dot, n, "theta1_dot", 0.0)
-    wd = _as_samples(theta1_ddot, n, "theta1_ddot", 0.0)
-    s1_arr = _as_samples(s1, n, "s1", dims.s1)
-    s1d = _as_samples(s1_dot, n, "s1_dot", 0.0)
-    s1dd = _as_samples(s1_ddot, n, "s1_ddot", 0.0)
+    th = as_sample_array(th, n, "theta1", 0.0)
+    w = as_sample_array(theta1_dot, n, "theta1_dot", 0.0)
+    wd = as_sample_array(theta1_ddot, n, "theta1_ddot", 0.0)
+    s1_arr = as_sample_array(s1, n, "s1", dims.s1)
+    s1d = as_sample_array(s1_dot, n, "s1_dot", 0.0)
+    s1dd = as_sample_array(s1_ddot, n, "s1_ddot", 0.0)
 
     b, c = _quadratic_coefficients(dims, th, s1_arr)
     disc = b * b - c
@@ -468,7 +479,7 @@ def _solve(
         )
     disc_sqrt = np.sqrt(np.where(assembles, disc, 1.0))  # placeholder 1 where masked below
     with np.errstate(divide="ignore", invalid="ignore"):  # rates at b² = c, unused for positions
-        core = _slider_and_rod(dims, th, w, wd, s1_arr, s1d, s1dd, mode, disc_sqrt=disc_sqrt)
+        core = slider_and_rod(dims, th, w, wd, s1_arr, s1d, s1dd, mode, disc_sqrt=disc_sqrt)
     for key, value in core.items():
         if key.startswith("crank_pin"):
             continue
@@ -476,20 +487,6 @@ def _solve(
         core[key] = np.where(mask, value, np.nan)
 
     u, ud, udd = core["rod_direction"], core["rod_direction_dot"], core["rod_direction_ddot"]
-    rod_ok, elev, e_d, e_dd, phi, phi_d, phi_dd = elevation_azimuth(u, ud, udd)
-    sa, ca = np.sin(dims.alpha4), np.cos(dims.alpha4)
-    to_slider = np.array([[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]])  # X(α4) = R_{4←1}
-    slider_ok, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = elevation_azimuth(
-        u @ to_slider.T, ud @ to_slider.T, udd @ to_slider.T
-    )
-    rod_ok &= assembles
-    slider_ok &= assembles
-
-    # Rahman's rod frame {3}: R_{1←3} = Z(θ1 + θ2) Y(η2), x3 = u (SPEC §1.1, L2).
-    phi_frame = np.where(rod_ok, phi, 0.0)
-    y3 = np.stack([-np.sin(phi_frame), np.cos(phi_frame), np.zeros(n)], axis=-1)
-    rod_frame = np.stack([u, y3, np.cross(u, y3)], axis=-1)
-
     out: dict[str, object] = {
         "dims": dims,
         "mode": mode,
@@ -500,13 +497,7 @@ def _solve(
         "crank_pin": core["crank_pin"],
         "slider_ball": core["slider_ball"],
         "rod_direction": u,
-        "theta2": np.where(rod_ok, _wrap(phi - th), np.nan),
-        "eta2": -elev,
-        "rod_angles_defined": rod_ok,
-        "theta3": th3,
-        "eta3": eta3,
-        "slider_angles_defined": slider_ok,
-        "rod_frame": rod_frame,
+        **_rod_and_slider_angles(dims, th, w, wd, u, ud, udd, assembles, need_rates),
     }
     if need_rates:
         out.update(
@@ -516,14 +507,6 @@ def _solve(
             s1_ddot=s1dd,
             s4_dot=core["s4_dot"],
             s4_ddot=core["s4_ddot"],
-            theta2_dot=phi_d - w,
-            theta2_ddot=phi_dd - wd,
-            eta2_dot=-e_d,
-            eta2_ddot=-e_dd,
-            theta3_dot=th3_d,
-            theta3_ddot=th3_dd,
-            eta3_dot=eta3_d,
-            eta3_ddot=eta3_dd,
             rod_direction_dot=ud,
             rod_direction_ddot=udd,
             rod_angular_velocity=np.cross(u, ud),
@@ -603,7 +586,10 @@ __all__ = [
     "CSSPPositions",
     "assembly_discriminant",
     "assembly_intervals",
+    "as_sample_array",
     "assembly_message",
+    "check_assembly_mode",
     "cssp_motion",
     "cssp_positions",
+    "slider_and_rod",
 ]

@@ -39,18 +39,18 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation
 
+from screwkit.dual.spatial import GIMBAL_TOL, rot_x
+from screwkit.errors import InputError
 from screwkit.kinematics.cssp import (
-    _GIMBAL_TOL,
     SEED_ASSEMBLY_MODE,
     CSSPAssemblyError,
     CSSPDimensions,
-    _as_samples,
-    _check_mode,
+    as_sample_array,
     assembly_message,
+    check_assembly_mode,
 )
-from screwkit.kinematics.loop import Configuration, rot_x
+from screwkit.kinematics.loop import Configuration
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
 
@@ -59,7 +59,7 @@ Array = NDArray[np.float64]
 _JOINTS = (("R", "C"), ("S",), ("S",), ("P",))
 
 
-class NotACSSPError(ValueError):
+class NotACSSPError(InputError):
     """The linkage given to :func:`cssp_mode_motion` is not a CSSP of the family constructor."""
 
 
@@ -155,7 +155,7 @@ def rahman_rod_axes(u: tuple[Any, Any, Any]) -> tuple[tuple[Any, Any, Any], tupl
     """y3 and z3 of Rahman's rod frame {3} = Z(θ1 + θ2)·Y(η2) with x3 = u:
     y3 = (−u_y, u_x, 0)/ρ, z3 = u × y3 (SPEC §1.1; y3 = (0, 1, 0) where u is vertical)."""
     rho2 = u[0] * u[0] + u[1] * u[1]
-    defined = rho2 > _GIMBAL_TOL**2
+    defined = rho2 > GIMBAL_TOL**2
     inv_rho = 1.0 / np.sqrt(np.where(defined, rho2, 1.0))
     y3 = (np.where(defined, -u[1] * inv_rho, 0.0), np.where(defined, u[0] * inv_rho, 1.0),
           np.zeros_like(rho2))
@@ -360,7 +360,7 @@ def _given(value: ArrayLike | None, n: int, name: str, default: float) -> float 
         if not np.isfinite(arr):
             raise ValueError(f"{name} must be finite, got {float(arr)!r}")
         return float(arr)
-    return _as_samples(arr, n, name, default)
+    return as_sample_array(arr, n, name, default)
 
 
 def cssp_sweep(
@@ -387,12 +387,12 @@ def cssp_sweep(
             f"{linkage.name}: the crank offset s1 is a constant of this CSSP "
             f"(s1 = {dims.s1!r} m); build it with cssp(..., s1_is_input=True) to drive s1"
         )
-    mode = _check_mode(mode)
+    mode = check_assembly_mode(mode)
     th = np.atleast_1d(np.asarray(theta1, dtype=float))
     if th.ndim != 1:
         raise ValueError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
     n = th.shape[0]
-    th = _as_samples(th, n, "theta1", 0.0)
+    th = as_sample_array(th, n, "theta1", 0.0)
     given = {
         name: _given(value, n, name, default)
         for name, value, default in zip(
@@ -514,6 +514,7 @@ def cssp_mode_motion(
     if joint_rotations:
         safe = np.where(ok[:, None, None], 1.0, 0.0)
         eye = np.where(ok[:, None, None], 0.0, 1.0) * np.eye(3)
+        from scipy.spatial.transform import Rotation  # on first use (start-up time)
         pin_rv = Rotation.from_matrix(np.nan_to_num(pin_rel) * safe + eye).as_rotvec()
         ball_rv = Rotation.from_matrix(np.nan_to_num(ball_rel) * safe + eye).as_rotvec()
     for name, r, rv in ((pin, 0, pin_rv if joint_rotations else None),

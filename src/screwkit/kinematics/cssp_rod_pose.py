@@ -12,9 +12,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.dual.spatial import rot_z
 from screwkit.kinematics.cssp import CSSPDimensions
 from screwkit.kinematics.idle_spin import zero_spin_angle
-from screwkit.kinematics.loop import Array, rot_z
+from screwkit.kinematics.loop import Array
 
 
 def rod_turn(dims: CSSPDimensions, mode: int, theta1: Array, ct: Array, st: Array,

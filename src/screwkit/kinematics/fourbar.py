@@ -26,8 +26,9 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.dual.spatial import wrap_angle_near
 from screwkit.kinematics.quartic import DEFAULT_DOUBLE_ROOT_TOL, sin_cos
-from screwkit.kinematics.rsrc import RSRCDimensions
+from screwkit.kinematics.rsrc.dimensions import RSRCDimensions, check_input_angles
 
 __all__ = [
     "FourBarDimensions",
@@ -130,25 +131,7 @@ class FourBarPositions:
     def coupler_angle(self) -> FloatArray:
         """(N, 2) absolute direction of the coupler from crank tip to rocker tip, phi0 - chi0,
         in (-pi, pi]."""
-        return _wrap(self.phi0 - self.chi0)
-
-
-def _check_angles(theta0: ArrayLike) -> FloatArray:
-    arr = np.asarray(theta0, dtype=np.float64)
-    if arr.ndim == 0:
-        arr = arr.reshape(1)
-    if arr.ndim != 1:
-        raise ValueError(f"theta0 must be a scalar or 1-D array (radians), got shape {arr.shape}")
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"theta0[{i}] = {arr[i]!r} is not finite")
-    return arr
-
-
-def _wrap(angle: FloatArray) -> FloatArray:
-    """Wrap angles in (-3 pi, 3 pi] into (-pi, pi]."""
-    return angle - _TWO_PI * ((angle > math.pi).astype(np.float64) - (angle <= -math.pi))
+        return wrap_angle_near(self.phi0 - self.chi0)
 
 
 def _positions_block(
@@ -203,7 +186,7 @@ def fourbar_positions(
     vectorised in blocks over ``theta0`` (scalar or (N,), radians).  It equals `rsrc_positions`
     of ``dims.as_rsrc()`` column by column (labels 1 and 2).
     """
-    theta = _check_angles(theta0)
+    theta = check_input_angles(theta0)
     n = theta.shape[0]
     phi = np.empty((n, 2))
     chi = np.empty((n, 2))
@@ -284,7 +267,7 @@ def fourbar_output_angles(dims: FourBarDimensions, theta0: ArrayLike, *,
     """Rocker angle φ0 of both assembly modes only, shape (N, 2) (column 0 = mode 1), NaN where
     the loop does not close — `fourbar_positions` without the coupler angle, for sweeps where
     only the output matters (Freudenstein, Bagci eq. 3.11: φ0 = atan2(M0, N0) ∓ α)."""
-    theta = _check_angles(theta0)
+    theta = check_input_angles(theta0)
     n = theta.shape[0]
     out = np.empty((2, n))  # mode-major: contiguous writes
     a, d1, d2, d3 = dims.a, dims.d1, dims.d2, dims.d3

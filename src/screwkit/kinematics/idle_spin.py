@@ -25,7 +25,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.loop import Array, Configuration, Layout, LoopFrames, cross, forward
+from screwkit.dual.spatial import cross
+from screwkit.kinematics.loop import Array, Configuration, Layout, LoopFrames, forward
 from screwkit.kinematics.rates import RateEquations, rate_equations, solve_rates
 from screwkit.model.linkage import Linkage
 

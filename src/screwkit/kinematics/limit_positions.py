@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.kinematics.motion import AssemblyError
 from screwkit.kinematics.registry import require
 from screwkit.model.linkage import Linkage
@@ -86,7 +87,7 @@ def limit_positions(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: 
 
     fam = require(linkage, "limits")
     if not dwell_tolerance > 0:
-        raise ValueError(f"the dwell tolerance must be positive; got {dwell_tolerance}")
+        raise InputError(f"the dwell tolerance must be positive; got {dwell_tolerance}")
     dims, planar = rsrc_dimensions(linkage)
     out: list[LimitPosition] = []
     rot = rsrc_rotation_limits(dims)

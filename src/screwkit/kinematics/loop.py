@@ -18,8 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
+from screwkit.dual.spatial import cross, rot_y, skew
 from screwkit.model.linkage import Linkage
 
 Array = NDArray[np.float64]
@@ -88,24 +88,6 @@ def layout(linkage: Linkage) -> Layout:
                   rotations, translations, linkage.length_scale)
 
 
-def rot_z(angle: Array) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    z, o = np.zeros_like(c), np.ones_like(c)
-    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
-
-
-def rot_y(angle: Array) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    z, o = np.zeros_like(c), np.ones_like(c)
-    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
-
-
-def rot_x(angle: Array) -> Array:
-    c, s = np.cos(angle), np.sin(angle)
-    z, o = np.zeros_like(c), np.ones_like(c)
-    return np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2)
-
-
 @dataclass(frozen=True)
 class LoopFrames:
     """Frames of one pass round the loop (ground frame), batch-first.
@@ -126,17 +108,6 @@ class LoopFrames:
     screws: Array
     centres: Array
     axes: Array
-
-
-def cross(a: Array, b: Array) -> Array:
-    """a × b over the last axis (3), without numpy's axis bookkeeping (a hot path)."""
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    out[..., 0] = a1 * b2 - a2 * b1
-    out[..., 1] = a2 * b0 - a0 * b2
-    out[..., 2] = a0 * b1 - a1 * b0
-    return out
 
 
 def _turn_z(R: Array, th: Array) -> Array:
@@ -241,7 +212,7 @@ def closure_twist(R: Array, p: Array) -> Array:
     Its norm is the loop-closure error; Newton drives it to zero."""
     w = rotation_vector(R)
     th = np.linalg.norm(w, axis=-1)
-    W = _skew(w)
+    W = skew(w)
     small = th < 1e-6
     ths = np.where(small, 1.0, th)
     # V^{-1} = I - W/2 + (1/θ²)(1 - (θ/2) cot(θ/2)) W²
@@ -263,20 +234,10 @@ def rotation_vector(R: Array) -> Array:
     w = vee * scale[..., None]
     near_half = cos < -0.9
     if np.any(near_half):
+        from scipy.spatial.transform import Rotation  # on first use (start-up time)
+
         w[near_half] = Rotation.from_matrix(R[near_half]).as_rotvec()
     return np.asarray(w)
-
-
-def _skew(v: Array) -> Array:
-    z = np.zeros_like(v[..., 0])
-    return np.stack(
-        [
-            np.stack([z, -v[..., 2], v[..., 1]], -1),
-            np.stack([v[..., 2], z, -v[..., 0]], -1),
-            np.stack([-v[..., 1], v[..., 0], z], -1),
-        ],
-        -2,
-    )
 
 
 def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configuration:
@@ -301,7 +262,7 @@ def rotation_matrix(w: Array) -> Array:
     safe = np.where(small, 1.0, th)
     a = np.where(small, 1.0 - th2 / 6.0, np.sin(safe) / safe)
     b = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(safe)) / np.where(small, 1.0, th2))
-    K = _skew(w)
+    K = skew(w)
     return np.asarray(np.eye(3) + a[:, None, None] * K + b[:, None, None] * (K @ K))
 
 

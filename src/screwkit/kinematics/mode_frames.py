@@ -16,15 +16,14 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
+from screwkit.dual.spatial import cross
 from screwkit.kinematics.idle_spin import hold_idle_spin
 from screwkit.kinematics.loop import (
     Array,
     Configuration,
     Layout,
     closure_twist,
-    cross,
     forward,
 )
 from screwkit.kinematics.motion import ModeMotion
@@ -68,6 +67,8 @@ def _variable_tables(linkage: Linkage, lay: Layout, conf: Configuration, mask: N
             variables[name] = values
         velocities[name] = qd[:, f]
         accelerations[name] = qdd[:, f]
+    from scipy.spatial.transform import Rotation  # on first use (start-up time)
+
     for i, sidx in lay.spherical_of_joint.items():
         rv = Rotation.from_matrix(conf.spherical[:, sidx]).as_rotvec()
         jn = linkage.joints[i].name

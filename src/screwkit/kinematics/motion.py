@@ -11,15 +11,20 @@ mask.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError, InputTypeError, UnknownNameError
 from screwkit.kinematics.loop import Array, Configuration
 from screwkit.model.linkage import Linkage
 
+if TYPE_CHECKING:
+    from screwkit.tables import ResultTable, UnitChoice
 
-class AssemblyError(ValueError):
+
+class AssemblyError(InputError):
     """The mechanism does not assemble where it was asked to."""
 
 
@@ -101,7 +106,7 @@ class Motion:
         """Assembly mode ``index`` (0 … len(modes) − 1), with a message naming the modes."""
         n = len(self.modes)
         if isinstance(index, bool) or not isinstance(index, int | np.integer):
-            raise TypeError(f"mode must be an integer index 0…{n - 1}; got {index!r}")
+            raise InputTypeError(f"mode must be an integer index 0…{n - 1}; got {index!r}")
         if not 0 <= index < n:
             raise AssemblyError(
                 f"{self.linkage.name}: assembly mode {index} asked for, but the mechanism has "
@@ -114,29 +119,53 @@ class Motion:
         md = self.mode(mode)
         tables = (md.variables, md.velocities, md.accelerations)
         if derivative not in (0, 1, 2):
-            raise ValueError(f"derivative must be 0, 1 or 2; got {derivative!r}")
+            raise InputError(f"derivative must be 0, 1 or 2; got {derivative!r}")
         table = tables[derivative]
         if name not in table:
-            raise KeyError(f"{self.linkage.name}: no variable {name!r} in mode {mode}; "
-                           f"the variables are {sorted(table)}")
+            raise UnknownNameError(f"{self.linkage.name}: no variable {name!r} in mode {mode}; "
+                                   f"the variables are {sorted(table)}")
         return table[name]
+
+    def table(self, coupler_point: Any = None, coupler_link: int = 1) -> ResultTable:
+        """One row per input sample and mode, one column per variable, rate and acceleration
+        (SI; :mod:`screwkit.kinematics.motion_table`)."""
+        from screwkit.kinematics.motion_table import motion_table
+
+        return motion_table(self, coupler_point, coupler_link)
+
+    def to_dataframe(self, units: UnitChoice | None = None) -> Any:
+        """:meth:`table` as a pandas DataFrame, headers with units (``phi0 [rad]``; pass
+        ``units=spec.display_units()`` for the spec's units). Needs pandas."""
+        return self.table().to_dataframe(units)
+
+    def to_csv(self, path: Any, units: UnitChoice | None = None) -> None:
+        """:meth:`table` as CSV (header ``phi0 [rad]``; empty cells where a mode does not
+        assemble)."""
+        self.table().to_csv(path, units)
 
 
 def as_input_array(linkage: Linkage, values: ArrayLike, name: str) -> Array:
     """``values`` as an (N, n_in) array of finite numbers, one column per input of the loop."""
-    a = np.asarray(values, dtype=float)
+    if not isinstance(linkage, Linkage):
+        raise InputTypeError(f"linkage must be a screwkit Linkage (e.g. sk.rsrc(...) or "
+                             f"load_spec(...).linkage); got {type(linkage).__name__}")
+    try:
+        a = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InputTypeError(f"{name}: give numbers (one per sample and input); got "
+                             f"{type(values).__name__}") from None
     n_in = len(linkage.inputs)
     if a.ndim == 0:
         a = a[None, None]
     if a.ndim == 1:
         a = a[:, None] if n_in == 1 else a[None, :]
     if a.ndim != 2 or a.shape[-1] != n_in:
-        raise ValueError(f"{name}: expected {n_in} value(s) per sample for inputs "
+        raise InputError(f"{name}: expected {n_in} value(s) per sample for inputs "
                          f"{list(linkage.inputs)}; got shape {np.shape(values)}")
     if a.shape[0] == 0:
-        raise ValueError(f"{name}: give at least one sample")
+        raise InputError(f"{name}: give at least one sample")
     if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name}: values must be finite")
+        raise InputError(f"{name}: values must be finite")
     return a
 
 

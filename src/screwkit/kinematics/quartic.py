@@ -29,12 +29,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.dual.spatial import wrap_angle_near
+
 __all__ = [
     "DEFAULT_DOUBLE_ROOT_TOL",
     "real_quartic_roots",
     "real_roots_of_trig_quadratic",
     "sin_cos",
-    "wrap_angle",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -45,12 +46,6 @@ BoolArray = NDArray[np.bool_]
 DEFAULT_DOUBLE_ROOT_TOL = 1e-6
 
 _NEWTON_STEPS = 1
-
-
-def wrap_angle(angle: ArrayLike) -> FloatArray:
-    """Wrap angles (radians) into the interval (-pi, pi]."""
-    angle = np.asarray(angle, dtype=np.float64)
-    return np.pi - np.mod(np.pi - angle, 2.0 * np.pi)
 
 
 def sin_cos(angle: ArrayLike) -> tuple[FloatArray, FloatArray]:
@@ -64,12 +59,6 @@ def sin_cos(angle: ArrayLike) -> tuple[FloatArray, FloatArray]:
     u2 = u * u
     inv = 1.0 / (1.0 + u2)
     return 2.0 * u * inv, (1.0 - u2) * inv
-
-
-def _wrap_near(angle: FloatArray) -> FloatArray:
-    """Wrap angles known to lie in (-3 pi, 3 pi] into (-pi, pi] (cheaper than `wrap_angle`)."""
-    two_pi = 2.0 * np.pi
-    return angle - two_pi * ((angle > np.pi).astype(np.float64) - (angle <= -np.pi))
 
 
 def _largest_real_cubic_root(b: FloatArray, c: FloatArray, d: FloatArray) -> FloatArray:
@@ -267,5 +256,5 @@ def real_roots_of_trig_quadratic(
     if degenerate.any():
         t = np.where(degenerate[..., None], np.nan, t)
     # NaN (non-real) entries stay NaN and np.sort places them last
-    phi = np.sort(_wrap_near(_ORIGINS[k][..., None] + 2.0 * np.arctan(t)), axis=-1)
+    phi = np.sort(wrap_angle_near(_ORIGINS[k][..., None] + 2.0 * np.arctan(t)), axis=-1)
     return phi, ~np.isnan(phi)

@@ -17,6 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
+from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics import seed_names
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion
@@ -71,7 +72,8 @@ class Family:
     def linkage(self, **dimensions: float) -> Linkage:
         """The family's loop from its dimensions (SI units, radians)."""
         if self.build is None:
-            raise ValueError(f"a {self.name} is built from its joint list, not from dimensions")
+            raise CapabilityError(f"a {self.name} is built from its joint list, not from "
+                                  "dimensions")
         return self.build(**{**self.optional, **dimensions})
 
 
@@ -172,7 +174,7 @@ def family(name: str) -> Family:
     """The family called ``name`` (case-insensitive; ``fourbar`` is the 4R)."""
     key = _ALIASES.get(str(name).lower())
     if key is None:
-        raise ValueError(f"unknown family {name!r}; use one of {', '.join(FAMILIES)}")
+        raise InputError(f"unknown family {name!r}; use one of {', '.join(FAMILIES)}")
     return FAMILIES[key]
 
 
@@ -191,7 +193,7 @@ def require(linkage_or_family: Linkage | Family, capability: str) -> Family:
         listed = (" and ".join(offered) if len(offered) < 3
                   else ", ".join(offered[:-1]) + " and " + offered[-1])
         why = fam.why_not.get(capability)
-        raise ValueError(f"{what} are computed for {listed or 'no family yet'} ({source}); this "
+        raise CapabilityError(f"{what} are computed for {listed or 'no family yet'} ({source}); this "
                          f"is a {fam.name}" + (f": {why}" if why else ""))
     return fam
 

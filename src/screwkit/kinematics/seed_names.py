@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from screwkit.kinematics.cssp import elevation_azimuth
+from screwkit.dual.spatial import elevation_azimuth, rot_x, wrap_angle
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.mode_frames import unwrap_runs
 from screwkit.kinematics.motion import ModeMotion
@@ -46,7 +46,7 @@ def fourbar_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Nam
     a = mode.link_angular_acceleration
     # Bagci's χ0 of the plane case is the coupler–rocker joint angle turned by π, in (−π, π]
     rocker_pin = next(j.name for j in linkage.joints[2:3])
-    chi = np.pi - np.mod(np.pi - (mode.variables[f"{rocker_pin}.theta"] + np.pi), 2 * np.pi)
+    chi = wrap_angle(mode.variables[f"{rocker_pin}.theta"] + np.pi)
     return ({"theta0": th, "phi0": ph, "chi0": chi},
             {"theta0": w[:, 0, 2], "phi0": w[:, 2, 2],
              "chi0": mode.velocities[f"{rocker_pin}.theta"]},
@@ -72,8 +72,7 @@ def cssp_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]
     th1dd = mode.accelerations[f"{crank}.theta"]
     _, elev, e_d, e_dd, psi, psi_d, psi_dd = elevation_azimuth(u, ud, udd)
     psi = unwrap_runs(psi, mode.assembles & np.isfinite(psi))
-    sa, ca = np.sin(linkage.parameters["alpha4"]), np.cos(linkage.parameters["alpha4"])
-    to_slider = np.array([[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]])  # X(α4)
+    to_slider = rot_x(linkage.parameters["alpha4"])  # X(α4)
     _, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = elevation_azimuth(
         u @ to_slider.T, ud @ to_slider.T, udd @ to_slider.T)
     eta3 = unwrap_runs(eta3, mode.assembles & np.isfinite(eta3))

@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 from screwkit.kinematics.loop import (
     Array,
@@ -199,6 +198,8 @@ def random_configurations(linkage: Linkage, count: int, rng: np.random.Generator
         else:
             q[:, c] = rng.uniform(-np.pi, np.pi, count)
     sph = np.empty((count, lay.n_spherical, 3, 3))
+    from scipy.spatial.transform import Rotation  # on first use (start-up time)
+
     for k in range(lay.n_spherical):
         sph[:, k] = Rotation.random(count, random_state=rng).as_matrix()
     return Configuration(q, sph)

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+from screwkit.errors import InputError
 
-class MobilityInputError(ValueError):
+
+class MobilityInputError(InputError):
     """Bad input to a mobility count: a negative count, an unknown pair, a loop count that
     contradicts Bagci's eq. (B.3), a Jacobian of the wrong shape, ...
 

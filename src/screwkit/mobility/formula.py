@@ -278,6 +278,50 @@ def _one_loop_constraints(value: GeneralConstraintsArg, where: str) -> tuple[int
     return m, note
 
 
+def _per_loop_constraints(general_constraints: GeneralConstraintsArg
+                          | Sequence[GeneralConstraintsArg], k: int) -> list[tuple[int, str | None]]:
+    """(m_j, notation) for each of the k loops, from one value for all or one per loop (B.5)."""
+    if isinstance(general_constraints, str | GeneralConstraints) or not isinstance(
+        general_constraints, Iterable
+    ):
+        m, note = _one_loop_constraints(general_constraints, "of every loop")
+        if k == 0 and m:
+            raise MobilityInputError(
+                f"general constraints m = {m} given, but the mechanism has no loop (k = 0 by "
+                "eq. B.3): an open chain has no general constraints"
+            )
+        return [(m, note)] * k
+    entries = list(general_constraints)
+    if len(entries) != k:
+        raise MobilityInputError(
+            f"{len(entries)} per-loop general constraints given for k = {k} loops "
+            "(eq. B.3); give one entry per loop or a single m for all"
+        )
+    return [_one_loop_constraints(v, f"of loop {j + 1}") for j, v in enumerate(entries)]
+
+
+def _overclosing(overclosing_constraints: int | Sequence[int], k: int
+                 ) -> tuple[int, tuple[int, ...] | None]:
+    """F_c and the per-loop q_j (None when F_c was given as one number)."""
+    q: tuple[int, ...] | None
+    if not isinstance(overclosing_constraints, Iterable):
+        fc, q = check_count(overclosing_constraints, "overclosing constraints F_c"), None
+    else:
+        q = tuple(check_count(x, f"overclosing constraints q_{j + 1}")
+                  for j, x in enumerate(overclosing_constraints))
+        if len(q) != k:
+            raise MobilityInputError(
+                f"{len(q)} per-loop overclosing constraints q_j given for k = {k} loops"
+            )
+        fc = sum(q)
+    if fc and k < 2:
+        raise MobilityInputError(
+            f"overclosing constraints F_c = {fc} need a multi-loop mechanism (Bagci, Appendix "
+            f"B); this one has k = {k} loop(s)"
+        )
+    return fc, q
+
+
 def formula_mobility(
     n_links: int,
     pairs: PairsArg | None = None,
@@ -332,48 +376,14 @@ def formula_mobility(
             "counts"
         )
 
-    if isinstance(general_constraints, str | GeneralConstraints) or not isinstance(
-        general_constraints, Iterable
-    ):
-        m, note = _one_loop_constraints(general_constraints, "of every loop")
-        if k == 0 and m:
-            raise MobilityInputError(
-                f"general constraints m = {m} given, but the mechanism has no loop (k = 0 by "
-                "eq. B.3): an open chain has no general constraints"
-            )
-        per_loop = [(m, note)] * k
-    else:
-        entries = list(general_constraints)
-        if len(entries) != k:
-            raise MobilityInputError(
-                f"{len(entries)} per-loop general constraints given for k = {k} loops "
-                "(eq. B.3); give one entry per loop or a single m for all"
-            )
-        per_loop = [_one_loop_constraints(v, f"of loop {j + 1}") for j, v in enumerate(entries)]
-
+    per_loop = _per_loop_constraints(general_constraints, k)
     freedoms = sum(i * c for i, c in enumerate(by_class, 1))
     fp = check_count(passive_freedoms, "passive freedoms F_p")
     if fp > freedoms:
         raise MobilityInputError(
             f"passive freedoms F_p = {fp} exceed the {freedoms} freedoms of all the pairs"
         )
-
-    q: tuple[int, ...] | None
-    if not isinstance(overclosing_constraints, Iterable):
-        fc, q = check_count(overclosing_constraints, "overclosing constraints F_c"), None
-    else:
-        q = tuple(check_count(x, f"overclosing constraints q_{j + 1}")
-                  for j, x in enumerate(overclosing_constraints))
-        if len(q) != k:
-            raise MobilityInputError(
-                f"{len(q)} per-loop overclosing constraints q_j given for k = {k} loops"
-            )
-        fc = sum(q)
-    if fc and k < 2:
-        raise MobilityInputError(
-            f"overclosing constraints F_c = {fc} need a multi-loop mechanism (Bagci, Appendix "
-            f"B); this one has k = {k} loop(s)"
-        )
+    fc, q = _overclosing(overclosing_constraints, k)
 
     return FormulaMobility(
         n_links=n,

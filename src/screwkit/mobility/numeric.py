@@ -478,25 +478,8 @@ def mobility_from_jacobian(
     rank = int(np.sum(s > tol))
     null = vt[rank:].T.copy()  # (m, F)
 
-    # General constraints of each loop: what its screw system cannot produce. M_R = 3 − rank of
-    # the angular parts; M_T = 3 − dim of the pure translations in the system; an axis is
-    # constrained in both when it is normal to the angular span and to the pure translations.
-    loop_constraints: list[LoopConstraints] = []
-    for j in range(k):
-        block = jn[6 * j: 6 * j + 6]
-        basis, _ = _range(block, tol)
-        r = basis.shape[1]
-        angular, _ = _range(basis[:3], sub_tol)
-        a = angular.shape[1]
-        translations, _ = _range(basis[3:] @ _null(basis[:3], sub_tol), sub_tol)
-        shared = 3 - _rank(np.concatenate([angular, translations], axis=1), sub_tol)
-        loop_constraints.append(LoopConstraints(
-            loop=j + 1,
-            freedoms=tuple(n for n, c in zip(names, block.T, strict=True) if c.any()),
-            motion_rank=r,
-            general=general_constraints_from_counts(3 - a, 3 - (r - a), shared),
-        ))
-
+    loop_constraints = [_loop_constraints(j, jn[6 * j: 6 * j + 6], names, tol, sub_tol)
+                        for j in range(k)]
     result = NumericMobility(
         freedom_names=names,
         loops=k,
@@ -513,6 +496,31 @@ def mobility_from_jacobian(
     if in_idx is None:
         return result
 
+    return _with_inputs(result, names, null, in_idx, out_idx, sub_tol)
+
+
+def _loop_constraints(j: int, block: NDArray[np.float64], names: tuple[str, ...], tol: float,
+                      sub_tol: float) -> LoopConstraints:
+    """General constraints of loop j: what its screw system cannot produce. M_R = 3 − rank of
+    the angular parts; M_T = 3 − dim of the pure translations in the system; an axis is
+    constrained in both when it is normal to the angular span and to the pure translations."""
+    basis, _ = _range(block, tol)
+    r = basis.shape[1]
+    angular, _ = _range(basis[:3], sub_tol)
+    a = angular.shape[1]
+    translations, _ = _range(basis[3:] @ _null(basis[:3], sub_tol), sub_tol)
+    shared = 3 - _rank(np.concatenate([angular, translations], axis=1), sub_tol)
+    return LoopConstraints(
+        loop=j + 1,
+        freedoms=tuple(n for n, c in zip(names, block.T, strict=True) if c.any()),
+        motion_rank=r,
+        general=general_constraints_from_counts(3 - a, 3 - (r - a), shared),
+    )
+
+
+def _with_inputs(result: NumericMobility, names: tuple[str, ...], null: NDArray[np.float64],
+                 in_idx: list[int], out_idx: list[int] | None, sub_tol: float) -> NumericMobility:
+    """The result with how the inputs (and outputs) determine the motion."""
     null_in = null[in_idx]
     free = null @ _null(null_in, sub_tol)  # motions that leave the inputs still
     fields: dict[str, object] = {

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from screwkit.dual import ScrewMatrix
+from screwkit.dual.spatial import rot_y
 from screwkit.model.joints import Joint
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
@@ -43,11 +44,6 @@ a1…a4 with twists α1…α4; input_offset is the input joint's constant offset
 
 # columns e2, e3, e1: a frame whose z axis is the x axis of the frame it is expressed in
 _P = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
-
-
-def _ry(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def _rt(R: np.ndarray, p: np.ndarray | list[float]) -> ScrewMatrix:
@@ -82,10 +78,10 @@ def rsrc(d1: float, d2: float, d3: float, a: float, b: float, e: float, delta0: 
     _finite("RSRC", d3=d3, a=a, b=b, e=e, delta0=delta0, lambda0=lambda0)
     if d3 < 0:
         raise LinkageError(f"RSRC: d3 must be ≥ 0 (output crank length); got {d3}")
-    Ry_l = _ry(lambda0)
+    Ry_l = rot_y(lambda0)
     L1 = _rt(np.eye(3), [d1, 0.0, 0.0])
     L2 = _rt(_P, [0.0, d2, 0.0])
-    L3 = _rt(_P.T @ _ry(delta0) @ _P, [-d3, 0.0, -e])
+    L3 = _rt(_P.T @ rot_y(delta0) @ _P, [-d3, 0.0, -e])
     R4 = _P.T @ Ry_l.T @ _P
     L4 = _rt(R4, -(_P.T @ Ry_l.T @ np.array([b, a, 0.0])))
     joints = (Joint("input", "R"), Joint("sphere", "S"), Joint("coupler_R", "R"),
@@ -120,7 +116,7 @@ def rssr(d1: float, d2: float, d3: float, a: float, b: float, lambda0: float,
     The coupler can spin about its own axis (a passive freedom)."""
     _positive("rssr", "RSSR", d1=d1, d2=d2, d3=d3)
     _finite("RSSR", a=a, b=b, lambda0=lambda0, output_offset=output_offset)
-    Ry_l = _ry(lambda0)
+    Ry_l = rot_y(lambda0)
     L1 = _rt(np.eye(3), [d1, 0.0, 0.0])
     L2 = _rt(np.eye(3), [d2, 0.0, 0.0])
     L3 = _rt(np.eye(3), [-d3, 0.0, -output_offset])

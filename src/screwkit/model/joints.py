@@ -25,6 +25,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from screwkit.errors import InputError
+
 JointKind = Literal["R", "P", "C", "H", "U", "S"]
 
 JOINT_FREEDOMS: dict[str, tuple[str, ...]] = {
@@ -70,17 +72,17 @@ class Joint:
 
     def __post_init__(self) -> None:
         if self.kind not in JOINT_FREEDOMS:
-            raise ValueError(
+            raise InputError(
                 f"joint {self.name!r}: unknown kind {self.kind!r}; use one of "
                 + ", ".join(f"{k} ({v})" for k, v in JOINT_DESCRIPTIONS.items())
             )
         if not self.name or "." in self.name:
-            raise ValueError(
+            raise InputError(
                 f"joint name {self.name!r} must be non-empty and contain no '.' "
                 "(it labels variables as '<joint>.<freedom>')"
             )
         if self.kind == "H" and self.pitch == 0.0:
-            raise ValueError(
+            raise InputError(
                 f"joint {self.name!r}: a helical (H) joint needs a non-zero pitch; "
                 "use an R joint for pitch 0"
             )

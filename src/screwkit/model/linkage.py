@@ -21,11 +21,12 @@ from typing import Any
 import numpy as np
 
 from screwkit.dual import ScrewMatrix
+from screwkit.errors import InputError
 from screwkit.model.joints import Joint
 from screwkit.model.mass import MassProperties
 
 
-class LinkageError(ValueError):
+class LinkageError(InputError):
     """A mechanism description that cannot be right (bad lengths, names, inputs ...)."""
 
 

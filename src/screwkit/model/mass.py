@@ -29,10 +29,10 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-Array = NDArray[np.float64]
+from screwkit.constants import STANDARD_GRAVITY
+from screwkit.errors import InputError
 
-STANDARD_GRAVITY = 9.80665
-"""Standard acceleration of gravity g₀ in m/s² (CGPM 1901), the default for weights."""
+Array = NDArray[np.float64]
 
 #: relative tolerance for symmetry, definiteness and triangle checks (round-off of frame changes)
 CONSISTENCY_RTOL = 1e-9
@@ -41,16 +41,12 @@ CONSISTENCY_RTOL = 1e-9
 N_INERTIAL_PARAMETERS = 10
 
 
-class PhysicalConsistencyError(ValueError):
+class PhysicalConsistencyError(InputError):
     """Mass properties that no real body can have (negative mass, non-PSD inertia, …)."""
 
 
-class PointMassSplitError(ValueError):
+class PointMassSplitError(InputError):
     """A split of a link mass into Rahman's point masses that cannot reproduce its inertia."""
-
-
-def _skew(v: Array) -> Array:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
 def _point_inertia(mass: float, r: Array) -> Array:

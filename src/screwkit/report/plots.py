@@ -8,16 +8,6 @@ from typing import Any
 
 import numpy as np
 
-ANGLE_NAMES = {"phi0", "chi0", "theta2", "eta2", "theta3", "eta3", "theta0", "theta1"}
-LENGTH_NAMES = {"S", "s4"}
-
-
-def _is_angle(name: str) -> bool:
-    """Seed names by list; joint freedoms by kind (``.s`` is a translation, the rest angles)."""
-    if "." in name:
-        return not name.endswith(".s")
-    return name in ANGLE_NAMES or name not in LENGTH_NAMES
-
 
 def pyplot() -> Any:
     try:
@@ -101,12 +91,19 @@ def _smoothed(mode: dict[str, Any], key: str) -> dict[str, np.ndarray]:
     return table
 
 
-def plot_analysis(doc: dict[str, Any], path: str | Path) -> None:
+def plot_analysis(doc: dict[str, Any], path: str | Path, units: Any = None) -> None:
     """One row per seed variable (position, velocity, acceleration columns), one line per
     assembly mode; plus the coupler curve projections when the document has a coupler point.
-    Angles and their rates share one unit (deg, deg/s, deg/s²); lengths are in m."""
+    In ``units`` (a :class:`~screwkit.io.display_units.DisplayUnits`, e.g. the spec's; default
+    deg and m): angles and their rates share the angle unit (deg, deg/s, deg/s²), lengths and
+    theirs the length unit."""
+    from screwkit.io.display_units import display_units
+    from screwkit.kinematics.motion_table import ACCELERATION_KIND, RATE_KIND, variable_kind
+
+    du = units if units is not None else display_units({"angle": "deg"})
     plt = pyplot()
-    x = np.degrees(np.asarray(doc["input"], dtype=float))
+    input_kind = variable_kind(doc["input_name"])
+    x = du.show(input_kind, np.asarray(doc["input"], dtype=float))
     modes = doc["modes"]
     names = [n for n in modes[0]["variables"] if "." not in n and n not in ("theta0", "theta1")]
     if not names:
@@ -117,19 +114,18 @@ def plot_analysis(doc: dict[str, Any], path: str | Path) -> None:
     tables = [{key: _smoothed(m, key) for key in ("variables", "velocities", "accelerations")}
               for m in modes]
     for r, name in enumerate(names):
-        angle = _is_angle(name)
+        base = variable_kind(name)
+        kinds = {"variables": base, "velocities": RATE_KIND[base],
+                 "accelerations": ACCELERATION_KIND[base]}
         for c, (key, label) in enumerate((("variables", ""), ("velocities", "'"), ("accelerations", "''"))):
             ax = axes[r, c]
             ys = []
             for m, t in zip(modes, tables, strict=True):
-                y = t[key][name]
-                y = np.degrees(y) if angle else y
+                y = du.show(kinds[key], t[key][name])
                 ys.append(y)
                 ax.plot(x, y, label=f"mode {m['mode']}")
-            unit = "deg" if angle else "m"
-            per = {"variables": "", "velocities": "/s", "accelerations": "/s²"}[key]
-            ax.set_title(f"{name}{label} ({unit}{per})")
-            ax.set_xlabel(f"{doc['input_name']} (deg)")
+            ax.set_title(f"{name}{label} ({du.pretty(kinds[key])})")
+            ax.set_xlabel(f"{doc['input_name']} ({du.pretty(input_kind)})")
             ax.grid(True, alpha=0.3)
             flatten_constant_axis(ax, ys)
         axes[r, 0].legend(fontsize=8)
@@ -139,12 +135,13 @@ def plot_analysis(doc: dict[str, Any], path: str | Path) -> None:
             for m in modes:
                 if "coupler_point" in m:
                     cp = m["coupler_point"]
-                    xi = np.asarray(cp[i], dtype=float)
-                    yj = np.asarray(cp[j], dtype=float)
-                    if _full_turn(x):  # close the curve of a periodic sweep
+                    xi = du.show("length", np.asarray(cp[i], dtype=float))
+                    yj = du.show("length", np.asarray(cp[j], dtype=float))
+                    if _full_turn(np.degrees(np.asarray(doc["input"], dtype=float))):  # close the curve of a periodic sweep
                         xi, yj = np.append(xi, xi[0]), np.append(yj, yj[0])
                     ax.plot(xi, yj, label=f"mode {m['mode']}")
-            ax.set_title(f"coupler curve, {i.upper()}–{j.upper()} projection (m)")
+            ax.set_title(f"coupler curve, {i.upper()}–{j.upper()} projection "
+                         f"({du.pretty('length')})")
             ax.set_aspect("equal", adjustable="datalim")
             ax.grid(True, alpha=0.3)
     fig.suptitle(f"{doc['mechanism']} — {doc.get('method', '')} analysis", fontsize=12)

@@ -51,10 +51,25 @@ def spec_scene(spec: Spec | Pipeline, *, gravity: bool = False,
     if synthesis_doc is None and s.synthesis is not None:
         synthesis_doc = synthesis_document(pipe.synthesize(), s.path)
     text = Path(s.path).read_text(encoding="utf-8")
-    return scene_from_motion(s, m, dynamics_doc=dynamics_doc, dynamics_mode=dyn_mode,
-                             balance_doc=balance_doc, synthesis_doc=synthesis_doc,
-                             spec_text=text, seed_variables=[seed_tables(md) for md in m.modes],
-                             solver=[m.solver] if m.solver else None, notes=notes)
+    scene = scene_from_motion(s, m, dynamics_doc=dynamics_doc, dynamics_mode=dyn_mode,
+                              balance_doc=balance_doc, synthesis_doc=synthesis_doc,
+                              spec_text=text, seed_variables=[seed_tables(md) for md in m.modes],
+                              solver=[m.solver] if m.solver else None, notes=notes)
+    if s.drive is not None and dynamics_doc is not None:
+        add_simulation_plots(scene, s)
+    return scene
+
+
+def add_simulation_plots(scene: dict[str, Any], spec: Spec) -> None:
+    """Add the speed and torque plots of ``screwkit simulate`` (the spec's ``[drive]``) to a
+    scene (docs/simulation.md)."""
+    from screwkit.report.simulation_plots import simulation_scene_plots
+    from screwkit.simulation.spec_run import simulate_spec
+
+    doc = simulate_spec(spec).as_dict(loads=True)
+    plots, groups = simulation_scene_plots(doc)
+    scene["plots"] += plots
+    scene["plot_groups"] += groups
 
 
 def write_spec_report(spec: Spec | Pipeline, path: str | Path, **docs: Any) -> dict[str, Any]:

@@ -9,7 +9,7 @@ See docs/synthesis.md.
 """
 
 from screwkit.synthesis.constraints import output_crank_from_constraints, q_from_dwell
-from screwkit.synthesis.equality import RangeConstraint, synthesize_equality_constrained
+from screwkit.synthesis.equality_constrained import RangeConstraint, synthesize_equality_constrained
 from screwkit.synthesis.expressions import ExpressionError, parse_expression
 from screwkit.synthesis.overlay import (
     OverlayCircle,
@@ -19,7 +19,7 @@ from screwkit.synthesis.overlay import (
     fit_overlay_circles,
     overlay_fit,
 )
-from screwkit.synthesis.overlay_route import OverlayOutcome, OverlayProblem, synthesize_overlay
+from screwkit.synthesis.overlay_synthesis import OverlayOutcome, OverlayProblem, synthesize_overlay
 from screwkit.synthesis.problem import (
     ConstraintConstruction,
     ConstraintPoint,

@@ -6,9 +6,10 @@ or a multistart, or the overlay technique (§5.4)."""
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 
-from screwkit.synthesis.overlay_route import OverlayOutcome, OverlayProblem, synthesize_overlay
+from screwkit.synthesis.overlay_synthesis import OverlayOutcome, OverlayProblem, synthesize_overlay
 from screwkit.synthesis.problem import RSRCSynthesisProblem
 from screwkit.synthesis.solve import SynthesisResult, synthesize, synthesize_multistart
 
@@ -47,7 +48,8 @@ class SynthesisRun:
 
 
 def run_synthesis(config: SynthesisConfig | RSRCSynthesisProblem | OverlayProblem, *,
-                  starts: int | None = None, seed: int | None = None) -> SynthesisRun:
+                  starts: int | None = None, seed: int | None = None,
+                  progress: Callable[[int, int], None] | None = None) -> SynthesisRun:
     """Dimensional synthesis of an RSRC (or its plane 4R case) for a desired screw displacement
     ψ_d(θ) + ε S_d(θ) (Bagci 1969 ch. V): least squares with exact derivatives (Programs B and C,
     dwell and range constraints by the parameters of constraint, eqs. 5.13–5.21), or the overlay
@@ -55,10 +57,11 @@ def run_synthesis(config: SynthesisConfig | RSRCSynthesisProblem | OverlayProble
 
     ``config``: a :class:`SynthesisConfig` (``spec.synthesis``) or a bare problem
     (:class:`~screwkit.synthesis.problem.RSRCSynthesisProblem`,
-    :class:`~screwkit.synthesis.overlay_route.OverlayProblem`). ``starts`` overrides the number
+    :class:`~screwkit.synthesis.overlay_synthesis.OverlayProblem`). ``starts`` overrides the number
     of starts (multistart of the least-squares route, or the overlay's circle-fit starts);
     ``seed`` the multistart's random seed. One start with a given inversion (or parameters of
-    constraint) is a single solve."""
+    constraint) is a single solve. ``progress(done, total)`` is called after each start of a
+    multistart."""
     if not isinstance(config, SynthesisConfig):
         config = SynthesisConfig(config)
     problem = config.problem
@@ -73,4 +76,4 @@ def run_synthesis(config: SynthesisConfig | RSRCSynthesisProblem | OverlayProble
         return SynthesisRun([synthesize(problem)])
     return SynthesisRun(synthesize_multistart(
         problem, n_starts=n_starts, seed=ms.seed if seed is None else seed, keep=ms.keep,
-        spread=ms.spread))
+        spread=ms.spread, progress=progress))

@@ -19,6 +19,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError
+
 __all__ = ["FUNCTIONS", "Expression", "ExpressionError", "parse_expression"]
 
 FloatArray = NDArray[np.float64]
@@ -35,7 +37,7 @@ MAX_LENGTH = 2000
 MAX_NODES = 500
 
 
-class ExpressionError(ValueError):
+class ExpressionError(InputError):
     """An expression that is not in the accepted grammar; the message says what and where."""
 
 

@@ -25,7 +25,7 @@ eqs. 5.19-5.21).
 The fit is started from a grid over (phi01, d3) (without a dwell the centre follows from a
 linear, Kasa-type circle fit on each grid point) and refined by `least_squares` with a
 complex-step Jacobian (exact to rounding).  The distinct local fits are returned; the caller
-analyses each with the RSRC closed form (`screwkit.synthesis.overlay_route`).
+analyses each with the RSRC closed form (`screwkit.synthesis.overlay_synthesis`).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
-from screwkit.kinematics.quartic import wrap_angle
+from screwkit.dual.spatial import wrap_angle
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
 
 __all__ = [
@@ -390,7 +390,7 @@ def overlay_fit(*, d1: float, d2: float, lambda0: float, theta01: float, theta: 
                 dwells: tuple[OverlayDwell, ...] = (), refine_d2: bool = False) -> OverlayResult:
     """The best overlay circle (`fit_overlay_circles`), analysed point by point with the closed
     form (`rsrc_positions`, the root nearest each overlay position).  The branch-following
-    analysis with whole-range check, errors and rows is `overlay_route.synthesize_overlay`."""
+    analysis with whole-range check, errors and rows is `overlay_synthesis.synthesize_overlay`."""
     th = np.asarray(theta, dtype=np.float64).reshape(-1)
     ps = np.asarray(psi, dtype=np.float64).reshape(-1)
     circle = fit_overlay_circles(d1=d1, d2=d2, lambda0=lambda0, theta01=theta01, theta=th,

@@ -154,7 +154,7 @@ class RSRCSynthesisProblem:
                 raise ValueError("parameters of constraint (eqs. 5.13-5.21) hold for delta0 = 0 "
                                  "only: make delta0 a constant 0, or drop the [synthesis."
                                  "constraint] table and impose the dwell/range as equations "
-                                 "with the Python function screwkit.synthesis.equality."
+                                 "with the Python function screwkit.synthesis.equality_constrained."
                                  "synthesize_equality_constrained (not reachable from the CLI)")
             if "lambda0" in self.unknowns and abs(math.sin(float(self.start["lambda0"]))) < 1e-9:
                 raise ValueError("lambda0 = 0 (plane) cannot be an unknown with parameters of "
@@ -185,6 +185,19 @@ class RSRCSynthesisProblem:
 
     def start_vector(self) -> NDArray[np.float64]:
         return np.array([float(self.start[n]) for n in self.unknowns])
+
+    def bound_vectors(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(lower, upper) bounds of the unknown vector, SI: ``bounds`` where given, otherwise
+        d1, d2, d3 >= 0 (a crank, coupler or output-crank length, as `RSRCDimensions` requires)
+        and no bound on the other unknowns."""
+        lo = np.full(len(self.unknowns), -np.inf)
+        hi = np.full(len(self.unknowns), np.inf)
+        for k, name in enumerate(self.unknowns):
+            if name in self.bounds:
+                lo[k], hi[k] = self.bounds[name]
+            elif name in ("d1", "d2", "d3"):
+                lo[k] = 0.0
+        return lo, hi
 
     def rotation_between(self) -> float:
         assert self.construction is not None

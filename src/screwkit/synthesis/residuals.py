@@ -26,63 +26,59 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.quartic import wrap_angle
+from screwkit.dual.spatial import wrap_angle
+from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
+from screwkit.kinematics.rsrc.loop_equation import RSRCDimensionArrays, loop_equation
 from screwkit.synthesis.problem import RSRCSynthesisProblem
 
-__all__ = ["Evaluation", "NotAssembled", "ResidualModel", "loop_equation", "translation"]
+__all__ = [
+    "Evaluation",
+    "NotAssembled",
+    "ResidualModel",
+    "dimensions_of",
+    "loop_residual",
+    "rotation_rate_numerator",
+    "translation",
+]
 
 FloatArray = NDArray[np.float64]
 Array = NDArray[Any]
 _STEP = 1e-30  # complex step: exact first derivatives to rounding, any step this small works
 
 
-class NotAssembled(ValueError):
+class NotAssembled(InputError):
     """The mechanism does not close (or locks) at a design point on the chosen mode."""
 
 
-def _m0_n0(p: dict[str, Array], theta0: Array) -> tuple[Array, Array]:
-    lam = p["lambda0"][:, None]
-    m0 = p["b"][:, None] * np.sin(lam) - p["d1"][:, None] * np.cos(lam) * np.sin(theta0)
-    n0 = p["a"][:, None] - p["d1"][:, None] * np.cos(theta0)
-    return m0, n0
+def _dimension_arrays(p: dict[str, Array]) -> RSRCDimensionArrays:
+    """The batch of mechanisms in ``p`` (one row each) as columns (B, 1) against angles (B, N)."""
+    return RSRCDimensionArrays.from_arrays(
+        **{n: p[n][:, None] for n in ("d1", "d2", "d3", "a", "b", "e", "delta0", "lambda0")})
 
 
-def _w1_w2(p: dict[str, Array], theta0: Array, phi: Array) -> tuple[Array, Array]:
-    m0, n0 = _m0_n0(p, theta0)
-    sp, cp = np.sin(phi), np.cos(phi)
-    w1 = m0 * sp + n0 * cp + p["d3"][:, None]
-    w2 = n0 * sp - m0 * cp - p["e"][:, None] * np.sin(p["delta0"][:, None])
-    return w1, w2
+def _real_dimension_arrays(p: dict[str, Array]) -> RSRCDimensionArrays:
+    """The real part of row 0 of ``p`` as one mechanism (floats)."""
+    return RSRCDimensionArrays.from_arrays(
+        **{n: float(np.real(p[n][0]))
+           for n in ("d1", "d2", "d3", "a", "b", "e", "delta0", "lambda0")})
 
 
-def loop_equation(p: dict[str, Array], theta0: Array, phi: Array) -> Array:
+def loop_residual(p: dict[str, Array], theta0: Array, phi: Array) -> Array:
     """G = (cos^2 d0 (W1^2 - d2^2) + W2^2) / 2, eq. 3.61 (zero on every assembly); (B, N)."""
-    w1, w2 = _w1_w2(p, theta0, phi)
-    c2 = np.cos(p["delta0"][:, None]) ** 2
-    return 0.5 * (c2 * (w1 * w1 - p["d2"][:, None] ** 2) + w2 * w2)
+    return loop_equation(_dimension_arrays(p), theta0, phi).residual
 
 
 def _loop_and_q5(p: dict[str, Array], theta0: FloatArray, phi: FloatArray
                  ) -> tuple[FloatArray, FloatArray]:
     """G (eq. 3.61, halved) and G_phi = Q5 = W2 M1 + cos^2 d0 W1 M2 (§3.5) at real (N,) angles."""
-    lam, d0 = float(np.real(p["lambda0"][0])), float(np.real(p["delta0"][0]))
-    b, d1, a = (float(np.real(p[n][0])) for n in ("b", "d1", "a"))
-    d2, d3, e = (float(np.real(p[n][0])) for n in ("d2", "d3", "e"))
-    m0 = b * np.sin(lam) - d1 * np.cos(lam) * np.sin(theta0)
-    n0 = a - d1 * np.cos(theta0)
-    sp, cp = np.sin(phi), np.cos(phi)
-    c2 = np.cos(d0) ** 2
-    w1 = m0 * sp + n0 * cp + d3
-    w2 = n0 * sp - m0 * cp - e * np.sin(d0)
-    g = 0.5 * (c2 * (w1 * w1 - d2 * d2) + w2 * w2)
-    q5 = w2 * (n0 * cp + m0 * sp) + c2 * w1 * (m0 * cp - n0 * sp)
-    return g, q5
+    eq = loop_equation(_real_dimension_arrays(p), theta0, phi)
+    return eq.residual, eq.slope
 
 
 def translation(p: dict[str, Array], theta0: Array, phi: Array) -> Array:
     """S = b cos l0 + d1 sin l0 sin th0 + e cos d0 - tan d0 W2 (eq. 3.60, chi-free); (B, N)."""
-    _, w2 = _w1_w2(p, theta0, phi)
+    w2 = loop_equation(_dimension_arrays(p), theta0, phi).w2
     lam, d0 = p["lambda0"][:, None], p["delta0"][:, None]
     return (p["b"][:, None] * np.cos(lam) + p["d1"][:, None] * np.sin(lam) * np.sin(theta0)
             + p["e"][:, None] * np.cos(d0) - np.tan(d0) * w2)
@@ -90,12 +86,12 @@ def translation(p: dict[str, Array], theta0: Array, phi: Array) -> Array:
 
 def rotation_rate_numerator(p: dict[str, Array], theta0: Array, phi: Array) -> Array:
     """Q4 = W2 L1 + cos^2 d0 W1 L2 (eq. 3.77: d phi0/d theta0 = -d1 Q4 / Q5); (B, N)."""
-    w1, w2 = _w1_w2(p, theta0, phi)
+    eq = loop_equation(_dimension_arrays(p), theta0, phi)
     lam = p["lambda0"][:, None]
     st, ct, sp, cp = np.sin(theta0), np.cos(theta0), np.sin(phi), np.cos(phi)
     l1 = st * sp + np.cos(lam) * ct * cp
     l2 = st * cp - np.cos(lam) * ct * sp
-    return w2 * l1 + np.cos(p["delta0"][:, None]) ** 2 * w1 * l2
+    return eq.w2 * l1 + np.cos(p["delta0"][:, None]) ** 2 * eq.w1 * l2
 
 
 def dimensions_of(p: dict[str, Array], row: int = 0) -> RSRCDimensions:
@@ -157,7 +153,7 @@ class ResidualModel:
         theta0 = np.real(self._theta0(p))[0]
         if self.problem.construction is not None:
             phi1 = float(np.real(p["phi1"][0]))
-            g = loop_equation(p, theta0[:1][None, :], np.array([[phi1]]))
+            g = loop_residual(p, theta0[:1][None, :], np.array([[phi1]]))
             scale = dims.length_scale ** 2
             if abs(float(np.real(g[0, 0]))) > 1e-8 * scale:
                 raise NotAssembled("the constructed configuration does not close the loop at "
@@ -259,7 +255,7 @@ class ResidualModel:
             xc = x[None, :] + 1j * _STEP * np.eye(n)
             pc = pr.parameters(xc)
             th0c = self._theta0(pc)
-            g_x = np.imag(loop_equation(pc, th0c, phi[None, :])) / _STEP  # (n, N)
+            g_x = np.imag(loop_residual(pc, th0c, phi[None, :])) / _STEP  # (n, N)
             s_x = np.imag(translation(pc, th0c, phi[None, :])) / _STEP
             g_phi = self._q5(p, theta0, phi)
             s_phi = np.imag(translation(p, theta0[None, :], phi[None, :] + 1j * _STEP))[0] / _STEP

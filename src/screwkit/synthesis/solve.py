@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
@@ -19,18 +20,20 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from screwkit.dual.spatial import wrap_angle
+from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
 from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled, ResidualModel, dimensions_of
 
-__all__ = ["RangeCheck", "evaluate_design", "SynthesisError", "SynthesisResult", "check_range", "synthesize",
-           "synthesize_multistart"]
+__all__ = ["RangeCheck", "evaluate_design", "SynthesisError", "SynthesisResult", "check_range",
+           "result_from_evaluation", "synthesize", "synthesize_multistart"]
 
 FloatArray = NDArray[np.float64]
 Status = Literal["converged", "iteration limit", "time limit", "not solved"]
 
 
-class SynthesisError(ValueError):
+class SynthesisError(InputError):
     """A synthesis that cannot start or has no solution; the message says why."""
 
 
@@ -118,7 +121,7 @@ def check_range(problem: RSRCSynthesisProblem, ev: Evaluation, n_samples: int = 
     inv = np.empty_like(order)
     inv[order] = np.arange(order.size)
     k0 = int(inv[int(np.flatnonzero(sweep == 0.0)[0])])
-    diff = np.abs(np.remainder(motion.phi0[k0] - ev.phi[0] + math.pi, 2 * math.pi) - math.pi)
+    diff = np.abs(wrap_angle(motion.phi0[k0] - ev.phi[0]))
     diff = np.where(motion.assembles[k0], diff, np.inf)
     branch = int(np.argmin(diff))
     ok_mask = motion.assembles[:, branch][inv]
@@ -190,9 +193,14 @@ def _fit_notes(problem: RSRCSynthesisProblem, psi_d: FloatArray, s_d: FloatArray
     return notes
 
 
-def _result(problem: RSRCSynthesisProblem, model: ResidualModel, ev: Evaluation, label: int,
-            iterations: int, evaluations: int, elapsed: float, status: Status,
-            message: str) -> SynthesisResult:
+def result_from_evaluation(
+    problem: RSRCSynthesisProblem, model: ResidualModel, ev: Evaluation, label: int,
+    iterations: int, evaluations: int, elapsed: float, status: Status, message: str,
+) -> SynthesisResult:
+    """The `SynthesisResult` of a solve ending at evaluation ``ev``: objective E = E_phi + E_S
+    (Bagci 1969, §5.1) and RMS and largest deviations, the gradient projected on the free unknowns
+    (an active bound is not a defect), dimensions with wrapped angles, a row per design point,
+    the whole-range check and the program label (root ordering at theta = 0) of the result."""
     n_rot = model.rot_idx.size
     r = ev.residuals
     r_phi, r_s = r[:n_rot], r[n_rot:] * problem.length_scale
@@ -239,8 +247,7 @@ def _result(problem: RSRCSynthesisProblem, model: ResidualModel, ev: Evaluation,
     # the program label (root ordering, Bagci's I8/I9) of the result's configuration at theta = 0
     pos = rsrc_positions(dimensions_of({k: np.array([v]) for k, v in ev.params.items()}),
                          ev.theta0[:1])
-    gap = np.where(pos.assembles[0], np.abs(np.remainder(pos.phi0[0] - ev.phi[0] + math.pi,
-                                                         2 * math.pi) - math.pi), np.inf)
+    gap = np.where(pos.assembles[0], np.abs(wrap_angle(pos.phi0[0] - ev.phi[0])), np.inf)
     label = int(np.argmin(gap)) + 1 if np.isfinite(gap).any() else label
     return SynthesisResult(
         dimensions=dims, inversion=label, mode_sign=model.sigma, objective=objective,
@@ -258,17 +265,6 @@ def _result(problem: RSRCSynthesisProblem, model: ResidualModel, ev: Evaluation,
         message=message, length_scale=problem.length_scale, rows=rows, range_check=check,
         evaluation=ev,
     )
-
-
-def _bounds(problem: RSRCSynthesisProblem) -> tuple[FloatArray, FloatArray]:
-    lo = np.full(len(problem.unknowns), -np.inf)
-    hi = np.full(len(problem.unknowns), np.inf)
-    for k, name in enumerate(problem.unknowns):
-        if name in problem.bounds:
-            lo[k], hi[k] = problem.bounds[name]
-        elif name in ("d1", "d2") or name == "d3":
-            lo[k] = 0.0  # crank and coupler lengths (RSRCDimensions: d1, d2 > 0, d3 >= 0)
-    return lo, hi
 
 
 def _show(name: str, value: float) -> str:
@@ -315,7 +311,7 @@ def synthesize(problem: RSRCSynthesisProblem, *, inversion: int | None = None,
         raise SynthesisError(f"cannot start: {exc}") from None
     label = label or 1
     x0 = problem.start_vector()
-    lo, hi = _bounds(problem)
+    lo, hi = problem.bound_vectors()
     _check_start(problem, x0, lo, hi)
     t_start = time.perf_counter()
     deadline = t_start + problem.time_limit
@@ -372,7 +368,7 @@ def synthesize(problem: RSRCSynthesisProblem, *, inversion: int | None = None,
         final = model.evaluate(x_final)
     except NotAssembled:
         final = model.evaluate(best["ev"].x)
-    return _result(problem, model, final, label, counts["jac"], counts["fun"], elapsed, status,
+    return result_from_evaluation(problem, model, final, label, counts["jac"], counts["fun"], elapsed, status,
                    message)
 
 
@@ -386,7 +382,7 @@ def evaluate_design(problem: RSRCSynthesisProblem, *,
         ev = model.evaluate(problem.start_vector())
     except NotAssembled as exc:
         raise SynthesisError(f"the design does not assemble: {exc}") from None
-    return _result(problem, model, ev, label or 1, 0, 1, 0.0, "not solved", "")
+    return result_from_evaluation(problem, model, ev, label or 1, 0, 1, 0.0, "not solved", "")
 
 
 def _distinct(a: SynthesisResult, b: SynthesisResult, scale: float) -> bool:
@@ -403,7 +399,9 @@ def _distinct(a: SynthesisResult, b: SynthesisResult, scale: float) -> bool:
 
 def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, seed: int = 0,
                           keep: int = 3, spread: float = 0.5,
-                          time_limit: float | None = None) -> list[SynthesisResult]:
+                          time_limit: float | None = None,
+                          progress: Callable[[int, int], None] | None = None
+                          ) -> list[SynthesisResult]:
     """Multi-start over random starts and every assembly mode; the best ``keep`` distinct results.
 
     Starts: the problem's own start, then random ones: each unknown length multiplied by
@@ -411,7 +409,8 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
     U(-spread, spread) rad.  For every start each inversion label 1..4 that assembles at
     theta = 0 is solved (the problem's ``inversion`` when it is set).  Results that fail the
     whole-range check are kept but ranked after those that pass.  ``time_limit`` bounds the whole
-    run (seconds; default n_starts * problem.time_limit).
+    run (seconds; default n_starts * problem.time_limit). ``progress(done, n_starts)`` is called
+    after each start.
     """
     if n_starts < 1 or keep < 1:
         raise ValueError("n_starts and keep must be >= 1")
@@ -422,7 +421,7 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
     scale = max(abs(problem.start.get(n, 0.0)) for n in ("d1", "d2", "d3", "a", "b", "e")
                 if n in problem.start) or problem.length_scale
     results: list[SynthesisResult] = []
-    lo, hi = _bounds(problem)
+    lo, hi = problem.bound_vectors()
     _check_start(problem, x0, lo, hi)
     reasons: dict[str, int] = {}  # distinct reasons a start/mode gave no result, with counts
 
@@ -477,6 +476,8 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
                 fail("the solve ended with a non-finite error measure")
                 continue
             results.append(res)
+        if progress is not None:
+            progress(k + 1, n_starts)
     if not results:
         shown = "; ".join(f"{r} ({n}x)" if n > 1 else r for r, n in list(reasons.items())[:5])
         more = f"; and {len(reasons) - 5} other reason(s)" if len(reasons) > 5 else ""

@@ -1,5 +1,5 @@
-"""Plots of a balancing run (like Rahman 1996, Figures 5.1–5.6) and of a Pareto front.
-matplotlib is imported lazily (the ``plot`` extra)."""
+"""Plots of a balancing run (like Rahman 1996, Figures 5.1–5.6) and of a Pareto front, in the
+units asked for. matplotlib is imported lazily (the ``plot`` extra)."""
 
 from __future__ import annotations
 
@@ -23,20 +23,35 @@ def _pyplot() -> Any:
     return plt
 
 
-def write_plots(result: BalanceResult, folder: str | Path) -> list[str]:
-    """One PNG per per-sample load, before and after, against the input in degrees."""
-    plt = _pyplot()
+def write_plots(result: BalanceResult, folder: str | Path, units: Any = None) -> list[str]:
+    """One PNG per per-sample load, before and after, against the input: in ``units`` (an
+    object with ``unit_of(kind) -> (label, SI value of one unit)``, e.g. the spec's
+    :class:`~screwkit.io.display_units.DisplayUnits`), by default the input in degrees and the
+    loads in SI."""
+    from screwkit.balancing.result_table import LOAD_KINDS
+    from screwkit.io.display_units import pretty_unit
     from screwkit.io.outputs import make_output_folder
+    from screwkit.tables import SI_LABELS
 
+    plt = _pyplot()
     out = make_output_folder(folder, "--plots")
-    x = np.degrees(result.inputs)
+
+    def unit_of(kind: str) -> tuple[str, float]:
+        if units is not None:
+            return tuple(units.unit_of(kind))  # type: ignore[return-value]
+        return ("deg", np.pi / 180) if kind == "angle" else (SI_LABELS[kind], 1.0)
+
+    x_label, x_factor = unit_of("length" if result.dynamics_before.input_names[0].endswith(".s")
+                                else "angle")
+    x = result.inputs / x_factor
     paths = []
-    for key, title, unit in SAMPLE_LOADS:
+    for key, title, _ in SAMPLE_LOADS:
+        label, factor = unit_of(LOAD_KINDS[key])
         fig, ax = plt.subplots(figsize=(6.4, 4.0))
-        ax.plot(x, result.per_sample_before[key], "o-", ms=3, label="before")
-        ax.plot(x, result.per_sample_after[key], "s--", ms=3, label="after")
-        ax.set_xlabel("input (deg)")
-        ax.set_ylabel(f"{title} ({unit})")
+        ax.plot(x, result.per_sample_before[key] / factor, "o-", ms=3, label="before")
+        ax.plot(x, result.per_sample_after[key] / factor, "s--", ms=3, label="after")
+        ax.set_xlabel(f"input ({x_label})")
+        ax.set_ylabel(f"{title} ({pretty_unit(label) or '1'})")
         ax.grid(True, alpha=0.3)
         ax.legend()
         fig.tight_layout()

@@ -19,8 +19,7 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.dynamics import soa
-from screwkit.dynamics.blocks import BLOCK_SAMPLES, Outputs, Setup, as_dynamics, blocks
+from screwkit.dynamics import component_arrays as soa
 from screwkit.dynamics.checks import (
     DynamicsInputError,
     ExternalLoad,
@@ -32,6 +31,7 @@ from screwkit.dynamics.cssp_statics import CSSPStatics, cssp_block_statics, cssp
 from screwkit.dynamics.inertia import inertia_wrenches_soa
 from screwkit.dynamics.loop_statics import statics_structure
 from screwkit.dynamics.result import Array, Dynamics
+from screwkit.dynamics.sample_blocks import BLOCK_SAMPLES, Outputs, Setup, as_dynamics, blocks
 from screwkit.dynamics.screws import freedom_screws
 from screwkit.kinematics.cssp import SEED_ASSEMBLY_MODE
 from screwkit.kinematics.cssp_motion import cssp_block_rows, cssp_mode_motion, cssp_sweep
@@ -104,7 +104,7 @@ def cssp_mode_block(
     check_finite: bool = False,
 ) -> bool:
     """:func:`cssp_rows_block` for a block of a ModeMotion (rows read by
-    :func:`screwkit.dynamics.soa.rows`: views of component-major arrays, zero rows as 0.0).
+    :func:`screwkit.dynamics.component_arrays.rows`: views of component-major arrays, zero rows as 0.0).
     With ``check_finite``, first checks that the block's motion is finite (while it is in the
     cache) and returns False, computing nothing, if it is not."""
     finite: list[bool] | None = [] if check_finite else None

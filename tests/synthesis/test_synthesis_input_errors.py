@@ -1,6 +1,7 @@
-"""Regressions of the synthesis review: the real reason instead of "no start assembled", targets
-checked up front (finite, span > 0, data range), bounds and d3_range in the spec's units,
-``--plot`` file names and folders, the equality-constrained route named."""
+"""Bad synthesis input gets the real reason in the user's words: starts outside their bounds and
+d3_range in the spec's units, the reason instead of "no start assembled", targets checked up
+front (finite, span > 0, data range), the equality-constrained route named for a construction
+with delta0, and ``--plot`` file names and folders checked before the solve."""
 
 from __future__ import annotations
 

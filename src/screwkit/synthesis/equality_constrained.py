@@ -31,7 +31,7 @@ from screwkit.synthesis.residuals import (
     dimensions_of,
     rotation_rate_numerator,
 )
-from screwkit.synthesis.solve import SynthesisError, SynthesisResult, _bounds, _result
+from screwkit.synthesis.solve import SynthesisError, SynthesisResult, result_from_evaluation
 
 __all__ = ["RangeConstraint", "synthesize_equality_constrained"]
 
@@ -46,6 +46,64 @@ class RangeConstraint:
     theta_first: float
     theta_second: float
     rotation: float
+
+
+Pieces = tuple[float, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
+
+
+class _ConstraintEvaluator:
+    """At one unknown vector x: E, its gradient, the dwell constraints Q4 / L^2 = 0 (eq. 5.9,
+    total derivative through phi by complex steps) and the range constraints with their exact
+    Jacobians.  The last x is cached: SLSQP asks for each piece separately."""
+
+    def __init__(self, problem: RSRCSynthesisProblem, model: ResidualModel,
+                 index: dict[float, int], dwell_idx: NDArray[np.int64],
+                 ranges: tuple[RangeConstraint, ...]) -> None:
+        self.problem, self.model, self.index = problem, model, index
+        self.dwell_idx, self.ranges = dwell_idx, ranges
+        self.cache: dict[bytes, Pieces] = {}
+        self.deadline = time.perf_counter() + problem.time_limit
+        self.evaluations = 0
+
+    def __call__(self, x: FloatArray) -> Pieces:
+        key = x.tobytes()
+        if key not in self.cache:
+            if time.perf_counter() > self.deadline:
+                raise SynthesisError(f"time limit of {self.problem.time_limit:g} s reached")
+            self.evaluations += 1
+            pieces = self._pieces(x)
+            self.cache.clear()
+            self.cache[key] = pieces
+        return self.cache[key]
+
+    def _pieces(self, x: FloatArray) -> Pieces:
+        problem, model, index, dwell_idx, ranges = (self.problem, self.model, self.index,
+                                                    self.dwell_idx, self.ranges)
+        scale = problem.length_scale
+        ev = model.evaluate(x)
+        assert ev.jacobian is not None and ev.phi_jacobian is not None
+        r = ev.residuals
+        e = float(r @ r)
+        grad = 2.0 * ev.jacobian.T @ r
+        # dwell constraints Q4 = 0 at theta_j (total derivative through phi)
+        p = problem.parameters(x[None, :])
+        th0 = ev.theta0[dwell_idx]
+        ph = ev.phi[dwell_idx]
+        q4 = np.real(rotation_rate_numerator(p, th0[None, :], ph[None, :]))[0] / scale**2
+        n = x.size
+        pc = problem.parameters(x[None, :] + 1j * _STEP * np.eye(n))
+        th0c = pc["theta01"][:, None] + problem.input_direction * model.theta[dwell_idx][None, :]
+        q4_x = np.imag(rotation_rate_numerator(pc, th0c, ph[None, :])) / _STEP
+        q4_phi = np.imag(rotation_rate_numerator(p, th0[None, :], ph[None, :] + 1j * _STEP))[
+            0] / _STEP
+        dq4 = (q4_x.T + q4_phi[:, None] * ev.phi_jacobian[dwell_idx]) / scale**2
+        rng = np.array([math.remainder(ev.phi[index[c.theta_second]]
+                                       - ev.phi[index[c.theta_first]] - c.rotation,
+                                       2 * math.pi) for c in ranges])
+        drng = np.array([ev.phi_jacobian[index[c.theta_second]]
+                         - ev.phi_jacobian[index[c.theta_first]] for c in ranges])
+        model.phi_ref = ev.phi
+        return (e, grad, q4, dq4, rng, drng.reshape(len(ranges), n))
 
 
 def synthesize_equality_constrained(
@@ -82,44 +140,8 @@ def synthesize_equality_constrained(
     dwell_idx = np.array([index[float(t)] for t in dwells], dtype=np.int64)
     scale = problem.length_scale
     x0 = problem.start_vector()
-    lo, hi = _bounds(problem)
-    cache: dict[bytes, tuple[float, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]] = {}
-    deadline = time.perf_counter() + problem.time_limit
-    counts = {"n": 0}
-
-    def evaluate(x: FloatArray) -> tuple[float, FloatArray, FloatArray, FloatArray, FloatArray,
-                                          FloatArray]:
-        key = x.tobytes()
-        if key not in cache:
-            if time.perf_counter() > deadline:
-                raise SynthesisError(f"time limit of {problem.time_limit:g} s reached")
-            counts["n"] += 1
-            ev = model.evaluate(x)
-            assert ev.jacobian is not None and ev.phi_jacobian is not None
-            r = ev.residuals
-            e = float(r @ r)
-            grad = 2.0 * ev.jacobian.T @ r
-            # dwell constraints Q4 = 0 at theta_j (total derivative through phi)
-            p = problem.parameters(x[None, :])
-            th0 = ev.theta0[dwell_idx]
-            ph = ev.phi[dwell_idx]
-            q4 = np.real(rotation_rate_numerator(p, th0[None, :], ph[None, :]))[0] / scale**2
-            n = x.size
-            pc = problem.parameters(x[None, :] + 1j * _STEP * np.eye(n))
-            th0c = pc["theta01"][:, None] + problem.input_direction * model.theta[dwell_idx][None, :]
-            q4_x = np.imag(rotation_rate_numerator(pc, th0c, ph[None, :])) / _STEP
-            q4_phi = np.imag(rotation_rate_numerator(p, th0[None, :], ph[None, :] + 1j * _STEP))[
-                0] / _STEP
-            dq4 = (q4_x.T + q4_phi[:, None] * ev.phi_jacobian[dwell_idx]) / scale**2
-            rng = np.array([math.remainder(ev.phi[index[c.theta_second]]
-                                           - ev.phi[index[c.theta_first]] - c.rotation,
-                                           2 * math.pi) for c in ranges])
-            drng = np.array([ev.phi_jacobian[index[c.theta_second]]
-                             - ev.phi_jacobian[index[c.theta_first]] for c in ranges])
-            model.phi_ref = ev.phi
-            cache.clear()
-            cache[key] = (e, grad, q4, dq4, rng, drng.reshape(len(ranges), n))
-        return cache[key]
+    lo, hi = problem.bound_vectors()
+    evaluate = _ConstraintEvaluator(problem, model, index, dwell_idx, ranges)
 
     # SLSQP starts from an identity Hessian: solve in lengths / L so that a unit step is sane
     unit = np.array([scale if n in LENGTH_NAMES else 1.0 for n in problem.unknowns])
@@ -157,5 +179,6 @@ def synthesize_equality_constrained(
         raise SynthesisError(f"the solve left the assembly mode: {exc}") from None
     final = model.evaluate(x)
     dimensions_of(problem.parameters(x[None, :]))
-    return _result(problem, model, final, inversion or problem.inversion or 1, iterations,
-                   counts["n"], time.perf_counter() - t0, status, message)  # type: ignore[arg-type]
+    return result_from_evaluation(
+        problem, model, final, inversion or problem.inversion or 1, iterations,
+        evaluate.evaluations, time.perf_counter() - t0, status, message)  # type: ignore[arg-type]

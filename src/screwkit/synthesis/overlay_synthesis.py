@@ -23,7 +23,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.quartic import wrap_angle
+from screwkit.dual.spatial import wrap_angle
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
 from screwkit.synthesis.overlay import (
     OverlayCircle,

@@ -3,7 +3,7 @@ blocks fill, and their assembly into a :class:`~screwkit.dynamics.result.Dynamic
 
 Samples are processed in blocks of :data:`BLOCK_SAMPLES`: the block's temporaries stay in the
 CPU caches and the peak memory is the (N, …) outputs plus one block, whatever N. The outputs
-are component-major (:func:`screwkit.dynamics.soa.component_major`): each component of a load
+are component-major (:func:`screwkit.dynamics.component_arrays.component_major`): each component of a load
 is contiguous over the samples, which the structure-of-arrays kernels write without transposing.
 """
 
@@ -15,10 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.dynamics import soa
+from screwkit.dual.spatial import cross
+from screwkit.dynamics import component_arrays as soa
 from screwkit.dynamics.loop_statics import StaticsStructure
 from screwkit.dynamics.result import Array, Dynamics, Indeterminacy, Reaction
-from screwkit.dynamics.screws import _cross
 from screwkit.model.linkage import Linkage
 
 BLOCK_SAMPLES = 16384
@@ -81,7 +81,7 @@ class Outputs:
 
     @classmethod
     def allocate(cls, linkage: Linkage, N: int, fill: bool) -> Outputs:
-        """Component-major (N, …) arrays (:func:`screwkit.dynamics.soa.component_major`), NaN
+        """Component-major (N, …) arrays (:func:`screwkit.dynamics.component_arrays.component_major`), NaN
         filled when some samples will not be computed."""
         def new(*shape: int) -> Array:
             out = soa.component_major(*shape)
@@ -148,7 +148,7 @@ def indeterminacy(s: Setup) -> Indeterminacy:
     """What the joints leave undetermined (:class:`Indeterminacy`), self-stress directions
     with their moments about the world origin."""
     directions = s.structure.indeterminate_directions.copy()
-    directions[:, 3:] += _cross(np.broadcast_to(s.reference, directions[:, :3].shape),
+    directions[:, 3:] += cross(np.broadcast_to(s.reference, directions[:, :3].shape),
                                 directions[:, :3])
     return Indeterminacy(count=s.structure.indeterminate_count, directions=directions,
                          idle_freedoms=s.structure.idle_count)

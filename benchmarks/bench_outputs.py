@@ -1,0 +1,110 @@
+"""Big results (issue 17): 100,000 samples of Bagci's Fig. 7 RSRC (every assembly mode, every
+variable with its rates) written as Parquet, NPZ, CSV and JSON, against the in-process analysis
+time; and the whole ``screwkit analyze -o`` commands. Target: the table built and written to
+Parquet in at most 2x the analysis time.
+
+    python benchmarks/bench_outputs.py [samples]
+"""
+
+from __future__ import annotations
+
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLES = 100_000
+CLI = [sys.executable, "-c", "from screwkit.cli.main import app; app()"]
+
+
+def _spec(folder: Path, samples: int) -> Path:
+    text = (ROOT / "examples" / "bagci_fig7_rsrc.toml").read_text(encoding="utf-8")
+    start = text.index("[motion]")
+    end = text.find("\n[", start + 1)
+    motion = f'[motion]\nstart = 0\nstop = 360\nstep = {360.0 / samples!r}\nspeed = "120 rpm"\n'
+    path = folder / "rsrc_big.toml"
+    path.write_text(text[:start] + motion + (text[end:] if end > 0 else ""), encoding="utf-8")
+    return path
+
+
+def _best(fn: Any, repeat: int = 3) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def _cli(args: list[str]) -> tuple[float, float]:
+    """Wall time (s) and peak resident memory (MB) of one command."""
+    t = time.perf_counter()
+    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    subprocess.run(args, check=True, capture_output=True)
+    wall = time.perf_counter() - t
+    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return wall, max(peak, before) / 1024
+
+
+def run(samples: int = SAMPLES) -> list[dict[str, Any]]:
+    import screwkit as sk
+    from screwkit.io.results import write_json_atomic
+    from screwkit.io.tables import write_table
+
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        spec_path = _spec(folder, samples)
+        spec = sk.load_spec(spec_path)
+        units = spec.display_units()
+        n = len(spec.inputs)
+
+        def analyse() -> Any:
+            return sk.solve_motion(spec.linkage, spec.inputs, rates=spec.speed)
+
+        t_analysis = _best(analyse)
+        motion = analyse()
+        from screwkit.io.documents import analysis_document
+
+        out: dict[str, float] = {}
+        for fmt in ("parquet", "npz", "csv"):
+            path = folder / f"a.{fmt}"
+            out[fmt] = _best(lambda p=path, f=fmt: write_table(
+                motion.table(spec.coupler_point), p, f, units), 2 if fmt == "csv" else 3)
+        out["json"] = _best(lambda: write_json_atomic(folder / "a.json", analysis_document(
+            motion, name=spec.name, coupler_point=spec.coupler_point)), 2)
+        sizes = {f: (folder / f"a.{f}").stat().st_size / 1e6 for f in out}
+        table = motion.table()
+        cli_parquet, rss_parquet = _cli([*CLI, "analyze", str(spec_path), "-o",
+                                         str(folder / "c.parquet")])
+        cli_json, _ = _cli([*CLI, "analyze", str(spec_path), "-o", str(folder / "c.json")])
+    note = f"{n} samples x {len(motion.modes)} modes = {table.rows} rows x {len(table.columns)} columns"
+    rows: list[dict[str, Any]] = [
+        {"name": "RSRC analysis in process (solve_motion, every mode)", "value": t_analysis,
+         "unit": "s", "target": "", "note": note},
+        {"name": "table + Parquet write / analysis", "value": out["parquet"] / t_analysis,
+         "unit": "ratio", "target": "<= 2",
+         "note": f"{out['parquet']:.3f} s, {sizes['parquet']:.1f} MB (snappy), display units"},
+    ]
+    for fmt in ("npz", "csv", "json"):
+        rows.append({"name": f"table + {fmt} write / analysis" if fmt != "json" else
+                     "JSON document (orjson) write / analysis",
+                     "value": out[fmt] / t_analysis, "unit": "ratio", "target": "",
+                     "note": f"{out[fmt]:.3f} s, {sizes[fmt]:.1f} MB"})
+    rows += [
+        {"name": "screwkit analyze -o big.parquet (whole command)", "value": cli_parquet,
+         "unit": "s", "target": "", "note": f"peak RSS {rss_parquet:.0f} MB (children max)"},
+        {"name": "screwkit analyze -o big.json (whole command)", "value": cli_json, "unit": "s",
+         "target": "", "note": "the issue measured 8.1 s before orjson and arrays"},
+    ]
+    return rows
+
+
+if __name__ == "__main__":
+    count = int(sys.argv[1]) if len(sys.argv) > 1 else SAMPLES
+    for row in run(count):
+        print(f"{row['name']}: {row['value']:.3f} {row['unit']} (target {row['target']}) - "
+              f"{row['note']}")

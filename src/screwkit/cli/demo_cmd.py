@@ -1,0 +1,143 @@
+"""``screwkit demo [EXAMPLES]``: the main job on every bundled example — validate, analyse,
+and every job the spec supports — writing ``<name>.<job>.json`` (SI), ``<name>.analysis.csv``
+and the plot in the spec's units, and an animated HTML report per example; ``index.html`` links
+them. A progress bar counts the examples (on a terminal)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+
+def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
+                reports: bool) -> tuple[list[str], dict[str, Any]]:
+    """Every job of one example: the demo table's row and the index entry."""
+    import numpy as np
+    from rich.markup import escape
+
+    from screwkit.cli.common import console, guard
+    from screwkit.cli.dynamics_cmd import dynamics_job
+    from screwkit.io.documents import analysis_document, synthesis_document
+    from screwkit.io.results import write_json_atomic
+    from screwkit.io.spec import load_spec
+    from screwkit.io.tables import write_table
+    from screwkit.pipeline import Pipeline
+
+    def write(path: Path, result: Any) -> None:
+        guard(lambda: write_json_atomic(path, result, files))
+
+    spec = guard(lambda: load_spec(f))
+    du = spec.display_units()
+    console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+    pipe = Pipeline(spec)
+    motion = guard(lambda: pipe.motion)
+    doc = analysis_document(motion, name=spec.name, coupler_point=spec.coupler_point)
+    write(output_dir / f"{f.stem}.analysis.json", doc)
+    table = motion.table(spec.coupler_point)
+    guard(lambda: write_table(table, output_dir / f"{f.stem}.analysis.csv", "csv", du, files))
+    if plots:
+        from screwkit.report.plots import plot_analysis
+
+        guard(lambda: plot_analysis(doc, output_dir / f"{f.stem}.analysis.png", units=du))
+    mob = guard(lambda: pipe.mobility().as_dict())
+    write(output_dir / f"{f.stem}.mobility.json", mob)
+    jobs = ["analysis", "mobility"]
+    dyn = bal = syn = sim = None
+    if all(link.mass is not None for link in spec.linkage.links):
+        dyn = guard(lambda: dynamics_job(pipe, False))
+        write(output_dir / f"{f.stem}.dynamics.json", dyn)
+        jobs.append("dynamics")
+    if spec.balancing is not None:
+        bal = guard(lambda: pipe.balance().as_dict())
+        write(output_dir / f"{f.stem}.balance.json", bal)
+        jobs.append("balance")
+    if spec.synthesis is not None:
+        syn = guard(lambda: synthesis_document(pipe.synthesize(), pipe.spec.path))
+        write(output_dir / f"{f.stem}.synthesis.json", syn)
+        jobs.append("synthesis")
+    if spec.drive is not None:
+        sim = guard(lambda: pipe.simulate().as_dict(loads=False))
+        write(output_dir / f"{f.stem}.simulation.json", sim)
+        jobs.append("simulation")
+    if reports:
+        from screwkit.report.spec_report import write_spec_report
+
+        guard(lambda: write_spec_report(pipe, output_dir / f"{f.stem}.html", balance_doc=bal,
+                                        synthesis_doc=syn))
+    res = max((float(np.nanmax(np.asarray(m.closure_residual, dtype=float)))
+               for m in motion.modes), default=float("nan"))
+    asm = ", ".join(str(int(np.sum(m.assembles))) for m in motion.modes)
+    row = [f.stem, spec.family, str(len(spec.inputs)), str(len(motion.modes)), asm,
+           f"{res:.1e}", ", ".join(jobs)]
+    summary: list[tuple[str, Any]] = [
+        ("input samples", len(spec.inputs)), ("analysis method", motion.method),
+        ("assembly modes (samples assembling)", f"{len(motion.modes)} ({asm})"),
+        ("max loop-closure residual", f"{res:.1e}"),
+        ("mobility (formula / Jacobian)",
+         f"{mob['formula']['mobility']} / {mob['numeric']['mobility']}"),
+    ]
+    if dyn is not None:
+        sf = dyn["summary"]["shaking_force"]
+        summary.append((f"shaking force RMS / peak ({du.label('force')})",
+                        f"{du.show('force', sf['rms']):.6g} / {du.show('force', sf['peak']):.6g}"))
+    if bal is not None:
+        g = bal["measures"]
+        summary.append(("balancing objective G before → after",
+                        f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
+    if sim is not None:
+        last = sim["cycles"][-1] if sim.get("cycles") else {}
+        summary.append(("simulated speed fluctuation (last cycle)",
+                        f"{last.get('fluctuation', float('nan')):.4g}"))
+    if syn is not None:
+        summary.append(("synthesis RMSE (φ rad, S m)",
+                        f"{syn.get('rmse_phi')} , {syn.get('rmse_S')}"))
+    entry = {
+        "name": f.stem, "family": spec.family, "description": spec.describe(),
+        "jobs": [(j, f"{f.stem}.{j}.json") for j in jobs], "summary": summary,
+        "picture": f"{f.stem}.analysis.png" if plots else None,
+        "report": f"{f.stem}.html" if reports else None,
+    }
+    return row, entry
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``demo`` command to ``app``."""
+
+    @app.command()
+    def demo(
+        examples: Annotated[Path, typer.Argument(help="Folder of spec files.")] = Path("examples"),
+        output_dir: Annotated[Path, typer.Option("--output-dir", help="Where results are written.")] = Path("out"),
+        plots: Annotated[bool, typer.Option("--plots/--no-plots", help="Also write a PNG per example.")] = True,
+        write_reports: Annotated[bool, typer.Option("--reports/--no-reports", help="Also write each example's animated HTML report (<example>.html).")] = True,
+    ) -> None:
+        """Run the main job on every bundled example: validate, analyse, write the results (JSON in SI, CSV and plots in each spec's units) and an animated HTML report per example (out/index.html links them)."""
+        from screwkit.cli.common import console, guard, user_error
+        from screwkit.cli.formatting import TextColumn, print_columns
+        from screwkit.cli.progress import progress_bar
+        from screwkit.io.outputs import make_output_folder
+
+        files = sorted(examples.glob("*.toml"))
+        if not files:
+            user_error(f"no spec files (*.toml) in {examples}")
+        guard(lambda: make_output_folder(output_dir, "--output-dir"))
+        rows: list[list[str]] = []
+        entries: list[dict[str, Any]] = []
+        with progress_bar("examples", total=len(files)) as advance:
+            for k, f in enumerate(files):
+                row, entry = run_example(f, output_dir, files, plots, write_reports)
+                rows.append(row)
+                entries.append(entry)
+                advance(k + 1, len(files))
+        heads = ("example", "family", "samples", "modes", "assembling", "max closure\nresidual",
+                 "jobs")
+        cols = [TextColumn(h, [r[i] for r in rows], "left") for i, h in enumerate(heads)]
+        print_columns(console, f"screwkit demo: {len(files)} examples", cols)
+        from screwkit.report.html import write_index
+
+        reports = sorted(Path("validation").glob("*/*.md")) if Path("validation").is_dir() else []
+        here = output_dir.resolve().parent == Path.cwd().resolve()
+        index = guard(lambda: write_index(output_dir, entries,
+                                          [Path("..") / r for r in reports] if here else None))
+        console.print(f"wrote {index}", highlight=False, markup=False)

@@ -1,0 +1,64 @@
+"""One progress bar for every long operation (multistart synthesis, Pareto sweeps, ``demo``;
+anything that can take more than about 2 s): a rich bar on stderr with the count done, the rate
+and the time left, removed when done; nothing at all when stderr is not a terminal (pipes, CI,
+``--json`` into a file stay clean).
+
+    with progress_bar("synthesising", total=40) as advance:
+        run(progress=advance)        # the library calls advance(done, total)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+
+from rich.progress import ProgressColumn, Task
+from rich.text import Text
+
+#: what a long library call is given: ``advance(done, total)``
+ProgressCallback = Callable[[int, int], None]
+
+
+class RateColumn(ProgressColumn):
+    """Items per second (or seconds per item when slower than one a second)."""
+
+    def render(self, task: Task) -> Text:
+        speed = task.finished_speed or task.speed
+        if not speed:
+            return Text("  —/s", style="progress.data.speed")
+        text = f"{speed:.3g}/s" if speed >= 1 else f"{1 / speed:.3g} s each"
+        return Text(text, style="progress.data.speed")
+
+
+def _silent(done: int, total: int) -> None:
+    return None
+
+
+@contextmanager
+def progress_bar(description: str, total: int | None = None,
+                 enabled: bool = True) -> Iterator[ProgressCallback]:
+    """A callback ``advance(done, total)`` that drives a progress bar on stderr (module
+    docstring); a no-op when stderr is not a terminal or ``enabled`` is false."""
+    from screwkit.cli.common import err_console
+
+    if not (enabled and err_console.is_terminal):
+        yield _silent
+        return
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+               RateColumn(), TextColumn("eta"), TimeRemainingColumn(), TimeElapsedColumn())
+    with Progress(*columns, console=err_console, transient=True) as bar:
+        task = bar.add_task(description, total=total)
+
+        def advance(done: int, new_total: int) -> None:
+            bar.update(task, completed=done, total=new_total)
+
+        yield advance

@@ -1,0 +1,215 @@
+"""The ``[drive]`` table of a spec file: the motor, the flywheel, the load on the output and the
+integration settings of ``screwkit simulate`` (docs/simulation.md), validated with pydantic and
+turned, once, into a typed :class:`DriveConfig` in SI units.
+
+Quantities take the spec's ``[units]`` or explicit unit strings (``"5 N*m"``, ``"3000 rpm"``).
+Every error names the file and the key (:class:`DriveConfigError`, a SpecError)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+)
+
+from screwkit.io.errors import SpecError
+from screwkit.io.validation import validation_lines
+
+Value = StrictFloat | StrictInt | StrictStr
+MOTOR_KINDS = ("none", "constant", "linear", "table")
+
+
+class DriveConfigError(SpecError):
+    """A ``[drive]`` table that cannot be used; the message names the file and the key."""
+
+
+@dataclass(frozen=True)
+class MotorConfig:
+    """The motor on the input shaft (SI): ``kind`` ``"none"`` (no torque), ``"constant"``
+    (``torque``), ``"linear"`` (τ = ``stall_torque``·(1 − ω/``no_load_speed``), the DC-motor
+    line) or ``"table"`` (τ(ω) linear between the points ``speeds``/``torques``, held at the
+    end values outside them)."""
+
+    kind: str = "none"
+    torque: float = 0.0
+    stall_torque: float = 0.0
+    no_load_speed: float = 0.0
+    speeds: tuple[float, ...] = ()
+    torques: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class LoadConfig:
+    """The load on one freedom of the output (SI): a torque (N·m) on a rotation or a force (N)
+    on a translation, ``constant`` + ``damping``·q̇ in magnitude. With ``against_motion`` the
+    constant part always opposes the output's motion (a resisting, Coulomb-like load);
+    otherwise it acts in the freedom's negative direction whatever the motion. The damping part
+    always opposes the motion."""
+
+    freedom: str
+    constant: float = 0.0
+    damping: float = 0.0
+    against_motion: bool = True
+
+
+@dataclass(frozen=True)
+class DriveConfig:
+    """The ``[drive]`` table in SI units (module docstring; docs/simulation.md)."""
+
+    motor: MotorConfig
+    load: LoadConfig | None
+    flywheel: float  # kg·m² on the input shaft
+    initial_speed: float  # rad/s
+    cycles: int
+    samples_per_cycle: int
+    rtol: float
+    atol: float | None  # rad and rad/s; None: rtol·(2π, initial speed)
+    gravity: bool
+    max_time: float | None  # s
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class MotorTable(_Strict):
+    kind: Literal["none", "constant", "linear", "table"] = "none"
+    torque: Value | None = None
+    stall_torque: Value | None = None
+    no_load_speed: Value | None = None
+    speeds: list[Value] | None = None
+    torques: list[Value] | None = None
+
+
+class LoadTable(_Strict):
+    freedom: StrictStr | None = None
+    torque: Value | None = None
+    force: Value | None = None
+    damping: Value | None = None
+    against_motion: StrictBool = True
+
+
+class DriveTable(_Strict):
+    motor: MotorTable = Field(default_factory=MotorTable)  # type: ignore[arg-type]
+    load: LoadTable | None = None
+    flywheel: Value = 0.0
+    initial_speed: Value | None = None
+    cycles: StrictInt = Field(10, ge=1, le=100_000)
+    samples_per_cycle: StrictInt = Field(72, ge=8, le=4096)
+    rtol: StrictFloat = Field(1e-9, gt=0.0, lt=1e-2)
+    atol: StrictFloat | None = Field(None, gt=0.0)
+    gravity: StrictBool = False
+    max_time: Value | None = None
+
+
+def _table(spec: Any) -> DriveTable:
+    try:
+        return DriveTable.model_validate(spec.raw.drive)
+    except ValidationError as exc:
+        lines = [f"{spec.path}: the [drive] table is not valid:"]
+        lines += validation_lines(exc, "drive.", "docs/simulation.md")
+        raise DriveConfigError("\n".join(lines)) from None
+
+
+def _si(spec: Any, value: Any, kind: str, key: str) -> float:
+    return float(spec.quantity(value, kind, f"drive.{key}"))
+
+
+def _fail(spec: Any, key: str, message: str) -> None:
+    raise DriveConfigError(f"{spec.path}: [drive.{key}] {message}")
+
+
+def _motor(spec: Any, t: MotorTable) -> MotorConfig:
+    need = {"constant": ("torque",), "linear": ("stall_torque", "no_load_speed"),
+            "table": ("speeds", "torques"), "none": ()}[t.kind]
+    given = {k for k in ("torque", "stall_torque", "no_load_speed", "speeds", "torques")
+             if getattr(t, k) is not None}
+    for k in need:
+        if k not in given:
+            _fail(spec, f"motor.{k}", f"a {t.kind} motor needs {' and '.join(need)}")
+    extra = sorted(given - set(need))
+    if extra:
+        _fail(spec, "motor", f"{extra} do not apply to a {t.kind!r} motor (it reads "
+                             f"{list(need) or 'nothing'}); remove them or change kind")
+    if t.kind == "constant":
+        return MotorConfig("constant", torque=_si(spec, t.torque, "torque", "motor.torque"))
+    if t.kind == "linear":
+        stall = _si(spec, t.stall_torque, "torque", "motor.stall_torque")
+        free = _si(spec, t.no_load_speed, "angular_velocity", "motor.no_load_speed")
+        if not free > 0:
+            _fail(spec, "motor.no_load_speed", f"must be a positive speed; got {t.no_load_speed!r}")
+        return MotorConfig("linear", stall_torque=stall, no_load_speed=free)
+    if t.kind == "table":
+        speeds = [_si(spec, v, "angular_velocity", "motor.speeds") for v in t.speeds or []]
+        torques = [_si(spec, v, "torque", "motor.torques") for v in t.torques or []]
+        if len(speeds) != len(torques) or len(speeds) < 2:
+            _fail(spec, "motor", f"speeds and torques need the same number of points, at least "
+                                 f"2; got {len(speeds)} and {len(torques)}")
+        if any(b <= a for a, b in zip(speeds, speeds[1:], strict=False)):
+            _fail(spec, "motor.speeds", "the speeds must increase strictly")
+        return MotorConfig("table", speeds=tuple(speeds), torques=tuple(torques))
+    return MotorConfig("none")
+
+
+def _load(spec: Any, t: LoadTable | None) -> LoadConfig | None:
+    if t is None:
+        return None
+    lk = spec.linkage
+    freedom = t.freedom or lk.joints[-1].freedom_names()[0]
+    if freedom not in lk.freedom_names:
+        _fail(spec, "load.freedom", f"no freedom {freedom!r}; the freedoms are "
+                                    f"{lk.freedom_names}")
+    if freedom not in lk.joints[-1].freedom_names():
+        _fail(spec, "load.freedom", f"the load acts on the output, a freedom of the last joint "
+                                    f"(the one to the ground): {lk.joints[-1].freedom_names()}")
+    translation = freedom.endswith(".s")
+    wrong = "torque" if translation else "force"
+    if getattr(t, wrong) is not None:
+        what, right = ("a translation", "force") if translation else ("a rotation", "torque")
+        _fail(spec, f"load.{wrong}", f"{freedom!r} is {what}: give {right}")
+    if (t.force if translation else t.torque) is None and t.damping is None:
+        _fail(spec, "load", f"give {'force' if translation else 'torque'} and/or damping")
+    constant = 0.0
+    if translation and t.force is not None:
+        constant = _si(spec, t.force, "force", "load.force")
+    if not translation and t.torque is not None:
+        constant = _si(spec, t.torque, "torque", "load.torque")
+    damping = 0.0
+    if t.damping is not None:
+        kind = "translational_damping" if translation else "rotational_damping"
+        damping = _si(spec, t.damping, kind, "load.damping")
+    if constant < 0 or damping < 0:
+        _fail(spec, "load", "give the load's size (>= 0): it acts against the motion, or in "
+                            "the freedom's negative direction with against_motion = false")
+    return LoadConfig(freedom, constant, damping, t.against_motion)
+
+
+def drive_config(spec: Any) -> DriveConfig:
+    """The ``[drive]`` table of a loaded spec as a typed, SI :class:`DriveConfig`."""
+    t = _table(spec)
+    if not spec.input_is_angle or len(spec.linkage.inputs) != 1:
+        _fail(spec, "", "simulation needs one rotating input (a crank)")
+    speed = (spec.speed if t.initial_speed is None
+             else _si(spec, t.initial_speed, "angular_velocity", "initial_speed"))
+    if not speed > 0:
+        _fail(spec, "initial_speed", f"the crank must start turning forward (> 0); got {speed} "
+                                     "rad/s")
+    flywheel = _si(spec, t.flywheel, "inertia", "flywheel")
+    if flywheel < 0:
+        _fail(spec, "flywheel", f"an inertia is >= 0; got {t.flywheel!r}")
+    max_time = None if t.max_time is None else _si(spec, t.max_time, "time", "max_time")
+    if max_time is not None and not max_time > 0:
+        _fail(spec, "max_time", f"must be positive; got {t.max_time!r}")
+    return DriveConfig(motor=_motor(spec, t.motor), load=_load(spec, t.load), flywheel=flywheel,
+                       initial_speed=speed, cycles=t.cycles,
+                       samples_per_cycle=t.samples_per_cycle, rtol=t.rtol, atol=t.atol,
+                       gravity=t.gravity, max_time=max_time)

@@ -1,0 +1,88 @@
+"""A :class:`~screwkit.kinematics.motion.Motion` as a column table: one row per input sample
+and assembly mode, one column per quantity (``Motion.table()``; written by ``to_csv``,
+``to_dataframe`` and ``screwkit analyze --csv``).
+
+Columns: ``mode``, ``input`` (the sweep value), ``assembles``, ``singular``; then every
+variable with its rate and acceleration — ``phi0``, ``phi0_dot``, ``phi0_ddot`` — the seed's
+names first, then every joint freedom (``B.theta``, ``B.theta_dot`` …; a spherical joint's
+rotation vector ``B.rx`` and its angular velocity ``B.wx`` with ``B.wx_dot``); then
+``closure_residual`` and, when asked, the coupler point ``coupler_x|y|z``. Values are SI and
+radians, NaN where the mode does not assemble (rates and accelerations also where it is
+singular), as in the JSON document.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from screwkit.tables import Column, ResultTable, stack_tables
+
+if TYPE_CHECKING:
+    from screwkit.kinematics.motion import ModeMotion, Motion
+
+_TRANSLATION_SEED = re.compile(r"[sS]\d*")
+
+
+def variable_kind(name: str) -> str:
+    """``"length"`` for a translation, ``"angle"`` for a rotation: a joint freedom by its name
+    (``<joint>.s`` is a slide; ``.theta``, ``.rx``, ``.wx`` … are rotations), a seed variable by
+    the seeds' convention (Bagci's S and Rahman's s_i are slides, θ, φ, χ, η angles)."""
+    if "." in name:
+        return "length" if name.rsplit(".", 1)[1] == "s" else "angle"
+    return "length" if _TRANSLATION_SEED.fullmatch(name) else "angle"
+
+
+RATE_KIND = {"length": "velocity", "angle": "angular_velocity"}
+ACCELERATION_KIND = {"length": "acceleration", "angle": "angular_acceleration"}
+
+
+def _ordered(names: Sequence[str]) -> list[str]:
+    """The seed's names (no dot) first, then the joint freedoms, each in their own order."""
+    return [n for n in names if "." not in n] + [n for n in names if "." in n]
+
+
+def mode_columns(md: ModeMotion, inputs: np.ndarray, input_kind: str) -> list[Column]:
+    """The columns of one mode (module docstring), without the coupler point."""
+    n = md.samples
+    cols = [Column("mode", "index", np.full(n, md.index, dtype=np.int64)),
+            Column("input", input_kind, np.asarray(inputs, dtype=float)),
+            Column("assembles", "flag", np.asarray(md.assembles, dtype=bool)),
+            Column("singular", "flag", np.asarray(md.singular, dtype=bool))]
+    for name in _ordered(list(md.variables)):
+        kind = variable_kind(name)
+        cols.append(Column(name, kind, md.variables[name]))
+        if name in md.velocities:
+            cols.append(Column(f"{name}_dot", RATE_KIND[kind], md.velocities[name]))
+        if name in md.accelerations:
+            cols.append(Column(f"{name}_ddot", ACCELERATION_KIND[kind], md.accelerations[name]))
+    for name in _ordered([v for v in md.velocities if v not in md.variables]):
+        # angular velocities of spherical joints (B.wx): a rate with no position of its own
+        kind = variable_kind(name)
+        cols.append(Column(name, RATE_KIND[kind], md.velocities[name]))
+        if name in md.accelerations:
+            cols.append(Column(f"{name}_dot", ACCELERATION_KIND[kind], md.accelerations[name]))
+    cols.append(Column("closure_residual", "ratio", md.closure_residual))
+    return cols
+
+
+def motion_table(motion: Motion, coupler_point: Sequence[float] | None = None,
+                 coupler_link: int = 1) -> ResultTable:
+    """Every mode of ``motion`` one under the other (module docstring); ``coupler_point``
+    (f, g, h) in the body frame of moving link ``coupler_link`` adds its world path."""
+    input_kind = variable_kind(motion.input_names[0])
+    x = motion.input_values
+    tables = []
+    for md in motion.modes:
+        cols = mode_columns(md, x, input_kind)
+        if coupler_point is not None:
+            from screwkit.kinematics.coupler_curves import coupler_point_path
+
+            p = coupler_point_path(md, coupler_point, coupler_link)
+            cols += [Column(f"coupler_{a}", "length", p[:, k]) for k, a in enumerate("xyz")]
+        tables.append(ResultTable(tuple(cols)))
+    title = f"{motion.linkage.name}: {motion.method} analysis, one row per input and mode"
+    return stack_tables(tables, title)

@@ -1,0 +1,102 @@
+"""Plots of a simulation (``screwkit simulate``): speed against the input angle (one curve per
+cycle) and against time, the motor torque and the shaft torque into the loop against time, and
+the coefficient of speed fluctuation per cycle — as report-scene plots (the viewer's plot
+dictionaries, :mod:`screwkit.report.scene`) and as one matplotlib PNG (``--plot``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from screwkit.io.results import jsonable
+
+DEG = 180.0 / np.pi
+RPM = 60.0 / (2.0 * np.pi)
+GROUP = "simulation"
+
+
+def _plot(pid: str, title: str, x_label: str, y_label: str, series: list[dict[str, Any]],
+          x_scale: float = 1.0, y_scale: float = 1.0) -> dict[str, Any]:
+    return {"id": pid, "group": GROUP, "title": title, "kind": "line", "x_label": x_label,
+            "y_label": y_label, "x_scale": x_scale, "y_scale": y_scale, "linked": False,
+            "series": series}
+
+
+def _series(name: str, x: Any, y: Any, style: str = "line") -> dict[str, Any]:
+    return {"name": name, "mode": None, "style": style, "x": np.asarray(x, dtype=float),
+            "y": np.asarray(y, dtype=float)}
+
+
+def simulation_scene_plots(doc: dict[str, Any], mode: int | None = None
+                           ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Scene plots and their group from a simulation document (``SpecSimulation.as_dict``)."""
+    s = {k: np.asarray(v, dtype=float) for k, v in doc["samples"].items()}
+    n_cycles = max(len(doc["cycles"]), 1)
+    per = s["time"].size // n_cycles if s["time"].size else 0
+    by_cycle = [_series(f"cycle {k + 1}", s["cycle_angle"][k * per:(k + 1) * per],
+                        s["speed"][k * per:(k + 1) * per]) for k in range(len(doc["cycles"]))]
+    plots = [
+        _plot("sim-speed-angle", "input speed against input angle (one curve per cycle)",
+              "input angle in the cycle (deg)", "speed (rpm)", by_cycle, DEG, RPM),
+        _plot("sim-speed-time", "input speed against time", "time (s)", "speed (rpm)",
+              [_series("speed", s["time"], s["speed"])], 1.0, RPM),
+        _plot("sim-torque-time", "motor torque and shaft torque into the loop", "time (s)",
+              "torque (N·m)", [_series("motor", s["time"], s["motor_torque"])]),
+    ]
+    loads = doc.get("loads")
+    if loads:
+        for name, e in loads["efforts"].items():
+            plots[-1]["series"].append(_series(f"shaft ({name})", s["time"],
+                                               [np.nan if v is None else v for v in e]))
+    cyc = doc["cycles"]
+    plots.append(_plot("sim-fluctuation", "coefficient of speed fluctuation per cycle", "cycle",
+                       "C_s", [_series("C_s", [c["cycle"] for c in cyc],
+                                       [c["fluctuation"] for c in cyc], "line+points")]))
+    steady = doc.get("steady") or {}
+    note = (f"Forward simulation with the [drive] table: {doc['message']}. Flywheel "
+            f"{doc['flywheel']:.6g} kg·m²; steady (last cycle) mean speed "
+            f"{steady.get('mean_speed', float('nan')) * RPM:.6g} rpm, C_s "
+            f"{steady.get('fluctuation', float('nan')):.4g}, motor torque RMS "
+            f"{steady.get('motor_torque_rms', float('nan')):.4g} N·m (docs/simulation.md).")
+    sizing = doc.get("flywheel_sizing")
+    if sizing:
+        note += (f" Flywheel sized for C_s = {sizing['requested_fluctuation']:g}: "
+                 f"{sizing['flywheel']:.6g} kg·m² (energy method "
+                 f"{sizing['energy_method']['flywheel']:.6g}).")
+    return jsonable(plots), [{"id": GROUP, "title": "Simulation (motor and flywheel)",
+                              "note": note}]
+
+
+def write_simulation_png(doc: dict[str, Any], path: str | Path) -> None:
+    """Speed against angle and time, torques against time and C_s per cycle in one PNG (or
+    SVG/PDF, by the suffix); needs matplotlib (the ``plot`` extra)."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError as exc:
+        raise ValueError("--plot needs matplotlib: pip install 'screwkit[plot]'") from exc
+    from screwkit.io.outputs import atomic_path
+
+    plots, _ = simulation_scene_plots(doc)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5))
+    for ax, p in zip(axes.ravel(), plots, strict=True):
+        for s in p["series"]:
+            x = np.asarray(s["x"], dtype=float) * p["x_scale"]
+            y = np.array([np.nan if v is None else v for v in s["y"]], dtype=float) * p["y_scale"]
+            ax.plot(x, y, "o-" if "points" in s["style"] else "-", lw=1, ms=3,
+                    label=s["name"] if len(p["series"]) <= 6 else None)
+        ax.set_title(p["title"], fontsize=9)
+        ax.set_xlabel(p["x_label"])
+        ax.set_ylabel(p["y_label"])
+        ax.grid(alpha=0.3)
+        if len(p["series"]) <= 6:
+            ax.legend(fontsize=7)
+    fig.suptitle(f"{doc['name']}: simulation", fontsize=11)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png", dpi=110)
+    plt.close(fig)
