@@ -424,6 +424,43 @@ def cssp_sweep(
     return CSSPSweep(dims, mode, driven_offset, n, th, ct, st, given, disc, ok, turn)
 
 
+def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
+                  rotations: tuple[Array, Array] | None, rates: Array | None,
+                  ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array]]:
+    """The joint variables of a CSSP mode, their rates and accelerations by name: the crank's
+    θ1 (and s1 when driven), the ball joints' rotation vectors (when ``rotations`` holds their
+    relative rotations) and child-frame rates (when ``rates`` holds them), the slider's s4."""
+    ok = sw.assembles
+    first = linkage.joints[0].name
+    pin, ball, slider = (j.name for j in linkage.joints[1:])
+    variables: dict[str, Array] = {f"{first}.theta": sw.theta1}
+    velocities: dict[str, Array] = {f"{first}.theta": sw.full("theta1_dot")}
+    accelerations: dict[str, Array] = {f"{first}.theta": sw.full("theta1_ddot")}
+    if sw.driven_offset:
+        variables[f"{first}.s"] = sw.full("s1")
+        velocities[f"{first}.s"] = sw.full("s1_dot")
+        accelerations[f"{first}.s"] = sw.full("s1_ddot")
+    vectors: list[Array | None] = [None, None]
+    if rotations is not None:
+        safe = np.where(ok[:, None, None], 1.0, 0.0)
+        eye = np.where(ok[:, None, None], 0.0, 1.0) * np.eye(3)
+        from scipy.spatial.transform import Rotation  # on first use (start-up time)
+        vectors = [Rotation.from_matrix(np.nan_to_num(rel) * safe + eye).as_rotvec()
+                   for rel in rotations]
+    for name, r, rv in ((pin, 0, vectors[0]), (ball, 2, vectors[1])):
+        if rates is None:
+            break
+        for a, ax in enumerate("xyz"):
+            if rv is not None:
+                variables[f"{name}.r{ax}"] = np.where(ok, rv[:, a], np.nan)
+            velocities[f"{name}.w{ax}"] = rates[r, a]
+            accelerations[f"{name}.w{ax}"] = rates[r + 1, a]
+    variables[f"{slider}.s"] = s4_st[0]
+    velocities[f"{slider}.s"] = s4_st[1]
+    accelerations[f"{slider}.s"] = s4_st[2]
+    return variables, velocities, accelerations
+
+
 def cssp_mode_motion(
     linkage: Linkage,
     theta1: ArrayLike,
@@ -502,70 +539,40 @@ def cssp_mode_motion(
     s1_all = sw.full("s1")
     scalars = [th] + ([s1_all] if driven_offset else []) + [s4_st[0]]
     conf = Configuration(np.stack(scalars, -1), relative)
-    first = linkage.joints[0].name
-    pin, ball, slider = (j.name for j in linkage.joints[1:])
-    variables: dict[str, Array] = {f"{first}.theta": th}
-    velocities: dict[str, Array] = {f"{first}.theta": sw.full("theta1_dot")}
-    accelerations: dict[str, Array] = {f"{first}.theta": sw.full("theta1_ddot")}
-    if driven_offset:
-        variables[f"{first}.s"] = s1_all
-        velocities[f"{first}.s"] = sw.full("s1_dot")
-        accelerations[f"{first}.s"] = sw.full("s1_ddot")
-    if joint_rotations:
-        safe = np.where(ok[:, None, None], 1.0, 0.0)
-        eye = np.where(ok[:, None, None], 0.0, 1.0) * np.eye(3)
-        from scipy.spatial.transform import Rotation  # on first use (start-up time)
-        pin_rv = Rotation.from_matrix(np.nan_to_num(pin_rel) * safe + eye).as_rotvec()
-        ball_rv = Rotation.from_matrix(np.nan_to_num(ball_rel) * safe + eye).as_rotvec()
-    for name, r, rv in ((pin, 0, pin_rv if joint_rotations else None),
-                        (ball, 2, ball_rv if joint_rotations else None)):
-        if not ball_joints:
-            break
-        for a, ax in enumerate("xyz"):
-            if rv is not None:
-                variables[f"{name}.r{ax}"] = np.where(ok, rv[:, a], np.nan)
-            velocities[f"{name}.w{ax}"] = RATE_st[r, a]
-            accelerations[f"{name}.w{ax}"] = RATE_st[r + 1, a]
-    variables[f"{slider}.s"] = s4_st[0]
-    velocities[f"{slider}.s"] = s4_st[1]
-    accelerations[f"{slider}.s"] = s4_st[2]
+    variables, velocities, accelerations = _joint_tables(
+        linkage, sw, s4_st, (pin_rel, ball_rel) if joint_rotations else None,
+        RATE_st if ball_joints else None)
 
     arrays = [link_rotation, link_origin, link_angular_velocity, link_origin_velocity,
               link_angular_acceleration, link_origin_acceleration, joint_centres, joint_axes]
-    bad = ~ok
-    if bad.any():
-        for arr in arrays:
-            arr[bad] = np.nan
-        if ball_joints:
-            relative[bad] = np.nan
-        conf.scalars[bad, -1] = np.nan
-        for table in (variables, velocities, accelerations):
-            for values in table.values():
-                values[bad] = np.nan
-        closure[bad] = np.nan
+    if ball_joints:
+        arrays.append(relative)
+    _mask_unassembled(ok, arrays, conf, (variables, velocities, accelerations), closure)
     closure /= linkage.length_scale
-    events: list[str] = []
-    if bad.any() and ok.any():
-        events.append(f"does not assemble at {int(bad.sum())} of {n} sample(s)")
+    bad = ~ok
+    events = ([f"does not assemble at {int(bad.sum())} of {n} sample(s)"]
+              if bad.any() and ok.any() else [])
     return ModeMotion(
-        assembles=ok,
-        singular=np.zeros(n, dtype=bool),
-        conf=conf,
-        variables=variables,
-        velocities=velocities,
-        accelerations=accelerations,
-        link_rotation=arrays[0],
-        link_origin=arrays[1],
-        link_angular_velocity=arrays[2],
-        link_origin_velocity=arrays[3],
-        link_angular_acceleration=arrays[4],
-        link_origin_acceleration=arrays[5],
-        joint_centres=arrays[6],
-        joint_axes=arrays[7],
-        closure_residual=closure,
-        events=events,
-    )
+        assembles=ok, singular=np.zeros(n, dtype=bool), conf=conf, variables=variables,
+        velocities=velocities, accelerations=accelerations, link_rotation=arrays[0],
+        link_origin=arrays[1], link_angular_velocity=arrays[2], link_origin_velocity=arrays[3],
+        link_angular_acceleration=arrays[4], link_origin_acceleration=arrays[5],
+        joint_centres=arrays[6], joint_axes=arrays[7], closure_residual=closure, events=events)
 
+
+def _mask_unassembled(ok: NDArray[np.bool_], arrays: list[Array], conf: Configuration,
+                      tables: tuple[dict[str, Array], ...], closure: Array) -> None:
+    """NaN (in place) wherever the CSSP does not assemble."""
+    bad = ~ok
+    if not bad.any():
+        return
+    for arr in arrays:
+        arr[bad] = np.nan
+    conf.scalars[bad, -1] = np.nan
+    for table in tables:
+        for values in table.values():
+            values[bad] = np.nan
+    closure[bad] = np.nan
 
 __all__ = [
     "CSSPBlockRows",
