@@ -6,7 +6,7 @@ The front door (``import screwkit as sk``), Pinocchio-style verbs on read-only m
     spec = sk.load_spec("examples/rsrc_fig7_dynamics.toml")      # a Spec (SI units)
     motion = sk.solve_motion(spec.linkage, spec.inputs, rates=spec.speed)   # a Motion
     dyn = sk.inverse_dynamics(motion, 0, gravity=[0, 0, -9.80665])         # a Dynamics
-    sk.mobility(spec.linkage), sk.limit_positions(spec.linkage)
+    sk.mobility(spec.linkage), sk.limit_positions(motion), sk.transmission(motion)
     sk.balance(motion, 0, [sk.point_mass_variables(spec.linkage, "coupler")], {"F": 1})
     sk.synthesize(sk.load_spec("examples/bagci_example1_synthesis.toml").synthesis)
     sk.Pipeline(spec).balance()       # every job of a spec on one solved motion
@@ -53,6 +53,7 @@ _EXPORTS: dict[str, str] = {
     "AssemblyError": "screwkit.kinematics.motion",
     "limit_positions": "screwkit.kinematics.limit_positions",
     "coupler_point_path": "screwkit.kinematics.coupler_curves",
+    "transmission": "screwkit.kinematics.transmission",
     "mobility": "screwkit.kinematics.loop_mobility",
     # dynamics
     "inverse_dynamics": "screwkit.dynamics.inverse",
@@ -107,6 +108,7 @@ __all__ = [
     "rssr",
     "solve_motion",
     "synthesize",
+    "transmission",
 ]
 
 
@@ -145,6 +147,7 @@ if TYPE_CHECKING:
     from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
     from screwkit.kinematics.registry import family
     from screwkit.kinematics.solve_motion import solve_motion
+    from screwkit.kinematics.transmission import transmission
     from screwkit.model.families import cssp, fourbar, rccc, rsrc, rssr
     from screwkit.model.joints import Joint
     from screwkit.model.linkage import Link, Linkage

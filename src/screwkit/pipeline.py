@@ -16,13 +16,23 @@ from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.result import BalanceResult
 from screwkit.constants import STANDARD_GRAVITY
 from screwkit.dynamics import Dynamics, inverse_dynamics
+from screwkit.errors import ScrewkitError
 from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec
-from screwkit.kinematics.limit_positions import LimitPositions, limit_positions
+from screwkit.kinematics.coupler_curves import coupler_curves
+from screwkit.kinematics.limit_positions import (
+    LimitPositions,
+    LimitsConfig,
+    limit_positions,
+    uses_closed_form,
+)
+from screwkit.kinematics.loop import Array
 from screwkit.kinematics.loop_mobility import LinkageMobility, mobility
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.kinematics.transmission import Transmission, transmission
 from screwkit.synthesis.config import SynthesisConfig, SynthesisRun, run_synthesis
+from screwkit.tables import ResultTable
 
 
 class Pipeline:
@@ -119,10 +129,52 @@ class Pipeline:
         ``progress(done, total)`` follows a multistart."""
         return run_synthesis(self.synthesis_config(), starts=starts, progress=progress)
 
-    def limits(self, dwell_tolerance: float = 1e-6, at: list[float] | None = None
-               ) -> LimitPositions:
-        """Limit positions and dwell orders (Bagci App. D); ``at`` in radians."""
-        return limit_positions(self.spec.linkage, dwell_tolerance, at=at)
+    def limits(self, dwell_tolerance: float | None = None, at: list[float] | None = None, *,
+               output: str | None = None, method: str | None = None,
+               max_order: int | None = None) -> LimitPositions:
+        """Limit positions and dwell orders of the loop's outputs (``at`` in radians, or metres
+        for a translation input): Bagci App. D's closed form where it answers, else the generic
+        route on the pipeline's motion. Arguments left out come from the spec's ``[limits]``."""
+        c = self.spec.limits or LimitsConfig()
+        out = output if output is not None else c.output
+        how = method if method is not None else c.method
+        tol = dwell_tolerance if dwell_tolerance is not None else c.dwell_tolerance
+        where = at if at is not None else list(c.at)
+        order = max_order if max_order is not None else c.max_order
+        closed = uses_closed_form(self.spec.linkage, out, how)
+        source = self.spec.linkage if closed else self.motion
+        return limit_positions(source, tol, order, where, output=out, method=how)
+
+    def analysis(self) -> dict[str, Any]:
+        """The analysis document (io/documents.py) of the pipeline's motion: every mode, the
+        spec's coupler points and the transmission quality (a note where a loop has none)."""
+        from screwkit.io.documents import analysis_document
+
+        try:
+            tr, note = self.transmission(), None
+        except ScrewkitError as exc:
+            tr, note = None, str(exc)
+        return analysis_document(self.motion, name=self.spec.name,
+                                 coupler_points=self.spec.coupler_points, transmission=tr,
+                                 transmission_note=note)
+
+    def analysis_table(self) -> ResultTable:
+        """The motion as a column table (``Motion.table``) with the spec's coupler points and
+        the transmission quality (where the loop has one)."""
+        try:
+            tr = self.transmission()
+        except ScrewkitError:
+            tr = None
+        return self.motion.table(coupler_points=self.spec.coupler_points, transmission=tr)
+
+    def transmission(self) -> Transmission:
+        """Transmission index, angle and ball-joint cone angles over every mode (a ValueError
+        says why a loop has none)."""
+        return transmission(self.motion)
+
+    def coupler_curves(self) -> list[dict[str, Array]]:
+        """Per mode, the world path (N, 3) of every coupler point of the spec, by name."""
+        return coupler_curves(self.motion, self.spec.coupler_points)
 
     def simulate(self, fluctuation: float | None = None, cycles: int | None = None) -> Any:
         """The spec's ``[drive]`` run forward in time (docs/simulation.md): a

@@ -215,14 +215,32 @@ def test_limits_reproduce_bagci_fig9_and_fig10_dwells():
     assert {d["inversion_label"]: d["dwell_order"] for d in doc["dwells_at"]}[2] == 2
 
 
-def test_limits_refuse_a_family_without_the_theory():
-    r = runner.invoke(app, ["limits", str(EXAMPLES / "rssr_spatial.toml")])
-    assert r.exit_code == 2 and "RSRC" in r.output
+def test_limits_of_a_loop_without_a_closed_form_take_the_generic_route():
+    r = runner.invoke(app, ["limits", str(EXAMPLES / "rssr_spatial.toml"), "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    assert doc["method"] == "generic" and doc["outputs"] == ["phi0"]
+    assert len(doc["limits"]) == 4 and all(lim["dwell_order"] == 1 for lim in doc["limits"])
+    r = runner.invoke(app, ["limits", str(EXAMPLES / "rssr_spatial.toml"), "--method", "closed"])
+    assert r.exit_code == 2 and "no closed-form limits" in r.output
 
 
-def test_limits_refuse_the_cssp_with_a_message():
-    r = runner.invoke(app, ["limits", str(EXAMPLES / "rahman_cssp.toml")])
-    assert r.exit_code == 2 and "RSRC and the planar 4R" in r.output.replace("\n", " ")
+def test_limits_of_the_cssp_slider_are_the_stroke_ends():
+    r = runner.invoke(app, ["limits", str(EXAMPLES / "rahman_cssp.toml"), "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    assert doc["method"] == "generic" and {lim["kind"] for lim in doc["limits"]} == {"translation"}
+    import screwkit as sk
+    from screwkit.io.spec import load_spec
+
+    s = load_spec(EXAMPLES / "rahman_cssp.toml")
+    for lim in doc["limits"]:  # the closed form just around each limit: s4 is extreme there
+        x = lim["input"] + np.radians(np.linspace(-0.5, 0.5, 1001))
+        md = sk.solve_motion(s.linkage, x, method="closed").modes[lim["mode"]]
+        s4 = md.variables["s4"]
+        k = int(np.argmax(s4) if lim["second_derivative"] < 0 else np.argmin(s4))
+        assert abs(x[k] - lim["input"]) < np.radians(1e-3)
+        assert abs(s4[k] - lim["value"]) < 1e-12
 
 
 def test_analyze_plot_writes_a_png(tmp_path):

@@ -48,9 +48,9 @@ CASES = [
     ("negative length", lambda f: sk.rsrc(d1=-1, d2=1, d3=1, a=1, b=0, e=0, delta0=0,
                                            lambda0=0), InputError, "d1 must be a positive"),
     ("unknown family", lambda f: sk.family("fivebar"), InputError, "unknown family"),
-    ("limits of a CSSP", lambda f: sk.limit_positions(
-        sk.load_spec(EXAMPLES / "rahman_cssp.toml").linkage), InputError,
-     "limit positions and dwells are computed for"),
+    ("closed-form limits of a CSSP", lambda f: sk.limit_positions(
+        sk.load_spec(EXAMPLES / "rahman_cssp.toml").linkage, method="closed"), InputError,
+     "no closed-form limits of s4 for a CSSP"),
     ("dynamics with a mode object for a Motion", lambda f: sk.inverse_dynamics(f[1], "x"),
      InputError, "assembly mode as an index"),
     ("dynamics without masses", lambda f: sk.inverse_dynamics(

@@ -19,9 +19,38 @@ def shown_variables(mode: Any, input_name: str) -> list[str]:
     return names or [n for n in mode.variables if n != input_name][:4]
 
 
-def show_analysis(spec: Any, motion: Any, units: Any, full: bool) -> None:
+def transmission_lines(entry: dict[str, Any] | None, units: Any, input_kind: str) -> list[str]:
+    """One line per transmission measure of a mode (its ``transmission`` entry in the analysis
+    document): the minimum index of each output, the worst transmission angle, each ball
+    joint's cone limit, with the input where it occurs, in ``units``."""
+    if not entry:
+        return []
+    summary = entry["summary"]
+    a = units.label("angle")
+
+    def where(x: float | None) -> str:
+        return "—" if x is None else f"{units.show(input_kind, x):.6g} {units.label(input_kind)}"
+
+    lines = []
+    for name, st in summary["index"].items():
+        if st["value"] is not None:
+            lines.append(f"transmission index of {name}: min {st['value']:.4f} at input "
+                         f"{where(st['at'])}")
+    if "angle" in summary and summary["angle"]["value"] is not None:
+        st = summary["angle"]
+        lines.append(f"transmission angle: worst {units.show('angle', st['value']):.6g} {a} from "
+                     f"a dead centre at input {where(st['at'])}")
+    for joint, st in summary["cone_limit"].items():
+        lines.append(f"ball joint {joint}: cone limit {units.show('angle', st['value']):.6g} {a} "
+                     f"(at input {where(st['at'])})")
+    return lines
+
+
+def show_analysis(spec: Any, motion: Any, units: Any, full: bool,
+                  doc: dict[str, Any] | None = None, table: Any = None) -> None:
     """The terminal view: per mode, the input and each shown variable with its rate and
-    acceleration in the display units; events; where the mode does not assemble."""
+    acceleration in the display units, the coupler points' paths, the transmission summary;
+    events; where the mode does not assemble."""
     import numpy as np
     from rich.markup import escape
 
@@ -32,20 +61,31 @@ def show_analysis(spec: Any, motion: Any, units: Any, full: bool) -> None:
     console.print(f"method: {motion.method}; {units.describe()}", highlight=False)
     for note in motion.notes:
         console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
-    whole = motion.table()
+    from screwkit.kinematics.motion_table import column_prefix, variable_kind
+
+    whole = table if table is not None else motion.table()
+    points = [column_prefix(cp.name) for cp in getattr(spec, "coupler_points", [])]
+    input_kind = variable_kind(motion.input_names[0])
     for md in motion.modes:
         t = whole.where(whole.column("mode").values == md.index)
         names = ["input"]
         for n in shown_variables(md, motion.input_names[0]):
             names += [c for c in (n, f"{n}_dot", f"{n}_ddot") if c in t.names]
+        names += [f"{p}_{a}" for p in points for a in "xyz" if f"{p}_{a}" in t.names]
         cols, values = table_columns(t, names, units)
         print_long_table(console, f"assembly mode {md.index}", cols, values, full)
+        entry = doc["modes"][md.index].get("transmission") if doc is not None else None
+        for line in transmission_lines(entry, units, input_kind):
+            console.print(f"  • {escape(line)}", highlight=False)
         for ev in md.events:
             console.print(f"  • {escape(ev)}", highlight=False)
         missing = int((~np.asarray(md.assembles)).sum())
         if missing:
             console.print(f"  • does not assemble at {missing} of {motion.samples} inputs",
                           highlight=False)
+    if doc is not None and "note" in doc.get("transmission", {}):
+        console.print(f"[yellow]transmission:[/] {escape(doc['transmission']['note'])}",
+                      highlight=False)
 
 
 def register(app: typer.Typer) -> None:
@@ -61,12 +101,11 @@ def register(app: typer.Typer) -> None:
         unit: UnitOpt = None,
         full: FullOpt = False,
         method: Annotated[str, typer.Option("--method", help="auto (closed form where the family has one), closed, or generic (any loop; every joint variable).")] = "auto",
-        plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of every variable and its rates over the input (display units), and the coupler curve projections.")] = None,
+        plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of every variable and its rates over the input (display units), the coupler curves (projections and 3-D) and the transmission quality.")] = None,
     ) -> None:
-        """Positions, velocities and accelerations of every joint variable in every assembly mode."""
+        """Positions, velocities and accelerations of every joint variable in every assembly mode, the coupler curves of the spec's coupler points and the transmission quality over the cycle."""
         from screwkit.cli.common import guard
         from screwkit.cli.outputs import Outputs
-        from screwkit.io.documents import analysis_document
         from screwkit.io.spec import load_spec
         from screwkit.pipeline import Pipeline
 
@@ -77,13 +116,12 @@ def register(app: typer.Typer) -> None:
         motion = guard(lambda: pipe.motion)
         du = out.units_for(s.units)
 
-        def document() -> dict[str, Any]:
-            return analysis_document(motion, name=s.name, coupler_point=s.coupler_point)
-
+        doc = guard(pipe.analysis)
+        table = guard(pipe.analysis_table)
         if plot is not None:
             from screwkit.report.plots import plot_analysis
 
-            guard(lambda: plot_analysis(document(), plot, units=du))
+            guard(lambda: plot_analysis(doc, plot, units=du))
             out.note_written(plot)
-        out.deliver(document=document, table=lambda: motion.table(s.coupler_point),
-                    show=lambda: show_analysis(s, motion, du, out.full), units=du)
+        out.deliver(document=lambda: doc, table=lambda: table,
+                    show=lambda: show_analysis(s, motion, du, out.full, doc, table), units=du)

@@ -19,7 +19,7 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
 
     from screwkit.cli.common import console, guard
     from screwkit.cli.dynamics_cmd import dynamics_job
-    from screwkit.io.documents import analysis_document, synthesis_document
+    from screwkit.io.documents import synthesis_document
     from screwkit.io.results import write_json_atomic
     from screwkit.io.spec import load_spec
     from screwkit.io.tables import write_table
@@ -33,9 +33,9 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
     console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
     pipe = Pipeline(spec)
     motion = guard(lambda: pipe.motion)
-    doc = analysis_document(motion, name=spec.name, coupler_point=spec.coupler_point)
+    doc = guard(pipe.analysis)
     write(output_dir / f"{f.stem}.analysis.json", doc)
-    table = motion.table(spec.coupler_point)
+    table = guard(pipe.analysis_table)
     guard(lambda: write_table(table, output_dir / f"{f.stem}.analysis.csv", "csv", du, files))
     if plots:
         from screwkit.report.plots import plot_analysis
@@ -44,7 +44,11 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
     mob = guard(lambda: pipe.mobility().as_dict())
     write(output_dir / f"{f.stem}.mobility.json", mob)
     jobs = ["analysis", "mobility"]
-    dyn = bal = syn = sim = None
+    dyn = bal = syn = sim = lim = None
+    if spec.limits is not None:
+        lim = guard(lambda: pipe.limits().as_dict())
+        write(output_dir / f"{f.stem}.limits.json", lim)
+        jobs.append("limits")
     if all(link.mass is not None for link in spec.linkage.links):
         dyn = guard(lambda: dynamics_job(pipe, False))
         write(output_dir / f"{f.stem}.dynamics.json", dyn)
@@ -71,28 +75,9 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
     asm = ", ".join(str(int(np.sum(m.assembles))) for m in motion.modes)
     row = [f.stem, spec.family, str(len(spec.inputs)), str(len(motion.modes)), asm,
            f"{res:.1e}", ", ".join(jobs)]
-    summary: list[tuple[str, Any]] = [
-        ("input samples", len(spec.inputs)), ("analysis method", motion.method),
-        ("assembly modes (samples assembling)", f"{len(motion.modes)} ({asm})"),
-        ("max loop-closure residual", f"{res:.1e}"),
-        ("mobility (formula / Jacobian)",
-         f"{mob['formula']['mobility']} / {mob['numeric']['mobility']}"),
-    ]
-    if dyn is not None:
-        sf = dyn["summary"]["shaking_force"]
-        summary.append((f"shaking force RMS / peak ({du.label('force')})",
-                        f"{du.show('force', sf['rms']):.6g} / {du.show('force', sf['peak']):.6g}"))
-    if bal is not None:
-        g = bal["measures"]
-        summary.append(("balancing objective G before → after",
-                        f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
-    if sim is not None:
-        last = sim["cycles"][-1] if sim.get("cycles") else {}
-        summary.append(("simulated speed fluctuation (last cycle)",
-                        f"{last.get('fluctuation', float('nan')):.4g}"))
-    if syn is not None:
-        summary.append(("synthesis RMSE (φ rad, S m)",
-                        f"{syn.get('rmse_phi')} , {syn.get('rmse_S')}"))
+    summary = example_summary(spec, motion, doc, mob, asm, res,
+                              {"limits": lim, "dynamics": dyn, "balance": bal,
+                               "simulation": sim, "synthesis": syn})
     entry = {
         "name": f.stem, "family": spec.family, "description": spec.describe(),
         "jobs": [(j, f"{f.stem}.{j}.json") for j in jobs], "summary": summary,
@@ -100,6 +85,48 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
         "report": f"{f.stem}.html" if reports else None,
     }
     return row, entry
+
+
+def example_summary(spec: Any, motion: Any, doc: dict[str, Any], mob: dict[str, Any], asm: str,
+                    res: float, done: dict[str, Any]) -> list[tuple[str, Any]]:
+    """An example's lines in the demo's index: the analysis (with the transmission quality),
+    the mobility and one line per other job that ran (``done``: job -> document or None)."""
+    from screwkit.cli.analyze_cmd import transmission_lines
+    from screwkit.kinematics.motion_table import variable_kind
+
+    du = spec.display_units()
+    input_kind = variable_kind(motion.input_names[0])
+    summary: list[tuple[str, Any]] = [
+        ("input samples", len(spec.inputs)), ("analysis method", motion.method),
+        ("assembly modes (samples assembling)", f"{len(motion.modes)} ({asm})"),
+        ("max loop-closure residual", f"{res:.1e}"),
+        ("mobility (formula / Jacobian)",
+         f"{mob['formula']['mobility']} / {mob['numeric']['mobility']}"),
+    ]
+    for m in doc["modes"]:
+        summary += [(f"mode {m['mode']}", line)
+                    for line in transmission_lines(m.get("transmission"), du, input_kind)]
+    if (lim := done.get("limits")) is not None:
+        xk = variable_kind(lim["input_name"] if lim["method"] == "generic" else "theta0")
+        summary.append((f"limit positions (output: input [{du.label(xk)}], dwell order)",
+                        "; ".join(f"{x['output']}: {du.show(xk, x['input']):.6g}, "
+                                  f"{x['dwell_order']}" for x in lim["limits"]) or "none"))
+    if (dyn := done.get("dynamics")) is not None:
+        sf = dyn["summary"]["shaking_force"]
+        summary.append((f"shaking force RMS / peak ({du.label('force')})",
+                        f"{du.show('force', sf['rms']):.6g} / {du.show('force', sf['peak']):.6g}"))
+    if (bal := done.get("balance")) is not None:
+        g = bal["measures"]
+        summary.append(("balancing objective G before → after",
+                        f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
+    if (sim := done.get("simulation")) is not None:
+        last = sim["cycles"][-1] if sim.get("cycles") else {}
+        summary.append(("simulated speed fluctuation (last cycle)",
+                        f"{last.get('fluctuation', float('nan')):.4g}"))
+    if (syn := done.get("synthesis")) is not None:
+        summary.append(("synthesis RMSE (φ rad, S m)",
+                        f"{syn.get('rmse_phi')} , {syn.get('rmse_S')}"))
+    return summary
 
 
 def register(app: typer.Typer) -> None:

@@ -1,5 +1,6 @@
-"""``screwkit limits SPEC`` (limit positions and dwell orders, Bagci App. D) and ``screwkit
-mobility SPEC`` (formula and Jacobian mobility). Registered by ``register(app)``."""
+"""``screwkit limits SPEC`` (limit positions and dwell orders of any output of any loop: Bagci
+App. D's closed form or the generic route) and ``screwkit mobility SPEC`` (formula and Jacobian
+mobility). Registered by ``register(app)``."""
 
 from __future__ import annotations
 
@@ -11,38 +12,53 @@ import typer
 from screwkit.cli.outputs import CsvOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 
-def show_limits(spec: Any, doc: dict[str, Any], units: Any, tolerance: float) -> None:
+def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
     """The limit positions and the dwell orders asked for, angles and lengths in ``units``."""
     from rich.markup import escape
 
     from screwkit.cli.common import console
     from screwkit.cli.formatting import TextColumn, number, print_columns
+    from screwkit.kinematics.motion_table import variable_kind
 
     console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
-    a, length = units.label("angle"), units.label("length")
+    console.print(f"method: {doc['method']}; derivatives: {escape(doc['derivatives'])}",
+                  highlight=False)
+    xk = variable_kind(doc["input_name"] if doc["method"] == "generic" else "theta0")
 
-    def ang(x: float | None) -> str:
-        return number(None if x is None else units.show("angle", x), 7)
+    def shown(x: float | None, kind: str) -> str:
+        return "—" if x is None else f"{number(units.show(kind, x), 7)} {units.label(kind)}"
 
+    def kind_of(x: dict[str, Any]) -> str:
+        return "angle" if x.get("kind", "rotation") == "rotation" else "length"
+
+    generic = doc["method"] == "generic"
     lims = doc["limits"]
-    cols = [TextColumn("kind", [x["kind"] for x in lims], "left"),
-            TextColumn("branch", [str(x["branch"]) for x in lims]),
-            TextColumn(f"θ0\n[{a}]", [ang(x["theta0"]) for x in lims]),
-            TextColumn(f"φ0\n[{a}]", [ang(x["phi0"]) for x in lims]),
-            TextColumn(f"S\n[{length}]", [number(None if x["S"] is None else
-                                                  units.show("length", x["S"])) for x in lims]),
+    cols = [TextColumn("output", [x["output"] for x in lims], "left"),
+            TextColumn("kind", [x["kind"] for x in lims], "left"),
+            TextColumn("mode" if generic else "branch",
+                       [str(x.get("mode", x.get("branch"))) for x in lims]),
+            TextColumn(f"input\n[{units.label(xk)}]",
+                       [number(units.show(xk, x["input"]), 7) for x in lims]),
+            TextColumn("value", [shown(x["value"], kind_of(x)) for x in lims]),
             TextColumn("2nd\nderivative", [number(x["second_derivative"], 4) for x in lims]),
-            TextColumn("dwell\norder", [str(x.get("dwell_order", "—")) for x in lims])]
-    print_columns(console, f"limit positions (dwell tolerance {tolerance:g})", cols)
+            TextColumn("dwell\norder", ["—" if x["dwell_order"] is None else str(x["dwell_order"])
+                                        for x in lims])]
+    print_columns(console, f"limit positions (dwell tolerance {doc['dwell_tolerance']:g})", cols)
     if doc["dwells_at"]:
         d = doc["dwells_at"]
-        cols = [TextColumn(f"θ0\n[{a}]", [ang(x["theta0"]) for x in d]),
-                TextColumn("inversion", [str(x["inversion_label"]) for x in d]),
-                TextColumn(f"φ0\n[{a}]", [ang(x["phi0"]) for x in d]),
+        kinds = {x["output"]: variable_kind(x["output"]) for x in d}
+        cols = [TextColumn("output", [x["output"] for x in d], "left"),
+                TextColumn(f"input\n[{units.label(xk)}]",
+                           [number(units.show(xk, x["input"]), 7) for x in d]),
+                TextColumn("mode" if generic else "inversion",
+                           [str(x.get("mode", x.get("inversion_label"))) for x in d]),
+                TextColumn("value", [shown(x["value"], kinds[x["output"]]) for x in d]),
                 TextColumn("dwell\norder", [str(x["dwell_order"]) for x in d]),
-                TextColumn("dφ0/dθ0 … [rad/radᵏ]",
+                TextColumn("dᵏy/dxᵏ, k = 1 … [SI]",
                            [", ".join(f"{v:.3g}" for v in x["derivatives"]) for x in d], "left")]
         print_columns(console, "dwell order at given inputs", cols)
+    for note in doc["notes"]:
+        console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
 
 
 def register(app: typer.Typer) -> None:
@@ -50,16 +66,18 @@ def register(app: typer.Typer) -> None:
 
     @app.command()
     def limits(
-        spec: Annotated[Path, typer.Argument(help="Spec file (TOML) of an RSRC or a planar 4R.")],
+        spec: Annotated[Path, typer.Argument(help="Spec file (TOML).")],
         as_json: JsonOpt = False,
         output: OutputOpt = None,
         csv: CsvOpt = None,
         units: UnitsOpt = "spec",
         unit: UnitOpt = None,
-        dwell_tolerance: Annotated[float, typer.Option("--dwell-tol", help="A derivative dᵏφ0/dθ0ᵏ counts as vanishing below this (rad/radᵏ). Printed dimensions hold a designed dwell only to ~1e-4.")] = 1e-6,
-        at: Annotated[list[float] | None, typer.Option("--at", help="Also give the dwell order at this input angle (degrees); repeatable.")] = None,
+        variable: Annotated[str | None, typer.Option("--var", "--output-variable", help="The output variable: a joint freedom (e.g. output.theta) or a seed name (phi0, S, s4 …); default the loop's outputs (or [limits] output).")] = None,
+        method: Annotated[str | None, typer.Option("--method", help="auto (Bagci's App. D closed form for the RSRC/4R φ0 and S, else generic), closed, or generic (any loop, over the [motion] sweep).")] = None,
+        dwell_tolerance: Annotated[float | None, typer.Option("--dwell-tol", help="A derivative dᵏy/dxᵏ counts as vanishing below this (output unit / input unitᵏ; default 1e-6 or [limits]). Printed dimensions hold a designed dwell only to ~1e-4.")] = None,
+        at: Annotated[list[float] | None, typer.Option("--at", help="Also give the dwell order at this input (degrees, or m for a translation input); repeatable.")] = None,
     ) -> None:
-        """Limit positions of the output rotation and translation over a full turn, and the order of the instantaneous dwell at each rotation limit (Bagci App. D)."""
+        """Limit positions of the output variables (d output/d input = 0) and the order of the instantaneous dwell at each (Bagci App. D for the RSRC and 4R; the generic route for any loop)."""
         import numpy as np
 
         from screwkit.cli.common import guard
@@ -71,11 +89,13 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit)
         s = guard(lambda: load_spec(spec))
-        at_rad = [float(np.radians(x)) for x in at or []]
-        doc = guard(lambda: Pipeline(s).limits(dwell_tolerance, at=at_rad).as_dict())
+        where = None if at is None else [float(np.radians(x)) if s.input_is_angle else float(x)
+                                         for x in at]
+        doc = guard(lambda: Pipeline(s).limits(dwell_tolerance, where, output=variable,
+                                               method=method).as_dict())
         du = out.units_for(s.units)
         out.deliver(document=lambda: doc, table=lambda: limits_table(doc),
-                    show=lambda: show_limits(s, doc, du, dwell_tolerance), units=du)
+                    show=lambda: show_limits(s, doc, du), units=du)
 
     @app.command()
     def mobility(

@@ -40,7 +40,7 @@ def main(
 
 @app.command()
 def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML).")]) -> None:
-    """Load and validate spec files and say what each describes (in the spec's units)."""
+    """Load and validate spec files and say what each describes (in the spec's units) and which jobs it has: every table is checked against what the family offers (coupler points, limits, synthesis routes, balancing), so what a job would refuse is reported here."""
     from rich.markup import escape
 
     from screwkit.io.spec import load_spec
@@ -50,6 +50,7 @@ def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML)
         ok, spec = attempt(lambda p=path: load_spec(p))  # type: ignore[misc]
         if ok and spec is not None:
             console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+            console.print(f"   jobs: {escape(', '.join(spec.jobs()))}", highlight=False)
         else:
             failed += 1
     if failed:

@@ -56,7 +56,7 @@ def _plot(results: list[Any], path: Path, du: Any) -> None:
     plt.close(fig)
 
 
-def _tables(name: str, results: list[Any], doc: dict[str, Any], scale_unit: str, du: Any,
+def _tables(name: str, results: list[Any], doc: dict[str, Any], config: Any, du: Any,
             full: bool) -> None:
     from screwkit.cli.formatting import (
         TextColumn,
@@ -67,6 +67,7 @@ def _tables(name: str, results: list[Any], doc: dict[str, Any], scale_unit: str,
     )
     from screwkit.io.tables import synthesis_table
 
+    scale_unit = config.length_unit
     best = results[0]
     a, lu = du.label("angle"), du.label("length")
     console.print(f"[bold]{escape(name)}[/]: synthesis ({best.status}; {best.iterations} "
@@ -74,15 +75,19 @@ def _tables(name: str, results: list[Any], doc: dict[str, Any], scale_unit: str,
                   highlight=False)
     if best.message:
         console.print(f"  {escape(best.message)}", highlight=False)
-    kinds = ["angle" if k in ("delta0", "lambda0", "theta01", "q1", "q2") else "length"
-             for k in best.dimensions]
+    kinds = ["angle" if k in config.angles else "length" for k in best.dimensions]
     print_columns(console, "optimised dimensions", [
         TextColumn("name", list(best.dimensions), "left"),
         TextColumn("value", [number(du.show(k, v), 7) for k, v in
                              zip(kinds, best.dimensions.values(), strict=True)]),
         TextColumn("unit", [du.label(k) for k in kinds], "left")])
+    rot, tra = config.outputs
+    mode = (f"assembly mode {best.inversion} (sign of Q5 {best.mode_sign:+.0f})"
+            if config.route == "closed" else
+            f"assembly mode {best.inversion} (generic route: the loop's screw Jacobian; outputs "
+            f"{', '.join(o for o in (rot, tra) if o)})")
     console.print(
-        f"assembly mode {best.inversion} (sign of Q5 {best.mode_sign:+.0f}); "
+        f"{mode}; "
         f"E = E_phi + E_S/L² = {best.objective:.6g} with L = {best.length_scale:g} m "
         f"({scale_unit}); E_phi = {best.E_phi:.6g} rad², E_S = {best.E_S:.6g} m²", highlight=False)
     console.print(
@@ -261,7 +266,7 @@ def register(app: typer.Typer) -> None:
             out.note_written(plot)
 
         def show() -> None:
-            _tables(s.name, results, doc, config.length_unit, du, out.full)
+            _tables(s.name, results, doc, config, du, out.full)
             if overlay:
                 _overlay_lines(docs)
 

@@ -9,9 +9,17 @@ from typing import Any
 import numpy as np
 
 from screwkit.dynamics import Dynamics
-from screwkit.kinematics.coupler_curves import coupler_point_path
+from screwkit.kinematics.coupler_curves import CouplerPoint, coupler_point_path
 from screwkit.kinematics.motion import Motion
+from screwkit.kinematics.transmission import Transmission
 from screwkit.synthesis.config import SynthesisRun
+
+TRANSMISSION_DEFINITION = (
+    "index: Sutherland-Roth transmission index of each output, |$T o $O| / max, 0 (dead "
+    "centre) ... 1 (ideal); angle: planar transmission angle mu at the coupler-output joint, "
+    "0 ... pi (worst: smallest min(mu, pi - mu)); cone_angle: angle of each ball joint's stem "
+    "from its socket axis (the centre of the smallest cone holding every stem direction), whose "
+    "maximum cone_limit a ball joint must allow (docs/kinematics.md)")
 
 ANALYSIS_UNITS = {"length": "m", "angle": "rad", "time": "s",
                   "velocities": "d/dt of each variable (rad/s or m/s)",
@@ -23,15 +31,41 @@ def _constant_or_list(values: np.ndarray) -> float | list[float]:
     return float(v[0]) if np.all(v == v[0]) else v.tolist()
 
 
+def _xyz(p: np.ndarray) -> dict[str, Any]:
+    return {"x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
+
+
+def transmission_entries(tr: Transmission, x: np.ndarray) -> list[dict[str, Any]]:
+    """Per mode, the ``transmission`` entry of the analysis document: the index of every
+    output, the transmission angle (planar loops), every ball joint's cone angle, all over the
+    sweep, and ``summary`` (minimum index and worst angle with the input where they occur, the
+    cone limits with the socket axes)."""
+    out = []
+    for m, summary in zip(tr.modes, tr.summary(x), strict=True):
+        entry: dict[str, Any] = {"index": m.index, "cone_angle": m.cone_angle,
+                                 "summary": summary}
+        if m.angle is not None:
+            entry["angle"] = m.angle
+        out.append(entry)
+    return out
+
+
 def analysis_document(motion: Motion, *, name: str | None = None,
                       coupler_point: tuple[float, float, float] | None = None,
-                      coupler_link: int = 1) -> dict[str, Any]:
+                      coupler_link: int = 1,
+                      coupler_points: list[CouplerPoint] | None = None,
+                      transmission: Transmission | None = None,
+                      transmission_note: str | None = None) -> dict[str, Any]:
     """The analysis document of ``screwkit analyze`` (docs/cli.md): every mode with every
     variable (joint freedoms and the seed's names), rates, accelerations, events, the closure
-    residual and, when asked, the coupler point's path (on link ``coupler_link``)."""
+    residual, the path of every coupler point (``coupler_points``; a bare ``coupler_point`` on
+    link ``coupler_link`` too) and the transmission quality (``transmission``)."""
     lk = motion.linkage
+    points = list(coupler_points or [])
+    x = motion.input_values
+    trans = transmission_entries(transmission, x) if transmission is not None else None
     modes: list[dict[str, Any]] = []
-    for md in motion.modes:
+    for k, md in enumerate(motion.modes):
         entry: dict[str, Any] = {
             "mode": md.index,
             "label": md.label,
@@ -43,9 +77,16 @@ def analysis_document(motion: Motion, *, name: str | None = None,
             "accelerations": md.accelerations,
             "closure_residual": md.closure_residual,
         }
-        if coupler_point is not None:
-            p = coupler_point_path(md, coupler_point, coupler_link)
-            entry["coupler_point"] = {"x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
+        if points:
+            entry["coupler_points"] = {
+                cp.name: {"link": cp.link_name, **_xyz(coupler_point_path(md, cp.point, cp.link))}
+                for cp in points}
+            entry["coupler_point"] = dict(entry["coupler_points"][points[0].name])
+            del entry["coupler_point"]["link"]
+        elif coupler_point is not None:
+            entry["coupler_point"] = _xyz(coupler_point_path(md, coupler_point, coupler_link))
+        if trans is not None:
+            entry["transmission"] = trans[k]
         modes.append(entry)
     doc: dict[str, Any] = {
         "method": motion.method,
@@ -60,6 +101,17 @@ def analysis_document(motion: Motion, *, name: str | None = None,
         "parameters": dict(lk.parameters),
         "modes": modes,
     }
+    if points:
+        doc["coupler_points"] = [{"name": cp.name, "link": cp.link_name, "point": list(cp.point)}
+                                 for cp in points]
+    if transmission is not None:
+        doc["transmission"] = {"outputs": list(transmission.outputs),
+                               "output_joint": transmission.output_joint,
+                               "driving_joint": transmission.driving_joint,
+                               "planar": transmission.planar,
+                               "definition": TRANSMISSION_DEFINITION}
+    elif transmission_note is not None:
+        doc["transmission"] = {"note": transmission_note}
     if motion.notes:
         doc["method_note"] = "; ".join(motion.notes)
     return doc

@@ -24,6 +24,7 @@ from pydantic import (
 )
 
 from screwkit.constants import STANDARD_GRAVITY
+from screwkit.errors import ScrewkitError
 from screwkit.io.errors import SpecError
 from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
@@ -35,6 +36,8 @@ if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
     from screwkit.io.display_units import DisplayUnits
     from screwkit.io.drive_table import DriveConfig
+    from screwkit.kinematics.coupler_curves import CouplerPoint
+    from screwkit.kinematics.limit_positions import LimitsConfig
     from screwkit.synthesis.config import SynthesisConfig
 
 Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
@@ -86,9 +89,19 @@ class LinkMassTable(_Strict):
 
 
 class CouplerPointTable(_Strict):
+    name: StrictStr | None = Field(None, max_length=80)
+    link: StrictStr | None = Field(None, description="moving link (default: the family's coupler)")
     f: Value = 0.0
     g: Value = 0.0
     h: Value = 0.0
+
+
+class LimitsTable(_Strict):
+    output: StrictStr | None = None
+    dwell_tolerance: Number = 1e-6
+    max_order: StrictInt = Field(5, ge=1, le=10)
+    at: list[Value] = Field(default_factory=list, max_length=1000)
+    method: Literal["auto", "closed", "generic"] = "auto"
 
 
 class SpecFile(_Strict):
@@ -99,6 +112,8 @@ class SpecFile(_Strict):
     motion: MotionTable = Field(default_factory=MotionTable)  # type: ignore[arg-type]
     links: dict[str, LinkMassTable] = Field(default_factory=dict)
     coupler_point: CouplerPointTable | None = None
+    coupler_points: list[CouplerPointTable] = Field(default_factory=list, max_length=100)
+    limits: LimitsTable | None = None
     gravity: Value | None = None
     gravity_direction: list[Number] = Field(default_factory=lambda: [0.0, 0.0, -1.0])
     balancing: dict[str, Any] | None = None
@@ -112,12 +127,17 @@ class Spec:
     Attributes: ``path``, ``name``, ``family``, ``source``, ``units`` (the ``[units]`` table),
     ``dimensions`` (SI), ``inputs`` (N,) input samples (rad or m), ``speed`` and
     ``acceleration`` of the input, ``mode`` (the assembly mode dynamics and balancing use),
-    ``gravity_magnitude``, ``gravity_direction``, ``coupler_point``; the property ``linkage`` is
-    the mechanism model (a :class:`~screwkit.model.Linkage`, built once at load); ``balancing``
-    and ``synthesis`` are the ``[balancing]`` and ``[synthesis]`` tables as typed configs
+    ``gravity_magnitude``, ``gravity_direction``, ``coupler_points`` (every
+    :class:`~screwkit.kinematics.coupler_curves.CouplerPoint` of ``[coupler_point]`` and
+    ``[[coupler_points]]``), ``coupler_point`` (the ``[coupler_point]`` table's (f, g, h), m);
+    the property ``linkage`` is the mechanism model (a :class:`~screwkit.model.Linkage`, built
+    once at load); ``balancing``, ``synthesis`` and ``limits`` are the ``[balancing]``,
+    ``[synthesis]`` and ``[limits]`` tables as typed configs
     (:class:`~screwkit.balancing.config.BalancingConfig`,
-    :class:`~screwkit.synthesis.config.SynthesisConfig`), or ``None``; ``drive`` the ``[drive]``
-    table of ``screwkit simulate`` (:class:`~screwkit.io.drive_table.DriveConfig`), or ``None``.
+    :class:`~screwkit.synthesis.config.SynthesisConfig`,
+    :class:`~screwkit.kinematics.limit_positions.LimitsConfig`), or ``None``; ``drive`` the
+    ``[drive]`` table of ``screwkit simulate`` (:class:`~screwkit.io.drive_table.DriveConfig`),
+    or ``None``.
     """
 
     def __init__(self, raw: SpecFile, path: str) -> None:
@@ -150,17 +170,12 @@ class Spec:
         if gd.shape != (3,) or not np.all(np.isfinite(gd)) or np.linalg.norm(gd) == 0:
             self._fail("gravity_direction", f"give a non-zero world vector [x, y, z]; got {raw.gravity_direction}")
         self.gravity_direction = gd / np.linalg.norm(gd)
-        self.coupler_point: tuple[float, float, float] | None = None
-        if raw.coupler_point is not None:
-            try:
-                require(family(self.family), "coupler_point")
-            except ValueError as exc:
-                self._fail("coupler_point", str(exc))
-            cp = raw.coupler_point
-            self.coupler_point = (self.quantity(cp.f, "length", "coupler_point.f"),
-                                  self.quantity(cp.g, "length", "coupler_point.g"),
-                                  self.quantity(cp.h, "length", "coupler_point.h"))
         self._linkage = self._build()
+        self.coupler_point: tuple[float, float, float] | None = None
+        self.coupler_points = self._coupler_points()
+        if raw.coupler_point is not None:
+            self.coupler_point = self.coupler_points[0].point
+        self.limits = self._limits()
         self.balancing: BalancingConfig | None = None
         self.synthesis: SynthesisConfig | None = None
         if raw.balancing is not None:
@@ -178,6 +193,54 @@ class Spec:
             self.drive = drive_config(self)
 
     # --- helpers ---------------------------------------------------------------------------
+    def _coupler_points(self) -> list[CouplerPoint]:
+        """``[coupler_point]`` and ``[[coupler_points]]`` as coupler points of the linkage."""
+        from screwkit.kinematics.coupler_curves import coupler_point
+        from screwkit.kinematics.registry import coupler_link_index
+
+        tables = [("coupler_point", self.raw.coupler_point, "coupler point")] if (
+            self.raw.coupler_point is not None) else []
+        tables += [(f"coupler_points[{k}]", t, f"point {k + 1}")
+                   for k, t in enumerate(self.raw.coupler_points)]
+        out: list[CouplerPoint] = []
+        for key, t, default in tables:
+            assert t is not None
+            try:
+                require(family(self.family), "coupler_point")
+            except ValueError as exc:
+                self._fail(key, str(exc))
+            xyz = [self.quantity(getattr(t, c), "length", f"{key}.{c}") for c in "fgh"]
+            name = t.name or default
+            if any(p.name == name for p in out):
+                self._fail(f"{key}.name", f"the name {name!r} is used twice; give each point "
+                                          "its own name")
+            try:
+                coupler_link_index(self._linkage, t.link)
+            except ScrewkitError as exc:
+                self._fail(f"{key}.link", str(exc))
+            try:
+                out.append(coupler_point(self._linkage, xyz, t.link, name))
+            except ValueError as exc:
+                self._fail(key, str(exc))
+        return out
+
+    def _limits(self) -> LimitsConfig | None:
+        """``[limits]`` as a :class:`LimitsConfig`, checked against the loop (the output names
+        a variable it has; the closed form is there when asked for)."""
+        from screwkit.kinematics.limit_positions import LimitsConfig, check_limits_config
+
+        t = self.raw.limits
+        if t is None:
+            return None
+        kind = "angle" if self.input_is_angle else "length"
+        at = tuple(self.quantity(v, kind, "limits.at") for v in t.at)
+        config = LimitsConfig(t.output, float(t.dwell_tolerance), t.max_order, at, t.method)
+        try:
+            check_limits_config(self._linkage, config)
+        except ScrewkitError as exc:
+            self._fail("limits", str(exc))
+        return config
+
     def _fail(self, key: str, message: str) -> None:
         raise SpecError(f"{self.path}: [{key}] {message}")
 
@@ -354,6 +417,26 @@ class Spec:
         span = (f"{du.show(kind, self.inputs[0]):.6g}…{du.show(kind, self.inputs[-1]):.6g} "
                 f"{du.label(kind)}")
         return f"{self.name}: {self.family} ({joints}) {dims}; {n} input samples {span}{src}"
+
+    def jobs(self) -> list[str]:
+        """The jobs this spec asks for, each checked at load against what its family offers
+        (the registry's capabilities): what ``screwkit demo`` runs on it."""
+        from screwkit.kinematics.limit_positions import uses_closed_form
+
+        out = ["analyze" + (f" ({len(self.coupler_points)} coupler point(s))"
+                            if self.coupler_points else ""), "mobility"]
+        if all(link.mass is not None for link in self._linkage.links):
+            out.append("dynamics")
+        if self.balancing is not None:
+            out.append("balance")
+        if self.synthesis is not None:
+            out.append(f"synthesize ({self.synthesis.route} route)")
+        if self.limits is not None:
+            closed = uses_closed_form(self._linkage, self.limits.output, self.limits.method)
+            out.append(f"limits ({'closed' if closed else 'generic'} route)")
+        if self.drive is not None:
+            out.append("simulate")
+        return out
 
     @property
     def input_is_angle(self) -> bool:

@@ -26,8 +26,9 @@ from pydantic import (
 
 from screwkit.io.errors import SpecError
 from screwkit.io.units import UnitError, to_si
-from screwkit.kinematics.registry import require
-from screwkit.synthesis.config import Multistart, SynthesisConfig
+from screwkit.kinematics.registry import family_of, require
+from screwkit.synthesis.config import Multistart, Problem, SynthesisConfig
+from screwkit.synthesis.loop_route import LoopSynthesisProblem
 from screwkit.synthesis.overlay import OverlayDwell
 from screwkit.synthesis.overlay_synthesis import OverlayProblem
 from screwkit.synthesis.problem import (
@@ -151,8 +152,10 @@ OVERLAY_UNKNOWNS = ({"d3", "a", "b"}, {"d2", "d3", "a", "b"})
 
 class SynthesisTable(_Strict):
     method: Literal["least_squares", "overlay"] = "least_squares"
+    solver: Literal["auto", "closed", "generic"] = "auto"
     unknowns: list[str] | None = None
     inversion: int | Literal["all"] = "all"
+    mode: int | Literal["all"] = "all"
     input_direction: Literal["ccw", "cw"] = "ccw"
     output_direction: Literal["ccw", "cw", "both"] = "ccw"
     length_scale: Value | None = None
@@ -170,6 +173,8 @@ class SynthesisTable(_Strict):
     def _check(self) -> SynthesisTable:
         if isinstance(self.inversion, int) and self.inversion not in (1, 2, 3, 4):
             raise ValueError("inversion must be 1, 2, 3, 4 or \"all\"")
+        if isinstance(self.mode, int) and not 0 <= self.mode <= 10_000:
+            raise ValueError("mode must be an assembly mode index (0, 1, …) or \"all\"")
         if self.rotation is None and self.translation is None:
             raise ValueError("give a rotation and/or a translation to generate")
         if self.method == "overlay":
@@ -204,7 +209,7 @@ class SynthesisTable(_Strict):
         return self
 
 
-def _fail(path: str, key: str, message: str) -> SynthesisConfigError:
+def key_error(path: str, key: str, message: str) -> SynthesisConfigError:
     return SynthesisConfigError(f"{path}: [synthesis.{key}] {message}")
 
 
@@ -213,7 +218,7 @@ def _kind(name: str) -> str:
 
 
 @dataclass(frozen=True)
-class _Parsed:
+class ParsedSynthesis:
     """The parts of a ``[synthesis]`` table that both routes share (SI units)."""
 
     table: SynthesisTable
@@ -224,15 +229,20 @@ class _Parsed:
     show: Callable[[float, str], str]
 
 
-def synthesis_from_spec(spec: MechanismSpec
-                        ) -> tuple[RSRCSynthesisProblem | OverlayProblem, SynthesisTable]:
-    """The problem of either route, as the ``[synthesis]`` table's ``method`` asks."""
+def synthesis_from_spec(spec: MechanismSpec) -> tuple[Problem, SynthesisTable]:
+    """The problem of the ``[synthesis]`` table's route: Bagci's closed form (least squares or
+    the overlay) for the RSRC and the 4R, the generic route for any loop (``solver``)."""
+    if synthesis_route(spec) == "generic":
+        from screwkit.io.loop_synthesis_table import loop_problem_from_spec
+
+        return loop_problem_from_spec(spec)
     if isinstance(spec.raw.synthesis, dict) and spec.raw.synthesis.get("method") == "overlay":
         return overlay_problem_from_spec(spec)
     return problem_from_spec(spec)
 
 
-def _parse(spec: MechanismSpec) -> _Parsed:
+def validated_table(spec: MechanismSpec) -> SynthesisTable:
+    """``[synthesis]`` validated by pydantic (a SynthesisConfigError lists every bad key)."""
     path = spec.path
     try:
         require(spec.linkage, "synthesize")
@@ -242,7 +252,7 @@ def _parse(spec: MechanismSpec) -> _Parsed:
     if raw is None:
         raise SynthesisConfigError(f"{path}: no [synthesis] table; see docs/synthesis.md")
     try:
-        table = SynthesisTable.model_validate(raw)
+        return SynthesisTable.model_validate(raw)
     except ValidationError as exc:
         lines = [f"{path}: the [synthesis] table is not valid:"]
         for err in exc.errors():
@@ -251,23 +261,71 @@ def _parse(spec: MechanismSpec) -> _Parsed:
                    else str(err["msg"]).removeprefix("Value error, "))
             lines.append(f"  [synthesis{'.' + loc if loc else ''}] {msg}")
         raise SynthesisConfigError("\n".join(lines)) from None
+
+
+def synthesis_route(spec: MechanismSpec) -> str:
+    """``"closed"`` (Bagci's closed form: the RSRC and its plane case the 4R) or ``"generic"``
+    (any loop), as ``solver`` asks; what the family cannot have is refused first, with why."""
+    raw = spec.raw.synthesis if isinstance(spec.raw.synthesis, dict) else {}
+    solver, method = raw.get("solver", "auto"), raw.get("method", "least_squares")
+    fam = family_of(spec.linkage)
+    closed = "closed_synthesis" in fam.capabilities
+    for key, capability, asked in (("solver", "closed_synthesis", solver == "closed"),
+                                   ("method", "overlay", method == "overlay")):
+        if asked:
+            try:
+                require(spec.linkage, capability)
+            except ValueError as exc:
+                raise key_error(spec.path, key, str(exc)) from None
+    route = "closed" if solver == "closed" or (solver != "generic" and closed) else "generic"
+    if route == "generic" and method == "overlay":
+        raise key_error(spec.path, "method", "the overlay technique (Bagci §5.4) belongs to the "
+                        "closed route; use method = \"least_squares\" with solver = \"generic\"")
+    validated_table(spec)
+    return route
+
+
+def _closed_names(spec: MechanismSpec) -> dict[str, str]:
+    """The start/unknown names of the closed route and their kinds: the RSRC's, or the 4R's own
+    (its other RSRC dimensions are held by the registry's ``closed_synthesis``)."""
+    fam = family_of(spec.linkage)
+    held = fam.closed_synthesis or {}
+    return {n: _kind(n) for n in (*DIMENSION_NAMES, "q1", "q2") if n not in held}
+
+
+def parse_synthesis(spec: MechanismSpec, names: dict[str, str] | None = None,
+           start_values: dict[str, float] | None = None) -> ParsedSynthesis:
+    """The shared part of every route. ``names``: the start/unknown names and their kinds
+    (default: the closed route's); ``start_values``: the start before ``[synthesis.start]``
+    (default: the spec's dimensions, with the dimensions the closed route holds)."""
+    path = spec.path
+    table = validated_table(spec)
+    fam = family_of(spec.linkage)
+    closed = names is None
+    names = _closed_names(spec) if names is None else names
+    held = dict(fam.closed_synthesis or {}) if closed else {}
     units = spec.units
 
     def si(value: Any, kind: str, key: str) -> float:
         try:
             return to_si(value, kind, units.get(kind))
         except UnitError as exc:
-            raise _fail(path, key, str(exc)) from None
+            raise key_error(path, key, str(exc)) from None
 
     angle_unit = si(1.0, "angle", "units")
     length_unit = si(1.0, "length", "units")
-    start: dict[str, float] = dict(spec.dimensions)
+    start: dict[str, float] = (dict(start_values) if start_values is not None
+                               else {**dict(fam.optional), **dict(spec.dimensions)})
     for name, value in table.start.items():
-        if name not in (*DIMENSION_NAMES, "q1", "q2"):
-            raise _fail(path, f"start.{name}", f"unknown name; use {list(DIMENSION_NAMES)}, q1, q2")
-        start[name] = si(value, _kind(name), f"start.{name}")
+        if name not in names:
+            why = (f" (the closed route solves a {fam.name} as Bagci's RSRC with "
+                   f"{', '.join(sorted(held))} = 0)" if name in held else "")
+            raise key_error(path, f"start.{name}", f"unknown name{why}; use "
+                        f"{', '.join(n for n in names)}")
+        start[name] = si(value, names[name], f"start.{name}")
+    start.update(held)
     if "theta01" not in start:
-        raise _fail(path, "start.theta01", "give the start (or value) of theta01, the input "
+        raise key_error(path, "start.theta01", "give the start (or value) of theta01, the input "
                     "angle at which the desired screw starts")
 
     def component(tab: ComponentTable, kind: str, key: str) -> tuple[DesiredFunction, np.ndarray]:
@@ -279,7 +337,7 @@ def _parse(spec: MechanismSpec) -> _Parsed:
                 a, b, h = (si(v, "angle", f"{key}.design_points") for v in (dp.start, dp.stop,
                                                                              dp.step))
                 if h <= 0 or b < a:
-                    raise _fail(path, f"{key}.design_points", "need step > 0 and stop >= start")
+                    raise key_error(path, f"{key}.design_points", "need step > 0 and stop >= start")
                 pts = a + h * np.arange(int(np.floor((b - a) / h + 1e-9)) + 1)
             else:
                 pts = np.array([si(v, "angle", f"{key}.design_points") for v in dp])
@@ -304,7 +362,7 @@ def _parse(spec: MechanismSpec) -> _Parsed:
         except SynthesisConfigError:
             raise  # already names its key
         except ValueError as exc:
-            raise _fail(path, key, str(exc)) from None
+            raise key_error(path, key, str(exc)) from None
         assert pts is not None
         return fn, pts
 
@@ -314,7 +372,7 @@ def _parse(spec: MechanismSpec) -> _Parsed:
         target = ScrewTarget(rot[0] if rot else None, rot[1] if rot else np.zeros(0),
                              tra[0] if tra else None, tra[1] if tra else np.zeros(0))
     except ValueError as exc:
-        raise _fail(path, "rotation", str(exc)) from None
+        raise key_error(path, "rotation", str(exc)) from None
     scale = (length_unit if table.length_scale is None
              else si(table.length_scale, "length", "length_scale"))
 
@@ -326,18 +384,36 @@ def _parse(spec: MechanismSpec) -> _Parsed:
             return f"{float(value):.6g} {si_unit}"
         return f"{float(value) / si(1.0, kind, 'units'):.6g} {unit} ({float(value):.6g} {si_unit})"
 
-    return _Parsed(table, si, start, target, scale, show)
+    return ParsedSynthesis(table, si, start, target, scale, show)
+
+
+def _check_closed_keys(spec: MechanismSpec, table: SynthesisTable) -> None:
+    """What Bagci's closed-form route cannot take from this family, refused with the key."""
+    fam = family_of(spec.linkage)
+    held = fam.closed_synthesis or {}
+    if table.mode != "all":
+        raise key_error(spec.path, "mode", "the closed route labels its assembly modes by "
+                        "Bagci's root order: use inversion = 1 … 4 (mode is the generic route's)")
+    for name in table.unknowns or []:
+        if name in held:
+            raise key_error(spec.path, "unknowns", f"{name} cannot be solved for: the closed "
+                            f"route solves a {fam.name} as Bagci's RSRC with "
+                            f"{', '.join(sorted(held))} = 0")
+    if table.translation is not None and "S" not in fam.outputs:
+        raise key_error(spec.path, "translation", f"the output of {fam.title} is a revolute "
+                        "(phi0): it generates no translation; prescribe the rotation only")
 
 
 def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, SynthesisTable]:
     """Validate ``spec.raw.synthesis`` and build the least-squares problem (SI units inside)."""
-    parsed = _parse(spec)
+    parsed = parse_synthesis(spec)
     table, si, start, target = parsed.table, parsed.si, parsed.start, parsed.target
     path = spec.path
     if table.method != "least_squares":
         raise SynthesisConfigError(f"{path}: [synthesis] method = {table.method!r}: use "
                                    "overlay_problem_from_spec (screwkit synthesize does)")
     assert table.unknowns is not None
+    _check_closed_keys(spec, table)
     construction = None
     if table.constraints is not None:
         pts_c = []
@@ -347,7 +423,7 @@ def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, Synthe
                 kind_q = pt.q
                 value = start.get(f"q{i}", 0.0)
                 if kind_q == "free" and f"q{i}" not in start:
-                    raise _fail(path, f"start.q{i}", f"q{i} is free: give its start value")
+                    raise key_error(path, f"start.q{i}", f"q{i} is free: give its start value")
             else:
                 kind_q = "fixed"
                 value = si(pt.q, "angle", f"constraints.points[{i}].q")
@@ -358,7 +434,7 @@ def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, Synthe
         try:
             construction = ConstraintConstruction(pts_c[0], pts_c[1], between)
         except ValueError as exc:
-            raise _fail(path, "constraints", str(exc)) from None
+            raise key_error(path, "constraints", str(exc)) from None
     bounds = {}
     for name, (lo, hi) in table.bounds.items():
         bounds[name] = (si(lo, _kind(name), f"bounds.{name}"), si(hi, _kind(name), f"bounds.{name}"))
@@ -366,7 +442,7 @@ def problem_from_spec(spec: MechanismSpec) -> tuple[RSRCSynthesisProblem, Synthe
         value = start.get(name, lo)
         if lo < hi and not lo <= value <= hi:
             k = _kind(name)
-            raise _fail(path, f"bounds.{name}", f"the start of {name}, {parsed.show(value, k)}, is "
+            raise key_error(path, f"bounds.{name}", f"the start of {name}, {parsed.show(value, k)}, is "
                         f"outside its bounds [{parsed.show(lo, k)}, {parsed.show(hi, k)}]: move "
                         "the start ([dimensions] or [synthesis.start]) inside them or widen the "
                         "bounds")
@@ -388,19 +464,21 @@ def overlay_problem_from_spec(spec: MechanismSpec) -> tuple[OverlayProblem, Synt
     """Validate a ``[synthesis]`` table with ``method = "overlay"`` and build the overlay problem
     (Bagci 1969, §5.4).  d1, d2, lambda0, delta0 (must be 0) and e come from ``[dimensions]`` /
     ``[synthesis.start]``, theta01 from ``[synthesis.start]``; d3, a, b are found."""
-    parsed = _parse(spec)
+    parsed = parse_synthesis(spec)
     table, si, start = parsed.table, parsed.si, parsed.start
     path = spec.path
+    if table.mode != "all":
+        raise key_error(path, "mode", "the overlay finds the assembly mode itself; remove mode")
     if table.method != "overlay":
         raise SynthesisConfigError(f"{path}: [synthesis] method is {table.method!r}, not "
                                    "\"overlay\"")
     if abs(math.sin(start.get("delta0", 0.0))) > 1e-12:
-        raise _fail(path, "start.delta0", "the overlay technique needs delta0 = 0 (the coupler "
+        raise key_error(path, "start.delta0", "the overlay technique needs delta0 = 0 (the coupler "
                     "ellipse is then a circle of radius d2, Bagci §5.4); use method = "
                     "\"least_squares\" for delta0 != 0")
     for name in ("d1", "d2", "lambda0"):
         if name not in start:
-            raise _fail(path, f"start.{name}", f"the overlay needs {name} (in [dimensions] or "
+            raise key_error(path, f"start.{name}", f"the overlay needs {name} (in [dimensions] or "
                         "[synthesis.start])")
     ov = table.overlay if table.overlay is not None else OverlayTable.model_validate({})
     dwells = tuple(OverlayDwell(si(d.theta, "angle", f"overlay.dwells[{i}].theta"), d.tangency)
@@ -409,7 +487,7 @@ def overlay_problem_from_spec(spec: MechanismSpec) -> tuple[OverlayProblem, Synt
     if ov.d3_range is not None:
         lo, hi = (si(v, "length", "overlay.d3_range") for v in ov.d3_range)
         if not 0 < lo < hi:
-            raise _fail(path, "overlay.d3_range", "need 0 < lower < upper, got "
+            raise key_error(path, "overlay.d3_range", "need 0 < lower < upper, got "
                         f"[{parsed.show(lo, 'length')}, {parsed.show(hi, 'length')}]")
         d3_range = (lo, hi)
     senses = {"ccw": (1,), "cw": (-1,), "both": (1, -1)}[table.output_direction]
@@ -434,4 +512,14 @@ def synthesis_config(spec: MechanismSpec) -> SynthesisConfig:
     multistart = None if ms is None else Multistart(ms.starts, ms.seed, ms.keep, ms.spread)
     unit = spec.units.get("length", "m")
     length_unit = f"1 {unit}" if table.length_scale is None else str(table.length_scale)
-    return SynthesisConfig(problem, multistart, length_unit)
+    fam = family_of(spec.linkage)
+    if isinstance(problem, LoopSynthesisProblem):
+        return SynthesisConfig(
+            problem, multistart, length_unit, (*problem.kinds, "theta01"),
+            frozenset({n for n, k in problem.kinds.items() if k == "angle"} | {"theta01"}),
+            (problem.rotation_output, problem.translation_output))
+    names = _closed_names(spec)
+    reported = None if not fam.closed_synthesis else tuple(names)
+    angles = frozenset(n for n, k in names.items() if k == "angle")
+    return SynthesisConfig(problem, multistart, length_unit, reported, angles,
+                           ("phi0", "S" if "S" in fam.outputs else None))

@@ -78,18 +78,33 @@ def synthesis_table(doc: dict[str, Any]) -> ResultTable:
 
 
 def limits_table(doc: dict[str, Any]) -> ResultTable:
-    """The limit positions of a ``screwkit limits`` document, one row each (SI)."""
+    """The limit positions of a ``screwkit limits`` document, one row each (SI): the output, its
+    kind, the mode (generic route) or branch (closed route; -1 where not given), the input, the
+    value (``value`` for a rotation, ``value_length`` for a translation), the second derivative,
+    the dwell order (-1: not computed, a closed-form translation limit) and the seed's variables
+    there (RSRC θ0, φ0, χ0, S) when every limit has them."""
+    from screwkit.kinematics.motion_table import variable_kind
+
     lims = doc["limits"]
 
-    def col(key: str) -> np.ndarray:
-        return np.array([np.nan if r.get(key) is None else r[key] for r in lims], dtype=float)
+    def col(key: str, keep: Any = None) -> np.ndarray:
+        return np.array([np.nan if r.get(key) is None or (keep and not keep(r)) else r[key]
+                         for r in lims], dtype=float)
 
-    order = np.array([-1 if r.get("dwell_order") is None else r["dwell_order"] for r in lims],
-                     dtype=np.int64)
-    cols = [Column("kind", "text", np.array([r["kind"] for r in lims], dtype=str)),
-            Column("branch", "index", np.array([r["branch"] for r in lims], dtype=np.int64)),
-            Column("theta0", "angle", col("theta0")), Column("phi0", "angle", col("phi0")),
-            Column("chi0", "angle", col("chi0")), Column("S", "length", col("S")),
+    def index(key: str) -> np.ndarray:
+        return np.array([-1 if r.get(key) is None else r[key] for r in lims], dtype=np.int64)
+
+    def rotation(r: dict[str, Any]) -> bool:
+        return bool(r["kind"] == "rotation")
+
+    cols = [Column("output", "text", np.array([r["output"] for r in lims], dtype=str)),
+            Column("kind", "text", np.array([r["kind"] for r in lims], dtype=str)),
+            Column("mode", "index", index("mode")), Column("branch", "index", index("branch")),
+            Column("input", variable_kind(doc.get("input_name", "theta0")), col("input")),
+            Column("value", "angle", col("value", rotation)),
+            Column("value_length", "length", col("value", lambda r: not rotation(r))),
             Column("second_derivative", "ratio", col("second_derivative")),
-            Column("dwell_order", "index", order)]
-    return ResultTable(tuple(cols), "limit positions (dwell_order -1: a translation limit)")
+            Column("dwell_order", "index", index("dwell_order"))]
+    cols += [Column(n, variable_kind(n), col(n)) for n in ("theta0", "phi0", "chi0", "S")
+             if lims and all(n in r for r in lims)]
+    return ResultTable(tuple(cols), "limit positions (dwell_order -1: not computed)")

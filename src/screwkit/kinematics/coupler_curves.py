@@ -1,15 +1,75 @@
-"""Coupler points and their curves: the world path of a point fixed to any moving link
-(Bagci 1969 App. C for the RSRC's coupler: P = O1 + f·B e1 + g·B e2 + h·B e3, with B the coupler
-frame at the sphere centre; here for any link of any loop from its body frame)."""
+"""Coupler points and their curves: the world path of a point fixed to any moving link of any
+loop (Bagci 1969 App. C for the RSRC's coupler: P = O1 + f·B e1 + g·B e2 + h·B e3, with B the
+coupler frame at the sphere centre — the RSRC coupler's body frame is exactly that frame).
+
+Link k (``linkage.links[k]``) lies between joints k and k+1; its body frame is joint k's frame
+after the joint motion (docs/kinematics.md, "Link frames", gives every family's). A point on a
+link between two ball joints must lie on the line of the two ball centres: such a link turns
+freely about that line (an idle freedom no joint drives), so a point off the line has no defined
+path.
+"""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from screwkit.errors import InputError
 from screwkit.kinematics.loop import Array
-from screwkit.kinematics.motion import ModeMotion
+from screwkit.kinematics.motion import ModeMotion, Motion
+from screwkit.kinematics.registry import coupler_link_index
+from screwkit.model.linkage import Linkage
+
+__all__ = ["CouplerPoint", "coupler_curves", "coupler_point", "coupler_point_path"]
+
+
+@dataclass(frozen=True)
+class CouplerPoint:
+    """A point fixed to moving link ``link`` (an index into ``linkage.links``, whose name is
+    ``link_name``), at ``point`` (m) in that link's body frame."""
+
+    name: str
+    link: int
+    link_name: str
+    point: tuple[float, float, float]
+
+
+def idle_axis(linkage: Linkage, link: int) -> Array | None:
+    """The direction, in link ``link``'s body frame, of the line of the two ball centres when the
+    link lies between two spherical joints (it spins idly about that line); else None."""
+    joints = linkage.joints
+    if not (joints[link].kind == "S" and joints[link + 1].kind == "S"):
+        return None
+    t = linkage.link_transforms[link]
+    centre = t.translation + t.real @ np.array([0.0, 0.0, joints[link + 1].offset])
+    return np.asarray(centre / np.linalg.norm(centre))
+
+
+def coupler_point(linkage: Linkage, point: ArrayLike, link: str | None = None,
+                  name: str = "coupler point") -> CouplerPoint:
+    """A coupler point of ``linkage``: ``point`` (3 coordinates, m) in the body frame of the
+    moving link called ``link`` (default: the family's coupler,
+    :func:`~screwkit.kinematics.registry.coupler_link_index`). A ValueError says why a point
+    has no defined path (module docstring)."""
+    p = np.asarray(point, dtype=float)
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
+    k = coupler_link_index(linkage, link)
+    axis = idle_axis(linkage, k)
+    if axis is not None:
+        off = float(np.linalg.norm(np.cross(p, axis)))
+        if off > 1e-9 * linkage.length_scale:
+            j1, j2 = linkage.joints[k].name, linkage.joints[k + 1].name
+            along = float(p @ axis)
+            raise InputError(
+                f"{linkage.name}: the {linkage.links[k].name} lies between the ball joints {j1} "
+                f"and {j2}, so it turns freely about the line of their centres and only points on "
+                f"that line have a defined path; this point is {off:.6g} m off it (the nearest "
+                f"point on it is {along:.6g} m along the line from {j1}, direction "
+                f"{np.round(axis, 9).tolist()} in the link frame)")
+    return CouplerPoint(name, k, linkage.links[k].name, (float(p[0]), float(p[1]), float(p[2])))
 
 
 def coupler_point_path(mode: ModeMotion, point: ArrayLike, link: int = 1) -> Array:
@@ -24,3 +84,10 @@ def coupler_point_path(mode: ModeMotion, point: ArrayLike, link: int = 1) -> Arr
         raise InputError(f"link index {link} out of range: the loop has {n_links} moving links")
     R = mode.link_rotation[:, link]
     return np.asarray(mode.link_origin[:, link] + np.einsum("nij,j->ni", R, p))
+
+
+def coupler_curves(motion: Motion, points: list[CouplerPoint]) -> list[dict[str, Array]]:
+    """Per mode of ``motion``, the (N, 3) world path of every coupler point, by name: the
+    coupler curves in 3-D (NaN where the mode does not assemble)."""
+    return [{cp.name: coupler_point_path(md, cp.point, cp.link) for cp in points}
+            for md in motion.modes]

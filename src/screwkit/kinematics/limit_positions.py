@@ -1,130 +1,108 @@
-"""Limit positions of the output and the order of the instantaneous dwell at each (Bagci 1969,
-App. D), for the families that offer them (the registry's ``limits`` capability: the RSRC and
-the planar 4R)."""
+"""Limit positions of a loop's output variables and the order of the instantaneous dwell at
+each: Bagci 1969 App. D's closed form for the RSRC and the planar 4R (their φ0 and S over a full
+input turn), and the generic route for any output of any loop
+(:mod:`screwkit.kinematics.generic_limits`; docs/kinematics.md)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
 from screwkit.errors import InputError
-from screwkit.kinematics.motion import AssemblyError
-from screwkit.kinematics.registry import require
+from screwkit.kinematics.generic_limits import generic_limit_positions
+from screwkit.kinematics.limit_results import DwellAt, LimitPosition, LimitPositions
+from screwkit.kinematics.motion import Motion
+from screwkit.kinematics.registry import default_outputs, family_of, output_freedom, require
 from screwkit.model.linkage import Linkage
 
+__all__ = ["DwellAt", "LimitPosition", "LimitPositions", "LimitsConfig", "check_limits_config",
+           "limit_positions", "uses_closed_form"]
 
-@dataclass(frozen=True)
-class LimitPosition:
-    """A rotation (``kind="rotation"``: dφ0/dθ0 = 0, eq. D.1) or translation (``"translation"``:
-    dS/dθ0 = 0, corrected eq. D.3) limit of the output on one closed-form branch, with the dwell
-    order (rotation limits only): the number of vanishing consecutive derivatives dᵏφ0/dθ0ᵏ."""
-
-    kind: str
-    theta0: float
-    phi0: float
-    chi0: float
-    S: float | None
-    second_derivative: float
-    branch: int
-    dwell_order: int | None = None
-    derivatives: list[float] | None = None
+METHODS = ("auto", "closed", "generic")
 
 
 @dataclass(frozen=True)
-class DwellAt:
-    """The dwell order of the output rotation at a given input angle and inversion label."""
+class LimitsConfig:
+    """What a spec's ``[limits]`` table asks for (SI units; docs/spec-format.md): the output
+    (None: the loop's outputs), the dwell tolerance, the highest derivative counted, inputs where
+    the dwell order is wanted, and the route."""
 
-    theta0: float
-    inversion_label: int
-    phi0: float
-    dwell_order: int
-    derivatives: list[float]
-
-
-@dataclass(frozen=True)
-class LimitPositions:
-    """Result of :func:`limit_positions` (SI units, radians)."""
-
-    mechanism: str
-    family: str
-    dwell_tolerance: float
-    limits: list[LimitPosition]
-    dwells_at: list[DwellAt] = field(default_factory=list)
-
-    def as_dict(self) -> dict[str, Any]:
-        """The JSON document of ``screwkit limits`` (docs/cli.md)."""
-        def limit(lim: LimitPosition) -> dict[str, Any]:
-            d = {k: getattr(lim, k) for k in ("kind", "theta0", "phi0", "chi0", "S",
-                                              "second_derivative", "branch")}
-            if lim.kind == "rotation":
-                d["dwell_order"] = lim.dwell_order
-                d["derivatives"] = lim.derivatives
-            return d
-
-        return {"mechanism": self.mechanism, "family": self.family,
-                "dwell_tolerance": self.dwell_tolerance, "units": {"angle": "rad", "length": "m"},
-                "limits": [limit(x) for x in self.limits],
-                "dwells_at": [vars(d) for d in self.dwells_at]}
+    output: str | None = None
+    dwell_tolerance: float = 1e-6
+    max_order: int = 5
+    at: tuple[float, ...] = ()
+    method: str = "auto"
 
 
-def limit_positions(linkage: Linkage, dwell_tolerance: float = 1e-6, max_order: int = 5,
-                    at: list[float] | None = None) -> LimitPositions:
-    """Limit positions of the output rotation and translation over a full input turn, each with
-    the order of its instantaneous dwell (Bagci 1969, App. D: rotation limits Q4 = 0, eq. D.1;
-    translation limits by the corrected eq. D.3; dwell order = number of vanishing consecutive
-    derivatives dᵏφ0/dθ0ᵏ, k = 1…max_order, within ``dwell_tolerance`` rad/radᵏ). ``at``: input
-    angles (rad) where the dwell order of every inversion is wanted too."""
-    from screwkit.kinematics.assembly_range import assembling_intervals, describe_intervals
-    from screwkit.kinematics.closed_form_motion import rsrc_dimensions
-    from screwkit.kinematics.rsrc import (
-        rsrc_dwell_order,
-        rsrc_positions,
-        rsrc_rotation_limits,
-        rsrc_translation_limits,
-    )
+def check_limits_config(linkage: Linkage, config: LimitsConfig) -> None:
+    """A ValueError naming what ``config`` asks that the loop cannot give."""
+    require(linkage, "limits")
+    if not 1 <= int(config.max_order) <= 10:
+        raise InputError(f"max_order must be 1 … 10; got {config.max_order}")
+    if not config.dwell_tolerance > 0:
+        raise InputError(f"dwell_tolerance must be positive; got {config.dwell_tolerance}")
+    if config.method not in METHODS:
+        raise InputError(f"method must be 'auto', 'closed' or 'generic'; got {config.method!r}")
+    outputs = (config.output,) if config.output is not None else default_outputs(linkage)
+    for name in outputs:
+        output_freedom(linkage, name)
+    if config.method == "closed" and not uses_closed_form(linkage, config.output, "closed"):
+        fam = family_of(linkage)
+        raise InputError(f"no closed-form limits of {', '.join(outputs)} for a {fam.name} "
+                         "(Bagci's App. D covers the RSRC's φ0 and S and the 4R's φ0); use "
+                         "method = \"generic\" or \"auto\"")
 
-    fam = require(linkage, "limits")
-    if not dwell_tolerance > 0:
-        raise InputError(f"the dwell tolerance must be positive; got {dwell_tolerance}")
-    dims, planar = rsrc_dimensions(linkage)
-    out: list[LimitPosition] = []
-    rot = rsrc_rotation_limits(dims)
-    runs = assembling_intervals(dims)
-    if not runs and not rot:
-        raise AssemblyError(f"{linkage.name}: the mechanism does not assemble at any input angle "
-                            "(scanned every 0.25° over a full turn), so it has no limit positions; "
-                            "check the dimensions (docs/kinematics.md)")
-    if rot:
-        order, deriv = rsrc_dwell_order(dims, np.array([r.theta0 for r in rot]),
-                                        np.array([r.phi0 for r in rot]), tol=dwell_tolerance,
-                                        max_order=max_order)
-    for k, r in enumerate(rot):
-        out.append(LimitPosition("rotation", r.theta0, r.phi0, r.chi0, None if planar else r.S,
-                                 r.second_derivative, r.branch, int(order[k]),
-                                 np.asarray(deriv[k]).tolist()))
-    if not planar:
-        for r in rsrc_translation_limits(dims):
-            out.append(LimitPosition("translation", r.theta0, r.phi0, r.chi0, r.S,
-                                     r.second_derivative, r.branch))
-    dwells: list[DwellAt] = []
-    if at:
-        th = np.asarray(at, dtype=float)
-        pos = rsrc_positions(dims, th)
-        nowhere = ~np.asarray(pos.assembles).any(axis=1)
-        if nowhere.any():
-            shown = ", ".join(f"{np.degrees(t):.6g}°" for t in th[nowhere][:8])
-            raise AssemblyError(f"{linkage.name}: the mechanism does not assemble at the input "
-                                f"angle(s) {shown} asked for; it assembles "
-                                f"{describe_intervals(runs)} (sampled every 0.25°)")
-        for j in range(pos.phi0.shape[1]):
-            ok = pos.assembles[:, j]
-            if not ok.any():
-                continue
-            order_at, deriv_at = rsrc_dwell_order(dims, th[ok], pos.phi0[ok, j],
-                                                  tol=dwell_tolerance, max_order=max_order)
-            for t, ph, o, dv in zip(th[ok], pos.phi0[ok, j], order_at, deriv_at, strict=True):
-                dwells.append(DwellAt(float(t), j + 1, float(ph), int(o),
-                                      np.asarray(dv).tolist()))
-    return LimitPositions(linkage.name, fam.name, dwell_tolerance, out, dwells)
+
+def uses_closed_form(linkage: Linkage, output: str | None, method: str) -> bool:
+    """Whether :func:`limit_positions` takes Bagci's closed-form route for these arguments."""
+    fam = family_of(linkage)
+    outputs = (output,) if output is not None else fam.outputs
+    return (method != "generic" and fam.closed_limits is not None and bool(outputs)
+            and set(outputs) <= set(fam.outputs))
+
+
+def limit_positions(source: Linkage | Motion, dwell_tolerance: float = 1e-6, max_order: int = 5,
+                    at: list[float] | None = None, *, output: str | None = None,
+                    method: str = "auto") -> LimitPositions:
+    """Limit positions of a loop's outputs (d output/d input = 0) with the order of the
+    instantaneous dwell at each: the number of vanishing consecutive derivatives
+    dᵏ output/d inputᵏ, k = 1 … ``max_order``, within ``dwell_tolerance`` (output unit per
+    input unitᵏ).
+
+    ``source``: a solved :class:`Motion` (the generic route searches its sweep and modes) or a
+    :class:`Linkage` (a full input turn in 1° steps is solved for the generic route).
+    ``output``: one variable (a scalar joint freedom or a seed name such as ``phi0``); default
+    the loop's outputs (:func:`~screwkit.kinematics.registry.default_outputs`). ``method``:
+    ``"closed"`` Bagci 1969 App. D (RSRC and 4R, their φ0 and S, rotation limits Q4 = 0 eq. D.1,
+    translation limits by the corrected eq. D.3, over a full input turn), ``"generic"`` the
+    generic route (any loop), ``"auto"`` the closed form where it answers the outputs asked for.
+    ``at``: inputs (rad or m) where the dwell order of every mode is wanted too."""
+    linkage = source.linkage if isinstance(source, Motion) else source
+    check_limits_config(linkage, LimitsConfig(output, dwell_tolerance, max_order,
+                                              tuple(at or ()), method))
+    fam = family_of(linkage)
+    outputs = (output,) if output is not None else default_outputs(linkage)
+    if uses_closed_form(linkage, output, method):
+        assert fam.closed_limits is not None
+        result: LimitPositions = fam.closed_limits(linkage, dwell_tolerance, max_order, at)
+        if output is None:
+            return result
+        keep = [lim for lim in result.limits if lim.output == output]
+        dwells = [d for d in result.dwells_at if d.output == output]
+        return LimitPositions(result.mechanism, result.family, result.method, result.input_name,
+                              (output,), dwell_tolerance, max_order, keep, dwells,
+                              result.derivatives, result.notes)
+    if isinstance(source, Motion):
+        motion = source
+    else:
+        from screwkit.kinematics.solve_motion import solve_motion
+
+        motion = solve_motion(linkage, np.radians(np.arange(0.0, 360.0, 1.0)) if not
+                              linkage.inputs[0].endswith(".s") else _translation_sweep(linkage))
+    return generic_limit_positions(motion, outputs, dwell_tolerance, int(max_order), at)
+
+
+def _translation_sweep(linkage: Linkage) -> np.ndarray:
+    L = linkage.length_scale
+    return np.linspace(-L, L, 401)

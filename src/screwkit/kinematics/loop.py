@@ -57,9 +57,25 @@ class Layout:
     is_translation: tuple[bool, ...]  # P/C s freedoms carry length units
     n_scalar: int
     n_spherical: int
-    link_rotations: Array = field(default_factory=lambda: np.zeros((0, 3, 3)))
-    link_translations: Array = field(default_factory=lambda: np.zeros((0, 3)))
-    length_scale: float = 1.0
+    #: the linkage the constants below were read from (a layout fits every loop with the same
+    #: joints, but its constants only this one: see :func:`constants`)
+    source: Linkage | None = field(default=None, compare=False, repr=False)
+    link_rotations: Array = field(default_factory=lambda: np.zeros((0, 3, 3)), compare=False,
+                                  repr=False)
+    link_translations: Array = field(default_factory=lambda: np.zeros((0, 3)), compare=False,
+                                     repr=False)
+    link_scale: float = field(default=1.0, compare=False, repr=False)
+
+
+def constants(linkage: Linkage, lay: Layout) -> tuple[Array, Array, float]:
+    """The link rotations (n, 3, 3), translations (n, 3) and length scale of ``linkage``: from
+    the layout when it was made for this very linkage (the hot paths), else read anew (a layout
+    reused for another loop with the same joints, e.g. a synthesis trial's dimensions)."""
+    if lay.source is linkage:
+        return lay.link_rotations, lay.link_translations, lay.link_scale
+    return (np.stack([np.asarray(t.real, dtype=float) for t in linkage.link_transforms]),
+            np.stack([np.asarray(t.translation, dtype=float) for t in linkage.link_transforms]),
+            linkage.length_scale)
 
 
 def layout(linkage: Linkage) -> Layout:
@@ -85,7 +101,7 @@ def layout(linkage: Linkage) -> Layout:
     translations = np.stack([np.asarray(t.translation, dtype=float)
                              for t in linkage.link_transforms])
     return Layout(tuple(names), tuple(joint_of), tuple(scalar_col), sph, tuple(is_tr), col, len(sph),
-                  rotations, translations, linkage.length_scale)
+                  linkage, rotations, translations, linkage.length_scale)
 
 
 @dataclass(frozen=True)
@@ -142,6 +158,7 @@ def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
     ``frames=False`` only the closure and the screws are filled (a Newton step's needs; the
     frame arrays are then left unset)."""
     lay = lay or layout(linkage)
+    link_R, link_p, _ = constants(linkage, lay)
     N = conf.size
     n = len(linkage.joints)
     R = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
@@ -201,8 +218,8 @@ def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
             aR[:, i] = R
             ap[:, i] = p
         # then the constant link transform: T <- T · L
-        p = p + R @ lay.link_translations[i]
-        R = R @ lay.link_rotations[i]
+        p = p + R @ link_p[i]
+        R = R @ link_R[i]
     return LoopFrames(bR, bp, aR, ap, R, p, screws, centres, axes)
 
 

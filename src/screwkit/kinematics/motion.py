@@ -126,12 +126,15 @@ class Motion:
                                    f"the variables are {sorted(table)}")
         return table[name]
 
-    def table(self, coupler_point: Any = None, coupler_link: int = 1) -> ResultTable:
+    def table(self, coupler_point: Any = None, coupler_link: int = 1, *,
+              coupler_points: Any = (), transmission: Any = None) -> ResultTable:
         """One row per input sample and mode, one column per variable, rate and acceleration
-        (SI; :mod:`screwkit.kinematics.motion_table`)."""
+        (SI; :mod:`screwkit.kinematics.motion_table`), with the coupler points' paths and the
+        transmission quality when given."""
         from screwkit.kinematics.motion_table import motion_table
 
-        return motion_table(self, coupler_point, coupler_link)
+        return motion_table(self, coupler_point, coupler_link, coupler_points=coupler_points,
+                            transmission=transmission)
 
     def to_dataframe(self, units: UnitChoice | None = None) -> Any:
         """:meth:`table` as a pandas DataFrame, headers with units (``phi0 [rad]``; pass

@@ -6,8 +6,10 @@ Columns: ``mode``, ``input`` (the sweep value), ``assembles``, ``singular``; the
 variable with its rate and acceleration — ``phi0``, ``phi0_dot``, ``phi0_ddot`` — the seed's
 names first, then every joint freedom (``B.theta``, ``B.theta_dot`` …; a spherical joint's
 rotation vector ``B.rx`` and its angular velocity ``B.wx`` with ``B.wx_dot``); then
-``closure_residual`` and, when asked, the coupler point ``coupler_x|y|z``. Values are SI and
-radians, NaN where the mode does not assemble (rates and accelerations also where it is
+``closure_residual`` and, when asked, the world path of each coupler point (``coupler_x|y|z``
+for one called "coupler point", ``<name>_x|y|z`` for others) and the transmission quality
+(``transmission_index_<output>``, ``transmission_angle``, ``cone_angle_<ball joint>``). Values are
+SI and radians, NaN where the mode does not assemble (rates and accelerations also where it is
 singular), as in the JSON document.
 """
 
@@ -22,7 +24,9 @@ import numpy as np
 from screwkit.tables import Column, ResultTable, stack_tables
 
 if TYPE_CHECKING:
+    from screwkit.kinematics.coupler_curves import CouplerPoint
     from screwkit.kinematics.motion import ModeMotion, Motion
+    from screwkit.kinematics.transmission import Transmission
 
 _TRANSLATION_SEED = re.compile(r"[sS]\d*")
 
@@ -69,20 +73,36 @@ def mode_columns(md: ModeMotion, inputs: np.ndarray, input_kind: str) -> list[Co
     return cols
 
 
+def column_prefix(point_name: str) -> str:
+    """The column prefix of a coupler point's path: ``coupler`` for the one called "coupler
+    point" (the ``[coupler_point]`` table), else its name with other characters as ``_``."""
+    return "coupler" if point_name == "coupler point" else re.sub(r"\W", "_", point_name)
+
+
 def motion_table(motion: Motion, coupler_point: Sequence[float] | None = None,
-                 coupler_link: int = 1) -> ResultTable:
+                 coupler_link: int = 1, *, coupler_points: Sequence[CouplerPoint] = (),
+                 transmission: Transmission | None = None) -> ResultTable:
     """Every mode of ``motion`` one under the other (module docstring); ``coupler_point``
-    (f, g, h) in the body frame of moving link ``coupler_link`` adds its world path."""
+    (f, g, h) in the body frame of moving link ``coupler_link`` adds its world path, as does
+    each of ``coupler_points``; ``transmission`` adds the transmission quality."""
+    from screwkit.kinematics.coupler_curves import coupler_point_path
+
     input_kind = variable_kind(motion.input_names[0])
     x = motion.input_values
+    points = [("coupler", coupler_link, coupler_point)] if coupler_point is not None else []
+    points += [(column_prefix(cp.name), cp.link, cp.point) for cp in coupler_points]
     tables = []
-    for md in motion.modes:
+    for k, md in enumerate(motion.modes):
         cols = mode_columns(md, x, input_kind)
-        if coupler_point is not None:
-            from screwkit.kinematics.coupler_curves import coupler_point_path
-
-            p = coupler_point_path(md, coupler_point, coupler_link)
-            cols += [Column(f"coupler_{a}", "length", p[:, k]) for k, a in enumerate("xyz")]
+        for prefix, link, point in points:
+            p = coupler_point_path(md, point, link)
+            cols += [Column(f"{prefix}_{a}", "length", p[:, j]) for j, a in enumerate("xyz")]
+        if transmission is not None:
+            mt = transmission.modes[k]
+            cols += [Column(f"transmission_index_{n}", "ratio", v) for n, v in mt.index.items()]
+            if mt.angle is not None:
+                cols.append(Column("transmission_angle", "angle", mt.angle))
+            cols += [Column(f"cone_angle_{j}", "angle", v) for j, v in mt.cone_angle.items()]
         tables.append(ResultTable(tuple(cols)))
     title = f"{motion.linkage.name}: {motion.method} analysis, one row per input and mode"
     return stack_tables(tables, title)

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.loop import Array, Layout, LoopFrames, lie_bracket
+from screwkit.kinematics.loop import Array, Layout, LoopFrames, constants, lie_bracket
 from screwkit.model.linkage import Linkage
 
 #: relative singular value of the scaled passive Jacobian below which a sample is singular.
@@ -130,7 +130,7 @@ def rate_equations(linkage: Linkage, lay: Layout, fr: LoopFrames,
     """The scaled rate equations at every sample of ``fr`` (samples outside ``mask`` are
     treated as singular and give NaN)."""
     N, _, m = fr.screws.shape
-    L = lay.length_scale
+    L = constants(linkage, lay)[2]
     names = list(lay.names)
     in_idx = [names.index(n) for n in linkage.inputs]
     p_idx = [k for k in range(m) if k not in in_idx]

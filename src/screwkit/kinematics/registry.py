@@ -16,17 +16,21 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
-from screwkit.errors import CapabilityError, InputError
+from screwkit.errors import CapabilityError, InputError, UnknownNameError
 from screwkit.kinematics import seed_names
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.model import families as constructors
+from screwkit.model import geometry as geometries
+from screwkit.model.geometry import LoopGeometry
 from screwkit.model.linkage import Linkage
 
 Named = dict[str, Array]
 ClosedForm = Callable[[Linkage, Array, Array, Array], Motion]
 SeedNames = Callable[[Linkage, ModeMotion], tuple[Named, Named, Named]]
+ClosedLimits = Callable[..., Any]  # (linkage, dwell_tolerance, max_order, at) -> LimitPositions
 
 #: capabilities a family can have, as (what, where it comes from); `require` names a missing
 #: one in a sentence: "<what> are computed for <families> (<source>); this is a <family>"
@@ -35,11 +39,20 @@ CAPABILITIES = {
     "mobility": ("mobilities by formula and from the loop Jacobian", "Bagci App. B"),
     "dynamics": ("inverse dynamics", "docs/dynamics.md"),
     "balance": ("optimum balances", "Rahman ch. 4"),
-    "limits": ("limit positions and dwells", "Bagci App. D"),
-    "coupler_point": ("coupler points", "Bagci App. C"),
-    "synthesize": ("dimensional syntheses", "Bagci ch. IV-V"),
+    "limits": ("limit positions and dwells", "Bagci App. D; docs/kinematics.md"),
+    "coupler_point": ("coupler points", "Bagci App. C; docs/kinematics.md"),
+    "transmission": ("transmission angles and indices", "docs/kinematics.md"),
+    "synthesize": ("dimensional syntheses", "Bagci ch. IV-V; docs/synthesis.md"),
+    "closed_synthesis": ("closed-form syntheses (Programs B and C, the overlay)",
+                         "Bagci ch. V"),
+    "overlay": ("overlay syntheses", "Bagci §5.4"),
 }
-_EVERY_LOOP = frozenset({"analyze", "mobility", "dynamics", "balance"})
+_NOT_CLOSED = ("it has no closed-form synthesis; it is synthesised by the generic route "
+               "(solver = \"generic\" or \"auto\", docs/synthesis.md)")
+_NOT_OVERLAY = ("the overlay draws Bagci's RSRC coupler circles about its input-crank ellipse, "
+                "which this loop does not have; use method = \"least_squares\"")
+_EVERY_LOOP = frozenset({"analyze", "mobility", "dynamics", "balance", "limits",
+                         "coupler_point", "transmission", "synthesize"})
 
 
 @dataclass(frozen=True)
@@ -60,6 +73,22 @@ class Family:
     aliases: tuple[str, ...] = ()
     sketch: str = ""
     why_not: Mapping[str, str] = field(default_factory=dict)  # capability -> reason it is missing
+    #: the seed's names that are a joint freedom times a sign (their derivatives are the
+    #: freedom's): name -> (freedom, sign), e.g. the RSRC's phi0 = -output_C.theta
+    seed_freedoms: Mapping[str, tuple[str, float]] = field(default_factory=dict)
+    #: the output variables (limits, transmission and synthesis default to them); empty for a
+    #: joint list, whose output is the freedoms of the ground joint that is not the input
+    outputs: tuple[str, ...] = ()
+    #: the moving link a coupler point is on by default (its body frame: docs/kinematics.md)
+    coupler_link: str | None = None
+    #: Bagci's App. D closed form of the limits of ``outputs`` (None: the generic route)
+    closed_limits: ClosedLimits | None = None
+    #: the loop's constant geometry from its dimensions, complex-safe (model/geometry.py): the
+    #: generic synthesis route differentiates the loop closure through it
+    geometry: Callable[..., LoopGeometry] | None = None
+    #: Bagci's closed-form synthesis (Programs B/C, the overlay) as the RSRC with these
+    #: dimensions held (the 4R: b = e = δ0 = λ0 = 0); None: the generic route only
+    closed_synthesis: Mapping[str, float] | None = None
 
     def closed_form_for(self, linkage: Linkage) -> ClosedForm | None:
         """The closed form that solves ``linkage``, or None (then the generic solver does)."""
@@ -107,6 +136,13 @@ def _is_rccc(linkage: Linkage) -> bool:
     return rccc_applies(linkage)
 
 
+def _rsrc_limits(linkage: Linkage, dwell_tolerance: float, max_order: int,
+                 at: list[float] | None) -> Any:
+    from screwkit.kinematics.closed_limits import rsrc_limit_positions
+
+    return rsrc_limit_positions(linkage, dwell_tolerance, max_order, at)
+
+
 def _cssp(a1: float, a2: float, a4: float, alpha4: float, s1: float = 0.0) -> Linkage:
     return constructors.cssp(a1, a2, a4, alpha4, s1)
 
@@ -125,32 +161,46 @@ FAMILIES: dict[str, Family] = {
             {"d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH, "a": _LENGTH, "b": _LENGTH,
              "e": _LENGTH, "delta0": _ANGLE, "lambda0": _ANGLE},
             build=constructors.rsrc, closed_form=_rsrc_closed, seed_names=seed_names.rsrc_names,
-            capabilities=_EVERY_LOOP | {"limits", "coupler_point", "synthesize"},
-            aliases=("rsrc",), sketch=constructors.RSRC_SKETCH),
+            aliases=("rsrc",), sketch=constructors.RSRC_SKETCH,
+            capabilities=_EVERY_LOOP | {"closed_synthesis", "overlay"},
+            seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output_C.theta", -1.0),
+                           "S": ("output_C.s", 1.0), "chi0": ("coupler_R.theta", 1.0)},
+            outputs=("phi0", "S"), coupler_link="coupler", closed_limits=_rsrc_limits,
+            geometry=geometries.rsrc_geometry, closed_synthesis={}),
         Family(
             "4R", "the planar 4R", "planar four-bar (Bagci's special case of the RSRC)",
             {"a": _LENGTH, "d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH},
             build=constructors.fourbar, closed_form=_rsrc_closed,
-            seed_names=seed_names.fourbar_names, capabilities=_EVERY_LOOP | {"limits"},
+            seed_names=seed_names.fourbar_names,
             aliases=("4r", "fourbar"), sketch=constructors.FOURBAR_SKETCH,
-            why_not={"synthesize": "restate the 4R as an RSRC with delta0 = lambda0 = b = e = 0 "
-                                   "(Bagci's plane case), as the bundled Example 3 does",
-                     "coupler_point": "coupler points are defined with Bagci's RSRC frames "
-                                      "(App. C)"}),
+            capabilities=_EVERY_LOOP | {"closed_synthesis"},
+            why_not={"overlay": "it turns the plane mechanism to put the output pivot on the "
+                                "line of centres (Program C L6248-L6262), which the 4R's own "
+                                "parameters do not carry; state it as an RSRC with lambda0 = "
+                                "delta0 = b = e = 0, or use method = \"least_squares\""},
+            seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output.theta", -1.0),
+                           "chi0": ("rocker_pin.theta", 1.0)},
+            outputs=("phi0",), coupler_link="coupler", closed_limits=_rsrc_limits,
+            geometry=geometries.fourbar_geometry,
+            closed_synthesis={"b": 0.0, "e": 0.0, "delta0": 0.0, "lambda0": 0.0}),
         Family(
             "CSSP", "the CSSP", "Rahman's generalised slider-crank (C-S-S-P)",
             {"a1": _LENGTH, "a2": _LENGTH, "a4": _LENGTH, "alpha4": _ANGLE, "s1": _LENGTH},
             optional={"s1": 0.0}, build=_cssp, closed_form=_cssp_closed,
             seed_names=seed_names.cssp_names, aliases=("cssp",), sketch=constructors.CSSP_SKETCH,
-            why_not={"limits": "the CSSP's output is a slider; its limits are where the quadratic's "
-                               "discriminant vanishes (reported as branch events by analyze)"}),
+            why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
+            seed_freedoms={"theta1": ("crank.theta", 1.0), "s4": ("slider.s", 1.0)},
+            outputs=("s4",), coupler_link="rod", geometry=geometries.cssp_geometry),
         Family(
             "RSSR", "the RSSR", "spatial R-S-S-R crank-rocker (closed form A cos φ0 + B sin φ0 = K)",
             {"d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH, "a": _LENGTH, "b": _LENGTH,
              "lambda0": _ANGLE, "output_offset": _LENGTH},
             optional={"output_offset": 0.0}, build=constructors.rssr, closed_form=_rssr_closed,
             seed_names=seed_names.rssr_names, aliases=("rssr",),
-            sketch=constructors.RSSR_SKETCH),
+            why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
+            sketch=constructors.RSSR_SKETCH,
+            seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output.theta", -1.0)},
+            outputs=("phi0",), coupler_link="coupler", geometry=geometries.rssr_geometry),
         Family(
             "RCCC", "the RCCC", "R-C-C-C loop in Hartenberg-Denavit form (closed form: the dual "
             "input-output equation)",
@@ -158,11 +208,14 @@ FAMILIES: dict[str, Family] = {
              "alpha2": _ANGLE, "alpha3": _ANGLE, "alpha4": _ANGLE, "input_offset": _LENGTH},
             optional={"input_offset": 0.0}, build=_rccc, closed_form=_rccc_closed,
             closed_form_applies=_is_rccc, aliases=("rccc",),
-            sketch=constructors.RCCC_SKETCH),
+            why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
+            sketch=constructors.RCCC_SKETCH, outputs=("C4.theta", "C4.s"), coupler_link="link2",
+            geometry=geometries.rccc_geometry),
         Family(
             "LOOP", "a joint-list loop", "any single loop given as a joint list (generic solver; "
             "the RCCC closed form for an R C C C list driven at its R joint)", {},
             closed_form=_rccc_closed, closed_form_applies=_is_rccc, aliases=("loop",),
+            why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch="[[joints]]: name, kind (R P C H U S), length, twist, offset, pitch, input "
                    "(Hartenberg-Denavit, Rahman eq. 2.2)"),
     )
@@ -204,3 +257,70 @@ def seed_variables(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Na
     if fam.seed_names is None:
         return {}, {}, {}
     return fam.seed_names(linkage, mode)
+
+
+def output_joint(linkage: Linkage) -> int:
+    """The index of the loop's output joint: the joint on the ground (the last or the first
+    joint; the ground link closes the loop between them) that is not the input joint. A
+    CapabilityError says why when the input is not on the ground (then no joint is the output)."""
+    n = len(linkage.joints)
+    driven = {name.split(".")[0] for name in linkage.inputs}
+    first, last = linkage.joints[0].name, linkage.joints[n - 1].name
+    if first in driven and last not in driven:
+        return n - 1
+    if last in driven and first not in driven:
+        return 0
+    raise CapabilityError(
+        f"{linkage.name}: the input joint ({', '.join(sorted(driven))}) is not one of the two "
+        f"joints on the ground ({first}, {last}), so the loop has no output joint to take limits, "
+        "transmission or synthesis of; name the output variable (e.g. --output <joint>.theta)")
+
+
+def default_outputs(linkage: Linkage) -> tuple[str, ...]:
+    """The output variables of a loop: the family's (RSRC φ0 and S, 4R and RSSR φ0, CSSP s4,
+    RCCC C4.theta and C4.s) or, for a joint list, the scalar freedoms of its output joint."""
+    fam = family_of(linkage)
+    if fam.outputs:
+        return fam.outputs
+    joint = linkage.joints[output_joint(linkage)]
+    if joint.kind == "S":
+        raise CapabilityError(f"{linkage.name}: the output joint {joint.name!r} is a ball joint, whose "
+                         "rotation has no scalar variable; name the output variable")
+    return tuple(joint.freedom_names())
+
+
+def output_freedom(linkage: Linkage, name: str) -> tuple[str, float]:
+    """The joint freedom and sign of an output variable ``name``: a scalar freedom
+    ``"<joint>.<freedom>"`` is itself (sign +1); a seed name of the family is its freedom times
+    a sign (RSRC ``phi0`` = −``output_C.theta``). An UnknownNameError lists the names that work."""
+    fam = family_of(linkage)
+    scalar = [f for j in linkage.joints if j.kind != "S" for f in j.freedom_names()]
+    if name in scalar:
+        return name, 1.0
+    if name in fam.seed_freedoms:
+        return fam.seed_freedoms[name]
+    raise UnknownNameError(f"{linkage.name}: no output variable {name!r}; use a joint freedom "
+                     f"({', '.join(scalar)})"
+                     + (f" or one of the seed's names {', '.join(fam.seed_freedoms)}"
+                        if fam.seed_freedoms else ""))
+
+
+def coupler_link_index(linkage: Linkage, name: str | None = None) -> int:
+    """The moving link a coupler point is on: the link called ``name``, else the family's
+    coupler (RSRC, 4R, RSSR ``coupler``; CSSP ``rod``; RCCC ``link2``), else the only moving
+    link of a joint list that touches no ground joint."""
+    names = [link.name for link in linkage.links]
+    if name is not None:
+        if name not in names:
+            raise UnknownNameError(f"{linkage.name}: no moving link called {name!r}; the links are "
+                             f"{', '.join(names)}")
+        return names.index(name)
+    fam = family_of(linkage)
+    if fam.coupler_link is not None and fam.coupler_link in names:
+        return names.index(fam.coupler_link)
+    floating = list(range(1, len(names) - 1))
+    if len(floating) == 1:
+        return floating[0]
+    raise InputError(f"{linkage.name}: a joint list of {len(linkage.joints)} joints has "
+                     f"{len(floating) or 'no'} moving link(s) off the ground, so it has no one "
+                     f"coupler; name the link (link = \"...\", one of {', '.join(names)})")

@@ -33,6 +33,7 @@ from screwkit.kinematics.loop import (
     Layout,
     apply_increment,
     configuration_difference,
+    constants,
 )
 from screwkit.kinematics.motion import format_inputs
 from screwkit.kinematics.rates import SINGULAR_RTOL, RateEquations
@@ -61,7 +62,7 @@ def continuum_dimension(linkage: Linkage, lay: Layout, conf: Configuration, null
         return np.zeros(N, dtype=int)
     names = list(lay.names)
     p_idx = [k for k, n in enumerate(names) if n not in linkage.inputs]
-    L = lay.length_scale
+    L = constants(linkage, lay)[2]
     cols = np.array([L if t else 1.0 for t in lay.is_translation])[p_idx]
     rep = conf.take(np.repeat(np.arange(N), d))
     delta = np.zeros((N * d, len(names)))
@@ -75,7 +76,7 @@ def continuum_dimension(linkage: Linkage, lay: Layout, conf: Configuration, null
 
 def _scaled_distance(linkage: Linkage, lay: Layout, a: Configuration, b: Configuration) -> Array:
     """|a ⊖ b| over the passive freedoms, scaled (rad; length / length scale)."""
-    L = lay.length_scale
+    L = constants(linkage, lay)[2]
     cols = np.array([1.0 / L if t else 1.0 for t in lay.is_translation])
     diff = configuration_difference(a, b, lay) * cols
     return np.asarray(np.linalg.norm(diff, axis=1))

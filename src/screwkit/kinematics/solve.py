@@ -18,6 +18,7 @@ from screwkit.kinematics.loop import (
     apply_increment,
     closure_error,
     closure_twist,
+    constants,
     forward,
     layout,
 )
@@ -64,7 +65,7 @@ def newton(
     minimum-norm Gauss–Newton step, also where J has fewer independent rows than 6 (a planar
     loop seen in space)."""
     lay = lay or layout(linkage)
-    L = lay.length_scale
+    L = constants(linkage, lay)[2]
     rows, cols = _scales(lay, L)
     passive = np.array([n not in linkage.inputs for n in lay.names])
     pidx = np.nonzero(passive)[0]
@@ -131,7 +132,7 @@ def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
     — Deuflhard's contraction test: a
     prediction inside the branch's basin of quadratic convergence contracts fast, a jump
     towards another branch does not. Predictions that fail a test are dropped at once."""
-    L = lay.length_scale
+    L = constants(linkage, lay)[2]
     rows, cols = _scales(lay, L)
     pidx = np.array([k for k, n in enumerate(lay.names) if n not in linkage.inputs])
     N = conf.size
@@ -187,7 +188,7 @@ def random_configurations(linkage: Linkage, count: int, rng: np.random.Generator
     """``count`` random starting configurations: angles uniform in (−π, π], translations
     uniform within ± the length scale, spherical joints uniformly random rotations."""
     lay = lay or layout(linkage)
-    L = lay.length_scale
+    L = constants(linkage, lay)[2]
     q = np.empty((count, lay.n_scalar))
     for f in range(len(lay.names)):
         c = lay.scalar_col[f]
@@ -211,7 +212,7 @@ def signature(linkage: Linkage, conf: Configuration, lay: Layout | None = None) 
     frame. Two configurations with the same signature are the same assembly."""
     lay = lay or layout(linkage)
     fr = forward(linkage, conf, lay)
-    L = lay.length_scale
+    L = constants(linkage, lay)[2]
     parts = [fr.centres.reshape(conf.size, -1) / L]
     ax = [fr.axes[:, i] for i, j in enumerate(linkage.joints) if j.kind != "S"]
     if ax:
@@ -265,7 +266,7 @@ def find_assemblies(
     # Near a double root (a limit position) the closure error grows only quadratically with
     # the distance from the root, so Newton's roots scatter by ~√tolerance: merge within that
     # wider radius where the passive Jacobian is near-singular.
-    rows, cols = _scales(lay, lay.length_scale)
+    rows, cols = _scales(lay, constants(linkage, lay)[2])
     pidx = [k for k, n in enumerate(lay.names) if n not in linkage.inputs]
     Jp = fr.screws[:, :, pidx] * rows[None, :, None] * cols[pidx][None, None, :]
     sv = np.linalg.svd(Jp, compute_uv=False)

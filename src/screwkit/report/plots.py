@@ -108,8 +108,11 @@ def plot_analysis(doc: dict[str, Any], path: str | Path, units: Any = None) -> N
     names = [n for n in modes[0]["variables"] if "." not in n and n not in ("theta0", "theta1")]
     if not names:
         names = [n for n in modes[0]["variables"] if n != doc["input_name"]][:3]
-    has_cp = any("coupler_point" in m for m in modes)
-    rows = len(names) + (1 if has_cp else 0)
+    curves = [_curves(m) for m in modes]
+    periodic = _full_turn(np.degrees(np.asarray(doc["input"], dtype=float)))
+    has_cp = any(curves)
+    has_tr = any("transmission" in m for m in modes)
+    rows = len(names) + (1 if has_cp else 0) + (1 if has_cp or has_tr else 0)
     fig, axes = plt.subplots(rows, 3, figsize=(13, 2.8 * rows), squeeze=False)
     tables = [{key: _smoothed(m, key) for key in ("variables", "velocities", "accelerations")}
               for m in modes]
@@ -130,26 +133,87 @@ def plot_analysis(doc: dict[str, Any], path: str | Path, units: Any = None) -> N
             flatten_constant_axis(ax, ys)
         axes[r, 0].legend(fontsize=8)
     if has_cp:
-        for c, (i, j) in enumerate((("x", "y"), ("x", "z"), ("y", "z"))):
-            ax = axes[-1, c]
-            for m in modes:
-                if "coupler_point" in m:
-                    cp = m["coupler_point"]
-                    xi = du.show("length", np.asarray(cp[i], dtype=float))
-                    yj = du.show("length", np.asarray(cp[j], dtype=float))
-                    if _full_turn(np.degrees(np.asarray(doc["input"], dtype=float))):  # close the curve of a periodic sweep
-                        xi, yj = np.append(xi, xi[0]), np.append(yj, yj[0])
-                    ax.plot(xi, yj, label=f"mode {m['mode']}")
-            ax.set_title(f"coupler curve, {i.upper()}–{j.upper()} projection "
-                         f"({du.pretty('length')})")
-            ax.set_aspect("equal", adjustable="datalim")
-            ax.grid(True, alpha=0.3)
+        _coupler_projections(axes[len(names)], modes, curves, du, periodic)
+    if has_cp or has_tr:
+        _last_row(fig, axes[-1], modes, curves, x, du, periodic,
+                  f"{doc['input_name']} ({du.pretty(input_kind)})")
     fig.suptitle(f"{doc['mechanism']} — {doc.get('method', '')} analysis", fontsize=12)
     fig.tight_layout()
     try:
         save_figure(fig, path)
     finally:
         plt.close(fig)
+
+
+def _curves(mode: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """The mode's coupler curves by name (a lone ``coupler_point`` as "coupler point")."""
+    if "coupler_points" in mode:
+        return dict(mode["coupler_points"])
+    return {"coupler point": mode["coupler_point"]} if "coupler_point" in mode else {}
+
+
+def _closed(periodic: bool, *arrays: Any) -> list[np.ndarray]:
+    """The arrays with their first sample appended when the sweep is a full turn."""
+    arrs = [np.asarray(a, dtype=float) for a in arrays]
+    return [np.append(a, a[0]) for a in arrs] if periodic else arrs
+
+
+def _coupler_projections(row: Any, modes: list[dict[str, Any]], curves: list[dict[str, Any]],
+                         du: Any, periodic: bool) -> None:
+    for c, (i, j) in enumerate((("x", "y"), ("x", "z"), ("y", "z"))):
+        ax = row[c]
+        for m, cv in zip(modes, curves, strict=True):
+            for name, cp in cv.items():
+                xi, yj = _closed(periodic, du.show("length", np.asarray(cp[i], dtype=float)),
+                                 du.show("length", np.asarray(cp[j], dtype=float)))
+                ax.plot(xi, yj, label=f"{name}, mode {m['mode']}")
+        ax.set_title(f"coupler curves, {i.upper()}–{j.upper()} projection "
+                     f"({du.pretty('length')})")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, alpha=0.3)
+    row[0].legend(fontsize=7)
+
+
+def _last_row(fig: Any, row: Any, modes: list[dict[str, Any]], curves: list[dict[str, Any]],
+              x: np.ndarray, du: Any, periodic: bool, x_label: str) -> None:
+    """The coupler curves in 3-D, the transmission index and the transmission angle (planar
+    loops) or the ball-joint cone angles, over the input."""
+    if any(curves):
+        pos = row[0].get_subplotspec()
+        row[0].remove()
+        ax3 = fig.add_subplot(pos, projection="3d")
+        for m, cv in zip(modes, curves, strict=True):
+            for name, cp in cv.items():
+                ax3.plot(*_closed(periodic, *(du.show("length", np.asarray(cp[k], dtype=float))
+                                              for k in "xyz")), label=f"{name}, mode {m['mode']}")
+        ax3.set_title(f"coupler curves in 3-D ({du.pretty('length')})")
+    else:
+        row[0].axis("off")
+    tr = [(m["mode"], m["transmission"]) for m in modes if "transmission" in m]
+    for col in (1, 2):
+        ax = row[col]
+        if not tr:
+            ax.axis("off")
+            continue
+        title = "transmission index"
+        for k, t in tr:
+            if col == 1:
+                for name, ti in t["index"].items():
+                    ax.plot(x, np.asarray(ti, dtype=float), label=f"{name}, mode {k}")
+            elif "angle" in t:
+                title = f"transmission angle μ ({du.pretty('angle')})"
+                ax.plot(x, du.show("angle", np.asarray(t["angle"], dtype=float)),
+                        label=f"mode {k}")
+            else:
+                title = f"ball-joint cone angles ({du.pretty('angle')})"
+                for joint, a in t["cone_angle"].items():
+                    ax.plot(x, du.show("angle", np.asarray(a, dtype=float)),
+                            label=f"{joint}, mode {k}")
+        ax.set_title(title)
+        ax.set_xlabel(x_label)
+        ax.grid(True, alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
 
 
 def _full_turn(x_deg: np.ndarray) -> bool:

@@ -187,8 +187,8 @@ def scene_from_motion(
 ) -> dict[str, Any]:
     """Build the scene (module docstring) of a solved motion.
 
-    ``spec_or_linkage``: a loaded spec (``screwkit.io.spec.load_spec``; gives the name, source,
-    units and coupler point) or a bare linkage. ``dynamics_doc``: ``Dynamics.as_dict()`` of the
+    ``spec_or_linkage``: a loaded spec (``screwkit.io.spec.load_spec``; gives the name, source
+    and units) or a bare linkage. ``dynamics_doc``: ``Dynamics.as_dict()`` of the
     mode with index ``dynamics_mode`` in ``motion.modes`` (default: its ``"mode"`` key, else 0);
     ``balance_doc``: ``BalanceResult.as_dict()``; ``synthesis_doc``: the ``screwkit
     synthesize`` document. ``coupler_points``: extra traces {name: (moving link index, point
@@ -208,9 +208,6 @@ def scene_from_motion(
     extent = float(np.nanmax(np.abs(all_c))) if np.isfinite(all_c).any() else 1.0
     units = display_length(getattr(spec, "units", {}).get("length") if spec else None, extent)
     points = dict(coupler_points or {})
-    cp = getattr(spec, "coupler_point", None)
-    if cp is not None:
-        points.setdefault("coupler point", (1, cp))
     mode_entries = []
     for k, md in enumerate(modes):
         traces = {name: point_trace(md, link, np.asarray(local, dtype=float))

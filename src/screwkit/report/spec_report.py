@@ -54,6 +54,8 @@ def spec_scene(spec: Spec | Pipeline, *, gravity: bool = False,
     scene = scene_from_motion(s, m, dynamics_doc=dynamics_doc, dynamics_mode=dyn_mode,
                               balance_doc=balance_doc, synthesis_doc=synthesis_doc,
                               spec_text=text, seed_variables=[seed_tables(md) for md in m.modes],
+                              coupler_points={p.name: (p.link, p.point)
+                                              for p in s.coupler_points},
                               solver=[m.solver] if m.solver else None, notes=notes)
     if s.drive is not None and dynamics_doc is not None:
         add_simulation_plots(scene, s)

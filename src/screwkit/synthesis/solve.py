@@ -14,7 +14,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,7 +27,7 @@ from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled, ResidualModel, dimensions_of
 
 __all__ = ["RangeCheck", "evaluate_design", "SynthesisError", "SynthesisResult", "check_range",
-           "result_from_evaluation", "synthesize", "synthesize_multistart"]
+           "fit_notes", "result_from_evaluation", "synthesize", "synthesize_multistart"]
 
 FloatArray = NDArray[np.float64]
 Status = Literal["converged", "iteration limit", "time limit", "not solved"]
@@ -98,7 +98,7 @@ class SynthesisResult:
     status: Status
     message: str
     length_scale: float
-    rows: list[dict[str, float]]
+    rows: list[dict[str, float | None]]
     range_check: RangeCheck
     evaluation: Evaluation = field(repr=False)
 
@@ -159,7 +159,7 @@ def check_range(problem: RSRCSynthesisProblem, ev: Evaluation, n_samples: int = 
     return RangeCheck(ok, tuple(gaps), tuple(mismatch), trans, msg)
 
 
-def _fit_notes(problem: RSRCSynthesisProblem, psi_d: FloatArray, s_d: FloatArray,
+def fit_notes(problem: Any, psi_d: FloatArray, s_d: FloatArray,
                r_phi: FloatArray, r_s: FloatArray, check: RangeCheck, status: Status) -> list[str]:
     """Plain-language notes for the result message: a limit that was hit, a target the result
     does not follow (a maximum deviation above 10 % of the desired range of that component),
@@ -230,7 +230,7 @@ def result_from_evaluation(
             dims[name] = math.remainder(dims[name], 2 * math.pi)
         elif name in ("theta01", "q1", "q2"):
             dims[name] = dims[name] % (2 * math.pi)
-    rows = []
+    rows: list[dict[str, float | None]] = []
     psi_all = problem.target.desired_rotation(ev.theta)
     s_all = problem.target.desired_translation(ev.theta)
     for i, th in enumerate(ev.theta):
@@ -242,7 +242,7 @@ def result_from_evaluation(
             "S_d": float(s_all[i]),
         })
     check = check_range(problem, ev)
-    message = "; ".join(m for m in (message, *_fit_notes(problem, psi_all, s_all, r_phi, r_s,
+    message = "; ".join(m for m in (message, *fit_notes(problem, psi_all, s_all, r_phi, r_s,
                                                           check, status)) if m)
     # the program label (root ordering, Bagci's I8/I9) of the result's configuration at theta = 0
     pos = rsrc_positions(dimensions_of({k: np.array([v]) for k, v in ev.params.items()}),

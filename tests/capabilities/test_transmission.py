@@ -1,0 +1,116 @@
+"""Transmission quality: the 4R's transmission angle by the law of cosines and its index |sin μ|;
+the RSSR's, RSRC's and CSSP's Sutherland–Roth index computed by hand from the joint centres and
+axes; the smallest cone of known direction sets; the ball joints' cone angles."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import screwkit as sk
+from screwkit.io.spec import load_spec
+from screwkit.kinematics.transmission import smallest_cone, transmission
+
+EXAMPLES = "examples"
+THETA = np.radians(np.arange(0.0, 360.0, 5.0))
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+@pytest.mark.parametrize("dims", [(3.0, 1.0, 3.0, 2.5), (0.3, 0.1, 0.28, 0.25), (2.0, 1.5, 2.2, 1.8)])
+def test_fourbar_transmission_angle_is_the_law_of_cosines(dims):
+    a, d1, d2, d3 = dims
+    motion = sk.solve_motion(sk.fourbar(a=a, d1=d1, d2=d2, d3=d3), THETA)
+    tr = transmission(motion)
+    assert tr.planar and tr.output_joint == "output" and tr.driving_joint == "rocker_pin"
+    cos_mu = (d2**2 + d3**2 - d1**2 - a**2 + 2 * a * d1 * np.cos(THETA)) / (2 * d2 * d3)
+    for md, mt in zip(motion.modes, tr.modes, strict=True):
+        ok = md.assembles
+        np.testing.assert_allclose(mt.angle[ok], np.arccos(cos_mu[ok]), atol=1e-12)
+        np.testing.assert_allclose(mt.index["phi0"][ok], np.sqrt(1 - cos_mu[ok] ** 2), atol=1e-12)
+        summary = tr.summary(motion.input_values)[md.index]
+        worst = np.minimum(mt.angle, np.pi - mt.angle)
+        assert summary["angle"]["value"] == pytest.approx(np.nanmin(worst))
+
+
+def test_rssr_index_is_the_cosine_of_the_force_to_the_ball_velocity():
+    s = load_spec(f"{EXAMPLES}/rssr_spatial.toml")
+    motion = sk.solve_motion(s.linkage, s.inputs)
+    p = s.linkage.parameters
+    u3 = np.array([math.cos(p["lambda0"]), 0.0, -math.sin(p["lambda0"])])
+    O3 = np.array([p["b"], p["a"], 0.0])
+    for md, mt in zip(motion.modes, transmission(motion).modes, strict=True):
+        c = md.joint_centres  # world frame: input axis X, output axis u3 through O3
+        force = _unit(c[:, 2] - c[:, 1])  # the coupler between the two balls
+        v = np.cross(u3, c[:, 2] - O3)  # the velocity of the output ball
+        hand = np.abs(np.einsum("ni,ni->n", force, v)) / np.linalg.norm(v, axis=1)
+        np.testing.assert_allclose(mt.index["phi0"], hand, atol=1e-12)
+
+
+def test_rsrc_index_of_both_output_freedoms_by_hand():
+    s = load_spec(f"{EXAMPLES}/bagci_fig7_rsrc.toml")
+    motion = sk.solve_motion(s.linkage, s.inputs)
+    p = s.linkage.parameters
+    u3 = np.array([math.cos(p["lambda0"]), 0.0, -math.sin(p["lambda0"])])
+    O3 = np.array([p["b"], p["a"], 0.0])
+    for md, mt in zip(motion.modes, transmission(motion).modes, strict=True):
+        O1, cR, uR = md.joint_centres[:, 1], md.joint_centres[:, 2], md.joint_axes[:, 2]
+        # forces through the sphere centre O1 meeting the coupler's R axis: the plane (O1, axis)
+        n = _unit(np.cross(cR - O1, uR))
+        f = _unit(np.cross(n, u3))  # for φ0: no work on the output's slide
+        ti = []
+        for k in range(len(O1)):
+            t, _ = np.linalg.lstsq(np.stack([f[k], -uR[k]], 1), cR[k] - O1[k], rcond=None)[0]
+            P = O1[k] + t * f[k]  # where it meets the R axis
+            v = np.cross(u3, P - O3)
+            ti.append(abs(f[k] @ v) / np.linalg.norm(v))
+        np.testing.assert_allclose(mt.index["phi0"], ti, atol=1e-12)
+        # for S: the force in that plane that meets the output axis (no moment about it)
+        X = O3 + ((np.einsum("ni,ni->n", n, O1 - O3)) / (n @ u3))[:, None] * u3
+        fs = _unit(X - O1)
+        np.testing.assert_allclose(mt.index["S"], np.abs(fs @ u3), atol=1e-12)
+
+
+def test_cssp_index_is_the_rod_angle_to_the_slide():
+    s = load_spec(f"{EXAMPLES}/rahman_cssp.toml")
+    motion = sk.solve_motion(s.linkage, s.inputs)
+    for md, mt in zip(motion.modes, transmission(motion).modes, strict=True):
+        rod = _unit(md.joint_centres[:, 2] - md.joint_centres[:, 1])
+        slide = md.joint_axes[:, 3]
+        np.testing.assert_allclose(mt.index["s4"], np.abs(np.einsum("ni,ni->n", rod, slide)),
+                                   atol=1e-12)
+        assert set(mt.cone_angle) == {"pin", "ball"}
+
+
+def test_smallest_cone_of_a_circle_of_directions():
+    rng = np.random.default_rng(3)
+    axis = _unit(rng.normal(size=3))
+    e1 = _unit(np.cross(axis, [1.0, 0.0, 0.0]))
+    e2 = np.cross(axis, e1)
+    half = math.radians(25.0)
+    phi = rng.uniform(0, 2 * np.pi, 40)
+    rim = (math.cos(half) * axis + math.sin(half) * (np.cos(phi)[:, None] * e1
+                                                     + np.sin(phi)[:, None] * e2))
+    inside = _unit(axis + 0.2 * rng.normal(size=(30, 3)) * 0.3)
+    inside = inside[inside @ axis > math.cos(half)]
+    got_axis, got_half = smallest_cone(np.vstack([rim, inside]))
+    assert got_half == pytest.approx(half, abs=1e-6)
+    assert np.linalg.norm(got_axis - axis) < 1e-5
+
+
+def test_rssr_ball_cone_angles_are_tilts_of_the_rod():
+    s = load_spec(f"{EXAMPLES}/rssr_spatial.toml")
+    motion = sk.solve_motion(s.linkage, s.inputs)
+    for md, mt in zip(motion.modes, transmission(motion).modes, strict=True):
+        rod = _unit(md.joint_centres[:, 2] - md.joint_centres[:, 1])
+        # ball1's socket on the crank, ball2's on the output crank: the rod seen from each
+        crank = np.einsum("nji,nj->ni", md.link_rotation[:, 0], rod)
+        out = np.einsum("nji,nj->ni", md.link_rotation[:, 2], -rod)
+        for joint, local in (("ball1", crank), ("ball2", out)):
+            axis = mt.socket_axis[joint]
+            np.testing.assert_allclose(mt.cone_angle[joint], np.arccos(local @ axis), atol=1e-9)
+            assert mt.cone_limit[joint] == pytest.approx(np.max(mt.cone_angle[joint]), abs=1e-12)
