@@ -194,3 +194,20 @@ def test_long_sweeps_are_accepted_and_report_progress():
     done, total = calls[-1]
     assert done == total == 2 * n  # every sample of both modes, counted once
     assert all(a[0] <= b[0] for a, b in zip(calls, calls[1:], strict=False))
+
+
+def test_a_layout_reused_for_other_dimensions_reads_their_link_transforms():
+    # a layout caches its linkage's link transforms for the hot paths; reused for a loop with
+    # the same joints and other dimensions (a synthesis trial), it must not apply the old ones
+    from screwkit.kinematics.loop import Configuration, forward, layout
+
+    a = rsrc(2, 4.5, 3, 3, 3, 1, deg(18), deg(60))
+    b = rsrc(2.5, 4.0, 3, 3.5, 3, 1, deg(18), deg(60))
+    lay = layout(a)
+    rng = np.random.default_rng(0)
+    conf = Configuration(rng.uniform(-3, 3, (5, lay.n_scalar)),
+                         np.tile(np.eye(3), (5, lay.n_spherical, 1, 1)))
+    reused, fresh = forward(b, conf, lay), forward(b, conf, layout(b))
+    np.testing.assert_allclose(reused.closure_p, fresh.closure_p, atol=1e-15)
+    np.testing.assert_allclose(reused.centres, fresh.centres, atol=1e-15)
+    assert not np.allclose(forward(a, conf, lay).centres, fresh.centres)
