@@ -1,8 +1,10 @@
 """RSRC closed form throughput: every inversion's positions, velocities and accelerations.
 
 Bagci's Fig. 7/8 mechanism (general delta0: the quartic path, two real inversions at every input
-angle) over 10^6 input angles, with `rsrc_kinematics` (one pass) and with `rsrc_positions`
-alone.  Target: >= 10^6 input angles per second on one core for positions + rates.
+angle) over 10^6 input angles, with `rsrc_kinematics` (one pass), with `rsrc_motion` +
+`rsrc_rates` (continuous branches with their rates: issue 12's target, 1 µs an input) and with
+`rsrc_positions` alone.  Target: >= 10^6 input angles per second on one core for positions +
+rates.
 """
 
 from __future__ import annotations
@@ -13,7 +15,14 @@ from typing import Any
 
 import numpy as np
 
-from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_kinematics, rsrc_positions
+from screwkit.kinematics.rsrc import (
+    RSRCDimensions,
+    RSRCPositions,
+    rsrc_kinematics,
+    rsrc_motion,
+    rsrc_positions,
+    rsrc_rates,
+)
 
 N_INPUTS = 1_000_000
 REPEATS = 3
@@ -43,6 +52,13 @@ def run() -> list[dict[str, Any]]:
     t_pos = _best_time(lambda: rsrc_positions(FIG7, theta))
     pos, _ = rsrc_kinematics(FIG7, theta[:1000])
     modes = int(pos.n_assemblies.max())
+
+    def branches_with_rates() -> None:
+        mot = rsrc_motion(FIG7, theta)
+        rsrc_rates(FIG7, RSRCPositions(mot.theta0, mot.phi0, mot.chi0, mot.S, mot.assembles,
+                                       FIG7.special_case), 1.0, 0.0)
+
+    t_motion = _best_time(branches_with_rates)
     return [
         {
             "name": "rsrc_kinematics (positions+velocities+accelerations, all modes)",
@@ -51,6 +67,14 @@ def run() -> list[dict[str, Any]]:
             "target": 1e6,
             "note": f"Fig. 7/8 mechanism, quartic path, {modes} real inversions per input, "
                     f"{N_INPUTS} inputs in {t_all:.3f} s (best of {REPEATS}, one core, CPU time)",
+        },
+        {
+            "name": "rsrc_motion + rsrc_rates (continuous branches, rates, accelerations)",
+            "value": t_motion / N_INPUTS * 1e6,
+            "unit": "µs/input",
+            "target": 1.0,
+            "note": f"what the closed-form Motion starts from; {N_INPUTS} inputs in "
+                    f"{t_motion:.3f} s (best of {REPEATS})",
         },
         {
             "name": "rsrc_positions (all modes)",

@@ -184,8 +184,30 @@ def test_bad_input_shapes():
         motion(lk, [0.0, np.nan])
 
 
-def test_too_many_samples_for_the_generic_solver_is_refused_up_front():
-    from screwkit.kinematics.generic_motion import MAX_GENERIC_SAMPLES
+def test_long_sweeps_are_accepted_and_report_progress():
+    # the old solver refused more than 20 000 samples; continuation costs ~tens of µs a sample
+    calls = []
+    n = 20_001
+    m = motion(fourbar(3.0, 1.0, 3.0, 2.5), np.linspace(0.0, 2 * np.pi, n),
+               progress=lambda done, total: calls.append((done, total)))
+    assert len(m.modes) == 2 and all(md.assembles.all() for md in m.modes)
+    done, total = calls[-1]
+    assert done == total == 2 * n  # every sample of both modes, counted once
+    assert all(a[0] <= b[0] for a, b in zip(calls, calls[1:], strict=False))
 
-    with pytest.raises(ValueError, match="too many for the generic solver"):
-        motion(fourbar(3.0, 1.0, 3.0, 2.5), np.linspace(0, 1, MAX_GENERIC_SAMPLES + 1))
+
+def test_a_layout_reused_for_other_dimensions_reads_their_link_transforms():
+    # a layout caches its linkage's link transforms for the hot paths; reused for a loop with
+    # the same joints and other dimensions (a synthesis trial), it must not apply the old ones
+    from screwkit.kinematics.loop import Configuration, forward, layout
+
+    a = rsrc(2, 4.5, 3, 3, 3, 1, deg(18), deg(60))
+    b = rsrc(2.5, 4.0, 3, 3.5, 3, 1, deg(18), deg(60))
+    lay = layout(a)
+    rng = np.random.default_rng(0)
+    conf = Configuration(rng.uniform(-3, 3, (5, lay.n_scalar)),
+                         np.tile(np.eye(3), (5, lay.n_spherical, 1, 1)))
+    reused, fresh = forward(b, conf, lay), forward(b, conf, layout(b))
+    np.testing.assert_allclose(reused.closure_p, fresh.closure_p, atol=1e-15)
+    np.testing.assert_allclose(reused.centres, fresh.centres, atol=1e-15)
+    assert not np.allclose(forward(a, conf, lay).centres, fresh.centres)

@@ -21,6 +21,12 @@ def assembling_intervals(dims: RSRCDimensions, samples: int = SCAN_SAMPLES) -> l
     theta = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
     with np.errstate(all="ignore"):
         ok = np.asarray(np.asarray(rsrc_positions(dims, theta).assembles).any(axis=1), dtype=bool)
+    return runs_over_a_turn(theta, ok)
+
+
+def runs_over_a_turn(theta: np.ndarray, ok: np.ndarray) -> list[tuple[float, float]]:
+    """The intervals (start ≤ end, start in [0, 2π)) of a scan ``theta`` of one full turn where
+    ``ok`` holds, a run through 360° = 0° joined into one."""
     if not ok.any():
         return []
     if ok.all():

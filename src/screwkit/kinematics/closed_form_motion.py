@@ -13,19 +13,27 @@ the tests compare both).
 Mode numbering (docs/conventions.md): the closed form's branches that assemble somewhere over the
 sweep, in the closed form's order — RSRC/4R: the columns of :func:`rsrc_motion` (branches
 labelled by Bagci's root order at the first sample); CSSP: the root s4 = −b + √(b² − c)
-(Rahman's branch) first, then the other root.
+(Rahman's branch) first, then the other root; RSSR and RCCC: the root with +acos of their
+input-output equation A cos x + B sin x = K first, then the one with −acos.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.loop import Array, Configuration, close_spherical_joint, layout
-from screwkit.kinematics.mode_frames import mode_from_configuration
+from screwkit.kinematics.loop import (
+    Array,
+    Configuration,
+    close_spherical_joint,
+    forward,
+    layout,
+)
+from screwkit.kinematics.mode_frames import mode_from_configuration, unwrap_runs
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion, format_inputs
 from screwkit.model.linkage import Linkage
 
@@ -33,6 +41,10 @@ if TYPE_CHECKING:
     from screwkit.kinematics.rsrc import RSRCDimensions
 
 RSRC_SOLVER = "RSRC closed form: quartic in tan(φ0/2) (Bagci 1969 eqs. 3.59–3.82)"
+RSSR_SOLVER = ("RSSR closed form: A cos φ0 + B sin φ0 = K from the crank circles and the coupler "
+               "length (kinematics/rssr.py)")
+RCCC_SOLVER = ("RCCC closed form: the dual input-output equation Â cos θ̂4 + B̂ sin θ̂4 = Ĉ "
+               "(transference of the spherical four-bar; kinematics/rccc.py)")
 FOURBAR_SOLVER = "planar 4R closed form: Bagci's RSRC with δ0 = λ0 = b = e = 0 (§3.4)"
 CSSP_SOLVER = "CSSP closed form: quadratic in s4 (Rahman 1996 §1.2)"
 
@@ -190,13 +202,110 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=CSSP_SOLVER)
 
 
-def unwrap_runs(angle: Array, ok: NDArray[np.bool_]) -> Array:
-    """Continuous angles along each run of assembling samples, each run starting in (−π, π]."""
-    out = np.array(angle, dtype=float)
-    idx = np.flatnonzero(ok & np.isfinite(out))
-    if idx.size == 0:
-        return out
-    for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1):
-        values = np.unwrap(out[run])
-        out[run] = values - 2 * np.pi * np.round(values[0] / (2 * np.pi))
-    return out
+def _branch_events(theta: Array, ok: NDArray[np.bool_]) -> list[str]:
+    stops = np.nonzero(ok[:-1] & ~ok[1:])[0]
+    starts = np.nonzero(~ok[:-1] & ok[1:])[0] + 1
+    return ([f"stops assembling after input [{theta[i]!r}] (limit position or dead centre "
+             f"before [{theta[i + 1]!r}])" for i in stops]
+            + [f"starts assembling at input [{theta[i]!r}] (limit position or dead centre "
+               f"after [{theta[i - 1]!r}])" for i in starts])
+
+
+def rssr_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
+    """Both roots of the RSSR's input-output equation (:mod:`screwkit.kinematics.rssr`) as
+    modes, with θ0, φ0 and the closed form's own rates of φ0 under the seed's names."""
+    from screwkit.kinematics.rssr import RSSRDimensions, rssr_motion
+
+    dims = RSSRDimensions(**dict(linkage.parameters))
+    theta = X[:, 0]
+    mot = rssr_motion(dims, theta)
+    lay = layout(linkage)
+    base = linkage.base.real
+    first, out = (f"{linkage.joints[k].name}.theta" for k in (0, 3))
+    modes: list[ModeMotion] = []
+    for j, label in ((0, "+acos root"), (1, "-acos root")):
+        ok = mot.assembles[:, j]
+        if not ok.any():
+            continue
+        phi = unwrap_runs(np.where(ok, mot.phi0[:, j], np.nan), ok)
+        scalars = np.zeros((len(theta), lay.n_scalar))
+        scalars[:, lay.scalar_col[lay.names.index(first)]] = theta
+        scalars[:, lay.scalar_col[lay.names.index(out)]] = -np.where(ok, phi, 0.0)
+        rod = np.where(ok[:, None], mot.coupler_ball[:, j] - mot.crank_ball, [1.0, 0.0, 0.0])
+        conf = _two_ball_configuration(linkage, scalars, rod @ base)
+        md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd,
+                                     _branch_events(theta, ok))
+        rate = mot.dphi[:, j]
+        seed = ({"theta0": theta, "phi0": phi}, {"theta0": Xd[:, 0], "phi0": rate * Xd[:, 0]},
+                {"theta0": Xdd[:, 0],
+                 "phi0": mot.ddphi[:, j] * Xd[:, 0] ** 2 + rate * Xdd[:, 0]})
+        modes.append(_with_seed(md, len(modes), label, seed, singular=mot.dead_centre[:, j]))
+    if not modes:
+        raise _no_modes(linkage, X, _where_over_a_turn(
+            lambda th: np.asarray(rssr_motion(dims, th).assembles.any(axis=1))))
+    return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=RSSR_SOLVER)
+
+
+def _where_over_a_turn(assembles: Callable[[Array], NDArray[np.bool_]]) -> str:
+    """Where over a full input turn a closed form assembles, in words (0.25° scan)."""
+    from screwkit.kinematics.assembly_range import (
+        SCAN_SAMPLES,
+        describe_intervals,
+        runs_over_a_turn,
+    )
+
+    theta = np.linspace(0.0, 2 * np.pi, SCAN_SAMPLES, endpoint=False)
+    return describe_intervals(runs_over_a_turn(theta, np.asarray(assembles(theta))))
+
+
+def _two_ball_configuration(linkage: Linkage, scalars: Array, rod: Array) -> Configuration:
+    """Joint configuration of a loop with two ball joints (an S–S rod) from its scalar
+    freedoms and the rod's direction ``rod`` (N, 3, ground frame): the proximal ball is the
+    least rotation turning the rod's rest direction into it (the idle spin is then set by
+    :mod:`screwkit.kinematics.idle_spin`), the distal ball closes the loop."""
+    from screwkit.kinematics.idle_spin import minimal_rotation_apply
+
+    lay = layout(linkage)
+    i = next(iter(lay.spherical_of_joint))
+    N = scalars.shape[0]
+    rest = Configuration(scalars, np.broadcast_to(np.eye(3), (N, 2, 3, 3)).copy())
+    B = forward(linkage, rest, lay).before_R[:, i]
+    u = np.einsum("nji,nj->ni", B, rod / np.linalg.norm(rod, axis=1, keepdims=True))
+    along = linkage.link_transforms[i].translation
+    u0 = np.broadcast_to(along / np.linalg.norm(along), (N, 3))
+    cols = [minimal_rotation_apply(u0, u, np.broadcast_to(e, (N, 3))) for e in np.eye(3)]
+    sph = rest.spherical
+    sph[:, 0] = np.stack(cols, axis=-1)
+    return close_spherical_joint(linkage, scalars, lay, sph, i + 1)
+
+
+def rccc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
+    """Both roots of the RCCC's dual input-output equation (:mod:`screwkit.kinematics.rccc`)
+    as modes; every joint's angle and slide from the closed form, rates from the loop's rate
+    equations."""
+    from screwkit.kinematics.rccc import rccc_dimensions, rccc_motion
+
+    dims = rccc_dimensions(linkage)
+    if dims is None:
+        raise ValueError(f"{linkage.name}: not an R-C-C-C loop in Hartenberg-Denavit form with "
+                         "the R joint as its input; use method 'generic'")
+    theta = X[:, 0]
+    mot = rccc_motion(dims, theta)
+    lay = layout(linkage)
+    modes: list[ModeMotion] = []
+    for j, label in ((0, "+acos root"), (1, "-acos root")):
+        ok = mot.assembles[:, j]
+        if not ok.any():
+            continue
+        scalars = np.where(ok[:, None], mot.scalars[:, j], 0.0)
+        for c in (1, 3, 5):
+            scalars[:, c] = np.where(ok, unwrap_runs(scalars[:, c], ok), 0.0)
+        conf = Configuration(scalars, np.zeros((len(theta), 0, 3, 3)))
+        md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd,
+                                     _branch_events(theta, ok))
+        modes.append(_with_seed(md, len(modes), label, ({}, {}, {}),
+                                singular=mot.dead_centre[:, j]))
+    if not modes:
+        raise _no_modes(linkage, X, _where_over_a_turn(
+            lambda th: np.asarray(rccc_motion(dims, th).assembles.any(axis=1))))
+    return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=RCCC_SOLVER)

@@ -14,17 +14,18 @@ Frames (those of :func:`screwkit.model.families.cssp` and :func:`screwkit.kinema
 * crank: rotation Z(θ1), origin on z1 at the crank offset s1 (joint 1's frame after its motion;
   x along the crank);
 * rod: origin at the crank pin D1, x along the rod u = (P − D1)/a2 (the pin S joint's child
-  frame). A two-ball rod's spin angle about u is not fixed by the loop; this adapter uses
-  Rahman's frame {3}, R = Z(θ1 + θ2)·Y(η2) (SPEC §1.1, L2), so y lies in the plane of z1;
+  frame). A two-ball rod's spin angle about u is not fixed by the loop; it is the zero-spin
+  frame along the branch, the generic solver's convention (:mod:`screwkit.kinematics.idle_spin`),
+  so that its rotation differentiates to its ω: Rahman's frame {3}, R = Z(θ1 + θ2)·Y(η2)
+  (SPEC §1.1, L2), turned about u by the sweep's ``rod_turn`` φ
+  (:mod:`screwkit.kinematics.cssp_rod_pose`);
 * slider: origin at the ball centre P, constant rotation X(−(α4 + π/2)) (the loop closes the
   slider's rotation with the ball joint).
 
 Rates follow the generic solver's rule for an S–S link: zero absolute spin, ω_rod·u = 0, so
-ω_rod = u × u̇ and α_rod = u × ü (Rahman 1996 §1.2). As in the generic solver, the rod's
-rotation is therefore not the time integral of its angular velocity (the spin angle is a free
-choice, the spin rate is zero); only quantities that do not depend on the spin angle are
-physical — the CoM kinematics of a rod whose CoM is on its axis, ω, α, the joint centres and the
-loads of an axisymmetric rod (docs/dynamics.md, "idle passive freedoms").
+ω_rod = u × u̇ and α_rod = u × ü (Rahman 1996 §1.2), and the rod's pose is the frame that spin
+rule carries along the branch (path dependent: after a full turn of the crank it comes back
+turned about u by the holonomy). The fused inverse dynamics reads the same block rows.
 
 Spherical-joint rates use the generic solver's convention: the three freedoms ``<joint>.wx|wy|wz``
 are the relative angular velocity in the child frame, and their "accelerations" the time
@@ -94,7 +95,7 @@ def _component_major(n: int, *shape: int) -> tuple[Array, Array]:
     return storage, np.moveaxis(storage, -1, 0)
 
 
-def _closed_form_block(
+def cssp_closed_form_block(
     dims: CSSPDimensions, mode: int, ct: Array, st: Array, w: Any, wd: Any, s1: Any, s1d: Any,
     s1dd: Any, disc: Array,
 ) -> dict[str, Any]:
@@ -148,6 +149,18 @@ def _combine(coefficients: Array, values: tuple[Any, Any, Any]) -> Any:
         term = v if c == 1.0 else (-v if c == -1.0 else c * v)
         total = term if type(total) is float and total == 0.0 else total + term
     return total
+
+
+def rahman_rod_axes(u: tuple[Any, Any, Any]) -> tuple[tuple[Any, Any, Any], tuple[Any, Any, Any]]:
+    """y3 and z3 of Rahman's rod frame {3} = Z(θ1 + θ2)·Y(η2) with x3 = u:
+    y3 = (−u_y, u_x, 0)/ρ, z3 = u × y3 (SPEC §1.1; y3 = (0, 1, 0) where u is vertical)."""
+    rho2 = u[0] * u[0] + u[1] * u[1]
+    defined = rho2 > GIMBAL_TOL**2
+    inv_rho = 1.0 / np.sqrt(np.where(defined, rho2, 1.0))
+    y3 = (np.where(defined, -u[1] * inv_rho, 0.0), np.where(defined, u[0] * inv_rho, 1.0),
+          np.zeros_like(rho2))
+    z3 = (-u[2] * y3[1], u[2] * y3[0], u[0] * y3[1] - u[1] * y3[0])
+    return y3, z3
 
 
 def _dot3(a: tuple[Any, Any, Any], b: tuple[Any, Any, Any]) -> Any:
@@ -223,15 +236,15 @@ def cssp_block_rows(
     w, wd = sw.block("theta1_dot", sel), sw.block("theta1_ddot", sel)
     s1 = sw.block("s1", sel)
     s1d, s1dd = sw.block("s1_dot", sel), sw.block("s1_ddot", sel)
-    k = _closed_form_block(dims, sw.mode, ct, st, w, wd, s1, s1d, s1dd, sw.discriminant[sel])
+    k = cssp_closed_form_block(dims, sw.mode, ct, st, w, wd, s1, s1d, s1dd,
+                               sw.discriminant[sel])
     u, ud, udd = k["u"], k["u_dot"], k["u_ddot"]
-    # Rahman's rod frame {3} = Z(θ1 + θ2)·Y(η2): x3 = u, y3 = (−u_y, u_x, 0)/ρ, z3 = u × y3
-    rho2 = u[0] * u[0] + u[1] * u[1]
-    defined = rho2 > GIMBAL_TOL**2
-    inv_rho = 1.0 / np.sqrt(np.where(defined, rho2, 1.0))
-    y3 = (np.where(defined, -u[1] * inv_rho, 0.0), np.where(defined, u[0] * inv_rho, 1.0))
-    z3 = (-u[2] * y3[1], u[2] * y3[0], u[0] * y3[1] - u[1] * y3[0])
-    rod = ((u[0], y3[0], z3[0]), (u[1], y3[1], z3[1]), (u[2], 0.0, z3[2]))
+    y3, z3 = rahman_rod_axes(u)
+    # the zero-spin frame: {3} turned about u by the sweep's rod turn φ (module docstring)
+    c, s = np.cos(sw.rod_turn[sel]), np.sin(sw.rod_turn[sel])
+    y3, z3 = (tuple(c * y + s * z for y, z in zip(y3, z3, strict=True)),
+              tuple(c * z - s * y for y, z in zip(y3, z3, strict=True)))
+    rod = ((u[0], y3[0], z3[0]), (u[1], y3[1], z3[1]), (u[2], y3[2], z3[2]))
     w_rod = _cross3(u, ud)
     al_rod = _cross3(u, udd)
     slider_R = rot_x(np.array(-(dims.alpha4 + np.pi / 2)))
@@ -280,8 +293,7 @@ def _ball_joint_block(loop: dict[str, Any], REL_st: Array, RATE_st: Array, sl: s
     for j in range(3):
         REL_st[0, 0, j, sl] = ct * rod[0][j] + st * rod[1][j]
         REL_st[0, 1, j, sl] = ct * rod[1][j] - st * rod[0][j]
-        if j != 1:  # rod[2][1] = y3_z = 0
-            REL_st[0, 2, j, sl] = rod[2][j]
+        REL_st[0, 2, j, sl] = rod[2][j]
         for i in range(3):
             REL_st[1, i, j, sl] = _combine(slider_R[:, j], (rod[0][i], rod[1][i], rod[2][i]))
     rel_w = (w_rod[0], w_rod[1], w_rod[2] - w)
@@ -326,6 +338,7 @@ class CSSPSweep:
     given: dict[str, float | Array]
     discriminant: Array
     assembles: NDArray[np.bool_]
+    rod_turn: Array  # (N,) φ turning Rahman's rod frame {3} about u to the zero-spin frame
 
     def block(self, name: str, sel: slice | NDArray[np.intp]) -> float | Array:
         """An input over some samples (a float if it is constant)."""
@@ -405,7 +418,47 @@ def cssp_sweep(
             raise CSSPAssemblyError(msg + " Pass allow_partial=True to get NaN there instead.",
                                     ok)
         disc = np.where(ok, disc, 1.0)
-    return CSSPSweep(dims, mode, driven_offset, n, th, ct, st, given, disc, ok)
+    from screwkit.kinematics.cssp_rod_pose import rod_turn
+
+    turn = rod_turn(dims, mode, th, ct, st, given, disc, ok)
+    return CSSPSweep(dims, mode, driven_offset, n, th, ct, st, given, disc, ok, turn)
+
+
+def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
+                  rotations: tuple[Array, Array] | None, rates: Array | None,
+                  ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array]]:
+    """The joint variables of a CSSP mode, their rates and accelerations by name: the crank's
+    θ1 (and s1 when driven), the ball joints' rotation vectors (when ``rotations`` holds their
+    relative rotations) and child-frame rates (when ``rates`` holds them), the slider's s4."""
+    ok = sw.assembles
+    first = linkage.joints[0].name
+    pin, ball, slider = (j.name for j in linkage.joints[1:])
+    variables: dict[str, Array] = {f"{first}.theta": sw.theta1}
+    velocities: dict[str, Array] = {f"{first}.theta": sw.full("theta1_dot")}
+    accelerations: dict[str, Array] = {f"{first}.theta": sw.full("theta1_ddot")}
+    if sw.driven_offset:
+        variables[f"{first}.s"] = sw.full("s1")
+        velocities[f"{first}.s"] = sw.full("s1_dot")
+        accelerations[f"{first}.s"] = sw.full("s1_ddot")
+    vectors: list[Array | None] = [None, None]
+    if rotations is not None:
+        safe = np.where(ok[:, None, None], 1.0, 0.0)
+        eye = np.where(ok[:, None, None], 0.0, 1.0) * np.eye(3)
+        from scipy.spatial.transform import Rotation  # on first use (start-up time)
+        vectors = [Rotation.from_matrix(np.nan_to_num(rel) * safe + eye).as_rotvec()
+                   for rel in rotations]
+    for name, r, rv in ((pin, 0, vectors[0]), (ball, 2, vectors[1])):
+        if rates is None:
+            break
+        for a, ax in enumerate("xyz"):
+            if rv is not None:
+                variables[f"{name}.r{ax}"] = np.where(ok, rv[:, a], np.nan)
+            velocities[f"{name}.w{ax}"] = rates[r, a]
+            accelerations[f"{name}.w{ax}"] = rates[r + 1, a]
+    variables[f"{slider}.s"] = s4_st[0]
+    velocities[f"{slider}.s"] = s4_st[1]
+    accelerations[f"{slider}.s"] = s4_st[2]
+    return variables, velocities, accelerations
 
 
 def cssp_mode_motion(
@@ -486,70 +539,40 @@ def cssp_mode_motion(
     s1_all = sw.full("s1")
     scalars = [th] + ([s1_all] if driven_offset else []) + [s4_st[0]]
     conf = Configuration(np.stack(scalars, -1), relative)
-    first = linkage.joints[0].name
-    pin, ball, slider = (j.name for j in linkage.joints[1:])
-    variables: dict[str, Array] = {f"{first}.theta": th}
-    velocities: dict[str, Array] = {f"{first}.theta": sw.full("theta1_dot")}
-    accelerations: dict[str, Array] = {f"{first}.theta": sw.full("theta1_ddot")}
-    if driven_offset:
-        variables[f"{first}.s"] = s1_all
-        velocities[f"{first}.s"] = sw.full("s1_dot")
-        accelerations[f"{first}.s"] = sw.full("s1_ddot")
-    if joint_rotations:
-        safe = np.where(ok[:, None, None], 1.0, 0.0)
-        eye = np.where(ok[:, None, None], 0.0, 1.0) * np.eye(3)
-        from scipy.spatial.transform import Rotation  # on first use (start-up time)
-        pin_rv = Rotation.from_matrix(np.nan_to_num(pin_rel) * safe + eye).as_rotvec()
-        ball_rv = Rotation.from_matrix(np.nan_to_num(ball_rel) * safe + eye).as_rotvec()
-    for name, r, rv in ((pin, 0, pin_rv if joint_rotations else None),
-                        (ball, 2, ball_rv if joint_rotations else None)):
-        if not ball_joints:
-            break
-        for a, ax in enumerate("xyz"):
-            if rv is not None:
-                variables[f"{name}.r{ax}"] = np.where(ok, rv[:, a], np.nan)
-            velocities[f"{name}.w{ax}"] = RATE_st[r, a]
-            accelerations[f"{name}.w{ax}"] = RATE_st[r + 1, a]
-    variables[f"{slider}.s"] = s4_st[0]
-    velocities[f"{slider}.s"] = s4_st[1]
-    accelerations[f"{slider}.s"] = s4_st[2]
+    variables, velocities, accelerations = _joint_tables(
+        linkage, sw, s4_st, (pin_rel, ball_rel) if joint_rotations else None,
+        RATE_st if ball_joints else None)
 
     arrays = [link_rotation, link_origin, link_angular_velocity, link_origin_velocity,
               link_angular_acceleration, link_origin_acceleration, joint_centres, joint_axes]
-    bad = ~ok
-    if bad.any():
-        for arr in arrays:
-            arr[bad] = np.nan
-        if ball_joints:
-            relative[bad] = np.nan
-        conf.scalars[bad, -1] = np.nan
-        for table in (variables, velocities, accelerations):
-            for values in table.values():
-                values[bad] = np.nan
-        closure[bad] = np.nan
+    if ball_joints:
+        arrays.append(relative)
+    _mask_unassembled(ok, arrays, conf, (variables, velocities, accelerations), closure)
     closure /= linkage.length_scale
-    events: list[str] = []
-    if bad.any() and ok.any():
-        events.append(f"does not assemble at {int(bad.sum())} of {n} sample(s)")
+    bad = ~ok
+    events = ([f"does not assemble at {int(bad.sum())} of {n} sample(s)"]
+              if bad.any() and ok.any() else [])
     return ModeMotion(
-        assembles=ok,
-        singular=np.zeros(n, dtype=bool),
-        conf=conf,
-        variables=variables,
-        velocities=velocities,
-        accelerations=accelerations,
-        link_rotation=arrays[0],
-        link_origin=arrays[1],
-        link_angular_velocity=arrays[2],
-        link_origin_velocity=arrays[3],
-        link_angular_acceleration=arrays[4],
-        link_origin_acceleration=arrays[5],
-        joint_centres=arrays[6],
-        joint_axes=arrays[7],
-        closure_residual=closure,
-        events=events,
-    )
+        assembles=ok, singular=np.zeros(n, dtype=bool), conf=conf, variables=variables,
+        velocities=velocities, accelerations=accelerations, link_rotation=arrays[0],
+        link_origin=arrays[1], link_angular_velocity=arrays[2], link_origin_velocity=arrays[3],
+        link_angular_acceleration=arrays[4], link_origin_acceleration=arrays[5],
+        joint_centres=arrays[6], joint_axes=arrays[7], closure_residual=closure, events=events)
 
+
+def _mask_unassembled(ok: NDArray[np.bool_], arrays: list[Array], conf: Configuration,
+                      tables: tuple[dict[str, Array], ...], closure: Array) -> None:
+    """NaN (in place) wherever the CSSP does not assemble."""
+    bad = ~ok
+    if not bad.any():
+        return
+    for arr in arrays:
+        arr[bad] = np.nan
+    conf.scalars[bad, -1] = np.nan
+    for table in tables:
+        for values in table.values():
+            values[bad] = np.nan
+    closure[bad] = np.nan
 
 __all__ = [
     "CSSPBlockRows",

@@ -1,28 +1,39 @@
 """The generic loop solver: every assembly mode of any single loop over an input sweep.
 
-Assembly modes are continuous branches (``../shared/DESIGN.md``): every closed configuration at
-every sample is found by :func:`~screwkit.kinematics.solve.find_assemblies`, then consecutive
-samples are linked by path following: each branch is continued from one sample to the next in
-small sub-steps with Newton correction and must land on a root found there. A branch that cannot
-be continued stops: the message says at which input it last assembled (a limit position or dead
-centre lies between that sample and the next). Rates and accelerations follow from the loop's
-rate equations (:mod:`screwkit.kinematics.mode_frames`).
+Assembly modes are continuous branches (``../shared/DESIGN.md``), found by continuation
+(:mod:`screwkit.kinematics.continuation`), not by a root search at every sample:
+
+1. a global root search (:func:`~screwkit.kinematics.solve.find_assemblies`, Newton from many
+   random starts) runs at the first sample and, as a safety net with half as many starts, at
+   a coarse stride of *anchor* samples (every :data:`ANCHOR_SPAN` rad of input, or that
+   fraction of the length scale for a sliding input);
+2. every root not on a known branch seeds a new branch, which is followed forwards and
+   backwards to where it ends (so a mode born after the first sample is found over all of its
+   life, not from the anchor that found it);
+3. where a branch ends between two samples (the corrector says it dies: a limit position or
+   dead centre) the root search runs again at both samples, since a branch may be born where
+   another dies;
+4. a continuum of closed configurations at one input (a motion left free with the input
+   fixed) is one degenerate set, seeded once (:mod:`screwkit.kinematics.degenerate`), and
+   branches that turn out to be the same (found from two anchors) are merged.
+
+Rates, accelerations, link frames and singular samples then follow from the loop's rate
+equations (:mod:`screwkit.kinematics.mode_frames`).
 """
 
 from __future__ import annotations
 
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.loop import (
-    Array,
-    Configuration,
-    Layout,
-    layout,
-)
+from screwkit.kinematics.continuation import Track, Tracker
+from screwkit.kinematics.degenerate import seeds_off_continua
+from screwkit.kinematics.loop import Array, Configuration, Layout, forward, layout
 from screwkit.kinematics.mode_frames import mode_from_configuration
 from screwkit.kinematics.motion import (
     AssemblyError,
@@ -30,90 +41,54 @@ from screwkit.kinematics.motion import (
     as_input_array,
     format_inputs,
 )
-from screwkit.kinematics.solve import Assemblies, find_assemblies, newton, signature
+from screwkit.kinematics.rates import rate_equations
+from screwkit.kinematics.solve import Assemblies, find_assemblies, signature
 from screwkit.model.linkage import Linkage
 
-MAX_GENERIC_SAMPLES = 20_000
+#: input movement between two anchor samples of the safety-net root search (rad; × the length
+#: scale for a sliding input)
+ANCHOR_SPAN = np.radians(15.0)
+#: a sweep at least this long shows a progress bar on a terminal (when no callback is given)
+PROGRESS_SAMPLES = 50_000
+SAME_ROOT = 1e-6  # signature distance (length-scale units) of two copies of one configuration
+
+Progress = Callable[[int, int], None]
 
 
-def _continue(linkage: Linkage, lay: Layout, conf: Configuration, x_from: Array, x_to: Array,
-              max_sub: Array) -> tuple[Configuration, NDArray[np.bool_]]:
-    """Path-follow a batch of closed configurations from inputs ``x_from`` to ``x_to`` in
-    sub-steps no larger than ``max_sub`` per input, Newton-correcting at each (Bagci's eq. 3.64
-    idea applied to the loop); returns the end configurations and which ones got there."""
-    n_sub = int(max(1, np.ceil(np.max(np.abs(x_to - x_from) / max_sub))))
-    ok = np.ones(conf.size, dtype=bool)
-    in_cols = [lay.scalar_col[lay.names.index(n)] for n in linkage.inputs]
-    for k in range(1, n_sub + 1):
-        x = x_from + (x_to - x_from) * (k / n_sub)
-        q = conf.scalars.copy()
-        q[:, in_cols] = x
-        res = newton(linkage, Configuration(q, conf.spherical), max_iter=30, lay=lay)
-        conf = res.conf
-        ok &= res.converged
-    return conf, ok
+def anchor_samples(linkage: Linkage, X: Array) -> NDArray[np.intp]:
+    """The first and last samples and every sample where the inputs have moved another
+    :data:`ANCHOR_SPAN` since the previous anchor (measured along the sweep)."""
+    N = X.shape[0]
+    if N == 1:
+        return np.array([0])
+    L = linkage.length_scale
+    scale = np.array([1.0 / L if n.endswith(".s") else 1.0 for n in linkage.inputs])
+    span = np.concatenate([[0.0], np.cumsum(np.max(np.abs(np.diff(X, axis=0)) * scale, axis=1))])
+    marks = np.searchsorted(span, np.arange(0.0, span[-1], ANCHOR_SPAN))
+    return np.unique(np.concatenate([[0], marks, [N - 1]]).clip(0, N - 1))
 
 
-def _track(linkage: Linkage, lay: Layout, X: Array, asm: Assemblies) -> list[tuple[Configuration, NDArray[np.bool_], list[int]]]:
-    """Link the roots of consecutive samples into continuous branches by path following."""
-    N, K = asm.found.shape
-    sig = asm.signature
-    max_sub = np.array([np.radians(2.0) if not lay.is_translation[lay.names.index(n)]
-                        else linkage.length_scale / 50 for n in linkage.inputs])
-    branches: list[dict[str, Any]] = []
-    active: list[int] = []
-    for i in range(N):  # sequential by nature: each step continues from the previous one
-        roots = np.nonzero(asm.found[i])[0]
-        claimed: dict[int, tuple[int, float]] = {}
-        still: list[int] = []
-        if active:
-            start = Configuration(
-                np.stack([branches[b]["q"][i - 1] for b in active]),
-                np.stack([branches[b]["r"][i - 1] for b in active]),
-            )
-            end, ok = _continue(linkage, lay, start, X[i - 1], X[i], max_sub)
-            sig_end = signature(linkage, end, lay)
-            for r, b in enumerate(active):
-                if not ok[r]:
-                    continue
-                d = np.max(np.abs(sig[i, roots] - sig_end[r]), axis=-1) if roots.size else np.array([])
-                moved = float(np.max(np.abs(sig_end[r] - branches[b]["sig"])))
-                if d.size and d.min() < 1e-6:
-                    root = int(roots[np.argmin(d)])
-                    if root in claimed and claimed[root][1] <= moved:
-                        continue
-                    if root in claimed:
-                        still.remove(claimed[root][0])
-                    claimed[root] = (b, moved)
-                branches[b]["q"][i] = end.scalars[r]
-                branches[b]["r"][i] = end.spherical[r]
-                branches[b]["sig"] = sig_end[r]
-                still.append(b)
-            for b in active:
-                if b not in still:
-                    branches[b]["stops"].append(i)
-                    branches[b]["mask"][i:] = False
-            for b in still:
-                branches[b]["mask"][i] = True
-        taken = set(claimed)
-        for root in roots.tolist():
-            if int(root) in taken:
-                continue
-            j = i * K + int(root)
-            q_new = np.full((N, lay.n_scalar), np.nan)
-            r_new = np.tile(np.eye(3), (N, lay.n_spherical, 1, 1))
-            q_new[i] = asm.conf.scalars[j]
-            r_new[i] = asm.conf.spherical[j]
-            m_new = np.zeros(N, dtype=bool)
-            m_new[i] = True
-            branches.append({"q": q_new, "r": r_new, "mask": m_new, "stops": [], "sig": sig[i, root]})
-            still.append(len(branches) - 1)
-        active = still
-    out = []
-    for br in branches:
-        q = np.where(np.isnan(br["q"]), 0.0, br["q"])
-        out.append((Configuration(q, br["r"]), br["mask"], br["stops"]))
-    return out
+@contextmanager
+def _reporter(progress: Progress | bool | None, N: int) -> Iterator[Progress | None]:
+    """The progress callback to use: the caller's, none, or a rich bar on stderr for a long
+    sweep on a terminal."""
+    if callable(progress):
+        yield progress
+        return
+    if progress is False or (progress is None and (N < PROGRESS_SAMPLES
+                                                   or not sys.stderr.isatty())):
+        yield None
+        return
+    from rich.console import Console
+    from rich.progress import Progress as Bar
+
+    with Bar(console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task("following assembly modes", total=N)
+
+        def update(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        yield update
 
 
 def generic_motion(
@@ -123,75 +98,219 @@ def generic_motion(
     input_accelerations: Array | list[float] | float = 0.0,
     starts: int = 48,
     seed: int = 0,
+    progress: Progress | bool | None = None,
 ) -> Motion:
     """Positions, velocities and accelerations of every freedom and link over an input sweep,
-    in every assembly mode (generic solver; works for any single loop)."""
+    in every assembly mode (generic solver; works for any single loop; module docstring).
+
+    ``starts`` random starts per root search and their ``seed``; ``progress`` a callback
+    ``(samples done, samples to do)`` (both grow as modes are found), ``False`` for none, or
+    ``None``: a progress bar on stderr for a sweep of 50 000 samples or more on a terminal."""
     lay = layout(linkage)
     X = as_input_array(linkage, input_values, "input values")
     N = X.shape[0]
-    Xd = np.broadcast_to(as_input_array(linkage, input_rates, "input rates"), X.shape)
-    Xdd = np.broadcast_to(as_input_array(linkage, input_accelerations, "input accelerations"), X.shape)
-    if N > MAX_GENERIC_SAMPLES:
-        raise ValueError(
-            f"{linkage.name}: {N} input samples is too many for the generic solver, which follows "
-            f"every branch sample by sample (~10 ms a sample): use at most {MAX_GENERIC_SAMPLES} "
-            "(a larger step), or a family with a closed form (RSRC, 4R, CSSP)"
-        )
-    asm = _find_all(linkage, X, starts, seed)
-    if not asm.found.any():
-        raise AssemblyError(
-            f"{linkage.name}: the loop does not close at any of the {N} inputs "
-            f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
-            "check the dimensions"
-        )
-    tracks = _track(linkage, lay, X, asm)
-    # a documented, deterministic mode order: by the first sample where the mode assembles,
-    # then by its configuration there (joint centres and axes), not by the random starts
-    def key(track: tuple[Configuration, NDArray[np.bool_], list[int]]) -> tuple[float, ...]:
-        conf, mask, _ = track
-        first = int(np.argmax(mask))
-        sig = signature(linkage, conf.take(np.array([first])), lay)[0]
-        return (float(first), *np.round(sig, 9).tolist())
-
-    modes = []
-    for conf, mask, stops in sorted(tracks, key=key):
-        events = [
-            f"stops assembling after input {format_inputs(linkage, X[s - 1])} (limit position "
-            f"or dead centre before {format_inputs(linkage, X[s])})"
-            for s in stops
-        ]
-        first = int(np.argmax(mask))
-        if first > 0:
-            events.insert(0, f"starts assembling at input {format_inputs(linkage, X[first])}")
-        modes.append(mode_from_configuration(linkage, lay, conf, mask, X, Xd, Xdd, events))
+    Xd = np.array(np.broadcast_to(as_input_array(linkage, input_rates, "input rates"), X.shape))
+    Xdd = np.array(np.broadcast_to(as_input_array(linkage, input_accelerations,
+                                                  "input accelerations"), X.shape))
+    with _reporter(progress, N) as report:
+        tracks = _all_branches(linkage, lay, X, starts, seed, report)
+        if not tracks:
+            raise AssemblyError(
+                f"{linkage.name}: the loop does not close at any of the {N} inputs "
+                f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
+                "check the dimensions")
+        modes = []
+        for tr in tracks:
+            modes.append(mode_from_configuration(linkage, lay, tr.configuration(), tr.mask.copy(),
+                                                 X, Xd, Xdd, _events(linkage, X, tr)))
     modes = [replace(md, index=k, label=f"branch {k}") for k, md in enumerate(modes)]
-    return Motion(linkage, X, np.array(Xd), np.array(Xdd), tuple(modes), method="generic",
-                  solver="generic loop solver: Newton on the loop closure from many starts, "
-                         "branches linked by path following (docs/kinematics.md)")
+    return Motion(linkage, X, Xd, Xdd, tuple(modes), method="generic",
+                  solver="generic loop solver: continuation along the input (second-order "
+                         "predictor, Newton corrector) from root searches at the first sample, "
+                         "at anchors and where branches end (docs/kinematics.md)")
 
 
-def _find_all(linkage: Linkage, X: Array, starts: int, seed: int) -> Assemblies:
-    """Every assembly at every sample. Random starts can miss a root, most often where the
-    number of roots changes (a branch is born or dies): samples whose count differs from a
-    neighbour's are searched again with four times the starts, keeping the richer answer."""
-    asm = find_assemblies(linkage, X, starts=starts, seed=seed)
-    count = asm.found.sum(axis=1)
-    if len(count) < 2:
-        return asm
-    differs = np.zeros(len(count), dtype=bool)
-    differs[1:] |= count[1:] != count[:-1]
-    differs[:-1] |= count[:-1] != count[1:]
-    idx = np.nonzero(differs)[0]
-    if idx.size == 0:
-        return asm
-    again = find_assemblies(linkage, X[idx], starts=4 * starts, seed=seed + 1)
+def _events(linkage: Linkage, X: Array, tr: Track) -> list[str]:
+    """Where a branch starts and stops assembling, from its mask."""
+    m = tr.mask
+    events = []
+    for k in np.nonzero(m[1:] & ~m[:-1])[0] + 1:
+        events.append(f"starts assembling at input {format_inputs(linkage, X[k])} (limit "
+                      f"position or dead centre after {format_inputs(linkage, X[k - 1])})")
+    for k in np.nonzero(m[:-1] & ~m[1:])[0]:
+        events.append(f"stops assembling after input {format_inputs(linkage, X[k])} (limit "
+                      f"position or dead centre before {format_inputs(linkage, X[k + 1])})")
+    return events
+
+
+def _signatures(linkage: Linkage, lay: Layout, tr: Track, samples: NDArray[np.intp]) -> Array:
+    conf = Configuration(tr.scalars[samples], tr.spherical[samples])
+    return signature(linkage, conf, lay)
+
+
+def _new_seeds(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray[np.intp],
+               asm: Assemblies, first_only: bool = False,
+               ) -> list[tuple[int, int, Configuration]]:
+    """The roots of a root search at ``samples`` that are on no known branch, per row of the
+    search (its index, its sample and the roots); of
+    the roots on a continuum (a motion free with the input fixed) one, and none where a known
+    branch is on a continuum already (:mod:`screwkit.kinematics.degenerate`)."""
     K = asm.found.shape[1]
-    better = again.found.sum(axis=1) > count[idx]
-    for r, i in zip(np.nonzero(better)[0], idx[better], strict=True):
-        asm.found[i] = again.found[r]
-        asm.signature[i] = again.signature[r]
-        asm.conf.scalars[i * K:(i + 1) * K] = again.conf.scalars[r * K:(r + 1) * K]
-        asm.conf.spherical[i * K:(i + 1) * K] = again.conf.spherical[r * K:(r + 1) * K]
-    return asm
+    known = [(tr, tr.mask[samples]) for tr in tracker.tracks]
+    known_sig = [_signatures(linkage, lay, tr, samples[m]) if m.any() else None
+                 for tr, m in known]
+    out = []
+    for r, s in enumerate(samples.tolist()):
+        found = np.nonzero(asm.found[r])[0]
+        if found.size == 0:
+            continue
+        sig, radius = asm.signature[r][found], asm.radius[r][found]
+        new = np.ones(found.size, dtype=bool)
+        here = []
+        for (tr, m), ks in zip(known, known_sig, strict=True):
+            if ks is not None and m[r]:
+                own = ks[int(np.sum(m[:r]))]
+                new &= np.max(np.abs(sig - own), axis=1) >= np.maximum(radius, SAME_ROOT)
+                here.append(tr)
+        if not new.any():
+            continue
+        conf = asm.conf.take(r * K + found[new])
+        seen = Configuration(np.stack([tr.scalars[s] for tr in here]),
+                             np.stack([tr.spherical[s] for tr in here])) if here \
+            else conf.take(np.array([], dtype=int))
+        keep = seeds_off_continua(linkage, lay, seen, conf)
+        if keep.any():
+            out.append((r, s, conf.take(np.nonzero(keep)[0])))
+            if first_only:
+                break
+    return out
 
 
+def _root_search(linkage: Linkage, X: Array, samples: NDArray[np.intp], starts: int,
+                 seed: int) -> tuple[NDArray[np.intp], Assemblies]:
+    """Every root at ``samples`` by Newton from random starts, in one vectorised search:
+    ``starts`` at the first sample of the sweep, half as many at the others (the safety net:
+    there the known branches are found again by most starts, and a branch missed at one
+    sample is found at the next). Returns the sample of each row of the search and the
+    search."""
+    half = max(starts // 2, 8)
+    lead = int(samples[0] == 0) * max(starts // half - 1, 0)  # extra copies of sample 0
+    rows = np.concatenate([np.zeros(lead, dtype=np.intp), samples])
+    return rows, find_assemblies(linkage, X[rows], starts=half, seed=seed)
+
+
+def _seed_from(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray[np.intp],
+               X: Array, starts: int, seed: int) -> bool:
+    """Root search at ``samples`` (vectorised over them); then, in the order of the samples,
+    follow the roots on no known branch at the first sample that has some, and look again at
+    the later samples — so a branch found at one sample is not seeded again at the next. True
+    if any root was new."""
+    if samples.size == 0:
+        return False
+    samples, asm = _root_search(linkage, X, samples, starts, seed)
+    K = asm.found.shape[1]
+    remaining = np.nonzero(asm.found.any(axis=1))[0]
+    found_new = False
+    while remaining.size:
+        rows = (remaining[:, None] * K + np.arange(K)).ravel()
+        sub = Assemblies(asm.conf.take(rows), asm.found[remaining], asm.signature[remaining],
+                         asm.radius[remaining])
+        seeds = _new_seeds(linkage, lay, tracker, samples[remaining], sub, first_only=True)
+        if not seeds:
+            break
+        row, sample, conf = seeds[0]
+        tracker.follow(tracker.add_seeds(sample, conf))
+        found_new = True
+        remaining = remaining[row + 1:]
+    return found_new
+
+
+def _all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int,
+                  report: Progress | None) -> list[Track]:
+    N = X.shape[0]
+    done = [0]
+
+    def count(n: int) -> None:
+        done[0] += n
+        if report is not None:
+            report(done[0], N * max(1, len(tracker.tracks)))
+
+    tracker = Tracker(linkage, lay, X, count if report is not None else None)
+    _seed_from(linkage, lay, tracker, anchor_samples(linkage, X), X, starts, seed)
+    searched: set[int] = set()
+    for round_ in range(4):  # births where branches die; rarely more than one round
+        ends: set[int] = set()
+        for tr in tracker.tracks:
+            for k, _ in tr.stops:
+                ends.update((k, k + 1))
+            for k, _ in tr.starts:
+                ends.update((k - 1, k))
+        todo = np.array(sorted(s for s in ends - searched if 0 <= s < N), dtype=np.intp)
+        searched |= set(todo.tolist())
+        if not _seed_from(linkage, lay, tracker, todo, X, starts, seed + 1 + round_):
+            break
+    tracks = _attach_turning_points(linkage, lay, _merge_duplicates(linkage, lay, tracker.tracks))
+    return sorted(tracks, key=lambda tr: _order_key(linkage, lay, tr))
+
+
+def _merge_duplicates(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
+    """Tracks that are the same configuration wherever both hold are one branch; a track that
+    shares another's configuration at some samples only has jumped onto it there (near a fold
+    both branches are close) and loses those samples. (Two branches that cross share one
+    singular configuration; that sample is kept by both.)"""
+    out: list[Track] = []
+    for tr in tracks:
+        for kept in out:
+            both = np.nonzero(kept.mask & tr.mask)[0]
+            if both.size == 0:
+                continue
+            d = np.max(np.abs(_signatures(linkage, lay, kept, both)
+                              - _signatures(linkage, lay, tr, both)), axis=1)
+            same = d < 1e-5
+            if same.all():
+                extra = tr.mask & ~kept.mask
+                kept.scalars[extra] = tr.scalars[extra]
+                kept.spherical[extra] = tr.spherical[extra]
+                kept.mask |= tr.mask
+                break
+            if same.sum() > 1:
+                tr.mask[both[same]] = False
+        else:
+            if tr.mask.any():
+                out.append(tr)
+    return out
+
+
+def _attach_turning_points(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
+    """A one-sample track at a singular configuration next to where other branches end is
+    the turning point where they meet (a sample exactly at a dead centre, found by the root
+    search there): it becomes the last sample of each of those branches, as the closed forms
+    report it."""
+    out = []
+    for tr in tracks:
+        held = np.nonzero(tr.mask)[0]
+        if held.size != 1:
+            out.append(tr)
+            continue
+        s = int(held[0])
+        ends = [o for o in tracks if o is not tr and not o.mask[s] and (
+            (s > 0 and o.mask[s - 1]) or (s + 1 < len(o.mask) and o.mask[s + 1]))]
+        conf = Configuration(tr.scalars[held], tr.spherical[held])
+        singular = rate_equations(linkage, lay, forward(linkage, conf, lay)).rank_deficient[0]
+        if not ends or not singular:
+            out.append(tr)
+            continue
+        for o in ends:
+            o.scalars[s], o.spherical[s], o.mask[s] = tr.scalars[s], tr.spherical[s], True
+    return out
+
+
+def _order_key(linkage: Linkage, lay: Layout, tr: Track) -> tuple[float, ...]:
+    """A documented, deterministic mode order: by the first sample where the mode assembles,
+    then by its configuration there (joint centres and axes), not by the random starts."""
+    first = int(np.argmax(tr.mask))
+    sig = _signatures(linkage, lay, tr, np.array([first]))[0]
+    return (float(first), *np.round(sig, 9).tolist())
+
+
+__all__ = ["ANCHOR_SPAN", "anchor_samples", "generic_motion"]

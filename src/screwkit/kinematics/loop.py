@@ -14,12 +14,12 @@ along u is (0; u) and a helical of pitch h is (u; c × u + h u).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.dual.spatial import rot_y, rot_z, skew
+from screwkit.dual.spatial import cross, rot_y, skew
 from screwkit.model.linkage import Linkage
 
 Array = NDArray[np.float64]
@@ -47,7 +47,8 @@ class Configuration:
 
 @dataclass(frozen=True)
 class Layout:
-    """Where each freedom of a linkage lives in a :class:`Configuration` and in the Jacobian."""
+    """Where each freedom of a linkage lives in a :class:`Configuration` and in the Jacobian,
+    and the loop's constants the hot paths need (link transforms as arrays, length scale)."""
 
     names: tuple[str, ...]  # all freedoms, loop order (Jacobian columns)
     joint_of: tuple[int, ...]  # joint index of each freedom
@@ -56,6 +57,25 @@ class Layout:
     is_translation: tuple[bool, ...]  # P/C s freedoms carry length units
     n_scalar: int
     n_spherical: int
+    #: the linkage the constants below were read from (a layout fits every loop with the same
+    #: joints, but its constants only this one: see :func:`constants`)
+    source: Linkage | None = field(default=None, compare=False, repr=False)
+    link_rotations: Array = field(default_factory=lambda: np.zeros((0, 3, 3)), compare=False,
+                                  repr=False)
+    link_translations: Array = field(default_factory=lambda: np.zeros((0, 3)), compare=False,
+                                     repr=False)
+    link_scale: float = field(default=1.0, compare=False, repr=False)
+
+
+def constants(linkage: Linkage, lay: Layout) -> tuple[Array, Array, float]:
+    """The link rotations (n, 3, 3), translations (n, 3) and length scale of ``linkage``: from
+    the layout when it was made for this very linkage (the hot paths), else read anew (a layout
+    reused for another loop with the same joints, e.g. a synthesis trial's dimensions)."""
+    if lay.source is linkage:
+        return lay.link_rotations, lay.link_translations, lay.link_scale
+    return (np.stack([np.asarray(t.real, dtype=float) for t in linkage.link_transforms]),
+            np.stack([np.asarray(t.translation, dtype=float) for t in linkage.link_transforms]),
+            linkage.length_scale)
 
 
 def layout(linkage: Linkage) -> Layout:
@@ -77,7 +97,11 @@ def layout(linkage: Linkage) -> Layout:
             else:
                 scalar_col.append(col)
                 col += 1
-    return Layout(tuple(names), tuple(joint_of), tuple(scalar_col), sph, tuple(is_tr), col, len(sph))
+    rotations = np.stack([np.asarray(t.real, dtype=float) for t in linkage.link_transforms])
+    translations = np.stack([np.asarray(t.translation, dtype=float)
+                             for t in linkage.link_transforms])
+    return Layout(tuple(names), tuple(joint_of), tuple(scalar_col), sph, tuple(is_tr), col, len(sph),
+                  linkage, rotations, translations, linkage.length_scale)
 
 
 @dataclass(frozen=True)
@@ -102,83 +126,100 @@ class LoopFrames:
     axes: Array
 
 
-def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None) -> LoopFrames:
-    """Walk the loop J_1 L_1 ··· J_n L_n for every sample (vectorised over samples)."""
+def _turn_z(R: Array, th: Array) -> Array:
+    """R · Rz(θ), column by column."""
+    c, s = np.cos(th)[:, None], np.sin(th)[:, None]
+    out = np.empty_like(R)
+    out[:, :, 0] = c * R[:, :, 0] + s * R[:, :, 1]
+    out[:, :, 1] = c * R[:, :, 1] - s * R[:, :, 0]
+    out[:, :, 2] = R[:, :, 2]
+    return out
+
+
+def _screw(u: Array, centre: Array, pitch: float = 0.0) -> Array:
+    """The unit screw (u; c × u + h u) of a rotation about the line through c along u."""
+    out = np.empty(u.shape[:-1] + (6,))
+    out[..., :3] = u
+    out[..., 3:] = cross(centre, u)
+    if pitch:
+        out[..., 3:] += pitch * u
+    return out
+
+
+def _slide(u: Array) -> Array:
+    out = np.zeros(u.shape[:-1] + (6,))
+    out[..., 3:] = u
+    return out
+
+
+def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
+            frames: bool = True) -> LoopFrames:
+    """Walk the loop J_1 L_1 ··· J_n L_n for every sample (vectorised over samples). With
+    ``frames=False`` only the closure and the screws are filled (a Newton step's needs; the
+    frame arrays are then left unset)."""
     lay = lay or layout(linkage)
+    link_R, link_p, _ = constants(linkage, lay)
     N = conf.size
     n = len(linkage.joints)
     R = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
     p = np.zeros((N, 3))
-    bR = np.empty((N, n, 3, 3))
-    bp = np.empty((N, n, 3))
-    aR = np.empty((N, n, 3, 3))
-    ap = np.empty((N, n, 3))
-    centres = np.empty((N, n, 3))
-    axes = np.empty((N, n, 3))
-    cols: list[Array] = []
+    shape = (N, n) if frames else (1, n)
+    bR = np.empty((*shape, 3, 3))
+    bp = np.empty((*shape, 3))
+    aR = np.empty((*shape, 3, 3))
+    ap = np.empty((*shape, 3))
+    centres = np.empty((*shape, 3))
+    axes = np.empty((*shape, 3))
+    screws = np.empty((N, 6, len(lay.names)))
     q = conf.scalars
     fi = 0  # running freedom index
-    for i, (joint, link) in enumerate(zip(linkage.joints, linkage.link_transforms, strict=True)):
-        bR[:, i] = R
-        bp[:, i] = p
-        u = R[..., :, 2]
+    for i, joint in enumerate(linkage.joints):
+        u = R[:, :, 2]
         kind = joint.kind
-        if kind == "P":
-            centre = p
-        else:
-            centre = p + joint.offset * u
-        centres[:, i] = centre
-        axes[:, i] = u
+        centre = p if kind == "P" or joint.offset == 0.0 else p + joint.offset * u
+        if frames:
+            bR[:, i] = R
+            bp[:, i] = p
+            centres[:, i] = centre
+            axes[:, i] = u
+        col = lay.scalar_col[fi]
         if kind == "R":
-            th = q[:, lay.scalar_col[fi]]
-            jR = rot_z(th)
-            jp = np.array([0.0, 0.0, joint.offset]) * np.ones((N, 1))
-            cols.append(np.concatenate([u, np.cross(centre, u)], -1))
+            R = _turn_z(R, q[:, col])
+            screws[:, :, fi] = _screw(u, centre)
+            p = centre
         elif kind == "P":
-            s = q[:, lay.scalar_col[fi]]
-            jR = np.broadcast_to(rot_z(np.array(joint.offset)), (N, 3, 3))
-            jp = np.stack([np.zeros(N), np.zeros(N), s], -1)
-            cols.append(np.concatenate([np.zeros_like(u), u], -1))
+            R = _turn_z(R, np.full(N, joint.offset))
+            screws[:, :, fi] = _slide(u)
+            p = p + q[:, col, None] * u
         elif kind == "C":
-            th = q[:, lay.scalar_col[fi]]
-            s = q[:, lay.scalar_col[fi + 1]]
-            jR = rot_z(th)
-            jp = np.stack([np.zeros(N), np.zeros(N), s], -1)
-            cols.append(np.concatenate([u, np.cross(centre, u)], -1))
-            cols.append(np.concatenate([np.zeros_like(u), u], -1))
+            R = _turn_z(R, q[:, col])
+            screws[:, :, fi] = _screw(u, centre)
+            screws[:, :, fi + 1] = _slide(u)
+            p = p + q[:, col + 1, None] * u
         elif kind == "H":
-            th = q[:, lay.scalar_col[fi]]
-            jR = rot_z(th)
-            jp = np.stack([np.zeros(N), np.zeros(N), joint.offset + joint.pitch * th], -1)
-            cols.append(np.concatenate([u, np.cross(centre, u) + joint.pitch * u], -1))
+            th = q[:, col]
+            R = _turn_z(R, th)
+            screws[:, :, fi] = _screw(u, centre, joint.pitch)
+            p = p + (joint.offset + joint.pitch * th)[:, None] * u
         elif kind == "U":
-            t1 = q[:, lay.scalar_col[fi]]
-            t2 = q[:, lay.scalar_col[fi + 1]]
-            r1 = rot_z(t1)
-            jR = r1 @ rot_y(t2)
-            jp = np.array([0.0, 0.0, joint.offset]) * np.ones((N, 1))
-            u2 = (R @ r1)[..., :, 1]
-            cols.append(np.concatenate([u, np.cross(centre, u)], -1))
-            cols.append(np.concatenate([u2, np.cross(centre, u2)], -1))
+            R = _turn_z(R, q[:, col])
+            u2 = R[:, :, 1].copy()
+            screws[:, :, fi] = _screw(u, centre)
+            screws[:, :, fi + 1] = _screw(u2, centre)
+            R = R @ rot_y(q[:, col + 1])
+            p = centre
         else:  # S
-            jR = conf.spherical[:, lay.spherical_of_joint[i]]
-            jp = np.array([0.0, 0.0, joint.offset]) * np.ones((N, 1))
-            child = R @ jR
+            R = R @ conf.spherical[:, lay.spherical_of_joint[i]]
             for k in range(3):
-                w = child[..., :, k]
-                cols.append(np.concatenate([w, np.cross(centre, w)], -1))
+                screws[:, :, fi + k] = _screw(R[:, :, k], centre)
+            p = centre
         fi += joint.dof
-        # after the joint motion: T <- T · J
-        p = p + np.einsum("nij,nj->ni", R, jp)
-        R = R @ jR
-        aR[:, i] = R
-        ap[:, i] = p
+        if frames:
+            aR[:, i] = R
+            ap[:, i] = p
         # then the constant link transform: T <- T · L
-        lR = link.real
-        lp = link.translation
-        p = p + R @ lp
-        R = R @ lR
-    screws = np.stack(cols, axis=-1)
+        p = p + R @ link_p[i]
+        R = R @ link_R[i]
     return LoopFrames(bR, bp, aR, ap, R, p, screws, centres, axes)
 
 
@@ -186,8 +227,7 @@ def closure_twist(R: Array, p: Array) -> Array:
     """The twist ξ (ω; v) with exp(ξ) = G = (R, p): the exact SE(3) logarithm, batched.
 
     Its norm is the loop-closure error; Newton drives it to zero."""
-    from scipy.spatial.transform import Rotation  # on first use (start-up time)
-    w = Rotation.from_matrix(R).as_rotvec()
+    w = rotation_vector(R)
     th = np.linalg.norm(w, axis=-1)
     W = skew(w)
     small = th < 1e-6
@@ -199,11 +239,27 @@ def closure_twist(R: Array, p: Array) -> Array:
     return np.concatenate([w, v], -1)
 
 
+def rotation_vector(R: Array) -> Array:
+    """The rotation vector (axis × angle, angle in [0, π]) of rotation matrices (..., 3, 3):
+    from the skew part and the trace, and by scipy near a half turn where that loses digits."""
+    vee = 0.5 * np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
+                          R[..., 1, 0] - R[..., 0, 1]], -1)
+    cos = np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0)
+    sin = np.linalg.norm(vee, axis=-1)
+    angle = np.arctan2(sin, cos)
+    scale = np.where(sin > 1e-300, angle / np.maximum(sin, 1e-300), 1.0)
+    w = vee * scale[..., None]
+    near_half = cos < -0.9
+    if np.any(near_half):
+        from scipy.spatial.transform import Rotation  # on first use (start-up time)
+
+        w[near_half] = Rotation.from_matrix(R[near_half]).as_rotvec()
+    return np.asarray(w)
+
+
 def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configuration:
     """Move a configuration by freedom increments ``delta`` (N, m): scalars add, spherical
     joints turn by exp([δ]) about their own moving axes (R ← R·exp([δ]))."""
-    from scipy.spatial.transform import Rotation  # on first use (start-up time)
-
     q = conf.scalars.copy()
     sph = conf.spherical.copy()
     cols = np.array(lay.scalar_col)
@@ -211,34 +267,85 @@ def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configura
     q[:, cols[scal]] += delta[:, np.nonzero(scal)[0]]
     for j, k in lay.spherical_of_joint.items():
         idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
-        d = delta[:, idx]
-        sph[:, k] = sph[:, k] @ Rotation.from_rotvec(d).as_matrix()
+        sph[:, k] = sph[:, k] @ rotation_matrix(delta[:, idx])
     return Configuration(q, sph)
+
+
+def rotation_matrix(w: Array) -> Array:
+    """exp([w]×) of rotation vectors w (N, 3) by Rodrigues' formula (series near zero)."""
+    th2 = np.einsum("ni,ni->n", w, w)
+    th = np.sqrt(th2)
+    small = th2 < 1e-8
+    safe = np.where(small, 1.0, th)
+    a = np.where(small, 1.0 - th2 / 6.0, np.sin(safe) / safe)
+    b = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(safe)) / np.where(small, 1.0, th2))
+    K = skew(w)
+    return np.asarray(np.eye(3) + a[:, None, None] * K + b[:, None, None] * (K @ K))
+
+
+def configuration_difference(a: Configuration, b: Configuration, lay: Layout) -> Array:
+    """Freedom increments (N, m) taking ``b`` to ``a``: scalar differences (angles wrapped to
+    (−π, π]) and, for a spherical joint, the rotation vector of R_bᵀR_a (its own axes)."""
+    out = np.zeros((a.size, len(lay.names)))
+    cols = np.array(lay.scalar_col)
+    scal = np.nonzero(cols >= 0)[0]
+    d = a.scalars[:, cols[scal]] - b.scalars[:, cols[scal]]
+    turn = ~np.array(lay.is_translation)[scal]
+    d[:, turn] = np.pi - np.mod(np.pi - d[:, turn], 2 * np.pi)
+    out[:, scal] = d
+    for j, k in lay.spherical_of_joint.items():
+        idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
+        rel = np.swapaxes(b.spherical[:, k], -1, -2) @ a.spherical[:, k]
+        out[:, idx] = rotation_vector(rel)
+    return out
+
+
+def closure_error(R: Array, p: Array) -> Array:
+    """A first-order closure twist (½ vee(R − Rᵀ); p): equal to :func:`closure_twist` up to
+    second order near closure, with the same derivative there — the residual of a corrector
+    that starts close (a prediction), at a fraction of the cost of the exact logarithm."""
+    out = np.empty(p.shape[:-1] + (6,))
+    out[..., 0] = 0.5 * (R[..., 2, 1] - R[..., 1, 2])
+    out[..., 1] = 0.5 * (R[..., 0, 2] - R[..., 2, 0])
+    out[..., 2] = 0.5 * (R[..., 1, 0] - R[..., 0, 1])
+    out[..., 3:] = p
+    return out
 
 
 def lie_bracket(a: Array, b: Array) -> Array:
     """[a, b] of twists (ω; v): (ωa × ωb; ωa × vb − ωb × va)."""
     wa, va = a[..., :3], a[..., 3:]
     wb, vb = b[..., :3], b[..., 3:]
-    return np.concatenate([np.cross(wa, wb), np.cross(wa, vb) - np.cross(wb, va)], -1)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., :3] = cross(wa, wb)
+    out[..., 3:] = cross(wa, vb) - cross(wb, va)
+    return out
 
 
-def close_spherical_joint(linkage: Linkage, scalars: Array, lay: Layout | None = None) -> Configuration:
-    """The configuration of a loop with exactly one spherical joint whose scalar freedoms are
-    known (e.g. from a closed form): the ball joint's rotation is what closes the loop.
+def close_spherical_joint(linkage: Linkage, scalars: Array, lay: Layout | None = None,
+                          spherical: Array | None = None, joint: int | None = None,
+                          ) -> Configuration:
+    """The configuration of a loop whose scalar freedoms and all spherical joints but one are
+    known (e.g. from a closed form): the remaining ball joint's rotation is what closes the loop.
 
-    With the ball at rest (R = I) the loop product is G₀ = P·Q′ (P up to the ball's frame); the
-    closing rotation is the conjugate R = R_Pᵀ R_G₀ᵀ R_P, exact wherever the scalars close the
-    loop's translation (which is what a closed form guarantees; the closure residual checks it).
+    ``spherical`` (N, n_S, 3, 3) holds the known rotations (default: identity; the loop's only
+    ball when ``joint`` is None); ``joint`` is the index of the ball to close. With that ball at
+    rest (R = I) the loop product is G₀ = P·Q′ (P up to the ball's frame); the closing rotation
+    is the conjugate R = R_Pᵀ R_G₀ᵀ R_P, exact wherever the known freedoms close the loop's
+    translation (which is what a closed form guarantees; the closure residual checks it).
     """
     lay = lay or layout(linkage)
-    if lay.n_spherical != 1:
-        raise ValueError(f"{linkage.name}: close_spherical_joint needs exactly one spherical joint; "
-                         f"this loop has {lay.n_spherical}")
+    if joint is None:
+        if lay.n_spherical != 1:
+            raise ValueError(f"{linkage.name}: close_spherical_joint needs exactly one spherical "
+                             f"joint or the joint to close; this loop has {lay.n_spherical}")
+        joint = next(iter(lay.spherical_of_joint))
     N = scalars.shape[0]
-    at_rest = Configuration(scalars, np.broadcast_to(np.eye(3), (N, 1, 3, 3)).copy())
-    fr = forward(linkage, at_rest, lay)
-    k = next(iter(lay.spherical_of_joint))
-    RP = fr.before_R[:, k]
-    R = np.einsum("nji,nkj,nkl->nil", RP, fr.closure_R, RP)
-    return Configuration(scalars, R[:, None])
+    rot = (np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)) if spherical is None
+           else spherical).copy()
+    k = lay.spherical_of_joint[joint]
+    rot[:, k] = np.eye(3)
+    fr = forward(linkage, Configuration(scalars, rot), lay)
+    RP = fr.before_R[:, joint]
+    rot[:, k] = np.einsum("nji,nkj,nkl->nil", RP, fr.closure_R, RP)
+    return Configuration(scalars, rot)

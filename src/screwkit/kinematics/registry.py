@@ -66,6 +66,8 @@ class Family:
     optional: Mapping[str, float] = field(default_factory=dict)  # name -> default (SI)
     build: Callable[..., Linkage] | None = None  # keyword dimensions (SI) -> Linkage
     closed_form: ClosedForm | None = None
+    #: whether the closed form solves a given loop of the family (None: every loop)
+    closed_form_applies: Callable[[Linkage], bool] | None = None
     seed_names: SeedNames | None = None
     capabilities: frozenset[str] = _EVERY_LOOP
     aliases: tuple[str, ...] = ()
@@ -88,6 +90,14 @@ class Family:
     #: dimensions held (the 4R: b = e = δ0 = λ0 = 0); None: the generic route only
     closed_synthesis: Mapping[str, float] | None = None
 
+    def closed_form_for(self, linkage: Linkage) -> ClosedForm | None:
+        """The closed form that solves ``linkage``, or None (then the generic solver does)."""
+        if self.closed_form is None:
+            return None
+        if self.closed_form_applies is not None and not self.closed_form_applies(linkage):
+            return None
+        return self.closed_form
+
     def linkage(self, **dimensions: float) -> Linkage:
         """The family's loop from its dimensions (SI units, radians)."""
         if self.build is None:
@@ -106,6 +116,24 @@ def _cssp_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
     from screwkit.kinematics.closed_form_motion import cssp_closed_motion
 
     return cssp_closed_motion(linkage, X, Xd, Xdd)
+
+
+def _rssr_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
+    from screwkit.kinematics.closed_form_motion import rssr_closed_motion
+
+    return rssr_closed_motion(linkage, X, Xd, Xdd)
+
+
+def _rccc_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
+    from screwkit.kinematics.closed_form_motion import rccc_closed_motion
+
+    return rccc_closed_motion(linkage, X, Xd, Xdd)
+
+
+def _is_rccc(linkage: Linkage) -> bool:
+    from screwkit.kinematics.rccc import rccc_applies
+
+    return rccc_applies(linkage)
 
 
 def _rsrc_limits(linkage: Linkage, dwell_tolerance: float, max_order: int,
@@ -164,26 +192,29 @@ FAMILIES: dict[str, Family] = {
             seed_freedoms={"theta1": ("crank.theta", 1.0), "s4": ("slider.s", 1.0)},
             outputs=("s4",), coupler_link="rod", geometry=geometries.cssp_geometry),
         Family(
-            "RSSR", "the RSSR", "spatial R-S-S-R crank-rocker (generic solver)",
+            "RSSR", "the RSSR", "spatial R-S-S-R crank-rocker (closed form A cos φ0 + B sin φ0 = K)",
             {"d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH, "a": _LENGTH, "b": _LENGTH,
              "lambda0": _ANGLE, "output_offset": _LENGTH},
-            optional={"output_offset": 0.0}, build=constructors.rssr,
+            optional={"output_offset": 0.0}, build=constructors.rssr, closed_form=_rssr_closed,
             seed_names=seed_names.rssr_names, aliases=("rssr",),
             why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch=constructors.RSSR_SKETCH,
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output.theta", -1.0)},
             outputs=("phi0",), coupler_link="coupler", geometry=geometries.rssr_geometry),
         Family(
-            "RCCC", "the RCCC", "R-C-C-C loop in Hartenberg-Denavit form (generic solver)",
+            "RCCC", "the RCCC", "R-C-C-C loop in Hartenberg-Denavit form (closed form: the dual "
+            "input-output equation)",
             {"a1": _LENGTH, "a2": _LENGTH, "a3": _LENGTH, "a4": _LENGTH, "alpha1": _ANGLE,
              "alpha2": _ANGLE, "alpha3": _ANGLE, "alpha4": _ANGLE, "input_offset": _LENGTH},
-            optional={"input_offset": 0.0}, build=_rccc, aliases=("rccc",),
+            optional={"input_offset": 0.0}, build=_rccc, closed_form=_rccc_closed,
+            closed_form_applies=_is_rccc, aliases=("rccc",),
             why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch=constructors.RCCC_SKETCH, outputs=("C4.theta", "C4.s"), coupler_link="link2",
             geometry=geometries.rccc_geometry),
         Family(
-            "LOOP", "a joint-list loop", "any single loop given as a joint list (generic solver)", {},
-            aliases=("loop",),
+            "LOOP", "a joint-list loop", "any single loop given as a joint list (generic solver; "
+            "the RCCC closed form for an R C C C list driven at its R joint)", {},
+            closed_form=_rccc_closed, closed_form_applies=_is_rccc, aliases=("loop",),
             why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch="[[joints]]: name, kind (R P C H U S), length, twist, offset, pitch, input "
                    "(Hartenberg-Denavit, Rahman eq. 2.2)"),

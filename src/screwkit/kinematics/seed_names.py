@@ -12,6 +12,7 @@ import numpy as np
 
 from screwkit.dual.spatial import elevation_azimuth, rot_x, wrap_angle
 from screwkit.kinematics.loop import Array
+from screwkit.kinematics.mode_frames import unwrap_runs
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.families import rsrc_seed_variables
 from screwkit.model.linkage import Linkage
@@ -40,8 +41,7 @@ def fourbar_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Nam
     th = np.arctan2(crank[:, 1], crank[:, 0])
     ph = np.arctan2(rocker[:, 1], rocker[:, 0])
     ok = mode.assembles
-    th[ok] = np.unwrap(th[ok])
-    ph[ok] = np.unwrap(ph[ok])
+    th, ph = unwrap_runs(th, ok), unwrap_runs(ph, ok)
     w = mode.link_angular_velocity
     a = mode.link_angular_acceleration
     # Bagci's χ0 of the plane case is the coupler–rocker joint angle turned by π, in (−π, π]
@@ -71,13 +71,11 @@ def cssp_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]
     th1d = mode.velocities[f"{crank}.theta"]
     th1dd = mode.accelerations[f"{crank}.theta"]
     _, elev, e_d, e_dd, psi, psi_d, psi_dd = elevation_azimuth(u, ud, udd)
-    ok = mode.assembles & np.isfinite(psi)
-    psi[ok] = np.unwrap(psi[ok])
+    psi = unwrap_runs(psi, mode.assembles & np.isfinite(psi))
     to_slider = rot_x(linkage.parameters["alpha4"])  # X(α4)
     _, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = elevation_azimuth(
         u @ to_slider.T, ud @ to_slider.T, udd @ to_slider.T)
-    ok3 = mode.assembles & np.isfinite(eta3)
-    eta3[ok3] = np.unwrap(eta3[ok3])
+    eta3 = unwrap_runs(eta3, mode.assembles & np.isfinite(eta3))
     return ({"theta1": th1, "s4": mode.variables[f"{slider}.s"], "theta2": psi - th1,
              "eta2": -elev, "theta3": th3, "eta3": eta3},
             {"theta1": th1d, "s4": mode.velocities[f"{slider}.s"], "theta2": psi_d - th1d,

@@ -16,13 +16,16 @@ from screwkit.kinematics.loop import (
     Configuration,
     Layout,
     apply_increment,
+    closure_error,
     closure_twist,
+    constants,
     forward,
     layout,
 )
 from screwkit.model.linkage import Linkage
 
 CLOSURE_TOL = 1e-11  # residual (radians, and lengths / length scale) accepted as closed
+POLISHED = 1e-15  # the corrector stops early below this (round-off)
 
 
 @dataclass(frozen=True)
@@ -62,7 +65,7 @@ def newton(
     minimum-norm Gauss–Newton step, also where J has fewer independent rows than 6 (a planar
     loop seen in space)."""
     lay = lay or layout(linkage)
-    L = linkage.length_scale
+    L = constants(linkage, lay)[2]
     rows, cols = _scales(lay, L)
     passive = np.array([n not in linkage.inputs for n in lay.names])
     pidx = np.nonzero(passive)[0]
@@ -108,11 +111,84 @@ def newton(
     return NewtonResult(Configuration(q, sph), res, ok, it)
 
 
+@dataclass(frozen=True)
+class Correction:
+    """The corrector's verdict on a batch of predicted configurations (:func:`correct`)."""
+
+    conf: Configuration
+    accepted: NDArray[np.bool_]  # converged and passed the contraction test
+
+
+def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
+            contraction: float | Array = 0.5, max_iter: int = 7, tol: float = CLOSURE_TOL,
+            ) -> Correction:
+    """Newton corrector of a continuation step (inputs held): minimum-norm Gauss–Newton steps
+    over the passive freedoms, vectorised over the batch, without damping.
+
+    A prediction is accepted when Newton converges to ``tol`` within ``max_iter`` steps, its
+    first step stays within ``reach`` (N,) (scaled freedoms), all its steps together within
+    1.5 ``reach``, and the
+    second step is at most ``contraction`` (a number or one per prediction) times the first
+    — Deuflhard's contraction test: a
+    prediction inside the branch's basin of quadratic convergence contracts fast, a jump
+    towards another branch does not. Predictions that fail a test are dropped at once."""
+    L = constants(linkage, lay)[2]
+    rows, cols = _scales(lay, L)
+    pidx = np.array([k for k, n in enumerate(lay.names) if n not in linkage.inputs])
+    N = conf.size
+    q = conf.scalars.copy()
+    sph = conf.spherical.copy()
+    limit = np.broadcast_to(np.asarray(contraction, dtype=float), (N,))
+    first = np.zeros(N)
+    total = np.zeros((N, len(pidx)))
+    done = np.zeros(N, dtype=bool)
+    last = np.full(N, np.inf)
+    todo = np.arange(N)
+    for it in range(max_iter + 1):
+        fr = forward(linkage, Configuration(q[todo], sph[todo]), lay, frames=False)
+        xi = closure_error(fr.closure_R, fr.closure_p) * rows
+        r = np.max(np.abs(xi), axis=-1)
+        # within tolerance, one more (quadratically converging) step polishes to round-off;
+        # stop when that no longer gains a digit
+        fine = (r <= POLISHED) | ((r <= tol) & (r > 0.1 * last[todo]))
+        last[todo] = r
+        done[todo[r <= tol]] = True
+        keep = ~fine & np.isfinite(r)
+        if it == max_iter or not keep.any():
+            break
+        done[todo[keep]] = False  # a polishing step must succeed too
+        todo, xi = todo[keep], xi[keep]
+        J = fr.screws[keep][:, :, pidx] * rows[:, None] * cols[pidx][None, :]
+        JJt = J @ np.swapaxes(J, -1, -2)
+        mu = 1e-13 * np.maximum(np.trace(JJt, axis1=-2, axis2=-1), 1e-300)
+        y = np.linalg.solve(JJt + mu[:, None, None] * np.eye(6), xi[..., None])[..., 0]
+        step = -np.einsum("nji,nj->ni", J, y)
+        size = np.linalg.norm(step, axis=-1)
+        total[todo] += step
+        if it == 0:
+            first[todo] = size
+            hopeful = size <= reach[todo]
+        else:
+            hopeful = np.linalg.norm(total[todo], axis=-1) <= 1.5 * reach[todo]
+            if it == 1:
+                hopeful &= size <= limit[todo] * np.maximum(first[todo], 1e-12)
+        if not hopeful.all():
+            todo, step = todo[hopeful], step[hopeful]
+            if todo.size == 0:
+                break
+        delta = np.zeros((len(todo), len(lay.names)))
+        delta[:, pidx] = step * cols[pidx]
+        moved = apply_increment(Configuration(q[todo], sph[todo]), delta, lay)
+        q[todo] = moved.scalars
+        sph[todo] = moved.spherical
+    return Correction(Configuration(q, sph), done)
+
+
 def random_configurations(linkage: Linkage, count: int, rng: np.random.Generator, lay: Layout | None = None) -> Configuration:
     """``count`` random starting configurations: angles uniform in (−π, π], translations
     uniform within ± the length scale, spherical joints uniformly random rotations."""
     lay = lay or layout(linkage)
-    L = linkage.length_scale
+    L = constants(linkage, lay)[2]
     q = np.empty((count, lay.n_scalar))
     for f in range(len(lay.names)):
         c = lay.scalar_col[f]
@@ -134,8 +210,9 @@ def signature(linkage: Linkage, conf: Configuration, lay: Layout | None = None) 
     """A vector per sample that identifies an assembly up to passive freedoms: every joint
     centre (divided by the length scale) and every non-spherical joint axis, in the ground
     frame. Two configurations with the same signature are the same assembly."""
+    lay = lay or layout(linkage)
     fr = forward(linkage, conf, lay)
-    L = linkage.length_scale
+    L = constants(linkage, lay)[2]
     parts = [fr.centres.reshape(conf.size, -1) / L]
     ax = [fr.axes[:, i] for i, j in enumerate(linkage.joints) if j.kind != "S"]
     if ax:
@@ -151,6 +228,7 @@ class Assemblies:
     conf: Configuration
     found: NDArray[np.bool_]
     signature: Array  # (N, K, d)
+    radius: Array  # (N, K) signature distance within which another root is the same one
 
 
 def find_assemblies(
@@ -174,20 +252,21 @@ def find_assemblies(
                           np.concatenate([p.conf.spherical for p in parts])),
             np.concatenate([p.found for p in parts]),
             np.concatenate([p.signature for p in parts]),
+            np.concatenate([p.radius for p in parts]),
         )
     lay = layout(linkage)
     N = values.shape[0]
     rng = np.random.default_rng(seed)
     conf0 = random_configurations(linkage, N * starts, rng, lay)
     conf0 = set_inputs(conf0, lay, linkage.inputs, np.repeat(values, starts, axis=0))
-    res = newton(linkage, conf0, max_iter=80, lay=lay)
+    res = newton(linkage, conf0, max_iter=50, lay=lay)
     fr = forward(linkage, res.conf, lay)
     sig = signature(linkage, res.conf, lay).reshape(N, starts, -1)
     ok = res.converged.reshape(N, starts)
     # Near a double root (a limit position) the closure error grows only quadratically with
     # the distance from the root, so Newton's roots scatter by ~√tolerance: merge within that
     # wider radius where the passive Jacobian is near-singular.
-    rows, cols = _scales(lay, linkage.length_scale)
+    rows, cols = _scales(lay, constants(linkage, lay)[2])
     pidx = [k for k, n in enumerate(lay.names) if n not in linkage.inputs]
     Jp = fr.screws[:, :, pidx] * rows[None, :, None] * cols[pidx][None, None, :]
     sv = np.linalg.svd(Jp, compute_uv=False)
@@ -207,4 +286,4 @@ def find_assemblies(
     flat = (np.arange(N)[:, None] * starts + order).ravel()
     conf = res.conf.take(flat)
     sig_k = np.take_along_axis(sig, order[..., None], axis=1)
-    return Assemblies(conf, found, sig_k)
+    return Assemblies(conf, found, sig_k, np.take_along_axis(radius, order, axis=1))

@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike
 
 from screwkit.budget import check_memory
 from screwkit.errors import CapabilityError, InputError
-from screwkit.kinematics.generic_motion import generic_motion
+from screwkit.kinematics.generic_motion import Progress, generic_motion
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion, as_input_array
 from screwkit.kinematics.registry import family_of, seed_variables
@@ -29,6 +29,7 @@ def solve_motion(
     method: str = "auto",
     starts: int = 48,
     seed: int = 0,
+    progress: Progress | bool | None = None,
 ) -> Motion:
     """Positions, velocities and accelerations of every freedom and link of ``linkage`` over an
     input sweep, in every assembly mode.
@@ -50,6 +51,11 @@ def solve_motion(
         closed form where the family has one and the sweep has at least 2 samples.
     starts, seed:
         random starts per sample and their seed, for the generic solver's root search.
+    progress:
+        a callback ``progress(done, total)`` called as the generic solver follows its branches
+        (samples done and to do, both growing as modes are found; a closed form calls it once,
+        when done), ``False`` for none, or ``None``: a progress bar on stderr for a sweep of
+        50 000 samples or more when stderr is a terminal.
 
     Both methods give the same fields and the same mode numbering (docs/conventions.md,
     "Assembly modes"): generic modes are numbered as the closed form's where a family has one.
@@ -63,20 +69,24 @@ def solve_motion(
     Xdd = np.array(np.broadcast_to(as_input_array(linkage, accelerations, "accelerations"),
                                    X.shape))
     fam = family_of(linkage)
-    closed = fam.closed_form if X.shape[0] >= 2 else None
+    closed = fam.closed_form_for(linkage) if X.shape[0] >= 2 else None
     if method == "closed" and closed is None:
         with_closed = ", ".join(f.name for f in _families_with_closed_forms())
         raise CapabilityError(
             f"no closed form for a {fam.name} with {X.shape[0]} input sample(s) (closed forms: "
             f"{with_closed}, with at least 2 input samples); use method 'generic'")
     if method in ("auto", "closed") and closed is not None:
-        return closed(linkage, X, Xd, Xdd)
-    motion = generic_motion(linkage, X, Xd, Xdd, starts=starts, seed=seed)
+        motion = closed(linkage, X, Xd, Xdd)
+        if callable(progress):
+            done = int(sum(md.assembles.sum() for md in motion.modes))
+            progress(done, done)
+        return motion
+    motion = generic_motion(linkage, X, Xd, Xdd, starts=starts, seed=seed, progress=progress)
     modes = tuple(_with_seed_names(linkage, md) for md in motion.modes)
     notes = motion.notes
-    if fam.closed_form is not None and closed is not None:
+    if closed is not None:
         modes = _numbered_as(modes, closed(linkage, X, Xd, Xdd).modes, linkage.length_scale)
-    elif fam.closed_form is not None and method == "auto":
+    elif fam.closed_form_for(linkage) is not None and method == "auto":
         notes += ("one input sample: the generic solver was used (the closed form tracks "
                   "branches over at least 2 samples)",)
     return replace(motion, modes=modes, notes=notes)

@@ -87,13 +87,22 @@ _COMPOSE = np.array(
 )
 
 _UNMATCHED_COST = 2.0  # cost of leaving a root unmatched: |unit-vector difference|^2 for 90 deg
+_BLOCK = 8192  # samples matched at once: the (n, 4, 4) costs stay in cache
 
 
 def _branch_features(
     phi: FloatArray, chi: FloatArray, s: FloatArray, length: float
-) -> FloatArray:
-    """(..., 5) features compared when matching roots: unit vectors of phi0, chi0 and S/L."""
-    return np.stack([np.cos(phi), np.sin(phi), np.cos(chi), np.sin(chi), s / length], axis=-1)
+) -> tuple[FloatArray, ...]:
+    """The 5 features compared when matching roots, each shaped like ``phi``: unit vectors of
+    phi0, chi0 and S/L; 0 where a root does not assemble (NaN)."""
+    return tuple(np.where(np.isnan(f), 0.0, f) for f in (
+        np.cos(phi), np.sin(phi), np.cos(chi), np.sin(chi), s / length))
+
+
+def _advanced(value: FloatArray, rate: FloatArray, step: FloatArray, limit: float) -> FloatArray:
+    """``value`` moved by its rate over the step, where that move is below ``limit``."""
+    delta = rate * step
+    return np.where(np.abs(delta) < limit, value + delta, value)
 
 
 def _match_consecutive(
@@ -102,27 +111,36 @@ def _match_consecutive(
     """Best permutation (index into _PERMS) from the columns at k-1 to those at k, for every k.
 
     The roots at k-1 are first advanced by their rates (d/d theta0 times the step) when that
-    step is small, then every one of the 24 assignments is scored at once (vectorised).
+    step is small, then every one of the 24 assignments is scored at once (vectorised) — only at
+    the steps where keeping every column is not already optimal: where each root's nearest root
+    at k is its own column, the identity costs the sum of the rows' minima, a lower bound of
+    every assignment's cost. Works in blocks of samples (the (n, 4, 4) costs stay in cache).
     """
-    step = np.diff(pos.theta0)[:, None]
-    valid_prev = pos.assembles[:-1]
-    valid_next = pos.assembles[1:]
-
-    def predict(value: FloatArray, rate: FloatArray, limit: float) -> FloatArray:
-        delta = np.nan_to_num(rate[:-1]) * step
-        return np.where(np.abs(delta) < limit, value[:-1] + delta, value[:-1])
-
-    phi_p = predict(pos.phi0, rates.phi0_dot, 0.5)
-    chi_p = predict(pos.chi0, rates.chi0_dot, 0.5)
-    s_p = predict(pos.S, rates.S_dot, 0.5 * length)
-    prev = np.nan_to_num(_branch_features(phi_p, chi_p, s_p, length))
-    nxt = np.nan_to_num(_branch_features(pos.phi0[1:], pos.chi0[1:], pos.S[1:], length))
-    cost = np.sum((prev[:, :, None, :] - nxt[:, None, :, :]) ** 2, axis=-1)  # (N-1, 4, 4)
-    both = valid_prev[:, :, None] & valid_next[:, None, :]
-    one = valid_prev[:, :, None] ^ valid_next[:, None, :]
-    cost = np.where(both, cost, np.where(one, _UNMATCHED_COST, 0.0))
-    total = cost[:, np.arange(4), _PERMS].sum(axis=-1)  # (N-1, 24)
-    return np.argmin(total, axis=1)
+    n = pos.theta0.shape[0] - 1
+    best = np.full(max(n, 0), _PERM_INDEX[(0, 1, 2, 3)], dtype=np.int64)
+    for start in range(0, n, _BLOCK):
+        k = slice(start, min(start + _BLOCK, n))
+        k1 = slice(start + 1, k.stop + 1)
+        step = (pos.theta0[k1] - pos.theta0[k])[:, None]
+        prev = _branch_features(_advanced(pos.phi0[k], rates.phi0_dot[k], step, 0.5),
+                                _advanced(pos.chi0[k], rates.chi0_dot[k], step, 0.5),
+                                _advanced(pos.S[k], rates.S_dot[k], step, 0.5 * length), length)
+        nxt = _branch_features(pos.phi0[k1], pos.chi0[k1], pos.S[k1], length)
+        # squared distances |p − q|², (n, 4, 4), feature by feature
+        cost = np.zeros((step.shape[0], 4, 4))
+        for f_prev, f_next in zip(prev, nxt, strict=True):
+            diff = f_prev[:, :, None] - f_next[:, None, :]
+            cost += diff * diff
+        valid_prev, valid_next = pos.assembles[k], pos.assembles[k1]
+        both = valid_prev[:, :, None] & valid_next[:, None, :]
+        one = valid_prev[:, :, None] ^ valid_next[:, None, :]
+        cost = np.where(both, cost, np.where(one, _UNMATCHED_COST, 0.0))
+        diagonal = np.diagonal(cost, axis1=1, axis2=2)
+        other = np.nonzero(~np.all(diagonal <= cost.min(axis=2), axis=1))[0]
+        if other.size:
+            total = cost[other][:, np.arange(4), _PERMS].sum(axis=-1)  # (m, 24)
+            best[start + other] = np.argmin(total, axis=1)
+    return best
 
 
 def _unwrap_runs(angle: FloatArray, valid: BoolArray) -> FloatArray:

@@ -1,0 +1,356 @@
+"""Branch tracking by continuation: every assembly mode followed along the input sweep from one
+closed configuration (a *seed*), forwards and backwards, with a second-order predictor and a
+vectorised Newton corrector.
+
+The sweep is a path in input space through the samples X_0 … X_{N−1}, straight between
+neighbours (position t ∈ [0, N−1]). From a closed configuration at t the predictor is the
+second-order Taylor expansion of the branch, q(X_t + d) ≈ q + q_X d + ½ q_XX(d, d), with the
+exact first and second derivatives from the rate equations (:mod:`screwkit.kinematics.rates`;
+where they are undefined, the secant through the last two points). A *front* (a branch end
+moving in one direction) predicts a whole chunk of samples ahead at once, and all fronts'
+predictions are corrected together (:func:`~screwkit.kinematics.solve.correct`, vectorised over
+fronts and samples). A corrected sample is accepted when Newton converged and contracted fast
+from a prediction close to the result (Deuflhard's test: a jump towards another branch does
+not); a chunk is accepted up to its first rejected sample and the next chunk doubles or shrinks
+accordingly. When even the next sample is rejected the front sub-steps between samples with
+steps cut by four; when the step falls below 2⁻⁸ of the sample spacing it tries once to step
+over the next sample to the one after (branches that cross — a bifurcation — are passed that
+way, the crossing sample closed by Newton alone), and if that fails too the branch ends there:
+a limit position or dead centre lies between the two samples (it *stops*, or going backwards it
+*starts assembling*). Near a fold the passive Jacobian's smallest singular value falls as the
+square root of the distance to it, σ² ∝ x* − x: where a step fails and the σ measured at the
+front's last two points extrapolates to zero before the next sample, the branch ends at once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics.loop import (
+    Array,
+    Configuration,
+    Layout,
+    apply_increment,
+    configuration_difference,
+    forward,
+)
+from screwkit.kinematics.rates import rate_equations, solve_rates
+from screwkit.kinematics.solve import correct, set_inputs, signature
+from screwkit.model.linkage import Linkage
+
+MIN_SUBSTEP = 2.0 ** -8  # of the sample spacing: a front that cannot advance further ends
+FOLD_SIGMA = 0.2  # σ_min/σ_max of J_p below which a failed step may be a fold ahead
+MAX_CHUNK = 2048  # samples predicted at once by one front
+MAX_SPAN = 1.5  # rad (or length scale) the inputs may move over one chunk
+FIRST_STEP = 0.2  # largest Newton correction, relative to the predicted step
+CONTRACTION = 0.5  # largest ratio of the second Newton step to the first
+
+
+@dataclass
+class Track:
+    """One branch over the sweep: its configurations where ``mask`` holds, the sample it was
+    seeded at, and where it ends: ``stops`` after sample k (forwards), ``starts`` at sample k
+    (backwards), each with the input position reached before the end."""
+
+    scalars: Array
+    spherical: Array
+    mask: NDArray[np.bool_]
+    seed: int
+    stops: list[tuple[int, float]] = field(default_factory=list)
+    starts: list[tuple[int, float]] = field(default_factory=list)
+
+    def configuration(self) -> Configuration:
+        return Configuration(np.where(self.mask[:, None], self.scalars, 0.0), self.spherical)
+
+
+@dataclass
+class _Front:
+    track: int
+    direction: int
+    t: float
+    conf: Configuration  # one row
+    prev: Configuration | None = None
+    prev_t: float = 0.0
+    chunk: int = 4
+    substep: float = 0.0  # 0: chunk mode; else the sub-step (a fraction of the spacing)
+    sigma: tuple[float, float] = (np.inf, np.nan)  # σ ratio of J_p at the front, and where
+    sigma_before: tuple[float, float] = (np.inf, np.nan)
+    jump: bool = False  # this wave steps over a singular sample to the one after it
+    jumped: bool = False  # a jump was tried since the front last advanced normally
+
+
+def input_at(X: Array, t: Array) -> Array:
+    """Inputs (T, n_in) at positions ``t`` (T,) along the sweep (straight between samples)."""
+    i0 = np.clip(np.floor(t).astype(int), 0, X.shape[0] - 1)
+    i1 = np.minimum(i0 + 1, X.shape[0] - 1)
+    frac = (t - i0)[:, None]
+    return np.asarray(X[i0] + frac * (X[i1] - X[i0]))
+
+
+def taylor(linkage: Linkage, lay: Layout, conf: Configuration) -> tuple[Array, Array, Array]:
+    """First and second derivatives of every freedom with respect to the inputs, q_X (B, m,
+    n_in) and q_XX (B, m, n_in, n_in), at each configuration; where the rate equations are
+    singular, their minimum-norm solution (on a continuum: the least motion that follows the
+    input; elsewhere the acceptance test judges the prediction). Also returns the σ ratio of
+    the passive Jacobian (B,)."""
+    B, n_in = conf.size, len(linkage.inputs)
+    m = len(lay.names)
+    eq = rate_equations(linkage, lay, forward(linkage, conf, lay))
+    Q1 = np.empty((B, m, n_in))
+    Q2 = np.empty((B, m, n_in, n_in))
+    zero = np.zeros((B, n_in))
+    eye = np.eye(n_in)
+    for i in range(n_in):
+        r = solve_rates(linkage, lay, eq, np.broadcast_to(eye[i], (B, n_in)), zero, True)
+        Q1[:, :, i] = r.qd
+        Q2[:, :, i, i] = r.qdd
+    for i in range(n_in):
+        for j in range(i + 1, n_in):
+            both = solve_rates(linkage, lay, eq, np.broadcast_to(eye[i] + eye[j], (B, n_in)),
+                               zero, True)
+            Q2[:, :, i, j] = Q2[:, :, j, i] = 0.5 * (both.qdd - Q2[:, :, i, i] - Q2[:, :, j, j])
+    return Q1, Q2, eq.sigma_ratio
+
+
+class Tracker:
+    """Follows seeds along the sweep ``X`` (module docstring); ``tracks`` grows as seeds are
+    added and followed."""
+
+    def __init__(self, linkage: Linkage, lay: Layout, X: Array,
+                 progress: Callable[[int], None] | None = None) -> None:
+        self.linkage, self.lay, self.X = linkage, lay, X
+        self.N = X.shape[0]
+        self.tracks: list[Track] = []
+        self._met: dict[int, bool] = {}
+        self.progress = progress
+        L = linkage.length_scale
+        self.col_scale = np.array([1.0 / L if t else 1.0 for t in lay.is_translation])
+        in_scale = np.array([1.0 / L if n.endswith(".s") else 1.0 for n in linkage.inputs])
+        steps = np.abs(np.diff(X, axis=0)) * in_scale if self.N > 1 else np.zeros((0, 1))
+        self.span = np.concatenate([[0.0], np.cumsum(steps.max(axis=1))]) if self.N > 1 \
+            else np.zeros(1)
+
+    def add_seeds(self, sample: int, conf: Configuration) -> list[int]:
+        """New tracks from closed configurations at one sample; returns their indices."""
+        ids = []
+        for k in range(conf.size):
+            tr = Track(np.full((self.N, self.lay.n_scalar), np.nan),
+                       np.tile(np.eye(3), (self.N, self.lay.n_spherical, 1, 1)),
+                       np.zeros(self.N, dtype=bool), sample)
+            tr.scalars[sample] = conf.scalars[k]
+            tr.spherical[sample] = conf.spherical[k]
+            tr.mask[sample] = True
+            self.tracks.append(tr)
+            ids.append(len(self.tracks) - 1)
+            self._met[ids[-1]] = False
+            if self.progress is not None:
+                self.progress(1)
+        return ids
+
+    def follow(self, ids: list[int]) -> None:
+        """Follow the given (seeded) tracks forwards and backwards to their ends."""
+        fronts = []
+        if not ids:
+            return
+        seeds = Configuration(np.stack([self.tracks[i].scalars[self.tracks[i].seed] for i in ids]),
+                              np.stack([self.tracks[i].spherical[self.tracks[i].seed]
+                                        for i in ids]))
+        sigma = rate_equations(self.linkage, self.lay,
+                               forward(self.linkage, seeds, self.lay)).sigma_ratio
+        for r, i in enumerate(ids):
+            tr = self.tracks[i]
+            row = seeds.take(np.array([r]))
+            for direction in (1, -1):
+                if 0 <= tr.seed + direction < self.N:
+                    # a seed near a fold starts with sub-steps: its Taylor series is short there
+                    fronts.append(_Front(i, direction, float(tr.seed), row,
+                                         substep=0.25 if sigma[r] < FOLD_SIGMA else 0.0))
+        while fronts:
+            fronts = self._wave(fronts)
+
+    # ---------------------------------------------------------------------------------------
+
+    def _position(self, t: float) -> float:
+        """Input distance along the sweep at position ``t``."""
+        k = min(int(np.floor(t)), self.N - 2) if self.N > 1 else 0
+        return float(self.span[k] + (t - k) * (self.span[min(k + 1, self.N - 1)] - self.span[k]))
+
+    def _fold_ahead(self, f: _Front) -> bool:
+        """Whether σ² of the front's last two points extrapolates to zero before the next
+        sample (a fold of the branch in the input lies there)."""
+        (s1, x1), (s0, x0) = f.sigma, f.sigma_before
+        if not (s1 < FOLD_SIGMA and s0 > s1 and np.isfinite(x0)) or x0 == x1:
+            return False
+        fold = x1 + s1**2 * (x1 - x0) / (s0**2 - s1**2)
+        nxt = np.floor(f.t) + 1 if f.direction > 0 else np.ceil(f.t) - 1
+        return bool(abs(fold - x1) <= abs(self._position(float(np.clip(nxt, 0, self.N - 1)))
+                                          - x1))
+
+    def _targets(self, fr: _Front) -> Array:
+        if fr.jump:
+            near = np.floor(fr.t) + 1 if fr.direction > 0 else np.ceil(fr.t) - 1
+            return np.array([near, near + fr.direction])
+        if fr.substep:
+            nxt = np.floor(fr.t) + 1 if fr.direction > 0 else np.ceil(fr.t) - 1
+            t = fr.t + fr.direction * fr.substep
+            return np.array([min(t, nxt) if fr.direction > 0 else max(t, nxt)])
+        k = int(round(fr.t))
+        stop = self.N - 1 if fr.direction > 0 else 0
+        count = min(fr.chunk, abs(stop - k))
+        idx = k + fr.direction * np.arange(1, count + 1)
+        # no more than MAX_SPAN of input movement in one chunk (always at least one sample)
+        within = np.abs(self.span[idx] - self.span[k]) <= MAX_SPAN
+        within[0] = True
+        n = int(np.argmin(within)) if not within.all() else len(idx)
+        return idx[:n].astype(float)
+
+    def _predict(self, fronts: list[_Front], owner: NDArray[np.intp], t: Array) -> Configuration:
+        lay, X = self.lay, self.X
+        here = Configuration(np.concatenate([f.conf.scalars for f in fronts]),
+                             np.concatenate([f.conf.spherical for f in fronts]))
+        Q1, Q2, sigma = taylor(self.linkage, lay, here)
+        for f, sg in zip(fronts, sigma.tolist(), strict=True):
+            at = self._position(f.t)
+            if at != f.sigma[1]:
+                f.sigma_before, f.sigma = f.sigma, (sg, at)
+        t_front = np.array([f.t for f in fronts])
+        d = input_at(X, t) - input_at(X, t_front)[owner]
+        delta = (np.einsum("tmi,ti->tm", Q1[owner], d)
+                 + 0.5 * np.einsum("tmij,ti,tj->tm", Q2[owner], d, d))
+        bad = ~np.all(np.isfinite(delta), axis=1)
+        if bad.any():  # singular front: the secant through its last two points
+            for r in np.nonzero(bad)[0]:
+                f = fronts[owner[r]]
+                if f.prev is None or f.t == f.prev_t:
+                    delta[r] = 0.0
+                else:
+                    sec = configuration_difference(f.conf, f.prev, lay)[0]
+                    delta[r] = sec * (t[r] - f.t) / (f.t - f.prev_t)
+        moved = apply_increment(here.take(owner), delta, lay)
+        return set_inputs(moved, lay, self.linkage.inputs, input_at(X, t))
+
+    def _wave(self, fronts: list[_Front]) -> list[_Front]:
+        """One predictor–corrector pass of every front; returns the fronts still moving."""
+        targets = [self._targets(f) for f in fronts]
+        owner = np.concatenate([np.full(len(tg), k) for k, tg in enumerate(targets)])
+        t = np.concatenate(targets)
+        pred = self._predict(fronts, owner, t)
+        here = Configuration(np.concatenate([f.conf.scalars for f in fronts]),
+                             np.concatenate([f.conf.spherical for f in fronts])).take(owner)
+        step = np.linalg.norm(configuration_difference(pred, here, self.lay) * self.col_scale,
+                              axis=1)
+        # a jump's near target is the singular sample itself: Newton converges there only
+        # linearly; it is accepted if it converges and the sample after it passes the test
+        near = np.zeros(len(t), dtype=bool)
+        near[np.cumsum([len(tg) for tg in targets]) - 2] = [f.jump for f in fronts]
+        reach = np.where(near, np.inf, FIRST_STEP * step + 1e-9)
+        res = correct(self.linkage, pred, self.lay, reach, np.where(near, 1.0, CONTRACTION),
+                      max_iter=40 if near.any() else 7)
+        ok = res.accepted
+        alive = []
+        start = 0
+        for k, f in enumerate(fronts):
+            n = len(targets[k])
+            sl = slice(start, start + n)
+            start += n
+            acc = ok[sl]
+            p = n if acc.all() else int(np.argmin(acc))
+            if f.jump:
+                f.jump = False
+                if not acc[1]:
+                    if not self._end(f):
+                        continue
+                keep = np.nonzero(acc)[0]
+                if self._advance(f, targets[k][keep], res.conf.take(sl.start + keep),
+                                 full=False):
+                    alive.append(f)
+                continue
+            if self._advance(f, targets[k][:p], res.conf.take(np.arange(sl.start, sl.start + p)),
+                             full=p == n):
+                alive.append(f)
+        return alive
+
+    def _advance(self, f: _Front, t: Array, conf: Configuration, full: bool) -> bool:
+        """Move front ``f`` over its accepted targets; False when it has ended."""
+        tr = self.tracks[f.track]
+        if len(t):
+            whole = np.nonzero(t == np.round(t))[0]
+            idx = t[whole].astype(int)
+            tr.scalars[idx] = conf.scalars[whole]
+            tr.spherical[idx] = conf.spherical[whole]
+            tr.mask[idx] = True
+            if self.progress is not None and len(idx):
+                self.progress(len(idx))
+            if len(self.tracks) > 1 and self._joins_another(f.track, idx, conf.take(whole)):
+                return False
+            last = len(t) - 1
+            if len(t) > 1:
+                f.prev, f.prev_t = conf.take(np.array([last - 1])), float(t[last - 1])
+            else:
+                f.prev, f.prev_t = f.conf, f.t
+            f.conf, f.t = conf.take(np.array([last])), float(t[last])
+            if f.substep:
+                if f.t == round(f.t):
+                    f.substep, f.chunk = 0.0, 1
+                else:
+                    f.substep = min(4 * f.substep, 0.5)
+            else:
+                f.chunk = min(2 * f.chunk, MAX_CHUNK) if full else max(len(t), 1)
+                f.jumped = False
+        elif self._fold_ahead(f):
+            return self._jump_or_end(f)
+        elif f.substep:
+            f.substep /= 4
+            if f.substep < MIN_SUBSTEP:
+                return self._jump_or_end(f)
+        else:
+            f.substep = 0.25
+        at_end = f.t == round(f.t) and not (0 <= round(f.t) + f.direction < self.N)
+        return not at_end
+
+    def _joins_another(self, track: int, idx: NDArray[np.intp], conf: Configuration) -> bool:
+        """Whether the newly reached samples ``idx`` of ``track`` are, at two of them or more,
+        the configurations another track already holds: the front has run onto a known branch
+        (a seed found again next to where a branch ended) and stops there; the two tracks are
+        merged afterwards. Branches that cross meet at one sample only."""
+        if len(idx) < 2:
+            idx, conf = idx[-1:], conf.take(np.arange(len(idx))[-1:])
+        others = [k for k, tr in enumerate(self.tracks) if k != track and tr.mask[idx].any()]
+        if not others or len(idx) == 0:
+            return False
+        mine = signature(self.linkage, conf, self.lay)
+        for k in others:
+            tr = self.tracks[k]
+            held = np.nonzero(tr.mask[idx])[0]
+            theirs = signature(self.linkage, Configuration(tr.scalars[idx[held]],
+                                                           tr.spherical[idx[held]]), self.lay)
+            same = np.max(np.abs(mine[held] - theirs), axis=1) < 1e-6
+            if same.sum() >= min(2, len(idx)) and (same.sum() >= 2 or self._met[track]):
+                return True
+            if same.any():
+                self._met[track] = True
+        return False
+
+    def _jump_or_end(self, f: _Front) -> bool:
+        """A front that cannot reach the next sample may be at a bifurcation (branches that
+        cross), which it can step over: try once to land on the sample after the next (the
+        next being the singular one); if that fails too, the branch ends (a fold)."""
+        near = np.floor(f.t) + 1 if f.direction > 0 else np.ceil(f.t) - 1
+        if f.jumped or not (0 <= near + f.direction < self.N):
+            return self._end(f)
+        f.jump = f.jumped = True
+        f.substep = 0.0
+        return True
+
+    def _end(self, f: _Front) -> bool:
+        tr = self.tracks[f.track]
+        last = int(np.floor(f.t)) if f.direction > 0 else int(np.ceil(f.t))
+        if f.direction > 0:
+            tr.stops.append((last, f.t))
+        else:
+            tr.starts.append((last, f.t))
+        return False

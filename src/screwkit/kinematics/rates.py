@@ -1,0 +1,234 @@
+"""The rate equations of a closed loop: velocities and accelerations of every freedom from the
+inputs' (Bagci 1969 eqs. 3.27–3.48 differentiated; Rahman 1996 §1.4 with the true axes).
+
+With the freedom screws S_k (ω; v) in the ground frame as the columns of the loop Jacobian,
+closure holds to first and second order when
+
+    J_p q̇_p = −J_in q̇_in,        J_p q̈_p = −J_in q̈_in − J̇q̇,   J̇q̇ = Σ_{j<k} [S_j, S_k] q̇_j q̇_k
+
+(Lie brackets of the screws). The spin of a link between two spherical joints (an S–S rod) about
+its own axis u is idle: its rule is zero absolute spin, ω·u = 0 (hence α·u = 0; Rahman 1996
+§1.2), one extra row per rod. Rows are scaled by the loop's length scale L (rotation rows as
+they are, translation rows / L) and translation freedoms by L, so every entry is dimensionless.
+
+**Honest singularities.** A sample is *singular* — no rates are reported there — where the
+scaled passive Jacobian J_p (with the spin rows) loses rank, σ_min < :data:`SINGULAR_RTOL`·σ_max
+(the rates are not unique: a dead centre, a bifurcation or a motion left free with the input
+fixed), or where the inputs' screws are not in its range (the input cannot move the loop: a
+locked or rigid configuration), so that the solved rates would leave a residual
+|J q̇| > :data:`RESIDUAL_TOL` (scaled). Every rate that is reported satisfies its equation to
+that tolerance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics.loop import Array, Layout, LoopFrames, constants, lie_bracket
+from screwkit.model.linkage import Linkage
+
+#: relative singular value of the scaled passive Jacobian below which a sample is singular.
+#: Positions are closed to ~1e-11, so at a double root (a dead centre) the configuration is
+#: known only to ~√1e-11 ≈ 3e-6 along the null direction and σ_min does not drop below that:
+#: the threshold sits above it. Rates at σ_min/σ_max = 1e-5 are ~1e5 times the input rate.
+SINGULAR_RTOL = 1e-5
+
+#: largest scaled residual |J q̇| (and |J q̈ + J̇q̇|) of a reported rate, relative to the size of
+#: the terms of the equation: a sample whose rates would leave more is singular (docs/kinematics.md)
+RESIDUAL_TOL = 1e-9
+
+
+def spin_links(linkage: Linkage) -> list[int]:
+    """Moving links that lie between two spherical joints (S–S rods): their spin is idle."""
+    return [i for i in range(len(linkage.joints) - 1)
+            if linkage.joints[i].kind == "S" and linkage.joints[i + 1].kind == "S"]
+
+
+def rod_axes(fr: LoopFrames, links: list[int]) -> Array:
+    """(N, r, 3) unit axes u of the S–S rods: from the proximal ball centre to the distal one."""
+    if not links:
+        return np.zeros((fr.centres.shape[0], 0, 3))
+    d = fr.centres[:, [i + 1 for i in links]] - fr.centres[:, links]
+    return np.asarray(d / np.linalg.norm(d, axis=-1, keepdims=True))
+
+
+@dataclass(frozen=True)
+class RateEquations:
+    """The scaled rate equations of a batch of closed configurations (module docstring)."""
+
+    screws: Array  # (N, 6, m) unit freedom screws, ground frame
+    spin: Array  # (N, r, m) zero-spin rows of the S–S rods
+    spin_links: list[int]
+    rod_axes: Array  # (N, r, 3)
+    rows: Array  # (6,) row scaling
+    cols: Array  # (m,) column scaling
+    in_idx: list[int]
+    p_idx: list[int]
+    passive: Array  # (N, 6 + r, m_p) scaled passive Jacobian
+    sigma_ratio: Array  # (N,) σ_min/σ_max of ``passive`` (0 when it has more columns than rows)
+    rank_deficient: NDArray[np.bool_]  # σ ratio below SINGULAR_RTOL
+    input_locked: NDArray[np.bool_]  # an input screw is not in the range of the passive one
+    singular: NDArray[np.bool_]  # either: no rates here
+
+    def solve(self, input_values: Array, bias: Array, spin_bias: Array,
+              minimum_norm: bool = False) -> tuple[Array, Array]:
+        """Passive rates (or accelerations) from the input ones and the bias terms J̇q̇ (N, 6)
+        and the rods' spin bias (N, r); NaN at singular samples (or, with ``minimum_norm``,
+        the minimum-norm least-squares solution there: a predictor, never a reported rate).
+        Also returns each sample's scaled residual relative to the size of the equation's
+        terms."""
+        S, C = self.screws, self.spin
+        rhs = np.concatenate(
+            [(-np.einsum("nij,nj->ni", S[:, :, self.in_idx], input_values) - bias) * self.rows,
+             -np.einsum("nij,nj->ni", C[:, :, self.in_idx], input_values) - spin_bias], axis=1)
+        x = _least_squares(self.passive, rhs, self.singular)
+        if minimum_norm and self.singular.any():
+            sing = self.singular
+            x[sing] = np.einsum("nij,nj->ni", np.linalg.pinv(self.passive[sing], rcond=1e-10),
+                                rhs[sing])
+            r = np.einsum("nij,nj->ni", self.passive, x) - rhs
+            return x * self.cols[self.p_idx], np.linalg.norm(r, axis=-1)
+        r = np.einsum("nij,nj->ni", self.passive, x) - rhs
+        size = np.linalg.norm(rhs, axis=-1) + np.linalg.norm(x, axis=-1) * _norm2(self.passive)
+        residual = np.linalg.norm(r, axis=-1) / np.maximum(size, 1e-300)
+        x[self.singular] = np.nan
+        return x * self.cols[self.p_idx], residual
+
+
+def _norm2(A: Array) -> Array:
+    """Frobenius norm per sample (an upper bound of the 2-norm, enough for a relative size)."""
+    return np.asarray(np.sqrt(np.einsum("nij,nij->n", A, A)))
+
+
+def _least_squares(A: Array, b: Array, skip: NDArray[np.bool_]) -> Array:
+    """x minimising |A x − b| per sample for A of full column rank (not at ``skip``): an LU
+    solve when A is square, else the normal equations with one step of iterative refinement
+    (the rank test has bounded the condition number by 1/SINGULAR_RTOL)."""
+    N, k, m = A.shape
+    x = np.zeros((N, m))
+    ok = ~skip
+    if not ok.any():
+        return x
+    Ao, bo = A[ok], b[ok]
+    if k == m:
+        x[ok] = np.linalg.solve(Ao, bo[..., None])[..., 0]
+        return x
+    At = np.swapaxes(Ao, -1, -2)
+    M = At @ Ao
+    xo = np.linalg.solve(M, np.einsum("nji,nj->ni", Ao, bo)[..., None])[..., 0]
+    r = bo - np.einsum("nij,nj->ni", Ao, xo)
+    xo = xo + np.linalg.solve(M, np.einsum("nji,nj->ni", Ao, r)[..., None])[..., 0]
+    x[ok] = xo
+    return x
+
+
+def rate_equations(linkage: Linkage, lay: Layout, fr: LoopFrames,
+                   mask: NDArray[np.bool_] | None = None) -> RateEquations:
+    """The scaled rate equations at every sample of ``fr`` (samples outside ``mask`` are
+    treated as singular and give NaN)."""
+    N, _, m = fr.screws.shape
+    L = constants(linkage, lay)[2]
+    names = list(lay.names)
+    in_idx = [names.index(n) for n in linkage.inputs]
+    p_idx = [k for k in range(m) if k not in in_idx]
+    rows = np.array([1, 1, 1, 1 / L, 1 / L, 1 / L])
+    cols = np.array([L if t else 1.0 for t in lay.is_translation])
+    S = fr.screws
+    links = spin_links(linkage)
+    u = rod_axes(fr, links)
+    C = np.zeros((N, len(links), m))
+    for r, i in enumerate(links):
+        upto = [f for f in range(m) if lay.joint_of[f] <= i]
+        C[:, r, upto] = np.einsum("ni,nif->nf", u[:, r], S[:, :3, upto])
+    scaled = np.concatenate([S * rows[None, :, None], C], axis=1) * cols[None, None, :]
+    Jp, Jin = scaled[:, :, p_idx], scaled[:, :, in_idx]
+    k, mp = Jp.shape[1:]
+    if mp > k or mp == 0:
+        ratio = np.zeros(N)
+    else:
+        lam = np.linalg.eigvalsh(np.swapaxes(Jp, -1, -2) @ Jp)
+        ratio = np.sqrt(np.maximum(lam[:, 0], 0.0) / np.maximum(lam[:, -1], 1e-300))
+    valid = np.ones(N, dtype=bool) if mask is None else np.asarray(mask, dtype=bool)
+    deficient = valid & (ratio < SINGULAR_RTOL)
+    locked = np.zeros(N, dtype=bool)
+    if k > mp and mp > 0:  # a tall system: is every input screw in the range of J_p?
+        for c in range(len(in_idx)):
+            x = _least_squares(Jp, Jin[..., c], deficient | ~valid)
+            r = np.einsum("nij,nj->ni", Jp, x) - Jin[..., c]
+            size = np.linalg.norm(Jin[..., c], axis=-1) + np.linalg.norm(x, axis=-1) * _norm2(Jp)
+            locked |= valid & ~deficient & (np.linalg.norm(r, axis=-1) > RESIDUAL_TOL * size)
+    singular = deficient | locked | ~valid
+    return RateEquations(S, C, links, u, rows, cols, in_idx, p_idx, Jp, ratio, deficient,
+                         locked, singular)
+
+
+def link_twists(linkage: Linkage, lay: Layout, S: Array, qd: Array) -> tuple[Array, Array]:
+    """Twist (ground frame) of the frame after each joint and the bias J̇q̇ accumulated up to
+    it: J̇q̇ = Σ_k [V_before(k), S_k] q̇_k, V_before(k) the motion of the loop before freedom k
+    (a U joint's second axis moves with its first)."""
+    N, _, m = S.shape
+    n = len(linkage.joints)
+    bracket = np.zeros((N, 6))
+    V = np.zeros((N, 6))
+    link_V = np.empty((N, n, 6))
+    link_bias = np.empty((N, n, 6))
+    for i, j in enumerate(linkage.joints):
+        ks = [f for f in range(m) if lay.joint_of[f] == i]
+        Vj = V.copy()
+        for f in ks:
+            if i > 0 or f != ks[0]:  # nothing moves before the first freedom
+                bracket = bracket + lie_bracket(Vj, S[:, :, f]) * qd[:, f:f + 1]
+            if j.kind == "U":
+                Vj = Vj + S[:, :, f] * qd[:, f:f + 1]
+        V = V + np.einsum("nik,nk->ni", S[:, :, ks], qd[:, ks])
+        link_V[:, i] = V
+        link_bias[:, i] = bracket
+    return link_V, link_bias
+
+
+def link_accelerations(linkage: Linkage, lay: Layout, S: Array, qdd: Array,
+                       link_bias: Array) -> Array:
+    """Acceleration (ground frame, the time derivative of the twist) of the frame after each
+    joint: Σ_{k ≤ joint} S_k q̈_k plus the bias accumulated up to it."""
+    N, _, m = S.shape
+    link_A = np.empty_like(link_bias)
+    acc = np.zeros((N, 6))
+    for i in range(len(linkage.joints)):
+        ks = [f for f in range(m) if lay.joint_of[f] == i]
+        acc = acc + np.einsum("nik,nk->ni", S[:, :, ks], qdd[:, ks])
+        link_A[:, i] = acc + link_bias[:, i]
+    return link_A
+
+
+@dataclass(frozen=True)
+class Rates:
+    """Freedom rates and accelerations of a batch and the twists of the frames after each
+    joint; ``residual`` the larger scaled residual of the two equations."""
+
+    qd: Array  # (N, m)
+    qdd: Array  # (N, m)
+    link_V: Array  # (N, n, 6)
+    link_A: Array  # (N, n, 6)
+    residual: Array  # (N,)
+
+
+def solve_rates(linkage: Linkage, lay: Layout, eq: RateEquations, Xd: Array,
+                Xdd: Array, minimum_norm: bool = False) -> Rates:
+    """Velocities and accelerations of every freedom and of the frame after every joint from
+    the inputs' ``Xd``, ``Xdd`` (N, n_in) (module docstring; NaN at singular samples, or the
+    minimum-norm solution there with ``minimum_norm``)."""
+    N, _, m = eq.screws.shape
+    r = len(eq.spin_links)
+    qd = np.zeros((N, m))
+    qd[:, eq.in_idx] = Xd
+    qd[:, eq.p_idx], res1 = eq.solve(Xd, np.zeros((N, 6)), np.zeros((N, r)), minimum_norm)
+    link_V, link_bias = link_twists(linkage, lay, eq.screws, np.nan_to_num(qd))
+    qdd = np.zeros((N, m))
+    qdd[:, eq.in_idx] = Xdd
+    spin_bias = np.einsum("nri,nri->nr", eq.rod_axes, link_bias[:, eq.spin_links, :3])
+    qdd[:, eq.p_idx], res2 = eq.solve(Xdd, link_bias[:, -1], spin_bias, minimum_norm)
+    link_A = link_accelerations(linkage, lay, eq.screws, np.nan_to_num(qdd), link_bias)
+    return Rates(qd, qdd, link_V, link_A, np.maximum(res1, res2))

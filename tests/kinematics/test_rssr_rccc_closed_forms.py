@@ -1,0 +1,136 @@
+"""The RSSR and RCCC closed forms (kinematics/rssr.py, kinematics/rccc.py) against the generic
+solver, the loop closure and their own derivatives."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from screwkit.io.spec import load_spec
+from screwkit.kinematics.loop import forward, layout
+from screwkit.kinematics.rates import rate_equations
+from screwkit.kinematics.rccc import rccc_applies
+from screwkit.kinematics.registry import family_of
+from screwkit.kinematics.rssr import RSSRDimensions, rssr_motion
+from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.model.families import rccc, rssr
+
+deg = np.radians
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def _same_modes(closed, generic, length):
+    """Every closed-form mode's samples are a generic mode's, with the same joint centres,
+    link frames and twists (both exact: round-off of the length scale), away from the band
+    around folds where the generic solver may stop a sample early (σ_min/σ_max < 1e-2:
+    test_never_miss_a_mode.py)."""
+    lk = closed.linkage
+    lay = layout(lk)
+    for c in closed.modes:
+        sigma = rate_equations(lk, lay, forward(lk, c.conf, lay), c.assembles).sigma_ratio
+        covered = np.zeros_like(c.assembles)
+        for g in generic.modes:
+            both = c.assembles & g.assembles
+            if not both.any():
+                continue
+            d = np.abs(c.joint_centres[both] - g.joint_centres[both]).max(axis=(1, 2))
+            same = both.copy()
+            same[both] = d < 1e-9 * length
+            if not same.any():
+                continue
+            covered |= same
+            ok = same & ~c.singular & ~g.singular
+            for name in ("link_rotation", "link_angular_velocity", "link_origin_acceleration"):
+                np.testing.assert_allclose(getattr(c, name)[ok], getattr(g, name)[ok],
+                                           atol=1e-8 * max(1.0, length), err_msg=name)
+        away = c.assembles & (sigma > 1e-2)
+        assert np.all(covered[away])
+
+
+@settings(max_examples=10, deadline=None, derandomize=True)
+@given(d1=st.floats(0.5, 1.5), d2=st.floats(3.0, 5.0), d3=st.floats(1.0, 3.5),
+       a=st.floats(1.5, 4.0), b=st.floats(-1.0, 3.0), lambda0=st.floats(0.1, 1.4),
+       offset=st.floats(-1.0, 1.0))
+def test_rssr_closed_form_equals_the_generic_solver(d1, d2, d3, a, b, lambda0, offset):
+    lk = rssr(d1, d2, d3, a, b, lambda0, offset)
+    theta = deg(np.arange(0.0, 360.0, 7.5))
+    try:
+        closed = solve_motion(lk, theta, rates=1.7, accelerations=0.3, method="closed")
+    except ValueError:
+        return  # does not assemble anywhere: the generic solver is tested on that elsewhere
+    generic = solve_motion(lk, theta, rates=1.7, accelerations=0.3, method="generic")
+    _same_modes(closed, generic, lk.length_scale)
+    for md in closed.modes:
+        ok = md.assembles
+        # the coupler closes: |Q − P| = d2 between the two ball centres
+        rod = md.joint_centres[ok, 2] - md.joint_centres[ok, 1]
+        np.testing.assert_allclose(np.linalg.norm(rod, axis=1), d2, atol=1e-12 * d2)
+        # the closed form's own φ0 rates (implicit differentiation) = the rate equations'
+        good = ok & ~md.singular
+        np.testing.assert_allclose(md.velocities["phi0"][good],
+                                   -md.velocities["output.theta"][good], atol=1e-9)
+        np.testing.assert_allclose(md.accelerations["phi0"][good],
+                                   -md.accelerations["output.theta"][good], atol=1e-8)
+
+
+def test_rssr_roots_meet_at_a_dead_centre():
+    # a non-Grashof RSSR: where its two roots meet (a double root of the input-output
+    # equation) both modes reach the sample, which is singular: no rates there
+    dims = RSSRDimensions(2.0, 3.0, 2.5, 3.5, 0.5, deg(30), 0.2)
+    lk = rssr(dims.d1, dims.d2, dims.d3, dims.a, dims.b, dims.lambda0, dims.output_offset)
+    theta = np.linspace(0.0, 2 * np.pi, 361)
+    both = rssr_motion(dims, theta).assembles.all(axis=1)
+    k = np.nonzero(both[:-1] & ~both[1:])[0][0]  # the last sample before the roots vanish
+    lo, hi = theta[k], theta[k + 1]
+    for _ in range(80):  # bisect the fold to round-off
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if rssr_motion(dims, np.array([mid])).assembles.all() else (lo, mid)
+    at = rssr_motion(dims, np.array([lo]))
+    assert abs(np.angle(np.exp(1j * (at.phi0[0, 0] - at.phi0[0, 1])))) < 1e-6
+    sweep = np.concatenate([np.linspace(lo - deg(10), lo, 11)])
+    for method in ("closed", "generic"):
+        m = solve_motion(lk, sweep, method=method)
+        assert len(m.modes) == 2
+        for md in m.modes:
+            assert md.assembles.all() and md.singular.tolist() == [False] * 10 + [True]
+            assert np.isnan(md.velocities["phi0"][10]) and np.isfinite(md.velocities["phi0"][:10]).all()
+            assert any("dead centre" in e for e in md.events)
+
+
+def _random_rccc(rng):
+    twists = rng.choice([-1.0, 1.0], 4) * rng.uniform(0.2, 1.4, 4)
+    return rccc(tuple(rng.uniform(0.2, 3.0, 4)), tuple(twists), rng.uniform(-1.0, 1.0))
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_rccc_closed_form_equals_the_generic_solver(seed):
+    lk = _random_rccc(np.random.default_rng(seed))
+    theta = deg(np.arange(0.0, 360.0, 7.5))
+    try:
+        closed = solve_motion(lk, theta, rates=0.9, accelerations=-0.2, method="closed")
+    except ValueError:
+        return
+    assert closed.method == "closed"
+    generic = solve_motion(lk, theta, rates=0.9, accelerations=-0.2, method="generic")
+    _same_modes(closed, generic, lk.length_scale)
+    for md in closed.modes:
+        assert np.nanmax(md.closure_residual) < 1e-12
+
+
+def test_rccc_joint_list_is_solved_by_the_closed_form():
+    s = load_spec(EXAMPLES / "rccc_loop.toml")
+    assert rccc_applies(s.linkage)
+    m = solve_motion(s.linkage, s.inputs)
+    assert m.method == "closed" and "dual input-output" in m.solver
+    g = solve_motion(s.linkage, s.inputs, method="generic")
+    _same_modes(m, g, s.linkage.length_scale)
+
+
+def test_rccc_with_parallel_cylinders_has_no_closed_form():
+    lk = rccc((1.0, 3.0, 2.5, 3.0), (0.3, 0.0, -0.4, 0.5))  # C2 ∥ C3: s2, s3 not separate
+    assert not rccc_applies(lk)
+    assert family_of(lk).closed_form_for(lk) is None  # method="auto" takes the generic solver
+    with pytest.raises(ValueError, match="no closed form"):
+        solve_motion(lk, deg(np.arange(0.0, 360.0, 30.0)), method="closed")
