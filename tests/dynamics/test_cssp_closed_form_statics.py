@@ -77,7 +77,7 @@ def test_cssp_closed_form_statics_equals_generic(seed: int, mode: int, driven_of
     fast = inverse_dynamics(lk, mm, **kwargs)  # type: ignore[arg-type]
     generic = inverse_dynamics(lk, mm, closed_form=False, **kwargs)  # type: ignore[arg-type]
     assert_same_dynamics(fast, generic, lk.length_scale)
-    fused = cssp_inverse_dynamics(lk, theta, rate, rate_dot, mode=mode,
+    fused = cssp_inverse_dynamics(lk, theta, rate, rate_dot, root=mode,
                                   **offset, **kwargs)  # type: ignore[arg-type]
     assert_same_dynamics(fused, generic, lk.length_scale)
     assert fast.indeterminacy.count == 0 and fast.indeterminacy.idle_freedoms == 1

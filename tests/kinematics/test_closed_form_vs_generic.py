@@ -24,7 +24,7 @@ def test_cssp_closed_form_equals_generic_solver(a1, a2, a4, alpha4, s1):
     dims = CSSPDimensions(a1, a2, a4, alpha4, s1)
     matched = 0
     for mode in (1, -1):
-        cf = cssp_motion(dims, theta, omega, omega_dot, mode=mode)
+        cf = cssp_motion(dims, theta, omega, omega_dot, root=mode)
         for md in m.modes:
             v, vd, vdd = seed_variables(lk, md)
             if not md.assembles.all() or abs(v["s4"][0] - cf.s4[0]) > 1e-9:

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from screwkit.kinematics.cssp import (
-    SEED_ASSEMBLY_MODE,
+    SEED_ROOT,
     CSSPAssemblyError,
     CSSPDimensions,
     assembly_discriminant,
@@ -51,9 +51,9 @@ def test_seed_example_stroke_and_10_degree_value() -> None:
     assert at10.s4[0] / INCH == pytest.approx(EXACT["s4_at_10deg_in"], abs=5e-4)
     # the seed program's value is 0.557 in away (SPEC §1.3); the exact value is not near it
     assert abs(at10.s4[0] / INCH - EXACT["program_s4_at_10deg_in"]) > 0.5
-    other = cssp_positions(dims, np.array([0.0]), mode=-1)
+    other = cssp_positions(dims, np.array([0.0]), root=-1)
     assert other.s4[0] / INCH == pytest.approx(EXACT["other_root_near_in"], abs=0.05)
-    assert SEED_ASSEMBLY_MODE == 1
+    assert SEED_ROOT == 1
     assert assembly_intervals(dims) == [(0.0, 2 * np.pi)]  # a full-turn crank
 
 
@@ -156,8 +156,8 @@ def test_dimension_errors() -> None:
 
 def test_input_errors() -> None:
     dims = seed_dims()
-    with pytest.raises(ValueError, match="mode must be"):
-        cssp_positions(dims, [0.0], mode=0)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="root must be"):
+        cssp_positions(dims, [0.0], root=0)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match=r"1-D array \(N,\)"):
         cssp_positions(dims, np.zeros((2, 2)))
     with pytest.raises(ValueError, match="theta1_dot has 3 entries but theta1 has 2"):

@@ -122,7 +122,7 @@ def test_random_cssp_equals_generic(a1, a2, a4, alpha4, s1):
     lk = _with_masses(cssp(a1, a2, a4, alpha4, s1), a1, a2)
     theta = deg(np.arange(0.0, 360.0, 30.0))
     slow = motion(lk, theta, OMEGA, OMEGA_DOT)
-    fast = cssp_mode_motion(lk, theta, OMEGA, OMEGA_DOT, mode=1)
+    fast = cssp_mode_motion(lk, theta, OMEGA, OMEGA_DOT, root=1)
     md = _matching_mode(fast, slow.modes)
     _spin_free_agreement(lk, fast, md, a2)
     _loads_agree(lk, fast, md)

@@ -78,8 +78,8 @@ def natural_scales(case: dict[str, Any]) -> dict[str, float]:
 def test_closure_and_both_roots(case: dict[str, Any]) -> None:
     dims, theta = case["dims"], case["theta"]
     size = dims.a1 + dims.a2 + abs(dims.a4) + abs(dims.s1)
-    plus = cssp_positions(dims, theta, mode=1)
-    minus = cssp_positions(dims, theta, mode=-1)
+    plus = cssp_positions(dims, theta, root=1)
+    minus = cssp_positions(dims, theta, root=-1)
     for pos in (plus, minus):
         assert np.all(pos.assembles)
         np.testing.assert_array_less(pos.loop_closure_gap, 1e-12 * size)
@@ -99,7 +99,7 @@ def test_rates_equal_complex_step_derivatives(case: dict[str, Any]) -> None:
     """First derivatives: complex step on the positions along θ1(t), s1(t). Second derivatives:
     complex step on the (independently checked) first derivatives."""
     dims, mode, theta, r = case["dims"], case["mode"], case["theta"], case["rates"]
-    motion = cssp_motion(dims, theta, mode=mode, **r)
+    motion = cssp_motion(dims, theta, root=mode, **r)
     n = theta.shape[0]
     w, wd, s1d, s1dd = (
         np.full(n, r[k]) for k in ("theta1_dot", "theta1_ddot", "s1_dot", "s1_ddot")
@@ -143,7 +143,7 @@ def test_rates_equal_complex_step_derivatives(case: dict[str, Any]) -> None:
 @given(assembled_cases())
 def test_rod_angular_motion_has_no_spin_and_moves_u(case: dict[str, Any]) -> None:
     dims, mode, theta, r = case["dims"], case["mode"], case["theta"], case["rates"]
-    m = cssp_motion(dims, theta, mode=mode, **r)
+    m = cssp_motion(dims, theta, root=mode, **r)
     u, ud, udd = m.rod_direction, m.rod_direction_dot, m.rod_direction_ddot
     w, a = m.rod_angular_velocity, m.rod_angular_acceleration
     nat = natural_scales(case)
@@ -161,7 +161,7 @@ def test_angle_rates_reproduce_rod_direction_rates(case: dict[str, Any]) -> None
     """u = (cη2 cφ, cη2 sφ, −sη2) with φ = θ1 + θ2, and X(α4)·u = (cθ3 cη3, cθ3 sη3, sθ3):
     the chain rule with the reported angle rates must give the (complex-step checked) u̇, ü."""
     dims, mode, theta, r = case["dims"], case["mode"], case["theta"], case["rates"]
-    m = cssp_motion(dims, theta, mode=mode, **r)
+    m = cssp_motion(dims, theta, root=mode, **r)
     assume(np.all(m.rod_angles_defined) and np.all(m.slider_angles_defined))
     rot4 = np.array(
         [
@@ -230,13 +230,13 @@ def test_angle_rates_against_finite_differences(mode: int) -> None:
     t = t0[None, :] + ks[:, None] * h  # (9, 7)
     theta = w0 * t + 0.5 * wd * t**2
     s1 = dims.s1 + s1d * t + 0.5 * s1dd * t**2
-    pos = cssp_positions(dims, theta.ravel(), mode=mode, s1=s1.ravel())
+    pos = cssp_positions(dims, theta.ravel(), root=mode, s1=s1.ravel())
     motion = cssp_motion(
         dims,
         w0 * t0 + 0.5 * wd * t0**2,
         w0 + wd * t0,
         wd,
-        mode=mode,
+        root=mode,
         s1=dims.s1 + s1d * t0 + 0.5 * s1dd * t0**2,
         s1_dot=s1d + s1dd * t0,
         s1_ddot=s1dd,

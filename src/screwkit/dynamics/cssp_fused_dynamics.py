@@ -33,7 +33,7 @@ from screwkit.dynamics.loop_statics import statics_structure
 from screwkit.dynamics.result import Array, Dynamics
 from screwkit.dynamics.sample_blocks import BLOCK_SAMPLES, Outputs, Setup, as_dynamics, blocks
 from screwkit.dynamics.screws import freedom_screws
-from screwkit.kinematics.cssp import SEED_ASSEMBLY_MODE
+from screwkit.kinematics.cssp import SEED_ROOT
 from screwkit.kinematics.cssp_motion import cssp_block_rows, cssp_mode_motion, cssp_sweep
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
@@ -134,7 +134,7 @@ def cssp_inverse_dynamics(
     gravity: ArrayLike | None = None,
     moment_point: ArrayLike | None = None,
     *,
-    mode: int = SEED_ASSEMBLY_MODE,
+    root: int = SEED_ROOT,
     s1: ArrayLike | None = None,
     s1_dot: ArrayLike = 0.0,
     s1_ddot: ArrayLike = 0.0,
@@ -158,7 +158,7 @@ def cssp_inverse_dynamics(
     masses = check_link_masses(linkage)
     if not isinstance(block_size, int | np.integer) or block_size < 1:
         raise DynamicsInputError(f"block_size must be a positive integer, got {block_size!r}")
-    sw = cssp_sweep(linkage, theta1, theta1_dot, theta1_ddot, mode, s1=s1, s1_dot=s1_dot,
+    sw = cssp_sweep(linkage, theta1, theta1_dot, theta1_ddot, root, s1=s1, s1_dot=s1_dot,
                     s1_ddot=s1_ddot, allow_partial=allow_partial)
     if not sw.assembles.any():
         from screwkit.dynamics.checks import NonAssemblingMotionError
@@ -175,7 +175,7 @@ def cssp_inverse_dynamics(
                                            min(32, valid_idx.size)).astype(int))]
     spread = cssp_mode_motion(
         linkage, sw.theta1[take], sw.block("theta1_dot", take), sw.block("theta1_ddot", take),
-        sw.mode, **{k: sw.block(k, take) for k in offset_names},  # type: ignore[arg-type]
+        sw.root, **{k: sw.block(k, take) for k in offset_names},  # type: ignore[arg-type]
         ball_joints=False)
     reference = np.mean(spread.joint_centres, axis=(0, 1))
     structure = statics_structure(freedom_screws(linkage, spread, reference),
@@ -184,7 +184,7 @@ def cssp_inverse_dynamics(
     if plan is None or structure.rank != 6 or structure.passive_count != 7:
         from screwkit.dynamics.inverse import inverse_dynamics
 
-        mm = cssp_mode_motion(linkage, theta1, theta1_dot, theta1_ddot, mode, s1=s1,
+        mm = cssp_mode_motion(linkage, theta1, theta1_dot, theta1_ddot, root, s1=s1,
                               s1_dot=s1_dot, s1_ddot=s1_ddot, allow_partial=allow_partial,
                               ball_joints=False)
         return inverse_dynamics(linkage, mm, gravity, moment_point,

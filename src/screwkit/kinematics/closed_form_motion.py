@@ -166,7 +166,7 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     modes: list[ModeMotion] = []
     for root, label in ((1, "s4 = -b + sqrt(b^2 - c)"), (-1, "s4 = -b - sqrt(b^2 - c)")):
         driven = len(linkage.inputs) == 2  # the crank offset s1 is a second input
-        md = cssp_mode_motion(linkage, theta, Xd[:, 0], Xdd[:, 0], mode=root, allow_partial=True,
+        md = cssp_mode_motion(linkage, theta, Xd[:, 0], Xdd[:, 0], root=root, allow_partial=True,
                               s1=X[:, 1] if driven else None, s1_dot=Xd[:, 1] if driven else 0.0,
                               s1_ddot=Xdd[:, 1] if driven else 0.0)
         ok = np.asarray(md.assembles)
@@ -174,7 +174,7 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
             continue
         # the seed's angles with their closed-form rates (for a fixed crank offset; with a
         # driven one the registry's names from the link frames are used)
-        cf = None if driven else cssp_motion(dims, theta, Xd[:, 0], Xdd[:, 0], mode=root,
+        cf = None if driven else cssp_motion(dims, theta, Xd[:, 0], Xdd[:, 0], root=root,
                                              allow_partial=True)
         seed_v: dict[str, Array] = {"theta1": theta}
         seed_d: dict[str, Array] = {"theta1": Xd[:, 0]}

@@ -11,7 +11,7 @@ is the crank axis, x1 the common normal from z1 to the slider axis, origin at it
 
 |P − D1| = a2 gives s4² + 2 b s4 + c = 0 with b = a1 sθ1 sα4 + s1 cα4 and
 c = a4² + 2 a1 a4 cθ1 + a1² + s1² − a2². Its two roots s4 = −b ± √(b² − c) are the two assembly
-modes; ``mode=+1`` (s4 = −b + √(b² − c)) is the branch of Rahman's program. Velocities and
+modes; ``root=+1`` (s4 = −b + √(b² − c)) is the branch of Rahman's program. Velocities and
 accelerations follow by differentiating the quadratic exactly (no least squares; compare SPEC
 §1.3–1.4, which describes the over-determined least-squares loop closure of the seed program and
 why it never closes). The rod is a two-ball link: its spin about u is a passive freedom, taken as
@@ -35,10 +35,10 @@ Array = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 AnyArray = NDArray[Any]  # real, or complex for complex-step differentiation
 
-AssemblyMode = Literal[1, -1]
+RootSign = Literal[1, -1]
 
-#: assembly mode of Rahman's FORTRAN program: s4 = −b + √(b² − c) (SPEC §1.2)
-SEED_ASSEMBLY_MODE: AssemblyMode = 1
+#: the root of Rahman's FORTRAN program: s4 = −b + √(b² − c) (SPEC §1.2); mode 0 of solve_motion
+SEED_ROOT: RootSign = 1
 
 class CSSPAssemblyError(InputError):
     """The CSSP does not assemble (b² < c) or sits on a branch point (b² = c) at some inputs."""
@@ -111,7 +111,7 @@ def slider_and_rod(
     s1: AnyArray,
     s1_dot: AnyArray,
     s1_ddot: AnyArray,
-    mode: int,
+    root: int,
     disc_sqrt: Array | None = None,
 ) -> dict[str, AnyArray]:
     """s4 and rod direction u with their first two time derivatives (SPEC §1.2).
@@ -123,19 +123,19 @@ def slider_and_rod(
     sa, ca = np.sin(dims.alpha4), np.cos(dims.alpha4)
     st, ct = np.sin(theta1), np.cos(theta1)
     b, c = _quadratic_coefficients(dims, theta1, s1)
-    root = mode * (np.sqrt(b * b - c) if disc_sqrt is None else disc_sqrt)  # = s4 + b
-    # −b + root cancels when mode·b > 0; there use the product of the roots, s4·s4' = c
-    other = -b - root
-    cancels = (mode * np.real(b) > 0) & (np.real(other) != 0)
-    s4 = np.where(cancels, c / np.where(cancels, other, 1.0), root - b)
+    radical = root * (np.sqrt(b * b - c) if disc_sqrt is None else disc_sqrt)  # = s4 + b
+    # −b + root cancels when root·b > 0; there use the product of the roots, s4·s4' = c
+    other = -b - radical
+    cancels = (root * np.real(b) > 0) & (np.real(other) != 0)
+    s4 = np.where(cancels, c / np.where(cancels, other, 1.0), radical - b)
 
     w, wd = theta1_dot, theta1_ddot
     b_dot = a1 * ct * w * sa + s1_dot * ca
     b_ddot = a1 * sa * (ct * wd - st * w**2) + s1_ddot * ca
     c_dot = -2 * a1 * a4 * st * w + 2 * s1 * s1_dot
     c_ddot = -2 * a1 * a4 * (ct * w**2 + st * wd) + 2 * (s1_dot**2 + s1 * s1_ddot)
-    s4_dot = -(b_dot * s4 + c_dot / 2) / root
-    s4_ddot = -(s4_dot**2 + 2 * b_dot * s4_dot + b_ddot * s4 + c_ddot / 2) / root
+    s4_dot = -(b_dot * s4 + c_dot / 2) / radical
+    s4_ddot = -(s4_dot**2 + 2 * b_dot * s4_dot + b_ddot * s4 + c_ddot / 2) / radical
 
     pin = np.stack([a1 * ct, a1 * st, s1], axis=-1)
     pin_dot = np.stack([-a1 * st * w, a1 * ct * w, s1_dot], axis=-1)
@@ -301,7 +301,7 @@ class CSSPPositions:
     """
 
     dims: CSSPDimensions
-    mode: int
+    root: int
     theta1: Array
     s1: Array
     assembles: BoolArray
@@ -380,13 +380,15 @@ def as_sample_array(value: ArrayLike | None, n: int, name: str, default: float) 
     return out
 
 
-def check_assembly_mode(mode: int) -> int:
-    """The assembly mode as an int, +1 (s4 = -b + sqrt(b^2 - c), Rahman's) or -1; else ValueError."""
-    if mode not in (1, -1):
-        raise ValueError(
-            f"mode must be +1 (s4 = -b + sqrt(b^2 - c), Rahman's branch) or -1, got {mode!r}"
+def check_root(root: int) -> int:
+    """The root sign of the quadratic in s4 as an int: +1 (s4 = -b + sqrt(b^2 - c), Rahman's
+    branch) or -1 — a sign, not a mode index (docs/conventions.md); else InputError."""
+    if isinstance(root, bool) or root not in (1, -1):
+        raise InputError(
+            f"root must be +1 (s4 = -b + sqrt(b^2 - c), Rahman's branch) or -1 (the other root); "
+            f"got {root!r} (solve_motion numbers the modes 0, 1: mode 0 is root +1)"
         )
-    return int(mode)
+    return int(root)
 
 
 def _rod_and_slider_angles(
@@ -446,11 +448,11 @@ def _solve(
     s1: ArrayLike | None,
     s1_dot: ArrayLike | None,
     s1_ddot: ArrayLike | None,
-    mode: int,
+    root: int,
     allow_partial: bool,
     need_rates: bool,
 ) -> dict[str, object]:
-    mode = check_assembly_mode(mode)
+    root = check_root(root)
     th = np.atleast_1d(np.asarray(theta1, dtype=float))
     if th.ndim != 1:
         raise ValueError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
@@ -479,7 +481,7 @@ def _solve(
         )
     disc_sqrt = np.sqrt(np.where(assembles, disc, 1.0))  # placeholder 1 where masked below
     with np.errstate(divide="ignore", invalid="ignore"):  # rates at b² = c, unused for positions
-        core = slider_and_rod(dims, th, w, wd, s1_arr, s1d, s1dd, mode, disc_sqrt=disc_sqrt)
+        core = slider_and_rod(dims, th, w, wd, s1_arr, s1d, s1dd, root, disc_sqrt=disc_sqrt)
     for key, value in core.items():
         if key.startswith("crank_pin"):
             continue
@@ -489,7 +491,7 @@ def _solve(
     u, ud, udd = core["rod_direction"], core["rod_direction_dot"], core["rod_direction_ddot"]
     out: dict[str, object] = {
         "dims": dims,
-        "mode": mode,
+        "root": root,
         "theta1": th,
         "s1": s1_arr,
         "assembles": assembles,
@@ -522,20 +524,20 @@ def _solve(
 def cssp_positions(
     dims: CSSPDimensions,
     theta1: ArrayLike,
-    mode: int = SEED_ASSEMBLY_MODE,
+    root: int = SEED_ROOT,
     *,
     s1: ArrayLike | None = None,
     allow_partial: bool = False,
 ) -> CSSPPositions:
     """Exact positions of the CSSP at crank angles ``theta1`` (N,) rad (SPEC §1.2).
 
-    ``mode=+1``: s4 = −b + √(b² − c), the branch of Rahman's program; ``mode=-1``: the other root.
+    ``root=+1``: s4 = −b + √(b² − c), the branch of Rahman's program; ``root=-1``: the other root.
     Each mode is a continuous branch wherever b² > c. ``s1`` (scalar or (N,)) overrides
     ``dims.s1`` for a driven cylindrical joint. Inputs where the CSSP does not assemble raise
     ``CSSPAssemblyError`` (with ``assembly_message``) unless ``allow_partial=True``, which returns
     NaN there and the mask ``assembles``.
     """
-    out = _solve(dims, theta1, None, None, s1, None, None, mode, allow_partial, need_rates=False)
+    out = _solve(dims, theta1, None, None, s1, None, None, root, allow_partial, need_rates=False)
     return CSSPPositions(**out)  # type: ignore[arg-type]
 
 
@@ -544,7 +546,7 @@ def cssp_motion(
     theta1: ArrayLike,
     theta1_dot: ArrayLike = 0.0,
     theta1_ddot: ArrayLike = 0.0,
-    mode: int = SEED_ASSEMBLY_MODE,
+    root: int = SEED_ROOT,
     *,
     s1: ArrayLike | None = None,
     s1_dot: ArrayLike = 0.0,
@@ -560,7 +562,7 @@ def cssp_motion(
     Rod: u̇ = (Ṗ − Ḋ1)/a2, ü likewise; ω_rod = u × u̇, α_rod = u × ü (zero axial spin).
     Angles: rates of η2, θ2, θ3, η3 from the exact derivatives of atan2/asin of u.
     Branch points (b² = c, where the two modes meet and the rates are unbounded) count as not
-    assembling. See ``cssp_positions`` for ``mode`` and ``allow_partial``.
+    assembling. See ``cssp_positions`` for ``root`` and ``allow_partial``.
     """
     out = _solve(
         dims,
@@ -570,7 +572,7 @@ def cssp_motion(
         s1,
         s1_dot,
         s1_ddot,
-        mode,
+        root,
         allow_partial,
         need_rates=True,
     )
@@ -578,8 +580,8 @@ def cssp_motion(
 
 
 __all__ = [
-    "SEED_ASSEMBLY_MODE",
-    "AssemblyMode",
+    "SEED_ROOT",
+    "RootSign",
     "CSSPAssemblyError",
     "CSSPDimensions",
     "CSSPMotion",
@@ -588,7 +590,7 @@ __all__ = [
     "assembly_intervals",
     "as_sample_array",
     "assembly_message",
-    "check_assembly_mode",
+    "check_root",
     "cssp_motion",
     "cssp_positions",
     "slider_and_rod",

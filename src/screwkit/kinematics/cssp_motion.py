@@ -43,12 +43,12 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.dual.spatial import GIMBAL_TOL, rot_x
 from screwkit.errors import InputError
 from screwkit.kinematics.cssp import (
-    SEED_ASSEMBLY_MODE,
+    SEED_ROOT,
     CSSPAssemblyError,
     CSSPDimensions,
     as_sample_array,
     assembly_message,
-    check_assembly_mode,
+    check_root,
 )
 from screwkit.kinematics.loop import Configuration
 from screwkit.kinematics.motion import ModeMotion
@@ -96,7 +96,7 @@ def _component_major(n: int, *shape: int) -> tuple[Array, Array]:
 
 
 def cssp_closed_form_block(
-    dims: CSSPDimensions, mode: int, ct: Array, st: Array, w: Any, wd: Any, s1: Any, s1d: Any,
+    dims: CSSPDimensions, root: int, ct: Array, st: Array, w: Any, wd: Any, s1: Any, s1d: Any,
     s1dd: Any, disc: Array,
 ) -> dict[str, Any]:
     """Crank pin, slider ball, s4, the rod direction u and their first two rates for one block,
@@ -109,12 +109,12 @@ def cssp_closed_form_block(
     a1c, a1s = a1 * ct, a1 * st
     b = sa * a1s + ca * s1
     c = (a4**2 + a1**2 - a2**2) + 2 * a4 * a1c + s1 * s1
-    root = np.sqrt(disc) if mode > 0 else -np.sqrt(disc)  # = s4 + b
-    # −b + root cancels when mode·b > 0; there use the product of the roots, s4·s4' = c
-    other = -b - root
-    cancels = (b > 0) if mode > 0 else (b < 0)
+    radical = np.sqrt(disc) if root > 0 else -np.sqrt(disc)  # = s4 + b
+    # −b + root cancels when root·b > 0; there use the product of the roots, s4·s4' = c
+    other = -b - radical
+    cancels = (b > 0) if root > 0 else (b < 0)
     cancels &= other != 0
-    s4 = np.where(cancels, c / np.where(cancels, other, 1.0), root - b)
+    s4 = np.where(cancels, c / np.where(cancels, other, 1.0), radical - b)
     w2 = w * w
     pin_v = (-a1s * w, a1c * w, s1d)
     pin_a = (-(a1c * w2 + a1s * wd), a1c * wd - a1s * w2, s1dd)
@@ -122,7 +122,7 @@ def cssp_closed_form_block(
     b_ddot = sa * pin_a[1] + ca * s1dd
     c_dot = 2 * (a4 * pin_v[0] + s1 * s1d)
     c_ddot = 2 * (a4 * pin_a[0] + s1d * s1d + s1 * s1dd)
-    inv_root = 1.0 / root
+    inv_root = 1.0 / radical
     s4_dot = -(b_dot * s4 + 0.5 * c_dot) * inv_root
     s4_ddot = -(s4_dot * s4_dot + 2 * b_dot * s4_dot + b_ddot * s4 + 0.5 * c_ddot) * inv_root
     inv_a2 = 1.0 / a2
@@ -236,7 +236,7 @@ def cssp_block_rows(
     w, wd = sw.block("theta1_dot", sel), sw.block("theta1_ddot", sel)
     s1 = sw.block("s1", sel)
     s1d, s1dd = sw.block("s1_dot", sel), sw.block("s1_ddot", sel)
-    k = cssp_closed_form_block(dims, sw.mode, ct, st, w, wd, s1, s1d, s1dd,
+    k = cssp_closed_form_block(dims, sw.root, ct, st, w, wd, s1, s1d, s1dd,
                                sw.discriminant[sel])
     u, ud, udd = k["u"], k["u_dot"], k["u_ddot"]
     y3, z3 = rahman_rod_axes(u)
@@ -329,7 +329,7 @@ class CSSPSweep:
     """
 
     dims: CSSPDimensions
-    mode: int
+    root: int
     driven_offset: bool
     n: int
     theta1: Array
@@ -368,7 +368,7 @@ def cssp_sweep(
     theta1: ArrayLike,
     theta1_dot: ArrayLike = 0.0,
     theta1_ddot: ArrayLike = 0.0,
-    mode: int = SEED_ASSEMBLY_MODE,
+    root: int = SEED_ROOT,
     *,
     s1: ArrayLike | None = None,
     s1_dot: ArrayLike = 0.0,
@@ -387,7 +387,7 @@ def cssp_sweep(
             f"{linkage.name}: the crank offset s1 is a constant of this CSSP "
             f"(s1 = {dims.s1!r} m); build it with cssp(..., s1_is_input=True) to drive s1"
         )
-    mode = check_assembly_mode(mode)
+    root = check_root(root)
     th = np.atleast_1d(np.asarray(theta1, dtype=float))
     if th.ndim != 1:
         raise ValueError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
@@ -420,8 +420,8 @@ def cssp_sweep(
         disc = np.where(ok, disc, 1.0)
     from screwkit.kinematics.cssp_rod_pose import rod_turn
 
-    turn = rod_turn(dims, mode, th, ct, st, given, disc, ok)
-    return CSSPSweep(dims, mode, driven_offset, n, th, ct, st, given, disc, ok, turn)
+    turn = rod_turn(dims, root, th, ct, st, given, disc, ok)
+    return CSSPSweep(dims, root, driven_offset, n, th, ct, st, given, disc, ok, turn)
 
 
 def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
@@ -466,7 +466,7 @@ def cssp_mode_motion(
     theta1: ArrayLike,
     theta1_dot: ArrayLike = 0.0,
     theta1_ddot: ArrayLike = 0.0,
-    mode: int = SEED_ASSEMBLY_MODE,
+    root: int = SEED_ROOT,
     *,
     s1: ArrayLike | None = None,
     s1_dot: ArrayLike = 0.0,
@@ -478,7 +478,7 @@ def cssp_mode_motion(
     """One assembly mode of a CSSP over N crank angles, from the closed form (no Newton).
 
     Same result as ``motion(linkage, theta1, theta1_dot, theta1_ddot).modes[k]`` for the mode
-    whose slider position is s4 = −b + mode·√(b² − c) (SPEC §1.2; ``mode=+1`` is Rahman's
+    whose slider position is s4 = −b + root·√(b² − c) (SPEC §1.2; ``root=+1`` is Rahman's
     branch), up to the rod's free spin angle (module docstring). ``theta1`` (N,) rad,
     ``theta1_dot``/``theta1_ddot`` rad/s, rad/s² (scalars or (N,)); ``s1``, ``s1_dot``,
     ``s1_ddot`` drive the crank offset of a CSSP built with ``s1_is_input=True`` (for a fixed
@@ -498,7 +498,7 @@ def cssp_mode_motion(
     not C-contiguous): the values are those of the (N, …) layout, and the blocked inverse
     dynamics reads them without a transposing copy.
     """
-    sw = cssp_sweep(linkage, theta1, theta1_dot, theta1_ddot, mode, s1=s1, s1_dot=s1_dot,
+    sw = cssp_sweep(linkage, theta1, theta1_dot, theta1_ddot, root, s1=s1, s1_dot=s1_dot,
                     s1_ddot=s1_ddot, allow_partial=allow_partial)
     driven_offset, n, ok = sw.driven_offset, sw.n, sw.assembles
     th = sw.theta1

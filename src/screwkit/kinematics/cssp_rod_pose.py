@@ -18,7 +18,7 @@ from screwkit.kinematics.idle_spin import zero_spin_angle
 from screwkit.kinematics.loop import Array
 
 
-def rod_turn(dims: CSSPDimensions, mode: int, theta1: Array, ct: Array, st: Array,
+def rod_turn(dims: CSSPDimensions, root: int, theta1: Array, ct: Array, st: Array,
              given: dict[str, Any], disc: Array, ok: NDArray[np.bool_]) -> Array:
     """φ (N,) for a sweep (module docstring): 0 where the CSSP does not assemble."""
     from screwkit.kinematics.cssp_motion import cssp_closed_form_block, rahman_rod_axes
@@ -30,7 +30,7 @@ def rod_turn(dims: CSSPDimensions, mode: int, theta1: Array, ct: Array, st: Arra
     s1v = np.broadcast_to(np.asarray(s1, dtype=float), (n,))
     steps = np.concatenate([[0.0], np.diff(theta1)])
     s1_steps = np.concatenate([[0.0], np.diff(s1v)])
-    k = cssp_closed_form_block(dims, mode, ct, st, steps, 0.0, s1, s1_steps, 0.0, disc)
+    k = cssp_closed_form_block(dims, root, ct, st, steps, 0.0, s1, s1_steps, 0.0, disc)
     u, u_dot, u_ddot = (np.stack(k[name], axis=-1) for name in ("u", "u_dot", "u_ddot"))
     y3, z3 = rahman_rod_axes(k["u"])
     rod = np.stack([u, np.stack(y3, axis=-1), np.stack(z3, axis=-1)], axis=-1)
