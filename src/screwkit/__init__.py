@@ -54,7 +54,7 @@ _EXPORTS: dict[str, str] = {
     "limit_positions": "screwkit.kinematics.limit_positions",
     "coupler_point_path": "screwkit.kinematics.coupler_curves",
     "transmission": "screwkit.kinematics.transmission",
-    "mobility": "screwkit.kinematics.loop_mobility",
+    "mobility": "screwkit.mobility",   # the package, callable: screwkit.mobility(linkage)
     # dynamics
     "inverse_dynamics": "screwkit.dynamics.inverse",
     "regressor": "screwkit.dynamics.inverse",
@@ -116,7 +116,8 @@ def __getattr__(name: str) -> Any:
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'screwkit' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), _ALIASES.get(name, name))
+    imported = importlib.import_module(module)
+    value = imported if module == f"screwkit.{name}" else getattr(imported, _ALIASES.get(name, name))
     globals()[name] = value
     return value
 

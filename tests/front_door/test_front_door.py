@@ -31,6 +31,24 @@ def test_every_front_door_name_resolves_and_documents_itself():
             assert any(k in doc for k in ("SI", "rad", "N·m", "(m)", "metres")), verb
 
 
+def test_mobility_verb_survives_importing_the_mobility_package():
+    """``screwkit.mobility`` is a package and the front-door verb: importing the package (as the
+    docs do for the formula functions) must not replace the verb with an uncallable module."""
+    import subprocess
+    import sys
+
+    code = ("{pre}\nimport screwkit as sk\nimport screwkit.mobility as m\n"
+            "lk = sk.load_spec(r'{spec}').linkage\n"
+            "assert m is sk.mobility\nprint(sk.mobility(lk).numeric.mobility)")
+    for pre in ("", "import screwkit.mobility", "from screwkit.mobility import formula_mobility",
+                "import screwkit.kinematics.loop_mobility"):
+        out = subprocess.run([sys.executable, "-c", code.format(
+            pre=pre, spec=EXAMPLES / "bagci_fig7_rsrc.toml")], capture_output=True, text=True,
+            timeout=120)
+        assert out.returncode == 0, (pre, out.stderr)
+        assert out.stdout.strip() == "1", pre
+
+
 def test_unknown_name_is_an_attribute_error():
     with pytest.raises(AttributeError, match="no attribute 'solve'"):
         sk.solve  # noqa: B018
