@@ -4,7 +4,7 @@
   and accelerations: the closed form's Motion (``solve_motion(method="closed")``) and the
   generic solver's (``method="generic"``, which also renumbers its modes as the closed form's)
   per sample, and their ratio (target: the generic solver within 10× of the closed form). The
-  bare closed form (``rsrc_motion`` + ``rsrc_rates``: the output angles, S, χ0 and their rates,
+  bare closed form (``rsrc_motion``: the output angles, S, χ0 and their rates,
   no link frames) is timed too, and its ratio to the generic solver reported.
 * RSSR, examples/rssr_spatial.toml, 3 600 samples with the generic solver: time (target < 1 s)
   and the peak resident memory of the whole process that imports screwkit, reads the spec and
@@ -63,7 +63,7 @@ def _in_a_fresh_process(code: str) -> dict[str, float]:
 def _rsrc_rows() -> list[dict[str, Any]]:
     from screwkit.io.spec import load_spec
     from screwkit.kinematics.closed_form_motion import rsrc_dimensions
-    from screwkit.kinematics.rsrc import RSRCPositions, rsrc_motion, rsrc_rates
+    from screwkit.kinematics.rsrc import rsrc_motion
     from screwkit.kinematics.solve_motion import solve_motion
 
     lk = load_spec(ROOT / "examples" / "bagci_fig7_rsrc.toml").linkage
@@ -75,10 +75,7 @@ def _rsrc_rows() -> list[dict[str, Any]]:
     many = np.linspace(0.0, 2 * np.pi, 100_000, endpoint=False)
 
     def bare() -> None:
-        mot = rsrc_motion(dims, many)
-        pos = RSRCPositions(mot.theta0, mot.phi0, mot.chi0, mot.S, mot.assembles,
-                            dims.special_case)
-        rsrc_rates(dims, pos, 1.0, 0.0)
+        rsrc_motion(dims, many, 1.0, 0.0)  # branches with their rates and accelerations
 
     raw = _best(bare) / many.size
     return [
@@ -89,7 +86,7 @@ def _rsrc_rows() -> list[dict[str, Any]]:
          "unit": "µs/sample", "target": "≤ 10× the closed form",
          "note": f"{generic / closed:.1f}× the closed-form Motion (same outputs); "
                  f"{generic / raw:.0f}× the bare closed form"},
-        {"name": "RSRC bare closed form (rsrc_motion + rsrc_rates)", "value": raw * 1e6,
+        {"name": "RSRC bare closed form (rsrc_motion: branches, rates, accelerations)", "value": raw * 1e6,
          "unit": "µs/sample", "target": "≤ 1", "note": "100 000 samples, all modes, rates and "
                                                        "accelerations of φ0, χ0, S"},
     ]

@@ -94,14 +94,13 @@ def rsrc_dimensions(linkage: Linkage) -> tuple[RSRCDimensions, bool]:
 def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
     """Every assembly mode of Bagci's RSRC (or its planar 4R case) from the quartic; the
     branches of :func:`~screwkit.kinematics.rsrc.rsrc_motion` become modes."""
-    from screwkit.kinematics.rsrc import RSRCPositions, rsrc_motion, rsrc_rates
+    from screwkit.kinematics.rsrc import rsrc_motion
 
     dims, planar = rsrc_dimensions(linkage)
     p = dict(linkage.parameters)
     theta = X[:, 0]
-    mot = rsrc_motion(dims, theta)
-    pos = RSRCPositions(mot.theta0, mot.phi0, mot.chi0, mot.S, mot.assembles, dims.special_case)
-    rates = rsrc_rates(dims, pos, Xd[:, 0], Xdd[:, 0])
+    mot = rsrc_motion(dims, theta, Xd[:, 0], Xdd[:, 0])
+    rates = mot.rates
     lay = layout(linkage)
     modes: list[ModeMotion] = []
     for j in range(mot.phi0.shape[1]):
