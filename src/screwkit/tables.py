@@ -24,6 +24,8 @@ from typing import IO, Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import InputError, UnknownNameError
+
 #: the SI unit of every quantity kind a column can have; "flag", "index" and "text" columns
 #: have no unit, "ratio" ones are plain numbers and "percent" ones are in %
 SI_LABELS: dict[str, str] = {
@@ -63,7 +65,7 @@ class Column:
 
     def __post_init__(self) -> None:
         if self.kind not in SI_LABELS:
-            raise ValueError(f"column {self.name!r}: unknown kind {self.kind!r}; kinds are "
+            raise InputError(f"column {self.name!r}: unknown kind {self.kind!r}; kinds are "
                              f"{sorted(SI_LABELS)}")
 
 
@@ -78,10 +80,10 @@ class ResultTable:
     def __post_init__(self) -> None:
         lengths = {c.values.shape[0] for c in self.columns}
         if len(lengths) > 1:
-            raise ValueError(f"columns of different lengths {sorted(lengths)} in {self.title!r}")
+            raise InputError(f"columns of different lengths {sorted(lengths)} in {self.title!r}")
         names = [c.name for c in self.columns]
         if len(set(names)) != len(names):
-            raise ValueError(f"repeated column names in {self.title!r}")
+            raise InputError(f"repeated column names in {self.title!r}")
 
     @property
     def rows(self) -> int:
@@ -98,7 +100,7 @@ class ResultTable:
         for c in self.columns:
             if c.name == name:
                 return c
-        raise KeyError(f"no column {name!r}; the columns are {list(self.names)}")
+        raise UnknownNameError(f"no column {name!r}; the columns are {list(self.names)}")
 
     def __iter__(self) -> Iterator[Column]:
         return iter(self.columns)
@@ -184,7 +186,7 @@ class ResultTable:
         conv = self.converted(units)
         arrays: dict[str, Any] = {n: v for n, _, v in conv}
         if "units" in arrays:
-            raise ValueError("a column is named 'units', which the .npz keeps for the units")
+            raise InputError("a column is named 'units', which the .npz keeps for the units")
         arrays["units"] = np.array([[n, label] for n, label, _ in conv], dtype=str)
         np.savez(path, **arrays)  # type: ignore[arg-type]
 
@@ -259,7 +261,7 @@ def _optional(module: str, what: str) -> Any:
 def stack_tables(tables: Sequence[ResultTable], title: str = "") -> ResultTable:
     """Tables with the same columns one under the other (e.g. every assembly mode)."""
     if not tables:
-        raise ValueError("no tables to stack")
+        raise InputError("no tables to stack")
     first = tables[0]
     cols = []
     for k, c in enumerate(first.columns):

@@ -98,3 +98,20 @@ def test_only_the_registry_compares_family_names():
                 if any(isinstance(s, ast.Attribute) and s.attr == "family" for s in sides):
                     bad.append(f"{path.relative_to(SRC)}:{node.lineno}")
     assert not bad, "family-name dispatch outside kinematics/registry.py:\n" + "\n".join(bad)
+
+
+def test_user_errors_are_screwkit_errors():
+    """A bad argument raises a ScrewkitError that is also the built-in a Python user expects
+    (InputError is a ValueError, InputTypeError a TypeError, UnknownNameError a KeyError), so
+    ``except screwkit.ScrewkitError`` catches every user mistake (docs/reliability.md)."""
+    bad = []
+    for path, tree in _modules():
+        if path.name == "errors.py" and path.parent == SRC:
+            continue
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Raise) and node.exc is not None:
+                exc = node.exc.func if isinstance(node.exc, ast.Call) else node.exc
+                if isinstance(exc, ast.Name) and exc.id in ("ValueError", "TypeError",
+                                                            "KeyError"):
+                    bad.append(f"{path.relative_to(SRC)}:{node.lineno} raises {exc.id}")
+    assert not bad, "raise the screwkit.errors classes instead:\n" + "\n".join(bad)

@@ -24,6 +24,7 @@ from typing import Annotated, Any
 import typer
 
 from screwkit.cli.common import check_paths, console, err_console, guard, user_error
+from screwkit.errors import InputError
 
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print the JSON document (SI units) instead of tables.")]
 OutputOpt = Annotated[Path | None, typer.Option("--output", "-o", help="Write the result to this file (atomically) and print one line; the format by extension: .json (the SI document), .csv, .parquet, .npz (the per-sample table in the display units).")]
@@ -98,7 +99,7 @@ class Outputs:
             nonlocal tab
             if tab is None:
                 if table is None:
-                    raise ValueError("this command has no per-sample table; write .json")
+                    raise InputError("this command has no per-sample table; write .json")
                 tab = guard(table)
             return tab
 

@@ -13,6 +13,8 @@ from typing import Annotated
 
 import typer
 
+from screwkit.errors import InputError
+
 STILL_SUFFIXES = (".png", ".svg", ".pdf")
 ANIMATION_SUFFIXES = (".gif", ".mp4")
 
@@ -21,12 +23,12 @@ def check_plot_paths(plots: list[Path]) -> None:
     """Each ``--plot`` file: a known suffix and an existing folder (checked before solving)."""
     for p in plots:
         if p.suffix.lower() not in STILL_SUFFIXES + ANIMATION_SUFFIXES:
-            raise ValueError(f"--plot {p}: give a file ending in .gif or .mp4 (an animation) or "
+            raise InputError(f"--plot {p}: give a file ending in .gif or .mp4 (an animation) or "
                              f".png, .svg or .pdf (one frame); got {p.suffix or 'no suffix'!r}")
         if p.is_dir():
-            raise ValueError(f"--plot {p}: is a folder; give a file name, e.g. {p / 'view.png'}")
+            raise InputError(f"--plot {p}: is a folder; give a file name, e.g. {p / 'view.png'}")
         if not p.parent.is_dir():
-            raise ValueError(f"--plot {p}: folder {p.parent} does not exist; create it first")
+            raise InputError(f"--plot {p}: folder {p.parent} does not exist; create it first")
 
 
 def register(app: typer.Typer) -> None:

@@ -16,6 +16,7 @@ from screwkit.cli.common import console
 from screwkit.cli.common import guard as _guard
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for
+from screwkit.errors import InputError
 
 __all__ = ["register", "synthesis_document"]
 
@@ -211,11 +212,11 @@ def plot_path(plot: Path) -> Path:
     exist and the name must not be a folder (checked before the solve)."""
     path = plot if plot.suffix or plot.is_dir() else plot.with_name(plot.name + ".png")
     if path.is_dir():
-        raise ValueError(f"--plot {plot}: {path} is a folder; give a file name, e.g. "
+        raise InputError(f"--plot {plot}: {path} is a folder; give a file name, e.g. "
                          f"{path / 'synthesis.png'}")
     folder = path.parent
     if not folder.is_dir():
-        raise ValueError(f"--plot {plot}: folder {folder} does not exist; create it first")
+        raise InputError(f"--plot {plot}: folder {folder} does not exist; create it first")
     return path
 
 

@@ -8,6 +8,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from screwkit.dual.number import Array, batch_index_text
+from screwkit.errors import InputError
 
 #: Default tolerance on orthogonality / unit-norm checks. Values typed from printed tables
 #: (4–6 digits) fail tighter checks, so the default is loose; pass ``tol`` to tighten.
@@ -19,7 +20,7 @@ def check_finite(x: ArrayLike, name: str = "value") -> Array:
     a = np.asarray(x, dtype=float)
     bad = ~np.isfinite(a)
     if np.any(bad):
-        raise ValueError(f"{name} contains NaN or inf{batch_index_text(bad)}; pass finite numbers")
+        raise InputError(f"{name} contains NaN or inf{batch_index_text(bad)}; pass finite numbers")
     return a
 
 
@@ -27,7 +28,7 @@ def check_trailing_shape(x: ArrayLike, shape: tuple[int, ...], name: str = "valu
     """``x`` as a finite float array whose last axes are ``shape`` (any leading batch axes)."""
     a = np.asarray(x, dtype=float)
     if a.ndim < len(shape) or a.shape[a.ndim - len(shape):] != shape:
-        raise ValueError(
+        raise InputError(
             f"{name} must have shape (..., {', '.join(map(str, shape))}); got shape {a.shape}"
         )
     return check_finite(a, name)
@@ -44,7 +45,7 @@ def check_unit_vector(v: ArrayLike, name: str = "direction", tol: float = DEFAUL
     err = np.abs(np.linalg.norm(a, axis=-1) - 1.0)
     bad = err > tol
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"{name} must be a unit vector: | |v| - 1 | = {err[bad].max():.3g} > {tol:g}"
             f"{batch_index_text(bad)}; normalise it first"
         )
@@ -58,7 +59,7 @@ def check_rotation_matrix(R: ArrayLike, name: str = "rotation", tol: float = DEF
     err = np.abs(np.swapaxes(a, -1, -2) @ a - np.eye(3)).max(axis=(-2, -1))
     bad = err > tol
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"{name} is not orthogonal: max |RᵀR − I| = {err[bad].max():.3g} > {tol:g}"
             f"{batch_index_text(bad)}; re-orthonormalise it (e.g. scipy Rotation.from_matrix) or "
             "loosen tol"
@@ -66,7 +67,7 @@ def check_rotation_matrix(R: ArrayLike, name: str = "rotation", tol: float = DEF
     det = np.linalg.det(a)
     bad = det < 0
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"{name} has det = {det[bad].min():.3g} < 0{batch_index_text(bad)}: a reflection is not a "
             "rotation; check the handedness of the frame"
         )
@@ -85,7 +86,7 @@ def check_screw_matrix_parts(
     scale = np.maximum(1.0, np.abs(D).max(axis=(-2, -1)))
     bad = err > tol * scale
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"{name} dual part is not [d]×R: D·Rᵀ is not skew-symmetric (max |W + Wᵀ| = "
             f"{err[bad].max():.3g}){batch_index_text(bad)}; build it with "
             "ScrewMatrix.from_rotation_translation"
@@ -99,7 +100,7 @@ def check_transform(T: ArrayLike, name: str = "transform", tol: float = DEFAULT_
     bottom = np.abs(a[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(axis=-1)
     bad = bottom > tol
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"{name} last row must be (0, 0, 0, 1); it is off by {bottom[bad].max():.3g}"
             f"{batch_index_text(bad)}"
         )
@@ -116,7 +117,7 @@ def check_unit_dual_quaternion(
     nerr = np.abs(np.linalg.norm(r, axis=-1) - 1.0)
     bad = nerr > tol
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"{name} real part is not a unit quaternion: | |r| - 1 | = {nerr[bad].max():.3g}"
             f"{batch_index_text(bad)}; call .normalized()"
         )
@@ -124,7 +125,7 @@ def check_unit_dual_quaternion(
     scale = np.maximum(1.0, np.linalg.norm(d, axis=-1))
     bad = derr > tol * scale
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"{name} is not unit: real·dual = {derr[bad].max():.3g} ≠ 0{batch_index_text(bad)}; "
             "call .normalized()"
         )
@@ -142,7 +143,7 @@ def check_unit_line(
     scale = np.maximum(1.0, np.linalg.norm(m, axis=-1))
     bad = err > tol * scale
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"{name} is not a line: direction·moment = {err[bad].max():.3g} ≠ 0"
             f"{batch_index_text(bad)}; build it with DualVector.line(point, direction)"
         )

@@ -18,6 +18,7 @@ from screwkit.dual.checks import DEFAULT_TOL, check_rotation_matrix, check_trans
 from screwkit.dual.number import Array
 from screwkit.dual.quaternion import DualQuaternion
 from screwkit.dual.screw_matrix import ScrewMatrix
+from screwkit.errors import InputError
 
 if TYPE_CHECKING:  # scipy.spatial is imported on first use: it costs 0.3 s at start-up
     from scipy.spatial.transform import RigidTransform, Rotation
@@ -70,7 +71,7 @@ def screw_matrix_from_rotation(
     from scipy.spatial.transform import Rotation
 
     if not isinstance(rotation, Rotation):
-        raise ValueError(
+        raise InputError(
             f"expected a scipy.spatial.transform.Rotation; got {type(rotation).__name__}"
         )
     R = rotation.as_matrix()
@@ -94,7 +95,7 @@ def screw_matrix_from_rigid_transform(transform: RigidTransform) -> ScrewMatrix:
     from scipy.spatial.transform import RigidTransform
 
     if not isinstance(transform, RigidTransform):
-        raise ValueError(
+        raise InputError(
             f"expected a scipy.spatial.transform.RigidTransform; got {type(transform).__name__}"
         )
     return ScrewMatrix.from_rotation_translation(
@@ -115,7 +116,7 @@ def dual_quaternion_from_rigid_transform(transform: RigidTransform) -> DualQuate
     from scipy.spatial.transform import RigidTransform
 
     if not isinstance(transform, RigidTransform):
-        raise ValueError(
+        raise InputError(
             f"expected a scipy.spatial.transform.RigidTransform; got {type(transform).__name__}"
         )
     return DualQuaternion.from_array(transform.as_dual_quat(scalar_first=True))

@@ -123,12 +123,12 @@ class Dual:
         bad_sign = (~integer) & (self.real < 0)
         bad_zero = (self.real == 0) & (nn < 1) & (nn != 0)
         if np.any(bad_sign):
-            raise ValueError(
+            raise InputError(
                 "dual power with a non-integer exponent needs a positive real part; got a "
                 "negative real part"
             )
         if np.any(bad_zero):
-            raise ValueError(
+            raise InputError(
                 "dual power d̂ⁿ with n < 1 is not defined at real part 0 (its derivative "
                 "n·d0ⁿ⁻¹ is infinite)"
             )
@@ -139,7 +139,7 @@ class Dual:
     def __abs__(self) -> Dual:
         """|d̂| = |d0| + ε d1·sign(d0), defined for d0 ≠ 0."""
         if np.any(self.real == 0):
-            raise ValueError("|d̂| is not a dual number where the real part is 0")
+            raise InputError("|d̂| is not a dual number where the real part is 0")
         return Dual(np.abs(self.real), self.dual * np.sign(self.real))
 
     def conjugate(self) -> Dual:
@@ -167,7 +167,7 @@ def sqrt(x: Dual | ArrayLike) -> Dual:
     x = Dual.coerce(x)
     bad = x.real <= 0
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"dual sqrt needs a positive real part; got {x.real[bad].min():.3g}{batch_index_text(bad)}"
         )
     r = np.sqrt(x.real)
@@ -201,7 +201,7 @@ def atan2(y: Dual | ArrayLike, x: Dual | ArrayLike) -> Dual:
     r2 = x.real**2 + y.real**2
     bad = r2 == 0
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"dual atan2 is undefined where both real parts are zero{batch_index_text(bad)}"
         )
     return Dual(np.arctan2(y.real, x.real), (x.real * y.dual - y.real * x.dual) / r2)
@@ -212,7 +212,7 @@ def asin(x: Dual | ArrayLike) -> Dual:
     x = Dual.coerce(x)
     bad = np.abs(x.real) >= 1
     if np.any(bad):
-        raise ValueError(f"dual asin needs |real part| < 1{batch_index_text(bad)}")
+        raise InputError(f"dual asin needs |real part| < 1{batch_index_text(bad)}")
     return Dual(np.arcsin(x.real), x.dual / np.sqrt(1.0 - x.real**2))
 
 
@@ -221,7 +221,7 @@ def acos(x: Dual | ArrayLike) -> Dual:
     x = Dual.coerce(x)
     bad = np.abs(x.real) >= 1
     if np.any(bad):
-        raise ValueError(f"dual acos needs |real part| < 1{batch_index_text(bad)}")
+        raise InputError(f"dual acos needs |real part| < 1{batch_index_text(bad)}")
     return Dual(np.arccos(x.real), -x.dual / np.sqrt(1.0 - x.real**2))
 
 
@@ -243,7 +243,7 @@ def log(x: Dual | ArrayLike) -> Dual:
     x = Dual.coerce(x)
     bad = x.real <= 0
     if np.any(bad):
-        raise ValueError(
+        raise InputError(
             f"dual log needs a positive real part; got {x.real[bad].min():.3g}{batch_index_text(bad)}"
         )
     return Dual(np.log(x.real), x.dual / x.real)

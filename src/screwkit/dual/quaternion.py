@@ -22,6 +22,7 @@ from screwkit.dual.rotation import (
     quaternion_multiply,
     rotation_from_quaternion,
 )
+from screwkit.errors import InputError
 
 
 def _pure(v: Array) -> Array:
@@ -47,7 +48,7 @@ class DualQuaternion:
         d = np.zeros_like(r) if dual is None else np.asarray(dual, dtype=float)
         r, d = np.broadcast_arrays(r, d)
         if r.ndim < 1 or r.shape[-1] != 4:
-            raise ValueError(
+            raise InputError(
                 f"a dual quaternion needs parts of trailing shape (4,) (w, x, y, z); got {r.shape}"
             )
         object.__setattr__(self, "real", np.array(r))
@@ -65,7 +66,7 @@ class DualQuaternion:
         """From (..., 8) = (w, x, y, z | w, x, y, z), the pytransform3d / scipy layout."""
         a = np.asarray(array, dtype=float)
         if a.ndim < 1 or a.shape[-1] != 8:
-            raise ValueError(f"a dual quaternion array needs trailing shape (8,); got {a.shape}")
+            raise InputError(f"a dual quaternion array needs trailing shape (8,); got {a.shape}")
         return cls(a[..., :4], a[..., 4:])
 
     def as_array(self) -> Array:
@@ -159,7 +160,7 @@ class DualQuaternion:
         """|q̂| = |r| + ε (r·d)/|r|."""
         n = np.linalg.norm(self.real, axis=-1)
         if np.any(n == 0):
-            raise ValueError("a dual quaternion with zero real part has no norm (pure dual)")
+            raise InputError("a dual quaternion with zero real part has no norm (pure dual)")
         return Dual(n, np.sum(self.real * self.dual, axis=-1) / n)
 
     def normalized(self) -> DualQuaternion:
@@ -173,7 +174,7 @@ class DualQuaternion:
         """q̂⁻¹ = r⁻¹ − ε r⁻¹ d r⁻¹ for any dual quaternion with r ≠ 0."""
         n2 = np.sum(self.real**2, axis=-1, keepdims=True)
         if np.any(n2 == 0):
-            raise ValueError("a dual quaternion with zero real part has no inverse")
+            raise InputError("a dual quaternion with zero real part has no inverse")
         ri = quaternion_conjugate(self.real) / n2
         return DualQuaternion(ri, -quaternion_multiply(quaternion_multiply(ri, self.dual), ri))
 

@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike
 
 from screwkit.dual.number import Array, Dual
 from screwkit.dual.spatial import elementary_rotation, skew, vee
+from screwkit.errors import InputError
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,7 +37,7 @@ class ScrewMatrix:
         d = np.zeros_like(r) if dual is None else np.asarray(dual, dtype=float)
         r, d = np.broadcast_arrays(r, d)
         if r.ndim < 2 or r.shape[-2:] != (3, 3):
-            raise ValueError(f"a screw matrix needs trailing shape (3, 3); got {r.shape}")
+            raise InputError(f"a screw matrix needs trailing shape (3, 3); got {r.shape}")
         object.__setattr__(self, "real", np.array(r))
         object.__setattr__(self, "dual", np.array(d))
 

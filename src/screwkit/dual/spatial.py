@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError
+
 __all__ = [
     "GIMBAL_TOL",
     "cross",
@@ -88,7 +90,7 @@ def elementary_rotation(c: Array, s: Array, axis: int) -> Array:
     elif axis == 2:
         rows = [[c, -s, zero], [s, c, zero], [zero, zero, one]]
     else:
-        raise ValueError(f"axis must be 0 (x), 1 (y) or 2 (z), got {axis!r}")
+        raise InputError(f"axis must be 0 (x), 1 (y) or 2 (z), got {axis!r}")
     return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
 
 

@@ -10,6 +10,7 @@ from numpy.typing import ArrayLike
 
 from screwkit.dual import number as dn
 from screwkit.dual.number import Array, Dual
+from screwkit.errors import InputError
 
 
 @dataclass(frozen=True, eq=False)
@@ -30,7 +31,7 @@ class DualVector:
         d = np.zeros_like(r) if dual is None else np.asarray(dual, dtype=float)
         r, d = np.broadcast_arrays(r, d)
         if r.shape[-1:] != (3,):
-            raise ValueError(f"a dual vector needs trailing shape (3,); got {r.shape}")
+            raise InputError(f"a dual vector needs trailing shape (3,); got {r.shape}")
         object.__setattr__(self, "real", np.array(r))
         object.__setattr__(self, "dual", np.array(d))
 
@@ -44,7 +45,7 @@ class DualVector:
         p = check_vector3(point, "point on the line")
         n = np.linalg.norm(u, axis=-1, keepdims=True)
         if np.any(n == 0):
-            raise ValueError(
+            raise InputError(
                 "a line needs a non-zero direction; got the zero vector"
                 + dn.batch_index_text(n[..., 0] == 0)
             )
@@ -113,7 +114,7 @@ class DualVector:
         """|Â| = |A| + ε (A·A°)/|A|."""
         n = np.linalg.norm(self.real, axis=-1)
         if np.any(n == 0):
-            raise ValueError("the norm of a dual vector with zero real part is not a dual number")
+            raise InputError("the norm of a dual vector with zero real part is not a dual number")
         return Dual(n, np.sum(self.real * self.dual, axis=-1) / n)
 
     def normalized(self) -> DualVector:
@@ -126,7 +127,7 @@ class DualVector:
         """Point of the line nearest the origin: u × m/|u|² (u × m for a unit line)."""
         n2 = np.sum(self.real * self.real, axis=-1, keepdims=True)
         if np.any(n2 == 0):
-            raise ValueError("a dual vector with zero real part is not a line (it has no point)")
+            raise InputError("a dual vector with zero real part is not a line (it has no point)")
         return np.cross(self.real, self.dual) / n2
 
 
@@ -179,7 +180,7 @@ def common_normal(a: DualVector, b: DualVector) -> DualVector:
     dist = np.linalg.norm(perp, axis=-1)
     coincident = parallel & (dist <= _PARALLEL_TOL * np.maximum(1.0, np.abs(pa).max(axis=-1)))
     if np.any(coincident):
-        raise ValueError(
+        raise InputError(
             "the common normal of two coincident lines is undefined"
             + dn.batch_index_text(coincident)
         )

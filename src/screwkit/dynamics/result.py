@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import UnknownNameError
+
 if TYPE_CHECKING:
     from screwkit.tables import ResultTable, UnitChoice
 
@@ -36,7 +38,7 @@ class Reaction:
 
     def __getitem__(self, key: str) -> Array:
         if key not in ("force", "moment", "point"):
-            raise KeyError(f"a reaction has 'force', 'moment' and 'point'; got {key!r}")
+            raise UnknownNameError(f"a reaction has 'force', 'moment' and 'point'; got {key!r}")
         return getattr(self, key)  # type: ignore[no-any-return]
 
 

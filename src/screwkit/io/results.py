@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from screwkit.errors import InputError
+from screwkit.errors import InputError, InputTypeError
 from screwkit.io.outputs import atomic_path, write_text_atomic
 
 SI_UNITS = {"length": "m", "angle": "rad", "time": "s", "mass": "kg", "force": "N",
@@ -105,7 +105,7 @@ def _encode_default(x: Any) -> Any:
         return x.item()
     if isinstance(x, Path):
         return str(x)
-    raise TypeError(f"cannot write a {type(x).__name__} to JSON")
+    raise InputTypeError(f"cannot write a {type(x).__name__} to JSON")
 
 
 def dumps_bytes(doc: Any, *, indent: bool = False) -> bytes:

@@ -24,6 +24,7 @@ from pydantic import (
     model_validator,
 )
 
+from screwkit.errors import InputError
 from screwkit.io.errors import SpecError
 from screwkit.io.units import UnitError, to_si
 from screwkit.kinematics.registry import family_of, require
@@ -89,12 +90,12 @@ class ComponentTable(_Strict):
     def _one_source(self) -> ComponentTable:
         given = [k for k in ("function", "expression", "data") if getattr(self, k) is not None]
         if len(given) != 1:
-            raise ValueError("give exactly one of function, expression or data "
+            raise InputError("give exactly one of function, expression or data "
                              f"(got {given or 'none'})")
         if self.function is not None and self.function not in LIBRARY:
-            raise ValueError(f"unknown function {self.function!r}; choose one of {sorted(LIBRARY)}")
+            raise InputError(f"unknown function {self.function!r}; choose one of {sorted(LIBRARY)}")
         if self.design_points is None and self.data is None:
-            raise ValueError("design_points are needed (a list, or {start, stop, step})")
+            raise InputError("design_points are needed (a list, or {start, stop, step})")
         return self
 
 
@@ -112,7 +113,7 @@ class ConstraintsTable(_Strict):
     @model_validator(mode="after")
     def _two(self) -> ConstraintsTable:
         if len(self.points) != 2:
-            raise ValueError(f"parameters of constraint need exactly 2 points, got "
+            raise InputError(f"parameters of constraint need exactly 2 points, got "
                              f"{len(self.points)}")
         return self
 
@@ -140,10 +141,10 @@ class OverlayTable(_Strict):
     @model_validator(mode="after")
     def _check(self) -> OverlayTable:
         if len(self.dwells) > 2:
-            raise ValueError(f"at most two dwells can be placed on the overlay, got "
+            raise InputError(f"at most two dwells can be placed on the overlay, got "
                              f"{len(self.dwells)} (two fix the output circle already)")
         if self.d3_range is not None and len(self.d3_range) != 2:
-            raise ValueError("d3_range must be [lower, upper]")
+            raise InputError("d3_range must be [lower, upper]")
         return self
 
 
@@ -172,39 +173,39 @@ class SynthesisTable(_Strict):
     @model_validator(mode="after")
     def _check(self) -> SynthesisTable:
         if isinstance(self.inversion, int) and self.inversion not in (1, 2, 3, 4):
-            raise ValueError("inversion must be 1, 2, 3, 4 or \"all\"")
+            raise InputError("inversion must be 1, 2, 3, 4 or \"all\"")
         if isinstance(self.mode, int) and not 0 <= self.mode <= 10_000:
-            raise ValueError("mode must be an assembly mode index (0, 1, …) or \"all\"")
+            raise InputError("mode must be an assembly mode index (0, 1, …) or \"all\"")
         if self.rotation is None and self.translation is None:
-            raise ValueError("give a rotation and/or a translation to generate")
+            raise InputError("give a rotation and/or a translation to generate")
         if self.method == "overlay":
             return self._check_overlay()
         if self.unknowns is None:
-            raise ValueError("unknowns: give the names to solve for (method = \"least_squares\")")
+            raise InputError("unknowns: give the names to solve for (method = \"least_squares\")")
         if self.overlay is not None:
-            raise ValueError("[synthesis.overlay] belongs to method = \"overlay\"; set method "
+            raise InputError("[synthesis.overlay] belongs to method = \"overlay\"; set method "
                              "or remove the table")
         if self.output_direction == "both":
-            raise ValueError("output_direction = \"both\" is for method = \"overlay\"; the "
+            raise InputError("output_direction = \"both\" is for method = \"overlay\"; the "
                              "least-squares route solves one sense (\"ccw\" or \"cw\")")
         for name, pair in self.bounds.items():
             if len(pair) != 2:
-                raise ValueError(f"bounds.{name} must be [lower, upper]")
+                raise InputError(f"bounds.{name} must be [lower, upper]")
         return self
 
     def _check_overlay(self) -> SynthesisTable:
         if self.rotation is None:
-            raise ValueError("the overlay technique fits the output rotation: give "
+            raise InputError("the overlay technique fits the output rotation: give "
                              "[synthesis.rotation] (the translation is only evaluated)")
         unused = [k for k in ("constraints", "multistart") if getattr(self, k) is not None]
         unused += ["bounds"] if self.bounds else []
         unused += ["inversion"] if self.inversion != "all" else []
         if unused:
-            raise ValueError(f"{unused} not used by method = \"overlay\" (it finds the output "
+            raise InputError(f"{unused} not used by method = \"overlay\" (it finds the output "
                              "circle and the assembly mode from the overlay; dwells go in "
                              "[synthesis.overlay] dwells)")
         if self.unknowns is not None and set(self.unknowns) not in OVERLAY_UNKNOWNS:
-            raise ValueError(f"unknowns of the overlay are [\"d3\", \"a\", \"b\"] or, to refine "
+            raise InputError(f"unknowns of the overlay are [\"d3\", \"a\", \"b\"] or, to refine "
                              f"the coupler too, [\"d2\", \"d3\", \"a\", \"b\"]; got {self.unknowns}")
         return self
 

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import InputError
 from screwkit.kinematics.loop import (
     Array,
     Configuration,
@@ -286,7 +287,7 @@ def rccc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
 
     dims = rccc_dimensions(linkage)
     if dims is None:
-        raise ValueError(f"{linkage.name}: not an R-C-C-C loop in Hartenberg-Denavit form with "
+        raise InputError(f"{linkage.name}: not an R-C-C-C loop in Hartenberg-Denavit form with "
                          "the R joint as its input; use method 'generic'")
     theta = X[:, 0]
     mot = rccc_motion(dims, theta)

@@ -73,13 +73,13 @@ class CSSPDimensions:
             if not isinstance(value, int | float | np.floating | np.integer) or not np.isfinite(
                 value
             ):
-                raise ValueError(
+                raise InputError(
                     f"CSSPDimensions.{name} must be a finite real number, got {value!r}"
                 )
             object.__setattr__(self, name, float(value))
         for name in ("a1", "a2"):
             if getattr(self, name) <= 0.0:
-                raise ValueError(
+                raise InputError(
                     f"CSSPDimensions.{name} must be > 0 (a length in m), got {getattr(self, name)!r}"
                 )
 
@@ -366,15 +366,15 @@ def as_sample_array(value: ArrayLike | None, n: int, name: str, default: float) 
     a ValueError names ``name`` and the offending shape or samples."""
     arr = np.asarray(default if value is None else value, dtype=float)
     if arr.ndim > 1:
-        raise ValueError(
+        raise InputError(
             f"{name} must be a scalar or a 1-D array over the samples, got {arr.shape}"
         )
     try:
         out = np.broadcast_to(arr, (n,)).astype(float)
     except ValueError as exc:
-        raise ValueError(f"{name} has {arr.shape[0]} entries but theta1 has {n}") from exc
+        raise InputError(f"{name} has {arr.shape[0]} entries but theta1 has {n}") from exc
     if not np.all(np.isfinite(out)):
-        raise ValueError(
+        raise InputError(
             f"{name} must be finite (got NaN/inf at samples {np.flatnonzero(~np.isfinite(out)).tolist()})"
         )
     return out
@@ -455,7 +455,7 @@ def _solve(
     root = check_root(root)
     th = np.atleast_1d(np.asarray(theta1, dtype=float))
     if th.ndim != 1:
-        raise ValueError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
+        raise InputError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
     n = th.shape[0]
     th = as_sample_array(th, n, "theta1", 0.0)
     w = as_sample_array(theta1_dot, n, "theta1_dot", 0.0)

@@ -358,7 +358,7 @@ def _given(value: ArrayLike | None, n: int, name: str, default: float) -> float 
     arr = np.asarray(default if value is None else value, dtype=float)
     if arr.ndim == 0:
         if not np.isfinite(arr):
-            raise ValueError(f"{name} must be finite, got {float(arr)!r}")
+            raise InputError(f"{name} must be finite, got {float(arr)!r}")
         return float(arr)
     return as_sample_array(arr, n, name, default)
 
@@ -383,14 +383,14 @@ def cssp_sweep(
     if not driven_offset and (
         s1 is not None or np.any(np.asarray(s1_dot) != 0) or np.any(np.asarray(s1_ddot) != 0)
     ):
-        raise ValueError(
+        raise InputError(
             f"{linkage.name}: the crank offset s1 is a constant of this CSSP "
             f"(s1 = {dims.s1!r} m); build it with cssp(..., s1_is_input=True) to drive s1"
         )
     root = check_root(root)
     th = np.atleast_1d(np.asarray(theta1, dtype=float))
     if th.ndim != 1:
-        raise ValueError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
+        raise InputError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
     n = th.shape[0]
     th = as_sample_array(th, n, "theta1", 0.0)
     given = {

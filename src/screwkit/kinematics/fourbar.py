@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dual.spatial import wrap_angle_near
+from screwkit.errors import InputError
 from screwkit.kinematics.quartic import DEFAULT_DOUBLE_ROOT_TOL, sin_cos
 from screwkit.kinematics.rsrc.dimensions import RSRCDimensions, check_input_angles
 
@@ -69,9 +70,9 @@ class FourBarDimensions:
             try:
                 number = float(value)
             except (TypeError, ValueError):
-                raise ValueError(f"fourbar {name} ({role}) must be a number, got {value!r}") from None
+                raise InputError(f"fourbar {name} ({role}) must be a number, got {value!r}") from None
             if not (math.isfinite(number) and number > 0.0):
-                raise ValueError(f"fourbar {name} ({role}) must be finite and > 0, got {value!r}")
+                raise InputError(f"fourbar {name} ({role}) must be finite and > 0, got {value!r}")
             object.__setattr__(self, name, number)
 
     def as_rsrc(self) -> RSRCDimensions:
@@ -241,7 +242,7 @@ def fourbar_rates(
         if arr.ndim == 0:
             arr = np.full(n, float(arr))
         if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-            raise ValueError(f"{name} must be finite, scalar or shape ({n},), got {arr.shape}")
+            raise InputError(f"{name} must be finite, scalar or shape ({n},), got {arr.shape}")
         rates.append(arr[:, None])
     td, tdd = rates
     th = theta[:, None]

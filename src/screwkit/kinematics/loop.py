@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual.spatial import cross, rot_y, skew
+from screwkit.errors import InputError
 from screwkit.model.linkage import Linkage
 
 Array = NDArray[np.float64]
@@ -337,7 +338,7 @@ def close_spherical_joint(linkage: Linkage, scalars: Array, lay: Layout | None =
     lay = lay or layout(linkage)
     if joint is None:
         if lay.n_spherical != 1:
-            raise ValueError(f"{linkage.name}: close_spherical_joint needs exactly one spherical "
+            raise InputError(f"{linkage.name}: close_spherical_joint needs exactly one spherical "
                              f"joint or the joint to close; this loop has {lay.n_spherical}")
         joint = next(iter(lay.spherical_of_joint))
     N = scalars.shape[0]

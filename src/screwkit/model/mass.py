@@ -69,18 +69,18 @@ def _clip_second_moment(inertia: Array) -> Array:
 def _vector3(value: ArrayLike, name: str) -> Array:
     arr = np.asarray(value, dtype=float)
     if arr.shape != (3,):
-        raise ValueError(f"{name} must have shape (3,), got {arr.shape}")
+        raise InputError(f"{name} must have shape (3,), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr}")
+        raise InputError(f"{name} must be finite, got {arr}")
     return arr.copy()
 
 
 def _matrix33(value: ArrayLike, name: str) -> Array:
     arr = np.asarray(value, dtype=float)
     if arr.shape != (3, 3):
-        raise ValueError(f"{name} must have shape (3, 3), got {arr.shape}")
+        raise InputError(f"{name} must have shape (3, 3), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got\n{arr}")
+        raise InputError(f"{name} must be finite, got\n{arr}")
     return arr.copy()
 
 
@@ -105,7 +105,7 @@ def physical_consistency_violations(
     problems: list[str] = []
     inertia_arr = np.asarray(inertia, dtype=float)
     if inertia_arr.shape != (3, 3) or not np.all(np.isfinite(inertia_arr)):
-        raise ValueError(f"inertia must be a finite (3, 3) array, got shape {inertia_arr.shape}")
+        raise InputError(f"inertia must be a finite (3, 3) array, got shape {inertia_arr.shape}")
     if not np.isfinite(mass) or mass <= 0.0:
         problems.append(f"mass must be > 0, got {mass!r} kg")
     scale = float(np.max(np.abs(inertia_arr)))
@@ -206,10 +206,10 @@ class MassProperties:
         if axes_as == "rows":
             axes = axes.T
         elif axes_as != "columns":
-            raise ValueError(f"axes_as must be 'columns' or 'rows', got {axes_as!r}")
+            raise InputError(f"axes_as must be 'columns' or 'rows', got {axes_as!r}")
         orth_err = float(np.max(np.abs(axes.T @ axes - np.eye(3))))
         if orth_err > 1e-5 or np.linalg.det(axes) <= 0:
-            raise ValueError(
+            raise InputError(
                 f"principal_axes must be orthonormal and right-handed (a direction-cosine matrix); "
                 f"max |L^T L - 1| = {orth_err:.3e}, det = {np.linalg.det(axes):.6g}. Check its "
                 "entries (printed direction cosines to 5-6 decimals are accepted)."
@@ -238,16 +238,16 @@ class MassProperties:
         before calling.
         """
         if not np.isfinite(gravity) or gravity <= 0.0:
-            raise ValueError(f"gravity must be a positive acceleration in m/s^2, got {gravity!r}")
+            raise InputError(f"gravity must be a positive acceleration in m/s^2, got {gravity!r}")
         if not np.isfinite(weight) or weight <= 0.0:
-            raise ValueError(f"weight must be a positive force in N, got {weight!r}")
+            raise InputError(f"weight must be a positive force in N, got {weight!r}")
         mass = float(weight) / float(gravity)
         if (inertia is None) == (radii_of_gyration is None):
-            raise ValueError("give exactly one of inertia= or radii_of_gyration=")
+            raise InputError("give exactly one of inertia= or radii_of_gyration=")
         if radii_of_gyration is not None:
             k = _vector3(radii_of_gyration, "radii_of_gyration")
             if np.any(k < 0.0):
-                raise ValueError(f"radii_of_gyration must be >= 0, got {k}")
+                raise InputError(f"radii_of_gyration must be >= 0, got {k}")
             return cls(mass, _vector3(com, "com"), mass * np.diag(k**2))
         assert inertia is not None
         return cls(mass, _vector3(com, "com"), _matrix33(inertia, "inertia"))
@@ -259,12 +259,12 @@ class MassProperties:
         ``inertial_parameters``."""
         pi = np.asarray(parameters, dtype=float)
         if pi.shape != (N_INERTIAL_PARAMETERS,):
-            raise ValueError(
+            raise InputError(
                 f"inertial parameters must have shape ({N_INERTIAL_PARAMETERS},) "
                 f"(m, m cx, m cy, m cz, Ixx, Iyy, Izz, Ixy, Ixz, Iyz), got {pi.shape}"
             )
         if not np.all(np.isfinite(pi)):
-            raise ValueError(f"inertial parameters must be finite, got {pi}")
+            raise InputError(f"inertial parameters must be finite, got {pi}")
         mass = float(pi[0])
         if mass <= 0.0:
             raise PhysicalConsistencyError(
@@ -349,14 +349,14 @@ class PointMassModel:
         positions = np.array(positions, dtype=float)
         masses = np.array(masses, dtype=float)
         if positions.ndim != 2 or positions.shape[1] != 3:
-            raise ValueError(f"positions must have shape (k, 3), got {positions.shape}")
+            raise InputError(f"positions must have shape (k, 3), got {positions.shape}")
         if masses.shape != (positions.shape[0],):
-            raise ValueError(
+            raise InputError(
                 f"masses must have shape ({positions.shape[0]},) to match positions, "
                 f"got {masses.shape}"
             )
         if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(masses))):
-            raise ValueError("positions and masses must be finite")
+            raise InputError("positions and masses must be finite")
         if np.any(masses < 0.0):
             bad = np.flatnonzero(masses < 0.0)
             raise PhysicalConsistencyError(
@@ -474,11 +474,11 @@ def equivalent_point_masses(
     if axes is not None:
         axes_arr = _matrix33(axes, "axes")
         if float(np.max(np.abs(axes_arr.T @ axes_arr - np.eye(3)))) > 1e-9:
-            raise ValueError("axes must be orthonormal (principal axes as columns)")
+            raise InputError("axes must be orthonormal (principal axes as columns)")
         in_axes = axes_arr.T @ props.inertia @ axes_arr
         off_diagonal = in_axes - np.diag(np.diag(in_axes))
         if np.max(np.abs(off_diagonal)) > 1e-9 * np.max(np.abs(in_axes)):
-            raise ValueError(
+            raise InputError(
                 "axes do not diagonalise the inertia tensor; pass principal axes "
                 "(MassProperties.principal()[1]) or omit axes"
             )

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.report.plots import pyplot
 
 JOINT_MARKERS = {"R": "o", "P": "s", "C": "D", "H": "*", "U": "X", "S": "o"}
@@ -28,11 +29,11 @@ def _arr(x: Any) -> np.ndarray:
 def _check(scene: dict[str, Any], mode: int, frame: int | None = None) -> None:
     modes = scene["modes"]
     if not 0 <= mode < len(modes):
-        raise ValueError(f"--mode {mode}: this mechanism has {len(modes)} assembly mode(s) "
+        raise InputError(f"--mode {mode}: this mechanism has {len(modes)} assembly mode(s) "
                          f"(0…{len(modes) - 1})")
     n = len(scene["input"]["values"])
     if frame is not None and not 0 <= frame < n:
-        raise ValueError(f"--frame {frame}: the sweep has {n} frames (0…{n - 1})")
+        raise InputError(f"--frame {frame}: the sweep has {n} frames (0…{n - 1})")
 
 
 class _Painter:
@@ -115,7 +116,7 @@ class _Painter:
 
 def _atomic(path: Path, write: Any) -> None:
     if not path.parent.is_dir():
-        raise ValueError(f"cannot write {path}: folder {path.parent} does not exist")
+        raise InputError(f"cannot write {path}: folder {path.parent} does not exist")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=str(path.parent))
     os.close(fd)
     try:
@@ -153,13 +154,13 @@ def render_animation(scene: dict[str, Any], path: str | Path, *, mode: int = 0,
 
     if p.suffix.lower() == ".mp4":
         if not animation.writers.is_available("ffmpeg"):
-            raise ValueError(f"{p}: an .mp4 needs ffmpeg, which is not installed; install it "
+            raise InputError(f"{p}: an .mp4 needs ffmpeg, which is not installed; install it "
                              "(e.g. apt-get install ffmpeg) or write a .gif")
         writer: Any = animation.FFMpegWriter(fps=fps or 12)
     elif p.suffix.lower() == ".gif":
         writer = animation.PillowWriter(fps=fps or 12)
     else:
-        raise ValueError(f"{p}: an animation is a .gif or an .mp4; got {p.suffix or 'no suffix'!r}")
+        raise InputError(f"{p}: an animation is a .gif or an .mp4; got {p.suffix or 'no suffix'!r}")
     n = len(scene["input"]["values"])
     fig = plt.figure(figsize=(6, 5.2))
     try:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import html
 from typing import Any
 
+from screwkit.errors import InputError
 from screwkit.report.scene import scene_from_motion
 from screwkit.report.viewer import render_report_html
 
@@ -87,5 +88,5 @@ def enable_notebook_display(shell: Any = None) -> None:
 
         shell = get_ipython()
         if shell is None:
-            raise ValueError("enable_notebook_display() works inside IPython or Jupyter only")
+            raise InputError("enable_notebook_display() works inside IPython or Jupyter only")
     shell.display_formatter.formatters["text/html"].for_type(Motion, lambda m: motion_html(m))

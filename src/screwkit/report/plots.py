@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
+
 
 def pyplot() -> Any:
     try:
@@ -16,7 +18,7 @@ def pyplot() -> Any:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError as exc:  # pragma: no cover - depends on the install
-        raise ValueError(
+        raise InputError(
             "plots need matplotlib: pip install 'screwkit[plot]' (or use --json and plot yourself)"
         ) from exc
     return plt

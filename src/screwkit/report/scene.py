@@ -58,6 +58,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import InputError
 from screwkit.io.results import jsonable
 from screwkit.report.scene_plots import (
     balancing_plots,
@@ -199,7 +200,7 @@ def scene_from_motion(
     spec = spec_or_linkage if spec_or_linkage is not linkage else None
     modes = list(motion.modes)
     if not modes:
-        raise ValueError(f"{linkage.name}: the motion has no assembly mode to show")
+        raise InputError(f"{linkage.name}: the motion has no assembly mode to show")
     n_frames = int(np.asarray(modes[0].assembles).shape[0])
     x = _input_values(motion, n_frames)
     input_name = str(linkage.inputs[0])
@@ -219,7 +220,7 @@ def scene_from_motion(
     if dynamics_doc is not None:
         dyn_mode = dynamics_mode if dynamics_mode is not None else int(dynamics_doc.get("mode", 0))
         if not 0 <= dyn_mode < len(modes):
-            raise ValueError(f"dynamics of mode {dyn_mode} given, but the motion has "
+            raise InputError(f"dynamics of mode {dyn_mode} given, but the motion has "
                              f"{len(modes)} mode(s)")
         centres = np.asarray(modes[dyn_mode].joint_centres, dtype=float)
         mode_entries[dyn_mode]["arrows"] = dynamics_arrows(dynamics_doc, centres, linkage)

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.io.results import jsonable
 
 DEG = 180.0 / np.pi
@@ -78,7 +79,7 @@ def write_simulation_png(doc: dict[str, Any], path: str | Path) -> None:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError as exc:
-        raise ValueError("--plot needs matplotlib: pip install 'screwkit[plot]'") from exc
+        raise InputError("--plot needs matplotlib: pip install 'screwkit[plot]'") from exc
     from screwkit.io.outputs import atomic_path
 
     plots, _ = simulation_scene_plots(doc)

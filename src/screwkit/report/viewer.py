@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from screwkit import __version__
+from screwkit.errors import InputError
 
 #: scene keys (per mode) kept in float64; every other numeric array is sent as float32
 FLOAT64_KEYS = {"joint_centres"}
@@ -72,7 +73,7 @@ def viewer_bundle() -> str:
     files = resources.files("screwkit.report") / "static"
     js = (files / "screwkit-viewer.min.js").read_text(encoding="utf-8")
     if "</script" in js.lower() or "<!--" in js:
-        raise ValueError("the viewer bundle contains '</script' or '<!--'; rebuild it with `make viewer`")
+        raise InputError("the viewer bundle contains '</script' or '<!--'; rebuild it with `make viewer`")
     return js
 
 

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.kinematics.motion import Motion
 from screwkit.kinematics.registry import family_of
 from screwkit.pipeline import Pipeline
@@ -210,5 +211,5 @@ JOB_ROWS: dict[str, Callable[[Pipeline, JobOptions], Row]] = {
 def check_job(job: str) -> str:
     """``job`` if it is one of :data:`JOBS`; a ValueError naming them otherwise."""
     if job not in JOB_ROWS:
-        raise ValueError(f"--job {job!r}: choose one of {', '.join(JOBS)}")
+        raise InputError(f"--job {job!r}: choose one of {', '.join(JOBS)}")
     return job

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.sweep.engine import Engine, batch_size, batches
 from screwkit.synthesis.config import SynthesisConfig, SynthesisRun, run_synthesis
 from screwkit.synthesis.problem import RSRCSynthesisProblem
@@ -42,7 +43,7 @@ def distributed_multistart(problem: RSRCSynthesisProblem, engine: Engine, *, n_s
                            ) -> list[SynthesisResult]:
     """The best ``keep`` distinct results of ``n_starts`` starts solved on ``engine``."""
     if keep < 1:
-        raise ValueError("n_starts and keep must be >= 1")
+        raise InputError("n_starts and keep must be >= 1")
     starts, scale = multistart_starts(problem, n_starts, seed, spread)
     size = batch_size(n_starts, engine.workers, None, largest=STARTS_PER_TASK)
     groups = batches(list(range(n_starts)), size)

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.io.outputs import atomic_path
 from screwkit.report.sweep_pictures import PICTURE_SOFTWARE
 
@@ -117,7 +118,7 @@ def plot_sweep(rows: Sequence[Row], metadata: dict[str, Any], path: Path, column
     import matplotlib.pyplot as plt
 
     if not any(column in r for r in rows):
-        raise ValueError(f"--plot-column {column!r}: the table has no such column; its columns "
+        raise InputError(f"--plot-column {column!r}: the table has no such column; its columns "
                          f"include {sorted({k for r in rows for k in r})[:12]}")
     labels = [k["column"] for k in metadata["keys"]]
     keys = np.array([[float(r[c]) for c in labels] for r in rows]).reshape(len(rows), -1)

@@ -21,6 +21,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import InputError
+
 __all__ = ["OutputCrank", "output_crank_from_constraints", "q_from_dwell"]
 
 Array = NDArray[Any]
@@ -92,7 +94,7 @@ def output_crank_from_constraints(
     half = 0.5 * np.asarray(dphi12)
     sh = np.sin(half)
     if np.any(np.abs(np.real(sh)) < 1e-12):
-        raise ValueError("the output rotation between the two constraint points must not be a "
+        raise InputError("the output rotation between the two constraint points must not be a "
                          "multiple of 360 deg (eq. 5.21 divides by sin(dphi12/2))")
     cot = np.cos(half) / sh
     cx = 0.5 * (x1 + x2) + 0.5 * (y1 - y2) * cot

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize
 
+from screwkit.errors import InputError
 from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
 from screwkit.synthesis.residuals import (
     NotAssembled,
@@ -120,10 +121,10 @@ def synthesize_equality_constrained(
     positions must be design points of the target (theta = 0 always is).
     """
     if problem.construction is not None:
-        raise ValueError("use an unconstrained problem (no parameters of constraint) with "
+        raise InputError("use an unconstrained problem (no parameters of constraint) with "
                          "equality constraints")
     if not dwells and not ranges:
-        raise ValueError("give at least one dwell or range constraint")
+        raise InputError("give at least one dwell or range constraint")
     try:
         model = ResidualModel(problem, inversion)
     except NotAssembled as exc:
@@ -131,7 +132,7 @@ def synthesize_equality_constrained(
     def find(th: float) -> int:
         k = int(np.argmin(np.abs(model.theta - th)))
         if abs(model.theta[k] - th) > 1e-9:
-            raise ValueError(f"constraint at theta = {math.degrees(th):.6g} deg is not a design "
+            raise InputError(f"constraint at theta = {math.degrees(th):.6g} deg is not a design "
                              "point; add it to the target's design points")
         return k
 

@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
 from screwkit.dual.spatial import wrap_angle
+from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
 
 __all__ = [
@@ -73,7 +74,7 @@ def ellipse_normal(d1: float, lambda0: float, theta0: ArrayLike,
     coupler circle) or inward ("interior").  Its slope is eq. 5.13, tan q = tan theta0 / cos l0."""
     b_axis = d1 * math.cos(lambda0)
     if abs(b_axis) < 1e-12 * d1:
-        raise ValueError("lambda0 = 90 deg: the input-crank ellipse degenerates to a segment and "
+        raise InputError("lambda0 = 90 deg: the input-crank ellipse degenerates to a segment and "
                          "has no normal; a dwell cannot be placed by the overlay")
     t = np.asarray(theta0, dtype=np.float64)
     nx, ny = np.cos(t) / d1, np.sin(t) / b_axis  # gradient of (x/d1)^2 + (y/B)^2: outward
@@ -102,10 +103,10 @@ class OverlayDwell:
 
     def __post_init__(self) -> None:
         if self.tangency not in ("interior", "exterior"):
-            raise ValueError(f"dwell tangency must be 'interior' or 'exterior', got "
+            raise InputError(f"dwell tangency must be 'interior' or 'exterior', got "
                              f"{self.tangency!r}")
         if not math.isfinite(self.theta):
-            raise ValueError("dwell theta must be finite")
+            raise InputError("dwell theta must be finite")
 
 
 @dataclass(frozen=True)
@@ -149,7 +150,7 @@ class _Geometry:
         for dw in dwells:
             hit = np.flatnonzero(np.abs(theta - dw.theta) <= 1e-12 * max(1.0, abs(dw.theta)))
             if hit.size == 0:
-                raise ValueError(f"dwell at theta = {math.degrees(dw.theta):.6g} deg is not one "
+                raise InputError(f"dwell at theta = {math.degrees(dw.theta):.6g} deg is not one "
                                  "of the rotation design points; add it to design_points")
             j = int(hit[0])
             self.dwell_index.append(j)
@@ -159,7 +160,7 @@ class _Geometry:
         if len(self.dwell_index) == 2:
             j, k = self.dwell_index
             if abs(math.sin(0.5 * (self.ang[k] - self.ang[j]))) < 1e-9:
-                raise ValueError(
+                raise InputError(
                     "contradictory constraints: the desired output rotation between the two "
                     f"dwell points is {math.degrees(self.ang[k] - self.ang[j]):.6g} deg, a "
                     "multiple of 360 deg, so no output circle carries one overlay point to the "
@@ -285,22 +286,22 @@ def fit_overlay_circles(*, d1: float, d2: float, lambda0: float, theta01: float,
     th = np.asarray(theta, dtype=np.float64).reshape(-1)
     ps = np.asarray(psi, dtype=np.float64).reshape(-1)
     if th.shape != ps.shape:
-        raise ValueError(f"theta and psi must have equal length, got {th.size} and {ps.size}")
+        raise InputError(f"theta and psi must have equal length, got {th.size} and {ps.size}")
     if not (np.all(np.isfinite(th)) and np.all(np.isfinite(ps))):
-        raise ValueError("theta and psi must be finite")
+        raise InputError("theta and psi must be finite")
     if not (d1 > 0 and d2 > 0 and math.isfinite(d1) and math.isfinite(d2)):
-        raise ValueError(f"d1 and d2 must be positive lengths, got d1 = {d1!r}, d2 = {d2!r}")
+        raise InputError(f"d1 and d2 must be positive lengths, got d1 = {d1!r}, d2 = {d2!r}")
     if len(dwells) > 2:
-        raise ValueError(f"at most two dwells can be placed on the overlay, got {len(dwells)}: "
+        raise InputError(f"at most two dwells can be placed on the overlay, got {len(dwells)}: "
                          "two fix the output circle already")
     geo = _Geometry(d1, d2, lambda0, theta01, th, ps, input_direction, output_direction,
                     tuple(dwells), refine_d2)
     if th.size < geo.n_free:
-        raise ValueError(f"the overlay fit has {geo.n_free} unknowns but only {th.size} design "
+        raise InputError(f"the overlay fit has {geo.n_free} unknowns but only {th.size} design "
                          "points: give more rotation design points")
     lo, hi = d3_range if d3_range is not None else (0.05 * d1, 20.0 * d1)
     if not 0 < lo < hi:
-        raise ValueError(f"d3_range must be 0 < lower < upper, got ({float(lo):.6g} m, "
+        raise InputError(f"d3_range must be 0 < lower < upper, got ({float(lo):.6g} m, "
                          f"{float(hi):.6g} m)")
     starts = _grid_starts(geo, lo, hi, n_starts)
     lower = np.full(geo.n_free, -np.inf)
@@ -339,7 +340,7 @@ def fit_overlay_circles(*, d1: float, d2: float, lambda0: float, theta01: float,
         else:
             distinct.append(c)
     if not distinct:
-        raise ValueError("the overlay fit found no output crank (every circle shrank to a "
+        raise InputError("the overlay fit found no output crank (every circle shrank to a "
                          "point); choose another d2 or theta01")
     return distinct
 

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual.spatial import wrap_angle
+from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
 from screwkit.synthesis.overlay import (
     OverlayCircle,
@@ -79,25 +80,25 @@ class OverlayProblem:
 
     def __post_init__(self) -> None:
         if self.target.rotation is None:
-            raise ValueError("the overlay technique fits the output rotation: give a rotation "
+            raise InputError("the overlay technique fits the output rotation: give a rotation "
                              "target (the translation is set by d1, lambda0, theta01 beforehand)")
         for name in ("d1", "d2"):
             value = getattr(self, name)
             if not (value > 0.0 and math.isfinite(value)):
-                raise ValueError(f"{name} must be a positive length, got {value!r}")
+                raise InputError(f"{name} must be a positive length, got {value!r}")
         for name in ("lambda0", "theta01", "e"):
             if not math.isfinite(getattr(self, name)):
-                raise ValueError(f"{name} must be finite")
+                raise InputError(f"{name} must be finite")
         if self.input_direction not in (1, -1):
-            raise ValueError("input_direction must be +1 or -1")
+            raise InputError("input_direction must be +1 or -1")
         if not self.output_directions or any(s not in (1, -1) for s in self.output_directions):
-            raise ValueError("output_directions must be a non-empty tuple of +1 / -1")
+            raise InputError("output_directions must be a non-empty tuple of +1 / -1")
         if self.keep < 1 or self.n_starts < 1:
-            raise ValueError("keep and n_starts must be >= 1")
+            raise InputError("keep and n_starts must be >= 1")
         if self.max_iterations < 1 or not self.time_limit > 0.0:
-            raise ValueError("max_iterations must be >= 1 and time_limit > 0")
+            raise InputError("max_iterations must be >= 1 and time_limit > 0")
         if not (self.length_scale > 0.0 and math.isfinite(self.length_scale)):
-            raise ValueError(f"length_scale must be a positive length, got {self.length_scale!r}")
+            raise InputError(f"length_scale must be a positive length, got {self.length_scale!r}")
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import InputError
 from screwkit.synthesis.constraints import output_crank_from_constraints, q_from_dwell
 from screwkit.synthesis.targets import ScrewTarget
 
@@ -57,10 +58,10 @@ class ConstraintPoint:
 
     def __post_init__(self) -> None:
         if self.kind not in ("dwell", "free", "fixed"):
-            raise ValueError(f"constraint point kind must be dwell, free or fixed, got {self.kind!r}")
+            raise InputError(f"constraint point kind must be dwell, free or fixed, got {self.kind!r}")
         for name in ("theta", "value"):
             if not math.isfinite(float(getattr(self, name))):
-                raise ValueError(f"constraint point {name} must be finite")
+                raise InputError(f"constraint point {name} must be finite")
 
 
 @dataclass(frozen=True)
@@ -78,7 +79,7 @@ class ConstraintConstruction:
 
     def __post_init__(self) -> None:
         if self.first.theta == self.second.theta:
-            raise ValueError("the two constraint points must be at different input positions")
+            raise InputError("the two constraint points must be at different input positions")
 
 
 @dataclass(frozen=True)
@@ -118,52 +119,52 @@ class RSRCSynthesisProblem:
         if self.construction is not None:
             allowed -= set(DERIVED_BY_CONSTRAINTS)
         if len(set(self.unknowns)) != len(self.unknowns) or not self.unknowns:
-            raise ValueError(f"unknowns must be distinct and not empty, got {self.unknowns!r}")
+            raise InputError(f"unknowns must be distinct and not empty, got {self.unknowns!r}")
         bad = [u for u in self.unknowns if u not in allowed]
         if bad:
             why = (" (with parameters of constraint d3, a and b are derived by eqs. 5.19-5.21)"
                    if self.construction is not None else "")
-            raise ValueError(f"unknown(s) {bad} cannot be solved for; choose among "
+            raise InputError(f"unknown(s) {bad} cannot be solved for; choose among "
                              f"{sorted(allowed)}{why}")
         missing_free = sorted(self.free_q_names - set(self.unknowns))
         if missing_free:
-            raise ValueError(f"{missing_free}: a 'free' parameter of constraint must be an unknown")
+            raise InputError(f"{missing_free}: a 'free' parameter of constraint must be an unknown")
         needed = set(DIMENSION_NAMES) - (set(DERIVED_BY_CONSTRAINTS) if self.construction else set())
         missing = sorted(needed - set(self.start))
         if missing:
-            raise ValueError(f"start/constants lack {missing}: give a value for every dimension")
+            raise InputError(f"start/constants lack {missing}: give a value for every dimension")
         for name, value in self.start.items():
             if not math.isfinite(float(value)):
-                raise ValueError(f"start value of {name} must be finite, got {value!r}")
+                raise InputError(f"start value of {name} must be finite, got {value!r}")
         for name, (lo, hi) in self.bounds.items():
             if name not in self.unknowns:
-                raise ValueError(f"bounds given for {name!r}, which is not an unknown")
+                raise InputError(f"bounds given for {name!r}, which is not an unknown")
             if not lo < hi:
-                raise ValueError(f"bounds of {name}: lower {lo!r} must be below upper {hi!r}")
+                raise InputError(f"bounds of {name}: lower {lo!r} must be below upper {hi!r}")
         if self.inversion is not None and self.inversion not in (1, 2, 3, 4):
-            raise ValueError(f"inversion must be 1, 2, 3, 4 or None (all), got {self.inversion!r}")
+            raise InputError(f"inversion must be 1, 2, 3, 4 or None (all), got {self.inversion!r}")
         if self.input_direction not in (1, -1) or self.output_direction not in (1, -1):
-            raise ValueError("input_direction and output_direction must be +1 or -1")
+            raise InputError("input_direction and output_direction must be +1 or -1")
         if not (self.length_scale > 0.0 and math.isfinite(self.length_scale)):
-            raise ValueError(f"length_scale must be a positive length, got {self.length_scale!r}")
+            raise InputError(f"length_scale must be a positive length, got {self.length_scale!r}")
         if self.max_iterations < 1 or not self.time_limit > 0.0:
-            raise ValueError("max_iterations must be >= 1 and time_limit > 0")
+            raise InputError("max_iterations must be >= 1 and time_limit > 0")
         if self.construction is not None:
             fixed = {n: float(self.start[n]) for n in ("delta0",) if n not in self.unknowns}
             if "delta0" in self.unknowns or abs(math.sin(fixed.get("delta0", 0.0))) > 1e-12:
-                raise ValueError("parameters of constraint (eqs. 5.13-5.21) hold for delta0 = 0 "
+                raise InputError("parameters of constraint (eqs. 5.13-5.21) hold for delta0 = 0 "
                                  "only: make delta0 a constant 0, or drop the [synthesis."
                                  "constraint] table and impose the dwell/range as equations "
                                  "with the Python function screwkit.synthesis.equality_constrained."
                                  "synthesize_equality_constrained (not reachable from the CLI)")
             if "lambda0" in self.unknowns and abs(math.sin(float(self.start["lambda0"]))) < 1e-9:
-                raise ValueError("lambda0 = 0 (plane) cannot be an unknown with parameters of "
+                raise InputError("lambda0 = 0 (plane) cannot be an unknown with parameters of "
                                  "constraint: the plane case re-references the fixed link")
             if (self.construction.rotation_between is None and self.target.rotation is None):
-                raise ValueError("give the constraint's rotation_between: the target has no "
+                raise InputError("give the constraint's rotation_between: the target has no "
                                  "rotation to take it from")
             if abs(math.sin(0.5 * self.rotation_between())) < 1e-9:
-                raise ValueError(
+                raise InputError(
                     "contradictory constraints: the output rotation between the two constraint "
                     f"points is {math.degrees(self.rotation_between()):.6g} deg, a multiple of "
                     "360 deg, so no output crank takes C1 to C2 (eq. 5.21); move a point or "

@@ -405,7 +405,7 @@ def multistart_starts(problem: RSRCSynthesisProblem, n_starts: int, seed: int,
     from ``numpy.random.default_rng(seed)``. The same seed gives the same starts, so the starts
     can be solved anywhere (one process or a cluster) with the same results."""
     if n_starts < 1:
-        raise ValueError("n_starts and keep must be >= 1")
+        raise InputError("n_starts and keep must be >= 1")
     rng = np.random.default_rng(seed)
     x0 = problem.start_vector()
     scale = max(abs(problem.start.get(n, 0.0)) for n in ("d1", "d2", "d3", "a", "b", "e")
@@ -510,7 +510,7 @@ def synthesize_multistart(problem: RSRCSynthesisProblem, *, n_starts: int = 20, 
     for running the starts elsewhere (screwkit.sweep).
     """
     if n_starts < 1 or keep < 1:
-        raise ValueError("n_starts and keep must be >= 1")
+        raise InputError("n_starts and keep must be >= 1")
     total_limit = time_limit if time_limit is not None else n_starts * problem.time_limit
     t0 = time.perf_counter()
     starts, scale = multistart_starts(problem, n_starts, seed, spread)

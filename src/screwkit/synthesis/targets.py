@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError
 from screwkit.synthesis.expressions import parse_expression
 
 __all__ = ["LIBRARY", "DesiredFunction", "ScrewTarget", "data_function", "library_function"]
@@ -65,19 +66,19 @@ def library_function(name: str, **parameters: float) -> DesiredFunction:
     """A function of `LIBRARY` by name; a wrong name or parameter raises ValueError."""
     factory = LIBRARY.get(name)
     if factory is None:
-        raise ValueError(f"unknown desired function {name!r}; choose one of {sorted(LIBRARY)} or "
+        raise InputError(f"unknown desired function {name!r}; choose one of {sorted(LIBRARY)} or "
                          "give an expression")
     for pname, value in parameters.items():
         if not np.isfinite(float(value)):
-            raise ValueError(f"desired function {name!r}: parameter {pname} must be finite, got "
+            raise InputError(f"desired function {name!r}: parameter {pname} must be finite, got "
                              f"{float(value)}")
     if "span" in parameters and not float(parameters["span"]) > 0.0:
-        raise ValueError(f"desired function {name!r}: span must be > 0 (the input rotation over "
+        raise InputError(f"desired function {name!r}: span must be > 0 (the input rotation over "
                          f"which the function runs), got {float(parameters['span'])}")
     try:
         return factory(**{k: float(v) for k, v in parameters.items()})
     except TypeError as exc:
-        raise ValueError(f"desired function {name!r}: {exc}") from None
+        raise InputError(f"desired function {name!r}: {exc}") from None
 
 
 def data_function(theta: ArrayLike, values: ArrayLike) -> DesiredFunction:
@@ -85,13 +86,13 @@ def data_function(theta: ArrayLike, values: ArrayLike) -> DesiredFunction:
     t = np.asarray(theta, dtype=np.float64)
     v = np.asarray(values, dtype=np.float64)
     if t.ndim != 1 or t.shape != v.shape or t.size < 1:
-        raise ValueError(f"data: theta and values must be 1-D of equal length, got {t.shape}, "
+        raise InputError(f"data: theta and values must be 1-D of equal length, got {t.shape}, "
                          f"{v.shape}")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
-        raise ValueError("data: theta and values must be finite")
+        raise InputError("data: theta and values must be finite")
     order = np.argsort(t)
     if np.any(np.diff(t[order]) == 0.0):
-        raise ValueError("data: theta values must be distinct")
+        raise InputError("data: theta values must be distinct")
     ts, vs = t[order], v[order]
 
     def interpolate(x: FloatArray) -> FloatArray:
@@ -99,7 +100,7 @@ def data_function(theta: ArrayLike, values: ArrayLike) -> DesiredFunction:
         outside = (x < ts[0]) | (x > ts[-1])
         if np.any(outside):
             shown = ", ".join(f"{math.degrees(float(v)):.6g}" for v in np.unique(x[outside])[:8])
-            raise ValueError(
+            raise InputError(
                 f"data: design point(s) theta = {shown} deg lie outside the data's range "
                 f"[{math.degrees(float(ts[0])):.6g}, {math.degrees(float(ts[-1])):.6g}] deg; the "
                 "data would be held constant there. Extend the data or move the design points")
@@ -123,11 +124,11 @@ def _check_finite(name: str, fn: DesiredFunction, theta: FloatArray) -> None:
     with np.errstate(all="ignore"):
         values = np.asarray(fn(pts), dtype=np.float64).reshape(-1)
     if values.shape != pts.shape:
-        raise ValueError(f"the desired {name} must give one value per design point")
+        raise InputError(f"the desired {name} must give one value per design point")
     bad = ~np.isfinite(values)
     if bad.any():
         shown = ", ".join(f"{math.degrees(float(t)):.6g}" for t in np.unique(pts[bad])[:8])
-        raise ValueError(f"the desired {name} is not finite at theta = {shown} deg (theta = 0 is "
+        raise InputError(f"the desired {name} is not finite at theta = {shown} deg (theta = 0 is "
                          "the reference the target is measured from): change the function, its "
                          "parameters or the design points")
 
@@ -153,19 +154,19 @@ class ScrewTarget:
         for name in ("theta_rotation", "theta_translation"):
             arr = np.asarray(getattr(self, name), dtype=np.float64).reshape(-1)
             if not np.all(np.isfinite(arr)):
-                raise ValueError(f"ScrewTarget.{name} must be finite")
+                raise InputError(f"ScrewTarget.{name} must be finite")
             object.__setattr__(self, name, arr)
         if self.rotation is None:
             object.__setattr__(self, "theta_rotation", np.zeros(0))
         if self.translation is None:
             object.__setattr__(self, "theta_translation", np.zeros(0))
         if self.theta_rotation.size + self.theta_translation.size == 0:
-            raise ValueError("the target prescribes nothing: give a rotation or a translation "
+            raise InputError("the target prescribes nothing: give a rotation or a translation "
                              "with at least one design point")
         if self.rotation is not None and self.theta_rotation.size == 0:
-            raise ValueError("a rotation is prescribed but it has no design points")
+            raise InputError("a rotation is prescribed but it has no design points")
         if self.translation is not None and self.theta_translation.size == 0:
-            raise ValueError("a translation is prescribed but it has no design points")
+            raise InputError("a translation is prescribed but it has no design points")
         for name, fn, pts in (("rotation", self.rotation, self.theta_rotation),
                               ("translation", self.translation, self.theta_translation)):
             if fn is not None:

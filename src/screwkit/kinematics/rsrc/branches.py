@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dual.spatial import wrap_angle, wrap_angle_near
+from screwkit.errors import InputError
 from screwkit.kinematics.quartic import DEFAULT_DOUBLE_ROOT_TOL
 from screwkit.kinematics.rsrc.dimensions import (
     RSRCDimensions,
@@ -295,7 +296,7 @@ def rsrc_motion(
     theta = check_input_angles(theta0_sweep, "theta0_sweep")
     n = theta.shape[0]
     if n < 2:
-        raise ValueError("theta0_sweep needs at least 2 samples to track branches")
+        raise InputError("theta0_sweep needs at least 2 samples to track branches")
     td = check_input_rate(theta0_dot, n, "theta0_dot")
     tdd = check_input_rate(theta0_ddot, n, "theta0_ddot")
     pos, deriv = rsrc_kinematics(dims, theta, 1.0, 0.0, double_root_tol=double_root_tol)

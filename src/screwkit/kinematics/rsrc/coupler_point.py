@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import InputError
 from screwkit.kinematics.rsrc.dimensions import RSRCDimensions
 from screwkit.kinematics.rsrc.positions import RSRCPositions
 
@@ -47,7 +48,7 @@ def rsrc_coupler_point(
     """
     for name, value in (("f", f), ("g", g), ("h", h)):
         if not math.isfinite(float(value)):
-            raise ValueError(f"coupler point coordinate {name} must be finite, got {value!r}")
+            raise InputError(f"coupler point coordinate {name} must be finite, got {value!r}")
     f, g, h = float(f), float(g), float(h)
     sl, cl = math.sin(dims.lambda0), math.cos(dims.lambda0)
     sd, cd = math.sin(dims.delta0), math.cos(dims.delta0)

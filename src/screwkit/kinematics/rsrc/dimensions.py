@@ -15,6 +15,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError
+
 __all__ = [
     "SPECIAL_ANGLE_TOL",
     "RSRCDimensions",
@@ -66,23 +68,23 @@ class RSRCDimensions:
             try:
                 number = float(value)
             except (TypeError, ValueError):
-                raise ValueError(
+                raise InputError(
                     f"RSRCDimensions.{name} must be a real number, got {value!r}"
                 ) from None
             if not math.isfinite(number):
-                raise ValueError(f"RSRCDimensions.{name} must be finite, got {number!r}")
+                raise InputError(f"RSRCDimensions.{name} must be finite, got {number!r}")
             object.__setattr__(self, name, number)
         if self.d1 <= 0.0:
-            raise ValueError(
+            raise InputError(
                 f"RSRCDimensions.d1 (input crank) must be > 0, got {self.d1!r}; a zero crank "
                 "leaves the input angle without effect"
             )
         if self.d2 <= 0.0:
-            raise ValueError(
+            raise InputError(
                 f"RSRCDimensions.d2 (coupler) must be > 0, got {self.d2!r}"
             )
         if self.d3 < 0.0:
-            raise ValueError(
+            raise InputError(
                 f"RSRCDimensions.d3 (output crank) must be >= 0, got {self.d3!r}; a negative "
                 "crank is the same mechanism with phi0 shifted by pi, pass -d3 instead"
             )
@@ -116,14 +118,14 @@ def check_input_angles(theta0: ArrayLike, name: str = "theta0") -> FloatArray:
     if arr.ndim == 0:
         arr = arr.reshape(1)
     if arr.ndim != 1:
-        raise ValueError(
+        raise InputError(
             f"{name} must be a scalar or a 1-D array of input angles (radians), got shape "
             f"{arr.shape}; flatten it first"
         )
     bad = ~np.isfinite(arr)
     if bad.any():
         index = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{name}[{index}] = {arr[index]!r} is not finite")
+        raise InputError(f"{name}[{index}] = {arr[index]!r} is not finite")
     return arr
 
 
@@ -133,9 +135,9 @@ def check_input_rate(value: ArrayLike, n: int, name: str) -> FloatArray:
     if arr.ndim == 0:
         arr = np.full(n, float(arr))
     if arr.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {arr.shape}")
+        raise InputError(f"{name} must be a scalar or have shape ({n},), got shape {arr.shape}")
     bad = ~np.isfinite(arr)
     if bad.any():
         index = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{name}[{index}] = {arr[index]!r} is not finite")
+        raise InputError(f"{name}[{index}] = {arr[index]!r} is not finite")
     return arr[:, None]

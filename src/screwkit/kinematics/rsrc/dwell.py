@@ -8,6 +8,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.errors import InputError
 from screwkit.kinematics.rsrc.dimensions import RSRCDimensions, check_input_angles
 from screwkit.kinematics.rsrc.loop_equation import loop_residual
 from screwkit.kinematics.rsrc.rates import LOCK_TOL
@@ -69,12 +70,12 @@ def rsrc_output_derivatives(
         If a (theta0, phi0) pair does not close the loop or is locked (Q5 = 0).
     """
     if not 1 <= int(order) <= 12:
-        raise ValueError(f"order must be between 1 and 12, got {order!r}")
+        raise InputError(f"order must be between 1 and 12, got {order!r}")
     order = int(order)
     theta = check_input_angles(theta0)
     phi = check_input_angles(phi0, "phi0")
     if phi.shape != theta.shape:
-        raise ValueError(f"phi0 has shape {phi.shape}, theta0 has shape {theta.shape}")
+        raise InputError(f"phi0 has shape {phi.shape}, theta0 has shape {theta.shape}")
     g0, g_phi = loop_residual(dims, theta, phi)
     scale = dims.length_scale
     half_pi = dims.special_case == "delta0_half_pi"
@@ -82,14 +83,14 @@ def rsrc_output_derivatives(
     off = np.abs(g0) > 1e-8 * residual_scale
     if off.any():
         i = int(np.flatnonzero(off)[0])
-        raise ValueError(
+        raise InputError(
             f"(theta0[{i}], phi0[{i}]) = ({theta[i]!r}, {phi[i]!r}) does not close the loop "
             f"(residual {g0[i]:.3g}); take phi0 from rsrc_positions"
         )
     locked = np.abs(g_phi) <= LOCK_TOL * residual_scale
     if locked.any():
         i = int(np.flatnonzero(locked)[0])
-        raise ValueError(
+        raise InputError(
             f"configuration {i} (theta0 = {theta[i]!r}) is locked (Q5 = 0): phi0(theta0) has no "
             "derivatives there"
         )
@@ -136,9 +137,9 @@ def dwell_order(derivatives: ArrayLike, tol: float) -> IntArray:
     """
     d = np.asarray(derivatives, dtype=np.float64)
     if d.ndim != 2:
-        raise ValueError(f"derivatives must have shape (M, K), got {d.shape}")
+        raise InputError(f"derivatives must have shape (M, K), got {d.shape}")
     if not tol >= 0.0:
-        raise ValueError(f"tol must be >= 0, got {tol!r}")
+        raise InputError(f"tol must be >= 0, got {tol!r}")
     small = np.abs(d) <= tol
     leading = np.cumprod(small, axis=1)
     return leading.sum(axis=1).astype(np.int64)

@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual.spatial import wrap_angle
+from screwkit.errors import InputError
 from screwkit.kinematics.rsrc.branches import rsrc_motion
 from screwkit.kinematics.rsrc.dimensions import RSRCDimensions
 from screwkit.kinematics.rsrc.loop_equation import (
@@ -132,10 +133,10 @@ def _limits(
     theta0_range: tuple[float, float],
 ) -> tuple[LimitPosition, ...]:
     if n_grid < 16:
-        raise ValueError(f"n_grid must be at least 16 samples, got {n_grid}")
+        raise InputError(f"n_grid must be at least 16 samples, got {n_grid}")
     start, stop = (float(v) for v in theta0_range)
     if not (math.isfinite(start) and math.isfinite(stop) and stop > start):
-        raise ValueError(f"theta0_range must be a finite increasing pair, got {theta0_range!r}")
+        raise InputError(f"theta0_range must be a finite increasing pair, got {theta0_range!r}")
     grid = np.linspace(start, stop, n_grid)
     motion = rsrc_motion(dims, grid)
     one = np.ones((n_grid, 1))

@@ -42,6 +42,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dual.spatial import wrap_angle
+from screwkit.errors import InputError
 from screwkit.kinematics.quartic import (
     DEFAULT_DOUBLE_ROOT_TOL,
     real_roots_of_trig_quadratic,
@@ -108,7 +109,7 @@ class RSRCPositions:
     def inversion(self, label: int) -> tuple[FloatArray, FloatArray, FloatArray, BoolArray]:
         """(phi0, chi0, S, assembles), each (N,), of the inversion with program label 1..4."""
         if label not in (1, 2, 3, 4):
-            raise ValueError(f"inversion label must be 1, 2, 3 or 4, got {label!r}")
+            raise InputError(f"inversion label must be 1, 2, 3 or 4, got {label!r}")
         j = label - 1
         return self.phi0[:, j], self.chi0[:, j], self.S[:, j], self.assembles[:, j]
 
