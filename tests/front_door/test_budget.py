@@ -58,3 +58,32 @@ def test_a_huge_pareto_sweep_is_refused_at_load(tmp_path):
     r = runner.invoke(app, ["validate", str(p)])
     assert time.perf_counter() - t < 5.0
     assert r.exit_code == 2 and "weightings" in r.output and "fewer divisions" in r.output
+
+
+@pytest.mark.parametrize("method", ["closed", "generic"])
+def test_the_motion_estimate_bounds_the_measured_peak_without_overstating_it(method):
+    """The estimate is an upper bound of the memory the solve really allocates (tracemalloc
+    sees numpy's buffers), and not wildly more, so that 10⁶ samples of a family with two modes
+    are accepted where they fit (docs/reliability.md)."""
+    import subprocess
+    import sys
+
+    code = f"""
+import tracemalloc, numpy as np, screwkit as sk
+from screwkit.kinematics.solve_motion import motion_bytes
+lk = sk.fourbar(3.0, 1.0, 3.0, 2.5)
+theta = np.linspace(0.0, 2 * np.pi, 20000, endpoint=False)
+sk.solve_motion(lk, theta[:50], method="{method}", progress=False)
+tracemalloc.start()
+m = sk.solve_motion(lk, theta, method="{method}", progress=False)
+peak = tracemalloc.get_traced_memory()[1]
+print(len(m.modes), peak, motion_bytes(lk, theta.size, sk.family("4R").max_modes))
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300)
+    assert out.returncode == 0, out.stderr
+    modes, peak, estimate = (float(v) for v in out.stdout.split())
+    assert modes == 2
+    assert peak < estimate < 4 * peak, (peak, estimate)
+    # at that rate 10⁶ samples of the 4R need under 10 GB: accepted under a 12 GiB limit
+    assert estimate * 50 < 10e9

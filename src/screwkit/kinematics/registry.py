@@ -89,6 +89,10 @@ class Family:
     #: Bagci's closed-form synthesis (Programs B/C, the overlay) as the RSRC with these
     #: dimensions held (the 4R: b = e = δ0 = λ0 = 0); None: the generic route only
     closed_synthesis: Mapping[str, float] | None = None
+    #: the most assembly modes a loop of the family has at one input (the degree of its
+    #: input-output equation: the RSRC quartic 3.63 gives 4, a quadratic 2); None: not known
+    #: here (a joint list), and memory estimates assume ``MODES_ESTIMATE``
+    max_modes: int | None = None
 
     def closed_form_for(self, linkage: Linkage) -> ClosedForm | None:
         """The closed form that solves ``linkage``, or None (then the generic solver does)."""
@@ -166,7 +170,7 @@ FAMILIES: dict[str, Family] = {
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output_C.theta", -1.0),
                            "S": ("output_C.s", 1.0), "chi0": ("coupler_R.theta", 1.0)},
             outputs=("phi0", "S"), coupler_link="coupler", closed_limits=_rsrc_limits,
-            geometry=geometries.rsrc_geometry, closed_synthesis={}),
+            geometry=geometries.rsrc_geometry, closed_synthesis={}, max_modes=4),
         Family(
             "4R", "the planar 4R", "planar four-bar (Bagci's special case of the RSRC)",
             {"a": _LENGTH, "d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH},
@@ -182,7 +186,7 @@ FAMILIES: dict[str, Family] = {
                            "chi0": ("rocker_pin.theta", 1.0)},
             outputs=("phi0",), coupler_link="coupler", closed_limits=_rsrc_limits,
             geometry=geometries.fourbar_geometry,
-            closed_synthesis={"b": 0.0, "e": 0.0, "delta0": 0.0, "lambda0": 0.0}),
+            closed_synthesis={"b": 0.0, "e": 0.0, "delta0": 0.0, "lambda0": 0.0}, max_modes=2),
         Family(
             "CSSP", "the CSSP", "Rahman's generalised slider-crank (C-S-S-P)",
             {"a1": _LENGTH, "a2": _LENGTH, "a4": _LENGTH, "alpha4": _ANGLE, "s1": _LENGTH},
@@ -190,7 +194,7 @@ FAMILIES: dict[str, Family] = {
             seed_names=seed_names.cssp_names, aliases=("cssp",), sketch=constructors.CSSP_SKETCH,
             why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             seed_freedoms={"theta1": ("crank.theta", 1.0), "s4": ("slider.s", 1.0)},
-            outputs=("s4",), coupler_link="rod", geometry=geometries.cssp_geometry),
+            outputs=("s4",), coupler_link="rod", geometry=geometries.cssp_geometry, max_modes=2),
         Family(
             "RSSR", "the RSSR", "spatial R-S-S-R crank-rocker (closed form A cos φ0 + B sin φ0 = K)",
             {"d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH, "a": _LENGTH, "b": _LENGTH,
@@ -200,7 +204,8 @@ FAMILIES: dict[str, Family] = {
             why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch=constructors.RSSR_SKETCH,
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output.theta", -1.0)},
-            outputs=("phi0",), coupler_link="coupler", geometry=geometries.rssr_geometry),
+            outputs=("phi0",), coupler_link="coupler", geometry=geometries.rssr_geometry,
+            max_modes=2),
         Family(
             "RCCC", "the RCCC", "R-C-C-C loop in Hartenberg-Denavit form (closed form: the dual "
             "input-output equation)",
@@ -210,7 +215,7 @@ FAMILIES: dict[str, Family] = {
             closed_form_applies=_is_rccc, aliases=("rccc",),
             why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch=constructors.RCCC_SKETCH, outputs=("C4.theta", "C4.s"), coupler_link="link2",
-            geometry=geometries.rccc_geometry),
+            geometry=geometries.rccc_geometry, max_modes=2),
         Family(
             "LOOP", "a joint-list loop", "any single loop given as a joint list (generic solver; "
             "the RCCC closed form for an R C C C list driven at its R joint)", {},
