@@ -45,3 +45,25 @@ def test_cssp_against_mujoco():
         assert driven[key] < crosscheck.TOLERANCE[key], (key, driven[key])
     free = crosscheck.free_run(spec, crosscheck.build(spec), turns=1.0)
     assert free["free-run speed"] < crosscheck.TOLERANCE["free-run speed"]
+
+
+def test_joint_friction_against_mujoco():
+    """MuJoCo's joint damping is [drive.friction]'s viscous friction: the driven input torque
+    (ideal inverse dynamics + B θ̇), the shaking loads (unchanged by friction) and the
+    coast-down agree as the frictionless run does, with friction carrying several per cent of
+    the torque."""
+    spec = sk.load_spec(ROOT / "examples" / "rsrc_fig7_dynamics.toml")
+    friction = crosscheck.friction_for(spec)
+    assert {f.joint for f in friction} == {"input", "coupler_R", "output_C"}
+    rec = crosscheck.driven_run(spec, crosscheck.build(spec, friction=friction), turns=0.5,
+                                samples=36)
+    driven = crosscheck.compare_driven_with_friction(spec, rec, friction)
+    assert driven["friction share"] > 0.01
+    for key in ("input torque (friction)", "shaking force (friction)",
+                "shaking moment (friction)"):
+        assert driven[key] < crosscheck.FRICTION_TOLERANCE[key], (key, driven[key])
+    coast = crosscheck.free_run(spec, crosscheck.build(spec, friction=friction), turns=1.0,
+                                friction=friction)
+    assert coast["speed lost"] > 0.05
+    key = "coast-down speed (friction)"
+    assert coast[key] < crosscheck.FRICTION_TOLERANCE[key]

@@ -34,6 +34,7 @@ def register(app: typer.Typer) -> None:
         s = guard(lambda: load_spec(spec))
         text = guard(lambda: mjcf_model(s.linkage, start=float(s.inputs[0]), mode=s.mode,
                                         gravity=spec_gravity(s) if gravity else None,
-                                        timestep=timestep, solref=(20 * timestep, 1.0)))
+                                        timestep=timestep, solref=(20 * timestep, 1.0),
+                                        friction=s.drive.friction if s.drive else ()))
         guard(lambda: write_atomic(output, text, [spec], "--output"))
         console.print(f"wrote {escape(str(output))}", highlight=False)

@@ -44,6 +44,8 @@ def _table(doc: dict[str, Any], describe: str, units: Any) -> None:
         col("min\n[rpm]", "min_speed", RPM), col("max\n[rpm]", "max_speed", RPM),
         col("C_s", "fluctuation"), col("motor\nwork [J]", "motor_work"),
         col("load\nwork [J]", "load_work"),
+        *([col("friction\nwork [J]", "friction_work")]
+          if any(c.get("friction_work") for c in shown) else []),
         col(f"motor τ\nRMS [{tu}]", "motor_torque_rms", kind="moment"),
         col(f"motor τ\npeak [{tu}]", "motor_torque_peak", kind="moment")])
     sizing = doc.get("flywheel_sizing")

@@ -23,6 +23,7 @@ from pydantic import (
 
 from screwkit.io.errors import SpecError
 from screwkit.io.validation import validation_lines
+from screwkit.kinematics.rates import spin_links
 
 Value = StrictFloat | StrictInt | StrictStr
 MOTOR_KINDS = ("none", "constant", "linear", "table")
@@ -62,6 +63,18 @@ class LoadConfig:
 
 
 @dataclass(frozen=True)
+class JointFriction:
+    """Viscous friction in one joint (SI): ``rotation`` (N·m·s/rad) resists the relative angular
+    velocity of the two links the joint joins (R, C, H, U, S joints: the moment −c ω_rel),
+    ``translation`` (N·s/m) their relative sliding along the axis (P and C joints: the force
+    −c ṡ u)."""
+
+    joint: str
+    rotation: float = 0.0
+    translation: float = 0.0
+
+
+@dataclass(frozen=True)
 class DriveConfig:
     """The ``[drive]`` table in SI units (module docstring; docs/simulation.md)."""
 
@@ -75,6 +88,7 @@ class DriveConfig:
     atol: float | None  # rad and rad/s; None: rtol·(2π, initial speed)
     gravity: bool
     max_time: float | None  # s
+    friction: tuple[JointFriction, ...] = ()  # viscous friction per joint
 
 
 class _Strict(BaseModel):
@@ -98,6 +112,11 @@ class LoadTable(_Strict):
     against_motion: StrictBool = True
 
 
+class FrictionTable(_Strict):
+    rotation: Value | None = None
+    translation: Value | None = None
+
+
 class DriveTable(_Strict):
     motor: MotorTable = Field(default_factory=MotorTable)  # type: ignore[arg-type]
     load: LoadTable | None = None
@@ -109,6 +128,7 @@ class DriveTable(_Strict):
     atol: StrictFloat | None = Field(None, gt=0.0)
     gravity: StrictBool = False
     max_time: Value | None = None
+    friction: dict[StrictStr, Value | FrictionTable] | None = None
 
 
 def _table(spec: Any) -> DriveTable:
@@ -193,6 +213,55 @@ def _load(spec: Any, t: LoadTable | None) -> LoadConfig | None:
     return LoadConfig(freedom, constant, damping, t.against_motion)
 
 
+_ROTATING = frozenset("RCHUS")
+_SLIDING = frozenset("PC")
+
+
+def _friction(spec: Any, table: dict[str, Any] | None) -> tuple[JointFriction, ...]:
+    """``[drive.friction]``: joint name -> a viscous coefficient (rotational for R, H, U, S;
+    translational for P) or ``{ rotation = …, translation = … }`` (a C joint has both)."""
+    if not table:
+        return ()
+    lk = spec.linkage
+    joints = {j.name: j for j in lk.joints}
+    rod_balls = {lk.joints[k].name: lk.links[i].name for i in spin_links(lk) for k in (i, i + 1)}
+    out = []
+    for name, value in table.items():
+        key = f"friction.{name}"
+        if name not in joints:
+            _fail(spec, key, f"no joint {name!r}; the joints are {list(joints)}")
+        kind = joints[name].kind
+        if isinstance(value, FrictionTable):
+            rotation, translation = value.rotation, value.translation
+            if rotation is None and translation is None:
+                _fail(spec, key, "give rotation and/or translation")
+        elif kind == "C":
+            _fail(spec, key, f"{name!r} is a C joint, which turns and slides: give "
+                             "{ rotation = …, translation = … } (N·m·s/rad and N·s/m)")
+        elif kind == "P":
+            rotation, translation = None, value
+        else:
+            rotation, translation = value, None
+        if rotation is not None and name in rod_balls:
+            _fail(spec, key, f"{name!r} is a ball joint of the rod {rod_balls[name]!r}, which "
+                             "lies between two ball joints: its spin about its own axis is free "
+                             "and screwkit holds it at zero (docs/kinematics.md), so friction "
+                             "there, which would drive that spin, is not modelled; put friction "
+                             "on the other joints")
+        if rotation is not None and kind not in _ROTATING:
+            _fail(spec, f"{key}.rotation", f"{name!r} is a {kind} joint: it does not turn")
+        if translation is not None and kind not in _SLIDING:
+            _fail(spec, f"{key}.translation", f"{name!r} is a {kind} joint: it does not slide "
+                                              "(a helical joint's friction is on its rotation)")
+        c_r = 0.0 if rotation is None else _si(spec, rotation, "rotational_damping", key)
+        c_t = 0.0 if translation is None else _si(spec, translation, "translational_damping",
+                                                  key)
+        if c_r < 0 or c_t < 0:
+            _fail(spec, key, "a viscous friction coefficient is >= 0")
+        out.append(JointFriction(name, c_r, c_t))
+    return tuple(out)
+
+
 def drive_config(spec: Any) -> DriveConfig:
     """The ``[drive]`` table of a loaded spec as a typed, SI :class:`DriveConfig`."""
     t = _table(spec)
@@ -212,4 +281,5 @@ def drive_config(spec: Any) -> DriveConfig:
     return DriveConfig(motor=_motor(spec, t.motor), load=_load(spec, t.load), flywheel=flywheel,
                        initial_speed=speed, cycles=t.cycles,
                        samples_per_cycle=t.samples_per_cycle, rtol=t.rtol, atol=t.atol,
-                       gravity=t.gravity, max_time=max_time)
+                       gravity=t.gravity, max_time=max_time,
+                       friction=_friction(spec, t.friction))

@@ -46,6 +46,9 @@ def simulation_scene_plots(doc: dict[str, Any], mode: int | None = None
         _plot("sim-torque-time", "motor torque and shaft torque into the loop", "time (s)",
               "torque (N·m)", [_series("motor", s["time"], s["motor_torque"])]),
     ]
+    if np.any(s.get("friction_torque", np.zeros(0))):
+        plots[-1]["series"].append(_series("joint friction (on the input)", s["time"],
+                                           s["friction_torque"]))
     loads = doc.get("loads")
     if loads:
         for name, e in loads["efforts"].items():

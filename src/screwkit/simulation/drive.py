@@ -1,10 +1,11 @@
 """The generalised forces on the input coordinate of a driven loop and its equation of motion
 
-    (J(θ) + J_f) θ̈ = τ_motor(θ̇) − ½ J′(θ) θ̇² + Q_g(θ) + Q_load(θ, θ̇),
+    (J(θ) + J_f) θ̈ = τ_motor(θ̇) − ½ J′(θ) θ̇² + Q_g(θ) + Q_load(θ, θ̇) − B(θ) θ̇,
 
-with J_f the flywheel on the input shaft, Q_g = −V′ the gravity torque and Q_load = Q_out · r(θ)
+with J_f the flywheel on the input shaft, Q_g = −V′ the gravity torque, Q_load = Q_out · r(θ)
 the load on the output freedom q_out carried to the input by the velocity ratio r = dq_out/dθ
-(virtual work: Q_out δq_out = Q_out r δθ). Motor models and the load law are those of the
+(virtual work: Q_out δq_out = Q_out r δθ) and B(θ) the viscous joint friction
+(:func:`~screwkit.simulation.reduced.friction_coefficient`: it dissipates B θ̇²). Motor models and the load law are those of the
 ``[drive]`` table (:class:`~screwkit.io.drive_table.DriveConfig`, docs/simulation.md)."""
 
 from __future__ import annotations
@@ -52,11 +53,13 @@ class EquationOfMotion:
         self._k = np.arange(c.shape[1])
         self._slope = c[0] * (1j * self._k)
         self._ratio_row = None if drive.load is None else model.row(drive.load.freedom)
+        self.friction_row = model.row("friction") if "friction" in model.rows else None
 
     def terms(self, theta: ArrayLike, speed: ArrayLike) -> dict[str, Array]:
         """Every term at (θ, θ̇) (arrays of the same shape): ``inertia`` J + J_f,
         ``inertia_slope`` J′, ``motor`` τ, ``gravity`` Q_g, ``load`` Q_load, ``output_force``
-        Q_out, ``ratio`` r, ``acceleration`` θ̈."""
+        Q_out, ``ratio`` r, ``friction`` −B θ̇ (the joints' viscous friction on the input),
+        ``acceleration`` θ̈."""
         th = np.asarray(theta, dtype=float)
         w = np.asarray(speed, dtype=float)
         e = np.exp(1j * np.multiply.outer(th - self.model.start, self._k))
@@ -68,9 +71,12 @@ class EquationOfMotion:
         q_out = output_force(self.drive.load, ratio * w)
         tau = motor_torque(self.drive.motor, w)
         load = q_out * ratio
-        acc = (tau - 0.5 * slope * w * w + rows[1] + load) / J
+        fr = self.friction_row
+        friction = -rows[fr] * w if fr is not None else np.zeros_like(th * w)
+        acc = (tau - 0.5 * slope * w * w + rows[1] + load + friction) / J
         return {"inertia": J, "inertia_slope": slope, "motor": tau, "gravity": rows[1],
-                "load": load, "output_force": q_out, "ratio": ratio, "acceleration": acc}
+                "load": load, "output_force": q_out, "ratio": ratio, "friction": friction,
+                "acceleration": acc}
 
     def rhs(self, t: float, y: Array) -> Array:
         """(θ̇, θ̈) for scipy's ``solve_ivp`` (one state: the fast path of :meth:`terms`)."""
@@ -84,7 +90,8 @@ class EquationOfMotion:
             r = rows[row]
             load = float(output_force(self.drive.load, r * w)) * r
         tau = float(motor_torque(self.drive.motor, w))
-        acc = (tau - 0.5 * slope * w * w + rows[1] + load) / (rows[0] + self.flywheel)
+        friction = -rows[self.friction_row] * w if self.friction_row is not None else 0.0
+        acc = (tau - 0.5 * slope * w * w + rows[1] + load + friction) / (rows[0] + self.flywheel)
         return np.array([w, acc])
 
     def energy(self, theta: ArrayLike, speed: ArrayLike) -> Array:
@@ -100,11 +107,13 @@ def equation_of_motion(linkage: Linkage, drive: DriveConfig, *, mode: int = 0,
                        flywheel: float | None = None, method: str = "auto"
                        ) -> EquationOfMotion:
     """The reduced model of ``linkage`` (assembly ``mode``, one turn from ``start``) with the
-    drive's load freedom among its velocity ratios, and its equation of motion."""
+    drive's load freedom among its velocity ratios and its joint friction, and its equation of
+    motion."""
     ratios = () if drive.load is None else (drive.load.freedom,)
     model = reduced_model(linkage, mode=mode, start=start,
                           gravity=gravity if drive.gravity else None, ratios=ratios,
-                          samples_per_cycle=drive.samples_per_cycle, method=method)
+                          samples_per_cycle=drive.samples_per_cycle, method=method,
+                          friction=drive.friction)
     fw = drive.flywheel if flywheel is None else float(flywheel)
     if not fw >= 0:
         raise SimulationError(f"the flywheel inertia must be >= 0; got {fw}")

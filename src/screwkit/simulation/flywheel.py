@@ -38,11 +38,11 @@ def with_flywheel(eom: EquationOfMotion, flywheel: float) -> EquationOfMotion:
 
 
 def _mean_generalised_force(eom: EquationOfMotion, speed: float) -> float:
-    """Mean over one turn of the motor + load torque at constant input speed (the gravity and
-    inertia terms average to zero over a turn)."""
+    """Mean over one turn of the motor + load + joint-friction torque at constant input speed
+    (the gravity and inertia terms average to zero over a turn)."""
     grid = eom.model.grid
     t = eom.terms(grid, np.full(grid.size, speed))
-    return float(np.mean(t["motor"] + t["load"]))
+    return float(np.mean(t["motor"] + t["load"] + t["friction"]))
 
 
 def balanced_speed(eom: EquationOfMotion, guess: float) -> float | None:
@@ -106,7 +106,8 @@ def energy_estimate(eom: EquationOfMotion, fluctuation: float, speed: float) -> 
     flywheel estimate (kg·m²)."""
     grid = eom.model.grid
     t = eom.terms(grid, np.full(grid.size, speed))
-    net = t["motor"] + t["gravity"] + t["load"] - 0.5 * t["inertia_slope"] * speed ** 2
+    net = (t["motor"] + t["gravity"] + t["load"] + t["friction"]
+           - 0.5 * t["inertia_slope"] * speed ** 2)
     net = net - np.mean(net)  # the steady state: the work per turn balances
     h = grid[1] - grid[0]
     energy = np.concatenate([[0.0], np.cumsum(0.5 * (net + np.roll(net, -1)) * h)])

@@ -2,8 +2,9 @@
 with scipy's ``solve_ivp`` (DOP853, dense output), an event counting the cycles (the input
 passing start + 2πk) and terminal events for the last cycle and for a stall (θ̇ reaching zero).
 
-The state is (θ, θ̇, W_motor, W_load, ∫τ² dt): the motor's and the load's work and the
-integral of the squared motor torque are integrated with the motion, to the same tolerance, so
+The state is (θ, θ̇, W_motor, W_load, ∫τ² dt), with W_friction appended when joints have
+friction (only then: scipy's error norm averages over the components): the motor's, the
+load's and the joint friction's work and the integral of the squared motor torque are integrated with the motion, to the same tolerance, so
 energy per cycle and RMS torque need no quadrature afterwards. Every completed cycle is then
 sampled at the model's grid angles (the time at which θ reaches each, by Newton's method on
 the dense output), where the full motion of the loop is known exactly
@@ -31,7 +32,8 @@ class SimulationRun:
 
     ``cycle_times`` (C + 1,) the times the input passes start + 2πk; ``time``, ``speed``,
     ``acceleration`` (C, N) at the grid angles ``eom.model.grid`` of each completed cycle;
-    ``cycle_work`` {``motor``, ``load``} (C,) the work per cycle (J); ``torque_square`` (C,)
+    ``cycle_work`` {``motor``, ``load``, ``friction``} (C,) the work per cycle (J; the load's
+    and the friction's are negative when they resist); ``torque_square`` (C,)
     ∫τ² dt per cycle; ``status`` ``"completed"``, ``"stalled"`` or ``"max_time"`` with a
     ``message``; ``end`` the last state (t, θ, θ̇)."""
 
@@ -65,7 +67,7 @@ class SimulationRun:
 
 
 def _rhs(eom: EquationOfMotion):  # type: ignore[no-untyped-def]
-    """(θ̇, θ̈, τω, Q_load ω, τ²) of the augmented state."""
+    """(θ̇, θ̈, τω, Q_load ω, τ², −B ω²) of the augmented state."""
     motor = eom.drive.motor
     k = np.arange(eom.model.series.coefficients.shape[1])
     coeff = eom.model.series.coefficients
@@ -74,6 +76,7 @@ def _rhs(eom: EquationOfMotion):  # type: ignore[no-untyped-def]
     row = None if eom.drive.load is None else eom.model.row(eom.drive.load.freedom)
     load_cfg = eom.drive.load
     fw = eom.flywheel
+    fr = eom.friction_row
 
     def f(t: float, y: Array) -> Array:
         th, w = y[0], y[1]
@@ -88,8 +91,12 @@ def _rhs(eom: EquationOfMotion):  # type: ignore[no-untyped-def]
                                              if load_cfg.against_motion else load_cfg.constant)
             load = q_out * r
         tau = float(motor_torque(motor, w))
-        acc = (tau - 0.5 * slope * w * w + rows[1] + load) / (rows[0] + fw)
-        return np.array([w, acc, tau * w, load * w, tau * tau])
+        if fr is None:
+            acc = (tau - 0.5 * slope * w * w + rows[1] + load) / (rows[0] + fw)
+            return np.array([w, acc, tau * w, load * w, tau * tau])
+        friction = -rows[fr] * w
+        acc = (tau - 0.5 * slope * w * w + rows[1] + load + friction) / (rows[0] + fw)
+        return np.array([w, acc, tau * w, load * w, tau * tau, friction * w])
 
     return f
 
@@ -123,7 +130,10 @@ def simulate_cycles(eom: EquationOfMotion, *, cycles: int, initial_speed: float,
     energy = 0.5 * J0 * initial_speed ** 2
     period = TWO_PI / initial_speed
     # absolute tolerances: θ (rad), θ̇ (rad/s), the works (J) and ∫τ² dt on their scales
-    atol_v = rtol * np.array([TWO_PI, initial_speed, energy, energy, energy ** 2 / period])
+    scales = [TWO_PI, initial_speed, energy, energy, energy ** 2 / period]
+    if eom.friction_row is not None:
+        scales.append(energy)
+    atol_v = rtol * np.array(scales)
     if atol is not None:
         atol_v[:2] = atol
     t_end = max_time if max_time is not None else 1000.0 * cycles * period
@@ -141,7 +151,8 @@ def simulate_cycles(eom: EquationOfMotion, *, cycles: int, initial_speed: float,
     done.direction = 1.0  # type: ignore[attr-defined]
     stall.terminal = True  # type: ignore[attr-defined]
     stall.direction = -1.0  # type: ignore[attr-defined]
-    y0 = np.array([start, initial_speed, 0.0, 0.0, 0.0])
+    y0 = np.zeros(len(scales))
+    y0[:2] = start, initial_speed
     res = solve_ivp(_rhs(eom), (0.0, t_end), y0, method="DOP853", rtol=rtol, atol=atol_v,
                     dense_output=True, events=(cycle, done, stall))
     if res.status == -1:
@@ -182,18 +193,21 @@ def _sampled(eom: EquationOfMotion, res: object, cycle_times: Array, initial_spe
         speed = y[1]
         acc = eom.terms(targets, speed)["acceleration"]
         at_ends = sol(cycle_times)
-        work = {"motor": np.diff(at_ends[2]), "load": np.diff(at_ends[3])}
+        friction = at_ends[5] if at_ends.shape[0] > 5 else np.zeros(C + 1)
+        work = {"motor": np.diff(at_ends[2]), "load": np.diff(at_ends[3]),
+                "friction": np.diff(friction)}
         torque_square = np.diff(at_ends[4])
     else:
         t = speed = acc = np.zeros((0, N))
-        work = {"motor": np.zeros(0), "load": np.zeros(0)}
+        work = {"motor": np.zeros(0), "load": np.zeros(0), "friction": np.zeros(0)}
         torque_square = np.zeros(0)
     t_last = float(res.t[-1])  # type: ignore[attr-defined]
     y_last = res.y[:, -1]  # type: ignore[attr-defined]
     e0 = float(eom.energy(grid[0], initial_speed))
     e1 = float(eom.energy(y_last[0], y_last[1]))
-    scale = max(abs(e0), abs(y_last[2]), abs(y_last[3]), 1e-300)
-    energy_error = abs(e1 - e0 - y_last[2] - y_last[3]) / scale
+    w_friction = float(y_last[5]) if y_last.shape[0] > 5 else 0.0
+    scale = max(abs(e0), abs(y_last[2]), abs(y_last[3]), abs(w_friction), 1e-300)
+    energy_error = abs(e1 - e0 - y_last[2] - y_last[3] - w_friction) / scale
     return SimulationRun(eom=eom, initial_speed=initial_speed, cycle_times=cycle_times, time=t,
                          speed=speed, acceleration=acc, cycle_work=work,
                          torque_square=torque_square, energy_error=float(energy_error),

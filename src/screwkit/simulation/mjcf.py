@@ -29,6 +29,7 @@ parameters: validation/mujoco/crosscheck.md measures what they do to the agreeme
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 from xml.sax.saxutils import quoteattr
@@ -60,6 +61,10 @@ class MjcfLayout:
     backward: tuple[int, ...]
     dofs: dict[str, tuple[str, ...]]
     spin_links: tuple[int, ...]
+
+
+#: joint name -> (rotational, translational) viscous damping
+Damping = Mapping[str, tuple[float, float]]
 
 
 def loop_layout(linkage: Linkage) -> MjcfLayout:
@@ -112,19 +117,21 @@ def start_configuration(linkage: Linkage, start: float, mode: int) -> ModeMotion
 
 
 def _joint_xml(linkage: Linkage, k: int, layout: MjcfLayout, centre: Array, axis: Array,
-               indent: str) -> list[str]:
+               indent: str, damping: Damping) -> list[str]:
     j = linkage.joints[k]
     lines = []
     tags = {"R": ("hinge",), "P": ("slide",), "C": ("hinge", "slide"), "S": ("ball",)}[j.kind]
+    rotation, translation = damping.get(j.name, (0.0, 0.0))
     for name, tag in zip(layout.dofs[j.name], tags, strict=True):
         extra = "" if tag == "ball" else f' axis="{_f(axis)}"'
+        c = translation if tag == "slide" else rotation
         lines.append(f'{indent}<joint name={quoteattr(name)} type="{tag}" pos="{_f(centre)}"'
-                     f'{extra} limited="false" damping="0" armature="0"/>')
+                     f'{extra} limited="false" damping="{float(c)!r}" armature="0"/>')
     return lines
 
 
 def _body_xml(linkage: Linkage, md: ModeMotion, link: int, joint: int, parent: int | None,
-              layout: MjcfLayout, indent: str) -> list[str]:
+              layout: MjcfLayout, indent: str, damping: Damping) -> list[str]:
     R, o = md.link_rotation[0, link], md.link_origin[0, link]
     if parent is None:
         pos, rot = o, R
@@ -142,7 +149,7 @@ def _body_xml(linkage: Linkage, md: ModeMotion, link: int, joint: int, parent: i
     lines = [f'{indent}<body name={quoteattr(lk.name)} pos="{_f(pos)}" quat="{_f(_quat(rot))}">',
              f'{indent}  <inertial pos="{_f(mp.com)}" mass="{mp.mass:.17g}" fullinertia="'
              f'{_f([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>']
-    lines += _joint_xml(linkage, joint, layout, centre, axis, indent + "  ")
+    lines += _joint_xml(linkage, joint, layout, centre, axis, indent + "  ", damping)
     ends = [R.T @ (md.joint_centres[0, k] - o) for k in (link, link + 1)]
     if np.linalg.norm(ends[1] - ends[0]) > 1e-9:
         lines.append(f'{indent}  <geom type="capsule" fromto="{_f(ends[0])} {_f(ends[1])}" '
@@ -152,14 +159,14 @@ def _body_xml(linkage: Linkage, md: ModeMotion, link: int, joint: int, parent: i
 
 
 def _chain(linkage: Linkage, md: ModeMotion, steps: list[tuple[int, int]],
-           layout: MjcfLayout) -> list[str]:
+           layout: MjcfLayout, damping: Damping) -> list[str]:
     """Nested bodies for (link, joint) pairs from the world outwards."""
     opened: list[str] = []
     lines: list[str] = []
     parent = None
     for depth, (link, joint) in enumerate(steps):
         indent = "    " + "  " * depth
-        lines += _body_xml(linkage, md, link, joint, parent, layout, indent)
+        lines += _body_xml(linkage, md, link, joint, parent, layout, indent, damping)
         opened.append(indent + "</body>")
         parent = link
     return lines + opened[::-1]
@@ -187,13 +194,23 @@ def _equality(linkage: Linkage, md: ModeMotion, layout: MjcfLayout, solref: tupl
 def mjcf_model(linkage: Linkage, *, start: float = 0.0, mode: int = 0,
                gravity: Array | None = None, timestep: float = DEFAULT_TIMESTEP,
                integrator: str = "RK4", solref: tuple[float, ...] = DEFAULT_SOLREF,
-               solimp: tuple[float, ...] = DEFAULT_SOLIMP) -> str:
+               solimp: tuple[float, ...] = DEFAULT_SOLIMP, friction: Sequence[Any] = ()
+               ) -> str:
     """The MJCF text of ``linkage`` in assembly ``mode`` posed at input ``start`` (module
-    docstring). SI units; ``gravity`` (m/s², world) zero if omitted."""
+    docstring). SI units; ``gravity`` (m/s², world) zero if omitted; ``friction``
+    (:class:`~screwkit.io.drive_table.JointFriction` items) becomes the joints' viscous
+    ``damping`` — MuJoCo's damping of a hinge, slide or ball is exactly this friction (a ball's
+    on its relative angular velocity)."""
     if len(linkage.inputs) != 1:
         raise SimulationError(f"{linkage.name}: MJCF export drives one input; this loop has "
                               f"{list(linkage.inputs)}")
     layout = loop_layout(linkage)
+    damping: Damping = {f.joint: (float(f.rotation), float(f.translation)) for f in friction}
+    cut = linkage.joints[layout.cut].name
+    if any(damping.get(cut, (0.0, 0.0))):
+        raise SimulationError(f"{linkage.name}: joint {cut!r} has friction, but the MJCF model "
+                              "closes the loop there by an equality constraint, which MuJoCo "
+                              "cannot damp; export without its friction")
     md = start_configuration(linkage, start, mode)
     g = np.zeros(3) if gravity is None else np.asarray(gravity, dtype=float)
     n = len(linkage.joints)
@@ -210,8 +227,8 @@ def mjcf_model(linkage: Linkage, *, start: float = 0.0, mode: int = 0,
              '    <flag contact="disable"/>',
              "  </option>",
              "  <worldbody>"]
-    lines += _chain(linkage, md, forward, layout)
-    lines += _chain(linkage, md, backward, layout)
+    lines += _chain(linkage, md, forward, layout, damping)
+    lines += _chain(linkage, md, backward, layout, damping)
     lines += ["  </worldbody>", "  <equality>"]
     lines += _equality(linkage, md, layout, solref, solimp)
     lines += ["  </equality>", "  <actuator>",

@@ -31,7 +31,9 @@ the exact derivative of J's series, so the integrated model conserves its own en
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -94,6 +96,39 @@ def energy_coefficients(linkage: Linkage, mode: ModeMotion,
     return {"inertia": J, "inertia_slope": dJ, "gravity_torque": Qg}
 
 
+def relative_angular_velocity(mode: ModeMotion, joint: int) -> Array:
+    """(N, 3) angular velocity of joint ``joint``'s distal link relative to its proximal one
+    (world frame; the ground is still): joint i joins moving link i − 1 (the ground for the
+    first joint) to moving link i (the ground for the last)."""
+    w = mode.link_angular_velocity
+    links = w.shape[1]
+    distal = w[:, joint] if joint < links else 0.0
+    proximal = w[:, joint - 1] if joint >= 1 else 0.0
+    return np.asarray(distal - proximal, dtype=float) * np.ones((w.shape[0], 3))
+
+
+def sliding_rate(linkage: Linkage, mode: ModeMotion, joint: int) -> Array:
+    """(N,) rate of a P or C joint's sliding freedom (m/s at unit input rate)."""
+    name = f"{linkage.joints[joint].name}.s"
+    return np.asarray(mode.velocities[name], dtype=float)
+
+
+def friction_coefficient(linkage: Linkage, mode: ModeMotion, friction: Sequence[Any]) -> Array:
+    """Exact samples (N,) of B(θ) = Σ_j c_rot,j |ω̂_rel,j|² + c_slide,j ŝ_j² from a mode at unit
+    input rate: viscous joint friction dissipates B θ̇², so its generalised force on the input is
+    −B(θ) θ̇ (N·m·s/rad). ``friction``: :class:`~screwkit.io.drive_table.JointFriction` items."""
+    index = {j.name: i for i, j in enumerate(linkage.joints)}
+    B = np.zeros(mode.link_angular_velocity.shape[0])
+    for f in friction:
+        j = index[f.joint]
+        if f.rotation:
+            w = relative_angular_velocity(mode, j)
+            B += f.rotation * np.einsum("ni,ni->n", w, w)
+        if f.translation:
+            B += f.translation * sliding_rate(linkage, mode, j) ** 2
+    return B
+
+
 @dataclass(frozen=True)
 class FourierSeries:
     """Real periodic functions of θ (period 2π) as truncated Fourier series about ``start``:
@@ -151,7 +186,8 @@ class ReducedModel:
     the grid motion at unit rate (to rebuild the full motion at any simulated speed).
 
     ``coefficients`` rows: ``inertia`` J, ``gravity_torque`` −V′, then the velocity ratios of
-    the freedoms in ``ratio_names`` (dq/dθ, the load's and the frictional joints').
+    the freedoms in ``ratio_names`` (dq/dθ, the load's), then ``friction`` B(θ) when the drive
+    has joint friction (:func:`friction_coefficient`).
     """
 
     linkage: Linkage
@@ -260,14 +296,21 @@ def _solve_grid(linkage: Linkage, grid: Array, mode: int, method: str) -> ModeMo
 def reduced_model(linkage: Linkage, *, mode: int = 0, start: float = 0.0,
                   gravity: ArrayLike | None = None, ratios: tuple[str, ...] = (),
                   samples_per_cycle: int = 72, method: str = "auto",
-                  tolerance: float = FOURIER_TOLERANCE) -> ReducedModel:
+                  tolerance: float = FOURIER_TOLERANCE,
+                  friction: Sequence[Any] = ()) -> ReducedModel:
     """The reduced equation of motion of assembly ``mode`` of a one-input loop whose input
     turns fully (module docstring), on a grid of ``samples_per_cycle``·2^k angles from
-    ``start`` refined until the Fourier series of J, −V′ and the velocity ratios of
-    ``ratios`` (freedom names, dq/dθ) converge to ``tolerance``. SI units."""
+    ``start`` refined until the Fourier series of J, −V′, the velocity ratios of ``ratios``
+    (freedom names, dq/dθ) and, with ``friction`` (JointFriction items), the viscous friction
+    coefficient B(θ) converge to ``tolerance``. SI units."""
     _one_input_crank(linkage)
     _masses(linkage)
     g = np.zeros(3) if gravity is None else np.asarray(gravity, dtype=float)
+    joints = [j.name for j in linkage.joints]
+    for f in friction:
+        if f.joint not in joints:
+            raise SimulationError(f"{linkage.name}: no joint {f.joint!r} for friction; the "
+                                  f"joints are {joints}")
     for name in ratios:
         if name not in linkage.freedom_names:
             raise SimulationError(f"{linkage.name}: no freedom {name!r}; the freedoms are "
@@ -281,9 +324,12 @@ def reduced_model(linkage: Linkage, *, mode: int = 0, start: float = 0.0,
         md = _solve_grid(linkage, grid, mode, method)
         coeff = energy_coefficients(linkage, md, g)
         rows = ("inertia", "gravity_torque", *ratios)
-        data = np.stack([coeff["inertia"], coeff["gravity_torque"],
-                         *[md.velocities[r] for r in ratios]])
-        series, converged = fit_fourier(start, data, tolerance)
+        data = [coeff["inertia"], coeff["gravity_torque"], *[md.velocities[r] for r in ratios]]
+        if friction:
+            rows += ("friction",)
+            coeff["friction"] = friction_coefficient(linkage, md, friction)
+            data.append(coeff["friction"])
+        series, converged = fit_fourier(start, np.stack(data), tolerance)
         if converged or 2 * n > MAX_GRID:
             break
     slope = series(grid, 1)[0]

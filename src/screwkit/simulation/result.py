@@ -57,7 +57,8 @@ class Simulation:
     @cached_property
     def cycle_statistics(self) -> dict[str, Array]:
         """Per completed cycle (C,): ``period`` (s), ``mean_speed``, ``min_speed``,
-        ``max_speed`` (rad/s), ``fluctuation`` C_s, ``motor_work``, ``load_work`` (J),
+        ``max_speed`` (rad/s), ``fluctuation`` C_s, ``motor_work``, ``load_work``,
+        ``friction_work`` (J; the joint friction's, ≤ 0),
         ``motor_torque_rms`` (time RMS), ``motor_torque_peak`` (N·m)."""
         r = self.run
         period = np.diff(r.cycle_times)
@@ -69,6 +70,7 @@ class Simulation:
         return {"period": period, "mean_speed": mean, "min_speed": lo, "max_speed": hi,
                 "fluctuation": (hi - lo) / mean if period.size else np.zeros(0),
                 "motor_work": r.cycle_work["motor"], "load_work": r.cycle_work["load"],
+                "friction_work": r.cycle_work["friction"],
                 "motor_torque_rms": np.sqrt(r.torque_square / period) if period.size
                 else np.zeros(0),
                 "motor_torque_peak": tau.max(axis=1) if r.cycles else np.zeros(0)}
@@ -90,7 +92,8 @@ class Simulation:
         """The reported samples (M = cycles × samples_per_cycle,), in time order: ``time``,
         ``angle`` (unwrapped, rad), ``cycle_angle`` (from the start of its cycle),
         ``speed``, ``acceleration``, ``motor_torque``, ``output_force`` (Q_out on the load
-        freedom), ``load_torque`` (Q_load on the input), ``gravity_torque``,
+        freedom), ``load_torque`` (Q_load on the input), ``friction_torque`` (−B θ̇, the joint
+        friction on the input), ``gravity_torque``,
         ``kinetic_energy`` (loop + flywheel), ``index`` (grid sample)."""
         r = self.run
         step = self.sample_step
@@ -104,20 +107,22 @@ class Simulation:
                - TWO_PI * np.arange(r.cycles)[:, None], "speed": speed,
                "acceleration": r.acceleration[sel], "motor_torque": terms["motor"],
                "output_force": terms["output_force"], "load_torque": terms["load"],
-               "gravity_torque": terms["gravity"], "kinetic_energy": 0.5 * J * speed ** 2,
-               "index": idx}
+               "friction_torque": terms["friction"], "gravity_torque": terms["gravity"],
+               "kinetic_energy": 0.5 * J * speed ** 2, "index": idx}
         return {k: np.asarray(v).ravel() for k, v in out.items()}
 
     @cached_property
     def loads(self) -> Dynamics:
         """Every load of the loop at the reported samples (inverse dynamics at the simulated
-        speed and acceleration, with gravity and the output load; simulation.reactions)."""
+        speed and acceleration, with gravity, the output load and the joint friction;
+        simulation.reactions)."""
         s = self.samples
         load = self.eom.drive.load
         dyn, _ = loop_loads(self.eom.model, s["index"], s["speed"], s["acceleration"],
                             gravity=self.eom.model.gravity,
                             load_freedom=None if load is None else load.freedom,
-                            output_force=s["output_force"], inputs=s["angle"][:, None])
+                            output_force=s["output_force"], inputs=s["angle"][:, None],
+                            friction=self.eom.drive.friction)
         return dyn
 
     def shaft_torque_check(self) -> float:

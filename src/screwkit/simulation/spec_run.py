@@ -37,7 +37,10 @@ class SpecSimulation:
                       "flywheel": d.flywheel, "initial_speed": d.initial_speed,
                       "cycles": d.cycles, "samples_per_cycle": d.samples_per_cycle,
                       "rtol": d.rtol, "atol": d.atol, "gravity": d.gravity,
-                      "max_time": d.max_time},
+                      "max_time": d.max_time,
+                      "friction": {f.joint: {"rotation": f.rotation,
+                                             "translation": f.translation}
+                                   for f in d.friction}},
             **self.simulation.as_dict(loads=loads),
         }
         if self.sizing is not None:

@@ -14,7 +14,7 @@ from screwkit.tables import Column, ResultTable, vector_columns
 SAMPLE_COLUMNS = (("time", "s"), ("angle", "rad"), ("cycle_angle", "rad"), ("speed", "rad/s"),
                   ("acceleration", "rad/s^2"), ("motor_torque", "N*m"),
                   ("output_force", "N*m or N"), ("load_torque", "N*m"),
-                  ("gravity_torque", "N*m"), ("kinetic_energy", "J"))
+                  ("friction_torque", "N*m"), ("gravity_torque", "N*m"), ("kinetic_energy", "J"))
 
 
 def simulation_table(sim: Simulation) -> ResultTable:
@@ -30,7 +30,7 @@ def simulation_table(sim: Simulation) -> ResultTable:
     kinds = {"time": "time", "angle": "angle", "cycle_angle": "angle",
              "speed": "angular_velocity", "acceleration": "angular_acceleration",
              "motor_torque": "moment", "output_force": output_kind, "load_torque": "moment",
-             "gravity_torque": "moment", "kinetic_energy": "energy"}
+             "friction_torque": "moment", "gravity_torque": "moment", "kinetic_energy": "energy"}
     cols = [Column(k, kinds[k], np.asarray(s[k])) for k, _ in SAMPLE_COLUMNS]
     if sim.run.cycles:
         dyn = sim.loads
