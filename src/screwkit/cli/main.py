@@ -22,6 +22,8 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    # help texts are plain text: "[drive]" is a spec table, not rich markup (which would eat it)
+    rich_markup_mode=None,
 )
 
 
