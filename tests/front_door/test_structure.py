@@ -115,3 +115,25 @@ def test_user_errors_are_screwkit_errors():
                                                             "KeyError"):
                     bad.append(f"{path.relative_to(SRC)}:{node.lineno} raises {exc.id}")
     assert not bad, "raise the screwkit.errors classes instead:\n" + "\n".join(bad)
+
+
+def test_every_exception_class_is_a_screwkit_error():
+    """Every public exception class screwkit defines derives from ScrewkitError, so one
+    ``except`` catches every user mistake (docs/reliability.md); private ones (``_TimeUp``)
+    are control flow that never leaves its module."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    import screwkit
+    from screwkit.errors import ScrewkitError
+
+    bad = []
+    for info in pkgutil.walk_packages(screwkit.__path__, "screwkit."):
+        module = importlib.import_module(info.name)
+        for name, obj in vars(module).items():
+            if (inspect.isclass(obj) and issubclass(obj, BaseException)
+                    and obj.__module__ == info.name and not name.startswith("_")
+                    and not issubclass(obj, ScrewkitError)):
+                bad.append(f"{info.name}.{name}")
+    assert not bad, "exception classes outside the ScrewkitError hierarchy: " + ", ".join(bad)

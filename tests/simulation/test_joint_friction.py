@@ -207,3 +207,41 @@ def test_mjcf_export_refuses_friction_at_the_cut_joint(tmp_path):
     r = CliRunner().invoke(app, ["export-mjcf", str(spec), "-o", str(tmp_path / "m.xml")])
     assert r.exit_code == 2 and "equality constraint" in " ".join(r.output.split()), r.output
     assert not (tmp_path / "m.xml").exists()
+
+
+def test_api_friction_is_checked_and_repeated_entries_add_up(rsrc):
+    """The Python API applies the spec's rules (one function, io.drive_table.friction_problem)
+    and merges repeated entries for a joint: a C joint's two parts given separately, or one
+    coefficient split in two, give the same loads as one entry."""
+    from screwkit.simulation.reduced import SimulationError
+
+    lk = rsrc.linkage
+    split = [JointFriction("coupler_R", 0.03), JointFriction("output_C", 0.03, 0.0),
+             JointFriction("coupler_R", 0.02), JointFriction("output_C", 0.0, 4.0)]
+    whole = [JointFriction("coupler_R", 0.05), JointFriction("output_C", 0.03, 4.0)]
+    model = equation_of_motion(lk, drive(whole), start=float(rsrc.inputs[0])).model
+    idx = np.arange(0, model.grid.size, 6)
+    speed, acc = np.full(idx.size, 9.0), np.linspace(-20, 20, idx.size)
+    a, _ = loop_loads(model, idx, speed, acc, friction=split)
+    b, _ = loop_loads(model, idx, speed, acc, friction=whole)
+    for name in b.reactions:
+        np.testing.assert_allclose(a.reactions[name].moment, b.reactions[name].moment,
+                                   rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(a.reactions[name].force, b.reactions[name].force,
+                                   rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(a.shaking_moment, b.shaking_moment, rtol=1e-12, atol=1e-12)
+    split_model = equation_of_motion(lk, drive(split), start=float(rsrc.inputs[0])).model
+    np.testing.assert_allclose(split_model.samples["friction"], model.samples["friction"],
+                               rtol=1e-14)
+    cssp = sk.load_spec(EXAMPLES / "rahman_cssp.toml").linkage
+    for bad, fragment in ((JointFriction("pin", 0.01), "spin"),
+                          (JointFriction("crank", -0.01), ">= 0"),
+                          (JointFriction("slider", 0.01), "does not turn"),
+                          (JointFriction("crank", 0.0, 1.0), "does not slide"),
+                          (JointFriction("nowhere", 0.01), "no joint")):
+        with pytest.raises(SimulationError, match=fragment):
+            equation_of_motion(cssp, drive([bad]))
+        with pytest.raises(sk.ScrewkitError, match=fragment):
+            from screwkit.simulation.mjcf import mjcf_model
+
+            mjcf_model(cssp, friction=[bad])

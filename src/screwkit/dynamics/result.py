@@ -104,7 +104,10 @@ class Dynamics:
         ``Reaction.point`` (N, 3).
     efforts:
         ``{driven freedom: (N,)}``: torque (N·m) of a driven rotation, force (N) of a driven
-        translation, exerted by the proximal link on the distal link along the freedom.
+        translation, exerted by the proximal link on the distal link along the freedom — the
+        actuator's. With viscous friction in the driven joint (a simulation's
+        ``[drive.friction]``) the joint's reaction along the freedom is the actuator's effort
+        plus the friction's (docs/simulation.md).
     residual:
         (N,) unbalanced generalised force along idle passive freedoms (N, moments divided by the
         length scale), zero when the joint model can carry every link load.

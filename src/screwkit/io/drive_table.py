@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Literal
 
+import numpy as np
 from pydantic import (
     BaseModel,
     ConfigDict,
@@ -217,20 +218,60 @@ _ROTATING = frozenset("RCHUS")
 _SLIDING = frozenset("PC")
 
 
+def friction_problem(linkage: Any, joint: str, rotation: bool, translation: bool
+                     ) -> tuple[str, str] | None:
+    """Why friction with a rotational (``rotation``) and/or translational part cannot be put
+    in ``joint`` of ``linkage``, as (which part: ``""``, ``"rotation"``, ``"translation"``,
+    the reason); None when it can. One rule for spec files and the Python API."""
+    joints = {j.name: j for j in linkage.joints}
+    if joint not in joints:
+        return "", f"no joint {joint!r}; the joints are {list(joints)}"
+    kind = joints[joint].kind
+    rods = {linkage.joints[k].name: linkage.links[i].name
+            for i in spin_links(linkage) for k in (i, i + 1)}
+    if rotation and joint in rods:
+        return "", (f"{joint!r} is a ball joint of the rod {rods[joint]!r}, which lies between "
+                    "two ball joints: its spin about its own axis is free and screwkit holds it "
+                    "at zero (docs/kinematics.md), so friction there, which would drive that "
+                    "spin, is not modelled; put friction on the other joints")
+    if rotation and kind not in _ROTATING:
+        return "rotation", f"{joint!r} is a {kind} joint: it does not turn"
+    if translation and kind not in _SLIDING:
+        return "translation", (f"{joint!r} is a {kind} joint: it does not slide (a helical "
+                               "joint's friction is on its rotation)")
+    return None
+
+
+def checked_friction(linkage: Any, friction: Any) -> tuple[JointFriction, ...]:
+    """``friction`` (JointFriction items) checked against ``linkage`` — finite, >= 0, each
+    part in a joint that has it (:func:`friction_problem`) — and merged by joint (the
+    coefficients of repeated entries add), in joint order. Raises :class:`DriveConfigError`."""
+    merged: dict[str, list[float]] = {}
+    for f in friction:
+        c = [float(f.rotation), float(f.translation)]
+        if not all(np.isfinite(c)) or min(c) < 0:
+            raise DriveConfigError(f"friction in joint {f.joint!r}: a viscous friction "
+                                   f"coefficient is finite and >= 0; got {c}")
+        problem = friction_problem(linkage, f.joint, c[0] > 0, c[1] > 0)
+        if problem is not None:
+            raise DriveConfigError(f"friction in joint {f.joint!r}: {problem[1]}")
+        total = merged.setdefault(f.joint, [0.0, 0.0])
+        total[0] += c[0]
+        total[1] += c[1]
+    order = [j.name for j in linkage.joints]
+    return tuple(JointFriction(name, *merged[name]) for name in order if name in merged)
+
+
 def _friction(spec: Any, table: dict[str, Any] | None) -> tuple[JointFriction, ...]:
     """``[drive.friction]``: joint name -> a viscous coefficient (rotational for R, H, U, S;
     translational for P) or ``{ rotation = …, translation = … }`` (a C joint has both)."""
     if not table:
         return ()
-    lk = spec.linkage
-    joints = {j.name: j for j in lk.joints}
-    rod_balls = {lk.joints[k].name: lk.links[i].name for i in spin_links(lk) for k in (i, i + 1)}
+    joints = {j.name: j for j in spec.linkage.joints}
     out = []
     for name, value in table.items():
         key = f"friction.{name}"
-        if name not in joints:
-            _fail(spec, key, f"no joint {name!r}; the joints are {list(joints)}")
-        kind = joints[name].kind
+        kind = joints[name].kind if name in joints else ""
         if isinstance(value, FrictionTable):
             rotation, translation = value.rotation, value.translation
             if rotation is None and translation is None:
@@ -242,17 +283,10 @@ def _friction(spec: Any, table: dict[str, Any] | None) -> tuple[JointFriction, .
             rotation, translation = None, value
         else:
             rotation, translation = value, None
-        if rotation is not None and name in rod_balls:
-            _fail(spec, key, f"{name!r} is a ball joint of the rod {rod_balls[name]!r}, which "
-                             "lies between two ball joints: its spin about its own axis is free "
-                             "and screwkit holds it at zero (docs/kinematics.md), so friction "
-                             "there, which would drive that spin, is not modelled; put friction "
-                             "on the other joints")
-        if rotation is not None and kind not in _ROTATING:
-            _fail(spec, f"{key}.rotation", f"{name!r} is a {kind} joint: it does not turn")
-        if translation is not None and kind not in _SLIDING:
-            _fail(spec, f"{key}.translation", f"{name!r} is a {kind} joint: it does not slide "
-                                              "(a helical joint's friction is on its rotation)")
+        problem = friction_problem(spec.linkage, name, rotation is not None,
+                                   translation is not None)
+        if problem is not None:
+            _fail(spec, f"{key}.{problem[0]}" if problem[0] else key, problem[1])
         c_r = 0.0 if rotation is None else _si(spec, rotation, "rotational_damping", key)
         c_t = 0.0 if translation is None else _si(spec, translation, "translational_damping",
                                                   key)

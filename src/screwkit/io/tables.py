@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.io.outputs import atomic_path
 from screwkit.tables import Column, ResultTable, UnitChoice
 
@@ -24,7 +25,7 @@ FORMATS = {".json": "json", ".csv": "csv", ".parquet": "parquet", ".npz": "npz"}
 TABLE_FORMATS = ("csv", "parquet", "npz")
 
 
-class OutputFormatError(ValueError):
+class OutputFormatError(InputError):
     """An output whose extension names no format the command writes."""
 
 

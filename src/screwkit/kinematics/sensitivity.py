@@ -24,12 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import InputError
 from screwkit.kinematics.loop import Array, forward, layout
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
 
 
-class SensitivityError(ValueError):
+class SensitivityError(InputError):
     """A parameter whose sensitivity cannot be computed (the message says why)."""
 
 

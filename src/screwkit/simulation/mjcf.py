@@ -40,7 +40,7 @@ from scipy.spatial.transform import Rotation
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.model.linkage import Linkage
-from screwkit.simulation.reduced import Array, SimulationError
+from screwkit.simulation.reduced import Array, SimulationError, joint_friction
 
 #: equality-constraint defaults: a time constant of 20 time steps and an impedance at MuJoCo's
 #: ceiling (hard constraints); validation/mujoco/crosscheck.md justifies them
@@ -205,7 +205,8 @@ def mjcf_model(linkage: Linkage, *, start: float = 0.0, mode: int = 0,
         raise SimulationError(f"{linkage.name}: MJCF export drives one input; this loop has "
                               f"{list(linkage.inputs)}")
     layout = loop_layout(linkage)
-    damping: Damping = {f.joint: (float(f.rotation), float(f.translation)) for f in friction}
+    damping: Damping = {f.joint: (float(f.rotation), float(f.translation))
+                        for f in joint_friction(linkage, friction)}
     cut = linkage.joints[layout.cut].name
     if any(damping.get(cut, (0.0, 0.0))):
         raise SimulationError(f"{linkage.name}: joint {cut!r} has friction, but the MJCF model "

@@ -40,6 +40,7 @@ from screwkit.kinematics.motion import ModeMotion
 from screwkit.simulation.reduced import (
     Array,
     ReducedModel,
+    joint_friction,
     relative_angular_velocity,
     sliding_rate,
 )
@@ -138,7 +139,9 @@ class FrictionWrenches:
 
 def friction_wrenches(linkage: Any, mode: ModeMotion, friction: Sequence[Any]
                       ) -> FrictionWrenches:
-    """Per-sample friction wrenches of ``friction`` on ``mode`` (module docstring)."""
+    """Per-sample friction wrenches of ``friction`` on ``mode`` (module docstring); repeated
+    entries for one joint add up."""
+    friction = joint_friction(linkage, friction)
     index = {j.name: i for i, j in enumerate(linkage.joints)}
     names = [link.name for link in linkage.links]
     n = mode.link_origin.shape[0]

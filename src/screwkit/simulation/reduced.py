@@ -39,6 +39,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dual.spatial import cross
+from screwkit.errors import InputError
+from screwkit.io.drive_table import DriveConfigError, checked_friction
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.model.linkage import Linkage
@@ -53,7 +55,7 @@ FOURIER_TOLERANCE = 1e-12
 MAX_GRID = 9216
 
 
-class SimulationError(ValueError):
+class SimulationError(InputError):
     """A simulation that cannot run as asked; the message says why and how to fix it."""
 
 
@@ -113,13 +115,23 @@ def sliding_rate(linkage: Linkage, mode: ModeMotion, joint: int) -> Array:
     return np.asarray(mode.velocities[name], dtype=float)
 
 
+def joint_friction(linkage: Linkage, friction: Sequence[Any]) -> tuple[Any, ...]:
+    """``friction`` (JointFriction items) checked against the loop and merged by joint
+    (:func:`~screwkit.io.drive_table.checked_friction`); a :class:`SimulationError` says what
+    is wrong."""
+    try:
+        return checked_friction(linkage, friction)
+    except DriveConfigError as exc:
+        raise SimulationError(f"{linkage.name}: {exc}") from None
+
+
 def friction_coefficient(linkage: Linkage, mode: ModeMotion, friction: Sequence[Any]) -> Array:
     """Exact samples (N,) of B(θ) = Σ_j c_rot,j |ω̂_rel,j|² + c_slide,j ŝ_j² from a mode at unit
     input rate: viscous joint friction dissipates B θ̇², so its generalised force on the input is
     −B(θ) θ̇ (N·m·s/rad). ``friction``: :class:`~screwkit.io.drive_table.JointFriction` items."""
     index = {j.name: i for i, j in enumerate(linkage.joints)}
     B = np.zeros(mode.link_angular_velocity.shape[0])
-    for f in friction:
+    for f in joint_friction(linkage, friction):
         j = index[f.joint]
         if f.rotation:
             w = relative_angular_velocity(mode, j)
@@ -306,11 +318,7 @@ def reduced_model(linkage: Linkage, *, mode: int = 0, start: float = 0.0,
     _one_input_crank(linkage)
     _masses(linkage)
     g = np.zeros(3) if gravity is None else np.asarray(gravity, dtype=float)
-    joints = [j.name for j in linkage.joints]
-    for f in friction:
-        if f.joint not in joints:
-            raise SimulationError(f"{linkage.name}: no joint {f.joint!r} for friction; the "
-                                  f"joints are {joints}")
+    friction = joint_friction(linkage, friction)
     for name in ratios:
         if name not in linkage.freedom_names:
             raise SimulationError(f"{linkage.name}: no freedom {name!r}; the freedoms are "

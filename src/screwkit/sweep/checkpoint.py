@@ -17,12 +17,13 @@ from pathlib import Path
 from typing import Any
 
 from screwkit import __version__
+from screwkit.errors import InputError
 from screwkit.io.outputs import write_text_atomic
 
 Row = dict[str, Any]
 
 
-class CheckpointError(ValueError):
+class CheckpointError(InputError):
     """A checkpoint that cannot be used for this sweep (the message says what to do)."""
 
 

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.io.quantity import QuantitySyntaxError, parse_quantity
 from screwkit.io.spec import Spec
 from screwkit.sweep.keys import SpecKey, SpecKeyError, spec_key, unit_of
@@ -26,7 +27,7 @@ from screwkit.sweep.keys import SpecKey, SpecKeyError, spec_key, unit_of
 MAX_DESIGNS = 10_000_000
 
 
-class DesignError(ValueError):
+class DesignError(InputError):
     """A ``--vary`` or ``--sample`` that cannot be read; the message shows the right form."""
 
 

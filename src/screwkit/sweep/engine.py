@@ -20,11 +20,13 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
+from screwkit.errors import InputError
+
 #: environment variable naming an existing scheduler
 SCHEDULER_ENV = "SCREWKIT_SCHEDULER"
 
 
-class EngineError(ValueError):
+class EngineError(InputError):
     """The engine cannot start (Dask missing, a scheduler that does not answer …)."""
 
 

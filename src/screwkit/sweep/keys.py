@@ -17,6 +17,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
+from screwkit.errors import InputError
 from screwkit.io.quantity import QuantitySyntaxError, parse_quantity
 from screwkit.io.spec import Spec
 from screwkit.io.units import SI_SYMBOL, UnitError, check_unit
@@ -28,7 +29,7 @@ _SEGMENT = re.compile(r"([A-Za-z_][A-Za-z0-9_\-]*)((?:\[\d+\])*)")
 _INDEX = re.compile(r"\[(\d+)\]")
 
 
-class SpecKeyError(ValueError):
+class SpecKeyError(InputError):
     """A key path that does not name a value of the spec (the message says which part)."""
 
 

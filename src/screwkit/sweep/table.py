@@ -19,6 +19,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
+from screwkit.errors import InputError
 from screwkit.io.outputs import atomic_path, write_text_atomic
 
 Row = dict[str, Any]
@@ -26,7 +27,7 @@ Row = dict[str, Any]
 FORMATS = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv"}
 
 
-class TableError(ValueError):
+class TableError(InputError):
     """A table that cannot be written as asked."""
 
 

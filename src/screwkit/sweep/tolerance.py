@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import InputError
 from screwkit.io.quantity import QuantitySyntaxError, parse_quantity
 from screwkit.io.spec import Spec, spec_from_data
 from screwkit.kinematics.loop import Array
@@ -36,7 +37,7 @@ from screwkit.sweep.keys import SpecKey, SpecKeyError, spec_key, unit_of, with_v
 _PLUS_MINUS = re.compile(r"^\s*(?:±|\+-|\+/-)\s*")
 
 
-class ToleranceError(ValueError):
+class ToleranceError(InputError):
     """A ``--tol`` that cannot be used; the message shows the right form."""
 
 
