@@ -106,3 +106,25 @@ def test_every_command_fits_80_columns_in_a_long_working_directory(tmp_path):
         assert res["code"] == 2, (name, res)
         assert any(missing in line for line in res["stderr"].splitlines()), (name, res)
         assert "Traceback" not in res["stderr"]
+
+
+def test_continued_tables_name_their_own_columns():
+    import io
+    import re
+
+    from rich.console import Console
+
+    from screwkit.cli.formatting import TextColumn, print_columns
+
+    out = io.StringIO()
+    console = Console(file=out, width=40, color_system=None)
+    cols = [TextColumn("key", ["1", "2"])] + [TextColumn(f"column{i}", ["123456", "7"])
+                                              for i in range(2, 11)]
+    print_columns(console, "t", cols, width=40)
+    ranges = [(int(a), int(b), int(n)) for a, b, n in
+              re.findall(r"columns (\d+)–(\d+) of (\d+)", out.getvalue())]
+    assert ranges and all(n == 10 for *_, n in ranges)
+    starts = [a for a, _, _ in ranges]
+    ends = [b for _, b, _ in ranges]
+    pairs = list(zip(ends[:-1], starts[1:], strict=True))
+    assert ends[-1] == 10 and all(a2 == b + 1 for b, a2 in pairs)  # no overlap, no gap

@@ -45,6 +45,7 @@ def test_report_mp4_needs_ffmpeg(tmp_path: Path) -> None:
         assert r.exit_code == 0 and mp4.stat().st_size > 0
     else:
         assert r.exit_code == 2 and "ffmpeg" in r.output and not mp4.exists()
+        assert not any(tmp_path.glob("*.html"))  # the report is not written either
 
 
 def test_report_bad_options_are_clear_errors(tmp_path: Path) -> None:
@@ -56,9 +57,11 @@ def test_report_bad_options_are_clear_errors(tmp_path: Path) -> None:
     r = runner.invoke(app, ["report", spec, "-o", str(tmp_path / "r.html"), "--plot",
                             str(tmp_path / "v.png"), "--frame", "99"])
     assert r.exit_code == 2 and "9 frames" in r.output and not (tmp_path / "v.png").exists()
+    assert not (tmp_path / "r.html").exists()  # refused before anything is written
     r = runner.invoke(app, ["report", spec, "-o", str(tmp_path / "r.html"), "--plot",
                             str(tmp_path / "v.png"), "--mode", "5"])
     assert r.exit_code == 2 and "2 assembly mode(s)" in r.output
+    assert not (tmp_path / "r.html").exists()
     r = runner.invoke(app, ["report", str(tmp_path / "missing.toml")])
     assert r.exit_code == 2 and "no such spec file" in r.output
 

@@ -160,3 +160,17 @@ def test_tolerance_command_on_the_embedded_cluster(tmp_path):
                              "--workers", "0", "--json"])
     assert json.loads(r2.stdout)["monte_carlo"] == doc["monte_carlo"]
     assert Path(out).read_text().count("NaN") == 0
+
+
+def test_tolerance_tables_are_in_the_spec_units():
+    """An inch spec gives its stack-ups in inches (and deg); the JSON stays SI."""
+    spec = str(EXAMPLES / "bagci_fig7_rsrc.toml")
+    args = ["tolerance", spec, "--tol", "d2=±0.01in", "--monte-carlo", "0"]
+    doc = json.loads(runner.invoke(app, [*args, "--json"]).stdout)
+    r = runner.invoke(app, args, env={"COLUMNS": "200"})
+    assert r.exit_code == 0, r.output
+    assert "lengths in in" in r.output
+    s_row = next(row for row in doc["summary"] if row["output"] == "S")
+    shown = next(line for line in r.output.splitlines() if line.strip("│ ").startswith("S "))
+    value = float(shown.split("│")[2])
+    assert value == pytest.approx(s_row["max_worst_case"] / 0.0254, rel=1e-4)

@@ -79,7 +79,8 @@ def print_columns(console: Console, title: str, columns: Sequence[TextColumn], *
     n = len(columns)
     for k, group in enumerate(groups):
         shown = list(range(key)) + group
-        t_title = title if k == 0 else f"{title} (continued: columns {group[0] + 1}–{n})"
+        t_title = title if k == 0 else (f"{title} (continued: columns {group[0] + 1}–"
+                                        f"{group[-1] + 1} of {n})")
         t = Table(title=Text(t_title), box=box.HEAVY_HEAD, title_justify="left",
                   padding=(0, 1))
         for i in shown:

@@ -58,18 +58,30 @@ def register(app: typer.Typer) -> None:
         s = _guard(lambda: load_spec(spec))
         out = output if output is not None else Path(f"{spec.stem}.html")
         scene = _guard(lambda: spec_scene(s, gravity=gravity))
-        page = render_report_html(scene)
-        _guard(lambda: write_atomic(out, page))
-        n_modes = len(scene["modes"])
-        console.print(f"wrote {escape(str(out))} ({len(page.encode()) / 1e6:.2f} MB; "
-                      f"{len(scene['input']['values'])} frames, {n_modes} assembly mode(s))",
-                      highlight=False)
         if plots:
-            from screwkit.report.animation import render_animation, render_still
+            from screwkit.report.animation import check_plots
 
-            for p in plots:
-                if p.suffix.lower() in ANIMATION_SUFFIXES:
-                    _guard(lambda p=p: render_animation(scene, p, mode=mode))  # type: ignore[misc]
-                else:
-                    _guard(lambda p=p: render_still(scene, p, mode=mode, frame=frame))  # type: ignore[misc]
-                console.print(f"wrote {escape(str(p))}", highlight=False)
+            _guard(lambda: check_plots(scene, plots, mode=mode, frame=frame))
+        page = render_report_html(scene)
+        written: list[Path] = []
+        try:
+            _guard(lambda: write_atomic(out, page))
+            written.append(out)
+            n_modes = len(scene["modes"])
+            console.print(f"wrote {escape(str(out))} ({len(page.encode()) / 1e6:.2f} MB; "
+                          f"{len(scene['input']['values'])} frames, {n_modes} assembly "
+                          "mode(s))", highlight=False)
+            if plots:
+                from screwkit.report.animation import render_animation, render_still
+
+                for p in plots:
+                    if p.suffix.lower() in ANIMATION_SUFFIXES:
+                        _guard(lambda p=p: render_animation(scene, p, mode=mode))  # type: ignore[misc]
+                    else:
+                        _guard(lambda p=p: render_still(scene, p, mode=mode, frame=frame))  # type: ignore[misc]
+                    written.append(p)
+                    console.print(f"wrote {escape(str(p))}", highlight=False)
+        except BaseException:
+            for path in written:  # a failed run leaves no file behind (docs/cli.md)
+                path.unlink(missing_ok=True)
+            raise

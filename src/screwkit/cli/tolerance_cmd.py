@@ -5,7 +5,6 @@ over the cycle, worst-case and RSS stack-ups, and a Monte Carlo check on the swe
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -14,7 +13,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from screwkit.cli.common import console, err_console, guard
-from screwkit.cli.outputs import JsonOpt, OutputOpt, Outputs
+from screwkit.cli.outputs import JsonOpt, Outputs, UnitOpt, UnitsOpt
 from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for, progress_bar
 
 
@@ -22,21 +21,29 @@ def _is_angle(freedom: str) -> bool:
     return not freedom.endswith(".s")
 
 
-def _show(value: float, angle: bool) -> str:
-    return f"{math.degrees(value):.5g}" if angle else f"{value:.5g}"
+def _kind(angle: bool) -> str:
+    return "angle" if angle else "length"
 
 
-def _tables(doc: dict[str, Any], description: str) -> None:
+def _show(units: Any, value: float, angle: bool) -> str:
+    return f"{units.show(_kind(angle), value):.5g}"
+
+
+def _tables(doc: dict[str, Any], description: str, units: Any, input_is_angle: bool) -> None:
     console.print(f"[bold]{escape(description)}[/]", highlight=False)
-    console.print(f"assembly mode {doc['mode']}; {doc['convention']}; angles in deg, lengths "
-                  "in m", highlight=False)
+    console.print(f"assembly mode {doc['mode']}; {doc['convention']}; angles in "
+                  f"{units.pretty('angle')}, lengths in {units.pretty('length')}",
+                  highlight=False)
     t = Table(title="stack-ups: the largest deviation over the cycle")
     for col in ("output", "worst case ±", "RSS ±", "at input", "dominant tolerance"):
         t.add_column(col, justify="right")
+    input_kind = _kind(input_is_angle)
     for row in doc["summary"]:
         angle = _is_angle(doc["outputs"][row["output"]]["joint_freedom"])
-        t.add_row(row["output"], _show(row["max_worst_case"], angle), _show(row["max_rss"], angle),
-                  f"{math.degrees(row['at_input']):.4g} deg", row["dominant"])
+        t.add_row(row["output"], _show(units, row["max_worst_case"], angle),
+                  _show(units, row["max_rss"], angle),
+                  f"{units.show(input_kind, row['at_input']):.4g} {units.pretty(input_kind)}",
+                  row["dominant"])
     console.print(t)
     mc = doc["monte_carlo"]
     if mc is None:
@@ -56,7 +63,8 @@ def _tables(doc: dict[str, Any], description: str) -> None:
         f"the first-order result {verdict}", highlight=False)
 
 
-def _plot(doc: dict[str, Any], path: Path, inputs: list[Path]) -> None:
+def _plot(doc: dict[str, Any], path: Path, inputs: list[Path], units: Any,
+          input_is_angle: bool) -> None:
     import matplotlib
     import numpy as np
 
@@ -68,10 +76,12 @@ def _plot(doc: dict[str, Any], path: Path, inputs: list[Path]) -> None:
     outs = list(doc["outputs"])
     fig, axes = plt.subplots(len(outs), 1, figsize=(7, 2.6 * len(outs)), sharex=True,
                              squeeze=False)
-    x = np.degrees(np.asarray(doc["input"], dtype=float))
+    input_kind = _kind(input_is_angle)
+    x = np.asarray(doc["input"], dtype=float) * units.show(input_kind, 1.0)
     for ax, name in zip(axes[:, 0], outs, strict=True):
         o = doc["outputs"][name]
-        scale = np.degrees(1.0) if _is_angle(o["joint_freedom"]) else 1.0
+        kind = _kind(_is_angle(o["joint_freedom"]))
+        scale = units.show(kind, 1.0)
         wc, rss = np.asarray(o["worst_case"]) * scale, np.asarray(o["rss"]) * scale
         ax.fill_between(x, -wc, wc, color="tab:orange", alpha=0.25, label="worst case")
         ax.plot(x, rss, "-", color="tab:blue", label="RSS (3σ)")
@@ -79,10 +89,10 @@ def _plot(doc: dict[str, Any], path: Path, inputs: list[Path]) -> None:
         if doc["monte_carlo"] is not None:
             sd = 3 * np.asarray(doc["monte_carlo"]["std"][name], dtype=float) * scale
             ax.plot(x, sd, ".", color="k", ms=3, label="Monte Carlo 3σ")
-        ax.set_ylabel(f"Δ{name} ({'deg' if scale != 1.0 else 'm'})")
+        ax.set_ylabel(f"Δ{name} ({units.pretty(kind)})")
         ax.grid(alpha=0.3)
     axes[0, 0].legend(fontsize=8)
-    axes[-1, 0].set_xlabel("input (deg)")
+    axes[-1, 0].set_xlabel(f"input ({units.pretty(input_kind)})")
     fig.suptitle(f"{doc['mechanism']}: tolerance stack-up", fontsize=10)
     with atomic_path(path, inputs, "--plot") as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
@@ -99,7 +109,9 @@ def register(app: typer.Typer) -> None:
         monte_carlo: Annotated[int, typer.Option("--monte-carlo", min=0, max=1_000_000, help="Monte Carlo designs checking the first-order result on the sweep engine (0: none).")] = 1000,
         seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the Monte Carlo draw.")] = 0,
         as_json: JsonOpt = False,
-        output: OutputOpt = None,
+        output: Annotated[Path | None, typer.Option("--output", "-o", help="Write the JSON document (SI units) to this file (atomically) and print one line.")] = None,
+        units: UnitsOpt = "spec",
+        unit: UnitOpt = None,
         plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of the stack-ups over the cycle.")] = None,
         scheduler: SchedulerOpt = None,
         workers: WorkersOpt = None,
@@ -111,7 +123,7 @@ def register(app: typer.Typer) -> None:
         from screwkit.sweep.tolerance import first_order, make_tolerances, tolerance_document
 
         out = Outputs.prepare([spec], as_json=as_json, output=output, files={"--plot": plot},
-                              formats=("json",))
+                              formats=("json",), units=units, unit=unit)
         data, s = guard(lambda: read_spec_tables(spec))
         tolerances = guard(lambda: make_tolerances(data, s, tol))
         pipe = Pipeline(s)
@@ -129,7 +141,9 @@ def register(app: typer.Typer) -> None:
                 raise typer.Exit(130) from None
             mc = compare(fo, tolerances, deviations, seed)
         doc = tolerance_document(spec, s, tolerances, fo, mc)
+        du = out.units_for(s.units)
         if plot is not None:
-            guard(lambda: _plot(doc, plot, [spec]))
+            guard(lambda: _plot(doc, plot, [spec], du, s.input_is_angle))
             out.note_written(plot)
-        out.deliver(document=lambda: doc, table=None, show=lambda: _tables(doc, s.describe()))
+        out.deliver(document=lambda: doc, table=None,
+                    show=lambda: _tables(doc, s.describe(du), du, s.input_is_angle))

@@ -36,6 +36,21 @@ def _check(scene: dict[str, Any], mode: int, frame: int | None = None) -> None:
         raise InputError(f"--frame {frame}: the sweep has {n} frames (0…{n - 1})")
 
 
+def check_plots(scene: dict[str, Any], paths: list[Path], *, mode: int, frame: int) -> None:
+    """Refuse, before anything is written, ``--plot`` files that :func:`render_still` or
+    :func:`render_animation` would refuse: the mode, the frame of a still, ffmpeg for an
+    .mp4."""
+    for p in paths:
+        still = p.suffix.lower() in (".png", ".svg", ".pdf")
+        _check(scene, mode, frame if still else None)
+        if p.suffix.lower() == ".mp4":
+            from matplotlib import animation
+
+            if not animation.writers.is_available("ffmpeg"):
+                raise InputError(f"{p}: an .mp4 needs ffmpeg, which is not installed; install "
+                                 "it (e.g. apt-get install ffmpeg) or write a .gif")
+
+
 class _Painter:
     """Draws frame i of one mode on a 3-D axes; everything in display units."""
 

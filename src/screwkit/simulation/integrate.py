@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import OdeSolution, solve_ivp
+from scipy.optimize import brentq
 
 from screwkit.simulation.drive import EquationOfMotion, motor_torque
 from screwkit.simulation.reduced import Array, SimulationError
@@ -66,8 +67,11 @@ class SimulationRun:
         return self.eom.terms(self.angle, self.speed)
 
 
-def _rhs(eom: EquationOfMotion):  # type: ignore[no-untyped-def]
-    """(θ̇, θ̈, τω, Q_load ω, τ², −B ω²) of the augmented state."""
+def _rhs(eom: EquationOfMotion, direction: float | None = None):  # type: ignore[no-untyped-def]
+    """(θ̇, θ̈, τω, Q_load ω, τ², −B ω²) of the augmented state. ``direction`` (±1) fixes the
+    sign of the output's motion that a load against the motion opposes, over one segment
+    between reversals (:func:`reversal_angles`), so that the right-hand side is smooth there;
+    None takes it from the state."""
     motor = eom.drive.motor
     k = np.arange(eom.model.series.coefficients.shape[1])
     coeff = eom.model.series.coefficients
@@ -87,7 +91,8 @@ def _rhs(eom: EquationOfMotion):  # type: ignore[no-untyped-def]
         if row is not None and load_cfg is not None:
             r = rows[row]
             q = r * w
-            q_out = -load_cfg.damping * q - (load_cfg.constant * np.sign(q)
+            sign = np.sign(q) if direction is None else direction
+            q_out = -load_cfg.damping * q - (load_cfg.constant * sign
                                              if load_cfg.against_motion else load_cfg.constant)
             load = q_out * r
         tau = float(motor_torque(motor, w))
@@ -99,6 +104,32 @@ def _rhs(eom: EquationOfMotion):  # type: ignore[no-untyped-def]
         return np.array([w, acc, tau * w, load * w, tau * tau, friction * w])
 
     return f
+
+
+def reversal_angles(eom: EquationOfMotion) -> Array:
+    """Input angles in [start, start + 2π) where the output reverses (its velocity ratio r(θ)
+    changes sign) when a constant load opposes the output's motion: the load jumps there, so
+    the integration stops and restarts at each (a step across the jump would be integrated to
+    low order). Empty when the load has no such part."""
+    load = eom.drive.load
+    if load is None or not load.against_motion or load.constant == 0.0:
+        return np.zeros(0)
+    model = eom.model
+    row = model.row(load.freedom)
+    grid = model.grid
+    r = np.asarray(model.grid_mode.velocities[load.freedom], dtype=float)  # exact samples
+    roots = []
+    for i in np.flatnonzero(np.sign(r) != np.sign(np.roll(r, -1))):
+        a, b = grid[i], grid[i] + (grid[1] - grid[0])
+        fa, fb = r[i], r[(i + 1) % r.size]
+        if fa == 0.0:
+            roots.append(a)
+            continue
+        if fb == 0.0:
+            continue  # found as the next sample's exact zero
+        roots.append(brentq(lambda x: float(model.series(np.array([x]))[row][0]), a, b,
+                            xtol=1e-15, rtol=1e-15))
+    return np.sort(np.asarray(roots, dtype=float))
 
 
 def _times_at_angles(sol: OdeSolution, t0: Array, t1: Array, targets: Array) -> Array:
@@ -153,13 +184,9 @@ def simulate_cycles(eom: EquationOfMotion, *, cycles: int, initial_speed: float,
     stall.direction = -1.0  # type: ignore[attr-defined]
     y0 = np.zeros(len(scales))
     y0[:2] = start, initial_speed
-    res = solve_ivp(_rhs(eom), (0.0, t_end), y0, method="DOP853", rtol=rtol, atol=atol_v,
-                    dense_output=True, events=(cycle, done, stall))
-    if res.status == -1:
-        raise SimulationError(f"the integration failed: {res.message}")
+    res, turns = _integrate(eom, y0, t_end, cycles, rtol, atol_v, (cycle, done, stall))
     # cycle ends: the counting event past the start, and the terminal event of the last cycle
     # (both may report the last end: keep one time per turn, by the angle reached)
-    turns: dict[int, float] = {}
     for t, y in zip([*res.t_events[0], *res.t_events[1]],
                     [*res.y_events[0], *res.y_events[1]], strict=True):
         k = int(round((y[0] - start) / TWO_PI))
@@ -178,6 +205,80 @@ def simulate_cycles(eom: EquationOfMotion, *, cycles: int, initial_speed: float,
         message = (f"only {len(ends)} of {cycles} cycle(s) completed in {t_end:.6g} s "
                    "(max_time); the input slows down too much")
     return _sampled(eom, res, np.array([0.0, *ends]), initial_speed, status, message)
+
+
+@dataclass
+class _Integration:
+    """The pieces of a piecewise integration joined into one (``solve_ivp``'s fields that the
+    sampling reads)."""
+
+    t_events: list[Array]
+    y_events: list[Array]
+    t: Array
+    y: Array
+    sol: OdeSolution
+
+
+def _integrate(eom: EquationOfMotion, y0: Array, t_end: float, cycles: int, rtol: float,
+               atol: Array, events: tuple) -> tuple[_Integration, dict[int, float]]:  # type: ignore[type-arg]
+    """``solve_ivp`` (DOP853, dense output) from y0, restarted at every reversal of the output
+    (:func:`reversal_angles`) with the load's direction fixed over each piece; the pieces'
+    events and dense outputs are joined. Also returns the turns that end exactly at a restart
+    (turn index -> time), which the counting event cannot see there."""
+    start = eom.model.start
+    final = start + TWO_PI * cycles
+    switches = reversal_angles(eom)
+    load_row = eom.model.row(eom.drive.load.freedom) if eom.drive.load is not None else 0
+    t0, y = 0.0, np.array(y0, dtype=float)
+    ts: list[float] = [0.0]
+    interpolants: list = []  # type: ignore[type-arg]
+    t_events: list[list[float]] = [[] for _ in events]
+    y_events: list[list[Array]] = [[] for _ in events]
+    turns: dict[int, float] = {}
+    last_t, last_y = t0, y
+    while True:
+        nxt = None
+        if switches.size:
+            after = switches + TWO_PI * np.ceil((y[0] + 1e-12 - switches) / TWO_PI)
+            candidate = float(np.min(after))
+            nxt = candidate if candidate < final - 1e-9 else None
+        direction = None
+        reach = []
+        if switches.size:
+            mid = 0.5 * (y[0] + (nxt if nxt is not None else final))
+            ratio = eom.model.series(np.array([mid]))[load_row][0]
+            direction = 1.0 if ratio * y[1] >= 0 else -1.0
+            if nxt is not None:
+                def hit(t: float, yy: Array, target: float = nxt) -> float:
+                    return float(yy[0] - target)
+
+                hit.terminal = True  # type: ignore[attr-defined]
+                hit.direction = 1.0  # type: ignore[attr-defined]
+                reach = [hit]
+        res = solve_ivp(_rhs(eom, direction), (t0, t_end), y, method="DOP853", rtol=rtol,
+                        atol=atol, dense_output=True, events=(*events, *reach))
+        if res.status == -1:
+            raise SimulationError(f"the integration failed: {res.message}")
+        for i in range(len(events)):
+            t_events[i] += list(res.t_events[i])
+            y_events[i] += list(res.y_events[i])
+        ts += list(res.sol.ts[1:])
+        interpolants += list(res.sol.interpolants)
+        last_t, last_y = float(res.t[-1]), res.y[:, -1]
+        stopped = any(res.t_events[i].size for i in range(1, len(events)))
+        if nxt is None or not (reach and res.status == 1 and res.t_events[-1].size
+                               and not stopped):
+            break
+        t0, y = float(res.t_events[-1][0]), np.array(res.y_events[-1][0], dtype=float)
+        y[0] = nxt
+        k = (nxt - start) / TWO_PI
+        if k >= 1 and abs(k - round(k)) < 1e-9:
+            turns.setdefault(int(round(k)), t0)
+    sol = OdeSolution(np.array(ts), interpolants)
+    joined = _Integration([np.array(t) for t in t_events],
+                          [np.array(v).reshape(-1, y0.size) for v in y_events],
+                          np.array([last_t]), np.asarray(last_y)[:, None], sol)
+    return joined, turns
 
 
 def _sampled(eom: EquationOfMotion, res: object, cycle_times: Array, initial_speed: float,
