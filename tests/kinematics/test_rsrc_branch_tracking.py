@@ -86,3 +86,20 @@ def test_branch_rates_equal_the_direct_rates_at_any_input_rate():
             np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-11 * scale, err_msg=name)
         for name in ("locked", "chi_singular", "valid"):
             np.testing.assert_array_equal(getattr(mot.rates, name), getattr(direct, name))
+
+
+def test_rsrc_rates_accept_columns_in_any_order():
+    """rsrc_rates on positions whose assembling columns are not first (branch order, e.g. a
+    column that does not assemble before one that does) gives the rates of each column."""
+    dims = _mechanisms(1)[0]
+    theta = np.linspace(0.0, 2 * np.pi, 50)
+    pos = rsrc_motion(dims, theta)
+    order = np.array([2, 0, 3, 1])  # Fig. 7 assembles in columns 0, 1: now 1 and 3
+    moved = RSRCPositions(pos.theta0, pos.phi0[:, order], pos.chi0[:, order], pos.S[:, order],
+                          pos.assembles[:, order], dims.special_case)
+    assert not moved.assembles[:, 0].any() and moved.assembles[:, 3].all()
+    got = rsrc_rates(dims, moved, 2.0, 3.0)
+    want = rsrc_rates(dims, RSRCPositions(pos.theta0, pos.phi0, pos.chi0, pos.S, pos.assembles,
+                                          dims.special_case), 2.0, 3.0)
+    for name in ("phi0_dot", "chi0_ddot", "S_ddot"):
+        np.testing.assert_array_equal(getattr(got, name), getattr(want, name)[:, order])

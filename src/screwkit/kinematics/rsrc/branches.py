@@ -268,8 +268,10 @@ def rsrc_motion(
     each root at sample k-1 is advanced by its rate (3.77)-(3.79) times the step, and the
     assignment of the columns that minimises the summed squared distance of
     (cos phi0, sin phi0, cos chi0, sin chi0, S/L) is chosen among all permutations of the
-    columns that ever assemble (vectorised over the sweep; a root is left unmatched when that
-    is cheaper than a 90-degree jump).  The per-step permutations are then composed along the
+    columns that ever assemble over the sweep (vectorised; where the number of assemblies
+    changes between two samples, a root is left unmatched when that is cheaper than a
+    90-degree jump; where it does not, every root is matched, so a branch stops only where
+    the count of roots changes).  The per-step permutations are then composed along the
     sweep (a loop over the steps that change the order only).  phi0 is unwrapped along each run
     of valid samples, and every place where a branch stops or starts assembling is reported
     with its input angle, refined by bisection.
@@ -280,7 +282,9 @@ def rsrc_motion(
     (they are linear in theta0-ddot and quadratic in theta0-dot).
 
     The sweep should be monotonic and fine enough that no root moves by more than about 30
-    degrees between samples.
+    degrees between samples; on a coarser sweep the matching is a guess (tested against
+    sweeps refined 200 times: mostly the right one), and it can depend on how many roots
+    the sweep meets elsewhere.
 
     Parameters
     ----------

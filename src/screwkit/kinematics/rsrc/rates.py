@@ -214,11 +214,12 @@ def rsrc_rates(
     tdd = check_input_rate(theta0_ddot, n, "theta0_ddot")
     rate_arrays = [np.full((n, 4), np.nan) for _ in range(6)]
     flags = [np.zeros((n, 4), dtype=bool) for _ in range(2)]
-    # inversions are stored first in each row (NaN last), so a block needs only k columns
-    counts = positions.n_assemblies
+    # a block needs the columns up to the last one that assembles in it (rsrc_positions puts
+    # the roots first; branch order, as in rsrc_motion, may not)
     for start in range(0, n, BLOCK_SIZE):
         rows = slice(start, start + BLOCK_SIZE)
-        k = int(counts[rows].max(initial=0))
+        used = np.flatnonzero(positions.assembles[rows].any(axis=0))
+        k = int(used[-1]) + 1 if used.size else 0
         if positions.case == "delta0_half_pi":
             k = 4  # the chi0 < 0 modes sit in columns 2, 3 even when 0, 1 do not assemble
         if k == 0:
