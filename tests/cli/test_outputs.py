@@ -190,6 +190,12 @@ def test_limits_csv_in_spec_units(tmp_path):
     _same(t["theta0 [deg]"], [x["theta0"] for x in doc["limits"]], DEG)
     _same(t["S [mm]"], [x["S"] for x in doc["limits"]], MM)
     assert list(t["kind"]) == [x["kind"] for x in doc["limits"]]
+    # d²y/dx² per rad²: a translation's in the display length, a rotation's a plain number
+    rows = doc["limits"]
+    _same(t["second_derivative_length_per_rad2 [mm]"],
+          [x["second_derivative"] if x["kind"] == "translation" else None for x in rows], MM)
+    _same(t["second_derivative"],
+          [x["second_derivative"] if x["kind"] == "rotation" else None for x in rows])
 
 
 BALANCE_MM = (EXAMPLES / "rahman_cssp_balance.toml").read_text(encoding="utf-8")

@@ -31,6 +31,15 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
     def kind_of(x: dict[str, Any]) -> str:
         return "angle" if x.get("kind", "rotation") == "rotation" else "length"
 
+    def second(x: dict[str, Any]) -> str:
+        """d²y/dx²: rad/rad² for a rotation, the display length per rad² for a translation."""
+        v = x["second_derivative"]
+        if v is None:
+            return "—"
+        if kind_of(x) == "angle":
+            return f"{number(v, 4)} rad"
+        return f"{number(units.show('length', v), 4)} {units.label('length')}"
+
     generic = doc["method"] == "generic"
     lims = doc["limits"]
     cols = [TextColumn("output", [x["output"] for x in lims], "left"),
@@ -40,7 +49,7 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
             TextColumn(f"input\n[{units.label(xk)}]",
                        [number(units.show(xk, x["input"]), 7) for x in lims]),
             TextColumn("value", [shown(x["value"], kind_of(x)) for x in lims]),
-            TextColumn("2nd\nderivative", [number(x["second_derivative"], 4) for x in lims]),
+            TextColumn("2nd derivative\n[per rad²]", [second(x) for x in lims]),
             TextColumn("dwell\norder", ["—" if x["dwell_order"] is None else str(x["dwell_order"])
                                         for x in lims])]
     print_columns(console, f"limit positions (dwell tolerance {doc['dwell_tolerance']:g})", cols)

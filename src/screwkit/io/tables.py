@@ -104,7 +104,11 @@ def limits_table(doc: dict[str, Any]) -> ResultTable:
             Column("input", variable_kind(doc.get("input_name", "theta0")), col("input")),
             Column("value", "angle", col("value", rotation)),
             Column("value_length", "length", col("value", lambda r: not rotation(r))),
-            Column("second_derivative", "ratio", col("second_derivative")),
+            # d²y/dx² per rad² of the input: a rotation's is a plain number (rad/rad²), a
+            # translation's a length per rad², in the display length unit
+            Column("second_derivative", "ratio", col("second_derivative", rotation)),
+            Column("second_derivative_length_per_rad2", "length",
+                   col("second_derivative", lambda r: not rotation(r))),
             Column("dwell_order", "index", index("dwell_order"))]
     cols += [Column(n, variable_kind(n), col(n)) for n in ("theta0", "phi0", "chi0", "S")
              if lims and all(n in r for r in lims)]
