@@ -31,3 +31,13 @@ def test_help_shows_every_bracketed_word(name):
     shown = " ".join(r.output.split())
     for token in re.findall(r"\[[a-z_.]+\]", _texts(name)):
         assert token in shown, (name, token)
+
+
+def test_analyze_says_which_variables_it_does_not_show():
+    from pathlib import Path
+
+    spec = Path(__file__).resolve().parents[2] / "examples" / "rrsrr_loop.toml"
+    r = CliRunner().invoke(app, ["analyze", str(spec)], env={"COLUMNS": "200"})
+    assert r.exit_code == 0, r.output
+    assert "4 of 6 variables shown; the others (ball.ry, ball.rz) are in --csv and --json" in (
+        " ".join(r.output.split()))

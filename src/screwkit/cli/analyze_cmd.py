@@ -69,11 +69,18 @@ def show_analysis(spec: Any, motion: Any, units: Any, full: bool,
     for md in motion.modes:
         t = whole.where(whole.column("mode").values == md.index)
         names = ["input"]
-        for n in shown_variables(md, motion.input_names[0]):
+        shown = shown_variables(md, motion.input_names[0])
+        for n in shown:
             names += [c for c in (n, f"{n}_dot", f"{n}_ddot") if c in t.names]
         names += [f"{p}_{a}" for p in points for a in "xyz" if f"{p}_{a}" in t.names]
         cols, values = table_columns(t, names, units)
         print_long_table(console, f"assembly mode {md.index}", cols, values, full)
+        # a joint list shows its first four freedoms (a family its seed's variables)
+        hidden = [n for n in md.variables if n not in shown and n != motion.input_names[0]]
+        if hidden and all("." in n for n in shown):
+            console.print(f"  • {len(shown)} of {len(shown) + len(hidden)} variables shown; "
+                          f"the others ({', '.join(hidden[:4])}{', …' if len(hidden) > 4 else ''}) "
+                          "are in --csv and --json", highlight=False)
         entry = doc["modes"][md.index].get("transmission") if doc is not None else None
         for line in transmission_lines(entry, units, input_kind):
             console.print(f"  • {escape(line)}", highlight=False)
