@@ -349,3 +349,11 @@ def test_simulate_csv_in_spec_units(tmp_path):
     _same(t["speed [rpm]"], s["speed"], 2 * math.pi / 60)
     _same(t["motor_torque [N*m]"], s["motor_torque"])
     assert "crank.point_z [in]" in t and "kinetic_energy [J]" in t
+
+
+def test_unit_option_takes_the_spec_kind_names():
+    """--unit accepts what [units] accepts for a moment: torque is the same kind."""
+    from screwkit.io.display_units import parse_unit_overrides
+
+    assert parse_unit_overrides(["torque=lbf*in"]) == {"moment": "lbf*in"}
+    assert parse_unit_overrides(["moment=N*m"]) == {"moment": "N*m"}

@@ -93,6 +93,8 @@ def parse_unit_overrides(items: Iterable[str]) -> dict[str, str]:
         if not sep or not kind or not unit:
             raise UnitError(f"--unit {item!r}: write kind=unit, e.g. --unit length=mm or "
                             f"--unit angle=deg; the kinds are {', '.join(DISPLAY_KINDS)}")
+        if kind == "torque":  # the [units] name of a moment (e.g. the drive's torques)
+            kind = "moment"
         if kind not in DISPLAY_KINDS:
             raise UnitError(f"--unit {item!r}: unknown kind {kind!r}; the kinds are "
                             f"{', '.join(DISPLAY_KINDS)}")
