@@ -50,3 +50,24 @@ def test_bad_sum_rule(tmp_path):
     with pytest.raises(BalancingError, match="pair_sum"):
         s = _spec(tmp_path, "[balancing.links.rod]\npair_sum = \"less\"\n")
         balancing_table(s)
+
+
+def test_what_balance_would_refuse_is_refused_at_load(tmp_path):
+    """validate reports it: an ellipsoid that does not contain its link, a free-position
+    counterweight with a measure other than F weighted (or in a Pareto sweep)."""
+    links = "[balancing.links.crank]\nvariables = [\"m1\", \"m2\"]\nmax_decrease = 0.05\n"
+    with pytest.raises(BalancingError, match="does not lie inside this ellipsoid"):
+        _spec(tmp_path, "[balancing]\nweights = { F = 1 }\n" + links
+              + "[balancing.bound.ellipsoids.crank]\ncentre = [0.0254, 0, 0]\n"
+                "semi_axes = [0.03, 0.01, 0.01]\n")
+    _spec(tmp_path, "[balancing]\nweights = { F = 1 }\n" + links
+          + "[balancing.bound.ellipsoids.crank]\ncentre = [1.0, 0, 0]\n"
+            "semi_axes = [1.5, 0.5, 0.5]\n")  # docs/balancing.md's: fine
+    free = ("[[balancing.counterweights]]\nname = \"cw\"\nlink = \"crank\"\nmass_max = \"0.5 kg\"\n"
+            "box_min = [-1, -1, -1]\nbox_max = [1, 1, 1]\n")
+    with pytest.raises(BalancingError, match="weight only the shaking force F"):
+        _spec(tmp_path, "[balancing]\nweights = { F = 1, T = 1 }\n" + free)
+    with pytest.raises(BalancingError, match="weight only the shaking force F"):
+        _spec(tmp_path, "[balancing]\nweights = { F = 1 }\n[balancing.pareto]\n"
+                        "measures = [\"F\", \"T\"]\ndivisions = 2\n" + free)
+    _spec(tmp_path, "[balancing]\nweights = { F = 1 }\n" + free)

@@ -125,8 +125,11 @@ def _check_idle_spin(linkage: Linkage, mode: ModeMotion, reg: Regressor,
         "equal (e.g. inertia = [Ia, I, I] with x along the rod) before balancing")
 
 
-def _check_free_counterweights(variables: DesignVariables, weights: Mapping[str, float]) -> None:
-    free = [b for b in variables.blocks if b.kind == "free_counterweight"]
+def check_free_counterweights(blocks: Sequence[VariableBlock], weights: Mapping[str, float]
+                              ) -> None:
+    """Free-position counterweights enter every measure but F non-linearly: refuse them with
+    another measure weighted (also checked at load, so `validate` reports it)."""
+    free = [b for b in blocks if b.kind == "free_counterweight"]
     others = {k: w for k, w in weights.items() if k != "F" and w > 0}
     if free and others:
         raise BalancingError(
@@ -167,7 +170,7 @@ def solve_setup(setup: BalancingSetup, weights: Mapping[str, float]) -> BalanceR
     """Solve the balancing QP for one set of weights W1…W5 (by measure name)."""
     w = check_weights(weights)
     v = setup.variables
-    _check_free_counterweights(v, w)
+    check_free_counterweights(v.blocks, w)
     objective: QuadraticObjective = quadratic_objective(setup.rows, v, w)
     opt = solve_balancing(objective, v, setup.extra_constraints)
     pi0, pi1 = v.physical_parameters(v.original), v.physical_parameters(opt.x)

@@ -11,10 +11,12 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError
 
+from screwkit.balancing.balance import check_free_counterweights
 from screwkit.balancing.config import BalancingConfig, NormalisationConfig
 from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.measures import MEASURES
 from screwkit.balancing.problem import check_weights
+from screwkit.balancing.sdp import ellipsoid_row
 from screwkit.balancing.variables import (
     POINT_MASS_NAMES,
     VariableBlock,
@@ -176,7 +178,31 @@ def _bound(spec: Any, table: BalancingTable) -> dict[str, tuple[list[float], lis
                                        "need 3 values each")
         ell[link] = ([_si(spec, v, "length", key) for v in e.centre],
                      [_si(spec, v, "length", key) for v in e.semi_axes])
+        _check_ellipsoid(spec, key, link, *ell[link])
     return ell
+
+
+def _check_ellipsoid(spec: Any, key: str, link: str, centre: list[float],
+                     semi_axes: list[float]) -> None:
+    """The bound keeps the link inside its ellipsoid, so the link as it is must be inside it
+    (checked at load: `validate` reports it)."""
+    links = {lk.name: lk for lk in spec.linkage.links}
+    if link not in links:
+        raise BalancingConfigError(f"{spec.path}: [balancing.{key}] no link {link!r}; the links "
+                                   f"are {list(links)}")
+    mass = links[link].mass
+    if mass is None:
+        return  # named by the dynamics' own check
+    try:
+        row = ellipsoid_row(centre, semi_axes)
+    except BalancingError as exc:
+        raise BalancingConfigError(f"{spec.path}: [balancing.{key}] {exc}") from None
+    pi = mass.inertial_parameters()
+    if row @ pi < -1e-9 * pi[0]:
+        raise BalancingConfigError(
+            f"{spec.path}: [balancing.{key}] the link {link!r} as it is does not lie inside "
+            "this ellipsoid (centre and semi-axes in the link's body frame, in the spec's "
+            "length unit); enlarge it or move its centre to the link's centre of mass")
 
 
 def balancing_config(spec: Any) -> BalancingConfig:
@@ -212,6 +238,15 @@ def balancing_config(spec: Any) -> BalancingConfig:
                 f"limit of {MAX_PARETO_WEIGHTINGS:,}; use fewer divisions (e.g. 10 gives "
                 f"{math.comb(10 + len(measures) - 1, len(measures) - 1)})")
         pareto = (tuple(table.pareto.measures), table.pareto.divisions)
-    return BalancingConfig(blocks=tuple(blocks_from_table(spec, table)),
+    blocks = blocks_from_table(spec, table)
+    weightings = [dict(table.weights)]
+    if pareto is not None:
+        weightings.append({k: 1.0 for k in pareto[0]})
+    for w in weightings:
+        try:
+            check_free_counterweights(blocks, w)
+        except BalancingError as exc:
+            raise BalancingConfigError(f"{spec.path}: [balancing] {exc}") from None
+    return BalancingConfig(blocks=tuple(blocks),
                            weights=dict(table.weights), gravity=table.gravity,
                            normalisation=norm, bound=_bound(spec, table), pareto=pareto)
