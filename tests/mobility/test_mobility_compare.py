@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from mobility_screws import bennett, parallelogram_chain, rsrc, rssr
 
 from screwkit.mobility import compare_mobility, formula_mobility, mobility_from_jacobian
@@ -70,3 +71,18 @@ def test_different_chains_are_flagged() -> None:
     jac, names = rssr(np.random.default_rng(4))
     c = compare_mobility(formula_mobility(4, "RSRC"), mobility_from_jacobian(jac, names))
     assert "do not describe the same chain" in c.describe()
+
+
+@pytest.mark.parametrize("example, redundant", [("rssr_spatial", 1), ("rahman_cssp", 1),
+                                                 ("bagci_fig7_rsrc", 0), ("rrsrr_loop", 0)])
+def test_linkage_mobility_names_the_idle_rod_spin_a_redundant_freedom(example, redundant):
+    """sk.mobility passes the output joint's freedoms: the S–S rod's spin leaves the output
+    still, so it is a redundant freedom (Bagci's R-S-S-R), not an undetermined output."""
+    from pathlib import Path
+
+    import screwkit as sk
+
+    spec = sk.load_spec(Path(__file__).resolve().parents[2] / "examples" / f"{example}.toml")
+    m = sk.mobility(spec.linkage)
+    assert m.numeric.redundant_freedoms == redundant
+    assert m.numeric.output_names is not None

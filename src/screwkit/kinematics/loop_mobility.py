@@ -10,8 +10,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from screwkit.errors import CapabilityError
 from screwkit.kinematics.loop import Array, forward, layout
 from screwkit.kinematics.motion import AssemblyError
+from screwkit.kinematics.registry import output_joint
 from screwkit.kinematics.solve import find_assemblies
 from screwkit.mobility import (
     FormulaMobility,
@@ -82,9 +84,21 @@ def mobility(linkage: Linkage, inputs: ArrayLike | None = None) -> LinkageMobili
     kinds = "".join(j.kind for j in linkage.joints)
     formula = formula_mobility(len(linkage.joints), kinds, name=linkage.name)
     numeric = mobility_from_jacobian(fr.screws[0], list(lay.names), inputs=list(linkage.inputs),
+                                     outputs=_output_freedoms(linkage),
                                      length_scale=linkage.length_scale)
     return LinkageMobility(linkage.name, kinds, X_i, formula, numeric,
                            compare_mobility(formula, numeric, name=linkage.name))
+
+
+def _output_freedoms(linkage: Linkage) -> list[str] | None:
+    """The freedoms of the loop's output joint (the ground joint that is not driven), so that
+    motions that leave it still — an S–S rod's spin — count as redundant freedoms; None when
+    the input is not on the ground."""
+    try:
+        joint = linkage.joints[output_joint(linkage)]
+    except CapabilityError:
+        return None
+    return list(joint.freedom_names())
 
 
 def linkage_mobility(linkage: Linkage, input_values: ArrayLike) -> dict[str, Any]:
