@@ -137,4 +137,4 @@ def test_spec_with_every_variable_on_a_bound_is_unique_through_the_cli(tmp_path)
     assert doc["unique"] is True
     assert doc["non_unique_directions"] == []
     table = CliRunner().invoke(app, ["balance", str(spec)])
-    assert "unique optimum: True" in table.output and "inf" not in table.output
+    assert "unique optimum: yes" in table.output and "inf" not in table.output

@@ -85,10 +85,12 @@ def show_balance(spec: Any, res: Any, doc: dict[str, Any], units: Any,
     if bounds:
         console.print("active bounds: " + "; ".join(
             escape(b["constraint"]) for b in doc["active_bounds"]), highlight=False)
-    verdict = "could not determine" if res.unique is None else str(res.unique)
+    verdict = ("could not be determined" if res.unique is None
+               else "yes" if res.unique else f"no ({len(res.directions)} free direction(s))")
     console.print(f"unique optimum: {verdict}", highlight=False)
     for d in res.directions:
-        console.print(escape(f"  free direction {d.direction} ({direction_range(d)})"),
+        combo = " ".join(f"{c:+.4g}·{name}" for name, c in d.direction.items())
+        console.print(escape(f"  free direction {combo} ({direction_range(d)})"),
                       highlight=False)
     bound = doc.get("redistribution_bound")
     if bound:
