@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from screwkit.io.spec import load_spec
@@ -50,6 +50,10 @@ def _same_modes(closed, generic, length):
 
 
 @settings(max_examples=10, deadline=None, derandomize=True)
+# two branches born at one sample next to a fold: the generic solver once handed each the
+# other's root there, so its rod poses were carried 1° off (generic_motion._pair_ends)
+@example(d1=1.0, d2=5.0, d3=3.2475464481429612, a=2.0, b=-0.3359375, lambda0=0.1875,
+         offset=0.125)
 @given(d1=st.floats(0.5, 1.5), d2=st.floats(3.0, 5.0), d3=st.floats(1.0, 3.5),
        a=st.floats(1.5, 4.0), b=st.floats(-1.0, 3.0), lambda0=st.floats(0.1, 1.4),
        offset=st.floats(-1.0, 1.0))

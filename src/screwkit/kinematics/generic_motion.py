@@ -250,7 +250,32 @@ def _all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: in
         if not _seed_from(linkage, lay, tracker, todo, X, starts, seed + 1 + round_):
             break
     tracks = _attach_turning_points(linkage, lay, _merge_duplicates(linkage, lay, tracker.tracks))
+    _pair_ends(linkage, lay, tracks)
     return sorted(tracks, key=lambda tr: _order_key(linkage, lay, tr))
+
+
+def _pair_ends(linkage: Linkage, lay: Layout, tracks: list[Track]) -> None:
+    """Where two branches are born (or die) at the same sample next to a fold, their two
+    roots there are close and the searches may hand each branch the other's: swap them when
+    that makes both continuous with the neighbouring sample (the closed forms' pairing). Each
+    mode then starts on its own branch, so the rates and the idle spin carried along it start
+    right."""
+    for step in (1, -1):  # births continue to k + 1, deaths come from k − 1
+        for a_i, a in enumerate(tracks):
+            for b in tracks[a_i + 1:]:
+                both = a.mask & b.mask
+                held = np.pad(a.mask | b.mask, 1)  # False beyond the sweep
+                nxt = np.roll(np.pad(both, 1), -step)[1:-1]
+                prev = np.roll(held, step)[1:-1]
+                for kk in np.nonzero(both & nxt & ~prev)[0].tolist():
+                    k, n = int(kk), int(kk) + step
+                    sa, sb = _signatures(linkage, lay, a, np.array([k, n]))
+                    ta, tb = _signatures(linkage, lay, b, np.array([k, n]))
+                    kept = np.linalg.norm(sa - sb) + np.linalg.norm(ta - tb)
+                    swapped = np.linalg.norm(sa - tb) + np.linalg.norm(ta - sb)
+                    if swapped < kept:
+                        for arr_a, arr_b in ((a.scalars, b.scalars), (a.spherical, b.spherical)):
+                            arr_a[k], arr_b[k] = arr_b[k].copy(), arr_a[k].copy()
 
 
 def _merge_duplicates(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
