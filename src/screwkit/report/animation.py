@@ -162,15 +162,12 @@ def render_animation(scene: dict[str, Any], path: str | Path, *, mode: int = 0,
                      fps: int | None = None, dpi: int = 80) -> None:
     """The whole cycle of one mode as an animation: ``.gif`` (Pillow, always there with
     matplotlib) or ``.mp4`` (needs ffmpeg on the PATH)."""
-    _check(scene, mode)
     p = Path(path)
+    check_plots(scene, [p], mode=mode, frame=0)
     plt = pyplot()
     from matplotlib import animation
 
     if p.suffix.lower() == ".mp4":
-        if not animation.writers.is_available("ffmpeg"):
-            raise InputError(f"{p}: an .mp4 needs ffmpeg, which is not installed; install it "
-                             "(e.g. apt-get install ffmpeg) or write a .gif")
         writer: Any = animation.FFMpegWriter(fps=fps or 12)
     elif p.suffix.lower() == ".gif":
         writer = animation.PillowWriter(fps=fps or 12)
