@@ -11,9 +11,11 @@ moving in one direction) predicts a whole chunk of samples ahead at once, and al
 predictions are corrected together (:func:`~screwkit.kinematics.solve.correct`, vectorised over
 fronts and samples). A corrected sample is accepted when Newton converged and contracted fast
 from a prediction close to the result (Deuflhard's test: a jump towards another branch does
-not); a chunk is accepted up to its first rejected sample and the next chunk doubles or shrinks
-accordingly. When even the next sample is rejected the front sub-steps between samples with
-steps cut by four; when the step falls below 2⁻⁸ of the sample spacing it tries once to step
+not), and, where the passive Jacobian is near singular (another branch may be as close as a
+step), when predicting and correcting back from it does not land on another root than where
+the step started (a reversibility test); a chunk is accepted up to its first rejected sample
+and the next chunk doubles or shrinks accordingly. When even the next sample is rejected the
+front sub-steps between samples with steps cut by four; when the step falls below 2⁻⁸ of the sample spacing it tries once to step
 over the next sample to the one after (branches that cross — a bifurcation — are passed that
 way, the crossing sample closed by Newton alone), and if that fails too the branch ends there:
 a limit position or dead centre lies between the two samples (it *stops*, or going backwards it
@@ -233,6 +235,32 @@ class Tracker:
         moved = apply_increment(here.take(owner), delta, lay)
         return set_inputs(moved, lay, self.linkage.inputs, input_at(X, t))
 
+    def _retraces(self, reached: Configuration, t_reached: Array, start: Configuration,
+                  t_start: Array, sigma: Array) -> NDArray[np.bool_]:
+        """The reversibility test of steps taken where the branch's passive Jacobian is near
+        singular (another branch close by): from each reached configuration, predict back to
+        where its step started and correct; the step is rejected when that converges to
+        another root than its start. A step that jumped onto a neighbouring branch comes back
+        on that branch (its nearest root), not on the start. Within the uncertainty of a root there, residual/σ,
+        the two count as one."""
+        lay, X = self.lay, self.X
+        Q1, Q2, _ = taylor(self.linkage, lay, reached)
+        d = input_at(X, t_start) - input_at(X, t_reached)
+        delta = (np.einsum("tmi,ti->tm", Q1, d) + 0.5 * np.einsum("tmij,ti,tj->tm", Q2, d, d))
+        delta = np.where(np.isfinite(delta), delta, 0.0)
+        pred = set_inputs(apply_increment(reached, delta, lay), lay, self.linkage.inputs,
+                          input_at(X, t_start))
+        step = np.linalg.norm(configuration_difference(pred, reached, lay) * self.col_scale,
+                              axis=1)
+        back = correct(self.linkage, pred, lay, FIRST_STEP * step + 1e-9, CONTRACTION)
+        # compared by signature (joint centres and axes): an S–S rod's idle spin is free
+        miss = np.max(np.abs(signature(self.linkage, back.conf, lay)
+                             - signature(self.linkage, start, lay)), axis=1)
+        # a way back that does not converge proves nothing (near a fold the backward
+        # prediction is short): only a return to another root rejects the step
+        return np.asarray(~back.accepted | (miss <= np.maximum(1e-6, 1e-10 / np.maximum(
+            sigma, 1e-300))))
+
     def _wave(self, fronts: list[_Front]) -> list[_Front]:
         """One predictor–corrector pass of every front; returns the fronts still moving."""
         targets = [self._targets(f) for f in fronts]
@@ -250,7 +278,7 @@ class Tracker:
         reach = np.where(near, np.inf, FIRST_STEP * step + 1e-9)
         res = correct(self.linkage, pred, self.lay, reach, np.where(near, 1.0, CONTRACTION),
                       max_iter=40 if near.any() else 7)
-        ok = res.accepted
+        ok = self._reversible(fronts, targets, res.conf, res.accepted)
         alive = []
         start = 0
         for k, f in enumerate(fronts):
@@ -273,6 +301,49 @@ class Tracker:
                              full=p == n):
                 alive.append(f)
         return alive
+
+    def _reversible(self, fronts: list[_Front], targets: list[Array], conf: Configuration,
+                    accepted: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        """``accepted`` less the steps that fail the reversibility test (:meth:`_retraces`):
+        every accepted step longer than σ of a front near a singular configuration (σ below
+        FOLD_SIGMA), each against the sample before it, all fronts at once. Steps over a
+        singular sample (a jump) are not tested: they cross where two branches meet by design."""
+        ok = accepted.copy()
+        rows, starts, t_to, t_from, sigma = [], [], [], [], []
+        first = 0
+        for f, tg in zip(fronts, targets, strict=True):
+            n = len(tg)
+            if not f.jump and f.sigma[0] < FOLD_SIGMA:
+                acc = accepted[first:first + n]
+                p = n if acc.all() else int(np.argmin(acc))
+                if p:
+                    mine = np.arange(first, first + p)
+                    rows.append(mine)
+                    before = conf.take(mine[:-1])
+                    starts.append(Configuration(np.concatenate([f.conf.scalars, before.scalars]),
+                                                np.concatenate([f.conf.spherical,
+                                                                before.spherical])))
+                    t_to.append(tg[:p])
+                    t_from.append(np.concatenate([[f.t], tg[:p - 1]]))
+                    sigma.append(np.full(p, f.sigma[0]))
+            first += n
+        if not rows:
+            return ok
+        idx = np.concatenate(rows)
+        start_conf = Configuration(np.concatenate([c.scalars for c in starts]),
+                                   np.concatenate([c.spherical for c in starts]))
+        reached = conf.take(idx)
+        sig = np.concatenate(sigma)
+        # only steps longer than σ (scaled freedoms): a root as close as the step lies within
+        # ~σ of the branch only where the Jacobian is that near singular
+        step = np.linalg.norm(configuration_difference(reached, start_conf, self.lay)
+                              * self.col_scale, axis=1)
+        long = np.nonzero(step > sig)[0]
+        if long.size:
+            ok[idx[long]] = self._retraces(reached.take(long), np.concatenate(t_to)[long],
+                                           start_conf.take(long),
+                                           np.concatenate(t_from)[long], sig[long])
+        return ok
 
     def _advance(self, f: _Front, t: Array, conf: Configuration, full: bool) -> bool:
         """Move front ``f`` over its accepted targets; False when it has ended."""
@@ -316,9 +387,15 @@ class Tracker:
         """Whether the newly reached samples ``idx`` of ``track`` are, at two of them or more,
         the configurations another track already holds: the front has run onto a known branch
         (a seed found again next to where a branch ended) and stops there; the two tracks are
-        merged afterwards. Branches that cross meet at one sample only."""
+        merged afterwards. Branches that cross meet at one sample only. A long chunk is
+        compared at its first two and last two samples: a front that runs onto a branch
+        stays on it to the chunk's end (where it left the branch again within the chunk, the
+        merge removes the shared samples afterwards)."""
         if len(idx) < 2:
             idx, conf = idx[-1:], conf.take(np.arange(len(idx))[-1:])
+        elif len(idx) > 4:
+            ends = np.array([0, 1, len(idx) - 2, len(idx) - 1])
+            idx, conf = idx[ends], conf.take(ends)
         others = [k for k, tr in enumerate(self.tracks) if k != track and tr.mask[idx].any()]
         if not others or len(idx) == 0:
             return False

@@ -23,8 +23,10 @@ from screwkit.kinematics.loop import (
     Array,
     Configuration,
     Layout,
+    closure_error,
     closure_twist,
     forward,
+    rotation_vector,
 )
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.kinematics.rates import RESIDUAL_TOL, rate_equations, solve_rates
@@ -67,14 +69,25 @@ def _variable_tables(linkage: Linkage, lay: Layout, conf: Configuration, mask: N
             variables[name] = values
         velocities[name] = qd[:, f]
         accelerations[name] = qdd[:, f]
-    from scipy.spatial.transform import Rotation  # on first use (start-up time)
-
     for i, sidx in lay.spherical_of_joint.items():
-        rv = Rotation.from_matrix(conf.spherical[:, sidx]).as_rotvec()
+        rv = rotation_vector(conf.spherical[:, sidx])
         jn = linkage.joints[i].name
         for a, ax in enumerate("xyz"):
             variables[f"{jn}.r{ax}"] = rv[:, a]
     return variables, velocities, accelerations
+
+
+def closure_residual(R: Array, p: Array, rows: Array) -> Array:
+    """The loop-closure error max|ξ| (scaled rows) of G = (R, p): the first-order twist
+    (:func:`~screwkit.kinematics.loop.closure_error`) where that is below 1e-6 (it then equals
+    the exact SE(3) logarithm's to a relative 1e-6, and the residual is only ever compared
+    with tolerances), the exact logarithm elsewhere (a rotation near a half turn has a small
+    first-order error)."""
+    res = np.max(np.abs(closure_error(R, p) * rows), axis=-1)
+    far = ~(res < 1e-6) | (np.trace(R, axis1=-2, axis2=-1) < 2.0)
+    if far.any():
+        res[far] = np.max(np.abs(closure_twist(R[far], p[far]) * rows), axis=-1)
+    return np.asarray(res)
 
 
 def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
@@ -86,7 +99,7 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
     ``X``, ``Xd``, ``Xdd`` (N, n_in) are the inputs and their first two time derivatives."""
     mask = np.asarray(mask, dtype=bool)
     fr = forward(linkage, conf, lay)
-    eq = rate_equations(linkage, lay, fr, mask)
+    eq = rate_equations(linkage, lay, fr, mask, exact_sigma=False)
     if eq.spin_links:
         conf = hold_idle_spin(linkage, lay, conf, mask, X, fr, eq)
         # the turns about the rods' axes leave round-off in the closure: one Newton step
@@ -96,7 +109,7 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
                              np.where(mask[:, None, None, None], polished.spherical,
                                       conf.spherical))
         fr = forward(linkage, conf, lay)
-        eq = rate_equations(linkage, lay, fr, mask)
+        eq = rate_equations(linkage, lay, fr, mask, exact_sigma=False)
     rates = solve_rates(linkage, lay, eq, Xd, Xdd)
     singular = mask & (eq.singular | ~(rates.residual <= RESIDUAL_TOL))
     qd, qdd, link_V, link_A = rates.qd, rates.qdd, rates.link_V, rates.link_A
@@ -110,14 +123,14 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
     a_o = a0 + cross(al, p_g) + cross(w, v_o)
 
     def world(x: Array) -> Array:
-        return np.einsum("ij,n...j->n...i", bR, x)
+        return np.asarray(x @ bR.T)
 
-    frames = [np.einsum("ij,nljk->nlik", bR, fr.after_R[:, :nl]), world(p_g) + bp]
+    frames = [np.asarray(bR @ fr.after_R[:, :nl]), world(p_g) + bp]
     twists = [world(w), world(v_o), world(al), world(a_o)]
     cen = world(fr.centres) + bp
     axs = world(fr.axes)
     variables, velocities, accelerations = _variable_tables(linkage, lay, conf, mask, X, qd, qdd)
-    xi_res = np.max(np.abs(closure_twist(fr.closure_R, fr.closure_p) * eq.rows), axis=-1)
+    xi_res = closure_residual(fr.closure_R, fr.closure_p, eq.rows)
     bad = ~mask
     for table in (variables, velocities, accelerations):
         for values in table.values():

@@ -68,7 +68,8 @@ class RateEquations:
     in_idx: list[int]
     p_idx: list[int]
     passive: Array  # (N, 6 + r, m_p) scaled passive Jacobian
-    sigma_ratio: Array  # (N,) σ_min/σ_max of ``passive`` (0 when it has more columns than rows)
+    sigma_ratio: Array  # (N,) σ_min/σ_max of ``passive`` (0 when it has more columns than rows;
+    #                     NaN where not computed: rate_equations(exact_sigma=False))
     rank_deficient: NDArray[np.bool_]  # σ ratio below SINGULAR_RTOL
     input_locked: NDArray[np.bool_]  # an input screw is not in the range of the passive one
     singular: NDArray[np.bool_]  # either: no rates here
@@ -125,10 +126,32 @@ def _least_squares(A: Array, b: Array, skip: NDArray[np.bool_]) -> Array:
     return x
 
 
+def _sigma_ratio(Jp: Array, exact: bool) -> Array:
+    """σ_min/σ_max of each tall or square ``Jp`` (N, k, m), from the eigenvalues of JᵀJ. With
+    ``exact=False`` only the rank test's answer is kept exact: where det(JᵀJ)/tr(JᵀJ)^m, a lower
+    bound of (σ_min/σ_max)² (λ_min ≥ det/λ_max^(m−1) and λ_max ≤ tr), already clears
+    SINGULAR_RTOL² the eigenvalues are not computed and the ratio is NaN ("well above the
+    threshold")."""
+    M = np.swapaxes(Jp, -1, -2) @ Jp
+    if exact:
+        lam = np.linalg.eigvalsh(M)
+        return np.asarray(np.sqrt(np.maximum(lam[:, 0], 0.0) / np.maximum(lam[:, -1], 1e-300)))
+    tr = np.maximum(np.trace(M, axis1=-2, axis2=-1), 1e-300)
+    bound = np.linalg.det(M / tr[:, None, None])  # det(M)/tr^m, scaled against overflow
+    ratio = np.full(M.shape[0], np.nan)
+    near = ~(bound > 4.0 * SINGULAR_RTOL**2)  # a margin for the determinant's round-off
+    if near.any():
+        ratio[near] = _sigma_ratio(Jp[near], True)
+    return ratio
+
+
 def rate_equations(linkage: Linkage, lay: Layout, fr: LoopFrames,
-                   mask: NDArray[np.bool_] | None = None) -> RateEquations:
+                   mask: NDArray[np.bool_] | None = None, exact_sigma: bool = True,
+                   ) -> RateEquations:
     """The scaled rate equations at every sample of ``fr`` (samples outside ``mask`` are
-    treated as singular and give NaN)."""
+    treated as singular and give NaN). With ``exact_sigma=False`` (a Motion's build, which
+    needs only the rank test) ``sigma_ratio`` is NaN where a cheap bound shows it is well above
+    :data:`SINGULAR_RTOL` (:func:`_sigma_ratio`)."""
     N, _, m = fr.screws.shape
     L = constants(linkage, lay)[2]
     names = list(lay.names)
@@ -143,14 +166,13 @@ def rate_equations(linkage: Linkage, lay: Layout, fr: LoopFrames,
     for r, i in enumerate(links):
         upto = [f for f in range(m) if lay.joint_of[f] <= i]
         C[:, r, upto] = np.einsum("ni,nif->nf", u[:, r], S[:, :3, upto])
-    scaled = np.concatenate([S * rows[None, :, None], C], axis=1) * cols[None, None, :]
+    scaled = np.concatenate([S * (rows[:, None] * cols[None, :]), C * cols], axis=1)
     Jp, Jin = scaled[:, :, p_idx], scaled[:, :, in_idx]
     k, mp = Jp.shape[1:]
     if mp > k or mp == 0:
         ratio = np.zeros(N)
     else:
-        lam = np.linalg.eigvalsh(np.swapaxes(Jp, -1, -2) @ Jp)
-        ratio = np.sqrt(np.maximum(lam[:, 0], 0.0) / np.maximum(lam[:, -1], 1e-300))
+        ratio = _sigma_ratio(Jp, exact_sigma)
     valid = np.ones(N, dtype=bool) if mask is None else np.asarray(mask, dtype=bool)
     deficient = valid & (ratio < SINGULAR_RTOL)
     locked = np.zeros(N, dtype=bool)
