@@ -12,12 +12,13 @@ predictions are corrected together (:func:`~screwkit.kinematics.solve.correct`, 
 fronts and samples). A corrected sample is accepted when Newton converged and contracted fast
 from a prediction close to the result (Deuflhard's test: a jump towards another branch does
 not), and, where the passive Jacobian is near singular (another branch may be as close as a
-step), when predicting and correcting back from it does not land on another root than where
-the step started (a reversibility test); a chunk is accepted up to its first rejected sample
+step), when the same step taken in two halves does not end elsewhere (a step-halving
+test); a chunk is accepted up to its first rejected sample
 and the next chunk doubles or shrinks accordingly. When even the next sample is rejected the
-front sub-steps between samples with steps cut by four; when the step falls below 2⁻⁸ of the sample spacing it tries once to step
-over the next sample to the one after (branches that cross — a bifurcation — are passed that
-way, the crossing sample closed by Newton alone), and if that fails too the branch ends there:
+front sub-steps between samples with steps cut by four; when the step falls below 2⁻⁸ of the
+sample spacing it tries once to step over the next sample to the one after (branches that
+cross — a bifurcation — are passed that way, the crossing sample closed by Newton alone), and
+if that fails too the branch ends there:
 a limit position or dead centre lies between the two samples (it *stops*, or going backwards it
 *starts assembling*). Near a fold the passive Jacobian's smallest singular value falls as the
 square root of the distance to it, σ² ∝ x* − x: where a step fails and the σ measured at the
@@ -41,7 +42,7 @@ from screwkit.kinematics.loop import (
     forward,
 )
 from screwkit.kinematics.rates import rate_equations, solve_rates
-from screwkit.kinematics.solve import correct, set_inputs, signature
+from screwkit.kinematics.solve import Correction, correct, set_inputs, signature
 from screwkit.model.linkage import Linkage
 
 MIN_SUBSTEP = 2.0 ** -8  # of the sample spacing: a front that cannot advance further ends
@@ -235,30 +236,42 @@ class Tracker:
         moved = apply_increment(here.take(owner), delta, lay)
         return set_inputs(moved, lay, self.linkage.inputs, input_at(X, t))
 
-    def _retraces(self, reached: Configuration, t_reached: Array, start: Configuration,
-                  t_start: Array, sigma: Array) -> NDArray[np.bool_]:
-        """The reversibility test of steps taken where the branch's passive Jacobian is near
-        singular (another branch close by): from each reached configuration, predict back to
-        where its step started and correct; the step is rejected when that converges to
-        another root than its start. A step that jumped onto a neighbouring branch comes back
-        on that branch (its nearest root), not on the start. Within the uncertainty of a root there, residual/σ,
-        the two count as one."""
+    def _step_to(self, here: Configuration, t_here: Array, t_to: Array) -> Correction:
+        """Predict from closed configurations ``here`` (at positions ``t_here``) to ``t_to``
+        and correct (the acceptance tests of a front's step)."""
         lay, X = self.lay, self.X
-        Q1, Q2, _ = taylor(self.linkage, lay, reached)
-        d = input_at(X, t_start) - input_at(X, t_reached)
+        Q1, Q2, _ = taylor(self.linkage, lay, here)
+        d = input_at(X, t_to) - input_at(X, t_here)
         delta = (np.einsum("tmi,ti->tm", Q1, d) + 0.5 * np.einsum("tmij,ti,tj->tm", Q2, d, d))
         delta = np.where(np.isfinite(delta), delta, 0.0)
-        pred = set_inputs(apply_increment(reached, delta, lay), lay, self.linkage.inputs,
-                          input_at(X, t_start))
-        step = np.linalg.norm(configuration_difference(pred, reached, lay) * self.col_scale,
+        pred = set_inputs(apply_increment(here, delta, lay), lay, self.linkage.inputs,
+                          input_at(X, t_to))
+        step = np.linalg.norm(configuration_difference(pred, here, lay) * self.col_scale,
                               axis=1)
-        back = correct(self.linkage, pred, lay, FIRST_STEP * step + 1e-9, CONTRACTION)
+        return correct(self.linkage, pred, lay, FIRST_STEP * step + 1e-9, CONTRACTION)
+
+    def _halves_agree(self, start: Configuration, t_start: Array, reached: Configuration,
+                      t_reached: Array, sigma: Array) -> NDArray[np.bool_]:
+        """The step-halving test of steps taken where the branch's passive Jacobian is near
+        singular (another branch close by): the same step taken in two halves, each from a
+        closer (so better) prediction, must end where the whole step did. A whole step that
+        jumped onto a neighbouring branch ends elsewhere than the halves, which stay on the
+        branch; it is rejected. Halves that do not converge prove nothing (the step stands).
+        Within the uncertainty of a root there, residual/σ, two ends count as one."""
+        mid_t = 0.5 * (t_start + t_reached)
+        mid = self._step_to(start, t_start, mid_t)
+        conclusive = mid.accepted.copy()
+        end = Configuration(reached.scalars.copy(), reached.spherical.copy())
+        if conclusive.any():
+            rows = np.nonzero(conclusive)[0]
+            second = self._step_to(mid.conf.take(rows), mid_t[rows], t_reached[rows])
+            conclusive[rows] = second.accepted
+            end.scalars[rows] = second.conf.scalars
+            end.spherical[rows] = second.conf.spherical
         # compared by signature (joint centres and axes): an S–S rod's idle spin is free
-        miss = np.max(np.abs(signature(self.linkage, back.conf, lay)
-                             - signature(self.linkage, start, lay)), axis=1)
-        # a way back that does not converge proves nothing (near a fold the backward
-        # prediction is short): only a return to another root rejects the step
-        return np.asarray(~back.accepted | (miss <= np.maximum(1e-6, 1e-10 / np.maximum(
+        miss = np.max(np.abs(signature(self.linkage, end, self.lay)
+                             - signature(self.linkage, reached, self.lay)), axis=1)
+        return np.asarray(~conclusive | (miss <= np.maximum(1e-6, 1e-10 / np.maximum(
             sigma, 1e-300))))
 
     def _wave(self, fronts: list[_Front]) -> list[_Front]:
@@ -278,7 +291,7 @@ class Tracker:
         reach = np.where(near, np.inf, FIRST_STEP * step + 1e-9)
         res = correct(self.linkage, pred, self.lay, reach, np.where(near, 1.0, CONTRACTION),
                       max_iter=40 if near.any() else 7)
-        ok = self._reversible(fronts, targets, res.conf, res.accepted)
+        ok = self._halving_test(fronts, targets, res.conf, res.accepted)
         alive = []
         start = 0
         for k, f in enumerate(fronts):
@@ -302,9 +315,9 @@ class Tracker:
                 alive.append(f)
         return alive
 
-    def _reversible(self, fronts: list[_Front], targets: list[Array], conf: Configuration,
+    def _halving_test(self, fronts: list[_Front], targets: list[Array], conf: Configuration,
                     accepted: NDArray[np.bool_]) -> NDArray[np.bool_]:
-        """``accepted`` less the steps that fail the reversibility test (:meth:`_retraces`):
+        """``accepted`` less the steps that fail the step-halving test (:meth:`_halves_agree`):
         every accepted step longer than σ of a front near a singular configuration (σ below
         FOLD_SIGMA), each against the sample before it, all fronts at once. Steps over a
         singular sample (a jump) are not tested: they cross where two branches meet by design."""
@@ -340,9 +353,10 @@ class Tracker:
                               * self.col_scale, axis=1)
         long = np.nonzero(step > sig)[0]
         if long.size:
-            ok[idx[long]] = self._retraces(reached.take(long), np.concatenate(t_to)[long],
-                                           start_conf.take(long),
-                                           np.concatenate(t_from)[long], sig[long])
+            ok[idx[long]] = self._halves_agree(start_conf.take(long),
+                                               np.concatenate(t_from)[long],
+                                               reached.take(long), np.concatenate(t_to)[long],
+                                               sig[long])
         return ok
 
     def _advance(self, f: _Front, t: Array, conf: Configuration, full: bool) -> bool:
