@@ -34,7 +34,7 @@ from screwkit.kinematics.loop import (
     forward,
     layout,
 )
-from screwkit.kinematics.mode_frames import mode_from_configuration, unwrap_runs
+from screwkit.kinematics.mode_frames import expect_modes, mode_from_configuration, unwrap_runs
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion, format_inputs
 from screwkit.model.linkage import Linkage
 
@@ -104,6 +104,7 @@ def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     rates = mot.rates
     lay = layout(linkage)
     modes: list[ModeMotion] = []
+    expect_modes(int(mot.assembles.any(axis=0).sum()))
     for j in range(mot.phi0.shape[1]):
         ok = mot.assembles[:, j]
         if not ok.any():
@@ -223,6 +224,7 @@ def rssr_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     base = linkage.base.real
     first, out = (f"{linkage.joints[k].name}.theta" for k in (0, 3))
     modes: list[ModeMotion] = []
+    expect_modes(int(mot.assembles.any(axis=0).sum()))
     for j, label in ((0, "+acos root"), (1, "-acos root")):
         ok = mot.assembles[:, j]
         if not ok.any():
@@ -293,6 +295,7 @@ def rccc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     mot = rccc_motion(dims, theta)
     lay = layout(linkage)
     modes: list[ModeMotion] = []
+    expect_modes(int(mot.assembles.any(axis=0).sum()))
     for j, label in ((0, "+acos root"), (1, "-acos root")):
         ok = mot.assembles[:, j]
         if not ok.any():

@@ -69,9 +69,10 @@ def anchor_samples(linkage: Linkage, X: Array) -> NDArray[np.intp]:
 
 
 @contextmanager
-def _reporter(progress: Progress | bool | None, N: int) -> Iterator[Progress | None]:
-    """The progress callback to use: the caller's, none, or a rich bar on stderr for a long
-    sweep on a terminal."""
+def progress_reporter(progress: Progress | bool | None, N: int,
+                      label: str = "following assembly modes") -> Iterator[Progress | None]:
+    """The progress callback to use: the caller's, none, or a rich bar (``label``) on stderr
+    for a sweep of :data:`PROGRESS_SAMPLES` samples or more on a terminal."""
     if callable(progress):
         yield progress
         return
@@ -83,7 +84,7 @@ def _reporter(progress: Progress | bool | None, N: int) -> Iterator[Progress | N
     from rich.progress import Progress as Bar
 
     with Bar(console=Console(stderr=True), transient=True) as bar:
-        task = bar.add_task("following assembly modes", total=N)
+        task = bar.add_task(label, total=N)
 
         def update(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)
@@ -112,7 +113,7 @@ def generic_motion(
     Xd = np.array(np.broadcast_to(as_input_array(linkage, input_rates, "input rates"), X.shape))
     Xdd = np.array(np.broadcast_to(as_input_array(linkage, input_accelerations,
                                                   "input accelerations"), X.shape))
-    with _reporter(progress, N) as report:
+    with progress_reporter(progress, N) as report:
         tracks = _all_branches(linkage, lay, X, starts, seed, report)
         if not tracks:
             raise AssemblyError(
@@ -338,4 +339,4 @@ def _order_key(linkage: Linkage, lay: Layout, tr: Track) -> tuple[float, ...]:
     return (float(first), *np.round(sig, 9).tolist())
 
 
-__all__ = ["ANCHOR_SPAN", "anchor_samples", "generic_motion"]
+__all__ = ["ANCHOR_SPAN", "anchor_samples", "generic_motion", "progress_reporter"]

@@ -14,6 +14,10 @@ Every solver ends here — the generic loop solver and the closed forms alike �
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -33,6 +37,53 @@ from screwkit.kinematics.rates import RESIDUAL_TOL, rate_equations, solve_rates
 from screwkit.kinematics.singularities import classify, singular_events
 from screwkit.kinematics.solve import newton
 from screwkit.model.linkage import Linkage
+
+#: where :func:`mode_from_configuration` reports how far its build has come (fraction 0…1);
+#: set by :func:`build_progress`
+_BUILD_PROGRESS: ContextVar[Callable[[float], None] | None] = ContextVar(
+    "screwkit_build_progress", default=None)
+
+
+def _built(fraction: float) -> None:
+    report = _BUILD_PROGRESS.get()
+    if report is not None:
+        report(fraction)
+
+
+def expect_modes(count: int) -> None:
+    """Tell an active :func:`build_progress` how many modes are about to be built (a closed
+    form knows after its root finding), so its total is right from the start."""
+    report = _BUILD_PROGRESS.get()
+    if report is not None:
+        report(-float(count))
+
+
+@contextmanager
+def build_progress(report: Callable[[int, int], None] | None, samples: int) -> Iterator[None]:
+    """While active, every mode built by :func:`mode_from_configuration` reports ``report(done,
+    to do)`` as its build passes its stages (frames, rate equations, idle spin, rates, link
+    motion, variables): each mode counts ``samples``, and the total grows by that as each mode
+    starts, unless the builder said beforehand how many it builds (:func:`expect_modes`). A
+    closed form's Motion is nearly all build, so this is its progress."""
+    if report is None:
+        yield
+        return
+    modes, expected = [0], [0]
+
+    def on(fraction: float) -> None:
+        if fraction < 0.0:  # expect_modes
+            expected[0] = modes[0] + int(-fraction)
+            return
+        if fraction == 0.0:
+            modes[0] += 1
+        total = max(modes[0], expected[0]) * samples
+        report(int((modes[0] - 1 + fraction) * samples), total)
+
+    token = _BUILD_PROGRESS.set(on)
+    try:
+        yield
+    finally:
+        _BUILD_PROGRESS.reset(token)
 
 
 def start_in_half_open(run: Array) -> Array:
@@ -98,8 +149,10 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
     accelerations of every freedom and link from the loop's rate equations (module docstring).
     ``X``, ``Xd``, ``Xdd`` (N, n_in) are the inputs and their first two time derivatives."""
     mask = np.asarray(mask, dtype=bool)
+    _built(0.0)
     fr = forward(linkage, conf, lay)
     eq = rate_equations(linkage, lay, fr, mask, exact_sigma=False)
+    _built(0.25)
     if eq.spin_links:
         conf = hold_idle_spin(linkage, lay, conf, mask, X, fr, eq)
         # the turns about the rods' axes leave round-off in the closure: one Newton step
@@ -110,7 +163,9 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
                                       conf.spherical))
         fr = forward(linkage, conf, lay)
         eq = rate_equations(linkage, lay, fr, mask, exact_sigma=False)
+        _built(0.45)
     rates = solve_rates(linkage, lay, eq, Xd, Xdd)
+    _built(0.7)
     singular = mask & (eq.singular | ~(rates.residual <= RESIDUAL_TOL))
     qd, qdd, link_V, link_A = rates.qd, rates.qdd, rates.link_V, rates.link_A
     # link frames and their motion in the world, per moving link i < n
@@ -129,6 +184,7 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
     twists = [world(w), world(v_o), world(al), world(a_o)]
     cen = world(fr.centres) + bp
     axs = world(fr.axes)
+    _built(0.85)
     variables, velocities, accelerations = _variable_tables(linkage, lay, conf, mask, X, qd, qdd)
     xi_res = closure_residual(fr.closure_R, fr.closure_p, eq.rows)
     bad = ~mask
@@ -149,6 +205,7 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
         kinds, dims = classify(linkage, lay, sub, rate_equations(
             linkage, lay, forward(linkage, sub, lay)))
         events = [*events, *singular_events(linkage, X, idx, kinds, dims)]
+    _built(1.0)
     return ModeMotion(mask, singular, conf, variables, velocities, accelerations,
                       link_rotation=frames[0], link_origin=frames[1],
                       link_angular_velocity=twists[0], link_origin_velocity=twists[1],

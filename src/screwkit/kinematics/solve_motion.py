@@ -11,8 +11,9 @@ from numpy.typing import ArrayLike
 
 from screwkit.budget import check_memory
 from screwkit.errors import CapabilityError, InputError
-from screwkit.kinematics.generic_motion import Progress, generic_motion
+from screwkit.kinematics.generic_motion import Progress, generic_motion, progress_reporter
 from screwkit.kinematics.loop import Array
+from screwkit.kinematics.mode_frames import build_progress
 from screwkit.kinematics.motion import ModeMotion, Motion, as_input_array
 from screwkit.kinematics.registry import family_of, seed_variables
 from screwkit.model.linkage import Linkage
@@ -53,9 +54,10 @@ def solve_motion(
         random starts per sample and their seed, for the generic solver's root search.
     progress:
         a callback ``progress(done, total)`` called as the generic solver follows its branches
-        (samples done and to do, both growing as modes are found; a closed form calls it once,
-        when done), ``False`` for none, or ``None``: a progress bar on stderr for a sweep of
-        50 000 samples or more when stderr is a terminal.
+        (samples done and to do, both growing as modes are found) or as a closed form builds
+        its modes (each mode counting every sample; the total grows as each mode starts),
+        ``False`` for none, or ``None``: a progress bar on stderr for a sweep of 50 000
+        samples or more when stderr is a terminal.
 
     Both methods give the same fields and the same mode numbering (docs/conventions.md,
     "Assembly modes"): generic modes are numbered as the closed form's where a family has one.
@@ -77,10 +79,12 @@ def solve_motion(
             f"no closed form for a {fam.name} with {X.shape[0]} input sample(s) (closed forms: "
             f"{with_closed}, with at least 2 input samples); use method 'generic'")
     if method in ("auto", "closed") and closed is not None:
-        motion = closed(linkage, X, Xd, Xdd)
+        N = X.shape[0]
+        with progress_reporter(progress, N, "building assembly modes (closed form)") as report, \
+                build_progress(report, N):
+            motion = closed(linkage, X, Xd, Xdd)
         if callable(progress):
-            done = int(sum(md.assembles.sum() for md in motion.modes))
-            progress(done, done)
+            progress(len(motion.modes) * N, len(motion.modes) * N)
         return motion
     motion = generic_motion(linkage, X, Xd, Xdd, starts=starts, seed=seed, progress=progress)
     modes = tuple(_with_seed_names(linkage, md) for md in motion.modes)
