@@ -192,7 +192,9 @@ def test_long_sweeps_are_accepted_and_report_progress():
                progress=lambda done, total: calls.append((done, total)))
     assert len(m.modes) == 2 and all(md.assembles.all() for md in m.modes)
     done, total = calls[-1]
-    assert done == total == 2 * n  # every sample of both modes, counted once
+    # every sample of both modes followed (counted once), then both modes built
+    assert done == total == 2 * n + 2 * n
+    assert any(c == (2 * n, 2 * n) for c in calls)  # the end of the following
     assert all(a[0] <= b[0] for a, b in zip(calls, calls[1:], strict=False))
 
 

@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 from screwkit.kinematics.continuation import Track, Tracker
 from screwkit.kinematics.degenerate import seeds_off_continua
 from screwkit.kinematics.loop import Array, Configuration, Layout, forward, layout
-from screwkit.kinematics.mode_frames import mode_from_configuration
+from screwkit.kinematics.mode_frames import build_progress, expect_modes, mode_from_configuration
 from screwkit.kinematics.motion import (
     AssemblyError,
     Motion,
@@ -105,8 +105,9 @@ def generic_motion(
     in every assembly mode (generic solver; works for any single loop; module docstring).
 
     ``starts`` random starts per root search and their ``seed``; ``progress`` a callback
-    ``(samples done, samples to do)`` (both grow as modes are found), ``False`` for none, or
-    ``None``: a progress bar on stderr for a sweep of 50 000 samples or more on a terminal."""
+    ``(samples done, samples to do)`` (both grow as modes are found; the samples followed, then
+    each mode's build counting every sample), ``False`` for none, or ``None``: a progress bar
+    on stderr for a sweep of 50 000 samples or more on a terminal."""
     lay = layout(linkage)
     X = as_input_array(linkage, input_values, "input values")
     N = X.shape[0]
@@ -114,16 +115,32 @@ def generic_motion(
     Xdd = np.array(np.broadcast_to(as_input_array(linkage, input_accelerations,
                                                   "input accelerations"), X.shape))
     with progress_reporter(progress, N) as report:
-        tracks = _all_branches(linkage, lay, X, starts, seed, report)
+        reached = [0]
+
+        def tracking(done: int, total: int) -> None:
+            reached[0] = max(reached[0], done)
+            if report is not None:
+                report(done, total)
+
+        tracks = _all_branches(linkage, lay, X, starts, seed,
+                               tracking if report is not None else None)
         if not tracks:
             raise AssemblyError(
                 f"{linkage.name}: the loop does not close at any of the {N} inputs "
                 f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
                 "check the dimensions")
+
+        def building(done: int, total: int) -> None:  # after the samples followed
+            if report is not None:
+                report(reached[0] + done, reached[0] + total)
+
         modes = []
-        for tr in tracks:
-            modes.append(mode_from_configuration(linkage, lay, tr.configuration(), tr.mask.copy(),
-                                                 X, Xd, Xdd, _events(linkage, X, tr)))
+        with build_progress(building if report is not None else None, N):
+            expect_modes(len(tracks))
+            for tr in tracks:
+                modes.append(mode_from_configuration(linkage, lay, tr.configuration(),
+                                                     tr.mask.copy(), X, Xd, Xdd,
+                                                     _events(linkage, X, tr)))
     modes = [replace(md, index=k, label=f"branch {k}") for k, md in enumerate(modes)]
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="generic",
                   solver="generic loop solver: continuation along the input (second-order "
