@@ -128,3 +128,29 @@ def test_continued_tables_name_their_own_columns():
     ends = [b for _, b, _ in ranges]
     pairs = list(zip(ends[:-1], starts[1:], strict=True))
     assert ends[-1] == 10 and all(a2 == b + 1 for b, a2 in pairs)  # no overlap, no gap
+
+
+def test_sweep_summary_fits_80_columns(monkeypatch):
+    # the engine used to be a table column, wrapped to one word a line; it is a sentence now
+    import io
+    from types import SimpleNamespace
+
+    from rich.console import Console
+
+    import screwkit.cli.sweep_cmd as sweep_cmd
+
+    out = io.StringIO()
+    monkeypatch.setattr(sweep_cmd, "console", Console(file=out, width=80, color_system=None))
+    engine = "embedded Dask cluster of 2 worker processes on 127.0.0.1 (LocalCluster)"
+    rows = [{"status": "ok", "reason": ""}] * 11 + [{"status": "failed",
+                                                       "reason": "does not assemble"}]
+    result = SimpleNamespace(rows=rows, computed=12, resumed=0, failed=1, errors=0,
+                             seconds=3.81, engine=engine)
+    sweep_cmd._summary(result, Path("sweep.csv"), None)
+    lines = out.getvalue().splitlines()
+    table = [line for line in lines if BOX & set(line)]
+    assert table and all(len(line) <= 80 for line in table)
+    body = [line for line in table if line.startswith("│")]
+    assert len(body) == 1  # one row, not wrapped
+    assert f"engine: {engine}" in lines
+    assert "  • 1 × does not assemble" in lines

@@ -60,13 +60,14 @@ def _summary(result: Any, output: Path, plot: Path | None) -> None:
     n = len(rows)
     t = Table(title=f"sweep: {n} designs")
     for col in ("computed", "resumed", "ok", "failed", "internal errors", "time (s)",
-                "ms per design, all in", "engine"):
+                "ms per design, all in"):
         t.add_column(col, justify="right")
     per = 1000 * result.seconds / result.computed if result.computed else float("nan")
     t.add_row(str(result.computed), str(result.resumed), str(n - result.failed - result.errors),
-              str(result.failed), str(result.errors), f"{result.seconds:.2f}", f"{per:.3g}",
-              escape(result.engine))
+              str(result.failed), str(result.errors), f"{result.seconds:.2f}", f"{per:.3g}")
     console.print(t)
+    # a sentence, below the table: as a column it wrapped to one word a line in 80 columns
+    console.print(f"engine: {escape(result.engine)}", highlight=False)
     reasons = Counter(r["reason"] for r in rows if r["status"] != "ok")
     for reason, count in reasons.most_common(5):
         console.print(f"  • {count} × {escape(reason)}", highlight=False)
