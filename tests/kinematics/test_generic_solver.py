@@ -228,6 +228,23 @@ def test_a_closed_form_reports_its_build_as_it_goes(family, monkeypatch):
     assert len(shown) >= 5 * k and shown[-1] == k * n
 
 
+def test_build_progress_counts_only_modes_built():
+    from screwkit.kinematics.mode_frames import _built, build_progress, expect_modes
+
+    calls = []
+    with build_progress(lambda d, t: calls.append((d, t)), 10):
+        expect_modes(0)  # a closed form with nothing to build says so, and is not a mode
+        assert calls == []
+        expect_modes(2)
+        _built(0.0)
+        _built(1.0)
+        _built(0.0)
+        _built(0.5)
+    assert calls == [(0, 20), (10, 20), (10, 20), (15, 20)]
+    _built(0.0)  # outside the context nothing is reported
+    assert len(calls) == 4
+
+
 def test_a_layout_reused_for_other_dimensions_reads_their_link_transforms():
     # a layout caches its linkage's link transforms for the hot paths; reused for a loop with
     # the same joints and other dimensions (a synthesis trial), it must not apply the old ones

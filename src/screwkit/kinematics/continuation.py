@@ -12,8 +12,8 @@ predictions are corrected together (:func:`~screwkit.kinematics.solve.correct`, 
 fronts and samples). A corrected sample is accepted when Newton converged and contracted fast
 from a prediction close to the result (Deuflhard's test: a jump towards another branch does
 not), and, where the passive Jacobian is near singular (another branch may be as close as a
-step), when the same step taken in two halves does not end elsewhere (a step-halving
-test); a chunk is accepted up to its first rejected sample
+step), when the same step taken in two halves converges and ends at the same root (a
+step-halving test); a chunk is accepted up to its first rejected sample
 and the next chunk doubles or shrinks accordingly. When even the next sample is rejected the
 front sub-steps between samples with steps cut by four; when the step falls below 2⁻⁸ of the
 sample spacing it tries once to step over the next sample to the one after (branches that
@@ -236,7 +236,7 @@ class Tracker:
         moved = apply_increment(here.take(owner), delta, lay)
         return set_inputs(moved, lay, self.linkage.inputs, input_at(X, t))
 
-    def _step_to(self, here: Configuration, t_here: Array, t_to: Array) -> Correction:
+    def step(self, here: Configuration, t_here: Array, t_to: Array) -> Correction:
         """Predict from closed configurations ``here`` (at positions ``t_here``) to ``t_to``
         and correct (the acceptance tests of a front's step)."""
         lay, X = self.lay, self.X
@@ -256,22 +256,24 @@ class Tracker:
         singular (another branch close by): the same step taken in two halves, each from a
         closer (so better) prediction, must end where the whole step did. A whole step that
         jumped onto a neighbouring branch ends elsewhere than the halves, which stay on the
-        branch; it is rejected. Halves that do not converge prove nothing (the step stands).
-        Within the uncertainty of a root there, residual/σ, two ends count as one."""
+        branch; it is rejected. So is a step whose halves do not converge (the half step from
+        the start failing its contraction test is itself the sign of a close branch): the
+        front then takes shorter steps, each tested the same way. Within the uncertainty of a
+        root there, residual/σ, two ends count as one."""
         mid_t = 0.5 * (t_start + t_reached)
-        mid = self._step_to(start, t_start, mid_t)
+        mid = self.step(start, t_start, mid_t)
         conclusive = mid.accepted.copy()
         end = Configuration(reached.scalars.copy(), reached.spherical.copy())
         if conclusive.any():
             rows = np.nonzero(conclusive)[0]
-            second = self._step_to(mid.conf.take(rows), mid_t[rows], t_reached[rows])
+            second = self.step(mid.conf.take(rows), mid_t[rows], t_reached[rows])
             conclusive[rows] = second.accepted
             end.scalars[rows] = second.conf.scalars
             end.spherical[rows] = second.conf.spherical
         # compared by signature (joint centres and axes): an S–S rod's idle spin is free
         miss = np.max(np.abs(signature(self.linkage, end, self.lay)
                              - signature(self.linkage, reached, self.lay)), axis=1)
-        return np.asarray(~conclusive | (miss <= np.maximum(1e-6, 1e-10 / np.maximum(
+        return np.asarray(conclusive & (miss <= np.maximum(1e-6, 1e-10 / np.maximum(
             sigma, 1e-300))))
 
     def _wave(self, fronts: list[_Front]) -> list[_Front]:

@@ -105,9 +105,10 @@ def generic_motion(
     in every assembly mode (generic solver; works for any single loop; module docstring).
 
     ``starts`` random starts per root search and their ``seed``; ``progress`` a callback
-    ``(samples done, samples to do)`` (both grow as modes are found; the samples followed, then
-    each mode's build counting every sample), ``False`` for none, or ``None``: a progress bar
-    on stderr for a sweep of 50 000 samples or more on a terminal."""
+    ``(samples done, samples to do)`` (the samples followed, then each mode's build counting
+    every sample; ``done`` never decreases and ends equal to the total, which is revised as
+    modes are found and merged), ``False`` for none, or ``None``: a progress bar on stderr
+    for a sweep of 50 000 samples or more on a terminal."""
     lay = layout(linkage)
     X = as_input_array(linkage, input_values, "input values")
     N = X.shape[0]
@@ -268,6 +269,7 @@ def _all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: in
         if not _seed_from(linkage, lay, tracker, todo, X, starts, seed + 1 + round_):
             break
     tracks = _attach_turning_points(linkage, lay, _merge_duplicates(linkage, lay, tracker.tracks))
+    tracks = _attach_lone_ends(linkage, lay, tracks)
     _pair_ends(linkage, lay, tracks)
     return sorted(tracks, key=lambda tr: _order_key(linkage, lay, tr))
 
@@ -346,6 +348,48 @@ def _attach_turning_points(linkage: Linkage, lay: Layout, tracks: list[Track]) -
         for o in ends:
             o.scalars[s], o.spherical[s], o.mask[s] = tr.scalars[s], tr.spherical[s], True
     return out
+
+
+def _attach_lone_ends(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
+    """One-sample tracks at a sample s next to where as many branches start (or stop)
+    assembling, at s + 1 (or s − 1), are those branches' first (or last) samples: next to a
+    fold the continuation may stop a sample short of where the branches still assemble, and
+    the root search then finds that sample's roots alone. Each root goes to one branch,
+    paired by continuity (the least total distance to the branches' neighbouring
+    configurations, as :func:`_pair_ends`), and only within ten of the branch's own step
+    there. Attached, a branch's run — and an S–S rod's pose carried along it from the run's
+    first sample — is the closed forms'."""
+    from itertools import permutations
+
+    lone = [tr for tr in tracks if int(tr.mask.sum()) == 1]
+    if not lone:
+        return tracks
+    N = len(tracks[0].mask)
+    attached: list[Track] = []
+    for s in sorted({int(np.argmax(tr.mask)) for tr in lone}):
+        roots = [tr for tr in lone if tr.mask[s] and not any(tr is a for a in attached)]
+        for n in (s + 1, s - 1):
+            far = n + (n - s)
+            if not roots or not 0 <= far < N:
+                continue
+            ends = [o for o in tracks if int(o.mask.sum()) > 1 and o.mask[n] and o.mask[far]
+                    and not o.mask[s]]
+            if len(ends) != len(roots) or len(roots) > 4:
+                continue
+            mine = np.stack([_signatures(linkage, lay, tr, np.array([s]))[0] for tr in roots])
+            near = np.stack([_signatures(linkage, lay, o, np.array([n, far])) for o in ends])
+            gap = np.linalg.norm(mine[:, None, :] - near[None, :, 0, :], axis=-1)
+            step = np.linalg.norm(near[:, 0] - near[:, 1], axis=-1)
+            best = min(permutations(range(len(ends))),
+                       key=lambda perm: sum(gap[i, j] for i, j in enumerate(perm)))
+            if not all(gap[i, j] <= 10.0 * step[j] + SAME_ROOT for i, j in enumerate(best)):
+                continue
+            for i, j in enumerate(best):
+                o, tr = ends[j], roots[i]
+                o.scalars[s], o.spherical[s], o.mask[s] = tr.scalars[s], tr.spherical[s], True
+                attached.append(tr)
+            roots = []
+    return [tr for tr in tracks if not any(tr is a for a in attached)]
 
 
 def _order_key(linkage: Linkage, lay: Layout, tr: Track) -> tuple[float, ...]:

@@ -38,24 +38,43 @@ from screwkit.kinematics.singularities import classify, singular_events
 from screwkit.kinematics.solve import newton
 from screwkit.model.linkage import Linkage
 
-#: where :func:`mode_from_configuration` reports how far its build has come (fraction 0…1);
-#: set by :func:`build_progress`
-_BUILD_PROGRESS: ContextVar[Callable[[float], None] | None] = ContextVar(
-    "screwkit_build_progress", default=None)
+
+class _BuildReport:
+    """How far the modes being built have come, for :func:`build_progress`."""
+
+    def __init__(self, report: Callable[[int, int], None], samples: int) -> None:
+        self.report, self.samples = report, samples
+        self.modes = 0  # builds started
+        self.expected = 0  # builds announced by expect_modes
+
+    def expect(self, count: int) -> None:
+        self.expected = self.modes + count
+
+    def stage(self, fraction: float) -> None:
+        if fraction == 0.0:
+            self.modes += 1
+        total = max(self.modes, self.expected) * self.samples
+        self.report(int((self.modes - 1 + fraction) * self.samples), total)
+
+
+#: where :func:`mode_from_configuration` reports how far its build has come; set by
+#: :func:`build_progress`
+_BUILD_PROGRESS: ContextVar[_BuildReport | None] = ContextVar("screwkit_build_progress",
+                                                              default=None)
 
 
 def _built(fraction: float) -> None:
-    report = _BUILD_PROGRESS.get()
-    if report is not None:
-        report(fraction)
+    active = _BUILD_PROGRESS.get()
+    if active is not None:
+        active.stage(fraction)
 
 
 def expect_modes(count: int) -> None:
     """Tell an active :func:`build_progress` how many modes are about to be built (a closed
     form knows after its root finding), so its total is right from the start."""
-    report = _BUILD_PROGRESS.get()
-    if report is not None:
-        report(-float(count))
+    active = _BUILD_PROGRESS.get()
+    if active is not None:
+        active.expect(count)
 
 
 @contextmanager
@@ -68,18 +87,7 @@ def build_progress(report: Callable[[int, int], None] | None, samples: int) -> I
     if report is None:
         yield
         return
-    modes, expected = [0], [0]
-
-    def on(fraction: float) -> None:
-        if fraction < 0.0:  # expect_modes
-            expected[0] = modes[0] + int(-fraction)
-            return
-        if fraction == 0.0:
-            modes[0] += 1
-        total = max(modes[0], expected[0]) * samples
-        report(int((modes[0] - 1 + fraction) * samples), total)
-
-    token = _BUILD_PROGRESS.set(on)
+    token = _BUILD_PROGRESS.set(_BuildReport(report, samples))
     try:
         yield
     finally:

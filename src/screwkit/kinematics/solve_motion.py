@@ -54,8 +54,9 @@ def solve_motion(
         random starts per sample and their seed, for the generic solver's root search.
     progress:
         a callback ``progress(done, total)`` called as the generic solver follows its branches
-        (samples done and to do, both growing as modes are found) or as a closed form builds
-        its modes (each mode counting every sample; the total grows as each mode starts),
+        and builds its modes, or as a closed form builds its modes (each mode counting every
+        sample): ``done`` never decreases and ends equal to ``total``, which is revised as
+        modes are found (and, in the generic solver, merged),
         ``False`` for none, or ``None``: a progress bar on stderr for a sweep of 50 000
         samples or more when stderr is a terminal.
 
