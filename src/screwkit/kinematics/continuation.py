@@ -13,16 +13,16 @@ fronts and samples). A corrected sample is accepted when Newton converged and co
 from a prediction close to the result (Deuflhard's test: a jump towards another branch does
 not), and, where the passive Jacobian is near singular (another branch may be as close as a
 step), when the same step taken in two halves converges and ends at the same root (a
-step-halving test); a chunk is accepted up to its first rejected sample
-and the next chunk doubles or shrinks accordingly. When even the next sample is rejected the
-front sub-steps between samples with steps cut by four; when the step falls below 2⁻⁸ of the
-sample spacing it tries once to step over the next sample to the one after (branches that
-cross — a bifurcation — are passed that way, the crossing sample closed by Newton alone), and
-if that fails too the branch ends there:
-a limit position or dead centre lies between the two samples (it *stops*, or going backwards it
-*starts assembling*). Near a fold the passive Jacobian's smallest singular value falls as the
-square root of the distance to it, σ² ∝ x* − x: where a step fails and the σ measured at the
-front's last two points extrapolates to zero before the next sample, the branch ends at once.
+step-halving test); a chunk is accepted up to its first rejected sample and the next chunk
+doubles or shrinks accordingly. When even the next sample is rejected the front sub-steps
+between samples with steps cut by four; when the step falls below 2⁻⁸ of the sample spacing it
+tries once to step over the next sample to the one after (branches that cross — a bifurcation
+— are passed that way, the crossing sample closed by Newton alone), and if that fails too the
+branch ends there: a limit position or dead centre lies between the two samples (it *stops*,
+or going backwards it *starts assembling*). Near a fold the passive Jacobian's smallest
+singular value falls as the square root of the distance to it, σ² ∝ x* − x: where a step
+fails and the σ measured at the front's last two points extrapolates to zero before the next
+sample, the branch ends at once.
 """
 
 from __future__ import annotations
@@ -117,6 +117,13 @@ def taylor(linkage: Linkage, lay: Layout, conf: Configuration) -> tuple[Array, A
                                zero, True)
             Q2[:, :, i, j] = Q2[:, :, j, i] = 0.5 * (both.qdd - Q2[:, :, i, i] - Q2[:, :, j, j])
     return Q1, Q2, eq.sigma_ratio
+
+
+def taylor_increment(Q1: Array, Q2: Array, d: Array) -> Array:
+    """The predictor's increment q_X d + ½ q_XX(d, d) (B, m) for input moves ``d`` (B, n_in)
+    from the derivatives of :func:`taylor`."""
+    return np.asarray(np.einsum("tmi,ti->tm", Q1, d)
+                      + 0.5 * np.einsum("tmij,ti,tj->tm", Q2, d, d))
 
 
 class Tracker:
@@ -221,9 +228,8 @@ class Tracker:
             if at != f.sigma[1]:
                 f.sigma_before, f.sigma = f.sigma, (sg, at)
         t_front = np.array([f.t for f in fronts])
-        d = input_at(X, t) - input_at(X, t_front)[owner]
-        delta = (np.einsum("tmi,ti->tm", Q1[owner], d)
-                 + 0.5 * np.einsum("tmij,ti,tj->tm", Q2[owner], d, d))
+        delta = taylor_increment(Q1[owner], Q2[owner],
+                                 input_at(X, t) - input_at(X, t_front)[owner])
         bad = ~np.all(np.isfinite(delta), axis=1)
         if bad.any():  # singular front: the secant through its last two points
             for r in np.nonzero(bad)[0]:
@@ -236,13 +242,12 @@ class Tracker:
         moved = apply_increment(here.take(owner), delta, lay)
         return set_inputs(moved, lay, self.linkage.inputs, input_at(X, t))
 
-    def step(self, here: Configuration, t_here: Array, t_to: Array) -> Correction:
+    def _step(self, here: Configuration, t_here: Array, t_to: Array) -> Correction:
         """Predict from closed configurations ``here`` (at positions ``t_here``) to ``t_to``
         and correct (the acceptance tests of a front's step)."""
         lay, X = self.lay, self.X
         Q1, Q2, _ = taylor(self.linkage, lay, here)
-        d = input_at(X, t_to) - input_at(X, t_here)
-        delta = (np.einsum("tmi,ti->tm", Q1, d) + 0.5 * np.einsum("tmij,ti,tj->tm", Q2, d, d))
+        delta = taylor_increment(Q1, Q2, input_at(X, t_to) - input_at(X, t_here))
         delta = np.where(np.isfinite(delta), delta, 0.0)
         pred = set_inputs(apply_increment(here, delta, lay), lay, self.linkage.inputs,
                           input_at(X, t_to))
@@ -261,12 +266,12 @@ class Tracker:
         front then takes shorter steps, each tested the same way. Within the uncertainty of a
         root there, residual/σ, two ends count as one."""
         mid_t = 0.5 * (t_start + t_reached)
-        mid = self.step(start, t_start, mid_t)
+        mid = self._step(start, t_start, mid_t)
         conclusive = mid.accepted.copy()
         end = Configuration(reached.scalars.copy(), reached.spherical.copy())
         if conclusive.any():
             rows = np.nonzero(conclusive)[0]
-            second = self.step(mid.conf.take(rows), mid_t[rows], t_reached[rows])
+            second = self._step(mid.conf.take(rows), mid_t[rows], t_reached[rows])
             conclusive[rows] = second.accepted
             end.scalars[rows] = second.conf.scalars
             end.spherical[rows] = second.conf.spherical

@@ -356,8 +356,8 @@ def _attach_lone_ends(linkage: Linkage, lay: Layout, tracks: list[Track]) -> lis
     fold the continuation may stop a sample short of where the branches still assemble, and
     the root search then finds that sample's roots alone. Each root goes to one branch,
     paired by continuity (the least total distance to the branches' neighbouring
-    configurations, as :func:`_pair_ends`), and only within ten of the branch's own step
-    there. Attached, a branch's run — and an S–S rod's pose carried along it from the run's
+    configurations, as :func:`_pair_ends`), and only within ten times the branch's own
+    step there. Attached, a branch's run — and an S–S rod's pose carried along it from the run's
     first sample — is the closed forms'."""
     from itertools import permutations
 
