@@ -48,6 +48,8 @@ _EXPORTS: dict[str, str] = {
     "family": "screwkit.kinematics.registry",
     # kinematics
     "solve_motion": "screwkit.kinematics.solve_motion",
+    "solve_joints": "screwkit.kinematics.joint_motion",
+    "JointMotion": "screwkit.kinematics.joint_motion",
     "Motion": "screwkit.kinematics.motion",
     "ModeMotion": "screwkit.kinematics.motion",
     "AssemblyError": "screwkit.kinematics.motion",
@@ -83,6 +85,7 @@ __all__ = [
     "ExternalLoad",
     "Joint",
     "Link",
+    "JointMotion",
     "Linkage",
     "MassProperties",
     "ModeMotion",
@@ -106,6 +109,7 @@ __all__ = [
     "regressor",
     "rsrc",
     "rssr",
+    "solve_joints",
     "solve_motion",
     "synthesize",
     "transmission",
@@ -143,6 +147,7 @@ if TYPE_CHECKING:
     from screwkit.io.errors import SpecError
     from screwkit.io.spec import Spec, load_spec
     from screwkit.kinematics.coupler_curves import coupler_point_path
+    from screwkit.kinematics.joint_motion import JointMotion, solve_joints
     from screwkit.kinematics.limit_positions import limit_positions
     from screwkit.kinematics.loop_mobility import mobility
     from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion

@@ -33,6 +33,13 @@ CASES = [
     ("NaN input", lambda f: sk.solve_motion(_lk(), [0.0, np.nan]), InputError, "finite"),
     ("two columns for one input", lambda f: sk.solve_motion(_lk(), np.zeros((3, 2))),
      InputError, "1 value(s) per sample"),
+    ("rates of the wrong length", lambda f: sk.solve_motion(_lk(), [0.0, 0.1, 0.2],
+                                                           rates=[1.0, 2.0]),
+     InputError, "one value for every sample or one per sample (3 samples); got 2"),
+    ("joints: accelerations of the wrong length", lambda f: sk.solve_joints(
+        _lk(), [0.0, 0.1, 0.2], accelerations=[1.0, 2.0]), InputError,
+     "accelerations: give one value for every sample"),
+    ("joints: text inputs", lambda f: sk.solve_joints(_lk(), "abc"), InputTypeError, "inputs"),
     ("unknown method", lambda f: sk.solve_motion(_lk(), [0.0, 0.1], method="fast"),
      InputError, "method must be"),
     ("closed form of a LOOP", lambda f: sk.solve_motion(

@@ -23,107 +23,80 @@ or going backwards it *starts assembling*). Near a fold the passive Jacobian's s
 singular value falls as the square root of the distance to it, σ² ∝ x* − x: where a step
 fails and the σ measured at the front's last two points extrapolates to zero before the next
 sample, the branch ends at once.
+
+On a fine sweep a chunk is corrected only at every few samples (at most FILL_STRIDE samples
+and FILL_SPAN of input apart); the samples in between are filled by quintic Hermite
+interpolation between neighbouring corrected samples (:mod:`screwkit.kinematics.branch_fill`)
+and kept where the loop closes there to the corrector's tolerance, else corrected by Newton
+with the same tests. Asked for rates, the tracker also solves the rate equations of those
+samples from the screws of that closure check (:class:`~screwkit.kinematics.tracks.TrackRates`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.kinematics.branch_fill import hermite_increments
 from screwkit.kinematics.loop import (
     Array,
     Configuration,
     Layout,
     apply_increment,
+    closure_error,
     configuration_difference,
     forward,
 )
-from screwkit.kinematics.rates import rate_equations, solve_rates
-from screwkit.kinematics.solve import Correction, correct, set_inputs, signature
+from screwkit.kinematics.rates import joint_rates, rate_equations, spin_links
+from screwkit.kinematics.solve import CLOSURE_TOL, Correction, correct, set_inputs, signature
+from screwkit.kinematics.tracks import (
+    Front,
+    Track,
+    TrackRates,
+    input_at,
+    taylor,
+    taylor_increment,
+)
 from screwkit.model.linkage import Linkage
 
 MIN_SUBSTEP = 2.0 ** -8  # of the sample spacing: a front that cannot advance further ends
 FOLD_SIGMA = 0.2  # σ_min/σ_max of J_p below which a failed step may be a fold ahead
-MAX_CHUNK = 2048  # samples predicted at once by one front
+MAX_CHUNK = 16384  # samples predicted at once by one front
 MAX_SPAN = 1.5  # rad (or length scale) the inputs may move over one chunk
 FIRST_STEP = 0.2  # largest Newton correction, relative to the predicted step
 CONTRACTION = 0.5  # largest ratio of the second Newton step to the first
+FILL_SPAN = 0.01  # rad (or length scale) of input between two corrected samples of a chunk
+FILL_STRIDE = 128  # samples between two corrected samples of a chunk, at most
 
 
-@dataclass
-class Track:
-    """One branch over the sweep: its configurations where ``mask`` holds, the sample it was
-    seeded at, and where it ends: ``stops`` after sample k (forwards), ``starts`` at sample k
-    (backwards), each with the input position reached before the end."""
+def _placer(idx: NDArray[np.intp], rows: NDArray[np.intp]) -> Callable[[Array, Array], None]:
+    """A writer of ``values[rows]`` into ``array[idx]``: by slices where both are runs of
+    consecutive indices (a chunk of samples, either direction; several times faster than
+    fancy indexing for the large arrays of long sweeps)."""
+    n = len(idx)
+    if n > 1 and abs(int(idx[-1]) - int(idx[0])) == n - 1 and rows[-1] - rows[0] == n - 1 \
+            and np.all(np.abs(np.diff(idx)) == 1):
+        lo, hi = int(min(idx[0], idx[-1])), int(max(idx[0], idx[-1])) + 1
+        src = slice(int(rows[0]), int(rows[-1]) + 1)
+        rev = idx[-1] < idx[0]
 
-    scalars: Array
-    spherical: Array
-    mask: NDArray[np.bool_]
-    seed: int
-    stops: list[tuple[int, float]] = field(default_factory=list)
-    starts: list[tuple[int, float]] = field(default_factory=list)
+        def by_slice(array: Array, values: Array) -> None:
+            array[lo:hi] = values[src][::-1] if rev else values[src]
 
-    def configuration(self) -> Configuration:
-        return Configuration(np.where(self.mask[:, None], self.scalars, 0.0), self.spherical)
+        return by_slice
 
+    def by_index(array: Array, values: Array) -> None:
+        array[idx] = values[rows]
 
-@dataclass
-class _Front:
-    track: int
-    direction: int
-    t: float
-    conf: Configuration  # one row
-    prev: Configuration | None = None
-    prev_t: float = 0.0
-    chunk: int = 4
-    substep: float = 0.0  # 0: chunk mode; else the sub-step (a fraction of the spacing)
-    sigma: tuple[float, float] = (np.inf, np.nan)  # σ ratio of J_p at the front, and where
-    sigma_before: tuple[float, float] = (np.inf, np.nan)
-    jump: bool = False  # this wave steps over a singular sample to the one after it
-    jumped: bool = False  # a jump was tried since the front last advanced normally
+    return by_index
 
 
-def input_at(X: Array, t: Array) -> Array:
-    """Inputs (T, n_in) at positions ``t`` (T,) along the sweep (straight between samples)."""
-    i0 = np.clip(np.floor(t).astype(int), 0, X.shape[0] - 1)
-    i1 = np.minimum(i0 + 1, X.shape[0] - 1)
-    frac = (t - i0)[:, None]
-    return np.asarray(X[i0] + frac * (X[i1] - X[i0]))
-
-
-def taylor(linkage: Linkage, lay: Layout, conf: Configuration) -> tuple[Array, Array, Array]:
-    """First and second derivatives of every freedom with respect to the inputs, q_X (B, m,
-    n_in) and q_XX (B, m, n_in, n_in), at each configuration; where the rate equations are
-    singular, their minimum-norm solution (on a continuum: the least motion that follows the
-    input; elsewhere the acceptance test judges the prediction). Also returns the σ ratio of
-    the passive Jacobian (B,)."""
-    B, n_in = conf.size, len(linkage.inputs)
-    m = len(lay.names)
-    eq = rate_equations(linkage, lay, forward(linkage, conf, lay))
-    Q1 = np.empty((B, m, n_in))
-    Q2 = np.empty((B, m, n_in, n_in))
-    zero = np.zeros((B, n_in))
-    eye = np.eye(n_in)
-    for i in range(n_in):
-        r = solve_rates(linkage, lay, eq, np.broadcast_to(eye[i], (B, n_in)), zero, True)
-        Q1[:, :, i] = r.qd
-        Q2[:, :, i, i] = r.qdd
-    for i in range(n_in):
-        for j in range(i + 1, n_in):
-            both = solve_rates(linkage, lay, eq, np.broadcast_to(eye[i] + eye[j], (B, n_in)),
-                               zero, True)
-            Q2[:, :, i, j] = Q2[:, :, j, i] = 0.5 * (both.qdd - Q2[:, :, i, i] - Q2[:, :, j, j])
-    return Q1, Q2, eq.sigma_ratio
-
-
-def taylor_increment(Q1: Array, Q2: Array, d: Array) -> Array:
-    """The predictor's increment q_X d + ½ q_XX(d, d) (B, m) for input moves ``d`` (B, n_in)
-    from the derivatives of :func:`taylor`."""
-    return np.asarray(np.einsum("tmi,ti->tm", Q1, d)
-                      + 0.5 * np.einsum("tmij,ti,tj->tm", Q2, d, d))
+def _coarse(n: int, stride: int) -> NDArray[np.intp]:
+    """Indices of every ``stride``-th of ``n`` targets, and always the last."""
+    idx = np.arange(stride - 1, n, stride)
+    return idx if idx.size and idx[-1] == n - 1 else np.append(idx, n - 1)
 
 
 class Tracker:
@@ -131,8 +104,13 @@ class Tracker:
     added and followed."""
 
     def __init__(self, linkage: Linkage, lay: Layout, X: Array,
-                 progress: Callable[[int], None] | None = None) -> None:
+                 progress: Callable[[int], None] | None = None,
+                 rates: tuple[Array, Array] | None = None) -> None:
         self.linkage, self.lay, self.X = linkage, lay, X
+        # the inputs' rates and accelerations (N, n_in): then the rates of the samples filled
+        # by interpolation are found from the closure check's screws (a loop without S–S
+        # rods, whose poses a Motion's build turns)
+        self.rates = rates if rates is not None and not spin_links(linkage) else None
         self.N = X.shape[0]
         self.tracks: list[Track] = []
         self._met: dict[int, bool] = {}
@@ -151,9 +129,11 @@ class Tracker:
             tr = Track(np.full((self.N, self.lay.n_scalar), np.nan),
                        np.tile(np.eye(3), (self.N, self.lay.n_spherical, 1, 1)),
                        np.zeros(self.N, dtype=bool), sample)
-            tr.scalars[sample] = conf.scalars[k]
-            tr.spherical[sample] = conf.spherical[k]
-            tr.mask[sample] = True
+            if self.rates is not None:
+                m = len(self.lay.names)
+                tr.rates = TrackRates(np.full((self.N, m), np.nan), np.full((self.N, m), np.nan),
+                                      np.zeros(self.N, dtype=bool), np.zeros(self.N, dtype=bool))
+            tr.set_sample(sample, conf.scalars[k], conf.spherical[k])
             self.tracks.append(tr)
             ids.append(len(self.tracks) - 1)
             self._met[ids[-1]] = False
@@ -177,7 +157,7 @@ class Tracker:
             for direction in (1, -1):
                 if 0 <= tr.seed + direction < self.N:
                     # a seed near a fold starts with sub-steps: its Taylor series is short there
-                    fronts.append(_Front(i, direction, float(tr.seed), row,
+                    fronts.append(Front(i, direction, float(tr.seed), row,
                                          substep=0.25 if sigma[r] < FOLD_SIGMA else 0.0))
         while fronts:
             fronts = self._wave(fronts)
@@ -189,7 +169,7 @@ class Tracker:
         k = min(int(np.floor(t)), self.N - 2) if self.N > 1 else 0
         return float(self.span[k] + (t - k) * (self.span[min(k + 1, self.N - 1)] - self.span[k]))
 
-    def _fold_ahead(self, f: _Front) -> bool:
+    def _fold_ahead(self, f: Front) -> bool:
         """Whether σ² of the front's last two points extrapolates to zero before the next
         sample (a fold of the branch in the input lies there)."""
         (s1, x1), (s0, x0) = f.sigma, f.sigma_before
@@ -200,7 +180,7 @@ class Tracker:
         return bool(abs(fold - x1) <= abs(self._position(float(np.clip(nxt, 0, self.N - 1)))
                                           - x1))
 
-    def _targets(self, fr: _Front) -> Array:
+    def _targets(self, fr: Front) -> Array:
         if fr.jump:
             near = np.floor(fr.t) + 1 if fr.direction > 0 else np.ceil(fr.t) - 1
             return np.array([near, near + fr.direction])
@@ -218,12 +198,14 @@ class Tracker:
         n = int(np.argmin(within)) if not within.all() else len(idx)
         return idx[:n].astype(float)
 
-    def _predict(self, fronts: list[_Front], owner: NDArray[np.intp], t: Array) -> Configuration:
+    def _predict(self, fronts: list[Front], owner: NDArray[np.intp], t: Array) -> Configuration:
         lay, X = self.lay, self.X
         here = Configuration(np.concatenate([f.conf.scalars for f in fronts]),
                              np.concatenate([f.conf.spherical for f in fronts]))
-        Q1, Q2, sigma = taylor(self.linkage, lay, here)
-        for f, sg in zip(fronts, sigma.tolist(), strict=True):
+        Q1, Q2, sigma, Jp = taylor(self.linkage, lay, here)
+        for k, (f, sg) in enumerate(zip(fronts, sigma.tolist(), strict=True)):
+            f.derivatives = (Q1[k], Q2[k])
+            f.passive = Jp[k]
             at = self._position(f.t)
             if at != f.sigma[1]:
                 f.sigma_before, f.sigma = f.sigma, (sg, at)
@@ -246,7 +228,7 @@ class Tracker:
         """Predict from closed configurations ``here`` (at positions ``t_here``) to ``t_to``
         and correct (the acceptance tests of a front's step)."""
         lay, X = self.lay, self.X
-        Q1, Q2, _ = taylor(self.linkage, lay, here)
+        Q1, Q2, _, _ = taylor(self.linkage, lay, here)
         delta = taylor_increment(Q1, Q2, input_at(X, t_to) - input_at(X, t_here))
         delta = np.where(np.isfinite(delta), delta, 0.0)
         pred = set_inputs(apply_increment(here, delta, lay), lay, self.linkage.inputs,
@@ -281,9 +263,14 @@ class Tracker:
         return np.asarray(conclusive & (miss <= np.maximum(1e-6, 1e-10 / np.maximum(
             sigma, 1e-300))))
 
-    def _wave(self, fronts: list[_Front]) -> list[_Front]:
-        """One predictor–corrector pass of every front; returns the fronts still moving."""
-        targets = [self._targets(f) for f in fronts]
+    def _wave(self, fronts: list[Front]) -> list[Front]:
+        """One predictor–corrector pass of every front; returns the fronts still moving. A
+        long chunk is corrected at every few samples only (its *coarse* targets) and filled
+        in between by interpolation (:meth:`_fill`)."""
+        every = [self._targets(f) for f in fronts]
+        strides = [self._fill_stride(f, tg) for f, tg in zip(fronts, every, strict=True)]
+        targets = [tg if s == 1 else tg[_coarse(len(tg), s)]
+                   for tg, s in zip(every, strides, strict=True)]
         owner = np.concatenate([np.full(len(tg), k) for k, tg in enumerate(targets)])
         t = np.concatenate(targets)
         pred = self._predict(fronts, owner, t)
@@ -300,6 +287,7 @@ class Tracker:
                       max_iter=40 if near.any() else 7)
         ok = self._halving_test(fronts, targets, res.conf, res.accepted)
         alive = []
+        fills: list[tuple[Front, Array, Array, Configuration, bool]] = []
         start = 0
         for k, f in enumerate(fronts):
             n = len(targets[k])
@@ -317,12 +305,152 @@ class Tracker:
                                  full=False):
                     alive.append(f)
                 continue
-            if self._advance(f, targets[k][:p], res.conf.take(np.arange(sl.start, sl.start + p)),
-                             full=p == n):
+            reached = res.conf.take(np.arange(sl.start, sl.start + p))
+            if strides[k] > 1:
+                if p == 0:  # the first coarse target failed: retry with single samples
+                    f.chunk = 1
+                    alive.append(f)
+                else:
+                    fills.append((f, every[k], targets[k][:p], reached, p == n))
+                continue
+            if self._advance(f, targets[k][:p], reached, full=p == n):
+                alive.append(f)
+        for f, t_acc, conf, full, rates in self._fill(fills):
+            if self._advance(f, t_acc, conf, full=full, rates=rates):
                 alive.append(f)
         return alive
 
-    def _halving_test(self, fronts: list[_Front], targets: list[Array], conf: Configuration,
+    def _fill_stride(self, f: Front, targets: Array) -> int:
+        """Every how many samples a front's chunk is corrected (1: every sample): so that each
+        interval between corrected samples spans at most FILL_SPAN of input and FILL_STRIDE
+        samples; only for chunks of plain samples (not sub-steps or jumps)."""
+        if f.jump or f.substep or len(targets) < 4:
+            return 1
+        k = int(round(f.t))
+        idx = targets.astype(int)
+        spacing = np.abs(np.diff(self.span[np.concatenate([[k], idx])])).max()
+        if spacing <= 0.0:
+            return 1
+        return int(np.clip(FILL_SPAN // spacing, 1, min(FILL_STRIDE, len(targets) // 2)))
+
+    def _fill(self, fills: list[tuple[Front, Array, Array, Configuration, bool]],
+              ) -> list[tuple[Front, Array, Configuration, bool, TrackRates | None]]:
+        """The samples between a front and its accepted coarse targets, all fronts at once:
+        predicted by quintic Hermite interpolation between neighbouring corrected samples of the
+        branch (:mod:`screwkit.kinematics.branch_fill`, with the derivatives from the rate
+        equations at both), accepted where the loop closes there to the corrector's tolerance
+        (the interpolation error is of sixth order in the interval); elsewhere corrected by
+        Newton with the usual acceptance tests. A front keeps its samples up to the first one
+        that fails. Returns, per front, the samples reached, their configurations, whether the
+        whole chunk was, and (when the tracker was asked for them) their rates where found."""
+        if not fills:
+            return []
+        lay, X = self.lay, self.X
+        starts = Configuration(np.concatenate([f.conf.scalars for f, *_ in fills]),
+                               np.concatenate([f.conf.spherical for f, *_ in fills]))
+        nodes = Configuration(np.concatenate([c.scalars for *_, c, _ in fills]),
+                              np.concatenate([c.spherical for *_, c, _ in fills]))
+        QB1, QB2, _, JB = taylor(self.linkage, lay, nodes, exact_sigma=False)
+        counts = [len(tc) for _, _, tc, _, _ in fills]
+        first = np.cumsum([0, *counts[:-1]])  # each front's first node
+        # interval j runs from node j − 1 (the front, for a front's first interval) to node j
+        prev = np.arange(nodes.size) - 1
+        is_first = np.zeros(nodes.size, dtype=bool)
+        is_first[first] = True
+        which = np.repeat(np.arange(len(fills)), counts)
+        A = Configuration(np.where(is_first[:, None], starts.scalars[which],
+                                   nodes.scalars[np.maximum(prev, 0)]),
+                          np.where(is_first[:, None, None, None], starts.spherical[which],
+                                   nodes.spherical[np.maximum(prev, 0)]))
+        def at_starts(of_front: list[Array], of_nodes: Array) -> Array:
+            """A quantity at each interval's start: the front's, or the node before."""
+            front = np.stack(of_front)[which]
+            return np.asarray(np.where(is_first.reshape(-1, *[1] * (front.ndim - 1)), front,
+                                       of_nodes[np.maximum(prev, 0)]))
+
+        # the front's derivatives and Jacobian are this wave's (set by _predict)
+        QA1 = at_starts([f.derivatives[0] for f, *_ in fills], QB1)  # type: ignore[index]
+        QA2 = at_starts([f.derivatives[1] for f, *_ in fills], QB2)  # type: ignore[index]
+        JA = at_starts([f.passive for f, *_ in fills], JB)  # type: ignore[misc]
+        tB = np.concatenate([tc for _, _, tc, _, _ in fills])
+        tA = np.where(is_first, np.array([f.t for f, *_ in fills])[which], np.roll(tB, 1))
+        dX = input_at(X, tB) - input_at(X, tA)
+        v0 = np.einsum("jmi,ji->jm", QA1, dX)
+        a0 = np.einsum("jmik,ji,jk->jm", QA2, dX, dX)
+        v1 = np.einsum("jmi,ji->jm", QB1, dX)
+        a1 = np.einsum("jmik,ji,jk->jm", QB2, dX, dX)
+        d1 = configuration_difference(nodes, A, lay)
+        # the samples strictly inside each interval
+        gap = np.abs(tB - tA).astype(int) - 1
+        interval = np.repeat(np.arange(nodes.size), gap)
+        offset = np.arange(interval.size) - np.repeat(np.cumsum(gap) - gap, gap) + 1
+        direction = np.sign(tB - tA)
+        t = tA[interval] + direction[interval] * offset
+        u = offset / (gap[interval] + 1.0)
+        delta = hermite_increments(lay, d1, v0, a0, v1, a1, interval, u)
+        line = ~np.all(np.isfinite(delta), axis=1)  # a singular end: the chord
+        delta[line] = u[line, None] * d1[interval[line]]
+        start_conf = A.take(interval)
+        pred = set_inputs(apply_increment(start_conf, delta, lay), lay, self.linkage.inputs,
+                          input_at(X, t))
+        near = (JA[interval], np.asarray(np.linalg.svd(JA, compute_uv=False)[:, -1],
+                                         dtype=float)[interval]) \
+            if JA.shape[1] >= JA.shape[2] > 0 else None
+        conf, closed, rates = self._closed_or_corrected(pred, start_conf, t, near)
+        out = []
+        for k, (f, _, tc, reached, full) in enumerate(fills):
+            mine = np.nonzero(which[interval] == k)[0]
+            t_all = np.concatenate([t[mine], tc])
+            order = np.argsort(t_all * f.direction, kind="stable")
+            ok = np.concatenate([closed[mine], np.ones(len(tc), dtype=bool)])[order]
+            p = len(order) if ok.all() else int(np.argmin(ok))
+            keep = order[:p]
+            here = Configuration(np.concatenate([conf.scalars[mine], reached.scalars])[keep],
+                                 np.concatenate([conf.spherical[mine], reached.spherical])[keep])
+            found = None
+            if rates is not None:  # the coarse targets' rates are not known here
+                pad = len(tc)
+                found = TrackRates(*(np.concatenate([a[mine], np.full((pad, *a.shape[1:]),
+                                                                      fill, a.dtype)])[keep]
+                                     for a, fill in ((rates.qd, np.nan), (rates.qdd, np.nan),
+                                                     (rates.singular, False),
+                                                     (rates.known, False))))
+            out.append((f, t_all[keep], here, full and p == len(order), found))
+        return out
+
+    def _closed_or_corrected(self, pred: Configuration, start: Configuration, t: Array,
+                             near: tuple[Array, Array] | None,
+                             ) -> tuple[Configuration, NDArray[np.bool_], TrackRates | None]:
+        """Interpolated samples (at positions ``t``) as they are where the loop closes to the
+        corrector's tolerance, else corrected by Newton from them (accepted by the corrector's
+        tests, the reach measured from the interval's start); with the rates of the samples
+        kept as they are, from the same screws, when the tracker was asked for rates (their
+        rank test helped by ``near``: each interval start's passive Jacobian and σ_min)."""
+        fr = forward(self.linkage, pred, self.lay, frames=False)
+        rows = np.array([1.0, 1.0, 1.0, *([1.0 / self.linkage.length_scale] * 3)])
+        r = np.max(np.abs(closure_error(fr.closure_R, fr.closure_p) * rows), axis=-1)
+        closed = r <= CLOSURE_TOL
+        rates = None
+        if self.rates is not None:
+            eq = rate_equations(self.linkage, self.lay, fr, closed, exact_sigma=False,
+                                near=near)
+            k = np.round(t).astype(int)
+            jr = joint_rates(self.linkage, self.lay, eq, closed, self.rates[0][k],
+                             self.rates[1][k])
+            rates = TrackRates(jr.qd, jr.qdd, jr.singular, closed.copy())
+        if closed.all():
+            return pred, closed, rates
+        bad = np.nonzero(~closed)[0]
+        sub = pred.take(bad)
+        step = np.linalg.norm(configuration_difference(sub, start.take(bad), self.lay)
+                              * self.col_scale, axis=1)
+        fixed = correct(self.linkage, sub, self.lay, FIRST_STEP * step + 1e-9, CONTRACTION)
+        scalars, spherical = pred.scalars.copy(), pred.spherical.copy()
+        scalars[bad], spherical[bad] = fixed.conf.scalars, fixed.conf.spherical
+        closed[bad] = fixed.accepted
+        return Configuration(scalars, spherical), closed, rates
+
+    def _halving_test(self, fronts: list[Front], targets: list[Array], conf: Configuration,
                     accepted: NDArray[np.bool_]) -> NDArray[np.bool_]:
         """``accepted`` less the steps that fail the step-halving test (:meth:`_halves_agree`):
         every accepted step longer than σ of a front near a singular configuration (σ below
@@ -366,15 +494,24 @@ class Tracker:
                                                sig[long])
         return ok
 
-    def _advance(self, f: _Front, t: Array, conf: Configuration, full: bool) -> bool:
-        """Move front ``f`` over its accepted targets; False when it has ended."""
+    def _advance(self, f: Front, t: Array, conf: Configuration, full: bool,
+                 rates: TrackRates | None = None) -> bool:
+        """Move front ``f`` over its accepted targets (with their rates where known); False
+        when it has ended."""
         tr = self.tracks[f.track]
         if len(t):
             whole = np.nonzero(t == np.round(t))[0]
             idx = t[whole].astype(int)
-            tr.scalars[idx] = conf.scalars[whole]
-            tr.spherical[idx] = conf.spherical[whole]
+            put = _placer(idx, whole)
+            put(tr.scalars, conf.scalars)
+            put(tr.spherical, conf.spherical)
             tr.mask[idx] = True
+            if tr.rates is not None:
+                if rates is None:
+                    tr.rates.known[idx] = False
+                else:
+                    for name in ("qd", "qdd", "singular", "known"):
+                        put(getattr(tr.rates, name), getattr(rates, name))
             if self.progress is not None and len(idx):
                 self.progress(len(idx))
             if len(self.tracks) > 1 and self._joins_another(f.track, idx, conf.take(whole)):
@@ -433,7 +570,7 @@ class Tracker:
                 self._met[track] = True
         return False
 
-    def _jump_or_end(self, f: _Front) -> bool:
+    def _jump_or_end(self, f: Front) -> bool:
         """A front that cannot reach the next sample may be at a bifurcation (branches that
         cross), which it can step over: try once to land on the sample after the next (the
         next being the singular one); if that fails too, the branch ends (a fold)."""
@@ -444,7 +581,7 @@ class Tracker:
         f.substep = 0.0
         return True
 
-    def _end(self, f: _Front) -> bool:
+    def _end(self, f: Front) -> bool:
         tr = self.tracks[f.track]
         last = int(np.floor(f.t)) if f.direction > 0 else int(np.ceil(f.t))
         if f.direction > 0:

@@ -31,7 +31,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.continuation import Track, Tracker
+from screwkit.kinematics.continuation import Tracker
 from screwkit.kinematics.degenerate import seeds_off_continua
 from screwkit.kinematics.loop import Array, Configuration, Layout, forward, layout
 from screwkit.kinematics.mode_frames import build_progress, expect_modes, mode_from_configuration
@@ -40,9 +40,11 @@ from screwkit.kinematics.motion import (
     Motion,
     as_input_array,
     format_inputs,
+    per_sample,
 )
 from screwkit.kinematics.rates import rate_equations
 from screwkit.kinematics.solve import Assemblies, find_assemblies, signature
+from screwkit.kinematics.tracks import Track
 from screwkit.model.linkage import Linkage
 
 #: input movement between two anchor samples of the safety-net root search (rad; × the length
@@ -50,6 +52,9 @@ from screwkit.model.linkage import Linkage
 ANCHOR_SPAN = np.radians(15.0)
 #: a sweep at least this long shows a progress bar on a terminal (when no callback is given)
 PROGRESS_SAMPLES = 50_000
+#: how far (signature units) two overlapping tracks may move between the samples where they
+#: are compared first (:func:`_same_samples`)
+MERGE_MOVE = 0.25
 SAME_ROOT = 1e-6  # signature distance (length-scale units) of two copies of one configuration
 
 Progress = Callable[[int, int], None]
@@ -112,9 +117,8 @@ def generic_motion(
     lay = layout(linkage)
     X = as_input_array(linkage, input_values, "input values")
     N = X.shape[0]
-    Xd = np.array(np.broadcast_to(as_input_array(linkage, input_rates, "input rates"), X.shape))
-    Xdd = np.array(np.broadcast_to(as_input_array(linkage, input_accelerations,
-                                                  "input accelerations"), X.shape))
+    Xd = per_sample(linkage, input_rates, "input rates", X)
+    Xdd = per_sample(linkage, input_accelerations, "input accelerations", X)
     with progress_reporter(progress, N) as report:
         reached = [0]
 
@@ -123,7 +127,7 @@ def generic_motion(
             if report is not None:
                 report(done, total)
 
-        tracks = _all_branches(linkage, lay, X, starts, seed,
+        tracks = all_branches(linkage, lay, X, starts, seed,
                                tracking if report is not None else None)
         if not tracks:
             raise AssemblyError(
@@ -244,8 +248,12 @@ def _seed_from(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray
     return found_new
 
 
-def _all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int,
-                  report: Progress | None) -> list[Track]:
+def all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int,
+                  report: Progress | None, rates: tuple[Array, Array] | None = None,
+                  ) -> list[Track]:
+    """Every branch over the sweep (module docstring); with the inputs' ``rates`` and
+    accelerations, each track also carries the rates the tracker found on the way
+    (:class:`~screwkit.kinematics.continuation.TrackRates`)."""
     N = X.shape[0]
     done = [0]
 
@@ -254,7 +262,7 @@ def _all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: in
         if report is not None:
             report(done[0], N * max(1, len(tracker.tracks)))
 
-    tracker = Tracker(linkage, lay, X, count if report is not None else None)
+    tracker = Tracker(linkage, lay, X, count if report is not None else None, rates)
     _seed_from(linkage, lay, tracker, anchor_samples(linkage, X), X, starts, seed)
     searched: set[int] = set()
     for round_ in range(4):  # births where branches die; rarely more than one round
@@ -294,8 +302,9 @@ def _pair_ends(linkage: Linkage, lay: Layout, tracks: list[Track]) -> None:
                     kept = np.linalg.norm(sa - sb) + np.linalg.norm(ta - tb)
                     swapped = np.linalg.norm(sa - tb) + np.linalg.norm(ta - sb)
                     if swapped < kept:
-                        for arr_a, arr_b in ((a.scalars, b.scalars), (a.spherical, b.spherical)):
-                            arr_a[k], arr_b[k] = arr_b[k].copy(), arr_a[k].copy()
+                        held_a = (a.scalars[k].copy(), a.spherical[k].copy())
+                        a.set_sample(k, b.scalars[k], b.spherical[k])
+                        b.set_sample(k, *held_a)
 
 
 def _merge_duplicates(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
@@ -309,14 +318,15 @@ def _merge_duplicates(linkage: Linkage, lay: Layout, tracks: list[Track]) -> lis
             both = np.nonzero(kept.mask & tr.mask)[0]
             if both.size == 0:
                 continue
-            d = np.max(np.abs(_signatures(linkage, lay, kept, both)
-                              - _signatures(linkage, lay, tr, both)), axis=1)
-            same = d < 1e-5
+            same = _same_samples(linkage, lay, kept, tr, both)
             if same.all():
                 extra = tr.mask & ~kept.mask
                 kept.scalars[extra] = tr.scalars[extra]
                 kept.spherical[extra] = tr.spherical[extra]
                 kept.mask |= tr.mask
+                if kept.rates is not None and tr.rates is not None:
+                    for name in ("qd", "qdd", "singular", "known"):
+                        getattr(kept.rates, name)[extra] = getattr(tr.rates, name)[extra]
                 break
             if same.sum() > 1:
                 tr.mask[both[same]] = False
@@ -324,6 +334,79 @@ def _merge_duplicates(linkage: Linkage, lay: Layout, tracks: list[Track]) -> lis
             if tr.mask.any():
                 out.append(tr)
     return out
+
+
+def _same_samples(linkage: Linkage, lay: Layout, a: Track, b: Track,
+                  both: NDArray[np.intp]) -> NDArray[np.bool_]:
+    """Which of the samples ``both`` (held by tracks ``a`` and ``b``) are the same
+    configuration in the two (signature distance below 1e-5). The signatures are compared first
+    at samples chosen so that between two of them the two tracks' signatures together move at
+    most :data:`MERGE_MOVE` (:func:`_signature_moves`, a bound from their joint variables'
+    steps; both sides of a gap are chosen too); in between, the tracks can meet only where the
+    distance at either end is not more than that move — and only there is every sample
+    compared."""
+    n = both.size
+    steps = _signature_moves(linkage, lay, a, both) + _signature_moves(linkage, lay, b, both)
+    gap = ~np.isfinite(steps)
+    moved = np.concatenate([[0.0], np.cumsum(np.where(gap, 0.0, steps))])
+    bucket = np.floor(moved / MERGE_MOVE)
+    chosen = np.zeros(n, dtype=bool)
+    chosen[[0, -1]] = True
+    chosen[1:] |= bucket[1:] != bucket[:-1]
+    chosen[:-1] |= bucket[1:] != bucket[:-1]
+    chosen[:-1] |= gap
+    chosen[1:] |= gap
+    pick = np.nonzero(chosen)[0]
+    sa, sb = _signatures(linkage, lay, a, both[pick]), _signatures(linkage, lay, b, both[pick])
+    d = np.max(np.abs(sa - sb), axis=1)
+    same = np.zeros(n, dtype=bool)
+    same[pick] = d < 1e-5
+    if pick.size == n:
+        return same
+    span = moved[pick[1:]] - moved[pick[:-1]]
+    contiguous = ~np.array([gap[i:j].any() for i, j in zip(pick[:-1], pick[1:], strict=True)]) \
+        if gap.any() else np.ones(pick.size - 1, dtype=bool)
+    apart = contiguous & (np.maximum(d[:-1], d[1:]) > span + 1e-5)
+    look = np.zeros(n, dtype=bool)
+    for j in np.nonzero(~apart)[0]:
+        look[pick[j] + 1:pick[j + 1]] = True
+    if look.any():
+        idx = both[look]
+        same[look] = np.max(np.abs(_signatures(linkage, lay, a, idx)
+                                   - _signatures(linkage, lay, b, idx)), axis=1) < 1e-5
+    return same
+
+
+def _signature_moves(linkage: Linkage, lay: Layout, tr: Track,
+                     samples: NDArray[np.intp]) -> Array:
+    """An upper bound (n − 1,) of how far the track's signature (max norm) moves between
+    consecutive ``samples``: every freedom's step times how far it can move a joint centre or
+    axis — a turn by δ moves a point at most δ times its distance from the axis, which is at most
+    the loop's whole length (links, offsets and helical pitches; divided by the length scale),
+    and an axis by δ; a slide moves points by its length. A ball joint's turn is bounded by
+    the difference of its rotation matrices' first two columns: |ΔR e₀|² + |ΔR e₁|² =
+    4 sin²(θ/2)(2 − n₀² − n₁²) ≥ 4 sin²(θ/2) for a turn θ about n, so θ ≤ (π/2)·√(that)."""
+    L = linkage.length_scale
+    reach = (sum(float(np.linalg.norm(t)) for t in lay.link_translations)
+             + sum(abs(j.offset) + abs(j.pitch) for j in linkage.joints)) / L
+    lever = max(1.0, reach)
+    lo, hi = int(samples[0]), int(samples[-1]) + 1  # steps between neighbours, by slices
+    q = tr.scalars[lo:hi]
+    dq = np.abs(q[1:] - q[:-1])
+    turn = ~np.array([lay.is_translation[f] for f in range(len(lay.names))
+                      if lay.scalar_col[f] >= 0], dtype=bool)
+    dq[:, turn] = np.abs(np.pi - np.mod(np.pi - dq[:, turn], 2 * np.pi))
+    dq[:, ~turn] /= L
+    steps = dq.sum(axis=1)
+    if lay.n_spherical:
+        cols = tr.spherical[lo:hi, :, :, :2]
+        d = cols[1:] - cols[:-1]
+        steps += 0.5 * np.pi * np.sqrt(np.einsum("nsij,nsij->ns", d, d)).sum(axis=1)
+    # between samples that are not neighbours (a gap) the bound is not known: infinite
+    out = np.full(len(samples) - 1, np.inf)
+    near = np.diff(samples) == 1
+    out[near] = steps[samples[:-1][near] - lo]
+    return np.asarray(lever * out)
 
 
 def _attach_turning_points(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
@@ -346,7 +429,7 @@ def _attach_turning_points(linkage: Linkage, lay: Layout, tracks: list[Track]) -
             out.append(tr)
             continue
         for o in ends:
-            o.scalars[s], o.spherical[s], o.mask[s] = tr.scalars[s], tr.spherical[s], True
+            o.set_sample(s, tr.scalars[s], tr.spherical[s])
     return out
 
 
@@ -386,7 +469,7 @@ def _attach_lone_ends(linkage: Linkage, lay: Layout, tracks: list[Track]) -> lis
                 continue
             for i, j in enumerate(best):
                 o, tr = ends[j], roots[i]
-                o.scalars[s], o.spherical[s], o.mask[s] = tr.scalars[s], tr.spherical[s], True
+                o.set_sample(s, tr.scalars[s], tr.spherical[s])
                 attached.append(tr)
             roots = []
     return [tr for tr in tracks if not any(tr is a for a in attached)]
@@ -400,4 +483,4 @@ def _order_key(linkage: Linkage, lay: Layout, tr: Track) -> tuple[float, ...]:
     return (float(first), *np.round(sig, 9).tolist())
 
 
-__all__ = ["ANCHOR_SPAN", "anchor_samples", "generic_motion", "progress_reporter"]
+__all__ = ["ANCHOR_SPAN", "all_branches", "anchor_samples", "generic_motion", "progress_reporter"]

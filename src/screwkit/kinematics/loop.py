@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.dual.spatial import cross, rot_y, skew
+from screwkit.dual.spatial import rot_y, skew
 from screwkit.errors import InputError
 from screwkit.model.linkage import Linkage
 
@@ -137,11 +137,17 @@ def _turn_z(R: Array, th: Array) -> Array:
     return out
 
 
-def _screw(u: Array, centre: Array, pitch: float = 0.0) -> Array:
-    """The unit screw (u; c × u + h u) of a rotation about the line through c along u."""
-    out = np.empty(u.shape[:-1] + (6,))
+def _screw(u: Array, centre: Array, pitch: float = 0.0, out: Array | None = None) -> Array:
+    """The unit screw (u; c × u + h u) of a rotation about the line through c along u (N, 6),
+    written into ``out`` when given."""
+    if out is None:
+        out = np.empty(u.shape[:-1] + (6,))
     out[..., :3] = u
-    out[..., 3:] = cross(centre, u)
+    c0, c1, c2 = centre[..., 0], centre[..., 1], centre[..., 2]
+    u0, u1, u2 = u[..., 0], u[..., 1], u[..., 2]
+    out[..., 3] = c1 * u2 - c2 * u1
+    out[..., 4] = c2 * u0 - c0 * u2
+    out[..., 5] = c0 * u1 - c1 * u0
     if pitch:
         out[..., 3:] += pitch * u
     return out
@@ -186,7 +192,7 @@ def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
         col = lay.scalar_col[fi]
         if kind == "R":
             R = _turn_z(R, q[:, col])
-            screws[:, :, fi] = _screw(u, centre)
+            _screw(u, centre, out=screws[:, :, fi])
             p = centre
         elif kind == "P":
             R = _turn_z(R, np.full(N, joint.offset))
@@ -194,32 +200,35 @@ def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
             p = p + q[:, col, None] * u
         elif kind == "C":
             R = _turn_z(R, q[:, col])
-            screws[:, :, fi] = _screw(u, centre)
+            _screw(u, centre, out=screws[:, :, fi])
             screws[:, :, fi + 1] = _slide(u)
             p = p + q[:, col + 1, None] * u
         elif kind == "H":
             th = q[:, col]
             R = _turn_z(R, th)
-            screws[:, :, fi] = _screw(u, centre, joint.pitch)
+            _screw(u, centre, joint.pitch, out=screws[:, :, fi])
             p = p + (joint.offset + joint.pitch * th)[:, None] * u
         elif kind == "U":
             R = _turn_z(R, q[:, col])
             u2 = R[:, :, 1].copy()
-            screws[:, :, fi] = _screw(u, centre)
-            screws[:, :, fi + 1] = _screw(u2, centre)
+            _screw(u, centre, out=screws[:, :, fi])
+            _screw(u2, centre, out=screws[:, :, fi + 1])
             R = R @ rot_y(q[:, col + 1])
             p = centre
         else:  # S
             R = R @ conf.spherical[:, lay.spherical_of_joint[i]]
             for k in range(3):
-                screws[:, :, fi + k] = _screw(R[:, :, k], centre)
+                _screw(R[:, :, k], centre, out=screws[:, :, fi + k])
             p = centre
         fi += joint.dof
         if frames:
             aR[:, i] = R
             ap[:, i] = p
-        # then the constant link transform: T <- T · L
-        p = p + R @ link_p[i]
+        # then the constant link transform: T <- T · L (R·l by columns: a batched matmul
+        # with a vector is several times slower)
+        lp = link_p[i]
+        if lp.any():
+            p = p + R[:, :, 0] * lp[0] + R[:, :, 1] * lp[1] + R[:, :, 2] * lp[2]
         R = R @ link_R[i]
     return LoopFrames(bR, bp, aR, ap, R, p, screws, centres, axes)
 
@@ -273,15 +282,28 @@ def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configura
 
 
 def rotation_matrix(w: Array) -> Array:
-    """exp([w]×) of rotation vectors w (N, 3) by Rodrigues' formula (series near zero)."""
+    """exp([w]×) of rotation vectors w (N, 3) by Rodrigues' formula (series near zero), as
+    cos θ I + a [w]× + b w wᵀ (a = sin θ/θ, b = (1 − cos θ)/θ², [w]×² = w wᵀ − θ² I)."""
     th2 = np.einsum("ni,ni->n", w, w)
     th = np.sqrt(th2)
     small = th2 < 1e-8
     safe = np.where(small, 1.0, th)
     a = np.where(small, 1.0 - th2 / 6.0, np.sin(safe) / safe)
     b = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(safe)) / np.where(small, 1.0, th2))
-    K = skew(w)
-    return np.asarray(np.eye(3) + a[:, None, None] * K + b[:, None, None] * (K @ K))
+    c = 1.0 - b * th2
+    out = np.empty((w.shape[0], 3, 3))
+    w0, w1, w2 = w[:, 0], w[:, 1], w[:, 2]
+    bw0, bw1 = b * w0, b * w1
+    out[:, 0, 0] = c + bw0 * w0
+    out[:, 1, 1] = c + bw1 * w1
+    out[:, 2, 2] = c + b * w2 * w2
+    out[:, 0, 1] = bw0 * w1 - a * w2
+    out[:, 1, 0] = bw0 * w1 + a * w2
+    out[:, 0, 2] = bw0 * w2 + a * w1
+    out[:, 2, 0] = bw0 * w2 - a * w1
+    out[:, 1, 2] = bw1 * w2 - a * w0
+    out[:, 2, 1] = bw1 * w2 + a * w0
+    return out
 
 
 def configuration_difference(a: Configuration, b: Configuration, lay: Layout) -> Array:
@@ -314,12 +336,16 @@ def closure_error(R: Array, p: Array) -> Array:
 
 
 def lie_bracket(a: Array, b: Array) -> Array:
-    """[a, b] of twists (ω; v): (ωa × ωb; ωa × vb − ωb × va)."""
-    wa, va = a[..., :3], a[..., 3:]
-    wb, vb = b[..., :3], b[..., 3:]
+    """[a, b] of twists (ω; v): (ωa × ωb; ωa × vb − ωb × va), written out by components."""
     out = np.empty(np.broadcast_shapes(a.shape, b.shape))
-    out[..., :3] = cross(wa, wb)
-    out[..., 3:] = cross(wa, vb) - cross(wb, va)
+    a0, a1, a2, a3, a4, a5 = (a[..., k] for k in range(6))
+    b0, b1, b2, b3, b4, b5 = (b[..., k] for k in range(6))
+    out[..., 0] = a1 * b2 - a2 * b1
+    out[..., 1] = a2 * b0 - a0 * b2
+    out[..., 2] = a0 * b1 - a1 * b0
+    out[..., 3] = a1 * b5 - a2 * b4 - b1 * a5 + b2 * a4
+    out[..., 4] = a2 * b3 - a0 * b5 - b2 * a3 + b0 * a5
+    out[..., 5] = a0 * b4 - a1 * b3 - b0 * a4 + b1 * a3
     return out
 
 

@@ -27,13 +27,14 @@ from screwkit.kinematics.loop import (
     Array,
     Configuration,
     Layout,
+    LoopFrames,
     closure_error,
     closure_twist,
     forward,
     rotation_vector,
 )
 from screwkit.kinematics.motion import ModeMotion
-from screwkit.kinematics.rates import RESIDUAL_TOL, rate_equations, solve_rates
+from screwkit.kinematics.rates import RESIDUAL_TOL, RateEquations, rate_equations, solve_rates
 from screwkit.kinematics.singularities import classify, singular_events
 from screwkit.kinematics.solve import newton
 from screwkit.model.linkage import Linkage
@@ -149,6 +150,22 @@ def closure_residual(R: Array, p: Array, rows: Array) -> Array:
     return np.asarray(res)
 
 
+def idle_spin_held(linkage: Linkage, lay: Layout, conf: Configuration,
+                   mask: NDArray[np.bool_], X: Array, fr: LoopFrames, eq: RateEquations,
+                   ) -> tuple[Configuration, LoopFrames, RateEquations]:
+    """The configurations with every S–S rod's idle spin held at zero along the sweep
+    (:func:`~screwkit.kinematics.idle_spin.hold_idle_spin`), their frames and rate equations."""
+    conf = hold_idle_spin(linkage, lay, conf, mask, X, fr, eq)
+    # the turns about the rods' axes leave round-off in the closure: one Newton step
+    # (minimum-norm, so it does not turn the rods back) restores it
+    polished = newton(linkage, conf, max_iter=2, tol=1e-15, lay=lay).conf
+    conf = Configuration(np.where(mask[:, None], polished.scalars, conf.scalars),
+                         np.where(mask[:, None, None, None], polished.spherical,
+                                  conf.spherical))
+    fr = forward(linkage, conf, lay)
+    return conf, fr, rate_equations(linkage, lay, fr, mask, exact_sigma=False)
+
+
 def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
                             mask: NDArray[np.bool_], X: Array, Xd: Array, Xdd: Array,
                             events: list[str]) -> ModeMotion:
@@ -162,15 +179,7 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
     eq = rate_equations(linkage, lay, fr, mask, exact_sigma=False)
     _built(0.25)
     if eq.spin_links:
-        conf = hold_idle_spin(linkage, lay, conf, mask, X, fr, eq)
-        # the turns about the rods' axes leave round-off in the closure: one Newton step
-        # (minimum-norm, so it does not turn the rods back) restores it
-        polished = newton(linkage, conf, max_iter=2, tol=1e-15, lay=lay).conf
-        conf = Configuration(np.where(mask[:, None], polished.scalars, conf.scalars),
-                             np.where(mask[:, None, None, None], polished.spherical,
-                                      conf.spherical))
-        fr = forward(linkage, conf, lay)
-        eq = rate_equations(linkage, lay, fr, mask, exact_sigma=False)
+        conf, fr, eq = idle_spin_held(linkage, lay, conf, mask, X, fr, eq)
         _built(0.45)
     rates = solve_rates(linkage, lay, eq, Xd, Xdd)
     _built(0.7)

@@ -172,6 +172,16 @@ def as_input_array(linkage: Linkage, values: ArrayLike, name: str) -> Array:
     return a
 
 
+def per_sample(linkage: Linkage, values: ArrayLike, name: str, X: Array) -> Array:
+    """The inputs' rates or accelerations ``values`` as an (N, n_in) array for the N samples of
+    ``X``: one value for every sample, or one per sample (:func:`as_input_array`)."""
+    a = as_input_array(linkage, values, name)
+    if a.shape[0] not in (1, X.shape[0]):
+        raise InputError(f"{name}: give one value for every sample or one per sample "
+                         f"({X.shape[0]} samples); got {a.shape[0]}")
+    return np.array(np.broadcast_to(a, X.shape))
+
+
 def format_inputs(linkage: Linkage, x: Array) -> str:
     """Input values for a message: degrees for rotations, metres for translations."""
     parts = []

@@ -23,6 +23,7 @@ that tolerance.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -74,6 +75,11 @@ class RateEquations:
     input_locked: NDArray[np.bool_]  # an input screw is not in the range of the passive one
     singular: NDArray[np.bool_]  # either: no rates here
 
+    @cached_property
+    def passive_norm(self) -> Array:
+        """(N,) Frobenius norm of each sample's ``passive``."""
+        return _norm2(self.passive)
+
     def solve(self, input_values: Array, bias: Array, spin_bias: Array,
               minimum_norm: bool = False) -> tuple[Array, Array]:
         """Passive rates (or accelerations) from the input ones and the bias terms J̇q̇ (N, 6)
@@ -82,9 +88,11 @@ class RateEquations:
         Also returns each sample's scaled residual relative to the size of the equation's
         terms."""
         S, C = self.screws, self.spin
-        rhs = np.concatenate(
-            [(-np.einsum("nij,nj->ni", S[:, :, self.in_idx], input_values) - bias) * self.rows,
-             -np.einsum("nij,nj->ni", C[:, :, self.in_idx], input_values) - spin_bias], axis=1)
+        rhs = (-np.einsum("nij,nj->ni", S[:, :, self.in_idx], input_values) - bias) * self.rows
+        if C.shape[1]:
+            rhs = np.concatenate(
+                [rhs, -np.einsum("nij,nj->ni", C[:, :, self.in_idx], input_values) - spin_bias],
+                axis=1)
         x = _least_squares(self.passive, rhs, self.singular)
         if minimum_norm and self.singular.any():
             sing = self.singular
@@ -93,7 +101,7 @@ class RateEquations:
             r = np.einsum("nij,nj->ni", self.passive, x) - rhs
             return x * self.cols[self.p_idx], np.linalg.norm(r, axis=-1)
         r = np.einsum("nij,nj->ni", self.passive, x) - rhs
-        size = np.linalg.norm(rhs, axis=-1) + np.linalg.norm(x, axis=-1) * _norm2(self.passive)
+        size = np.linalg.norm(rhs, axis=-1) + np.linalg.norm(x, axis=-1) * self.passive_norm
         residual = np.linalg.norm(r, axis=-1) / np.maximum(size, 1e-300)
         x[self.singular] = np.nan
         return x * self.cols[self.p_idx], residual
@@ -109,8 +117,10 @@ def _least_squares(A: Array, b: Array, skip: NDArray[np.bool_]) -> Array:
     solve when A is square, else the normal equations with one step of iterative refinement
     (the rank test has bounded the condition number by 1/SINGULAR_RTOL)."""
     N, k, m = A.shape
-    x = np.zeros((N, m))
     ok = ~skip
+    if ok.all() and k == m:
+        return np.asarray(np.linalg.solve(A, b[..., None])[..., 0])
+    x = np.zeros((N, m))
     if not ok.any():
         return x
     Ao, bo = A[ok], b[ok]
@@ -126,32 +136,48 @@ def _least_squares(A: Array, b: Array, skip: NDArray[np.bool_]) -> Array:
     return x
 
 
-def _sigma_ratio(Jp: Array, exact: bool) -> Array:
+def _sigma_ratio(Jp: Array, exact: bool, near: tuple[Array, Array] | None = None) -> Array:
     """σ_min/σ_max of each tall or square ``Jp`` (N, k, m), from the eigenvalues of JᵀJ. With
     ``exact=False`` only the rank test's answer is kept exact: where det(JᵀJ)/tr(JᵀJ)^m, a lower
     bound of (σ_min/σ_max)² (λ_min ≥ det/λ_max^(m−1) and λ_max ≤ tr), already clears
     SINGULAR_RTOL² the eigenvalues are not computed and the ratio is NaN ("well above the
-    threshold")."""
-    M = np.swapaxes(Jp, -1, -2) @ Jp
+    threshold"). ``near`` — a nearby sample's Jacobian (N, k, m) and its σ_min (N,) — certifies
+    it without the determinant where Weyl's inequality σ_min ≥ σ_min,near − |Jp − J_near|_F
+    already clears twice SINGULAR_RTOL·|Jp|_F (|Jp|_F ≥ σ_max)."""
     if exact:
-        lam = np.linalg.eigvalsh(M)
+        lam = np.linalg.eigvalsh(np.swapaxes(Jp, -1, -2) @ Jp)
         return np.asarray(np.sqrt(np.maximum(lam[:, 0], 0.0) / np.maximum(lam[:, -1], 1e-300)))
-    tr = np.maximum(np.trace(M, axis1=-2, axis2=-1), 1e-300)
-    bound = np.linalg.det(M / tr[:, None, None])  # det(M)/tr^m, scaled against overflow
-    ratio = np.full(M.shape[0], np.nan)
-    near = ~(bound > 4.0 * SINGULAR_RTOL**2)  # a margin for the determinant's round-off
-    if near.any():
-        ratio[near] = _sigma_ratio(Jp[near], True)
+    if near is not None:
+        fro = np.sqrt(np.einsum("nij,nij->n", Jp, Jp))
+        d = Jp - near[0]
+        clear = near[1] - np.sqrt(np.einsum("nij,nij->n", d, d)) > 2.0 * SINGULAR_RTOL * fro
+        ratio = np.full(Jp.shape[0], np.nan)
+        rest = np.nonzero(~clear)[0]
+        if rest.size:
+            ratio[rest] = _sigma_ratio(Jp[rest], False)
+        return ratio
+    if Jp.shape[1] == Jp.shape[2]:  # square: det(JᵀJ) = det(J)², tr(JᵀJ) = |J|²_F
+        fro = np.sqrt(np.maximum(np.einsum("nij,nij->n", Jp, Jp), 1e-300))
+        bound = np.linalg.det(Jp / fro[:, None, None]) ** 2
+    else:
+        M = np.swapaxes(Jp, -1, -2) @ Jp
+        tr = np.maximum(np.trace(M, axis1=-2, axis2=-1), 1e-300)
+        bound = np.linalg.det(M / tr[:, None, None])  # det(M)/tr^m, scaled against overflow
+    ratio = np.full(Jp.shape[0], np.nan)
+    close = ~(bound > 4.0 * SINGULAR_RTOL**2)  # a margin for the determinant's round-off
+    if close.any():
+        ratio[close] = _sigma_ratio(Jp[close], True)
     return ratio
 
 
 def rate_equations(linkage: Linkage, lay: Layout, fr: LoopFrames,
                    mask: NDArray[np.bool_] | None = None, exact_sigma: bool = True,
-                   ) -> RateEquations:
+                   near: tuple[Array, Array] | None = None) -> RateEquations:
     """The scaled rate equations at every sample of ``fr`` (samples outside ``mask`` are
     treated as singular and give NaN). With ``exact_sigma=False`` (a Motion's build, which
     needs only the rank test) ``sigma_ratio`` is NaN where a cheap bound shows it is well above
-    :data:`SINGULAR_RTOL` (:func:`_sigma_ratio`)."""
+    :data:`SINGULAR_RTOL` (:func:`_sigma_ratio`, which ``near`` — a nearby sample's passive
+    Jacobian and its smallest singular value, per sample — makes cheaper still)."""
     N, _, m = fr.screws.shape
     L = constants(linkage, lay)[2]
     names = list(lay.names)
@@ -166,13 +192,15 @@ def rate_equations(linkage: Linkage, lay: Layout, fr: LoopFrames,
     for r, i in enumerate(links):
         upto = [f for f in range(m) if lay.joint_of[f] <= i]
         C[:, r, upto] = np.einsum("ni,nif->nf", u[:, r], S[:, :3, upto])
-    scaled = np.concatenate([S * (rows[:, None] * cols[None, :]), C * cols], axis=1)
+    scaled = S * (rows[:, None] * cols[None, :])
+    if links:
+        scaled = np.concatenate([scaled, C * cols], axis=1)
     Jp, Jin = scaled[:, :, p_idx], scaled[:, :, in_idx]
     k, mp = Jp.shape[1:]
     if mp > k or mp == 0:
         ratio = np.zeros(N)
     else:
-        ratio = _sigma_ratio(Jp, exact_sigma)
+        ratio = _sigma_ratio(Jp, exact_sigma, near)
     valid = np.ones(N, dtype=bool) if mask is None else np.asarray(mask, dtype=bool)
     deficient = valid & (ratio < SINGULAR_RTOL)
     locked = np.zeros(N, dtype=bool)
@@ -254,3 +282,76 @@ def solve_rates(linkage: Linkage, lay: Layout, eq: RateEquations, Xd: Array,
     qdd[:, eq.p_idx], res2 = eq.solve(Xdd, link_bias[:, -1], spin_bias, minimum_norm)
     link_A = link_accelerations(linkage, lay, eq.screws, np.nan_to_num(qdd), link_bias)
     return Rates(qd, qdd, link_V, link_A, np.maximum(res1, res2))
+
+
+def loop_bias(linkage: Linkage, lay: Layout, S: Array, qd: Array,
+              links: list[int]) -> tuple[Array, Array]:
+    """The bias J̇q̇ = Σ_k [V_before(k), S_k] q̇_k of the whole loop (N, 6) and accumulated up
+    to the frame after each joint in ``links`` (N, r, 6): :func:`link_twists`' sums without
+    the link twists, one bracket per joint (the bracket is bilinear: a joint's freedoms all
+    move with the loop before it, V_before, and a U joint's second axis also with its
+    first)."""
+    N = S.shape[0]
+    V = np.zeros((N, 6))
+    total = np.zeros((N, 6))
+    upto = np.zeros((N, len(links), 6))
+    for i, j in enumerate(linkage.joints):
+        ks = [f for f, jj in enumerate(lay.joint_of) if jj == i]
+        T = np.einsum("nik,nk->ni", S[:, :, ks], qd[:, ks]) if len(ks) > 1 \
+            else S[:, :, ks[0]] * qd[:, ks[0], None]
+        if i > 0:
+            total += lie_bracket(V, T)
+        if j.kind == "U":
+            total += lie_bracket(S[:, :, ks[0]] * qd[:, ks[0], None],
+                                 S[:, :, ks[1]] * qd[:, ks[1], None])
+        V += T
+        if i in links:
+            upto[:, links.index(i)] = total
+    return total, upto
+
+
+@dataclass(frozen=True)
+class JointRates:
+    """Rates and accelerations of every freedom (N, m), NaN where ``singular`` (or outside
+    the mask), and each sample's larger scaled residual of the two rate equations."""
+
+    qd: Array
+    qdd: Array
+    singular: NDArray[np.bool_]
+    residual: Array
+
+
+def freedom_rates(linkage: Linkage, lay: Layout, eq: RateEquations, Xd: Array, Xdd: Array,
+                  minimum_norm: bool = False) -> tuple[Array, Array, Array]:
+    """Velocities and accelerations of every freedom (N, m) from the inputs' ``Xd``, ``Xdd``
+    (N, n_in) and the larger scaled residual of the two equations (N,): :func:`solve_rates`
+    without the links' twists (the bias by :func:`loop_bias`); NaN at singular samples, or
+    with ``minimum_norm`` the minimum-norm solution there."""
+    N, _, m = eq.screws.shape
+    r = len(eq.spin_links)
+    qd = np.zeros((N, m))
+    qd[:, eq.in_idx] = Xd
+    qd[:, eq.p_idx], res1 = eq.solve(Xd, np.zeros((N, 6)), np.zeros((N, r)), minimum_norm)
+    bias, upto = loop_bias(linkage, lay, eq.screws, np.nan_to_num(qd) if not minimum_norm
+                           else qd, eq.spin_links)
+    qdd = np.zeros((N, m))
+    qdd[:, eq.in_idx] = Xdd
+    spin_bias = np.einsum("nri,nri->nr", eq.rod_axes, upto[:, :, :3]) if r \
+        else np.zeros((N, 0))
+    qdd[:, eq.p_idx], res2 = eq.solve(Xdd, bias, spin_bias, minimum_norm)
+    return qd, qdd, np.maximum(res1, res2)
+
+
+def joint_rates(linkage: Linkage, lay: Layout, eq: RateEquations, mask: NDArray[np.bool_],
+                Xd: Array, Xdd: Array) -> JointRates:
+    """Velocities and accelerations of every freedom from the inputs' ``Xd``, ``Xdd`` (N,
+    n_in) from the rate equations ``eq`` of closed configurations where ``mask`` holds
+    (module docstring; :func:`freedom_rates`). A sample is singular where the rank test or
+    either residual says so (a Motion's rule); its rates are NaN, as outside the mask."""
+    qd, qdd, residual = freedom_rates(linkage, lay, eq, Xd, Xdd)
+    singular = mask & (eq.singular | ~(residual <= RESIDUAL_TOL))
+    gone = singular | ~mask
+    if gone.any():
+        qd[gone] = np.nan
+        qdd[gone] = np.nan
+    return JointRates(qd, qdd, singular, residual)

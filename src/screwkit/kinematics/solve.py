@@ -79,7 +79,7 @@ def newton(
     it = 0
     for it in range(1, max_iter + 1):  # noqa: B007 - loop over iterations, vectorised over samples
         sub = Configuration(q[todo], sph[todo])
-        fr = forward(linkage, sub, lay)
+        fr = forward(linkage, sub, lay, frames=False)
         xi = closure_twist(fr.closure_R, fr.closure_p) * rows
         r = np.max(np.abs(xi), axis=-1)
         res[todo] = r
@@ -105,7 +105,7 @@ def newton(
         sph[todo] = moved.spherical
     else:
         sub = Configuration(q[todo], sph[todo])
-        fr = forward(linkage, sub, lay)
+        fr = forward(linkage, sub, lay, frames=False)
         res[todo] = np.max(np.abs(closure_twist(fr.closure_R, fr.closure_p) * rows), axis=-1)
     ok = np.isfinite(res) & (res <= max(tol * 10, 1e-10))
     return NewtonResult(Configuration(q, sph), res, ok, it)

@@ -14,7 +14,7 @@ from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.generic_motion import Progress, generic_motion, progress_reporter
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.mode_frames import build_progress
-from screwkit.kinematics.motion import ModeMotion, Motion, as_input_array
+from screwkit.kinematics.motion import ModeMotion, Motion, as_input_array, per_sample
 from screwkit.kinematics.registry import family_of, seed_variables
 from screwkit.model.linkage import Linkage
 
@@ -70,9 +70,8 @@ def solve_motion(
     check_memory(motion_bytes(linkage, X.shape[0], fam.max_modes or MODES_ESTIMATE),
                  f"a motion of {X.shape[0]} samples",
                  "use fewer input samples (a larger [motion] step or a shorter range)")
-    Xd = np.array(np.broadcast_to(as_input_array(linkage, rates, "rates"), X.shape))
-    Xdd = np.array(np.broadcast_to(as_input_array(linkage, accelerations, "accelerations"),
-                                   X.shape))
+    Xd = per_sample(linkage, rates, "rates", X)
+    Xdd = per_sample(linkage, accelerations, "accelerations", X)
     closed = fam.closed_form_for(linkage) if X.shape[0] >= 2 else None
     if method == "closed" and closed is None:
         with_closed = ", ".join(f.name for f in _families_with_closed_forms())
@@ -110,8 +109,8 @@ def motion_bytes(linkage: Linkage, samples: int, modes: int = MODES_ESTIMATE) ->
     10⁶ samples of a planar 4R with the generic solver, 6.3 GB; 1.4 with the closed form)."""
     n, links = len(linkage.joints), len(linkage.links)
     freedoms = sum(j.dof for j in linkage.joints)
-    per_sample = 24 * links + 6 * n + 4 * (freedoms + 8) + 9 * n
-    return 2.8 * 8 * per_sample * modes * samples
+    floats = 24 * links + 6 * n + 4 * (freedoms + 8) + 9 * n
+    return 2.8 * 8 * floats * modes * samples
 
 
 def _families_with_closed_forms() -> list:  # type: ignore[type-arg]
