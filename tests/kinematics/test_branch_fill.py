@@ -294,7 +294,7 @@ def test_signature_moves_bound_how_far_the_signature_moves(name):
         near = np.diff(held) == 1
         assert np.all(true[near] <= bound[near] + 1e-12)
         assert np.all(np.isinf(bound[~near]))
-        assert np.median(bound[near] / np.maximum(true[near], 1e-300)) < 50  # not vacuous
+        assert np.median(bound[near] / np.maximum(true[near], 1e-300)) < 100  # not vacuous
 
 
 def test_joint_motion_names_its_freedoms_and_modes():
@@ -315,3 +315,113 @@ def test_joint_motion_names_its_freedoms_and_modes():
         j.variable("output_C.s", 5)
     with pytest.raises(InputError, match="ball joint's body rate"):
         j.variable("sphere.wx")
+
+
+@pytest.mark.parametrize("family", ["RSRC", "4R", "RSSR", "RCCC"])
+def test_long_sweeps_of_random_mechanisms_miss_no_mode_and_match_the_closed_forms(family):
+    # the never-miss property test at 20 000 samples, where nearly every sample is filled:
+    # the same mode count as the closed form away from the band around folds, every sample
+    # closed, and each closed mode's rates some bare-route mode's
+    from test_never_miss_a_mode import BAND, _counts, _sigma, _solve, random_linkage
+
+    rng = np.random.default_rng({"RSRC": 11, "4R": 12, "RSSR": 13, "RCCC": 14}[family])
+    N = 20_000
+    x = np.linspace(0.0, 2 * np.pi, N, endpoint=False)
+    checked = 0
+    for _ in range(5):
+        lk = random_linkage(family, rng)
+        closed = _solve(solve_motion, lk, x, method="closed")
+        joints = _solve(solve_joints, lk, x)
+        if closed is None and joints is None:
+            continue
+        g = np.zeros(N, dtype=int) if joints is None else joints.assembles.sum(axis=0)
+        away = _sigma(closed, N) > BAND
+        np.testing.assert_array_equal(g[away], _counts(closed, N)[away])
+        if closed is None:
+            continue
+        checked += 1
+        lay = layout(lk)
+        for k in range(joints.modes):
+            rot, tra = _closure(lk, joints.configurations[k])
+            held = joints.assembles[k]
+            assert np.max(rot[held]) < 1e-10 and np.max(tra[held]) < 1e-10
+        names = [n for n in lay.names if lay.scalar_col[lay.names.index(n)] >= 0
+                 and n not in lk.inputs]
+        cols = [lay.names.index(n) for n in names]
+        for md in closed.modes:
+            ok = md.assembles & ~md.singular & away
+            qd = np.stack([md.velocities[n] for n in names], axis=1)
+            gap = np.min([np.where(joints.assembles[k][:, None],
+                                   np.abs(joints.rates[k][:, cols] - qd), np.inf).max(axis=1)
+                          for k in range(joints.modes)], axis=0)
+            scale = np.maximum(1.0, np.abs(qd).max(axis=1))
+            assert np.all((gap / scale)[ok] < 1e-7), np.nanmax((gap / scale)[ok])
+    assert checked >= 2
+
+
+def _rpscr():
+    # two inputs, one of them a long slide (≈ 4 length scales): points far from earlier axes
+    return Linkage.from_hartenberg_denavit(
+        "RPSCR", [Joint("in", "R"), Joint("slide", "P"), Joint("ball", "S"), Joint("cyl", "C"),
+                  Joint("out", "R")],
+        [0.1, 0.1, 0.2, 0.3, 0.5], [np.pi / 2, 0, 0.3, np.pi / 2, 0],
+        inputs=["in.theta", "slide.s"])
+
+
+def test_signature_moves_count_the_slides_of_the_loop():
+    from screwkit.kinematics.generic_motion import _signature_moves
+    from screwkit.kinematics.solve import signature
+
+    lk = _rpscr()
+    lay = layout(lk)
+    X = np.stack([np.linspace(0.0, 0.5, 100), np.full(100, 5.0)], axis=1)
+    tracks = all_branches(lk, lay, X, 48, 0, None)
+    assert tracks
+    for tr in tracks:
+        held = np.nonzero(tr.mask)[0]
+        bound = _signature_moves(lk, lay, tr, held)
+        true = np.abs(np.diff(signature(lk, tr.configuration().take(held), lay), axis=0))
+        assert np.all(true.max(axis=1) <= bound)
+
+
+def test_a_two_input_loop_takes_one_rate_for_every_input():
+    import screwkit as sk
+
+    lk = _rpscr()
+    X = np.stack([np.linspace(0.0, 0.5, 40), np.linspace(4.0, 5.0, 40)], axis=1)
+    j = sk.solve_joints(lk, X)  # default rates 1 and accelerations 0, for both inputs
+    m = sk.solve_motion(lk, X, rates=1.0)
+    assert j.modes == len(m.modes) > 0
+    for k, md in enumerate(m.modes):
+        ok = md.assembles & ~md.singular
+        np.testing.assert_allclose(j.rates[k][ok, 1], md.velocities["slide.s"][ok])
+        np.testing.assert_allclose(md.velocities["slide.s"][ok], 1.0)
+
+
+def test_an_unevenly_sampled_sweep_is_filled_too(monkeypatch):
+    # ±30 % jitter in the spacing: the interpolation follows the inputs, so chunks stay long
+    lk = _fig7()
+    N = 20_000
+    x = np.linspace(0.0, 2 * np.pi, N, endpoint=False)
+    x += 0.3 * (x[1] - x[0]) * np.random.default_rng(0).uniform(-1, 1, N)
+    waves = []
+    real = continuation.Tracker._wave
+
+    def counted(self, fronts):
+        waves.append(len(fronts))
+        return real(self, fronts)
+
+    monkeypatch.setattr(continuation.Tracker, "_wave", counted)
+    j = solve_joints(lk, x)
+    assert len(waves) < 200
+    closed = solve_motion(lk, x, method="closed")
+    assert j.modes == len(closed.modes) == 2
+    np.testing.assert_array_equal(j.assembles.sum(axis=0),
+                                  sum(md.assembles for md in closed.modes))
+    lay = layout(lk)
+    c = lay.names.index("output_C.s")
+    for md in closed.modes:
+        ok = md.assembles & ~md.singular
+        gap = np.min([np.abs(j.rates[k][:, c] - md.velocities["output_C.s"]) for k in range(2)],
+                     axis=0)
+        assert np.nanmax(gap[ok]) < 1e-9

@@ -27,7 +27,7 @@ sample, the branch ends at once.
 On a fine sweep a chunk is corrected only at every few samples (at most FILL_STRIDE samples
 and FILL_SPAN of input apart); the samples in between are filled by quintic Hermite
 interpolation between neighbouring corrected samples (:mod:`screwkit.kinematics.branch_fill`)
-and kept where the loop closes there to the corrector's tolerance, else corrected by Newton
+and kept where the loop closes there to round-off (FILL_TOL), else corrected by Newton
 with the same tests. Asked for rates, the tracker also solves the rate equations of those
 samples from the screws of that closure check (:class:`~screwkit.kinematics.tracks.TrackRates`).
 """
@@ -55,7 +55,9 @@ from screwkit.kinematics.tracks import (
     Front,
     Track,
     TrackRates,
+    coarse_targets,
     input_at,
+    sample_writer,
     taylor,
     taylor_increment,
 )
@@ -69,34 +71,10 @@ FIRST_STEP = 0.2  # largest Newton correction, relative to the predicted step
 CONTRACTION = 0.5  # largest ratio of the second Newton step to the first
 FILL_SPAN = 0.01  # rad (or length scale) of input between two corrected samples of a chunk
 FILL_STRIDE = 128  # samples between two corrected samples of a chunk, at most
-
-
-def _placer(idx: NDArray[np.intp], rows: NDArray[np.intp]) -> Callable[[Array, Array], None]:
-    """A writer of ``values[rows]`` into ``array[idx]``: by slices where both are runs of
-    consecutive indices (a chunk of samples, either direction; several times faster than
-    fancy indexing for the large arrays of long sweeps)."""
-    n = len(idx)
-    if n > 1 and abs(int(idx[-1]) - int(idx[0])) == n - 1 and rows[-1] - rows[0] == n - 1 \
-            and np.all(np.abs(np.diff(idx)) == 1):
-        lo, hi = int(min(idx[0], idx[-1])), int(max(idx[0], idx[-1])) + 1
-        src = slice(int(rows[0]), int(rows[-1]) + 1)
-        rev = idx[-1] < idx[0]
-
-        def by_slice(array: Array, values: Array) -> None:
-            array[lo:hi] = values[src][::-1] if rev else values[src]
-
-        return by_slice
-
-    def by_index(array: Array, values: Array) -> None:
-        array[idx] = values[rows]
-
-    return by_index
-
-
-def _coarse(n: int, stride: int) -> NDArray[np.intp]:
-    """Indices of every ``stride``-th of ``n`` targets, and always the last."""
-    idx = np.arange(stride - 1, n, stride)
-    return idx if idx.size and idx[-1] == n - 1 else np.append(idx, n - 1)
+#: closure residual at which an interpolated sample is kept as it is (else Newton corrects
+#: it), or 8× the round-off of the corrected samples on either side where that is more (a loop
+#: with S–S rods: the corrector's tolerance, its build polishes every sample afterwards)
+FILL_TOL = 1e-14
 
 
 class Tracker:
@@ -111,6 +89,9 @@ class Tracker:
         # by interpolation are found from the closure check's screws (a loop without S–S
         # rods, whose poses a Motion's build turns)
         self.rates = rates if rates is not None and not spin_links(linkage) else None
+        # the fill keeps a sample at round-off closure, as polished as a corrected one; with
+        # S–S rods the Motion's build turns the rods and polishes every sample afterwards
+        self.fill_tol = CLOSURE_TOL if spin_links(linkage) else FILL_TOL
         self.N = X.shape[0]
         self.tracks: list[Track] = []
         self._met: dict[int, bool] = {}
@@ -118,6 +99,7 @@ class Tracker:
         L = linkage.length_scale
         self.col_scale = np.array([1.0 / L if t else 1.0 for t in lay.is_translation])
         in_scale = np.array([1.0 / L if n.endswith(".s") else 1.0 for n in linkage.inputs])
+        self.in_scale = in_scale
         steps = np.abs(np.diff(X, axis=0)) * in_scale if self.N > 1 else np.zeros((0, 1))
         self.span = np.concatenate([[0.0], np.cumsum(steps.max(axis=1))]) if self.N > 1 \
             else np.zeros(1)
@@ -269,7 +251,7 @@ class Tracker:
         in between by interpolation (:meth:`_fill`)."""
         every = [self._targets(f) for f in fronts]
         strides = [self._fill_stride(f, tg) for f, tg in zip(fronts, every, strict=True)]
-        targets = [tg if s == 1 else tg[_coarse(len(tg), s)]
+        targets = [tg if s == 1 else tg[coarse_targets(len(tg), s)]
                    for tg, s in zip(every, strides, strict=True)]
         owner = np.concatenate([np.full(len(tg), k) for k, tg in enumerate(targets)])
         t = np.concatenate(targets)
@@ -313,9 +295,14 @@ class Tracker:
                 else:
                     fills.append((f, every[k], targets[k][:p], reached, p == n))
                 continue
+            f.plain = False
             if self._advance(f, targets[k][:p], reached, full=p == n):
                 alive.append(f)
         for f, t_acc, conf, full, rates in self._fill(fills):
+            if not full and f.plain:  # an interpolated sample failed: the next chunk is
+                if not len(t_acc):    # corrected sample by sample, from here
+                    alive.append(f)
+                    continue
             if self._advance(f, t_acc, conf, full=full, rates=rates):
                 alive.append(f)
         return alive
@@ -324,7 +311,7 @@ class Tracker:
         """Every how many samples a front's chunk is corrected (1: every sample): so that each
         interval between corrected samples spans at most FILL_SPAN of input and FILL_STRIDE
         samples; only for chunks of plain samples (not sub-steps or jumps)."""
-        if f.jump or f.substep or len(targets) < 4:
+        if f.jump or f.substep or f.plain or len(targets) < 4:
             return 1
         k = int(round(f.t))
         idx = targets.astype(int)
@@ -338,7 +325,7 @@ class Tracker:
         """The samples between a front and its accepted coarse targets, all fronts at once:
         predicted by quintic Hermite interpolation between neighbouring corrected samples of the
         branch (:mod:`screwkit.kinematics.branch_fill`, with the derivatives from the rate
-        equations at both), accepted where the loop closes there to the corrector's tolerance
+        equations at both), accepted where the loop closes there to round-off (FILL_TOL)
         (the interpolation error is of sixth order in the interval); elsewhere corrected by
         Newton with the usual acceptance tests. A front keeps its samples up to the first one
         that fails. Returns, per front, the samples reached, their configurations, whether the
@@ -386,7 +373,12 @@ class Tracker:
         offset = np.arange(interval.size) - np.repeat(np.cumsum(gap) - gap, gap) + 1
         direction = np.sign(tB - tA)
         t = tA[interval] + direction[interval] * offset
-        u = offset / (gap[interval] + 1.0)
+        # where the input lies between the interval's ends (projected on its chord: exact for
+        # a straight sweep however unevenly sampled)
+        scale = self.in_scale
+        chord = dX[interval] * scale
+        u = np.einsum("ti,ti->t", (input_at(X, t) - input_at(X, tA)[interval]) * scale, chord) \
+            / np.maximum(np.einsum("ti,ti->t", chord, chord), 1e-300)
         delta = hermite_increments(lay, d1, v0, a0, v1, a1, interval, u)
         line = ~np.all(np.isfinite(delta), axis=1)  # a singular end: the chord
         delta[line] = u[line, None] * d1[interval[line]]
@@ -396,7 +388,16 @@ class Tracker:
         near = (JA[interval], np.asarray(np.linalg.svd(JA, compute_uv=False)[:, -1],
                                          dtype=float)[interval]) \
             if JA.shape[1] >= JA.shape[2] > 0 else None
-        conf, closed, rates = self._closed_or_corrected(pred, start_conf, t, near)
+        # an interpolated sample is kept as it is only where the loop closes there to about the
+        # round-off of the corrected samples on either side (each polished by Newton)
+        ends = forward(self.linkage, Configuration(
+            np.concatenate([starts.scalars, nodes.scalars]),
+            np.concatenate([starts.spherical, nodes.spherical])), lay, frames=False)
+        res = self._residual(ends.closure_R, ends.closure_p)
+        res_a = np.where(is_first, res[:len(fills)][which], res[len(fills):][np.maximum(prev, 0)])
+        tol = np.clip(8.0 * np.maximum(res_a, res[len(fills):]), self.fill_tol, CLOSURE_TOL)
+        conf, closed, rates = self._closed_or_corrected(pred, start_conf, t, near,
+                                                        tol[interval])
         out = []
         for k, (f, _, tc, reached, full) in enumerate(fills):
             mine = np.nonzero(which[interval] == k)[0]
@@ -404,6 +405,7 @@ class Tracker:
             order = np.argsort(t_all * f.direction, kind="stable")
             ok = np.concatenate([closed[mine], np.ones(len(tc), dtype=bool)])[order]
             p = len(order) if ok.all() else int(np.argmin(ok))
+            f.plain = p < len(order)
             keep = order[:p]
             here = Configuration(np.concatenate([conf.scalars[mine], reached.scalars])[keep],
                                  np.concatenate([conf.spherical[mine], reached.spherical])[keep])
@@ -418,8 +420,13 @@ class Tracker:
             out.append((f, t_all[keep], here, full and p == len(order), found))
         return out
 
+    def _residual(self, R: Array, p: Array) -> Array:
+        """The corrector's closure residual max|ξ| (scaled rows) of closure displacements."""
+        rows = np.array([1.0, 1.0, 1.0, *([1.0 / self.linkage.length_scale] * 3)])
+        return np.asarray(np.max(np.abs(closure_error(R, p) * rows), axis=-1))
+
     def _closed_or_corrected(self, pred: Configuration, start: Configuration, t: Array,
-                             near: tuple[Array, Array] | None,
+                             near: tuple[Array, Array] | None, tol: Array,
                              ) -> tuple[Configuration, NDArray[np.bool_], TrackRates | None]:
         """Interpolated samples (at positions ``t``) as they are where the loop closes to the
         corrector's tolerance, else corrected by Newton from them (accepted by the corrector's
@@ -427,9 +434,7 @@ class Tracker:
         kept as they are, from the same screws, when the tracker was asked for rates (their
         rank test helped by ``near``: each interval start's passive Jacobian and σ_min)."""
         fr = forward(self.linkage, pred, self.lay, frames=False)
-        rows = np.array([1.0, 1.0, 1.0, *([1.0 / self.linkage.length_scale] * 3)])
-        r = np.max(np.abs(closure_error(fr.closure_R, fr.closure_p) * rows), axis=-1)
-        closed = r <= CLOSURE_TOL
+        closed = self._residual(fr.closure_R, fr.closure_p) <= tol
         rates = None
         if self.rates is not None:
             eq = rate_equations(self.linkage, self.lay, fr, closed, exact_sigma=False,
@@ -502,7 +507,7 @@ class Tracker:
         if len(t):
             whole = np.nonzero(t == np.round(t))[0]
             idx = t[whole].astype(int)
-            put = _placer(idx, whole)
+            put = sample_writer(idx, whole)
             put(tr.scalars, conf.scalars)
             put(tr.spherical, conf.spherical)
             tr.mask[idx] = True

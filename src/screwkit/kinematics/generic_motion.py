@@ -12,7 +12,8 @@ Assembly modes are continuous branches (``../shared/DESIGN.md``), found by conti
    life, not from the anchor that found it);
 3. where a branch ends between two samples (the corrector says it dies: a limit position or
    dead centre) the root search runs again at both samples, since a branch may be born where
-   another dies;
+   another dies, and Newton looks for the root the branch meets at the fold along the passive
+   Jacobian's null direction (:func:`_seed_fold_partners`);
 4. a continuum of closed configurations at one input (a motion left free with the input
    fixed) is one degenerate set, seeded once (:mod:`screwkit.kinematics.degenerate`), and
    branches that turn out to be the same (found from two anchors) are merged.
@@ -33,7 +34,7 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.continuation import Tracker
 from screwkit.kinematics.degenerate import seeds_off_continua
-from screwkit.kinematics.loop import Array, Configuration, Layout, forward, layout
+from screwkit.kinematics.loop import Array, Configuration, Layout, apply_increment, forward, layout
 from screwkit.kinematics.mode_frames import build_progress, expect_modes, mode_from_configuration
 from screwkit.kinematics.motion import (
     AssemblyError,
@@ -43,7 +44,13 @@ from screwkit.kinematics.motion import (
     per_sample,
 )
 from screwkit.kinematics.rates import rate_equations
-from screwkit.kinematics.solve import Assemblies, find_assemblies, signature
+from screwkit.kinematics.solve import (
+    Assemblies,
+    assemblies_from,
+    find_assemblies,
+    set_inputs,
+    signature,
+)
 from screwkit.kinematics.tracks import Track
 from screwkit.model.linkage import Linkage
 
@@ -231,6 +238,13 @@ def _seed_from(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray
     if samples.size == 0:
         return False
     samples, asm = _root_search(linkage, X, samples, starts, seed)
+    return _seed_from_search(linkage, lay, tracker, samples, asm)
+
+
+def _seed_from_search(linkage: Linkage, lay: Layout, tracker: Tracker,
+                      samples: NDArray[np.intp], asm: Assemblies) -> bool:
+    """Follow the roots of a search (row r at ``samples[r]``) that are on no known branch, in
+    the order of the rows, looking again after each (:func:`_seed_from`)."""
     K = asm.found.shape[1]
     remaining = np.nonzero(asm.found.any(axis=1))[0]
     found_new = False
@@ -265,6 +279,7 @@ def all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int
     tracker = Tracker(linkage, lay, X, count if report is not None else None, rates)
     _seed_from(linkage, lay, tracker, anchor_samples(linkage, X), X, starts, seed)
     searched: set[int] = set()
+    partnered: set[tuple[int, int]] = set()
     for round_ in range(4):  # births where branches die; rarely more than one round
         ends: set[int] = set()
         for tr in tracker.tracks:
@@ -274,12 +289,54 @@ def all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int
                 ends.update((k - 1, k))
         todo = np.array(sorted(s for s in ends - searched if 0 <= s < N), dtype=np.intp)
         searched |= set(todo.tolist())
-        if not _seed_from(linkage, lay, tracker, todo, X, starts, seed + 1 + round_):
+        found = _seed_from(linkage, lay, tracker, todo, X, starts, seed + 1 + round_)
+        if not (_seed_fold_partners(linkage, lay, tracker, X, partnered) or found):
             break
     tracks = _attach_turning_points(linkage, lay, _merge_duplicates(linkage, lay, tracker.tracks))
     tracks = _attach_lone_ends(linkage, lay, tracks)
     _pair_ends(linkage, lay, tracks)
     return sorted(tracks, key=lambda tr: _order_key(linkage, lay, tr))
+
+
+#: steps (scaled freedoms) along the passive Jacobian's null direction from a branch's last
+#: sample before a fold, where Newton looks for the root it meets there
+PARTNER_STEPS = (1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3, 1.0, 3.0)
+
+
+def _seed_fold_partners(linkage: Linkage, lay: Layout, tracker: Tracker, X: Array,
+                        done: set[tuple[int, int]]) -> bool:
+    """Where a branch ends between two samples (a fold: it turns back in the input), the root it
+    meets there lies next to its last sample, along the passive Jacobian's null direction:
+    Newton from steps ±PARTNER_STEPS along it at that sample looks for it, and a root on no
+    known branch seeds one. (Random starts can miss a root whose basin is small — an island of
+    two modes that lives over a short stretch of input.) ``done`` holds the (track, sample)
+    ends already looked at; True if any root was new."""
+    ends = [(i, k) for i, tr in enumerate(tracker.tracks)
+            for k in [k for k, _ in tr.stops] + [k for k, _ in tr.starts]
+            if (i, k) not in done and tr.mask[k]]
+    done.update(ends)
+    if not ends:
+        return False
+    samples = np.array([k for _, k in ends], dtype=np.intp)
+    base = Configuration(np.stack([tracker.tracks[i].scalars[k] for i, k in ends]),
+                         np.stack([tracker.tracks[i].spherical[k] for i, k in ends]))
+    eq = rate_equations(linkage, lay, forward(linkage, base, lay))
+    k_rows, m_p = eq.passive.shape[1:]
+    if m_p == 0 or m_p > k_rows:
+        return False
+    null = np.linalg.svd(eq.passive)[2][:, -1, :]  # (B, m_p) scaled passive freedoms
+    steps = np.array([s * d for s in PARTNER_STEPS for d in (1.0, -1.0)])
+    per = len(steps)
+    delta = np.zeros((len(ends) * per, len(lay.names)))
+    delta[:, eq.p_idx] = (np.repeat(null, per, axis=0) * np.tile(steps, len(ends))[:, None]
+                          * eq.cols[eq.p_idx])
+    starts = set_inputs(apply_increment(base.take(np.repeat(np.arange(len(ends)), per)), delta,
+                                        lay), lay, linkage.inputs, np.repeat(X[samples], per,
+                                                                             axis=0))
+    order = np.argsort(samples, kind="stable")
+    asm = assemblies_from(linkage, starts.take(
+        (order[:, None] * per + np.arange(per)).ravel()), per)
+    return _seed_from_search(linkage, lay, tracker, samples[order], asm)
 
 
 def _pair_ends(linkage: Linkage, lay: Layout, tracks: list[Track]) -> None:
@@ -382,16 +439,28 @@ def _signature_moves(linkage: Linkage, lay: Layout, tr: Track,
     """An upper bound (n − 1,) of how far the track's signature (max norm) moves between
     consecutive ``samples``: every freedom's step times how far it can move a joint centre or
     axis — a turn by δ moves a point at most δ times its distance from the axis, which is at most
-    the loop's whole length (links, offsets and helical pitches; divided by the length scale),
-    and an axis by δ; a slide moves points by its length. A ball joint's turn is bounded by
+    the loop's whole length (links, offsets, and the largest slide of every P, C and H joint
+    over the samples; divided by the length scale), and an axis by δ; a slide moves points by
+    its length. A ball joint's turn is bounded by
     the difference of its rotation matrices' first two columns: |ΔR e₀|² + |ΔR e₁|² =
     4 sin²(θ/2)(2 − n₀² − n₁²) ≥ 4 sin²(θ/2) for a turn θ about n, so θ ≤ (π/2)·√(that)."""
     L = linkage.length_scale
-    reach = (sum(float(np.linalg.norm(t)) for t in lay.link_translations)
-             + sum(abs(j.offset) + abs(j.pitch) for j in linkage.joints)) / L
-    lever = max(1.0, reach)
     lo, hi = int(samples[0]), int(samples[-1]) + 1  # steps between neighbours, by slices
     q = tr.scalars[lo:hi]
+    # every length along the chain: links, offsets, and the largest slide of each P, C and H
+    # joint over these samples (a point's distance from an earlier axis includes them)
+    reach = sum(float(np.linalg.norm(t)) for t in lay.link_translations)
+    for i, joint in enumerate(linkage.joints):
+        if joint.kind == "H":  # its slide is offset + pitch θ, and a turn also moves by pitch
+            c = lay.scalar_col[lay.joint_of.index(i)]
+            reach += float(np.max(np.abs(joint.offset + joint.pitch * q[:, c]))) \
+                + abs(joint.pitch)
+        elif joint.kind != "P":  # a P joint's offset is an angle
+            reach += abs(joint.offset)
+    for f, c in enumerate(lay.scalar_col):
+        if lay.is_translation[f]:
+            reach += float(np.max(np.abs(q[:, c])))
+    lever = max(1.0, reach / L)
     dq = np.abs(q[1:] - q[:-1])
     turn = ~np.array([lay.is_translation[f] for f in range(len(lay.names))
                       if lay.scalar_col[f] >= 0], dtype=bool)

@@ -175,6 +175,9 @@ def as_input_array(linkage: Linkage, values: ArrayLike, name: str) -> Array:
 def per_sample(linkage: Linkage, values: ArrayLike, name: str, X: Array) -> Array:
     """The inputs' rates or accelerations ``values`` as an (N, n_in) array for the N samples of
     ``X``: one value for every sample, or one per sample (:func:`as_input_array`)."""
+    if np.ndim(values) == 0 and not isinstance(values, str):  # one value for every input
+        values = np.full(len(linkage.inputs), values, dtype=float) if np.isreal(values) \
+            else values
     a = as_input_array(linkage, values, name)
     if a.shape[0] not in (1, X.shape[0]):
         raise InputError(f"{name}: give one value for every sample or one per sample "

@@ -259,6 +259,16 @@ def find_assemblies(
     rng = np.random.default_rng(seed)
     conf0 = random_configurations(linkage, N * starts, rng, lay)
     conf0 = set_inputs(conf0, lay, linkage.inputs, np.repeat(values, starts, axis=0))
+    return assemblies_from(linkage, conf0, starts, max_modes, tol_same)
+
+
+def assemblies_from(linkage: Linkage, conf0: Configuration, starts: int, max_modes: int = 16,
+                    tol_same: float = 1e-6) -> Assemblies:
+    """The distinct assemblies Newton reaches from given starting configurations, ``starts``
+    consecutive rows per sample (inputs already set): :func:`find_assemblies` from chosen
+    starts."""
+    lay = layout(linkage)
+    N = conf0.size // starts
     res = newton(linkage, conf0, max_iter=50, lay=lay)
     fr = forward(linkage, res.conf, lay)
     sig = signature(linkage, res.conf, lay).reshape(N, starts, -1)

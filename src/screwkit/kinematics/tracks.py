@@ -5,6 +5,7 @@ rate equations — the predictor's q(X + d) ≈ q + q_X d + ½ q_XX(d, d)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -68,6 +69,7 @@ class Front:
     jumped: bool = False  # a jump was tried since the front last advanced normally
     derivatives: tuple[Array, Array] | None = None  # q_X, q_XX at the front (this wave)
     passive: Array | None = None  # the scaled passive Jacobian there
+    plain: bool = False  # an interpolated sample failed: correct the next chunk sample by sample
 
 
 def input_at(X: Array, t: Array) -> Array:
@@ -112,4 +114,33 @@ def taylor_increment(Q1: Array, Q2: Array, d: Array) -> Array:
                       + 0.5 * np.einsum("tmij,ti,tj->tm", Q2, d, d))
 
 
-__all__ = ["Front", "Track", "TrackRates", "input_at", "taylor", "taylor_increment"]
+def sample_writer(idx: NDArray[np.intp], rows: NDArray[np.intp]) -> Callable[[Array, Array], None]:
+    """A writer of ``values[rows]`` into ``array[idx]``: by slices where both are runs of
+    consecutive indices (a chunk of samples, either direction; several times faster than
+    fancy indexing for the large arrays of long sweeps)."""
+    n = len(idx)
+    if n > 1 and abs(int(idx[-1]) - int(idx[0])) == n - 1 and rows[-1] - rows[0] == n - 1 \
+            and np.all(np.abs(np.diff(idx)) == 1):
+        lo, hi = int(min(idx[0], idx[-1])), int(max(idx[0], idx[-1])) + 1
+        src = slice(int(rows[0]), int(rows[-1]) + 1)
+        rev = idx[-1] < idx[0]
+
+        def by_slice(array: Array, values: Array) -> None:
+            array[lo:hi] = values[src][::-1] if rev else values[src]
+
+        return by_slice
+
+    def by_index(array: Array, values: Array) -> None:
+        array[idx] = values[rows]
+
+    return by_index
+
+
+def coarse_targets(n: int, stride: int) -> NDArray[np.intp]:
+    """Indices of every ``stride``-th of ``n`` targets, and always the last."""
+    idx = np.arange(stride - 1, n, stride)
+    return idx if idx.size and idx[-1] == n - 1 else np.append(idx, n - 1)
+
+
+__all__ = ["Front", "Track", "TrackRates", "coarse_targets", "input_at", "sample_writer", "taylor",
+           "taylor_increment"]
