@@ -45,18 +45,25 @@ from screwkit.kinematics.loop import (
     Configuration,
     Layout,
     apply_increment,
-    closure_error,
     configuration_difference,
     forward,
 )
 from screwkit.kinematics.rates import joint_rates, rate_equations, spin_links
-from screwkit.kinematics.solve import CLOSURE_TOL, Correction, correct, set_inputs, signature
+from screwkit.kinematics.solve import (
+    CLOSURE_TOL,
+    Correction,
+    correct,
+    set_inputs,
+    signature,
+)
 from screwkit.kinematics.tracks import (
     Front,
     Track,
     TrackRates,
+    closure_residual,
     coarse_targets,
     input_at,
+    polished,
     sample_writer,
     taylor,
     taylor_increment,
@@ -105,8 +112,10 @@ class Tracker:
             else np.zeros(1)
 
     def add_seeds(self, sample: int, conf: Configuration) -> list[int]:
-        """New tracks from closed configurations at one sample; returns their indices."""
+        """New tracks from closed configurations at one sample (polished by Newton to
+        round-off, as every corrected sample is); returns their indices."""
         ids = []
+        conf = polished(self.linkage, self.lay, conf)
         for k in range(conf.size):
             tr = Track(np.full((self.N, self.lay.n_scalar), np.nan),
                        np.tile(np.eye(3), (self.N, self.lay.n_spherical, 1, 1)),
@@ -393,7 +402,7 @@ class Tracker:
         ends = forward(self.linkage, Configuration(
             np.concatenate([starts.scalars, nodes.scalars]),
             np.concatenate([starts.spherical, nodes.spherical])), lay, frames=False)
-        res = self._residual(ends.closure_R, ends.closure_p)
+        res = closure_residual(self.linkage, ends.closure_R, ends.closure_p)
         res_a = np.where(is_first, res[:len(fills)][which], res[len(fills):][np.maximum(prev, 0)])
         tol = np.clip(8.0 * np.maximum(res_a, res[len(fills):]), self.fill_tol, CLOSURE_TOL)
         conf, closed, rates = self._closed_or_corrected(pred, start_conf, t, near,
@@ -420,11 +429,6 @@ class Tracker:
             out.append((f, t_all[keep], here, full and p == len(order), found))
         return out
 
-    def _residual(self, R: Array, p: Array) -> Array:
-        """The corrector's closure residual max|ξ| (scaled rows) of closure displacements."""
-        rows = np.array([1.0, 1.0, 1.0, *([1.0 / self.linkage.length_scale] * 3)])
-        return np.asarray(np.max(np.abs(closure_error(R, p) * rows), axis=-1))
-
     def _closed_or_corrected(self, pred: Configuration, start: Configuration, t: Array,
                              near: tuple[Array, Array] | None, tol: Array,
                              ) -> tuple[Configuration, NDArray[np.bool_], TrackRates | None]:
@@ -434,7 +438,7 @@ class Tracker:
         kept as they are, from the same screws, when the tracker was asked for rates (their
         rank test helped by ``near``: each interval start's passive Jacobian and σ_min)."""
         fr = forward(self.linkage, pred, self.lay, frames=False)
-        closed = self._residual(fr.closure_R, fr.closure_p) <= tol
+        closed = closure_residual(self.linkage, fr.closure_R, fr.closure_p) <= tol
         rates = None
         if self.rates is not None:
             eq = rate_equations(self.linkage, self.lay, fr, closed, exact_sigma=False,

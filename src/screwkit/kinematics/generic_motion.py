@@ -447,19 +447,20 @@ def _signature_moves(linkage: Linkage, lay: Layout, tr: Track,
     L = linkage.length_scale
     lo, hi = int(samples[0]), int(samples[-1]) + 1  # steps between neighbours, by slices
     q = tr.scalars[lo:hi]
+    held = q[samples - lo]  # the slides' extent over the samples held (not the NaN between)
     # every length along the chain: links, offsets, and the largest slide of each P, C and H
     # joint over these samples (a point's distance from an earlier axis includes them)
     reach = sum(float(np.linalg.norm(t)) for t in lay.link_translations)
     for i, joint in enumerate(linkage.joints):
         if joint.kind == "H":  # its slide is offset + pitch θ, and a turn also moves by pitch
             c = lay.scalar_col[lay.joint_of.index(i)]
-            reach += float(np.max(np.abs(joint.offset + joint.pitch * q[:, c]))) \
+            reach += float(np.max(np.abs(joint.offset + joint.pitch * held[:, c]))) \
                 + abs(joint.pitch)
         elif joint.kind != "P":  # a P joint's offset is an angle
             reach += abs(joint.offset)
     for f, c in enumerate(lay.scalar_col):
         if lay.is_translation[f]:
-            reach += float(np.max(np.abs(q[:, c])))
+            reach += float(np.max(np.abs(held[:, c])))
     lever = max(1.0, reach / L)
     dq = np.abs(q[1:] - q[:-1])
     turn = ~np.array([lay.is_translation[f] for f in range(len(lay.names))

@@ -11,8 +11,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.loop import Array, Configuration, Layout, forward
+from screwkit.kinematics.loop import Array, Configuration, Layout, closure_error, forward
 from screwkit.kinematics.rates import freedom_rates, rate_equations, spin_links
+from screwkit.kinematics.solve import newton
 from screwkit.model.linkage import Linkage
 
 
@@ -114,6 +115,24 @@ def taylor_increment(Q1: Array, Q2: Array, d: Array) -> Array:
                       + 0.5 * np.einsum("tmij,ti,tj->tm", Q2, d, d))
 
 
+def closure_residual(linkage: Linkage, R: Array, p: Array) -> Array:
+    """The corrector's closure residual max|ξ| (scaled rows) of closure displacements (R, p)."""
+    rows = np.array([1.0, 1.0, 1.0, *([1.0 / linkage.length_scale] * 3)])
+    return np.asarray(np.max(np.abs(closure_error(R, p) * rows), axis=-1))
+
+
+def polished(linkage: Linkage, lay: Layout, conf: Configuration) -> Configuration:
+    """Roots of a root search (closed to 1e-11) polished by Newton to round-off, as every
+    corrected sample is; kept as they were where that does not lower the residual."""
+    fr = forward(linkage, conf, lay, frames=False)
+    before = closure_residual(linkage, fr.closure_R, fr.closure_p)
+    res = newton(linkage, conf, max_iter=3, tol=1e-15, lay=lay)
+    better = res.residual <= before
+    return Configuration(np.where(better[:, None], res.conf.scalars, conf.scalars),
+                         np.where(better[:, None, None, None], res.conf.spherical,
+                                  conf.spherical))
+
+
 def sample_writer(idx: NDArray[np.intp], rows: NDArray[np.intp]) -> Callable[[Array, Array], None]:
     """A writer of ``values[rows]`` into ``array[idx]``: by slices where both are runs of
     consecutive indices (a chunk of samples, either direction; several times faster than
@@ -142,5 +161,5 @@ def coarse_targets(n: int, stride: int) -> NDArray[np.intp]:
     return idx if idx.size and idx[-1] == n - 1 else np.append(idx, n - 1)
 
 
-__all__ = ["Front", "Track", "TrackRates", "coarse_targets", "input_at", "sample_writer", "taylor",
-           "taylor_increment"]
+__all__ = ["Front", "Track", "TrackRates", "closure_residual", "coarse_targets", "input_at",
+           "polished", "sample_writer", "taylor", "taylor_increment"]
