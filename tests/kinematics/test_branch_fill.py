@@ -86,17 +86,12 @@ def test_quintic_hermite_reproduces_a_quintic():
 
 
 def _loops():
-    rshc = Linkage.from_hartenberg_denavit(
-        "RSHC", [Joint("in", "R"), Joint("ball", "S"), Joint("screw", "H", pitch=0.02),
-                 Joint("cyl", "C")],
-        [0.05, 0.2, 0.15, 0.18], [deg(20), deg(10), deg(-30), deg(40)], inputs=["in.theta"])
-    rusr = Linkage.from_hartenberg_denavit(
-        "RUSR", [Joint("in", "R"), Joint("u", "U", offset=0.01), Joint("ball", "S"),
-                 Joint("out", "R", offset=0.02)],
-        [0.05, 0.2, 0.15, 0.18], [deg(30), deg(0), deg(10), deg(60)], inputs=["in.theta"])
+    from test_joint_kinds import _loops as joint_kind_loops  # RSHC, RUSR: H and U joints
+
+    kinds = joint_kind_loops()
     return {"RSRC": _fig7(), "RSSR": rssr(0.025, 0.1, 0.075, 0.075, 0.05, deg(50), 0.0125),
             "RCCC": load_spec(ROOT / "examples" / "rccc_loop.toml").linkage,
-            "4R": fourbar(0.1, 0.04, 0.12, 0.09), "RSHC": rshc, "RUSR": rusr}
+            "4R": fourbar(0.1, 0.04, 0.12, 0.09), "RSHC": kinds["RSHC"], "RUSR": kinds["RUSR"]}
 
 
 @pytest.mark.parametrize("name", ["RSRC", "RSSR", "RCCC", "4R", "RSHC", "RUSR"])

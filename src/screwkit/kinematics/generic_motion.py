@@ -137,10 +137,7 @@ def generic_motion(
         tracks = all_branches(linkage, lay, X, starts, seed,
                                tracking if report is not None else None)
         if not tracks:
-            raise AssemblyError(
-                f"{linkage.name}: the loop does not close at any of the {N} inputs "
-                f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
-                "check the dimensions")
+            raise closes_nowhere(linkage, X)
 
         def building(done: int, total: int) -> None:  # after the samples followed
             if report is not None:
@@ -158,6 +155,14 @@ def generic_motion(
                   solver="generic loop solver: continuation along the input (second-order "
                          "predictor, Newton corrector) from root searches at the first sample, "
                          "at anchors and where branches end (docs/kinematics.md)")
+
+
+def closes_nowhere(linkage: Linkage, X: Array) -> AssemblyError:
+    """The error of a sweep where the generic solver finds no closed configuration at all."""
+    return AssemblyError(
+        f"{linkage.name}: the loop does not close at any of the {X.shape[0]} inputs "
+        f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
+        "check the dimensions")
 
 
 def _events(linkage: Linkage, X: Array, tr: Track) -> list[str]:
@@ -553,4 +558,4 @@ def _order_key(linkage: Linkage, lay: Layout, tr: Track) -> tuple[float, ...]:
     return (float(first), *np.round(sig, 9).tolist())
 
 
-__all__ = ["ANCHOR_SPAN", "all_branches", "anchor_samples", "generic_motion", "progress_reporter"]
+__all__ = ["ANCHOR_SPAN", "all_branches", "closes_nowhere", "anchor_samples", "generic_motion", "progress_reporter"]

@@ -19,10 +19,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.budget import check_memory
 from screwkit.errors import InputError, InputTypeError, UnknownNameError
-from screwkit.kinematics.generic_motion import Progress, all_branches, progress_reporter
+from screwkit.kinematics.generic_motion import (
+    Progress,
+    all_branches,
+    closes_nowhere,
+    progress_reporter,
+)
 from screwkit.kinematics.loop import Array, Configuration, forward, layout
 from screwkit.kinematics.mode_frames import idle_spin_held
-from screwkit.kinematics.motion import AssemblyError, as_input_array, format_inputs, per_sample
+from screwkit.kinematics.motion import AssemblyError, as_input_array, per_sample
 from screwkit.kinematics.rates import joint_rates, rate_equations, spin_links
 from screwkit.kinematics.registry import family_of
 from screwkit.kinematics.solve_motion import MODES_ESTIMATE
@@ -110,10 +115,7 @@ def solve_joints(
     with progress_reporter(progress, N) as report:
         tracks = all_branches(linkage, lay, X, starts, seed, report, (Xd, Xdd))
     if not tracks:
-        raise AssemblyError(
-            f"{linkage.name}: the loop does not close at any of the {N} inputs "
-            f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
-            "check the dimensions")
+        raise closes_nowhere(linkage, X)
     rods = bool(spin_links(linkage))
     confs: list[Configuration] = []
     velocities: list[Array] = []
