@@ -6,7 +6,7 @@ The modes are the generic solver's (:func:`~screwkit.kinematics.generic_motion.g
 continuation from root searches, the same mode order and numbering), their rates and
 accelerations the loop's rate equations' (:func:`~screwkit.kinematics.rates.joint_rates`: the
 same values and the same singular samples as the Motion's). An S–S rod's idle spin is held at
-zero as in a Motion (docs/kinematics.md, "Idle spins"), so a ball joint's rotation here is the
+zero as in a Motion (docs/kinematics.md, "Idle spin"), so a ball joint's rotation here is the
 Motion's.
 """
 
