@@ -119,6 +119,10 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full, files={"--plot": plot})
         s = guard(lambda: load_spec(spec))
+        if getattr(s, "family", None) == "graph":  # any mechanism as a graph
+            from screwkit.cli.graph_views import analyze_graph
+
+            return analyze_graph(s, out, plot)
         pipe = Pipeline(s, method=method)
         motion = guard(lambda: pipe.motion)
         du = out.units_for(s.units)

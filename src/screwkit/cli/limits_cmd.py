@@ -122,7 +122,12 @@ def register(app: typer.Typer) -> None:
 
         out = Outputs.prepare([spec], as_json=as_json, output=output, formats=("json",))
         s = guard(lambda: load_spec(spec))
-        doc = guard(lambda: Pipeline(s).mobility().as_dict())
+        if getattr(s, "family", None) == "graph":
+            from screwkit.cli.graph_views import graph_mobility
+
+            doc = guard(lambda: graph_mobility(s))
+        else:
+            doc = guard(lambda: Pipeline(s).mobility().as_dict())
 
         def show() -> None:
             console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)

@@ -53,6 +53,9 @@ def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML)
         if ok and spec is not None:
             console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
             console.print(f"   jobs: {escape(', '.join(spec.jobs()))}", highlight=False)
+            if getattr(spec, "family", None) == "graph":
+                for line in spec.topology.summary():  # type: ignore[union-attr]
+                    console.print(f"   {escape(line)}", highlight=False)
         else:
             failed += 1
     if failed:

@@ -460,6 +460,10 @@ def load_spec(path: str | Path) -> Spec:
         data = read_toml(p)  # size, encoding, nesting and string-length checks
     except SpecFileError as exc:
         raise SpecError(str(exc)) from None
+    from screwkit.io.mechanism_spec import graph_spec_from_data, is_graph_spec
+
+    if is_graph_spec(data):
+        return graph_spec_from_data(data, p)  # type: ignore[return-value]
     return spec_from_data(data, p)
 
 

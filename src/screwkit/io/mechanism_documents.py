@@ -1,0 +1,84 @@
+"""Documents and tables of a mechanism graph's motion (``screwkit analyze`` on a graph spec):
+the JSON document (SI) with every mode's variables, rates, accelerations, events, closure
+residual, body poses and the paths of the ``[[points]]`` under ``coupler_points.<name>``, and
+the per-sample column table (CSV, Parquet, NPZ) in the same shape as a single loop's."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from screwkit.kinematics.graph.motion import MechanismMotion
+from screwkit.kinematics.graph.topology import MechanismTopology
+from screwkit.kinematics.motion_table import mode_columns, variable_kind
+from screwkit.tables import Column, ResultTable, stack_tables
+
+
+def _xyz(p: np.ndarray) -> dict[str, Any]:
+    return {"x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
+
+
+def mechanism_document(motion: MechanismMotion, topology: MechanismTopology | None = None
+                       ) -> dict[str, Any]:
+    """The analysis document of a graph spec (docs/mechanisms.md)."""
+    mech = motion.mechanism
+    modes = []
+    for md in motion.modes:
+        modes.append({
+            "mode": md.index,
+            "label": md.label or "drawn",
+            "assembles": md.assembles,
+            "singular": md.singular,
+            "events": list(md.events),
+            "variables": md.variables,
+            "velocities": md.velocities,
+            "accelerations": md.accelerations,
+            "closure_residual": md.closure_residual,
+            "coupler_points": {name: {"body": _body_of(motion, name), **_xyz(p)}
+                               for name, p in md.points.items()},
+            "bodies": {b.name: {"origin": md.link_origin[:, k],
+                                "rotation": md.link_rotation[:, k]}
+                       for k, b in enumerate(mech.bodies)},
+        })
+    doc: dict[str, Any] = {
+        "method": motion.method,
+        "solver": motion.solver,
+        "mechanism": mech.name,
+        "family": "graph",
+        "units": {"length": "m", "angle": "rad", "time": "s"},
+        "input_names": list(mech.inputs),
+        "input_name": mech.inputs[0],
+        "input": motion.inputs[:, 0] if motion.inputs.shape[1] == 1 else motion.inputs,
+        "input_speed": motion.input_rates[0].tolist(),
+        "input_acceleration": motion.input_accelerations[0].tolist(),
+        "bodies": ["ground", *mech.body_names],
+        "joints": [{"name": j.name, "kind": j.kind, "between": list(j.bodies)}
+                   for j in mech.joints],
+        "loops": mech.loop_joint_names(),
+        "modes": modes,
+    }
+    if topology is not None:
+        doc["topology"] = topology.as_dict()
+    return doc
+
+
+def _body_of(motion: MechanismMotion, point: str) -> str:
+    return next(p.body for p in motion.mechanism.points if p.name == point)
+
+
+def mechanism_table(motion: MechanismMotion) -> ResultTable:
+    """One row per sample and mode: the inputs, every freedom with its rates, the closure
+    residual and every point's path (``<point>_x|y|z``)."""
+    mech = motion.mechanism
+    tables = []
+    for md in motion.modes:
+        kind0 = variable_kind(mech.inputs[0])
+        cols = mode_columns(md, motion.inputs[:, 0], kind0)
+        for k, name in enumerate(mech.inputs[1:], start=1):
+            cols.insert(2 + k - 1, Column(f"input_{k + 1}", variable_kind(name),
+                                          motion.inputs[:, k]))
+        for name, p in md.points.items():
+            cols += [Column(f"{name}_{a}", "length", p[:, j]) for j, a in enumerate("xyz")]
+        tables.append(ResultTable(tuple(cols)))
+    return stack_tables(tables, f"{mech.name}: graph analysis, one row per input and mode")

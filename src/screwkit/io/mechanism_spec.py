@@ -1,0 +1,316 @@
+"""Graph spec files: any mechanism, placed by world coordinates in one drawn configuration.
+
+A spec is a graph spec when it has ``[[bodies]]`` or joints with ``between`` (docs/mechanisms.md);
+``[mechanism]`` then holds no ``family``. Every length is in ``[units] length`` (or a string with
+its unit), every angle in ``[units] angle``; inputs are measured from the drawing. The file
+becomes a :class:`GraphSpec` in SI with its :class:`~screwkit.model.mechanism.Mechanism`.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr
+from pydantic import ValidationError
+
+from screwkit.errors import ScrewkitError
+from screwkit.io.display_units import DisplayUnits, display_units
+from screwkit.io.errors import SpecError
+from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
+from screwkit.io.validation import validation_lines
+from screwkit.model.mass import MassProperties
+from screwkit.model.mechanism import (
+    MAX_BODIES,
+    MAX_JOINTS,
+    Body,
+    BodyPoint,
+    Mechanism,
+    MechanismJoint,
+)
+
+Value = StrictFloat | StrictInt | StrictStr
+MAX_ROWS = 10_000_000
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class GraphMechanismTable(_Strict):
+    name: StrictStr | None = Field(None, max_length=200)
+    source: StrictStr | None = None
+    description: StrictStr | None = None
+
+
+class BodyTable(_Strict):
+    name: StrictStr = Field(max_length=80)
+    mass: Value | None = None
+    com: list[Value] | None = Field(None, min_length=3, max_length=3)
+    inertia: list[list[Value]] | None = None
+
+
+class GraphJointTable(_Strict):
+    name: StrictStr = Field(max_length=80)
+    kind: Literal["R", "P", "C", "H", "U", "S"]
+    between: list[StrictStr] = Field(min_length=2, max_length=2)
+    at: list[Value] = Field(min_length=3, max_length=3)
+    axis: list[Value] | None = Field(None, min_length=3, max_length=3)
+    axis2: list[Value] | None = Field(None, min_length=3, max_length=3)
+    pitch: Value = 0.0
+    input: StrictBool | StrictStr = False
+
+
+class PointTable(_Strict):
+    name: StrictStr = Field(max_length=80)
+    body: StrictStr
+    at: list[Value] = Field(min_length=3, max_length=3)
+
+
+class GraphMotionTable(_Strict):
+    start: Value = 0.0
+    stop: Value | None = None
+    step: Value | None = None
+    rows: list[list[Value]] | None = Field(None, max_length=100_000)
+    speed: Value = 1.0
+    acceleration: Value = 0.0
+
+
+class GraphSpecFile(_Strict):
+    mechanism: GraphMechanismTable = Field(default_factory=GraphMechanismTable)
+    units: dict[str, str] = Field(default_factory=dict)
+    bodies: list[BodyTable] = Field(default_factory=list, max_length=MAX_BODIES + 1)
+    joints: list[GraphJointTable] = Field(max_length=MAX_JOINTS + 1)
+    points: list[PointTable] = Field(default_factory=list, max_length=1000)
+    motion: GraphMotionTable = Field(default_factory=GraphMotionTable)  # type: ignore[arg-type]
+    gravity: Value | None = None
+    gravity_direction: list[StrictFloat | StrictInt] = Field(
+        default_factory=lambda: [0.0, 0.0, -1.0])
+
+
+def is_graph_spec(data: dict[str, Any]) -> bool:
+    """Whether parsed TOML describes a mechanism graph (``[[bodies]]`` or ``between``)."""
+    if "bodies" in data:
+        return True
+    joints = data.get("joints")
+    return isinstance(joints, list) and any(isinstance(j, dict) and "between" in j
+                                            for j in joints)
+
+
+class GraphSpec:
+    """A validated graph spec in SI: ``mechanism``, ``inputs`` (N, n_in) measured from the
+    drawing, ``speed`` and ``acceleration`` of the inputs, ``units``, ``gravity_vector``."""
+
+    family = "graph"
+
+    def __init__(self, raw: GraphSpecFile, path: str) -> None:
+        self.raw = raw
+        self.path = path
+        self.name = raw.mechanism.name or Path(path).stem
+        self.source = raw.mechanism.source
+        self.units = dict(raw.units)
+        for kind, unit in self.units.items():
+            if kind not in KIND_UNITS or kind == "dimensionless":
+                self._fail(f"units.{kind}", f"unknown kind {kind!r}; the kinds are "
+                           + ", ".join(k for k in KIND_UNITS if k != "dimensionless"))
+            try:
+                check_unit(unit, kind)
+            except UnitError as exc:
+                self._fail(f"units.{kind}", str(exc))
+        self.mode = 0
+        self.mechanism = self._mechanism()
+        self.inputs = self._inputs()
+        kinds = [self._input_kind(k) for k in range(len(self.mechanism.inputs))]
+        rate = {"angle": "angular_velocity", "length": "velocity"}
+        accel = {"angle": "angular_acceleration", "length": "acceleration"}
+        self.speed = np.array([self.quantity(raw.motion.speed, rate[k], "motion.speed")
+                               for k in kinds])
+        self.acceleration = np.array([self.quantity(raw.motion.acceleration, accel[k],
+                                                    "motion.acceleration") for k in kinds])
+        g = 9.80665 if raw.gravity is None else self.quantity(raw.gravity, "acceleration",
+                                                              "gravity")
+        d = np.asarray(raw.gravity_direction, dtype=float)
+        if d.shape != (3,) or not np.linalg.norm(d) > 0:
+            self._fail("gravity_direction", f"give a non-zero vector [x, y, z]; got {d.tolist()}")
+        self.gravity_vector = g * d / np.linalg.norm(d)
+        from screwkit.kinematics.graph.topology import mechanism_topology
+
+        self.topology = mechanism_topology(self.mechanism)
+        if self.topology.free or "conflict" in self.topology.verdict:
+            self._fail("joints", f"{self.topology.verdict} (mark input = true on as many "
+                                 "joints as the mechanism has freedoms)")
+
+    def describe(self, units: DisplayUnits | None = None) -> str:
+        """One line: what the spec describes."""
+        t = self.topology
+        n = self.inputs.shape[0]
+        return (f"{self.path}: {self.name}: a mechanism of {t.bodies} moving bodies, {t.joints} "
+                f"joints and {len(t.loops)} loop(s); inputs {', '.join(self.mechanism.inputs)} "
+                f"over {n} sample(s) from the drawing")
+
+    def jobs(self) -> list[str]:
+        return ["analyze", "mobility"]
+
+    # --- helpers ---------------------------------------------------------------------------
+    def _fail(self, key: str, message: str) -> None:
+        raise SpecError(f"{self.path}: [{key}] {message}")
+
+    def quantity(self, value: Any, kind: str, key: str) -> float:
+        try:
+            return to_si(value, kind, self.units.get(kind))
+        except UnitError as exc:
+            self._fail(key, str(exc))
+        raise AssertionError  # unreachable
+
+    def _vector(self, values: list[Any], kind: str, key: str) -> np.ndarray:
+        return np.array([self.quantity(v, kind, f"{key}[{k}]") for k, v in enumerate(values)])
+
+    def _direction(self, values: list[Any], key: str) -> np.ndarray:
+        try:
+            v = np.array([float(x) for x in values])
+        except (TypeError, ValueError):
+            self._fail(key, f"an axis is three plain numbers (a direction has no unit); "
+                            f"got {values!r}")
+        if not np.all(np.isfinite(v)) or float(np.linalg.norm(v)) == 0.0:
+            self._fail(key, f"the axis {values!r} has zero length; give a direction such as "
+                            "[0, 0, 1]")
+        return v / np.linalg.norm(v)
+
+    def _mechanism(self) -> Mechanism:
+        raw = self.raw
+        if len(raw.bodies) > MAX_BODIES or len(raw.joints) > MAX_JOINTS:
+            self._fail("bodies", f"{len(raw.bodies)} bodies and {len(raw.joints)} joints: at "
+                                 f"most {MAX_BODIES} bodies and {MAX_JOINTS} joints")
+        bodies = [Body(b.name, self._mass(b, k)) for k, b in enumerate(raw.bodies)]
+        joints = []
+        inputs = []
+        for k, j in enumerate(raw.joints):
+            key = f"joints.{k}"
+            if j.kind == "S" and j.axis is not None:
+                self._fail(f"{key}.axis", f"joint {j.name!r} is spherical: it has no axis; "
+                                          "remove 'axis'")
+            if j.kind != "S" and j.axis is None:
+                self._fail(f"{key}.axis", f"joint {j.name!r} ({j.kind}) needs an axis, e.g. "
+                                          "axis = [0, 0, 1]")
+            if (j.axis2 is not None) != (j.kind == "U"):
+                self._fail(f"{key}.axis2", f"joint {j.name!r}: 'axis2' is for U joints only, "
+                                           "and a U joint needs it")
+            axis = self._direction(j.axis, f"{key}.axis") if j.axis else np.array([0, 0, 1.0])
+            axis2 = self._direction(j.axis2, f"{key}.axis2") if j.axis2 else None
+            pitch = (self.quantity(j.pitch, "length", f"{key}.pitch") if j.kind == "H" else 0.0)
+            at = self._vector(j.at, "length", f"{key}.at")
+            joints.append(MechanismJoint(j.name, j.kind, (j.between[0], j.between[1]), at,
+                                         axis, axis2, pitch))
+            inputs.extend(self._joint_inputs(j, key))
+        points = [BodyPoint(p.name, p.body, self._vector(p.at, "length", f"points.{k}.at"))
+                  for k, p in enumerate(raw.points)]
+        if not inputs:
+            self._fail("joints", "no joint is driven: mark the driven joint with input = true")
+        try:
+            return Mechanism(self.name, tuple(bodies), tuple(joints), tuple(inputs),
+                             tuple(points))
+        except ScrewkitError as exc:
+            raise SpecError(f"{self.path}: {exc}") from None
+
+    def _joint_inputs(self, j: GraphJointTable, key: str) -> list[str]:
+        from screwkit.model.joints import JOINT_FREEDOMS
+
+        if j.input is False:
+            return []
+        freedoms = JOINT_FREEDOMS[j.kind]
+        if j.kind == "S":
+            self._fail(f"{key}.input", f"joint {j.name!r} is spherical: its freedoms cannot be "
+                                       "driven; drive an R, P, C, H or U joint")
+        if j.input is True:
+            if len(freedoms) > 1:
+                self._fail(f"{key}.input", f"joint {j.name!r} ({j.kind}) has freedoms "
+                                           f"{list(freedoms)}: say which is driven, e.g. "
+                                           f"input = {freedoms[0]!r}")
+            return [f"{j.name}.{freedoms[0]}"]
+        names = [x.strip() for x in str(j.input).split(",")]
+        for n in names:
+            if n not in freedoms:
+                self._fail(f"{key}.input", f"joint {j.name!r} ({j.kind}) has no freedom {n!r}; "
+                                           f"its freedoms are {list(freedoms)}")
+        return [f"{j.name}.{n}" for n in names]
+
+    def _mass(self, b: BodyTable, k: int) -> MassProperties | None:
+        key = f"bodies.{k}"
+        if b.mass is None:
+            if b.com is not None or b.inertia is not None:
+                self._fail(f"{key}.mass", f"body {b.name!r} has 'com' or 'inertia' but no mass")
+            return None
+        mass = self.quantity(b.mass, "mass", f"{key}.mass")
+        com = (self._vector(b.com, "length", f"{key}.com") if b.com is not None
+               else np.zeros(3))
+        if b.inertia is None:
+            inertia = np.zeros((3, 3))
+        else:
+            if len(b.inertia) != 3 or any(len(r) != 3 for r in b.inertia):
+                self._fail(f"{key}.inertia", "the inertia about the centre of mass is a 3×3 "
+                                             "matrix [[Ixx, Ixy, Ixz], [..], [..]]")
+            inertia = np.array([[self.quantity(v, "inertia", f"{key}.inertia")
+                                 for v in row] for row in b.inertia])
+        try:
+            return MassProperties(mass, com, inertia)
+        except ScrewkitError as exc:
+            self._fail(key, f"body {b.name!r}: {exc}")
+        raise AssertionError  # unreachable
+
+    def _input_kind(self, k: int) -> str:
+        name = self.mechanism.inputs[k]
+        return "length" if name.endswith(".s") else "angle"
+
+    def _inputs(self) -> np.ndarray:
+        m = self.raw.motion
+        n_in = len(self.mechanism.inputs)
+        kinds = [self._input_kind(k) for k in range(n_in)]
+        if m.rows is not None:
+            if m.stop is not None or m.step is not None:
+                self._fail("motion", "give either rows or start/stop/step, not both")
+            rows = []
+            for r, row in enumerate(m.rows):
+                if len(row) != n_in:
+                    self._fail(f"motion.rows.{r}", f"each row gives one value per input "
+                               f"({n_in}: {', '.join(self.mechanism.inputs)}); got {len(row)}")
+                rows.append([self.quantity(v, kinds[c], f"motion.rows.{r}")
+                             for c, v in enumerate(row)])
+            if not rows:
+                self._fail("motion.rows", "give at least one row")
+            return np.array(rows, dtype=float)
+        if n_in != 1:
+            self._fail("motion", f"the mechanism has {n_in} inputs "
+                                 f"({', '.join(self.mechanism.inputs)}): give their values as "
+                                 "rows = [[...], ...], one value per input")
+        if m.stop is None or m.step is None:
+            self._fail("motion", "give start, stop and step (measured from the drawing)")
+        start = self.quantity(m.start, kinds[0], "motion.start")
+        stop = self.quantity(m.stop, kinds[0], "motion.stop")
+        step = self.quantity(m.step, kinds[0], "motion.step")
+        if not step > 0:
+            self._fail("motion.step", f"the step must be positive; got {m.step!r}")
+        if stop < start:
+            self._fail("motion.stop", f"stop ({m.stop!r}) must not be below start ({m.start!r})")
+        n = int(math.floor((stop - start) / step + 1e-9)) + 1
+        if n > MAX_ROWS:
+            self._fail("motion.step", f"{n} samples is too many; use a larger step")
+        return (start + step * np.arange(n))[:, None]
+
+    def display_units(self, system: str = "spec", overrides: dict[str, str] | None = None
+                      ) -> DisplayUnits:
+        return display_units(self.units, system=system, overrides=overrides)
+
+    @property
+    def input_is_angle(self) -> bool:
+        return self._input_kind(0) == "angle"
+
+
+def graph_spec_from_data(data: dict[str, Any], path: str | Path) -> GraphSpec:
+    try:
+        raw = GraphSpecFile.model_validate(data)
+    except ValidationError as exc:
+        raise SpecError("\n".join([f"{path}: the spec file is not valid:",
+                                   *validation_lines(exc)])) from exc
+    return GraphSpec(raw, str(path))

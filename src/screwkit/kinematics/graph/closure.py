@@ -1,0 +1,270 @@
+"""The stacked loop closure of a :class:`~screwkit.model.mechanism.Mechanism`, batched over samples.
+
+Body poses come from the spanning tree by the product of exponentials (model/mechanism.py):
+T_child = T_parent · M_j(q_j)^{±1}. Each chord j between bodies a and b closes one loop; its
+closure is E_j = T_a · M_j(q_j) · T_b⁻¹ = I, and the exact SE(3) logarithm of E_j is the loop's
+residual twist (world frame). Its derivative is Σ sign·S_f q̇_f round the loop, with S_f the unit
+screw of freedom f in the world (Bagci 1969 eqs. 3.19–3.26 generalised to a loop basis): the rows
+of the stacked screw Jacobian, six per loop.
+
+Screws are 6-vectors (ω; v), v the velocity of the point at the world origin (as
+kinematics/loop.py). A configuration is a :class:`~screwkit.kinematics.loop.Configuration`:
+scalar freedoms in joint order and one rotation per spherical joint (body increments).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.dual.spatial import cross
+from screwkit.kinematics.loop import Configuration, closure_twist, lie_bracket
+from screwkit.model.mechanism import GROUND, Mechanism
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class GraphLayout:
+    """Where each freedom lives in a configuration and in the Jacobian, and the constants the
+    hot paths need (joint points and axes as arrays, the loops as signed joint lists)."""
+
+    names: tuple[str, ...]
+    joint_of: tuple[int, ...]
+    scalar_col: tuple[int, ...]  # column in Configuration.scalars, -1 for S freedoms
+    first_freedom: tuple[int, ...]  # per joint: index of its first freedom
+    spherical_of_joint: dict[int, int]
+    is_translation: tuple[bool, ...]
+    n_scalar: int
+    n_spherical: int
+    inputs: tuple[int, ...]  # freedom indices of the inputs, in input order
+    passive: tuple[int, ...]
+    body_of: dict[str, int]  # body name -> index into pose arrays (ground last)
+    length: float
+
+    @property
+    def m(self) -> int:
+        return len(self.names)
+
+
+def graph_layout(mech: Mechanism) -> GraphLayout:
+    names: list[str] = []
+    joint_of: list[int] = []
+    scalar_col: list[int] = []
+    first: list[int] = []
+    is_tr: list[bool] = []
+    sph: dict[int, int] = {}
+    col = 0
+    for i, j in enumerate(mech.joints):
+        first.append(len(names))
+        if j.kind == "S":
+            sph[i] = len(sph)
+        for f in j.freedoms:
+            names.append(f"{j.name}.{f}")
+            joint_of.append(i)
+            is_tr.append(f == "s")
+            if j.kind == "S":
+                scalar_col.append(-1)
+            else:
+                scalar_col.append(col)
+                col += 1
+    inputs = tuple(names.index(x) for x in mech.inputs)
+    passive = tuple(k for k in range(len(names)) if k not in inputs)
+    body_of = {b: k for k, b in enumerate(mech.body_names)}
+    body_of[GROUND] = len(mech.bodies)
+    return GraphLayout(tuple(names), tuple(joint_of), tuple(scalar_col), tuple(first), sph,
+                       tuple(is_tr), col, len(sph), inputs, passive, body_of,
+                       mech.length_scale)
+
+
+def zero_configuration(lay: GraphLayout, count: int = 1) -> Configuration:
+    """The drawn configuration (every freedom 0), ``count`` times."""
+    return Configuration(np.zeros((count, lay.n_scalar)),
+                         np.broadcast_to(np.eye(3), (count, lay.n_spherical, 3, 3)).copy())
+
+
+def _axis_rotation(u: Array, th: Array) -> Array:
+    """Rotations (N, 3, 3) by angles θ (N,) about the fixed unit axis u (Rodrigues)."""
+    K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
+    s, c = np.sin(th)[:, None, None], np.cos(th)[:, None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+
+
+def joint_motion(mech: Mechanism, lay: GraphLayout, conf: Configuration, i: int
+                 ) -> tuple[Array, Array]:
+    """M_j(q) (R (N, 3, 3), p (N, 3)) of joint ``i`` in drawn world coordinates."""
+    j = mech.joints[i]
+    N = conf.size
+    f0 = lay.first_freedom[i]
+    c, u = j.at, j.axis
+    if j.kind == "S":
+        R = conf.spherical[:, lay.spherical_of_joint[i]]
+    elif j.kind == "P":
+        s = conf.scalars[:, lay.scalar_col[f0]]
+        return np.broadcast_to(np.eye(3), (N, 3, 3)), s[:, None] * u
+    elif j.kind == "U":
+        assert j.axis2 is not None
+        R = (_axis_rotation(u, conf.scalars[:, lay.scalar_col[f0]])
+             @ _axis_rotation(j.axis2, conf.scalars[:, lay.scalar_col[f0 + 1]]))
+    else:  # R, C, H
+        th = conf.scalars[:, lay.scalar_col[f0]]
+        R = _axis_rotation(u, th)
+    p = c - R @ c
+    if j.kind == "C":
+        p = p + conf.scalars[:, lay.scalar_col[f0 + 1], None] * u
+    elif j.kind == "H":
+        p = p + (j.pitch * conf.scalars[:, lay.scalar_col[f0]])[:, None] * u
+    return R, p
+
+
+@dataclass(frozen=True)
+class GraphFrames:
+    """Body poses (N, B+1, …; the ground last), the unit screws of every freedom in the world
+    (N, 6, m), the loop residual twists (N, L, 6) and joint centres and axes (N, J, 3)."""
+
+    R: Array
+    p: Array
+    screws: Array
+    residual: Array
+    centres: Array
+    axes: Array
+
+
+def graph_forward(mech: Mechanism, lay: GraphLayout, conf: Configuration) -> GraphFrames:
+    """Body poses along the spanning tree, every freedom's world screw and every loop's
+    closure twist (module docstring)."""
+    N = conf.size
+    B = len(mech.bodies) + 1
+    R = np.empty((N, B, 3, 3))
+    p = np.empty((N, B, 3))
+    g = lay.body_of[GROUND]
+    R[:, g] = np.eye(3)
+    p[:, g] = 0.0
+    motions = {}
+    for k, parent, child in mech.topology.tree:
+        Mr, Mp = joint_motion(mech, lay, conf, k)
+        motions[k] = (Mr, Mp)
+        a, b = lay.body_of[parent], lay.body_of[child]
+        if mech.joints[k].bodies[0] != parent:  # the tree runs against the joint: M⁻¹
+            Mr = np.swapaxes(Mr, -1, -2)
+            Mp = -np.einsum("nij,nj->ni", Mr, Mp)
+        R[:, b] = R[:, a] @ Mr
+        p[:, b] = np.einsum("nij,nj->ni", R[:, a], Mp) + p[:, a]
+    residual = np.empty((N, len(mech.topology.chords), 6))
+    for l, k in enumerate(mech.topology.chords):
+        Mr, Mp = joint_motion(mech, lay, conf, k)
+        a, b = (lay.body_of[x] for x in mech.joints[k].bodies)
+        Ra = R[:, a] @ Mr
+        pa = np.einsum("nij,nj->ni", R[:, a], Mp) + p[:, a]
+        Rbt = np.swapaxes(R[:, b], -1, -2)
+        ER = Ra @ Rbt
+        Ep = pa - np.einsum("nij,nj->ni", ER, p[:, b])
+        residual[:, l] = closure_twist(ER, Ep)
+    screws, centres, axes = _screws(mech, lay, R, p)
+    return GraphFrames(R, p, screws, residual, centres, axes)
+
+
+def _line_screw(u: Array, c: Array, pitch: float = 0.0) -> Array:
+    return np.concatenate([u, cross(c, u) + pitch * u], -1)
+
+
+def _screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
+            ) -> tuple[Array, Array, Array]:
+    """World screws of every freedom (N, 6, m), joint centres and first axes (N, J, 3)."""
+    N = R.shape[0]
+    S = np.empty((N, 6, lay.m))
+    J = len(mech.joints)
+    centres = np.empty((N, J, 3))
+    axes = np.empty((N, J, 3))
+    for i, j in enumerate(mech.joints):
+        a, b = (lay.body_of[x] for x in j.bodies)
+        c = R[:, a] @ j.at + p[:, a]
+        u = R[:, a] @ j.axis
+        centres[:, i], axes[:, i] = c, u
+        f = lay.first_freedom[i]
+        if j.kind == "P":
+            S[:, :3, f] = 0.0
+            S[:, 3:, f] = u
+        elif j.kind in "RH":
+            S[:, :, f] = _line_screw(u, c, j.pitch if j.kind == "H" else 0.0)
+        elif j.kind == "C":
+            S[:, :, f] = _line_screw(u, c)
+            S[:, :3, f + 1] = 0.0
+            S[:, 3:, f + 1] = u
+        elif j.kind == "U":
+            assert j.axis2 is not None
+            S[:, :, f] = _line_screw(u, c)
+            S[:, :, f + 1] = _line_screw(R[:, b] @ j.axis2, c)
+        else:  # S: body increments about the child's own axes through the centre
+            for k in range(3):
+                S[:, :, f + k] = _line_screw(R[:, b, :, k], c)
+    return S, centres, axes
+
+
+def loop_jacobian(mech: Mechanism, lay: GraphLayout, screws: Array) -> Array:
+    """The stacked loop-closure Jacobian (N, 6L, m): rows 6l…6l+5 hold sign·S_f for every
+    freedom f of a joint of loop l (module docstring)."""
+    loops = mech.topology.loops
+    N = screws.shape[0]
+    Jac = np.zeros((N, 6 * len(loops), lay.m))
+    for l, loop in enumerate(loops):
+        for k, sign in loop:
+            f0 = lay.first_freedom[k]
+            n = len(mech.joints[k].freedoms)
+            Jac[:, 6 * l:6 * l + 6, f0:f0 + n] = sign * screws[:, :, f0:f0 + n]
+    return Jac
+
+
+def body_twists(mech: Mechanism, lay: GraphLayout, screws: Array, qd: Array
+                ) -> tuple[Array, Array]:
+    """World twists V (N, B+1, 6) of every body for freedom rates ``qd`` (N, m), and the
+    velocity-product part of every joint's relative acceleration, bias_j (N, J, 6):
+    A_second − A_first = Σ S q̈ + bias_j with bias_j = [V_first, Σ S q̇] (+ [S₁θ̇₁, S₂θ̇₂] for a U),
+    since a screw fixed in a body moving with twist V changes at the rate [V, S]."""
+    N = qd.shape[0]
+    V = np.zeros((N, len(mech.bodies) + 1, 6))
+    rel = np.empty((N, len(mech.joints), 6))
+    for i, j in enumerate(mech.joints):
+        f = lay.first_freedom[i]
+        n = len(j.freedoms)
+        rel[:, i] = np.einsum("nkf,nf->nk", screws[:, :, f:f + n], qd[:, f:f + n])
+    for k, parent, child in mech.topology.tree:
+        sign = 1.0 if mech.joints[k].bodies[0] == parent else -1.0
+        V[:, lay.body_of[child]] = V[:, lay.body_of[parent]] + sign * rel[:, k]
+    bias = np.empty_like(rel)
+    for i, j in enumerate(mech.joints):
+        bias[:, i] = lie_bracket(V[:, lay.body_of[j.bodies[0]]], rel[:, i])
+        if j.kind == "U":
+            f = lay.first_freedom[i]
+            bias[:, i] += lie_bracket(screws[:, :, f] * qd[:, f, None],
+                                      screws[:, :, f + 1] * qd[:, f + 1, None])
+    return V, bias
+
+
+def loop_bias(mech: Mechanism, bias: Array) -> Array:
+    """The velocity-product terms of the stacked closure's second derivative (N, 6L):
+    J q̈ = −(this), from Σ sign·(S q̈ + bias_j) = 0 round each loop."""
+    loops = mech.topology.loops
+    out = np.zeros((bias.shape[0], 6 * len(loops)))
+    for l, loop in enumerate(loops):
+        for k, sign in loop:
+            out[:, 6 * l:6 * l + 6] += sign * bias[:, k]
+    return out
+
+
+def body_accelerations(mech: Mechanism, lay: GraphLayout, screws: Array, qdd: Array,
+                       bias: Array) -> Array:
+    """World accelerations (N, B+1, 6): the time derivative of each body's world twist, along
+    the tree A_child = A_parent ± (S q̈ + bias_j)."""
+    N = qdd.shape[0]
+    A = np.zeros((N, len(mech.bodies) + 1, 6))
+    for k, parent, child in mech.topology.tree:
+        j = mech.joints[k]
+        f = lay.first_freedom[k]
+        n = len(j.freedoms)
+        rel = np.einsum("nkf,nf->nk", screws[:, :, f:f + n], qdd[:, f:f + n]) + bias[:, k]
+        sign = 1.0 if j.bodies[0] == parent else -1.0
+        A[:, lay.body_of[child]] = A[:, lay.body_of[parent]] + sign * rel
+    return A

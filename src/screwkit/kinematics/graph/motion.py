@@ -1,0 +1,274 @@
+"""The motion of any mechanism over its inputs: :func:`solve_mechanism` → :class:`MechanismMotion`.
+
+The drawn assembly mode is followed along the inputs (graph/track.py); then, at every sample and
+all at once, the body poses, the freedoms' rates and accelerations from the stacked screw
+Jacobian (graph/newton.py: J_p q̇_p = −J_in ẋ, J_p q̈_p = −J_in ẍ − bias), every body's twist and
+acceleration (graph/closure.py), joint centres and axes, and the paths of the points carried by
+bodies. Per mode the fields are those of a single loop's :class:`ModeMotion` with "link" read as
+"body" (``link_rotation[:, k]`` is body k's pose, in ``mechanism.bodies`` order), plus the points.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.dual.spatial import cross
+from screwkit.errors import InputError, UnknownNameError
+from screwkit.kinematics.graph.closure import (
+    GraphLayout,
+    body_accelerations,
+    body_twists,
+    graph_layout,
+)
+from screwkit.kinematics.graph.newton import (
+    RANK_CUTOFF,
+    accelerations,
+    linearise,
+    rates,
+    scaled_residual,
+)
+from screwkit.kinematics.graph.track import follow_drawn_mode
+from screwkit.kinematics.loop import Configuration, rotation_vector
+from screwkit.kinematics.motion import AssemblyError, ModeMotion
+from screwkit.model.mechanism import Mechanism
+
+Array = NDArray[np.float64]
+
+#: a sample is singular where the passive block's smallest kept singular value falls below this
+#: fraction of its largest (the inputs no longer fix the mechanism there)
+SINGULAR_TOL = 1e-7
+
+
+@dataclass(frozen=True, eq=False)
+class MechanismMode(ModeMotion):
+    """One assembly mode of a mechanism (ModeMotion's fields, "link" read as "body") with the
+    paths of its points: ``points[name]`` (N, 3) world positions, and their velocities and
+    accelerations."""
+
+    points: dict[str, Array] = field(default_factory=dict)
+    point_velocities: dict[str, Array] = field(default_factory=dict)
+    point_accelerations: dict[str, Array] = field(default_factory=dict)
+
+
+@dataclass(frozen=True, eq=False)
+class MechanismMotion:
+    """Positions, rates and accelerations of a mechanism over its inputs, per assembly mode
+    (mode 0 is the drawn mode)."""
+
+    mechanism: Mechanism
+    inputs: Array
+    input_rates: Array
+    input_accelerations: Array
+    modes: tuple[MechanismMode, ...]
+    method: str = "graph"
+    solver: str = "continuation from the drawn configuration on the stacked loop closure"
+    notes: tuple[str, ...] = ()
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        return self.mechanism.inputs
+
+    @property
+    def samples(self) -> int:
+        return int(self.inputs.shape[0])
+
+    def mode(self, index: int) -> MechanismMode:
+        n = len(self.modes)
+        if isinstance(index, bool) or not isinstance(index, int | np.integer):
+            raise InputError(f"mode must be an integer index 0…{n - 1}; got {index!r}")
+        if not 0 <= index < n:
+            raise AssemblyError(f"{self.mechanism.name}: assembly mode {index} asked for; the "
+                                f"mechanism has {n} mode(s) here (0…{n - 1})")
+        return self.modes[index]
+
+    def variable(self, name: str, mode: int = 0, *, derivative: int = 0) -> Array:
+        md = self.mode(mode)
+        if derivative not in (0, 1, 2):
+            raise InputError(f"derivative must be 0, 1 or 2; got {derivative!r}")
+        table = (md.variables, md.velocities, md.accelerations)[derivative]
+        if name not in table:
+            raise UnknownNameError(f"{self.mechanism.name}: no variable {name!r}; the "
+                                   f"variables are {sorted(table)}")
+        return table[name]
+
+    def point(self, name: str, mode: int = 0, *, derivative: int = 0) -> Array:
+        md = self.mode(mode)
+        table = (md.points, md.point_velocities, md.point_accelerations)[derivative]
+        if name not in table:
+            raise UnknownNameError(f"{self.mechanism.name}: no point {name!r}; the points "
+                                   f"are {sorted(md.points)}")
+        return table[name]
+
+
+def _per_sample(values: ArrayLike | None, N: int, n_in: int, name: str) -> Array:
+    if values is None:
+        return np.zeros((N, n_in))
+    try:
+        a = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be numbers; got {values!r}") from None
+    if a.ndim == 0:
+        a = np.full((N, n_in), float(a))
+    elif a.ndim == 1 and a.shape[0] == N and n_in == 1:
+        a = a[:, None]
+    elif a.ndim == 1 and a.shape[0] == n_in:
+        a = np.broadcast_to(a, (N, n_in))
+    if a.shape != (N, n_in) or not np.all(np.isfinite(a)):
+        raise InputError(f"{name}: give one finite value per input ({n_in}) or one per sample "
+                         f"and input ({N}×{n_in}); got shape {np.shape(values)}")
+    return np.array(a, dtype=float)
+
+
+def input_rows(mech: Mechanism, inputs: ArrayLike) -> Array:
+    """Input values as (N, n_in) rows, checked (one column per input of ``mech``)."""
+    try:
+        X = np.asarray(inputs, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"inputs must be numbers; got {inputs!r}") from None
+    n_in = len(mech.inputs)
+    if X.ndim == 1 and n_in == 1:
+        X = X[:, None]
+    if X.ndim != 2 or X.shape[1] != n_in or X.shape[0] == 0:
+        raise InputError(f"{mech.name}: inputs must be rows of {n_in} value(s) "
+                         f"({', '.join(mech.inputs)}); got shape {np.shape(X)}")
+    if not np.all(np.isfinite(X)):
+        raise InputError(f"{mech.name}: inputs must be finite numbers (a NaN or inf was given)")
+    return X
+
+
+def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | None = 1.0,
+                    accelerations: ArrayLike | None = 0.0,
+                    progress: Callable[[int, int], None] | None = None) -> MechanismMotion:
+    """The drawn mode of ``mech`` over ``inputs`` (N rows, one value per input, measured from
+    the drawing; SI), with input ``rates`` and ``accelerations`` (a scalar, one per input or
+    one per sample and input)."""
+    X = input_rows(mech, inputs)
+    N, n_in = X.shape
+    Xd = _per_sample(rates, N, n_in, "rates")
+    Xdd = _per_sample(accelerations, N, n_in, "accelerations")
+    lay = graph_layout(mech)
+    followed = follow_drawn_mode(mech, lay, X, progress)
+    if not followed.mask.any():
+        raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
+                            f"first input row {_fmt(mech, lay, X[0])}: the mechanism stops "
+                            "assembling before it")
+    mode = build_mode(mech, lay, followed.conf, followed.mask, X, Xd, Xdd)
+    events = list(mode.events)
+    if followed.stopped_after is not None and followed.stopped_after >= 0:
+        k = followed.stopped_after
+        nxt = f" (a limit position or dead centre before {_fmt(mech, lay, X[k + 1])})" \
+            if k + 1 < N else ""
+        events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[k])}{nxt}")
+    mode = _with_events(mode, events)
+    return MechanismMotion(mech, X, Xd, Xdd, (mode,))
+
+
+def _with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:
+    fields = {k: getattr(mode, k) for k in mode.__dataclass_fields__}
+    fields["events"] = events
+    return MechanismMode(**fields)
+
+
+def _fmt(mech: Mechanism, lay: GraphLayout, x: Array) -> str:
+    parts = []
+    for name, f, v in zip(mech.inputs, lay.inputs, x, strict=True):
+        parts.append(f"{name} = {v:.6g} m" if lay.is_translation[f]
+                     else f"{name} = {np.degrees(v):.6g} deg")
+    return ", ".join(parts)
+
+
+def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDArray[np.bool_],
+               X: Array, Xd: Array, Xdd: Array) -> MechanismMode:
+    """Everything about one mode from its configurations (module docstring)."""
+    lin = linearise(mech, lay, conf)
+    fr = lin.frames
+    qd = rates(mech, lay, lin, Xd)
+    qdd, bias = accelerations(mech, lay, lin, qd, Xdd)
+    V, _ = body_twists(mech, lay, fr.screws, qd)
+    A = body_accelerations(mech, lay, fr.screws, qdd, bias)
+    nb = len(mech.bodies)
+    singular = mask & _singular(mech, lay, lin.sigma)
+    w, v0, al, a0 = V[:, :nb, :3], V[:, :nb, 3:], A[:, :nb, :3], A[:, :nb, 3:]
+    p = fr.p[:, :nb]
+    v_o = v0 + cross(w, p)
+    a_o = a0 + cross(al, p) + cross(w, v_o)
+    variables, velocities, accels = _variables(mech, lay, conf, qd, qdd)
+    residual = np.linalg.norm(scaled_residual(mech, lay, fr), axis=1)
+    points, pv, pa = {}, {}, {}
+    for pt in mech.points:
+        b = lay.body_of[pt.body]
+        x = np.einsum("nij,j->ni", fr.R[:, b], pt.at) + fr.p[:, b]
+        v = V[:, b, 3:] + cross(V[:, b, :3], x)
+        a = A[:, b, 3:] + cross(A[:, b, :3], x) + cross(V[:, b, :3], v)
+        points[pt.name], pv[pt.name], pa[pt.name] = x, v, a
+    frames = [fr.R[:, :nb].copy(), p.copy()]
+    twists = [w.copy(), v_o, al.copy(), a_o]
+    bad = ~mask
+    for table in (variables, velocities, accels, points, pv, pa):
+        for values in table.values():
+            values[bad] = np.nan
+    for table in (velocities, accels, pv, pa):
+        for values in table.values():
+            values[singular] = np.nan
+    centres, axes = fr.centres.copy(), fr.axes.copy()
+    for arr in [*frames, *twists, centres, axes]:
+        arr[bad] = np.nan
+    for arr in twists:
+        arr[singular] = np.nan
+    residual[bad] = np.nan
+    events = []
+    if singular.any():
+        idx = np.nonzero(singular)[0]
+        shown = ", ".join(_fmt(mech, lay, X[k]) for k in idx[:4]) + (" …" if idx.size > 4 else "")
+        events.append(f"singular at {idx.size} sample(s) ({shown}): the inputs do not fix the "
+                      "mechanism there (a dead centre, or a platform that gains a freedom)")
+    return MechanismMode(mask, singular, conf, variables, velocities, accels,
+                         link_rotation=frames[0], link_origin=frames[1],
+                         link_angular_velocity=twists[0], link_origin_velocity=twists[1],
+                         link_angular_acceleration=twists[2], link_origin_acceleration=twists[3],
+                         joint_centres=centres, joint_axes=axes, closure_residual=residual,
+                         events=events, points=points, point_velocities=pv,
+                         point_accelerations=pa)
+
+
+def expected_rank(mech: Mechanism, lay: GraphLayout) -> int:
+    """Rank of the passive block at the drawing (idle freedoms and redundant constraints
+    excluded): what a regular sample keeps."""
+    lin = linearise(mech, lay, Configuration(np.zeros((1, lay.n_scalar)), np.broadcast_to(
+        np.eye(3), (1, lay.n_spherical, 3, 3)).copy()))
+    s = lin.sigma[0]
+    return int(np.sum(s > RANK_CUTOFF * max(float(s[0]) if s.size else 0.0, 1e-300)))
+
+
+def _singular(mech: Mechanism, lay: GraphLayout, sigma: Array) -> NDArray[np.bool_]:
+    r = expected_rank(mech, lay)
+    if r == 0 or sigma.shape[1] == 0:
+        return np.zeros(sigma.shape[0], dtype=bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = sigma[:, r - 1] / sigma[:, 0]
+    return np.asarray(~(ratio > SINGULAR_TOL))
+
+
+def _variables(mech: Mechanism, lay: GraphLayout, conf: Configuration, qd: Array, qdd: Array
+               ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array]]:
+    values: dict[str, Array] = {}
+    vel: dict[str, Array] = {}
+    acc: dict[str, Array] = {}
+    for i, j in enumerate(mech.joints):
+        f0 = lay.first_freedom[i]
+        if j.kind == "S":
+            rv = rotation_vector(conf.spherical[:, lay.spherical_of_joint[i]])
+            for k, c in enumerate("xyz"):
+                values[f"{j.name}.r{c}"] = rv[:, k].copy()
+        for k, name in enumerate(j.freedoms):
+            f = f0 + k
+            full = lay.names[f]
+            if j.kind != "S":
+                values[full] = conf.scalars[:, lay.scalar_col[f]].copy()
+            vel[full] = qd[:, f].copy()
+            acc[full] = qdd[:, f].copy()
+    return values, vel, acc

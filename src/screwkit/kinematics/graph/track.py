@@ -1,0 +1,196 @@
+"""Continuation of the drawn assembly mode along the inputs, in batched waves.
+
+From the drawn configuration (every freedom 0 at inputs 0) the mode is followed to the first
+sample and then along the sweep. A wave predicts up to K samples at once from the last accepted
+one by the second-order Taylor expansion of the closure (rates and the velocity-product term
+along each sample's input increment), corrects them all by one batched Newton solve, and keeps the
+longest run that (a) closes and (b) is consistent with its own rates: consecutive samples must
+differ by the trapezoid rule's ½(q̇ₖ + q̇ₖ₊₁)Δx up to a fraction of the step, which a jump onto
+another branch cannot meet. K doubles after a full wave and shrinks after a short one; where a
+single sample fails, the input step is split (up to 2⁶ parts) before the mode is declared to stop
+assembling there (a fold: the branch turns back, a dead centre or limit position).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics.graph.closure import GraphLayout, body_twists, loop_bias
+from screwkit.kinematics.graph.newton import (
+    CLOSURE_TOL,
+    Linearised,
+    column_scale,
+    difference,
+    increment,
+    linearise,
+    newton,
+    rates,
+    row_scale,
+)
+from screwkit.kinematics.loop import Configuration
+from screwkit.model.mechanism import Mechanism
+
+Array = NDArray[np.float64]
+
+MAX_WAVE = 512
+#: a step is consistent when its trapezoid-rule error is below this fraction of the step
+CONSISTENCY = 0.05
+MAX_SPLIT_DEPTH = 6
+
+
+@dataclass
+class _Point:
+    conf: Configuration  # one sample
+    x: Array  # (n_in,)
+    lin: Linearised
+
+
+def _predict(mech: Mechanism, lay: GraphLayout, at: _Point, X: Array) -> Configuration:
+    """Second-order Taylor prediction from ``at`` to every input row of ``X`` (K, n_in)."""
+    K = X.shape[0]
+    d = X - at.x[None, :]
+    lin = Linearised(at.lin.frames, np.broadcast_to(at.lin.J, (K, *at.lin.J.shape[1:])),
+                     np.broadcast_to(at.lin.pinv, (K, *at.lin.pinv.shape[1:])), at.lin.sigma)
+    qd = rates(mech, lay, lin, d)
+    screws = np.broadcast_to(at.lin.frames.screws, (K, *at.lin.frames.screws.shape[1:]))
+    _, bias = body_twists(mech, lay, screws, qd)
+    L = len(mech.topology.loops)
+    rhs = -loop_bias(mech, bias) * row_scale(lay, L)
+    cs = column_scale(lay)
+    qdd = np.zeros_like(qd)
+    qdd[:, list(lay.passive)] = np.einsum("nij,nj->ni", lin.pinv, rhs) * cs[list(lay.passive)]
+    start = Configuration(np.repeat(at.conf.scalars, K, 0), np.repeat(at.conf.spherical, K, 0))
+    return increment(start, qd + 0.5 * qdd, lay)
+
+
+def _consistent(mech: Mechanism, lay: GraphLayout, prev: _Point, conf: Configuration,
+                X: Array, lin: Linearised) -> NDArray[np.bool_]:
+    """Whether each sample follows from the one before it by the trapezoid rule."""
+    K = conf.size
+    before = Configuration(np.concatenate([prev.conf.scalars, conf.scalars[:-1]]),
+                           np.concatenate([prev.conf.spherical, conf.spherical[:-1]]))
+    Xb = np.concatenate([prev.x[None, :], X[:-1]])
+    piv = np.concatenate([prev.lin.pinv, lin.pinv[:-1]])
+    Jb = np.concatenate([prev.lin.J, lin.J[:-1]])
+    d = X - Xb
+    cs = column_scale(lay)
+    rate_after = rates(mech, lay, lin, d)
+    rate_before = rates(mech, lay, Linearised(lin.frames, Jb, piv, lin.sigma), d)
+    actual = difference(conf, before, lay) / cs
+    trap = 0.5 * (rate_after + rate_before) / cs
+    passive = list(lay.passive)
+    miss = (actual - trap)[:, passive]
+    # idle freedoms (null directions of J_p) may move freely: compare off the null space
+    proj = np.einsum("nij,njk->nik", lin.pinv, lin.J[:, :, passive])
+    miss = np.einsum("nij,nj->ni", proj, miss)
+    size = np.linalg.norm(actual[:, passive], axis=1)
+    ok = np.linalg.norm(miss, axis=1) <= CONSISTENCY * size + 1e-9
+    return np.asarray(ok[:K])
+
+
+def _wave(mech: Mechanism, lay: GraphLayout, at: _Point, X: Array
+          ) -> tuple[int, Configuration, Linearised]:
+    """Predict and correct the samples ``X``; the count of the leading run that is kept."""
+    pred = _predict(mech, lay, at, X)
+    conf, err, lin = newton(mech, lay, pred, X, max_iter=6)
+    ok = err <= CLOSURE_TOL * 10
+    if ok.any():
+        ok &= _consistent(mech, lay, at, conf, X, lin)
+    bad = np.nonzero(~ok)[0]
+    return (int(bad[0]) if bad.size else X.shape[0]), conf, lin
+
+
+def _split_step(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array, depth: int
+                ) -> _Point | None:
+    """Reach input ``x`` from ``at`` in 2, then 4 … sub-steps; None where it cannot."""
+    if depth > MAX_SPLIT_DEPTH:
+        return None
+    mid = 0.5 * (at.x + x)
+    for target in (mid, x):
+        count, conf, lin = _wave(mech, lay, at, target[None, :])
+        if count == 1:
+            at = _Point(conf, target, lin)
+            continue
+        reached = _split_step(mech, lay, at, target, depth + 1)
+        if reached is None:
+            return None
+        at = reached
+    return at
+
+
+@dataclass(frozen=True)
+class Followed:
+    """The drawn mode over the samples: configurations (N), where they hold, and the input
+    where the mode stops assembling (None if it assembles throughout)."""
+
+    conf: Configuration
+    mask: NDArray[np.bool_]
+    stopped_after: int | None
+
+
+def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
+                      progress: object = None) -> Followed:
+    """Follow the drawn configuration (inputs 0) to ``X[0]`` and along every row of ``X``."""
+    N, n_in = X.shape
+    conf0 = Configuration(np.zeros((1, lay.n_scalar)),
+                          np.broadcast_to(np.eye(3), (1, lay.n_spherical, 3, 3)).copy())
+    at = _Point(conf0, np.zeros(n_in), linearise(mech, lay, conf0))
+    scal = np.empty((N, lay.n_scalar))
+    sph = np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy()
+    mask = np.zeros(N, dtype=bool)
+    if np.any(X[0] != 0.0):
+        reached = _approach(mech, lay, at, X[0])
+        if reached is None:
+            return Followed(Configuration(scal, sph), mask, -1)
+        at = reached
+        scal[0], sph[0], mask[0] = at.conf.scalars[0], at.conf.spherical[0], True
+        k = 1
+    else:
+        scal[0], sph[0], mask[0] = 0.0, np.eye(3), True
+        k = 1
+    wave = 8
+    report = progress if callable(progress) else None
+    while k < N:
+        X_wave = X[k:k + wave]
+        count, conf, lin = _wave(mech, lay, at, X_wave)
+        if count == 0:
+            if wave > 1:
+                wave = max(1, wave // 4)
+                continue
+            reached = _split_step(mech, lay, at, X[k], 1)
+            if reached is None:
+                return Followed(Configuration(scal, sph), mask, k - 1)
+            conf, lin, count = reached.conf, reached.lin, 1
+        scal[k:k + count] = conf.scalars[:count]
+        sph[k:k + count] = conf.spherical[:count]
+        mask[k:k + count] = True
+        last = count - 1
+        at = _Point(conf.take(slice(last, last + 1)), X[k + last].copy(),
+                    lin.take(slice(last, last + 1)))
+        k += count
+        wave = min(2 * wave, MAX_WAVE) if count == X_wave.shape[0] else max(1, count)
+        if report is not None:
+            report(k, N)
+    return Followed(Configuration(scal, sph), mask, None)
+
+
+def _approach(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array) -> _Point | None:
+    """From the drawing to the first sample in steps of at most ~3° (or 5 % of the length
+    scale) of input travel."""
+    span = np.abs(x - at.x) / np.where(np.array([lay.is_translation[f] for f in lay.inputs]),
+                                       0.05 * lay.length, 0.05)
+    steps = max(1, int(np.ceil(span.max())))
+    path = at.x[None, :] + (x - at.x)[None, :] * (np.arange(1, steps + 1) / steps)[:, None]
+    for target in path:
+        count, conf, lin = _wave(mech, lay, at, target[None, :])
+        if count == 1:
+            at = _Point(conf, target, lin)
+            continue
+        reached = _split_step(mech, lay, at, target, 1)
+        if reached is None:
+            return None
+        at = reached
+    return at

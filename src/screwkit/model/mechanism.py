@@ -1,0 +1,328 @@
+"""Any mechanism as an immutable graph: bodies, joints between any two bodies, driven freedoms.
+
+A :class:`Mechanism` is described the way a drawing is dimensioned: every joint is placed in one
+assembled, *drawn* configuration by its point and axis in world coordinates. Every body's frame
+coincides with the world frame in the drawing, so a joint's screw in either body's frame is its
+drawn world screw, and the relative motion of the joint's second body with respect to its first
+is the product of exponentials of those screws (Brockett's form; Murray, Li & Sastry 1994 §3.2):
+
+    T_second = T_first · M_j(q_j),   M_j(0) = I
+
+with, for the joint's point c and unit axis u (docs/mechanisms.md):
+
+====  ======================================  ====================================
+kind  freedoms                                M_j(q)
+====  ======================================  ====================================
+R     theta                                   rotation θ about the line (c, u)
+P     s                                       translation s along u
+C     theta, s                                rotation θ about and slide s along (c, u)
+H     theta                                   rotation θ about (c, u), slide pitch·θ along u
+U     theta1, theta2                          rotation θ1 about (c, u) · rotation θ2 about (c, u2)
+S     wx, wy, wz (body increments)            any rotation about c
+====  ======================================  ====================================
+
+Input values are measured from the drawing (every freedom is 0 there). A single loop is the case
+with one independent loop (:meth:`Mechanism.from_linkage`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.errors import InputError, UnknownNameError
+from screwkit.model.joints import JOINT_DESCRIPTIONS, JOINT_FREEDOMS
+from screwkit.model.mass import MassProperties
+
+Array = NDArray[np.float64]
+
+GROUND = "ground"
+#: the largest mechanism accepted (bodies, joints): the stacked closure is dense, so its cost
+#: grows with the cube of the joint count; past this the work is not bounded sensibly
+MAX_BODIES = 200
+MAX_JOINTS = 400
+#: names a spreadsheet would evaluate as a formula when they reach a CSV header
+_FORMULA_STARTS = ("=", "+", "-", "@")
+
+
+class MechanismError(InputError):
+    """A mechanism description that cannot be right (names, bodies, joints, inputs)."""
+
+
+@dataclass(frozen=True)
+class Body:
+    """A moving body. ``mass`` is in the body frame, which is the world frame of the drawing
+    (CAD's world-axes mass properties go in unchanged); ``None`` when no loads are asked for."""
+
+    name: str
+    mass: MassProperties | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class MechanismJoint:
+    """A joint between ``bodies[0]`` and ``bodies[1]``, placed in the drawn configuration.
+
+    ``at`` is its point (a U or S joint's centre), ``axis`` its unit axis (a P joint's slide
+    direction; a U joint's first axis, fixed in ``bodies[0]``), ``axis2`` a U joint's second
+    axis (fixed in ``bodies[1]``), ``pitch`` an H joint's lead per radian (m/rad)."""
+
+    name: str
+    kind: str
+    bodies: tuple[str, str]
+    at: Array
+    axis: Array
+    axis2: Array | None = None
+    pitch: float = 0.0
+
+    @property
+    def freedoms(self) -> tuple[str, ...]:
+        return JOINT_FREEDOMS[self.kind]
+
+    def freedom_names(self) -> list[str]:
+        return [f"{self.name}.{f}" for f in self.freedoms]
+
+
+@dataclass(frozen=True)
+class BodyPoint:
+    """A point carried by a body, given where it is in the drawn configuration (world)."""
+
+    name: str
+    body: str
+    at: Array
+
+
+@dataclass(frozen=True)
+class Topology:
+    """The body–joint graph: a spanning tree from the ground and the independent loops.
+
+    ``tree`` lists (joint index, parent body, child body) in an order where every parent is
+    placed before its child; ``chords`` are the joints that close a loop; ``loops[k]`` is loop
+    k as (joint index, sign) pairs, the sign +1 where the loop runs from the joint's first body
+    to its second (the closure is Σ sign·S q̇ = 0 round the loop)."""
+
+    tree: tuple[tuple[int, str, str], ...]
+    chords: tuple[int, ...]
+    loops: tuple[tuple[tuple[int, int], ...], ...]
+    depth: dict[str, int]
+
+
+def _name_ok(kind: str, name: object) -> str:
+    if not isinstance(name, str) or not name.strip():
+        raise MechanismError(f"{kind} name {name!r} must be a non-empty string")
+    if "." in name:
+        raise MechanismError(f"{kind} name {name!r} must contain no '.' (it labels variables "
+                             "as '<joint>.<freedom>')")
+    if name.startswith(_FORMULA_STARTS):
+        raise MechanismError(f"{kind} name {name!r} must not start with '=', '+', '-' or '@' "
+                             "(a spreadsheet would run it as a formula from a CSV header)")
+    return name
+
+
+def unit_vector(value: ArrayLike, what: str) -> Array:
+    """A 3-vector scaled to unit length; a clear error for a wrong shape or zero length."""
+    v = np.asarray(value, dtype=float)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise MechanismError(f"{what} must be three finite numbers; got {value!r}")
+    n = float(np.linalg.norm(v))
+    if n == 0.0:
+        raise MechanismError(f"{what} has zero length; give a direction such as [0, 0, 1]")
+    return v / n
+
+
+def point3(value: ArrayLike, what: str) -> Array:
+    v = np.asarray(value, dtype=float)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise MechanismError(f"{what} must be three finite numbers [x, y, z]; got {value!r}")
+    return v
+
+
+@dataclass(frozen=True, eq=False)
+class Mechanism:
+    """Any mechanism: moving ``bodies`` (the ground is implicit, named ``"ground"``), ``joints``
+    between any two bodies, the driven freedoms ``inputs`` (``"<joint>.<freedom>"``) and
+    ``points`` carried by bodies. Never modified: solvers return new result objects."""
+
+    name: str
+    bodies: tuple[Body, ...]
+    joints: tuple[MechanismJoint, ...]
+    inputs: tuple[str, ...]
+    points: tuple[BodyPoint, ...] = ()
+    #: a characteristic length (m): the spread of the joint points, for scale-aware checks
+    length_scale: float = field(default=0.0)
+
+    def __post_init__(self) -> None:
+        if len(self.bodies) > MAX_BODIES or len(self.joints) > MAX_JOINTS:
+            raise MechanismError(
+                f"mechanism {self.name!r}: {len(self.bodies)} bodies and {len(self.joints)} "
+                f"joints; at most {MAX_BODIES} bodies and {MAX_JOINTS} joints are accepted")
+        names = [_name_ok("body", b.name) for b in self.bodies]
+        _unique("body", [GROUND, *names], self.name)
+        _unique("joint", [_name_ok("joint", j.name) for j in self.joints], self.name)
+        _unique("point", [_name_ok("point", p.name) for p in self.points], self.name)
+        known = {GROUND, *names}
+        for j in self.joints:
+            self._check_joint(j, known)
+        for p in self.points:
+            if p.body not in known:
+                raise UnknownNameError(f"point {p.name!r}: body {p.body!r} is not a body of "
+                                       f"{self.name!r}; bodies are {sorted(known)}")
+        self._check_inputs()
+        if not self.length_scale:
+            pts = np.array([j.at for j in self.joints])
+            spread = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
+            object.__setattr__(self, "length_scale", max(spread, 1e-9))
+        _ = self.topology  # bodies attached to nothing are refused here
+
+    def _check_joint(self, j: MechanismJoint, known: set[str]) -> None:
+        if j.kind not in JOINT_FREEDOMS:
+            raise MechanismError(
+                f"joint {j.name!r}: unknown kind {j.kind!r}; use one of "
+                + ", ".join(f"{k} ({v})" for k, v in JOINT_DESCRIPTIONS.items()))
+        a, b = j.bodies
+        for body in (a, b):
+            if body not in known:
+                raise UnknownNameError(f"joint {j.name!r}: body {body!r} is not a body of "
+                                       f"{self.name!r}; bodies are {sorted(known)}")
+        if a == b:
+            raise MechanismError(f"joint {j.name!r} joins body {a!r} to itself; "
+                                 "give two different bodies in 'between'")
+        if j.kind == "H" and j.pitch == 0.0:
+            raise MechanismError(f"joint {j.name!r}: a helical (H) joint needs a non-zero pitch")
+        if j.kind == "U":
+            if j.axis2 is None:
+                raise MechanismError(f"joint {j.name!r}: a U joint needs 'axis2', its second axis")
+            if float(np.linalg.norm(np.cross(j.axis, j.axis2))) < 1e-6:
+                raise MechanismError(f"joint {j.name!r}: a U joint's two axes must not be "
+                                     "parallel")
+
+    def _check_inputs(self) -> None:
+        freedoms = self.freedom_names
+        if len(set(self.inputs)) != len(self.inputs):
+            raise MechanismError(f"mechanism {self.name!r}: an input is named twice: "
+                                 f"{list(self.inputs)}")
+        balls = {j.name for j in self.joints if j.kind == "S"}
+        for inp in self.inputs:
+            if inp.split(".")[0] in balls:
+                raise MechanismError(f"input {inp!r}: a spherical joint's freedoms cannot be "
+                                     "driven; drive an R, P, C, H or U joint")
+            if inp not in freedoms:
+                joint = inp.split(".")[0]
+                own = [f for f in freedoms if f.split(".")[0] == joint]
+                hint = (f"joint {joint!r} has {own}" if own else
+                        f"there is no joint {joint!r}")
+                raise MechanismError(f"input {inp!r} is not a freedom of {self.name!r} ({hint})")
+
+    # --- derived data ----------------------------------------------------------------------
+    @property
+    def body_names(self) -> tuple[str, ...]:
+        return tuple(b.name for b in self.bodies)
+
+    @property
+    def freedom_names(self) -> list[str]:
+        return [f for j in self.joints for f in j.freedom_names()]
+
+    @property
+    def passive_names(self) -> list[str]:
+        return [f for f in self.freedom_names if f not in self.inputs]
+
+    def joint(self, name: str) -> MechanismJoint:
+        for j in self.joints:
+            if j.name == name:
+                return j
+        raise UnknownNameError(f"{self.name!r} has no joint {name!r}; joints are "
+                               f"{[j.name for j in self.joints]}")
+
+    def body_index(self, name: str) -> int:
+        """Index of a body in :attr:`bodies` (the ground is −1)."""
+        if name == GROUND:
+            return -1
+        names = self.body_names
+        if name not in names:
+            raise UnknownNameError(f"{self.name!r} has no body {name!r}; bodies are "
+                                   f"{[GROUND, *names]}")
+        return names.index(name)
+
+    @cached_property
+    def topology(self) -> Topology:
+        """Spanning tree by breadth-first search from the ground; each chord closes one loop
+        (a fundamental cycle basis of the body–joint graph)."""
+        adjacent: dict[str, list[int]] = {GROUND: [], **{b: [] for b in self.body_names}}
+        for k, j in enumerate(self.joints):
+            adjacent[j.bodies[0]].append(k)
+            adjacent[j.bodies[1]].append(k)
+        parent_joint: dict[str, int] = {}
+        depth = {GROUND: 0}
+        order: list[tuple[int, str, str]] = []
+        queue = [GROUND]
+        used: set[int] = set()
+        while queue:
+            body = queue.pop(0)
+            for k in adjacent[body]:
+                if k in used:
+                    continue
+                a, b = self.joints[k].bodies
+                other = b if a == body else a
+                if other in depth:
+                    continue
+                used.add(k)
+                depth[other] = depth[body] + 1
+                parent_joint[other] = k
+                order.append((k, body, other))
+                queue.append(other)
+        loose = [b for b in self.body_names if b not in depth]
+        if loose:
+            raise MechanismError(
+                f"mechanism {self.name!r}: bodies {loose} are attached to nothing that leads "
+                "to the ground; join each to the mechanism with a joint")
+        chords = tuple(k for k in range(len(self.joints)) if k not in used)
+        loops = tuple(self._loop_of(c, parent_joint, depth) for c in chords)
+        return Topology(tuple(order), chords, loops, depth)
+
+    def _loop_of(self, chord: int, parent_joint: dict[str, int], depth: dict[str, int]
+                 ) -> tuple[tuple[int, int], ...]:
+        """The fundamental loop of a chord from body a to body b: a's tree path from the
+        common ancestor down (+), the chord (+), b's path back up (−), each signed by the
+        joint's own direction."""
+        a, b = self.joints[chord].bodies
+
+        def up(body: str) -> list[tuple[int, int]]:  # joints from body up to the ground
+            out = []
+            while body != GROUND:
+                k = parent_joint[body]
+                first, second = self.joints[k].bodies
+                out.append((k, 1 if second == body else -1))  # +1: parent→child is first→second
+                body = first if second == body else second
+            return out
+
+        pa, pb = up(a), up(b)
+        common = {k for k, _ in pa} & {k for k, _ in pb}
+        down_a = [(k, s) for k, s in reversed(pa) if k not in common]
+        up_b = [(k, -s) for k, s in pb if k not in common]
+        return (*down_a, (chord, 1), *up_b)
+
+    def loop_joint_names(self) -> list[list[str]]:
+        return [[self.joints[k].name for k, _ in loop] for loop in self.topology.loops]
+
+    def with_bodies(self, bodies: Sequence[Body]) -> Mechanism:
+        """A copy with other body data (e.g. mass properties)."""
+        return Mechanism(self.name, tuple(bodies), self.joints, self.inputs, self.points,
+                         self.length_scale)
+
+    def with_inputs(self, inputs: Sequence[str]) -> Mechanism:
+        """A copy driven by other freedoms (the same drawing)."""
+        return Mechanism(self.name, self.bodies, self.joints, tuple(inputs), self.points,
+                         self.length_scale)
+
+
+def _unique(kind: str, names: list[str], mechanism: str) -> None:
+    seen: set[str] = set()
+    for n in names:
+        if n in seen:
+            extra = " ('ground' exists already)" if n == GROUND else ""
+            raise MechanismError(f"mechanism {mechanism!r}: {kind} name {n!r} is used twice"
+                                 f"{extra}; give each {kind} its own name")
+        seen.add(n)
