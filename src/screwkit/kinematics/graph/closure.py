@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual.spatial import cross
-from screwkit.kinematics.loop import Configuration, closure_twist, lie_bracket
+from screwkit.kinematics.loop import Configuration, closure_error, closure_twist, lie_bracket
 from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]
@@ -132,9 +132,12 @@ class GraphFrames:
     axes: Array
 
 
-def graph_forward(mech: Mechanism, lay: GraphLayout, conf: Configuration) -> GraphFrames:
+def graph_forward(mech: Mechanism, lay: GraphLayout, conf: Configuration, exact: bool = True
+                  ) -> GraphFrames:
     """Body poses along the spanning tree, every freedom's world screw and every loop's
-    closure twist (module docstring)."""
+    closure twist (module docstring): the exact logarithm, or with ``exact=False`` its
+    first-order form (loop.closure_error: the same zero and the same derivative there, for a
+    corrector that starts close)."""
     N = conf.size
     B = len(mech.bodies) + 1
     R = np.empty((N, B, 3, 3))
@@ -161,7 +164,7 @@ def graph_forward(mech: Mechanism, lay: GraphLayout, conf: Configuration) -> Gra
         Rbt = np.swapaxes(R[:, b], -1, -2)
         ER = Ra @ Rbt
         Ep = pa - np.einsum("nij,nj->ni", ER, p[:, b])
-        residual[:, l] = closure_twist(ER, Ep)
+        residual[:, l] = closure_twist(ER, Ep) if exact else closure_error(ER, Ep)
     screws, centres, axes = _screws(mech, lay, R, p)
     return GraphFrames(R, p, screws, residual, centres, axes)
 

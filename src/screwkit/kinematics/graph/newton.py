@@ -85,8 +85,12 @@ class Linearised:
 
 
 def linearise(mech: Mechanism, lay: GraphLayout, conf: Configuration,
-              frames: GraphFrames | None = None) -> Linearised:
-    fr = frames if frames is not None else graph_forward(mech, lay, conf)
+              frames: GraphFrames | None = None, exact: bool = True) -> Linearised:
+    """The scaled Jacobian and the passive block's pseudo-inverse: by the SVD (``exact``: the
+    singular values too, for rank tests and singular flags) or, for the tracker's corrector and
+    rates, by the normal equations with a Tikhonov term of 1e-14·tr(JᵀJ) (the minimum-norm
+    solution up to that relative size; idle freedoms stay still)."""
+    fr = frames if frames is not None else graph_forward(mech, lay, conf, exact)
     L = len(mech.topology.loops)
     J = (loop_jacobian(mech, lay, fr.screws) * row_scale(lay, L)[:, None]
          * column_scale(lay)[None, :])
@@ -94,6 +98,11 @@ def linearise(mech: Mechanism, lay: GraphLayout, conf: Configuration,
     if Jp.shape[1] == 0 or Jp.shape[2] == 0:
         N = conf.size
         return Linearised(fr, J, np.zeros((N, Jp.shape[2], Jp.shape[1])), np.zeros((N, 0)))
+    if not exact:
+        JtJ = np.einsum("nki,nkj->nij", Jp, Jp)
+        mu = 1e-14 * np.einsum("nii->n", JtJ)[:, None, None] + 1e-300
+        pinv = np.linalg.solve(JtJ + mu * np.eye(Jp.shape[2]), np.swapaxes(Jp, 1, 2))
+        return Linearised(fr, J, pinv, np.zeros((conf.size, 0)))
     U, s, Vt = np.linalg.svd(Jp, full_matrices=False)
     keep = s > RANK_CUTOFF * np.maximum(s[:, :1], 1e-300)
     inv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
@@ -107,7 +116,7 @@ def scaled_residual(mech: Mechanism, lay: GraphLayout, fr: GraphFrames) -> Array
 
 
 def newton(mech: Mechanism, lay: GraphLayout, conf: Configuration, X: Array,
-           max_iter: int = 8, tol: float = CLOSURE_TOL
+           max_iter: int = 8, tol: float = CLOSURE_TOL, exact: bool = True
            ) -> tuple[Configuration, Array, Linearised]:
     """Close every sample of ``conf`` at inputs ``X`` (N, n_in) by Newton's method on the
     passive freedoms. Returns the configurations, each sample's scaled residual norm and the
@@ -115,7 +124,7 @@ def newton(mech: Mechanism, lay: GraphLayout, conf: Configuration, X: Array,
     conf = set_inputs(conf, lay, X)
     cs = column_scale(lay)[list(lay.passive)]
     passive = list(lay.passive)
-    lin = linearise(mech, lay, conf)
+    lin = linearise(mech, lay, conf, exact=exact)
     err = np.linalg.norm(scaled_residual(mech, lay, lin.frames), axis=1)
     for _ in range(max_iter):
         todo = err > tol
@@ -126,7 +135,7 @@ def newton(mech: Mechanism, lay: GraphLayout, conf: Configuration, X: Array,
         step[:, passive] = -np.einsum("nij,nj->ni", lin.pinv, r) * cs
         step[~todo] = 0.0
         conf = increment(conf, step, lay)
-        lin = linearise(mech, lay, conf)
+        lin = linearise(mech, lay, conf, exact=exact)
         new = np.linalg.norm(scaled_residual(mech, lay, lin.frames), axis=1)
         err = np.where(todo, new, err)
     err = np.where(np.isfinite(err), err, np.inf)

@@ -95,7 +95,7 @@ def _wave(mech: Mechanism, lay: GraphLayout, at: _Point, X: Array
           ) -> tuple[int, Configuration, Linearised]:
     """Predict and correct the samples ``X``; the count of the leading run that is kept."""
     pred = _predict(mech, lay, at, X)
-    conf, err, lin = newton(mech, lay, pred, X, max_iter=6)
+    conf, err, lin = newton(mech, lay, pred, X, max_iter=6, exact=False)
     ok = err <= CLOSURE_TOL * 10
     if ok.any():
         ok &= _consistent(mech, lay, at, conf, X, lin)
@@ -137,7 +137,7 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
     N, n_in = X.shape
     conf0 = Configuration(np.zeros((1, lay.n_scalar)),
                           np.broadcast_to(np.eye(3), (1, lay.n_spherical, 3, 3)).copy())
-    at = _Point(conf0, np.zeros(n_in), linearise(mech, lay, conf0))
+    at = _Point(conf0, np.zeros(n_in), linearise(mech, lay, conf0, exact=False))
     scal = np.empty((N, lay.n_scalar))
     sph = np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy()
     mask = np.zeros(N, dtype=bool)
