@@ -30,6 +30,15 @@ def graph_mobility(spec: Any) -> dict[str, Any]:
     return mechanism_topology(spec.mechanism, md.conf.take(idx)).as_dict()
 
 
+def graph_limits(spec: Any, output: str | None, dwell_tolerance: float | None
+                 ) -> dict[str, Any]:
+    """The limits document of a one-input graph spec."""
+    from screwkit.kinematics.graph.limits import graph_limit_positions
+
+    return graph_limit_positions(solved(spec), output,
+                                 1e-6 if dwell_tolerance is None else dwell_tolerance).as_dict()
+
+
 def analyze_graph(spec: Any, out: Any, plot: Path | None) -> None:
     """``screwkit analyze`` on a graph spec: tables in the spec's units, or the document."""
     from screwkit.cli.common import guard

@@ -98,6 +98,14 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit)
         s = guard(lambda: load_spec(spec))
+        if getattr(s, "family", None) == "graph":
+            from screwkit.cli.graph_views import graph_limits
+
+            doc = guard(lambda: graph_limits(s, variable, dwell_tolerance))
+            du = out.units_for(s.units)
+            out.deliver(document=lambda: doc, table=lambda: limits_table(doc),
+                        show=lambda: show_limits(s, doc, du), units=du)
+            return
         where = None if at is None else [float(np.radians(x)) if s.input_is_angle else float(x)
                                          for x in at]
         doc = guard(lambda: Pipeline(s).limits(dwell_tolerance, where, output=variable,

@@ -194,3 +194,16 @@ def _approach(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array) -> _Point
             return None
         at = reached
     return at
+
+
+def reach(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from: Array, x_to: Array
+          ) -> Configuration | None:
+    """The configuration at inputs ``x_to`` on the branch through ``conf`` (one sample, closed
+    at ``x_from``), followed by continuation; None where the branch does not get there."""
+    at = _Point(conf, np.asarray(x_from, dtype=float), linearise(mech, lay, conf, exact=False))
+    x_to = np.asarray(x_to, dtype=float)
+    count, reached, _ = _wave(mech, lay, at, x_to[None, :])
+    if count == 1:
+        return reached
+    end = _split_step(mech, lay, at, x_to, 1)
+    return None if end is None else end.conf

@@ -1,0 +1,126 @@
+"""The graph model's own checks (issue 26): topology and redundancy, limit positions against
+geometry, where a mode stops assembling, the analyze document, several inputs by rows."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import screwkit as sk
+from screwkit.cli.main import app
+from screwkit.kinematics.graph import solve_mechanism
+from screwkit.kinematics.graph.limits import graph_limit_positions
+from screwkit.kinematics.graph.topology import mechanism_topology
+from screwkit.model.mechanism import Body, BodyPoint, Mechanism, MechanismJoint
+
+FOURBAR = Path(__file__).parents[2] / "examples" / "mechanisms" / "fourbar_graph.toml"
+Z = np.array([0.0, 0.0, 1.0])
+
+
+def joint(name: str, kind: str, a: str, b: str, at: list[float], axis: np.ndarray = Z,
+          **kw: object) -> MechanismJoint:
+    return MechanismJoint(name, kind, (a, b), np.array(at, float), np.array(axis, float),
+                          **kw)  # type: ignore[arg-type]
+
+
+def rssr() -> Mechanism:
+    x = np.array([1.0, 0.0, 0.0])
+    return Mechanism("rssr", (Body("crank"), Body("rod"), Body("rocker")),
+                     (joint("A", "R", "ground", "crank", [0, 0, 0]),
+                      joint("B", "S", "crank", "rod", [1, 0, 0]),
+                      joint("C", "S", "rod", "rocker", [3, 2, 1]),
+                      joint("D", "R", "rocker", "ground", [3, 0, 1], x)), ("A.theta",),
+                     (BodyPoint("mid", "rod", np.array([2.0, 1.0, 0.5])),))
+
+
+def test_planar_loop_in_3d_has_three_redundant_constraints_named() -> None:
+    spec = sk.load_spec(FOURBAR)
+    t = spec.topology
+    assert (t.mobility, t.rank, t.grubler, t.redundant_count) == (1, 3, -2, 3)
+    assert t.loops == [["A", "B", "C", "D"]]
+    assert sorted(r.split(": ")[1] for r in t.redundant) == [
+        "rotation about x", "rotation about y", "translation along z"]
+    assert not t.idle and not t.free
+
+
+def test_rod_spin_is_an_idle_freedom() -> None:
+    t = mechanism_topology(rssr())
+    assert (t.mobility, t.redundant_count, len(t.idle)) == (2, 0, 1)
+    assert t.idle[0].split(".")[0] in ("B", "C")
+    assert "drive the mechanism (mobility 1 + 1 idle)" in t.verdict
+
+
+def test_rocker_limits_are_where_crank_and_coupler_line_up() -> None:
+    spec = sk.load_spec(FOURBAR)
+    motion = solve_mechanism(spec.mechanism, spec.inputs, rates=spec.speed)
+    lims = graph_limit_positions(motion, "D.theta").limits
+    assert len(lims) == 2
+    A, B0, C0 = (np.array(spec.mechanism.joint(n).at) for n in "ABC")
+    d1, d2 = np.linalg.norm(B0 - A), np.linalg.norm(C0 - B0)
+    reach = []
+    for lim in lims:
+        assert abs(lim.derivatives[0]) < 1e-12
+        g = solve_mechanism(spec.mechanism, [lim.input]).modes[0]
+        reach.append(np.linalg.norm(g.joint_centres[0, 2] - A))
+    # the rocker turns back where A, B, C are collinear: |AC| = d2 ± d1
+    np.testing.assert_allclose(sorted(reach), [d2 - d1, d2 + d1], rtol=1e-10)
+
+
+def test_a_mode_that_stops_assembling_says_where() -> None:
+    m = solve_mechanism(rssr(), np.radians(np.arange(0.0, 361.0, 2.0))).modes[0]
+    assert not m.assembles.all()
+    last = int(np.nonzero(m.assembles)[0][-1])
+    assert m.events[0].startswith(f"stops assembling after input A.theta = {2 * last:.6g} deg")
+    assert np.isnan(m.variables["D.theta"][last + 1:]).all()
+    # the rod stays rigid while it assembles
+    c = m.joint_centres[: last + 1]
+    np.testing.assert_allclose(np.linalg.norm(c[:, 1] - c[:, 2], axis=1), np.sqrt(9.0),
+                               rtol=1e-12)
+
+
+def test_several_inputs_by_rows_and_bad_rows() -> None:
+    five = Mechanism("5R", (Body("a"), Body("b"), Body("c"), Body("d")),
+                     (joint("A", "R", "ground", "a", [0, 0, 0]),
+                      joint("B", "R", "a", "b", [1, 0, 0]),
+                      joint("C", "R", "b", "c", [2, 2, 0]),
+                      joint("D", "R", "c", "d", [3, 0, 0]),
+                      joint("E", "R", "d", "ground", [4, 0, 0])), ("A.theta", "E.theta"))
+    rows = np.radians([[0, 0], [5, -3], [10, -6], [15, -9]])
+    m = solve_mechanism(five, rows, rates=[1.0, -0.5]).modes[0]
+    assert m.assembles.all() and np.nanmax(m.closure_residual) < 1e-12
+    np.testing.assert_allclose(m.variables["E.theta"], rows[:, 1])
+    with pytest.raises(sk.ScrewkitError, match="rows of 2 value"):
+        solve_mechanism(five, np.zeros((3, 3)))
+    with pytest.raises(sk.ScrewkitError, match="finite"):
+        solve_mechanism(five, [[0.0, np.nan]])
+
+
+def test_analyze_document_reports_points_by_name() -> None:
+    r = CliRunner().invoke(app, ["analyze", str(FOURBAR), "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.output)
+    assert doc["family"] == "graph" and doc["loops"] == [["A", "B", "C", "D"]]
+    p = doc["modes"][0]["coupler_points"]["P"]
+    spec = sk.load_spec(FOURBAR)
+    m = solve_mechanism(spec.mechanism, spec.inputs, rates=spec.speed).modes[0]
+    np.testing.assert_allclose(p["x"], m.points["P"][:, 0], rtol=0, atol=1e-15)
+    assert doc["topology"]["redundant_constraints"]
+    # the coupler point stays rigid on the coupler: distances to B and C keep their drawn values
+    B, C = m.joint_centres[:, 1], m.joint_centres[:, 2]
+    P = m.points["P"]
+    for J in (B, C):
+        d = np.linalg.norm(P - J, axis=1)
+        np.testing.assert_allclose(d, d[0], rtol=1e-12)
+
+
+def test_limits_and_mobility_commands_on_a_graph() -> None:
+    r = CliRunner().invoke(app, ["limits", str(FOURBAR), "--var", "D.theta", "--json"])
+    assert r.exit_code == 0, r.output
+    assert len(json.loads(r.output)["limits"]) == 2
+    r = CliRunner().invoke(app, ["mobility", str(FOURBAR), "--json"])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.output)["mobility"] == 1
