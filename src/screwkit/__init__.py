@@ -45,6 +45,13 @@ _EXPORTS: dict[str, str] = {
     "fourbar": "screwkit.model.families",
     "rssr": "screwkit.model.families",
     "rccc": "screwkit.model.families",
+    "Mechanism": "screwkit.model.mechanism",
+    "Body": "screwkit.model.mechanism",
+    "MechanismJoint": "screwkit.model.mechanism",
+    "BodyPoint": "screwkit.model.mechanism",
+    "solve_mechanism": "screwkit.kinematics.graph.motion",
+    "MechanismMotion": "screwkit.kinematics.graph.motion",
+    "mechanism_topology": "screwkit.kinematics.graph.topology",
     "family": "screwkit.kinematics.registry",
     # kinematics
     "solve_motion": "screwkit.kinematics.solve_motion",
@@ -80,6 +87,8 @@ __all__ = [
     "ScrewkitError",
     "AssemblyError",
     "BalanceResult",
+    "Body",
+    "BodyPoint",
     "BalancingConfig",
     "Dynamics",
     "ExternalLoad",
@@ -88,6 +97,9 @@ __all__ = [
     "JointMotion",
     "Linkage",
     "MassProperties",
+    "Mechanism",
+    "MechanismJoint",
+    "MechanismMotion",
     "ModeMotion",
     "Motion",
     "Pipeline",
@@ -103,6 +115,7 @@ __all__ = [
     "inverse_dynamics",
     "limit_positions",
     "load_spec",
+    "mechanism_topology",
     "mobility",
     "point_mass_variables",
     "rccc",
@@ -110,6 +123,7 @@ __all__ = [
     "rsrc",
     "rssr",
     "solve_joints",
+    "solve_mechanism",
     "solve_motion",
     "synthesize",
     "transmission",
@@ -147,6 +161,8 @@ if TYPE_CHECKING:
     from screwkit.io.errors import SpecError
     from screwkit.io.spec import Spec, load_spec
     from screwkit.kinematics.coupler_curves import coupler_point_path
+    from screwkit.kinematics.graph.motion import MechanismMotion, solve_mechanism
+    from screwkit.kinematics.graph.topology import mechanism_topology
     from screwkit.kinematics.joint_motion import JointMotion, solve_joints
     from screwkit.kinematics.limit_positions import limit_positions
     from screwkit.kinematics.loop_mobility import mobility
@@ -158,6 +174,7 @@ if TYPE_CHECKING:
     from screwkit.model.joints import Joint
     from screwkit.model.linkage import Link, Linkage
     from screwkit.model.mass import MassProperties
+    from screwkit.model.mechanism import Body, BodyPoint, Mechanism, MechanismJoint
     from screwkit.pipeline import Pipeline
     from screwkit.synthesis.config import SynthesisConfig
     from screwkit.synthesis.config import run_synthesis as synthesize

@@ -54,7 +54,7 @@ def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML)
             console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
             console.print(f"   jobs: {escape(', '.join(spec.jobs()))}", highlight=False)
             if getattr(spec, "family", None) == "graph":
-                for line in spec.topology.summary():  # type: ignore[union-attr]
+                for line in spec.topology.summary():  # type: ignore[attr-defined]
                     console.print(f"   {escape(line)}", highlight=False)
         else:
             failed += 1

@@ -13,8 +13,16 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr
-from pydantic import ValidationError
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+)
 
 from screwkit.errors import ScrewkitError
 from screwkit.io.display_units import DisplayUnits, display_units
@@ -79,7 +87,7 @@ class GraphMotionTable(_Strict):
 
 
 class GraphSpecFile(_Strict):
-    mechanism: GraphMechanismTable = Field(default_factory=GraphMechanismTable)
+    mechanism: GraphMechanismTable = Field(default_factory=GraphMechanismTable)  # type: ignore[arg-type]
     units: dict[str, str] = Field(default_factory=dict)
     bodies: list[BodyTable] = Field(default_factory=list, max_length=MAX_BODIES + 1)
     joints: list[GraphJointTable] = Field(max_length=MAX_JOINTS + 1)

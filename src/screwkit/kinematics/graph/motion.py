@@ -264,7 +264,7 @@ def _variables(mech: Mechanism, lay: GraphLayout, conf: Configuration, qd: Array
             rv = rotation_vector(conf.spherical[:, lay.spherical_of_joint[i]])
             for k, c in enumerate("xyz"):
                 values[f"{j.name}.r{c}"] = rv[:, k].copy()
-        for k, name in enumerate(j.freedoms):
+        for k in range(len(j.freedoms)):
             f = f0 + k
             full = lay.names[f]
             if j.kind != "S":
