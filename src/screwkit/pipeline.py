@@ -42,6 +42,11 @@ class Pipeline:
     :func:`~screwkit.kinematics.solve_motion.solve_motion`)."""
 
     def __init__(self, spec: Spec, *, method: str = "auto") -> None:
+        if getattr(spec, "family", None) == "graph":  # io.mechanism_spec.GraphSpec
+            raise SpecError(f"{spec.path}: a mechanism graph (bodies and joints): validate, "
+                            "analyze, mobility, limits and report work on it so far; loads, "
+                            "balancing, synthesis, simulation and sweeps of graphs are not "
+                            "there yet (docs/mechanisms.md)")
         self.spec = spec
         self.method = method
 

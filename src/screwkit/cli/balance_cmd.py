@@ -123,7 +123,7 @@ def register(app: typer.Typer) -> None:
         plots: Annotated[Path | None, typer.Option("--plots", help="Write PNG plots of each load over the cycle (display units) into this folder (needs matplotlib).")] = None,
     ) -> None:
         """Choose the links' point masses (and counterweights) that minimise the weighted load measures over the cycle; print the before/after summary."""
-        from screwkit.cli.common import guard
+        from screwkit.cli.common import guard, loop_only
         from screwkit.cli.outputs import Outputs
         from screwkit.cli.progress import progress_bar
         from screwkit.io.balance_tables import write_balance_tables
@@ -134,7 +134,7 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full,
                               folders={"--tables": tables, "--plots": plots})
-        s = guard(lambda: load_spec(spec))
+        s = loop_only(guard(lambda: load_spec(spec)), "balance")
         du = out.units_for(s.units)
         pareto = s.balancing.pareto if s.balancing is not None else None
         total = None if pareto is None else pareto_size(pareto)

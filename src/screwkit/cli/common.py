@@ -59,6 +59,16 @@ def user_error(message: str) -> NoReturn:
     raise typer.Exit(2)
 
 
+def loop_only(spec: T, command: str) -> T:
+    """``spec`` if it is a single loop (a family or a joint list); a one-line refusal for a
+    mechanism graph, which ``command`` does not take yet (docs/mechanisms.md)."""
+    if getattr(spec, "family", None) == "graph":
+        user_error(f"{getattr(spec, 'path', '')}: `screwkit {command}` does not take a mechanism "
+                   "graph (bodies and joints) yet; graphs work with validate, analyze, mobility, "
+                   "limits and report (docs/mechanisms.md)")
+    return spec
+
+
 def attempt(fn: Callable[[], T]) -> tuple[bool, T | None]:
     """Like :func:`guard`, but a user error is printed and returned as ``(False, None)`` so
     that a command over several inputs can report every one."""

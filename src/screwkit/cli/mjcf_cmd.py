@@ -24,14 +24,14 @@ def register(app: typer.Typer) -> None:
         """Write a MuJoCo model (MJCF) of the spec's loop at its [motion] start, in its [motion] mode."""
         from rich.markup import escape
 
-        from screwkit.cli.common import check_paths, console, guard
+        from screwkit.cli.common import check_paths, console, guard, loop_only
         from screwkit.io.results import write_atomic
         from screwkit.io.spec import load_spec
         from screwkit.simulation.mjcf import mjcf_model
         from screwkit.simulation.spec_run import spec_gravity
 
         check_paths([spec], {"--output": output})
-        s = guard(lambda: load_spec(spec))
+        s = loop_only(guard(lambda: load_spec(spec)), "export-mjcf")
         text = guard(lambda: mjcf_model(s.linkage, start=float(s.inputs[0]), mode=s.mode,
                                         gravity=spec_gravity(s) if gravity else None,
                                         timestep=timestep, solref=(20 * timestep, 1.0),

@@ -90,7 +90,7 @@ def register(app: typer.Typer) -> None:
         flywheel: Annotated[str | None, typer.Option("--flywheel", help="Flywheel inertia on the input shaft, e.g. \"0.02 kg*m^2\" (overrides [drive] flywheel).")] = None,
     ) -> None:
         """Forward dynamics of the machine: motor, flywheel and load of the [drive] table; speed fluctuation, motor torque, energy per cycle and every load; --fluctuation sizes the flywheel."""
-        from screwkit.cli.common import guard, user_error
+        from screwkit.cli.common import guard, loop_only, user_error
         from screwkit.cli.outputs import Outputs
         from screwkit.io.spec import load_spec
         from screwkit.io.units import to_si
@@ -103,7 +103,7 @@ def register(app: typer.Typer) -> None:
             user_error(f"--plot {plot}: give a file ending in .png, .svg or .pdf")
         fw = None if flywheel is None else guard(
             lambda: to_si(flywheel, "inertia", "kg*m**2"))
-        s = guard(lambda: load_spec(spec))
+        s = loop_only(guard(lambda: load_spec(spec)), "simulate")
         run = guard(lambda: simulate_spec(s, fluctuation=fluctuation, cycles=cycles, flywheel=fw))
         doc = guard(lambda: run.as_dict())
         du = out.units_for(s.units)

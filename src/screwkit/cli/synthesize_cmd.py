@@ -14,6 +14,7 @@ from rich.markup import escape
 
 from screwkit.cli.common import console
 from screwkit.cli.common import guard as _guard
+from screwkit.cli.common import loop_only
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for
 from screwkit.errors import InputError
@@ -277,7 +278,7 @@ def register(app: typer.Typer) -> None:
             plot = _guard(lambda: plot_path(asked))
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full, files={"--plot": plot})
-        s = _guard(lambda: load_spec(spec))
+        s = loop_only(_guard(lambda: load_spec(spec)), "synthesize")
         du = out.units_for(s.units)
         pipe = Pipeline(s)
         config = _guard(lambda: pipe.synthesis_config())

@@ -34,6 +34,12 @@ def read_spec_tables(path: Path) -> tuple[dict[str, Any], Spec]:
         data = read_toml(path)
     except SpecFileError as exc:
         raise SpecError(str(exc)) from None
+    from screwkit.io.mechanism_spec import is_graph_spec
+
+    if is_graph_spec(data):
+        raise SpecError(f"{path}: sweeps and tolerance analysis do not take a mechanism graph "
+                        "(bodies and joints) yet; graphs work with validate, analyze, mobility, "
+                        "limits and report (docs/mechanisms.md)")
     return data, spec_from_data(data, path)
 
 
