@@ -12,9 +12,8 @@ from typing import Annotated, Any
 import typer
 from rich.markup import escape
 
-from screwkit.cli.common import console
+from screwkit.cli.common import console, loop_only
 from screwkit.cli.common import guard as _guard
-from screwkit.cli.common import loop_only
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for
 from screwkit.errors import InputError
