@@ -184,14 +184,15 @@ def _fmt(mech: Mechanism, lay: GraphLayout, x: Array) -> str:
 def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDArray[np.bool_],
                X: Array, Xd: Array, Xdd: Array) -> MechanismMode:
     """Everything about one mode from its configurations (module docstring)."""
-    lin = linearise(mech, lay, conf)
+    rank = expected_rank(mech, lay)
+    lin = linearise(mech, lay, conf, full_rank=rank == len(lay.passive))
     fr = lin.frames
     qd = rates(mech, lay, lin, Xd)
     qdd, bias = accelerations(mech, lay, lin, qd, Xdd)
     V, _ = body_twists(mech, lay, fr.screws, qd)
     A = body_accelerations(mech, lay, fr.screws, qdd, bias)
     nb = len(mech.bodies)
-    singular = mask & _singular(mech, lay, lin.sigma)
+    singular = mask & _singular(rank, lin.sigma)
     w, v0, al, a0 = V[:, :nb, :3], V[:, :nb, 3:], A[:, :nb, :3], A[:, :nb, 3:]
     p = fr.p[:, :nb]
     v_o = v0 + cross(w, p)
@@ -244,8 +245,7 @@ def expected_rank(mech: Mechanism, lay: GraphLayout) -> int:
     return int(np.sum(s > RANK_CUTOFF * max(float(s[0]) if s.size else 0.0, 1e-300)))
 
 
-def _singular(mech: Mechanism, lay: GraphLayout, sigma: Array) -> NDArray[np.bool_]:
-    r = expected_rank(mech, lay)
+def _singular(r: int, sigma: Array) -> NDArray[np.bool_]:
     if r == 0 or sigma.shape[1] == 0:
         return np.zeros(sigma.shape[0], dtype=bool)
     with np.errstate(invalid="ignore", divide="ignore"):

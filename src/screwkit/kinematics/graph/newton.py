@@ -85,11 +85,15 @@ class Linearised:
 
 
 def linearise(mech: Mechanism, lay: GraphLayout, conf: Configuration,
-              frames: GraphFrames | None = None, exact: bool = True) -> Linearised:
+              frames: GraphFrames | None = None, exact: bool = True,
+              full_rank: bool = False) -> Linearised:
     """The scaled Jacobian and the passive block's pseudo-inverse: by the SVD (``exact``: the
     singular values too, for rank tests and singular flags) or, for the tracker's corrector and
     rates, by the normal equations with a Tikhonov term of 1e-14·tr(JᵀJ) (the minimum-norm
-    solution up to that relative size; idle freedoms stay still)."""
+    solution up to that relative size; idle freedoms stay still). ``full_rank`` (a mechanism
+    with no idle freedom) takes the exact route by a QR factorisation J_p = QR (the least-squares
+    solution R⁻¹Qᵀ, exact for the consistent closure equations, with R's singular values, which
+    are J_p's), and the SVD only where R is singular to working precision."""
     fr = frames if frames is not None else graph_forward(mech, lay, conf, exact)
     L = len(mech.topology.loops)
     J = (loop_jacobian(mech, lay, fr.screws) * row_scale(lay, L)[:, None]
@@ -103,11 +107,24 @@ def linearise(mech: Mechanism, lay: GraphLayout, conf: Configuration,
         mu = 1e-14 * np.einsum("nii->n", JtJ)[:, None, None] + 1e-300
         pinv = np.linalg.solve(JtJ + mu * np.eye(Jp.shape[2]), np.swapaxes(Jp, 1, 2))
         return Linearised(fr, J, pinv, np.zeros((conf.size, 0)))
+    if full_rank and Jp.shape[1] >= Jp.shape[2]:
+        Q, R = np.linalg.qr(Jp)
+        s = np.linalg.svd(R, compute_uv=False)
+        bad = ~(s[:, -1] > RANK_CUTOFF * s[:, 0])
+        R[bad] = np.eye(R.shape[-1])
+        pinv = np.linalg.solve(R, np.swapaxes(Q, 1, 2))
+        if bad.any():
+            pinv[bad] = _svd_pinv(Jp[bad])[0]
+        return Linearised(fr, J, pinv, s)
+    pinv, s = _svd_pinv(Jp)
+    return Linearised(fr, J, pinv, s)
+
+
+def _svd_pinv(Jp: Array) -> tuple[Array, Array]:
     U, s, Vt = np.linalg.svd(Jp, full_matrices=False)
     keep = s > RANK_CUTOFF * np.maximum(s[:, :1], 1e-300)
     inv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
-    pinv = np.einsum("nji,nj,nkj->nik", Vt, inv, U)
-    return Linearised(fr, J, pinv, s)
+    return np.einsum("nji,nj,nkj->nik", Vt, inv, U), s
 
 
 def scaled_residual(mech: Mechanism, lay: GraphLayout, fr: GraphFrames) -> Array:
