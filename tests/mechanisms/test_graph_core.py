@@ -124,3 +124,27 @@ def test_limits_and_mobility_commands_on_a_graph() -> None:
     r = CliRunner().invoke(app, ["mobility", str(FOURBAR), "--json"])
     assert r.exit_code == 0, r.output
     assert json.loads(r.output)["mobility"] == 1
+
+
+def test_a_dead_centre_is_flagged_and_named() -> None:
+    # a parallelogram four-bar: crank, coupler and rocker fall in line at input −90°
+    pg = Mechanism("parallelogram", (Body("crank"), Body("coupler"), Body("rocker")),
+                   (joint("A", "R", "ground", "crank", [0, 0, 0]),
+                    joint("B", "R", "crank", "coupler", [0, 1, 0]),
+                    joint("C", "R", "coupler", "rocker", [2, 1, 0]),
+                    joint("D", "R", "rocker", "ground", [2, 0, 0])), ("A.theta",))
+    m = solve_mechanism(pg, np.radians(np.arange(0.0, -120.0, -1.0))).modes[0]
+    assert np.nonzero(m.singular)[0].tolist() == [90]
+    assert any("singular at A.theta = -90 deg: a dead centre of loop 1" in e for e in m.events)
+    # up to the dead centre the parallelogram keeps the rocker parallel to the crank
+    np.testing.assert_allclose(m.variables["D.theta"][:90], m.variables["A.theta"][:90],
+                               atol=1e-12)
+
+
+def test_a_drawing_at_a_dead_centre_is_refused_with_the_reason() -> None:
+    dc = Mechanism("dead centre", (Body("crank"), Body("coupler"), Body("rocker")),
+                   (joint("A", "R", "ground", "crank", [0, 0, 0]),
+                    joint("B", "R", "crank", "coupler", [0, 1, 0]),
+                    joint("C", "R", "coupler", "rocker", [2, 1, 0]),
+                    joint("D", "R", "rocker", "ground", [3, 1, 0])), ("A.theta",))
+    assert "the drawing is at a dead centre" in mechanism_topology(dc).verdict

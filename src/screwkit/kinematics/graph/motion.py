@@ -221,12 +221,13 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
     for arr in twists:
         arr[singular] = np.nan
     residual[bad] = np.nan
-    events = []
+    events: list[str] = []
     if singular.any():
+        from screwkit.kinematics.graph.singular import singular_events
+
         idx = np.nonzero(singular)[0]
-        shown = ", ".join(_fmt(mech, lay, X[k]) for k in idx[:4]) + (" …" if idx.size > 4 else "")
-        events.append(f"singular at {idx.size} sample(s) ({shown}): the inputs do not fix the "
-                      "mechanism there (a dead centre, or a platform that gains a freedom)")
+        events = singular_events(mech, lay, conf, rank, idx,
+                                 {int(k): _fmt(mech, lay, X[k]) for k in idx})
     return MechanismMode(mask, singular, conf, variables, velocities, accels,
                          link_rotation=frames[0], link_origin=frames[1],
                          link_angular_velocity=twists[0], link_origin_velocity=twists[1],

@@ -176,7 +176,8 @@ def _verdict(mech: Mechanism, lay: GraphLayout, J: Array, mobility: int, idle: l
     if free:
         return (f"the inputs do not drive the mechanism: mobility {effective} (idle freedoms "
                 f"aside) needs {effective} input(s), {n_in} given; free with the inputs held: "
-                + ", ".join(free))
+                + ", ".join(free) + " (if the mechanism has fewer freedoms, the drawing is at "
+                "a dead centre or another singular configuration: draw it away from there)")
     if effective < n_in:
         return (f"the inputs conflict: mobility {effective} (idle freedoms aside) but {n_in} "
                 f"inputs ({', '.join(mech.inputs)}); drive {effective}")
