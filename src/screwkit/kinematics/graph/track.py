@@ -138,7 +138,7 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
     conf0 = Configuration(np.zeros((1, lay.n_scalar)),
                           np.broadcast_to(np.eye(3), (1, lay.n_spherical, 3, 3)).copy())
     at = _Point(conf0, np.zeros(n_in), linearise(mech, lay, conf0, exact=False))
-    scal = np.empty((N, lay.n_scalar))
+    scal = np.zeros((N, lay.n_scalar))  # samples it does not reach keep the drawing (finite)
     sph = np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy()
     mask = np.zeros(N, dtype=bool)
     if np.any(X[0] != 0.0):
