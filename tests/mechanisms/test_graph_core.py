@@ -136,8 +136,9 @@ def test_a_dead_centre_is_flagged_and_named() -> None:
     m = solve_mechanism(pg, np.radians(np.arange(0.0, -120.0, -1.0))).modes[0]
     assert np.nonzero(m.singular)[0].tolist() == [90]
     assert any("singular at A.theta = -90 deg: a dead centre of loop 1" in e for e in m.events)
-    # up to the dead centre the parallelogram keeps the rocker parallel to the crank
-    np.testing.assert_allclose(m.variables["D.theta"][:90], m.variables["A.theta"][:90],
+    # up to the dead centre the rocker turns with the crank (D turns the ground on the rocker,
+    # so its angle is the rocker's with the sign changed)
+    np.testing.assert_allclose(m.variables["D.theta"][:90], -m.variables["A.theta"][:90],
                                atol=1e-12)
 
 
