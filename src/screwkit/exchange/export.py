@@ -33,15 +33,25 @@ class Export:
     notes: list[str] = field(default_factory=list)
 
 
+#: the library each format is written with (the ``[cad]`` extra)
+LIBRARIES = {"dxf": "ezdxf", "gltf": "pygltflib"}
+
+
 def export_format(name: str) -> str:
     """The format ``name`` (``dxf``, ``gltf`` or its binary form's name ``glb``, ``step``)
-    checked before any work: an unknown one, or STEP, is an :class:`ExportError`."""
+    checked before any work: an unknown one, STEP, or one whose library is not installed is an
+    :class:`ExportError`."""
+    import importlib.util
+
     fmt = str(name).strip().lower()
     fmt = "gltf" if fmt == "glb" else fmt
     if fmt == "step":
         raise ExportError(STEP_UNAVAILABLE)
-    if fmt not in FORMATS:
+    if fmt not in LIBRARIES:
         raise ExportError(f"--format {name!r} is not an export format; choose dxf or gltf")
+    if importlib.util.find_spec(LIBRARIES[fmt]) is None:
+        raise ExportError(f"{fmt.upper()} export needs {LIBRARIES[fmt]}: "
+                          "pip install 'screwkit[cad]'")
     return fmt
 
 
@@ -105,10 +115,12 @@ def samples_for(spec: Any, at: Sequence[str] = ()) -> tuple[ExportSamples, list[
     """The spec's sweep with the ``--at`` inputs (:func:`input_values`) merged in, and their
     labels; with none, the sweep's first sample."""
     x = np.asarray(spec.inputs, dtype=float).reshape(len(spec.inputs), -1)[:, 0]
+    kind = "angle" if spec.input_is_angle else "length"
+    unit = spec.units.get(kind) or ("rad" if kind == "angle" else "m")
+    factor = unit_factor(unit, kind)
     values, labels = input_values(spec, at)
     if not values:
-        kind = "angle" if spec.input_is_angle else "length"
-        unit = spec.units.get(kind) or ("rad" if kind == "angle" else "m")
         values = [float(x[0])]
-        labels = [f"{x[0] / unit_factor(unit, kind):.6g} {unit}"]
-    return export_samples(x, values, labels), labels
+        labels = [f"{x[0] / factor:.6g} {unit}"]
+    span = f" ({x.min() / factor:.6g}…{x.max() / factor:.6g} {unit})"
+    return export_samples(x, values, labels, span), labels

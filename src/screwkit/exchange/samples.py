@@ -31,11 +31,12 @@ class ExportSamples:
 
 
 def export_samples(sweep: Sequence[float] | Array, at: Sequence[float] = (),
-                   shown: Sequence[str] = ()) -> ExportSamples:
+                   shown: Sequence[str] = (), span: str = "") -> ExportSamples:
     """Merge the ``at`` values (SI) into the sweep (SI, monotonic). A value within round-off
     (1e-12 of the sweep's span) of a sample is that sample, so the motion is unchanged; a value
     outside the sweep's range is refused (mode numbering is fixed by the sweep's first sample,
-    docs/conventions.md "Assembly modes"), naming it as the user wrote it (``shown``)."""
+    docs/conventions.md "Assembly modes"), naming it as the user wrote it (``shown``) and the
+    sweep's range (``span``, as the user reads it)."""
     x = np.asarray(sweep, dtype=float).reshape(-1)
     ascending = np.sort(x)
     lo, hi = float(ascending[0]), float(ascending[-1])
@@ -49,8 +50,8 @@ def export_samples(sweep: Sequence[float] | Array, at: Sequence[float] = (),
     for k, v in enumerate(at):
         if not np.isfinite(v) or v < lo - tol or v > hi + tol:
             name = shown[k] if k < len(shown) else repr(v)
-            raise ExportError(f"--at {name} lies outside the spec's [motion] sweep; give inputs "
-                              "between its start and stop, or widen the sweep")
+            raise ExportError(f"--at {name} lies outside the spec's [motion] sweep{span}; give "
+                              "inputs between its start and stop, or widen the sweep")
         if nearest(ascending, v) > tol and all(abs(v - e) > tol for e in extra):
             extra.append(float(v))
     every = np.concatenate([x, np.asarray(extra, dtype=float)])
