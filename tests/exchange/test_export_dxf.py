@@ -133,3 +133,27 @@ def test_units_and_layer_names():
     with pytest.raises(ExportError, match="no unit code"):
         dxf_unit("furlong")
     assert layer_name('mode0 a/b:"c"') == "mode0 a_b__c_"
+
+
+def test_curves_are_cut_where_the_mode_does_not_assemble(tmp_path):
+    """Bagci's Example 7 does not assemble at its 7th input (305.35207°): each joint path is two
+    open polylines around it, and asking for the skeleton there gives a note, not a layer."""
+    spec_path = EXAMPLES / "bagci_example7_double_crank.toml"
+    out = tmp_path / "ex7.dxf"
+    r = runner.invoke(app, ["export", str(spec_path), "-f", "dxf", "-o", str(out),
+                            "--at", "305.35207", "--at", "230.35207"])
+    assert r.exit_code == 0, r.output
+    assert "mode 0 does not assemble at input 305.35207 deg: no skeleton drawn" in r.stderr
+    layers = _layers(ezdxf.readfile(out))
+    spec = sk.load_spec(spec_path)
+    md = sk.solve_motion(spec.linkage, spec.inputs, rates=spec.speed).mode(0)
+    assert np.flatnonzero(~md.assembles).tolist() == [6]
+    assert "mode0 skeleton at 305.35207 deg" not in layers
+    assert "mode0 skeleton at 230.35207 deg" in layers
+    joint = [j.name for j in spec.linkage.joints].index("sphere")
+    first, second = layers["mode0 joint sphere"]
+    assert not first.is_closed and not second.is_closed
+    got = [np.array([tuple(v) for v in p.points()]) * INCH for p in (first, second)]
+    want = md.joint_centres[:, joint]
+    assert len(got[0]) == 6 and len(got[1]) == 17
+    assert np.abs(got[0] - want[:6]).max() < 1e-15 and np.abs(got[1] - want[7:]).max() < 1e-15

@@ -115,3 +115,23 @@ def test_trimesh_sees_each_link_at_its_first_pose(tmp_path):
         centre = (world[:108] @ Y_UP).mean(axis=0)  # back to z-up
         want = md.joint_centres[0, (k + 1) % 4]
         assert np.linalg.norm(centre - want) < 1e-6 * np.abs(md.joint_centres).max()
+
+
+def test_animation_skips_samples_where_the_mode_does_not_assemble(tmp_path):
+    spec_path = EXAMPLES / "bagci_example7_double_crank.toml"  # no assembly at sample 6
+    out = tmp_path / "ex7.glb"
+    r = runner.invoke(app, ["export", str(spec_path), "-f", "gltf", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    gltf = pygltflib.GLTF2().load(str(out))
+    spec = sk.load_spec(spec_path)
+    md = sk.solve_motion(spec.linkage, spec.inputs, rates=spec.speed).mode(0)
+    keep = md.assembles
+    assert int(keep.sum()) == 23
+    (anim,) = gltf.animations
+    times = _read(gltf, anim.samplers[0].input)[:, 0]
+    assert np.allclose(times, (spec.inputs[keep] - spec.inputs[0]) / spec.speed, atol=1e-5)
+    for ch in anim.channels:
+        if ch.target.path == "translation":
+            link = [lk.name for lk in spec.linkage.links].index(gltf.nodes[ch.target.node].name)
+            values = _read(gltf, anim.samplers[ch.sampler].output)
+            assert np.abs(values - md.link_origin[keep, link]).max() < 1e-6
