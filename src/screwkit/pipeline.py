@@ -177,7 +177,7 @@ class Pipeline:
         return coupler_curves(self.motion, self.spec.coupler_points)
 
     def export(self, fmt: str, at: Sequence[str] = (), *, mode: int | None = None,
-               splines: bool = False, binary: bool = True) -> Any:
+               splines: bool = False, binary: bool = True, max_points: int = 5000) -> Any:
         """A CAD exchange file of the spec (:mod:`screwkit.exchange`, docs/exchange.md): DXF
         curves and the skeleton at the ``at`` inputs (text in the spec's unit of the input), or
         the animated glTF scene of ``mode`` (GLB, or glTF JSON if not ``binary``). Inputs off the sweep are solved with it, in one
@@ -193,7 +193,7 @@ class Pipeline:
             motion = solve_motion(s.linkage, samples.inputs, rates=s.speed,
                                   accelerations=s.acceleration, method=self.method)
         return export_motion(self.spec, motion, samples, kind, at_labels=labels, mode=mode,
-                             splines=splines, binary=binary)
+                             splines=splines, binary=binary, max_points=max_points)
 
     def simulate(self, fluctuation: float | None = None, cycles: int | None = None) -> Any:
         """The spec's ``[drive]`` run forward in time (docs/simulation.md): a

@@ -157,3 +157,35 @@ def test_curves_are_cut_where_the_mode_does_not_assemble(tmp_path):
     want = md.joint_centres[:, joint]
     assert len(got[0]) == 6 and len(got[1]) == 17
     assert np.abs(got[0] - want[:6]).max() < 1e-15 and np.abs(got[1] - want[7:]).max() < 1e-15
+
+
+def test_a_fine_sweep_is_drawn_through_every_kth_sample(tmp_path):
+    """7,200 samples and --max-points 1000: one in 8 samples, each exactly the analysis's."""
+    spec_path = tmp_path / "fine.toml"
+    spec_path.write_text(FIG7.read_text().replace('step = "10 deg"', 'step = "0.05 deg"'))
+    out = _export_noted(tmp_path, spec_path, "--max-points", "1000", "--mode", "0")
+    layers = _layers(ezdxf.readfile(out))
+    analysis = _analysis(spec_path)
+    name = analysis["coupler_points"][0]["name"]
+    path = analysis["modes"][0]["coupler_points"][name]
+    want = np.column_stack([path["x"], path["y"], path["z"]]) / INCH
+    assert len(want) == 7200
+    (curve,) = layers[f"mode0 {name}"]
+    got = np.array([tuple(v) for v in curve.points()])
+    rows = [*range(0, 7200, 8), 7199]
+    assert got.shape == (len(rows), 3) and curve.is_closed
+    assert np.max(np.abs(got - want[rows])) < 1e-12 * np.max(np.abs(want))
+    full = _export_noted(tmp_path, spec_path, "--max-points", "0", "--mode", "0",
+                         note=None, name="full.dxf")
+    (curve,) = _layers(ezdxf.readfile(full))[f"mode0 {name}"]
+    assert len(curve.vertices) == 7200
+
+
+def _export_noted(tmp_path: Path, spec: Path, *args: str, name: str = "thin.dxf",
+                  note: str | None = "curves drawn through one in 8 of the sweep's 7200 "
+                                     "samples (--max-points 1000; 0 draws every sample)") -> Path:
+    out = tmp_path / name
+    r = runner.invoke(app, ["export", str(spec), "-f", "dxf", "-o", str(out), *args])
+    assert r.exit_code == 0, r.output
+    assert (note in r.stderr) if note else ("note" not in r.stderr)
+    return out

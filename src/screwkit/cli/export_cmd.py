@@ -22,6 +22,7 @@ def register(app: typer.Typer) -> None:
         at: Annotated[list[str] | None, typer.Option("--at", help="DXF: draw the link skeleton at this input, in the spec's unit of the input (or with a unit: '45 deg'); repeatable; default the sweep's first input. Inputs between samples are solved with the sweep.")] = None,
         mode: Annotated[int | None, typer.Option("--mode", help="Assembly mode: DXF draws every mode unless this is given; glTF animates this one (default: the spec's [motion] mode).", min=0)] = None,
         splines: Annotated[bool, typer.Option("--splines", help="DXF: curves as fit-point splines instead of polylines.")] = False,
+        max_points: Annotated[int, typer.Option("--max-points", help="DXF: a curve over more samples goes through every k-th of them (exact samples, about 14,000 vertices a second to write); 0 draws every sample.", min=0)] = 5000,
         method: Annotated[str, typer.Option("--method", help="auto, closed or generic (as for analyze).")] = "auto",
     ) -> None:
         """Write the spec's motion for CAD: DXF curves and skeletons, or an animated glTF scene."""
@@ -37,9 +38,9 @@ def register(app: typer.Typer) -> None:
         kind = guard(lambda: export_format(fmt))  # refused before the spec is solved
         binary = output.suffix.lower() != ".gltf"  # a .gltf file is JSON, anything else GLB
         s = guard(lambda: load_spec(spec))
-        result = guard(lambda: Pipeline(s, method=method).export(kind, at or (), mode=mode,
-                                                                  splines=splines,
-                                                                  binary=binary))
+        pipe = Pipeline(s, method=method)
+        result = guard(lambda: pipe.export(kind, at or (), mode=mode, splines=splines,
+                                           binary=binary, max_points=max_points))
         guard(lambda: write_bytes_atomic(output, result.data, [spec], "--output"))
         for note in result.notes:
             err_console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)

@@ -66,11 +66,15 @@ def layer_name(text: str) -> str:
     return cleaned.strip() or "_"
 
 
-def _add_curve(msp: Any, points: Array, layer: str, *, splines: bool, closed: bool) -> int:
-    """Add one curve (K, 3) split at NaN rows; returns the number of entities added."""
+def _add_curve(msp: Any, points: Array, layer: str, *, splines: bool, closed: bool,
+               stride: int = 1) -> int:
+    """Add one curve (K, 3) split at NaN rows, each piece through every ``stride``-th point and
+    its last; returns the number of entities added."""
     added = 0
     for a, b in assembled_runs(np.asarray(np.isfinite(points).all(axis=1))):
-        run = [tuple(map(float, p)) for p in points[a:b]]
+        rows = list(range(a, b, stride))
+        rows += [b - 1] if rows[-1] != b - 1 else []
+        run = [tuple(map(float, p)) for p in points[rows]]
         whole = closed and a == 0 and b == len(points)
         if len(run) == 1:
             msp.add_point(run[0], dxfattribs={"layer": layer})
@@ -90,13 +94,16 @@ def _moving(path: Array, scale: float) -> bool:
 
 def dxf_text(motion: Motion, samples: ExportSamples, *, points: Sequence[CouplerPoint],
              modes: Sequence[int], unit: DxfUnit, at_labels: Sequence[str],
-             splines: bool = False, full_turn: bool = False) -> tuple[str, list[str]]:
+             splines: bool = False, full_turn: bool = False,
+             max_points: int = 5000) -> tuple[str, list[str]]:
     """The DXF drawing (text, R2013) of ``motion`` and notes for the user.
 
     ``samples`` says which samples are the sweep's (curves) and where the skeleton is drawn
     (``samples.at``, labelled ``at_labels`` in the layer names); ``points`` the coupler points;
     ``modes`` the assembly modes drawn; ``full_turn`` closes the curves of a mode that
-    assembles over a whole turn of the input."""
+    assembles over a whole turn of the input. A curve over more than ``max_points`` samples
+    (0: no limit) goes through every k-th of them (and the ends of each piece), exact samples
+    all: ezdxf writes a 3-D polyline at about 14,000 vertices a second."""
     import ezdxf
 
     doc = ezdxf.new("R2013", units=unit.code)
@@ -105,6 +112,11 @@ def dxf_text(motion: Motion, samples: ExportSamples, *, points: Sequence[Coupler
     lk = motion.linkage
     notes: list[str] = []
     colour = 1
+    n = len(samples.sweep)
+    stride = -(-n // max_points) if max_points > 0 and n > max_points else 1
+    if stride > 1:
+        notes.append(f"curves drawn through one in {stride} of the sweep's {n} samples "
+                     f"(--max-points {max_points}; 0 draws every sample)")
 
     def layer(text: str) -> str:
         nonlocal colour
@@ -121,12 +133,12 @@ def dxf_text(motion: Motion, samples: ExportSamples, *, points: Sequence[Coupler
         for cp in points:
             path = coupler_point_path(md, cp.point, cp.link)[sweep] / unit.metres
             _add_curve(msp, path, layer(f"mode{k} {cp.name}"), splines=splines,
-                       closed=full_turn)
+                       closed=full_turn, stride=stride)
         for j, joint in enumerate(lk.joints):
             path = np.asarray(md.joint_centres[sweep, j]) / unit.metres
             if _moving(path, scale / unit.metres):
                 _add_curve(msp, path, layer(f"mode{k} joint {joint.name}"), splines=splines,
-                           closed=full_turn)
+                           closed=full_turn, stride=stride)
         skeleton = link_polylines(lk, md) / unit.metres
         tiny = 1e-12 * scale / unit.metres
         for i, label in zip(samples.at, at_labels, strict=True):

@@ -85,10 +85,12 @@ def full_turn(x: Any, is_angle: bool) -> bool:
 
 def export_motion(spec: Any, motion: Motion, samples: ExportSamples, fmt: str, *,
                   at_labels: Sequence[str], mode: int | None = None,
-                  splines: bool = False, binary: bool = True) -> Export:
+                  splines: bool = False, binary: bool = True, max_points: int = 5000
+                  ) -> Export:
     """The export of ``motion`` (solved at ``samples.inputs``) of ``spec`` in format ``fmt``
     (from :func:`export_format`). DXF draws every mode (or ``mode``), glTF animates ``mode``
-    (default the spec's ``[motion] mode``), as GLB or (``binary=False``) glTF JSON."""
+    (default the spec's ``[motion] mode``), as GLB or (``binary=False``) glTF JSON;
+    ``max_points`` bounds the samples of a DXF curve (:func:`screwkit.exchange.dxf.dxf_text`)."""
     points = list(getattr(spec, "coupler_points", []))
     if fmt == "dxf":
         from screwkit.exchange.dxf import dxf_text, dxf_unit
@@ -98,7 +100,7 @@ def export_motion(spec: Any, motion: Motion, samples: ExportSamples, fmt: str, *
             raise ExportError(f"{spec.name}: the motion has no assembly mode to export")
         text, notes = dxf_text(motion, samples, points=points, modes=modes,
                                unit=dxf_unit(spec.units.get("length")), at_labels=at_labels,
-                               splines=splines,
+                               splines=splines, max_points=max_points,
                                full_turn=full_turn(spec.inputs, spec.input_is_angle))
         return Export(text.encode("utf-8"), fmt, notes)
     if fmt == "gltf":

@@ -91,11 +91,11 @@ def quaternions(R: Array) -> Array:
     consecutive keyframes are within 90° (glTF interpolates them linearly)."""
     from scipy.spatial.transform import Rotation
 
-    q = Rotation.from_matrix(R).as_quat()
-    for k in range(1, len(q)):
-        if np.dot(q[k], q[k - 1]) < 0:
-            q[k] = -q[k]
-    return np.asarray(q)
+    q = np.asarray(Rotation.from_matrix(R).as_quat())
+    # flip q_k when it points away from the (already flipped) q_{k-1}: a running product of signs
+    turn = np.where(np.sum(q[1:] * q[:-1], axis=1) < 0, -1.0, 1.0)
+    q[1:] *= np.cumprod(turn)[:, None]
+    return q
 
 
 class _Buffer:
