@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -53,6 +54,20 @@ def export_format(name: str) -> str:
         raise ExportError(f"{fmt.upper()} export needs {LIBRARIES[fmt]}: "
                           "pip install 'screwkit[cad]'")
     return fmt
+
+
+#: the file name endings of each format
+SUFFIXES = {"dxf": (".dxf",), "gltf": (".glb", ".gltf")}
+
+
+def check_suffix(fmt: str, path: Any) -> None:
+    """Refuse an output name whose ending does not match the format (a CAD program chooses its
+    reader by it): ``out.json`` for a DXF is a slip, caught before any work."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in SUFFIXES[fmt]:
+        endings = " or ".join(SUFFIXES[fmt])
+        raise ExportError(f"--output {path}: a {fmt.upper()} file's name ends in {endings}; "
+                          f"rename it or choose the format that matches {suffix or 'no ending'}")
 
 
 def input_values(spec: Any, texts: Sequence[str]) -> tuple[list[float], list[str]]:
