@@ -5,7 +5,7 @@ run, whichever jobs run on it (docs/architecture.md)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import cached_property
 from typing import Any
 
@@ -180,6 +180,25 @@ class Pipeline:
     def coupler_curves(self) -> list[dict[str, Array]]:
         """Per mode, the world path (N, 3) of every coupler point of the spec, by name."""
         return coupler_curves(self.motion, self.spec.coupler_points)
+
+    def export(self, fmt: str, at: Sequence[str] = (), *, mode: int | None = None,
+               splines: bool = False, binary: bool = True, max_points: int = 5000) -> Any:
+        """A CAD exchange file of the spec (:mod:`screwkit.exchange`, docs/exchange.md): DXF
+        curves and the skeleton at the ``at`` inputs (text in the spec's unit of the input), or
+        the animated glTF scene of ``mode`` (GLB, or glTF JSON if not ``binary``). Inputs off the sweep are solved with it, in one
+        solve; otherwise the pipeline's motion is used."""
+        from screwkit.exchange.export import export_format, export_motion, samples_for
+
+        kind = export_format(fmt)
+        samples, labels = samples_for(self.spec, at)
+        if len(samples.inputs) == len(self.spec.inputs):
+            motion = self.motion
+        else:
+            s = self.spec
+            motion = solve_motion(s.linkage, samples.inputs, rates=s.speed,
+                                  accelerations=s.acceleration, method=self.method)
+        return export_motion(self.spec, motion, samples, kind, at_labels=labels, mode=mode,
+                             splines=splines, binary=binary, max_points=max_points)
 
     def simulate(self, fluctuation: float | None = None, cycles: int | None = None) -> Any:
         """The spec's ``[drive]`` run forward in time (docs/simulation.md): a

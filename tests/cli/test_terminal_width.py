@@ -81,11 +81,14 @@ def test_every_command_fits_80_columns_in_a_long_working_directory(tmp_path):
                  "--no-reports"],
         "simulate": ["simulate", str(ex / "rahman_cssp_drive.toml"), "--cycles", "3"],
         "export-mjcf": ["export-mjcf", str(ex / "rahman_cssp.toml"), "-o", str(folder / "m.xml")],
+        "export": ["export", str(ex / "bagci_fig7_rsrc.toml"), "-f", "dxf", "-o",
+                   str(folder / "c.dxf")],
     }
     errors = {f"{name} error": [name, missing] for name in
               ("analyze", "limits", "mobility", "dynamics", "balance", "synthesize", "report",
                "simulate")}
     errors["export-mjcf error"] = ["export-mjcf", missing, "-o", str(folder / "x.xml")]
+    errors["export error"] = ["export", missing, "-f", "gltf", "-o", str(folder / "x.glb")]
     env = {**os.environ, "COLUMNS": "80"}
     r = subprocess.run([sys.executable, "-c", DRIVER, json.dumps({**runs, **errors})],
                        capture_output=True, text=True, cwd=folder, env=env, timeout=600)
@@ -96,7 +99,7 @@ def test_every_command_fits_80_columns_in_a_long_working_directory(tmp_path):
         assert res["code"] == 0, (name, res)
         table_lines = [line for line in res["stdout"].splitlines() if BOX & set(line)]
         assert table_lines or name in ("validate", "mobility", "analyze -o", "report",
-                                       "export-mjcf"), name
+                                       "export-mjcf", "export"), name
         wide = [line for line in table_lines if len(line) > 80]
         assert not wide, f"{name}: table lines over 80 columns:\n" + "\n".join(wide)
     assert f"wrote {folder / 'a.csv'} (" in results["analyze -o"]["stdout"]

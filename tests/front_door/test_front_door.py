@@ -133,6 +133,23 @@ def test_each_command_solves_the_motion_once(monkeypatch, command, example):
     assert rsrc.calls + cssp.calls == 1 and generic.calls == 0
 
 
+@pytest.mark.parametrize("at", [[], ["40"], ["45", "90"]])
+def test_export_solves_the_motion_once(monkeypatch, tmp_path, at):
+    """An input between samples (45) is solved with the sweep, in the same single solve."""
+    import screwkit.kinematics.closed_form_motion as closed
+    import screwkit.pipeline as pipeline
+
+    solve = _Counter(pipeline.solve_motion)
+    rsrc = _Counter(closed.rsrc_closed_motion)
+    monkeypatch.setattr(pipeline, "solve_motion", solve)
+    monkeypatch.setattr(closed, "rsrc_closed_motion", rsrc)
+    args = [a for x in at for a in ("--at", x)]
+    r = CliRunner().invoke(app, ["export", str(EXAMPLES / "bagci_fig7_rsrc.toml"), "-f", "dxf",
+                                 "-o", str(tmp_path / "f.dxf"), *args])
+    assert r.exit_code == 0, r.output
+    assert solve.calls == 1 and rsrc.calls == 1
+
+
 def test_the_pipeline_reuses_its_motion():
     pipe = sk.Pipeline(sk.load_spec(EXAMPLES / "rahman_cssp_balance.toml"))
     first = pipe.motion

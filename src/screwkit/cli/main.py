@@ -68,6 +68,7 @@ def _register_subcommands() -> None:
     from screwkit.cli.balance_cmd import register as register_balance
     from screwkit.cli.demo_cmd import register as register_demo
     from screwkit.cli.dynamics_cmd import register as register_dynamics
+    from screwkit.cli.export_cmd import register as register_export
     from screwkit.cli.limits_cmd import register as register_limits
     from screwkit.cli.mjcf_cmd import register as register_mjcf
     from screwkit.cli.report_cmd import register as register_report
@@ -85,6 +86,7 @@ def _register_subcommands() -> None:
     register_report(app)
     register_simulate(app)
     register_mjcf(app)
+    register_export(app)
     register_sweep(app)
     register_tolerance(app)
 

@@ -176,3 +176,10 @@ def write_text_atomic(path: str | Path, text: str, inputs: Iterable[str | Path] 
     """Write ``text`` (UTF-8) to ``path`` through :func:`atomic_path`."""
     with atomic_path(path, inputs, option) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         fh.write(text)
+
+
+def write_bytes_atomic(path: str | Path, data: bytes, inputs: Iterable[str | Path] = (),
+                       option: str | None = None) -> None:
+    """Write ``data`` to ``path`` through :func:`atomic_path`."""
+    with atomic_path(path, inputs, option) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)

@@ -1,0 +1,48 @@
+"""``screwkit export SPEC --format dxf|gltf|step -o FILE``: the spec's motion as a CAD exchange
+file — DXF coupler curves, joint paths and link skeletons in the spec's length unit, or the
+animated glTF (GLB) scene; STEP is refused with the reason (docs/exchange.md). Registered on the
+main app by ``register(app)``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``export`` command to ``app``."""
+
+    @app.command("export")
+    def export(
+        spec: Annotated[Path, typer.Argument(help="Spec file (TOML).")],
+        fmt: Annotated[str, typer.Option("--format", "-f", help="dxf (coupler curves, joint paths and link skeletons as 3-D polylines, in the spec's length unit), gltf (the animated scene, metres: glTF JSON for an -o name ending in .gltf, binary GLB otherwise) or step (not available; says why).")],
+        output: Annotated[Path, typer.Option("--output", "-o", help="The file to write (atomically): .dxf for DXF, .glb or .gltf for glTF.")],
+        at: Annotated[list[str] | None, typer.Option("--at", help="DXF: draw the link skeleton at this input, in the spec's unit of the input (or with a unit: '45 deg'); repeatable; default the sweep's first input. Inputs between samples are solved with the sweep.")] = None,
+        mode: Annotated[int | None, typer.Option("--mode", help="Assembly mode: DXF draws every mode unless this is given; glTF animates this one (default: the spec's [motion] mode).", min=0)] = None,
+        splines: Annotated[bool, typer.Option("--splines", help="DXF: curves as fit-point splines instead of polylines.")] = False,
+        max_points: Annotated[int, typer.Option("--max-points", help="DXF: a curve over more samples goes through every k-th of them (exact samples, about 14,000 vertices a second to write); 0 draws every sample.", min=0)] = 5000,
+        method: Annotated[str, typer.Option("--method", help="auto, closed or generic (as for analyze).")] = "auto",
+    ) -> None:
+        """Write the spec's motion for CAD: DXF curves and skeletons, or an animated glTF scene."""
+        from rich.markup import escape
+
+        from screwkit.cli.common import check_paths, console, err_console, guard
+        from screwkit.exchange.export import check_suffix, export_format
+        from screwkit.io.outputs import write_bytes_atomic
+        from screwkit.io.spec import load_spec
+        from screwkit.pipeline import Pipeline
+
+        check_paths([spec], {"--output": output})
+        kind = guard(lambda: export_format(fmt))  # refused before the spec is solved
+        guard(lambda: check_suffix(kind, output))
+        binary = output.suffix.lower() != ".gltf"  # a .gltf file is JSON, anything else GLB
+        s = guard(lambda: load_spec(spec))
+        pipe = Pipeline(s, method=method)
+        result = guard(lambda: pipe.export(kind, at or (), mode=mode, splines=splines,
+                                           binary=binary, max_points=max_points))
+        guard(lambda: write_bytes_atomic(output, result.data, [spec], "--output"))
+        for note in result.notes:
+            err_console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
+        console.print(f"wrote {escape(str(output))}", highlight=False)
