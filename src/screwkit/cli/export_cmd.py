@@ -28,7 +28,7 @@ def register(app: typer.Typer) -> None:
         """Write the spec's motion for CAD: DXF curves and skeletons, or an animated glTF scene."""
         from rich.markup import escape
 
-        from screwkit.cli.common import check_paths, console, err_console, guard
+        from screwkit.cli.common import check_paths, console, err_console, guard, loop_only
         from screwkit.exchange.export import check_suffix, export_format
         from screwkit.io.outputs import write_bytes_atomic
         from screwkit.io.spec import load_spec
@@ -38,7 +38,7 @@ def register(app: typer.Typer) -> None:
         kind = guard(lambda: export_format(fmt))  # refused before the spec is solved
         guard(lambda: check_suffix(kind, output))
         binary = output.suffix.lower() != ".gltf"  # a .gltf file is JSON, anything else GLB
-        s = guard(lambda: load_spec(spec))
+        s = loop_only(guard(lambda: load_spec(spec)), "export")
         pipe = Pipeline(s, method=method)
         result = guard(lambda: pipe.export(kind, at or (), mode=mode, splines=splines,
                                            binary=binary, max_points=max_points))
