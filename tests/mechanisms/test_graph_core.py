@@ -149,3 +149,26 @@ def test_a_drawing_at_a_dead_centre_is_refused_with_the_reason() -> None:
                     joint("C", "R", "coupler", "rocker", [2, 1, 0]),
                     joint("D", "R", "rocker", "ground", [3, 1, 0])), ("A.theta",))
     assert "the drawing is at a dead centre" in mechanism_topology(dc).verdict
+
+
+def test_outputs_body_angle_and_point_travel() -> None:
+    from screwkit.model.mechanism_outputs import BodyAngle, PointTravel
+
+    base = rssr()
+    x = np.array([1.0, 0.0, 0.0])
+    mech = Mechanism(base.name, base.bodies, base.joints, base.inputs, base.points,
+                     outputs=(BodyAngle("tilt", "rocker", np.array([0.0, 0.0, 1.0]), x),
+                              PointTravel("rise", "mid", np.array([0.0, 0.0, 1.0]))))
+    m = solve_mechanism(mech, np.radians(np.arange(0.0, 80.0, 1.0)), rates=2.0,
+                        accelerations=0.5).modes[0]
+    # the rocker turns about x by its joint angle (D turns the ground on the rocker: − sign)
+    np.testing.assert_allclose(m.outputs["tilt"], -m.variables["D.theta"], atol=1e-12)
+    np.testing.assert_allclose(m.output_rates["tilt"], -m.velocities["D.theta"], atol=1e-10)
+    np.testing.assert_allclose(m.output_accelerations["tilt"], -m.accelerations["D.theta"],
+                               atol=1e-9)
+    np.testing.assert_allclose(m.outputs["rise"], m.points["mid"][:, 2] - 0.5, atol=1e-12)
+    np.testing.assert_allclose(m.output_rates["rise"], m.point_velocities["mid"][:, 2],
+                               atol=1e-12)
+    with pytest.raises(sk.ScrewkitError, match="lies along 'about'"):
+        Mechanism(base.name, base.bodies, base.joints, base.inputs, base.points,
+                  outputs=(BodyAngle("bad", "rocker", x, x),))

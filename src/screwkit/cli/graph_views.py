@@ -68,8 +68,9 @@ def _show(spec: Any, motion: Any, units: Any, full: bool) -> None:
     mech = spec.mechanism
     for md in motion.modes:
         names = ["input"] + [f"input_{k + 1}" for k in range(1, len(mech.inputs))]
-        shown = [n for n in md.variables if n not in mech.inputs][:3]
-        for n in shown:
+        outs = [o.name for o in mech.outputs][:4]
+        shown = [n for n in md.variables if n not in mech.inputs][:max(0, 3 - len(outs))]
+        for n in outs + shown:
             names += [n, f"{n}_dot"]
         for p in list(md.points)[:2]:
             names += [f"{p}_{a}" for a in "xyz"]

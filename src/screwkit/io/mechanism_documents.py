@@ -37,6 +37,10 @@ def mechanism_document(motion: MechanismMotion, topology: MechanismTopology | No
             "closure_residual": md.closure_residual,
             "coupler_points": {name: {"body": _body_of(motion, name), **_xyz(p)}
                                for name, p in md.points.items()},
+            "outputs": {o.name: {"kind": o.kind, "value": md.outputs[o.name],
+                                 "rate": md.output_rates[o.name],
+                                 "acceleration": md.output_accelerations[o.name]}
+                        for o in mech.outputs},
             "bodies": {b.name: {"origin": md.link_origin[:, k],
                                 "rotation": md.link_rotation[:, k]}
                        for k, b in enumerate(mech.bodies)},
@@ -78,6 +82,12 @@ def mechanism_table(motion: MechanismMotion) -> ResultTable:
         for k, name in enumerate(mech.inputs[1:], start=1):
             cols.insert(2 + k - 1, Column(f"input_{k + 1}", variable_kind(name),
                                           motion.inputs[:, k]))
+        for o in mech.outputs:
+            rate = "angular_velocity" if o.kind == "angle" else "velocity"
+            acc = "angular_acceleration" if o.kind == "angle" else "acceleration"
+            cols += [Column(o.name, o.kind, md.outputs[o.name]),
+                     Column(f"{o.name}_dot", rate, md.output_rates[o.name]),
+                     Column(f"{o.name}_ddot", acc, md.output_accelerations[o.name])]
         for name, p in md.points.items():
             cols += [Column(f"{name}_{a}", "length", p[:, j]) for j, a in enumerate("xyz")]
         tables.append(ResultTable(tuple(cols)))

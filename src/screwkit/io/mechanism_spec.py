@@ -38,6 +38,7 @@ from screwkit.model.mechanism import (
     Mechanism,
     MechanismJoint,
 )
+from screwkit.model.mechanism_outputs import BodyAngle, Output, PointTravel
 
 Value = StrictFloat | StrictInt | StrictStr
 MAX_ROWS = 10_000_000
@@ -77,6 +78,15 @@ class PointTable(_Strict):
     at: list[Value] = Field(min_length=3, max_length=3)
 
 
+class OutputTable(_Strict):
+    name: StrictStr = Field(max_length=80)
+    body: StrictStr | None = None
+    vector: list[StrictFloat | StrictInt] | None = Field(None, min_length=3, max_length=3)
+    about: list[StrictFloat | StrictInt] | None = Field(None, min_length=3, max_length=3)
+    point: StrictStr | None = None
+    along: list[StrictFloat | StrictInt] | None = Field(None, min_length=3, max_length=3)
+
+
 class GraphMotionTable(_Strict):
     start: Value = 0.0
     stop: Value | None = None
@@ -92,6 +102,7 @@ class GraphSpecFile(_Strict):
     bodies: list[BodyTable] = Field(default_factory=list, max_length=MAX_BODIES + 1)
     joints: list[GraphJointTable] = Field(max_length=MAX_JOINTS + 1)
     points: list[PointTable] = Field(default_factory=list, max_length=1000)
+    outputs: list[OutputTable] = Field(default_factory=list, max_length=100)
     motion: GraphMotionTable = Field(default_factory=GraphMotionTable)  # type: ignore[arg-type]
     gravity: Value | None = None
     gravity_direction: list[StrictFloat | StrictInt] = Field(
@@ -216,11 +227,27 @@ class GraphSpec:
                   for k, p in enumerate(raw.points)]
         if not inputs:
             self._fail("joints", "no joint is driven: mark the driven joint with input = true")
+        outputs = tuple(self._output(o, k) for k, o in enumerate(raw.outputs))
         try:
             return Mechanism(self.name, tuple(bodies), tuple(joints), tuple(inputs),
-                             tuple(points))
+                             tuple(points), outputs=outputs)
         except ScrewkitError as exc:
             raise SpecError(f"{self.path}: {exc}") from None
+
+    def _output(self, o: OutputTable, k: int) -> Output:
+        key = f"outputs.{k}"
+        if o.body is not None:
+            if o.vector is None or o.about is None or o.point or o.along:
+                self._fail(key, f"output {o.name!r}: a body angle takes 'body', 'vector' (fixed "
+                                "in the body, as drawn) and 'about' (a world axis)")
+            return BodyAngle(o.name, o.body, self._direction(list(o.vector or []),
+                                                              f"{key}.vector"),
+                             self._direction(list(o.about or []), f"{key}.about"))
+        if o.point is None or o.along is None or o.vector or o.about:
+            self._fail(key, f"output {o.name!r}: give either body, vector and about (an angle) "
+                            "or point and along (a travel)")
+        assert o.point is not None and o.along is not None
+        return PointTravel(o.name, o.point, self._direction(list(o.along), f"{key}.along"))
 
     def _joint_inputs(self, j: GraphJointTable, key: str) -> list[str]:
         from screwkit.model.joints import JOINT_FREEDOMS

@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.errors import InputError, UnknownNameError
 from screwkit.model.joints import JOINT_DESCRIPTIONS, JOINT_FREEDOMS
 from screwkit.model.mass import MassProperties
+from screwkit.model.mechanism_outputs import BodyAngle, Output, PointTravel
 
 Array = NDArray[np.float64]
 
@@ -153,6 +154,8 @@ class Mechanism:
     points: tuple[BodyPoint, ...] = ()
     #: a characteristic length (m): the spread of the joint points, for scale-aware checks
     length_scale: float = field(default=0.0)
+    #: named outputs (body angles, point travels), reported beside the joint variables
+    outputs: tuple[Output, ...] = ()
 
     def __post_init__(self) -> None:
         if len(self.bodies) > MAX_BODIES or len(self.joints) > MAX_JOINTS:
@@ -171,6 +174,7 @@ class Mechanism:
                 raise UnknownNameError(f"point {p.name!r}: body {p.body!r} is not a body of "
                                        f"{self.name!r}; bodies are {sorted(known)}")
         self._check_inputs()
+        self._check_outputs(known)
         if not self.length_scale:
             pts = np.array([j.at for j in self.joints])
             spread = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
@@ -198,6 +202,24 @@ class Mechanism:
             if float(np.linalg.norm(np.cross(j.axis, j.axis2))) < 1e-6:
                 raise MechanismError(f"joint {j.name!r}: a U joint's two axes must not be "
                                      "parallel")
+
+    def _check_outputs(self, known: set[str]) -> None:
+        _unique("output", [_name_ok("output", o.name) for o in self.outputs], self.name)
+        points = {p.name for p in self.points}
+        taken = set(self.freedom_names) | points
+        for o in self.outputs:
+            if o.name in taken:
+                raise MechanismError(f"output {o.name!r}: the name is taken by a freedom or a "
+                                     "point; give the output its own name")
+            if isinstance(o, BodyAngle) and o.body not in known:
+                raise UnknownNameError(f"output {o.name!r}: body {o.body!r} is not a body of "
+                                       f"{self.name!r}; bodies are {sorted(known)}")
+            if isinstance(o, BodyAngle) and np.linalg.norm(np.cross(o.vector, o.about)) < 1e-9:
+                raise MechanismError(f"output {o.name!r}: 'vector' lies along 'about', so it "
+                                     "turns through no angle about it; choose another vector")
+            if isinstance(o, PointTravel) and o.point not in points:
+                raise UnknownNameError(f"output {o.name!r}: point {o.point!r} is not a point of "
+                                       f"{self.name!r}; points are {sorted(points)}")
 
     def _check_inputs(self) -> None:
         freedoms = self.freedom_names
@@ -310,12 +332,12 @@ class Mechanism:
     def with_bodies(self, bodies: Sequence[Body]) -> Mechanism:
         """A copy with other body data (e.g. mass properties)."""
         return Mechanism(self.name, tuple(bodies), self.joints, self.inputs, self.points,
-                         self.length_scale)
+                         self.length_scale, self.outputs)
 
     def with_inputs(self, inputs: Sequence[str]) -> Mechanism:
         """A copy driven by other freedoms (the same drawing)."""
         return Mechanism(self.name, self.bodies, self.joints, tuple(inputs), self.points,
-                         self.length_scale)
+                         self.length_scale, self.outputs)
 
 
 def _unique(kind: str, names: list[str], mechanism: str) -> None:

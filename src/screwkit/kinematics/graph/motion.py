@@ -52,6 +52,10 @@ class MechanismMode(ModeMotion):
     points: dict[str, Array] = field(default_factory=dict)
     point_velocities: dict[str, Array] = field(default_factory=dict)
     point_accelerations: dict[str, Array] = field(default_factory=dict)
+    #: the mechanism's named outputs (kinematics/graph/outputs.py): value, rate, acceleration
+    outputs: dict[str, Array] = field(default_factory=dict)
+    output_rates: dict[str, Array] = field(default_factory=dict)
+    output_accelerations: dict[str, Array] = field(default_factory=dict)
 
 
 @dataclass(frozen=True, eq=False)
@@ -206,13 +210,14 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
         v = V[:, b, 3:] + cross(V[:, b, :3], x)
         a = A[:, b, 3:] + cross(A[:, b, :3], x) + cross(V[:, b, :3], v)
         points[pt.name], pv[pt.name], pa[pt.name] = x, v, a
+    outs = _outputs(mech, lay, fr.R, V, A, points, pv, pa)
     frames = [fr.R[:, :nb].copy(), p.copy()]
     twists = [w.copy(), v_o, al.copy(), a_o]
     bad = ~mask
-    for table in (variables, velocities, accels, points, pv, pa):
+    for table in (variables, velocities, accels, points, pv, pa, *outs):
         for values in table.values():
             values[bad] = np.nan
-    for table in (velocities, accels, pv, pa):
+    for table in (velocities, accels, pv, pa, outs[1], outs[2]):
         for values in table.values():
             values[singular] = np.nan
     centres, axes = fr.centres.copy(), fr.axes.copy()
@@ -234,7 +239,29 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
                          link_angular_acceleration=twists[2], link_origin_acceleration=twists[3],
                          joint_centres=centres, joint_axes=axes, closure_residual=residual,
                          events=events, points=points, point_velocities=pv,
-                         point_accelerations=pa)
+                         point_accelerations=pa, outputs=outs[0], output_rates=outs[1],
+                         output_accelerations=outs[2])
+
+
+def _outputs(mech: Mechanism, lay: GraphLayout, R: Array, V: Array, A: Array,
+             points: dict[str, Array], pv: dict[str, Array], pa: dict[str, Array]
+             ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array]]:
+    """The mechanism's named outputs over the samples (kinematics/graph/outputs.py)."""
+    from screwkit.kinematics.graph.outputs import body_angle, point_travel
+    from screwkit.model.mechanism_outputs import BodyAngle
+
+    values: dict[str, Array] = {}
+    rates_: dict[str, Array] = {}
+    accs: dict[str, Array] = {}
+    drawn = {pt.name: pt.at for pt in mech.points}
+    for o in mech.outputs:
+        if isinstance(o, BodyAngle):
+            b = lay.body_of[o.body]
+            got = body_angle(o, R[:, b], V[:, b, :3], A[:, b, :3])
+        else:
+            got = point_travel(o, drawn[o.point], points[o.point], pv[o.point], pa[o.point])
+        values[o.name], rates_[o.name], accs[o.name] = (np.array(g) for g in got)
+    return values, rates_, accs
 
 
 def expected_rank(mech: Mechanism, lay: GraphLayout) -> int:
