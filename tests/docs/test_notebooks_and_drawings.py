@@ -45,3 +45,18 @@ def test_family_drawing_is_made_from_the_constructors(tmp_path):
     for family in ("rsrc", "cssp", "4r", "rssr", "loop"):
         assert f"(families/{family}.png)" in doc and (ROOT / "docs" / "families" /
                                                      f"{family}.png").is_file()
+
+
+def test_mechanism_pictures_are_drawn_and_linked(tmp_path: Path) -> None:
+    """docs/draw_mechanisms.py draws a bundled graph example, and docs/mechanisms.md shows every
+    example's picture."""
+    r = subprocess.run([sys.executable, str(ROOT / "docs" / "draw_mechanisms.py"), str(tmp_path),
+                        "watt_sixbar"], capture_output=True, text=True, timeout=300,
+                       env={**os.environ, "MPLBACKEND": "Agg"})
+    assert r.returncode == 0, r.stderr
+    png = tmp_path / "watt_sixbar.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
+    doc = (ROOT / "docs" / "mechanisms.md").read_text(encoding="utf-8")
+    for spec in sorted((ROOT / "examples" / "mechanisms").glob("*.toml")):
+        assert f"(mechanisms/{spec.stem}.png)" in doc
+        assert (ROOT / "docs" / "mechanisms" / f"{spec.stem}.png").is_file()

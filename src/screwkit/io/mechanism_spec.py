@@ -165,9 +165,8 @@ class GraphSpec:
         """One line: what the spec describes."""
         t = self.topology
         n = self.inputs.shape[0]
-        return (f"{self.path}: {self.name}: a mechanism of {t.bodies} moving bodies, {t.joints} "
-                f"joints and {len(t.loops)} loop(s); inputs {', '.join(self.mechanism.inputs)} "
-                f"over {n} sample(s) from the drawing")
+        return (f"{self.path}: {self.name}: {t.bodies} bodies, {t.joints} joints, "
+                f"{len(t.loops)} loop(s); input {', '.join(self.mechanism.inputs)}, {n} samples")
 
     def jobs(self) -> list[str]:
         return ["analyze", "mobility"]
@@ -183,8 +182,21 @@ class GraphSpec:
             self._fail(key, str(exc))
         raise AssertionError  # unreachable
 
+    def coordinate(self, value: Any, kind: str, key: str) -> float:
+        """A coordinate or an input measured from the drawing, in SI: like :meth:`quantity`,
+        but a plain number whose size is below the smallest accepted (CAD's round-off, such as
+        1e-15 mm) is 0, since a position or an offset from the drawing may be nought."""
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            from screwkit.io.units import MAGNITUDE_LIMITS, unit_factor
+
+            unit = self.units.get(kind)
+            factor = unit_factor(unit, kind) if unit else 1.0
+            if abs(value * factor) < MAGNITUDE_LIMITS[kind][1]:
+                return 0.0
+        return self.quantity(value, kind, key)
+
     def _vector(self, values: list[Any], kind: str, key: str) -> np.ndarray:
-        return np.array([self.quantity(v, kind, f"{key}[{k}]") for k, v in enumerate(values)])
+        return np.array([self.coordinate(v, kind, f"{key}[{k}]") for k, v in enumerate(values)])
 
     def _direction(self, values: list[Any], key: str) -> np.ndarray:
         try:
@@ -310,7 +322,7 @@ class GraphSpec:
                 if len(row) != n_in:
                     self._fail(f"motion.rows.{r}", f"each row gives one value per input "
                                f"({n_in}: {', '.join(self.mechanism.inputs)}); got {len(row)}")
-                rows.append([self.quantity(v, kinds[c], f"motion.rows.{r}")
+                rows.append([self.coordinate(v, kinds[c], f"motion.rows.{r}")
                              for c, v in enumerate(row)])
             if not rows:
                 self._fail("motion.rows", "give at least one row")
@@ -321,7 +333,7 @@ class GraphSpec:
                                  "rows = [[...], ...], one value per input")
         if m.stop is None or m.step is None:
             self._fail("motion", "give start, stop and step (measured from the drawing)")
-        start = self.quantity(m.start, kinds[0], "motion.start")
+        start = self.coordinate(m.start, kinds[0], "motion.start")
         stop = self.quantity(m.stop, kinds[0], "motion.stop")
         step = self.quantity(m.step, kinds[0], "motion.step")
         if not step > 0:

@@ -53,21 +53,27 @@ class MechanismTopology:
         return len(self.redundant)
 
     def summary(self) -> list[str]:
+        """The report in short lines (each under 80 columns but for long names)."""
         lines = [f"{self.bodies} moving bodies, {self.joints} joints, {len(self.loops)} "
                  f"independent loop(s)"]
         for k, loop in enumerate(self.loops):
             lines.append(f"loop {k + 1}: {' – '.join(loop)}")
         lines.append(f"Grübler–Kutzbach (spatial): M = 6·{self.bodies} − Σ(6 − f) = "
                      f"{self.grubler}")
-        lines.append(f"screw Jacobian: {self.freedoms} freedoms, rank {self.rank} → mobility "
-                     f"{self.mobility} (rank at sampled configurations: "
-                     f"{sorted(set(self.ranks_at_samples))})")
+        sampled = ", ".join(str(r) for r in sorted(set(self.ranks_at_samples)))
+        lines.append(f"screw Jacobian: {self.freedoms} freedoms, rank {self.rank}, mobility "
+                     f"{self.mobility}")
+        lines.append(f"  (rank at the drawing and at sampled configurations: {sampled})")
         if self.redundant:
-            lines.append(f"{len(self.redundant)} redundant constraint(s): "
-                         + "; ".join(self.redundant))
+            lines.append(f"{len(self.redundant)} redundant constraint(s):")
+            by_loop: dict[str, list[str]] = {}
+            for r in self.redundant:
+                where, what = r.split(": ", 1)
+                by_loop.setdefault(where.split(" (")[0], []).append(what)
+            lines += [f"  {where}: {', '.join(what)}" for where, what in by_loop.items()]
         if self.idle:
-            lines.append(f"{len(self.idle)} idle freedom(s) (move no joint centre): "
-                         + ", ".join(self.idle))
+            lines.append(f"{len(self.idle)} idle freedom(s), moving no joint centre:")
+            lines += [f"  {x}" for x in self.idle]
         lines.append(self.verdict)
         return lines
 
@@ -157,16 +163,30 @@ def _null_freedoms(mech: Mechanism, lay: GraphLayout, lin: Any) -> tuple[list[st
     free_dirs = Wt[:rc] @ null
     names = [lay.names[f] for f in passive]
 
-    def top(dirs: Array) -> list[str]:
-        out: list[str] = []
-        for d in dirs:
-            for k in np.argsort(-np.abs(d)):
-                if names[k] not in out:
-                    out.append(names[k])
-                    break
-        return out
+    def pick(dirs: Array) -> list[str]:
+        """One freedom per direction, all different: the column pivots of a QR factorisation
+        of the directions (the freedoms that carry the subspace most independently)."""
+        if dirs.shape[0] == 0:
+            return []
+        _, _, piv = scipy.linalg.qr(dirs, pivoting=True, mode="economic")
+        return [names[k] for k in piv[: dirs.shape[0]]]
 
-    return top(idle_dirs), top(free_dirs)
+    rods = _rods(mech)
+    idle = ([f"{body} spin (about the line {a}–{b})" for body, a, b in rods]
+            if len(rods) == idle_dirs.shape[0] else pick(idle_dirs))
+    return idle, pick(free_dirs)
+
+
+def _rods(mech: Mechanism) -> list[tuple[str, str, str]]:
+    """Bodies held by exactly two ball joints and nothing else: each can spin about the line
+    through its two ball centres, an idle freedom (a point it carries off that line turns with
+    it, but no joint moves)."""
+    out = []
+    for b in mech.body_names:
+        joints = [j for j in mech.joints if b in j.bodies]
+        if len(joints) == 2 and all(j.kind == "S" for j in joints):
+            out.append((b, joints[0].name, joints[1].name))
+    return out
 
 
 def _verdict(mech: Mechanism, lay: GraphLayout, J: Array, mobility: int, idle: list[str],
@@ -181,5 +201,5 @@ def _verdict(mech: Mechanism, lay: GraphLayout, J: Array, mobility: int, idle: l
     if effective < n_in:
         return (f"the inputs conflict: mobility {effective} (idle freedoms aside) but {n_in} "
                 f"inputs ({', '.join(mech.inputs)}); drive {effective}")
-    return (f"the {n_in} input(s) ({', '.join(mech.inputs)}) drive the mechanism "
-            f"(mobility {effective}" + (f" + {len(idle)} idle" if idle else "") + ")")
+    return (f"the input(s) drive the mechanism: mobility {effective}"
+            + (f" + {len(idle)} idle" if idle else "") + f", {n_in} input(s)")
