@@ -191,3 +191,18 @@ def test_graph_report_in_browser(solved: Any, tmp_path: Path, open_report: Any) 
     assert (pixels < 100).mean() > 0.002, "no dark pixels: the mechanism is not drawn"
     assert page.errors == []
     assert page.requests == [page.url], f"requests besides the page: {page.requests}"
+
+
+def test_notebook_view_of_a_mechanism_motion() -> None:
+    from screwkit.errors import InputError
+    from screwkit.report.notebook import motion_html, view
+
+    spec = load_spec(SPECS[2])
+    motion = solve_mechanism(spec.mechanism, spec.inputs)
+    shown = view(motion)  # the bare mechanism: its name, the topology at the drawing
+    assert shown.scene["family"] == "graph" and shown.scene["loops"][0]["joint_names"] == [
+        "A", "B", "C", "D"]
+    assert shown.scene["text"]["topology"] == spec.topology.summary()
+    assert motion_html(motion, spec).startswith("<iframe srcdoc=")
+    with pytest.raises(InputError, match="kinematics only"):
+        view(motion, spec, dynamics={"mode": 0})
