@@ -73,7 +73,6 @@ def _body_index(mech: Mechanism) -> dict[str, int]:
 def body_vertices(mech: Mechanism) -> list[tuple[list[int], list[str], Array]]:
     """Per body (moving bodies, then the ground): its joints, its points and the drawn
     positions of the polyline that pictures it (module docstring), in world = body frame."""
-    index = _body_index(mech)
     out = []
     for name in [*mech.body_names, GROUND]:
         joints = [i for i, j in enumerate(mech.joints) if name in j.bodies]
@@ -81,7 +80,6 @@ def body_vertices(mech: Mechanism) -> list[tuple[list[int], list[str], Array]]:
         drawn = [mech.joints[i].at for i in joints]
         drawn += [pt.at for pt in mech.points if pt.body == name]
         out.append((joints, points, _polyline(np.array(drawn, dtype=float).reshape(-1, 3))))
-    assert len(out) == len(index)
     return out
 
 
