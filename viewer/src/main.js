@@ -1,7 +1,9 @@
 // screwkit report viewer: reads the scene from <script id="screwkit-scene">, builds the 3-D
 // view, the controls and the linked plots, autoplays, and exposes window.screwkitViewer for
 // tests: frameCount, frame, modeCount, mode, playing, play(), pause(), setFrame(i),
-// setMode(k), setView(name), jointPositions(i) (the joint centres drawn at frame i, metres).
+// setMode(k), setView(name), jointPositions(i) (the joint centres drawn at frame i, metres),
+// and for a mechanism with loops: loopCount, loop, setLoop(k) (-1: all), fullJoints() (the
+// joints drawn in full, not faint).
 import { decode, value } from './data.js';
 import { MechanismView } from './view3d.js';
 import { buildPlots } from './plots.js';
@@ -57,6 +59,15 @@ class ViewerApp {
     this.modeSelect.addEventListener('change', () => this.setMode(+this.modeSelect.value));
     bar.append(this.playButton, this.slider, el('span', { class: 'sk-label' }, 'speed'), speed);
     if (this.scene.modes.length > 1) bar.append(el('span', { class: 'sk-label' }, 'mode'), this.modeSelect);
+    const loops = this.scene.loops || [];
+    if (loops.length) {
+      this.loopSelect = el('select', { 'aria-label': 'loop', class: 'sk-loop' });
+      this.loopSelect.appendChild(el('option', { value: '-1' }, 'all loops'));
+      loops.forEach((lp, k) => this.loopSelect.appendChild(el('option', { value: String(k) },
+        `${lp.name}: ${lp.joint_names.join('–')}`)));
+      this.loopSelect.addEventListener('change', () => this.setLoop(+this.loopSelect.value));
+      bar.append(el('span', { class: 'sk-label' }, 'show'), this.loopSelect);
+    }
     const views = el('span', { class: 'sk-views' });
     for (const v of ['front', 'top', 'side', 'iso']) {
       const b = el('button', { type: 'button' }, v);
@@ -124,6 +135,12 @@ class ViewerApp {
     document.body.dataset.mode = String(k);
     this.updateLegend();
     this.setFrame(this.frame);
+  }
+
+  setLoop(k) {
+    this.view.setLoop(k);
+    if (this.loopSelect) this.loopSelect.value = String(k);
+    document.body.dataset.loop = String(k);
   }
 
   setFrame(i) {
@@ -198,6 +215,10 @@ class ViewerApp {
         return app.view.drawnJointCentres();
       },
       renderNow: () => { app.view.dirty = true; app.view.render(); },
+      get loopCount() { return (app.scene.loops || []).length; },
+      get loop() { return app.view.loopIndex; },
+      setLoop: (k) => app.setLoop(k),
+      fullJoints: () => app.view.fullJoints(),
     };
   }
 }

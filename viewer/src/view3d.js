@@ -1,6 +1,9 @@
 // The 3-D view: links between their joints, joints drawn by type, the fixed frame and the
 // world axes, traces and load arrows, with three.js and its OrbitControls. The scene graph is
 // built even where WebGL is missing (then only the picture is absent, with a message).
+// Each link is a polyline of link_points.shape[2] points (3 for a loop; a body of a graph
+// goes round all its joints and points); a mechanism's scene also lists its loops, and
+// setLoop(k) draws the joints and bodies outside loop k faint.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { point } from './data.js';
@@ -12,6 +15,23 @@ const INPUT_COLOUR = 0xe07020;
 const GROUND_COLOUR = 0x9e9e9e;
 const TRACE_COLOURS = [0x6fa8dc, 0x76c7b7, 0xb4a7d6, 0xf6b26b, 0x93c47d, 0xe06666];
 const ARROW_COLOURS = [0xd32f2f, 0xf57c00, 0x388e3c, 0x7b1fa2, 0x0288d1, 0x5d4037, 0xc2185b];
+const FAINT = 0.12;
+
+// Opacity of every material under obj: its own (as built, kept in material.userData) times
+// `factor`; materials shared by several meshes are set once per call, to the same value.
+function fade(obj, factor) {
+  obj.traverse((o) => {
+    const m = o.material;
+    if (!m) return;
+    if (m.userData.opacity === undefined) {
+      m.userData.opacity = m.opacity;
+      m.userData.transparent = m.transparent;
+    }
+    m.opacity = m.userData.opacity * factor;
+    m.transparent = m.userData.transparent || factor < 1;
+    m.needsUpdate = true;
+  });
+}
 
 function niceStep(x) {
   const p = Math.pow(10, Math.floor(Math.log10(x)));
@@ -66,6 +86,7 @@ export class MechanismView {
     this.showArrows = true;
     this.modeIndex = 0;
     this.frame = 0;
+    this.loopIndex = -1;
     this.three = new THREE.Scene();
     this.three.background = new THREE.Color(0xffffff);
     this.measure();
@@ -232,15 +253,20 @@ export class MechanismView {
       return parts;
     });
     const seg = new THREE.CylinderGeometry(1, 1, 1, 16);
+    const nSegments = this.sceneData.modes[0].link_points.shape[2] - 1;
     this.links = this.sceneData.links.map((link, k) => {
       const radius = (link.ground ? 0.06 : 0.1) * this.jointSize;
+      // one material per link, so that a link can be drawn faint on its own
       const mat = this.material(link.ground ? GROUND_COLOUR : LINK_COLOURS[k % LINK_COLOURS.length]);
-      const a = new THREE.Mesh(seg, mat), b = new THREE.Mesh(seg, mat);
-      a.geometry = seg; b.geometry = seg;
-      a.scale.set(radius, 1, radius); b.scale.set(radius, 1, radius);
-      a.userData.radius = radius; b.userData.radius = radius;
-      this.mechanism.add(a); this.mechanism.add(b);
-      return [a, b];
+      const parts = [];
+      for (let q = 0; q < nSegments; q++) {
+        const m = new THREE.Mesh(seg, mat);
+        m.scale.set(radius, 1, radius);
+        m.userData.radius = radius;
+        this.mechanism.add(m);
+        parts.push(m);
+      }
+      return parts;
     });
     this.traceGroup = new THREE.Group();
     this.three.add(this.traceGroup);
@@ -331,21 +357,29 @@ export class MechanismView {
           orient(parts.second, point(mode.second_axes, i, jj));
         }
         if (parts.rail) {
-          const lp = mode.link_points;
-          const k = ((i * lp.shape[1] + jj) * 3) * 3;
-          placeSegment(parts.rail, c, [lp[k], lp[k + 1], lp[k + 2]]);
+          // the travel ends where the distal link leaves the joint: rail_ends when the scene
+          // has them (a graph), else the first point of link jj (a loop)
+          let end;
+          if (mode.rail_ends) end = point(mode.rail_ends, i, jj);
+          else {
+            const lp = mode.link_points;
+            const k = ((i * lp.shape[1] + jj) * lp.shape[2]) * 3;
+            end = [lp[k], lp[k + 1], lp[k + 2]];
+          }
+          placeSegment(parts.rail, c, end);
           const rr = 0.45 * 0.25 * this.jointSize;
           parts.rail.scale.x = rr; parts.rail.scale.z = rr;
         }
       });
       const lp = mode.link_points;
-      const n = lp.shape[1];
-      this.links.forEach(([a, b], k) => {
-        const base = ((i * n + k) * 3) * 3;
+      const n = lp.shape[1], P = lp.shape[2];
+      this.links.forEach((parts, k) => {
+        const base = ((i * n + k) * P) * 3;
         const p = (q) => [lp[base + 3 * q], lp[base + 3 * q + 1], lp[base + 3 * q + 2]];
-        placeSegment(a, p(0), p(1));
-        placeSegment(b, p(1), p(2));
-        for (const m of [a, b]) { m.scale.x = m.userData.radius; m.scale.z = m.userData.radius; }
+        parts.forEach((m, q) => {
+          placeSegment(m, p(q), p(q + 1));
+          m.scale.x = m.userData.radius; m.scale.z = m.userData.radius;
+        });
       });
     }
     for (const arrow of this.arrows || []) {
@@ -360,6 +394,35 @@ export class MechanismView {
     }
     this.dirty = true;
     return ok;
+  }
+
+  // Draw the joints and links outside loop k faint (k = -1: every part in full).
+  setLoop(k) {
+    const loops = this.sceneData.loops || [];
+    if (!(k === -1 || (k >= 0 && k < loops.length))) throw new RangeError(`loop ${k} out of range`);
+    this.loopIndex = k;
+    const joints = k < 0 ? null : new Set(loops[k].joints);
+    const links = k < 0 ? null : new Set(loops[k].links);
+    this.joints.forEach((parts, jj) => {
+      const f = !joints || joints.has(jj) ? 1 : FAINT;
+      for (const o of [parts.group, parts.second, parts.rail]) if (o) fade(o, f);
+    });
+    this.links.forEach((parts, kk) => {
+      const f = !links || links.has(kk) ? 1 : FAINT;
+      for (const m of parts) fade(m, f);
+    });
+    this.dirty = true;
+  }
+
+  // Indices of the joints drawn in full (not faint).
+  fullJoints() {
+    const out = [];
+    this.joints.forEach((parts, jj) => {
+      let full = true;
+      parts.group.traverse((o) => { const m = o.material; if (m && m.userData.opacity !== undefined && m.opacity < m.userData.opacity) full = false; });
+      if (full) out.push(jj);
+    });
+    return out;
   }
 
   // Joint centres as drawn (metres), or nulls where the mode does not assemble.

@@ -57,7 +57,13 @@ def register(app: typer.Typer) -> None:
         _guard(lambda: check_plot_paths(plots))
         s = _guard(lambda: load_spec(spec))
         out = output if output is not None else Path(f"{spec.stem}.html")
-        scene = _guard(lambda: spec_scene(s, gravity=gravity))
+        if getattr(s, "family", None) == "graph":  # any mechanism (docs/mechanisms.md)
+            from screwkit.cli.graph_views import solved
+            from screwkit.report.graph_scene import graph_spec_scene
+
+            scene = _guard(lambda: graph_spec_scene(s, solved(s)))
+        else:
+            scene = _guard(lambda: spec_scene(s, gravity=gravity))
         if plots:
             from screwkit.report.animation import check_plots
 

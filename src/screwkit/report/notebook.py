@@ -4,6 +4,7 @@ page as ``screwkit report`` (:func:`screwkit.report.viewer.render_report_html`).
 >>> from screwkit.report.notebook import view
 >>> view(m)                              # a Motion: shows the animated 3-D view and plots
 >>> view(m, spec, dynamics=dyn, dynamics_mode=0, balance=bal)
+>>> view(solve_mechanism(mech, inputs))  # any mechanism, a graph (kinematics only)
 
 or once per session :func:`enable_notebook_display`, after which every ``Motion`` shown as the
 last value of a cell draws itself. A result class can also offer ``_repr_html_`` by returning
@@ -37,6 +38,23 @@ def _doc(x: Any) -> dict[str, Any] | None:
     return dict(x.as_dict())
 
 
+def _scene(motion: Any, owner: Any, dynamics: Any, dynamics_mode: int | None, balance: Any,
+           synthesis: Any, options: dict[str, Any]) -> dict[str, Any]:
+    """The scene of a loop's ``Motion``, or of a mechanism's ``MechanismMotion`` (kinematics
+    only: :func:`screwkit.report.graph_scene.scene_from_mechanism`)."""
+    if hasattr(motion, "mechanism"):
+        from screwkit.report.graph_scene import scene_from_mechanism
+
+        if dynamics is not None or balance is not None or synthesis is not None:
+            raise InputError("the report of a mechanism (a graph) shows its kinematics only; "
+                             "leave out dynamics, balance and synthesis")
+        return scene_from_mechanism(owner if owner is not None else motion.mechanism, motion,
+                                    **options)
+    return scene_from_motion(owner if owner is not None else motion.linkage, motion,
+                             dynamics_doc=_doc(dynamics), dynamics_mode=dynamics_mode,
+                             balance_doc=_doc(balance), synthesis_doc=synthesis, **options)
+
+
 def motion_html(motion: Any, spec_or_linkage: Any = None, *, dynamics: Any = None,
                 dynamics_mode: int | None = None, balance: Any = None, synthesis: Any = None,
                 height: int = DEFAULT_HEIGHT, **scene_options: Any) -> str:
@@ -44,10 +62,8 @@ def motion_html(motion: Any, spec_or_linkage: Any = None, *, dynamics: Any = Non
     ``motion.linkage``; ``dynamics`` (a ``Dynamics`` or its ``as_dict()``) of mode
     ``dynamics_mode``; ``balance`` a ``BalanceResult`` or its document; ``synthesis`` the
     synthesis document. Other keywords go to :func:`scene_from_motion`."""
-    owner = spec_or_linkage if spec_or_linkage is not None else motion.linkage
-    scene = scene_from_motion(owner, motion, dynamics_doc=_doc(dynamics),
-                              dynamics_mode=dynamics_mode, balance_doc=_doc(balance),
-                              synthesis_doc=synthesis, **scene_options)
+    scene = _scene(motion, spec_or_linkage, dynamics, dynamics_mode, balance, synthesis,
+                   scene_options)
     return report_iframe(scene, height)
 
 
@@ -72,10 +88,8 @@ def view(motion: Any, spec_or_linkage: Any = None, *, dynamics: Any = None,
          dynamics_mode: int | None = None, balance: Any = None, synthesis: Any = None,
          height: int = DEFAULT_HEIGHT, **scene_options: Any) -> ReportView:
     """A :class:`ReportView` of a motion (same arguments as :func:`motion_html`)."""
-    owner = spec_or_linkage if spec_or_linkage is not None else motion.linkage
-    scene = scene_from_motion(owner, motion, dynamics_doc=_doc(dynamics),
-                              dynamics_mode=dynamics_mode, balance_doc=_doc(balance),
-                              synthesis_doc=synthesis, **scene_options)
+    scene = _scene(motion, spec_or_linkage, dynamics, dynamics_mode, balance, synthesis,
+                   scene_options)
     return ReportView(scene, height)
 
 

@@ -142,7 +142,8 @@ def point_trace(mode: Any, link: int, local: Array) -> Array:
     return np.asarray(mode.link_origin, dtype=float)[:, link] + np.einsum("nij,j->ni", R, local)
 
 
-def _is_full_turn(x: Array, kind: str) -> bool:
+def is_full_turn(x: Array, kind: str) -> bool:
+    """Whether angle samples ``x`` (evenly stepped) cover one full turn, so that traces close."""
     if kind != "angle" or len(x) < 3:
         return False
     step = x[1] - x[0]
@@ -244,7 +245,7 @@ def scene_from_motion(
         "description": spec.describe() if spec is not None else str(linkage.name),
         "display_units": units,
         "input": {"name": input_name, "kind": kind, "values": x,
-                  "periodic": _is_full_turn(x, kind)},
+                  "periodic": is_full_turn(x, kind)},
         "joints": [{"name": j.name, "kind": j.kind, "pitch": float(j.pitch),
                     "input": any(i.split(".")[0] == j.name for i in linkage.inputs)}
                    for j in linkage.joints],

@@ -17,14 +17,15 @@ GENERIC_SOLVER = ("generic single-loop solver (screwkit.kinematics.motion): ever
 
 
 def link_span_variation(link_points: Array, assembles: NDArray[np.bool_]) -> float:
-    """Largest change over the assembling frames of any distance between the three points of a
-    drawn link (start, common-normal foot, next joint centre), in metres; 0 for a rigid
-    picture. NaN when no frame assembles."""
+    """Largest change over the assembling frames of any distance between two points of a
+    drawn link (a loop's link: start, common-normal foot, next joint centre; a body of a graph:
+    its joints and points), in metres; 0 for a rigid picture. NaN when no frame assembles."""
     p = link_points[assembles]
     if p.shape[0] == 0:
         return float("nan")
+    P = p.shape[2]
     d = np.stack([np.linalg.norm(p[:, :, a] - p[:, :, b], axis=-1)
-                  for a, b in ((0, 1), (1, 2), (0, 2))], axis=-1)
+                  for a in range(P) for b in range(a + 1, P)], axis=-1)
     return float(np.max(d.max(axis=0) - d.min(axis=0)))
 
 

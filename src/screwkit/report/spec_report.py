@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from screwkit.io.mechanism_spec import GraphSpec
 from screwkit.io.spec import Spec
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.pipeline import Pipeline
@@ -23,16 +24,22 @@ def seed_tables(mode: ModeMotion) -> tuple[Named, Named, Named]:
     return seeds(mode.variables), seeds(mode.velocities), seeds(mode.accelerations)
 
 
-def spec_scene(spec: Spec | Pipeline, *, gravity: bool = False,
+def spec_scene(spec: Spec | Pipeline | GraphSpec, *, gravity: bool = False,
                dynamics_doc: dict[str, Any] | None = None,
                balance_doc: dict[str, Any] | None = None,
                synthesis_doc: dict[str, Any] | None = None) -> dict[str, Any]:
     """The report scene of a loaded spec (or of a pipeline, whose motion is reused): every
     mode's motion and, when the spec has them, the dynamics of ``[motion] mode`` (masses),
     balancing (``[balancing]``) and synthesis (``[synthesis]``) — computed here unless their
-    documents are given."""
+    documents are given. A graph spec (``[[joints]]``, docs/mechanisms.md) gives the scene of
+    its drawn mode (:func:`screwkit.report.graph_scene.graph_spec_scene`; kinematics only)."""
     from screwkit.io.documents import synthesis_document
     from screwkit.report.scene import scene_from_motion
+
+    if isinstance(spec, GraphSpec):
+        from screwkit.report.graph_scene import graph_spec_scene
+
+        return graph_spec_scene(spec)
 
     pipe = spec if isinstance(spec, Pipeline) else Pipeline(spec)
     s = pipe.spec
@@ -74,9 +81,11 @@ def add_simulation_plots(scene: dict[str, Any], spec: Spec) -> None:
     scene["plot_groups"] += groups
 
 
-def write_spec_report(spec: Spec | Pipeline, path: str | Path, **docs: Any) -> dict[str, Any]:
-    """Write the HTML report of a loaded spec (or pipeline) to ``path`` atomically; returns its
-    scene. ``docs``: ``gravity``, ``dynamics_doc``, ``balance_doc``, ``synthesis_doc``."""
+def write_spec_report(spec: Spec | Pipeline | GraphSpec, path: str | Path, **docs: Any
+                      ) -> dict[str, Any]:
+    """Write the HTML report of a loaded spec (or pipeline, or graph spec) to ``path``
+    atomically; returns its scene. ``docs``: ``gravity``, ``dynamics_doc``, ``balance_doc``,
+    ``synthesis_doc`` (ignored for a graph spec)."""
     from screwkit.io.results import write_atomic
     from screwkit.report.viewer import render_report_html
 

@@ -102,6 +102,8 @@ def pack_scene(scene: dict[str, Any]) -> dict[str, Any]:
         pm = dict(m)
         for key in MODE_ARRAYS:
             pm[key] = _pack(m[key], "f8" if key in FLOAT64_KEYS else "f4")
+        if m.get("rail_ends") is not None:  # a mechanism's scene (report/graph_scene.py)
+            pm["rail_ends"] = _pack(m["rail_ends"], "f4")
         pm["traces"] = {k: _pack(v, "f4") for k, v in m.get("traces", {}).items()}
         pm["arrows"] = {k: {**a, "vectors": _pack(a["vectors"], "f4"),
                             "points": _pack(a["points"], "f4")}
@@ -133,7 +135,7 @@ def _list(lines: list[str]) -> str:
 
 def _text_section(text: dict[str, Any]) -> str:
     parts = ["<section id='sk-text'>"]
-    for key, title in (("units", "Units"), ("solver", "Solver"),
+    for key, title in (("units", "Units"), ("solver", "Solver"), ("topology", "Topology"),
                        ("validation", "Validation status")):
         if text.get(key):
             parts.append(f"<h2>{title}</h2>{_list(text[key])}")
