@@ -77,7 +77,18 @@ class Linearised:
     pinv: Array
     sigma: Array
 
-    def take(self, index: slice) -> Linearised:
+    def overwrite(self, index: NDArray[np.intp], part: Linearised) -> None:
+        """Replace the samples ``index`` by ``part``'s, in place (this object's arrays are its
+        own: Newton's work arrays)."""
+        for a, b in ((self.frames.R, part.frames.R), (self.frames.p, part.frames.p),
+                     (self.frames.screws, part.frames.screws),
+                     (self.frames.residual, part.frames.residual),
+                     (self.frames.centres, part.frames.centres),
+                     (self.frames.axes, part.frames.axes), (self.J, part.J),
+                     (self.pinv, part.pinv), (self.sigma, part.sigma)):
+            a[index] = b
+
+    def take(self, index: slice | NDArray[np.intp]) -> Linearised:
         f = self.frames
         return Linearised(GraphFrames(f.R[index], f.p[index], f.screws[index], f.residual[index],
                                       f.centres[index], f.axes[index]),
@@ -143,20 +154,26 @@ def newton(mech: Mechanism, lay: GraphLayout, conf: Configuration, X: Array,
     passive = list(lay.passive)
     lin = linearise(mech, lay, conf, exact=exact)
     err = np.linalg.norm(scaled_residual(mech, lay, lin.frames), axis=1)
+    scal, sph = conf.scalars.copy(), conf.spherical.copy()
     for _ in range(max_iter):
-        todo = err > tol
-        if not todo.any():
+        todo = np.nonzero(err > tol)[0]  # only the samples still open are worked on
+        if not todo.size:
             break
-        r = scaled_residual(mech, lay, lin.frames)
-        step = np.zeros((conf.size, lay.m))
-        step[:, passive] = -np.einsum("nij,nj->ni", lin.pinv, r) * cs
-        step[~todo] = 0.0
-        conf = increment(conf, step, lay)
-        lin = linearise(mech, lay, conf, exact=exact)
-        new = np.linalg.norm(scaled_residual(mech, lay, lin.frames), axis=1)
-        err = np.where(todo, new, err)
+        whole = todo.size == err.size
+        sub = lin if whole else lin.take(todo)
+        r = scaled_residual(mech, lay, sub.frames)
+        step = np.zeros((todo.size, lay.m))
+        step[:, passive] = -np.einsum("nij,nj->ni", sub.pinv, r) * cs
+        moved = increment(Configuration(scal[todo], sph[todo]), step, lay)
+        scal[todo], sph[todo] = moved.scalars, moved.spherical
+        new = linearise(mech, lay, moved, exact=exact)
+        if whole:
+            lin = new
+        else:
+            lin.overwrite(todo, new)
+        err[todo] = np.linalg.norm(scaled_residual(mech, lay, new.frames), axis=1)
     err = np.where(np.isfinite(err), err, np.inf)
-    return conf, err, lin
+    return Configuration(scal, sph), err, lin
 
 
 def rates(mech: Mechanism, lay: GraphLayout, lin: Linearised, Xd: Array) -> Array:
