@@ -93,7 +93,7 @@ def register(app: typer.Typer) -> None:
         gravity: Annotated[bool, typer.Option("--gravity/--no-gravity", help="Include gravity: magnitude 'gravity' (default 9.80665 m/s²) along 'gravity_direction' (default −z) of the spec.")] = False,
     ) -> None:
         """Shaking force and moment, every joint reaction and the actuator efforts over the cycle, with the RMS and peak of each (one assembly mode: motion.mode in the spec)."""
-        from screwkit.cli.common import guard, loop_only
+        from screwkit.cli.common import guard
         from screwkit.cli.outputs import Outputs
         from screwkit.io.documents import dynamics_document
         from screwkit.io.spec import load_spec
@@ -101,7 +101,11 @@ def register(app: typer.Typer) -> None:
 
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full)
-        s = loop_only(guard(lambda: load_spec(spec)), "dynamics")
+        s = guard(lambda: load_spec(spec))
+        if getattr(s, "family", None) == "graph":  # any mechanism (docs/mechanisms.md)
+            from screwkit.cli.graph_views import dynamics_graph
+
+            return dynamics_graph(s, out, gravity)
         pipe = Pipeline(s)
         dyn = guard(lambda: pipe.dynamics(gravity))
         note = guard(lambda: load_note(pipe))

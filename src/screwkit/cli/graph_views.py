@@ -87,3 +87,107 @@ def _show(spec: Any, motion: Any, units: Any, full: bool) -> None:
         if missing:
             console.print(f"  • does not assemble at {missing} of {motion.samples} inputs",
                           highlight=False)
+
+
+def graph_dynamics(spec: Any, gravity: bool) -> Any:
+    """The loads of a graph spec's drawn mode (gravity along the spec's direction if asked)."""
+    from screwkit.dynamics.graph_inverse import graph_inverse_dynamics
+
+    return graph_inverse_dynamics(solved(spec), 0, spec.gravity_vector if gravity else None)
+
+
+def dynamics_table(spec: Any, dyn: Any) -> Any:
+    """One row per sample: the inputs, every effort, the shaking loads, every reaction."""
+    from screwkit.tables import Column, ResultTable
+
+    mech = spec.mechanism
+    cols = []
+    for k, name in enumerate(mech.inputs):
+        kind = "length" if name.endswith(".s") else "angle"
+        cols.append(Column("input" if k == 0 else f"input_{k + 1}", kind, spec.inputs[:, k]))
+    cols.append(Column("assembles", "flag", dyn.ok))
+    for k, name in enumerate(mech.inputs):
+        cols.append(Column(f"effort_{name}", "force" if name.endswith(".s") else "moment",
+                           dyn.efforts[:, k]))
+    for what, kind, arr in (("shaking_force", "force", dyn.shaking_force),
+                            ("shaking_moment", "moment", dyn.shaking_moment)):
+        cols += [Column(f"{what}_{a}", kind, arr[:, i]) for i, a in enumerate("xyz")]
+    for j, name in enumerate(dyn.joint_names):
+        cols += [Column(f"{name}.force_{a}", "force", dyn.reaction_force[:, j, i])
+                 for i, a in enumerate("xyz")]
+        cols += [Column(f"{name}.moment_{a}", "moment", dyn.reaction_moment[:, j, i])
+                 for i, a in enumerate("xyz")]
+    return ResultTable(tuple(cols), f"{mech.name}: loads of the drawn mode, one row per sample")
+
+
+def dynamics_summary(dyn: Any) -> dict[str, dict[str, Any]]:
+    """RMS and peak (with the sample where it occurs) of every effort, the shaking loads and
+    the largest joint reaction."""
+    out: dict[str, dict[str, Any]] = {}
+
+    def add(name: str, kind: str, size: np.ndarray) -> None:
+        ok = np.isfinite(size)
+        if not ok.any():
+            return
+        k = int(np.nanargmax(np.abs(size)))
+        out[name] = {"kind": kind, "rms": float(np.sqrt(np.mean(size[ok] ** 2))),
+                     "peak": float(np.abs(size[k])), "sample": k}
+
+    for k, name in enumerate(dyn.input_names):
+        add(f"effort {name}", "force" if name.endswith(".s") else "moment", dyn.efforts[:, k])
+    add("shaking force", "force", np.linalg.norm(dyn.shaking_force, axis=1))
+    add("shaking moment", "moment", np.linalg.norm(dyn.shaking_moment, axis=1))
+    for j, name in enumerate(dyn.joint_names):
+        add(f"reaction {name} force", "force", np.linalg.norm(dyn.reaction_force[:, j], axis=1))
+    return out
+
+
+def dynamics_graph(spec: Any, out: Any, gravity: bool) -> None:
+    """``screwkit dynamics`` on a graph spec."""
+    from screwkit.cli.common import guard
+
+    dyn = guard(lambda: graph_dynamics(spec, gravity))
+    du = out.units_for(spec.units)
+    summary = dynamics_summary(dyn)
+
+    def document() -> dict[str, Any]:
+        doc = dyn.as_dict()
+        doc.update(mode=0, gravity_on=bool(gravity), summary=summary,
+                   input=spec.inputs[:, 0] if spec.inputs.shape[1] == 1 else spec.inputs)
+        return doc
+
+    out.deliver(document=document, table=lambda: dynamics_table(spec, dyn),
+                show=lambda: _show_dynamics(spec, dyn, summary, du, gravity), units=du)
+
+
+def _show_dynamics(spec: Any, dyn: Any, summary: dict[str, dict[str, Any]], units: Any,
+                   gravity: bool) -> None:
+    from rich.markup import escape
+
+    from screwkit.cli.common import console
+    from screwkit.cli.formatting import TextColumn, number, print_columns
+
+    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
+    console.print("gravity on" if gravity else "gravity off (add it with --gravity)",
+                  highlight=False)
+    kind0 = "length" if spec.mechanism.inputs[0].endswith(".s") else "angle"
+    names = list(summary)
+    cols = [TextColumn("load", names, "left"),
+            TextColumn("unit", [units.label(summary[n]["kind"]) for n in names], "left"),
+            TextColumn("RMS", [number(units.show(summary[n]["kind"], summary[n]["rms"]), 6)
+                               for n in names]),
+            TextColumn("peak", [number(units.show(summary[n]["kind"], summary[n]["peak"]), 6)
+                                for n in names]),
+            TextColumn(f"at input\n[{units.label(kind0)}]",
+                       [number(units.show(kind0, spec.inputs[summary[n]["sample"], 0]), 6)
+                        for n in names])]
+    print_columns(console, "loads of the drawn mode (RMS and peak over the motion)", cols)
+    if dyn.indeterminate:
+        console.print(f"  • {dyn.indeterminate} statically indeterminate reaction component(s) "
+                      f"(joints {', '.join(dyn.indeterminate_joints[:6])}"
+                      f"{', …' if len(dyn.indeterminate_joints) > 6 else ''}): the least-norm "
+                      "reactions are shown", highlight=False)
+    bad = int((~dyn.ok).sum())
+    if bad:
+        console.print(f"  • no loads at {bad} sample(s) where the mode does not assemble or "
+                      "is singular", highlight=False)

@@ -192,7 +192,14 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
     lin = linearise(mech, lay, conf, full_rank=rank == len(lay.passive))
     fr = lin.frames
     qd = rates(mech, lay, lin, Xd)
+    idle = rank < len(lay.passive)
+    if idle:  # rods between two balls: their spin held still (graph/idle.py)
+        from screwkit.kinematics.graph.idle import hold_rod_spin
+
+        qd = hold_rod_spin(mech, lay, lin, qd)
     qdd, bias = accelerations(mech, lay, lin, qd, Xdd)
+    if idle:
+        qdd = hold_rod_spin(mech, lay, lin, qdd, bias)
     V, _ = body_twists(mech, lay, fr.screws, qd)
     A = body_accelerations(mech, lay, fr.screws, qdd, bias)
     nb = len(mech.bodies)

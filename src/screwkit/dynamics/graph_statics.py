@@ -1,0 +1,123 @@
+"""Joint wrenches and input efforts of any mechanism graph from the loads on its bodies.
+
+Unknowns: the wrench W_j = (f_j; m_j) (moment about the world origin) exerted through joint j by
+its first body on its second (``between = [a, b]``: by a on b), for every joint.
+
+Equations (Newton–Euler for every moving body b, B_b its applied inertia + weight wrench):
+
+    Σ_{j: b second} W_j − Σ_{j: b first} W_j + B_b = 0          (6 per moving body)
+    S_k · W_{j(k)} = 0                                           (1 per passive freedom k)
+
+with S·W = ω·m + v·f the reciprocal product of a unit freedom screw with the wrench (no work
+along a frictionless freedom; Bagci 1969 §3.4). A driven freedom's effort is τ_k = S_k·W_{j(k)}.
+
+The system is solved per sample for the wrenches that minimise Σ_j |f_j|² + |m_cj/ℓ|², moments
+taken about each joint's centre c_j and divided by the length scale ℓ (as single loops do,
+dynamics/loop_statics.py): the choice is independent of the reference point and of how the graph
+is cut. Its null space — self-stress that rigid joints can carry without any load, three per
+loop of a planar mechanism drawn in 3-D — is counted and named by the joints it loads. Idle
+freedoms (a rod's spin) make the passive equations consistent only when the loads do no work
+along them; the least-squares solution is returned and the residual reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.model.mechanism import GROUND, Mechanism
+
+Array = NDArray[np.float64]
+
+RANK_RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class GraphStatics:
+    """Solved joint wrenches (N, J, 6, K) by first body on second, moment about the world
+    origin; efforts (N, n_in, K); the equations' residual (N, K) (relative to the loads); the
+    count of statically indeterminate components and the joints that carry them."""
+
+    wrenches: Array
+    efforts: Array
+    residual: Array
+    indeterminate: int
+    indeterminate_joints: list[str]
+
+
+def _system(mech: Mechanism, screws: Array, centres: Array, passive: list[int],
+            joint_of: tuple[int, ...], length: float) -> Array:
+    """The scaled matrix (N, 6B + m_p, 6J) acting on y_j = (f_j; m_cj/ℓ)."""
+    N = screws.shape[0]
+    B, J = len(mech.bodies), len(mech.joints)
+    index = {b: k for k, b in enumerate(mech.body_names)}
+    A = np.zeros((N, 6 * B + len(passive), 6 * J))
+    # W_j = T_j y_j: f = f, m_O = c_j × f + ℓ m_c/ℓ
+    T = np.zeros((N, J, 6, 6))
+    T[:, :, :3, :3] = np.eye(3)
+    T[:, :, 3:, 3:] = length * np.eye(3)
+    c = centres
+    T[:, :, 3, 1], T[:, :, 3, 2] = -c[..., 2], c[..., 1]
+    T[:, :, 4, 0], T[:, :, 4, 2] = c[..., 2], -c[..., 0]
+    T[:, :, 5, 0], T[:, :, 5, 1] = -c[..., 1], c[..., 0]
+    rows = np.ones(6)
+    rows[3:] = 1.0 / length  # moment rows in force units
+    for j, joint in enumerate(mech.joints):
+        a, b = joint.bodies
+        for body, sign in ((b, 1.0), (a, -1.0)):
+            if body != GROUND:
+                k = index[body]
+                A[:, 6 * k:6 * k + 6, 6 * j:6 * j + 6] = sign * rows[:, None] * T[:, j]
+    for r, f in enumerate(passive):
+        j = joint_of[f]
+        S = screws[:, :, f]  # (ω; v): S·W = ω·m + v·f
+        SW = np.concatenate([S[:, 3:], S[:, :3]], -1)
+        scale = 1.0 / length if np.any(S[:, :3] != 0.0) else 1.0
+        A[:, 6 * B + r, 6 * j:6 * j + 6] = scale * np.einsum("nk,nkl->nl", SW, T[:, j])
+    return A
+
+
+def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: Array,
+                        passive: list[int], inputs: list[int], joint_of: tuple[int, ...],
+                        length: float) -> GraphStatics:
+    """Joint wrenches and efforts (module docstring) from the body loads ``loads``
+    (N, B, 6, K): applied wrenches about the world origin, one column per load case."""
+    N, _, _, K = loads.shape
+    B, J = len(mech.bodies), len(mech.joints)
+    A = _system(mech, screws, centres, passive, joint_of, length)
+    rows = np.ones(6)
+    rows[3:] = 1.0 / length
+    rhs = np.zeros((N, A.shape[1], K))
+    rhs[:, :6 * B] = -(loads * rows[None, None, :, None]).reshape(N, 6 * B, K)
+    U, s, Vt = np.linalg.svd(A, full_matrices=False)
+    keep = s > RANK_RTOL * np.maximum(s[:, :1], 1e-300)
+    inv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+    y = np.einsum("nji,nj,nkj,nkl->nil", Vt, inv, U, rhs)
+    rank = int(np.median(keep.sum(axis=1)))
+    indeterminate = 6 * J - rank
+    named = _null_joints(mech, np.linalg.svd(A[0])[2][rank:]) if indeterminate else []
+    # back to W_j about the origin
+    wrench = y.reshape(N, J, 6, K).copy()
+    c = centres
+    wrench[:, :, 3:] = length * wrench[:, :, 3:] + np.cross(c[:, :, None, :],
+                                                               wrench[:, :, :3].swapaxes(2, 3)
+                                                               ).swapaxes(2, 3)
+    res = np.einsum("nij,njk->nik", A, y) - rhs
+    size = np.linalg.norm(rhs, axis=1) + 1e-300
+    residual = np.linalg.norm(res, axis=1) / size
+    efforts = np.empty((N, len(inputs), K))
+    for k, f in enumerate(inputs):
+        j = joint_of[f]
+        S = screws[:, :, f]
+        efforts[:, k] = (np.einsum("nk,nkl->nl", S[:, :3], wrench[:, j, 3:])
+                         + np.einsum("nk,nkl->nl", S[:, 3:], wrench[:, j, :3]))
+    return GraphStatics(wrench, efforts, residual, indeterminate, named)
+
+
+def _null_joints(mech: Mechanism, null: Array) -> list[str]:
+    """The joints the self-stress directions load (largest components first)."""
+    weight = np.abs(null).reshape(null.shape[0], len(mech.joints), 6).max(axis=(0, 2))
+    order = np.argsort(-weight)
+    return [mech.joints[j].name for j in order if weight[j] > 1e-6 * weight.max()]

@@ -1,0 +1,75 @@
+"""Idle rod spins held still: a body joined by exactly two ball joints can spin about the line
+through their centres without moving anything else. The minimum-norm rates leave some of that
+spin in (the norm is the joints', not the rod's); here the idle part of the rates is chosen so
+that every such rod's angular velocity and acceleration have no component along its axis
+(ω·u = 0 and then α·u = 0, since u̇ = ω × u), as single loops hold theirs
+(kinematics/idle_spin.py). Loads that do no work along a spin (a centre of mass on the axis, an
+inertia symmetric about it) are then carried exactly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics.graph.closure import GraphLayout, body_accelerations, body_twists
+from screwkit.kinematics.graph.newton import RANK_CUTOFF, Linearised, column_scale
+from screwkit.model.mechanism import Mechanism
+
+Array = NDArray[np.float64]
+
+
+def rods(mech: Mechanism) -> list[tuple[str, int, int]]:
+    """(body, first ball joint, second ball joint) of every body held by exactly two balls."""
+    out = []
+    for b in mech.body_names:
+        joints = [k for k, j in enumerate(mech.joints) if b in j.bodies]
+        if len(joints) == 2 and all(mech.joints[k].kind == "S" for k in joints):
+            out.append((b, joints[0], joints[1]))
+    return out
+
+
+def _spin_of(mech: Mechanism, lay: GraphLayout, lin: Linearised, q: Array,
+             found: list[tuple[str, int, int]], bias: Array | None = None) -> Array:
+    """Each rod's spin ω·u (N, r) under freedom rates ``q`` (N, m); with the joints'
+    velocity-product terms ``bias``, ``q`` are accelerations and this is α·u."""
+    if bias is None:
+        V, _ = body_twists(mech, lay, lin.frames.screws, q)
+    else:
+        V = body_accelerations(mech, lay, lin.frames.screws, q, bias)
+    out = np.empty((q.shape[0], len(found)))
+    for k, (body, j1, j2) in enumerate(found):
+        u = lin.frames.centres[:, j2] - lin.frames.centres[:, j1]
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        out[:, k] = np.einsum("ni,ni->n", V[:, lay.body_of[body], :3], u)
+    return out
+
+
+def hold_rod_spin(mech: Mechanism, lay: GraphLayout, lin: Linearised, q: Array,
+                  bias: Array | None = None) -> Array:
+    """Rates ``q`` (N, m) with the idle part chosen so no rod spins; with the joints'
+    velocity-product terms ``bias`` (closure.body_twists), accelerations with no spin
+    acceleration."""
+    found = rods(mech)
+    passive = list(lay.passive)
+    if not found or not passive:
+        return q
+    Jp = lin.J[:, :, passive]
+    _, s, Vt = np.linalg.svd(Jp)
+    keep = s > RANK_CUTOFF * np.maximum(s[:, :1], 1e-300)
+    rank = int(np.median(keep.sum(axis=1)))
+    null = Vt[:, rank:]  # (N, d, m_p): scaled idle directions
+    d = null.shape[1]
+    if d == 0:
+        return q
+    cs = column_scale(lay)[passive]
+    C = np.empty((q.shape[0], len(found), d))
+    for k in range(d):
+        z = np.zeros_like(q)
+        z[:, passive] = null[:, k] * cs
+        C[:, :, k] = _spin_of(mech, lay, lin, z, found)
+    spin = _spin_of(mech, lay, lin, q, found, bias)
+    coef = -np.einsum("nij,nj->ni", np.linalg.pinv(C), spin)
+    out = q.copy()
+    out[:, passive] += np.einsum("ndi,nd->ni", null, coef) * cs
+    return out
