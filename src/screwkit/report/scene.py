@@ -185,6 +185,8 @@ def scene_from_motion(
     seed_variables: list[tuple[dict[str, Array], dict[str, Array], dict[str, Array]]] | None = None,
     solver: list[str] | None = None,
     notes: list[str] | None = None,
+    linkage: Any = None,
+    initial_mode: int | None = None,
 ) -> dict[str, Any]:
     """Build the scene (module docstring) of a solved motion.
 
@@ -195,9 +197,12 @@ def scene_from_motion(
     synthesize`` document. ``coupler_points``: extra traces {name: (moving link index, point
     in that link's frame, m)}. ``seed_variables``: per mode the (variables, velocities,
     accelerations) under the seed's names, plotted instead of the joint variables.
+    ``linkage``: the loop the motion is of, when it is not the spec's (the synthesised one);
+    ``initial_mode``: the mode shown first (default: the mode with dynamics, else 0).
     """
-    linkage = getattr(spec_or_linkage, "linkage", spec_or_linkage)
-    spec = spec_or_linkage if spec_or_linkage is not linkage else None
+    spec_linkage = getattr(spec_or_linkage, "linkage", spec_or_linkage)
+    spec = spec_or_linkage if spec_or_linkage is not spec_linkage else None
+    linkage = spec_linkage if linkage is None else linkage
     modes = list(motion.modes)
     if not modes:
         raise InputError(f"{linkage.name}: the motion has no assembly mode to show")
@@ -232,7 +237,7 @@ def scene_from_motion(
         plots += p
         groups += g
     if synthesis_doc is not None:
-        p, g = synthesis_plots(synthesis_doc, units)
+        p, g = synthesis_plots(synthesis_doc, units, synthesised=linkage is not spec_linkage)
         plots += p
         groups += g
     base_R = np.asarray(linkage.base.real, dtype=float)
@@ -254,7 +259,7 @@ def scene_from_motion(
         "fixed_frame": {"origin": np.asarray(linkage.base.translation, dtype=float),
                         "rotation": base_R},
         "modes": mode_entries,
-        "initial_mode": dyn_mode or 0,
+        "initial_mode": initial_mode if initial_mode is not None else dyn_mode or 0,
         "plots": plots,
         "plot_groups": groups,
         "text": text_sections(linkage, mode_entries, units, kind, spec_text=spec_text,

@@ -192,10 +192,11 @@ def balancing_plots(doc: dict[str, Any], mode: int | None, x: Array, input_name:
     return plots, [{"id": "balancing", "title": "Balancing (before / after)", "note": note}]
 
 
-def synthesis_plots(doc: dict[str, Any], units: dict[str, Any],
+def synthesis_plots(doc: dict[str, Any], units: dict[str, Any], synthesised: bool = False,
                     ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Desired vs generated output rotation and translation at the design points, and the
-    error curves (not linked: the synthesised mechanism is not the one animated)."""
+    error curves, against the design parameter θ (not linked to the animation). ``synthesised``:
+    whether the 3-D view shows the synthesised mechanism (else the synthesis start)."""
     rows = sorted(doc["rows"], key=lambda r: r["theta"])
 
     def col(key: str) -> Array:
@@ -232,6 +233,8 @@ def synthesis_plots(doc: dict[str, Any], units: dict[str, Any],
 
     note = (f"{doc.get('method', 'least_squares')}: status {doc.get('status')}; RMSE ψ "
             f"{num(doc.get('rmse_phi'), DEG)}°, S {num(doc.get('rmse_S'))} m; {len(rows)} design "
-            "points. The 3-D view shows the spec's mechanism (the synthesis start), not the "
-            "synthesised one.")
+            "points. " + ("The 3-D view shows the synthesised mechanism; the plots of its output "
+                          "from θ01 follow the animation." if synthesised else
+                          "The 3-D view shows the spec's mechanism (the synthesis start), not "
+                          "the synthesised one."))
     return plots, [{"id": g, "title": "Synthesis", "note": note}]
