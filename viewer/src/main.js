@@ -1,7 +1,8 @@
 // screwkit report viewer: reads the scene from <script id="screwkit-scene">, builds the 3-D
 // view, the controls and the linked plots, autoplays, and exposes window.screwkitViewer for
 // tests: frameCount, frame, modeCount, mode, playing, play(), pause(), setFrame(i),
-// setMode(k), setView(name), jointPositions(i) (the joint centres drawn at frame i, metres).
+// setMode(k), setView(name), jointPositions(i) (the joint centres drawn at frame i, metres),
+// plotAxes() (each plot's axis limits and tick labels).
 import { decode, value } from './data.js';
 import { MechanismView } from './view3d.js';
 import { buildPlots } from './plots.js';
@@ -198,6 +199,8 @@ class ViewerApp {
         return app.view.drawnJointCentres();
       },
       renderNow: () => { app.view.dirty = true; app.view.render(); },
+      // each plot's axes as drawn: {plot id: {x: {min, max, labels}, y: {…}}}
+      plotAxes: () => Object.fromEntries(app.plots.map((p) => [p.plot.id, p.axes()])),
     };
   }
 }

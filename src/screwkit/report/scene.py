@@ -213,6 +213,8 @@ def scene_from_motion(
     all_c = np.concatenate([np.asarray(m.joint_centres, dtype=float).reshape(-1, 3) for m in modes])
     extent = float(np.nanmax(np.abs(all_c))) if np.isfinite(all_c).any() else 1.0
     units = display_length(getattr(spec, "units", {}).get("length") if spec else None, extent)
+    # forces and moments in the spec's [units] (the tables' units), SI for a bare linkage
+    du = spec.display_units() if spec is not None and hasattr(spec, "display_units") else None
     points = dict(coupler_points or {})
     mode_entries = []
     for k, md in enumerate(modes):
@@ -229,11 +231,11 @@ def scene_from_motion(
                              f"{len(modes)} mode(s)")
         centres = np.asarray(modes[dyn_mode].joint_centres, dtype=float)
         mode_entries[dyn_mode]["arrows"] = dynamics_arrows(dynamics_doc, centres, linkage)
-        p, g = dynamics_plots(dynamics_doc, dyn_mode, x, input_name, kind)
+        p, g = dynamics_plots(dynamics_doc, dyn_mode, x, input_name, kind, du)
         plots += p
         groups += g
     if balance_doc is not None:
-        p, g = balancing_plots(balance_doc, dyn_mode, x, input_name, kind)
+        p, g = balancing_plots(balance_doc, dyn_mode, x, input_name, kind, du)
         plots += p
         groups += g
     if synthesis_doc is not None:
