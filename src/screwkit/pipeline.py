@@ -39,18 +39,21 @@ class Pipeline:
     """The jobs of one spec, sharing one solved motion.
 
     ``method`` chooses the solver (``"auto"``, ``"closed"``, ``"generic"``; see
-    :func:`~screwkit.kinematics.solve_motion.solve_motion`)."""
+    :func:`~screwkit.kinematics.solve_motion.solve_motion`); ``progress`` is the solver's
+    progress (a callback ``(done, total)``, ``False`` for none, ``None`` its default bar)."""
 
-    def __init__(self, spec: Spec, *, method: str = "auto") -> None:
+    def __init__(self, spec: Spec, *, method: str = "auto",
+                 progress: Callable[[int, int], None] | bool | None = None) -> None:
         self.spec = spec
         self.method = method
+        self.progress = progress
 
     @cached_property
     def motion(self) -> Motion:
         """Every assembly mode over the spec's ``[motion]`` sweep (solved on first use only)."""
         s = self.spec
         return solve_motion(s.linkage, s.inputs, rates=s.speed, accelerations=s.acceleration,
-                            method=self.method)
+                            method=self.method, progress=self.progress)
 
     @property
     def gravity_vector(self) -> np.ndarray:

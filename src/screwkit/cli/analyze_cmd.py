@@ -113,22 +113,30 @@ def register(app: typer.Typer) -> None:
         """Positions, velocities and accelerations of every joint variable in every assembly mode, the coupler curves of the spec's coupler points and the transmission quality over the cycle."""
         from screwkit.cli.common import guard
         from screwkit.cli.outputs import Outputs
+        from screwkit.cli.progress import SWEEP_PROGRESS_SAMPLES, staged_progress
         from screwkit.io.spec import load_spec
         from screwkit.pipeline import Pipeline
 
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full, files={"--plot": plot})
         s = guard(lambda: load_spec(spec))
-        pipe = Pipeline(s, method=method)
-        motion = guard(lambda: pipe.motion)
-        du = out.units_for(s.units)
+        stages = ["solving", "coupler curves and transmission", "tables", "output"]
+        # a long sweep shows its stages (stderr, terminals only); the solver's own bar is off
+        with staged_progress("analyze", stages,
+                             enabled=len(s.inputs) >= SWEEP_PROGRESS_SAMPLES) as stage:
+            pipe = Pipeline(s, method=method, progress=stage("solving"))
+            motion = guard(lambda: pipe.motion)
+            du = out.units_for(s.units)
+            stage("coupler curves and transmission")
+            doc = guard(pipe.analysis)
+            stage("tables")
+            table = guard(pipe.analysis_table)
+            stage("output")
+            if plot is not None:
+                from screwkit.report.plots import plot_analysis
 
-        doc = guard(pipe.analysis)
-        table = guard(pipe.analysis_table)
-        if plot is not None:
-            from screwkit.report.plots import plot_analysis
-
-            guard(lambda: plot_analysis(doc, plot, units=du))
-            out.note_written(plot)
-        out.deliver(document=lambda: doc, table=lambda: table,
-                    show=lambda: show_analysis(s, motion, du, out.full, doc, table), units=du)
+                guard(lambda: plot_analysis(doc, plot, units=du))
+                out.note_written(plot)
+            out.deliver(document=lambda: doc, table=lambda: table,
+                        show=lambda: show_analysis(s, motion, du, out.full, doc, table),
+                        units=du)
