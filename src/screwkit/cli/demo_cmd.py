@@ -1,7 +1,7 @@
 """``screwkit demo [EXAMPLES]``: the main job on every bundled example — validate, analyse,
 and every job the spec supports — writing ``<name>.<job>.json`` (SI), ``<name>.analysis.csv``
-and the plot in the spec's units, and an animated HTML report per example; ``index.html`` links
-them. A progress bar counts the examples (on a terminal)."""
+and the plot in the spec's units, and an animated HTML report per example; ``index.html`` shows
+them as a gallery (a small picture and one line each) linking to the reports. A progress bar counts the examples (on a terminal)."""
 
 from __future__ import annotations
 
@@ -78,8 +78,14 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
     summary = example_summary(spec, motion, doc, mob, asm, res,
                               {"limits": lim, "dynamics": dyn, "balance": bal,
                                "simulation": sim, "synthesis": syn})
+    from screwkit.report.thumbnail import mechanism_svg
+
     entry = {
         "name": f.stem, "family": spec.family, "description": spec.describe(),
+        "thumbnail": guard(lambda: mechanism_svg(spec.linkage, motion, spec.mode, spec.name)),
+        # every example has analysis and mobility: the line names the other jobs
+        "line": " · ".join([spec.family, f"{len(motion.modes)} mode(s)",
+                            *[j for j in jobs if j not in ("analysis", "mobility")]]),
         "jobs": [(j, f"{f.stem}.{j}.json") for j in jobs], "summary": summary,
         "picture": f"{f.stem}.analysis.png" if plots else None,
         "report": f"{f.stem}.html" if reports else None,
