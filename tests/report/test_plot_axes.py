@@ -109,5 +109,7 @@ def test_report_dynamics_are_in_the_spec_units(tmp_path: Path) -> None:
     assert np.isclose(plots["dyn-sf-xy"]["x_scale"], 1 / LBF, rtol=1e-12)
     torque = next(p for k, p in plots.items() if k.startswith("dyn-effort-"))
     assert torque["y_label"] == "effort (lbf·in)"
+    assert scene["display_units"]["force"] == "lbf"  # the arrows' legend
+    assert np.isclose(scene["display_units"]["force_factor"], 1 / LBF, rtol=1e-12)
     note = next(g["note"] for g in scene["plot_groups"] if g["id"] == "dynamics")
     assert "forces in lbf, moments in lbf·in" in note

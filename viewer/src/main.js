@@ -103,8 +103,9 @@ class ViewerApp {
     const u = this.scene.display_units;
     this.legend.appendChild(el('div', {}, `lengths in ${u.length}; grid step ${this.view.gridStep}`));
     if (this.view.showArrows && this.view.arrows && this.view.arrows.length && this.view.arrowScale > 0) {
-      const per = 1 / (this.view.arrowScale * u.factor);
-      this.legend.appendChild(el('div', {}, `arrows: 1 ${u.length} = ${+per.toPrecision(3)} N`));
+      // forces in the spec's unit (display_units.force; N in older scenes)
+      const per = (u.force_factor || 1) / (this.view.arrowScale * u.factor);
+      this.legend.appendChild(el('div', {}, `arrows: 1 ${u.length} = ${+per.toPrecision(3)} ${u.force || 'N'}`));
       for (const a of this.view.arrows) {
         const row = el('div', { class: 'sk-arrow-key' });
         const sw = el('span', { class: 'sk-swatch' });

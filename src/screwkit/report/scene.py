@@ -11,8 +11,10 @@ same table):
 ``name``, ``family``, ``source``, ``description``
     Text about the mechanism (``family`` and ``source`` may be ``None``).
 ``display_units``
-    ``{"length": "mm", "factor": 1000.0, "angle": "deg"}``: how lengths are shown (metres ×
-    ``factor``); angles are shown in degrees. Data stay SI.
+    ``{"length": "mm", "factor": 1000.0, "angle": "deg", "force": "N", "force_factor": 1.0}``:
+    how lengths are shown (metres × ``factor``) and forces (newtons × ``force_factor``, the
+    spec's ``[units] force``; absent for a bare linkage: N); angles are shown in degrees. Data
+    stay SI.
 ``input``
     ``{"name", "kind": "angle" | "length", "values": [N], "periodic": bool}``, the driven
     freedom over the N frames (rad or m); ``periodic`` closes traces over a full turn.
@@ -215,6 +217,9 @@ def scene_from_motion(
     units = display_length(getattr(spec, "units", {}).get("length") if spec else None, extent)
     # forces and moments in the spec's [units] (the tables' units), SI for a bare linkage
     du = spec.display_units() if spec is not None and hasattr(spec, "display_units") else None
+    if du is not None:
+        units["force"] = du.pretty("force")
+        units["force_factor"] = 1.0 / du.unit_of("force")[1]
     points = dict(coupler_points or {})
     mode_entries = []
     for k, md in enumerate(modes):
