@@ -78,11 +78,9 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
     summary = example_summary(spec, motion, doc, mob, asm, res,
                               {"limits": lim, "dynamics": dyn, "balance": bal,
                                "simulation": sim, "synthesis": syn})
-    from screwkit.report.thumbnail import mechanism_svg
-
     entry = {
         "name": f.stem, "family": spec.family, "description": spec.describe(),
-        "thumbnail": guard(lambda: mechanism_svg(spec.linkage, motion, spec.mode, spec.name)),
+        "thumbnail": guard(lambda: thumbnail(spec, motion, syn)),
         # every example has analysis and mobility: the line names the other jobs
         "line": " · ".join([spec.family, f"{len(motion.modes)} mode(s)",
                             *[j for j in jobs if j not in ("analysis", "mobility")]]),
@@ -91,6 +89,23 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
         "report": f"{f.stem}.html" if reports else None,
     }
     return row, entry
+
+
+def thumbnail(spec: Any, motion: Any, synthesis_doc: dict[str, Any] | None) -> str:
+    """The gallery picture of an example: the mechanism its report animates — the synthesised
+    one for a synthesis spec (:mod:`screwkit.report.synthesis_scene`), else the spec's."""
+    from screwkit.errors import ScrewkitError
+    from screwkit.report.synthesis_scene import synthesised_motion
+    from screwkit.report.thumbnail import mechanism_svg
+
+    if synthesis_doc is not None and spec.synthesis is not None:
+        try:
+            shown = synthesised_motion(spec.synthesis, synthesis_doc, spec.family or "LOOP")
+            return mechanism_svg(shown.linkage, shown.motion, shown.mode,
+                                 f"{spec.name} (synthesised)")
+        except ScrewkitError:
+            pass  # the report shows the spec's mechanism then, and so does the picture
+    return mechanism_svg(spec.linkage, motion, spec.mode, spec.name)
 
 
 def example_summary(spec: Any, motion: Any, doc: dict[str, Any], mob: dict[str, Any], asm: str,
