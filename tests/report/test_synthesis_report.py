@@ -71,3 +71,10 @@ def test_the_report_animates_the_synthesised_mechanism(name: str, build: object)
         tr = next(p for p in scene["plots"] if p["id"] == "syn-follow-tr")
         assert np.allclose(np.array(tr["series"][0]["y"])[at], _rows(doc, "S_g"), atol=1e-9)
     assert "synthesised" in scene["description"]
+    # the start stands still as a ghost: its links end at joint centres of the spec's motion
+    ends = np.array([[np.nan if v is None else v for v in link[2]]
+                     for link in scene["ghost"]["link_points"]], dtype=float)
+    spec_motion = sk.solve_motion(spec.linkage, spec.inputs)
+    assert any(np.allclose(np.roll(np.asarray(m.joint_centres)[i], -1, axis=0), ends, atol=1e-12)
+               for m in spec_motion.modes for i in range(len(spec.inputs)))
+    assert "synthesis start" in scene["ghost"]["label"]

@@ -102,6 +102,7 @@ class ViewerApp {
     this.legend.textContent = '';
     const u = this.scene.display_units;
     this.legend.appendChild(el('div', {}, `lengths in ${u.length}; grid step ${this.view.gridStep}`));
+    if (this.scene.ghost) this.legend.appendChild(el('div', {}, `grey lines: ${this.scene.ghost.label}`));
     if (this.view.showArrows && this.view.arrows && this.view.arrows.length && this.view.arrowScale > 0) {
       // forces in the spec's unit (display_units.force; N in older scenes)
       const per = (u.force_factor || 1) / (this.view.arrowScale * u.factor);

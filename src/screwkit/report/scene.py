@@ -45,6 +45,9 @@ same table):
     ``[{"id", "title", "note"}]`` in the order the report shows them.
 ``text``
     ``{"spec": str | None, "units": [str], "solver": [str], "validation": [str]}``.
+``ghost`` (optional)
+    ``{"label", "link_points": [n][3][3]}``: another loop drawn still, as thin grey lines (the
+    synthesis start behind a synthesised mechanism; :mod:`screwkit.report.spec_report`).
 
 ``None`` stands wherever a value does not exist (a mode that does not assemble, a singular
 velocity). The adapter reads only these attributes of a motion: ``inputs`` and ``modes``, and of
@@ -87,6 +90,18 @@ def display_length(spec_unit: str | None, extent: float) -> dict[str, Any]:
     if unit not in LENGTH_UNITS:
         unit = "mm" if extent < 1.0 else "m"
     return {"length": unit, "factor": 1.0 / LENGTH_UNITS[unit], "angle": "deg"}
+
+
+def _display_units(spec: Any, extent: float) -> tuple[dict[str, Any], Any]:
+    """The scene's ``display_units`` (:func:`display_length`, and the spec's force unit) and
+    the spec's :class:`~screwkit.io.display_units.DisplayUnits` for forces and moments (the
+    tables' units), None for a bare linkage (SI)."""
+    units = display_length(getattr(spec, "units", {}).get("length") if spec else None, extent)
+    du = spec.display_units() if spec is not None and hasattr(spec, "display_units") else None
+    if du is not None:
+        units["force"] = du.pretty("force")
+        units["force_factor"] = 1.0 / du.unit_of("force")[1]
+    return units, du
 
 
 def _input_values(motion: Any, n: int) -> Array:
@@ -214,12 +229,7 @@ def scene_from_motion(
     kind = "length" if input_name.endswith(".s") else "angle"
     all_c = np.concatenate([np.asarray(m.joint_centres, dtype=float).reshape(-1, 3) for m in modes])
     extent = float(np.nanmax(np.abs(all_c))) if np.isfinite(all_c).any() else 1.0
-    units = display_length(getattr(spec, "units", {}).get("length") if spec else None, extent)
-    # forces and moments in the spec's [units] (the tables' units), SI for a bare linkage
-    du = spec.display_units() if spec is not None and hasattr(spec, "display_units") else None
-    if du is not None:
-        units["force"] = du.pretty("force")
-        units["force_factor"] = 1.0 / du.unit_of("force")[1]
+    units, du = _display_units(spec, extent)
     points = dict(coupler_points or {})
     mode_entries = []
     for k, md in enumerate(modes):

@@ -7,10 +7,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from screwkit.io.results import jsonable
 from screwkit.io.spec import Spec
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.pipeline import Pipeline
-from screwkit.report.synthesis_scene import SynthesisedMotion, add_synthesised_plots
+from screwkit.report.synthesis_scene import SynthesisedMotion, add_synthesised_plots, start_ghost
 
 Named = dict[str, Any]
 
@@ -69,6 +70,10 @@ def spec_scene(spec: Spec | Pipeline, *, gravity: bool = False,
                               initial_mode=None if shown is None else shown.mode)
     if shown is not None and s.synthesis is not None:
         add_synthesised_plots(scene, shown, s.synthesis)
+        ghost = start_ghost(s.linkage, m, s.mode, float(synthesis_doc["dimensions"]["theta01"])
+                            if synthesis_doc else 0.0)
+        if ghost is not None:
+            scene["ghost"] = jsonable(ghost)
         scene["description"] = synthesised_description(s, synthesis_doc or {}, shown)
     if s.drive is not None and dynamics_doc is not None:
         add_simulation_plots(scene, s)

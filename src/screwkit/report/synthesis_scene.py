@@ -182,3 +182,26 @@ def add_synthesised_plots(scene: dict[str, Any], shown: SynthesisedMotion,
     first = next((i for i, p in enumerate(scene["plots"]) if p["group"] == "synthesis"),
                  len(scene["plots"]))
     scene["plots"][first:first] = jsonable(plots)
+
+
+def start_ghost(linkage: Linkage, motion: Motion, preferred_mode: int, theta01: float
+                ) -> dict[str, Any] | None:
+    """The synthesis start (the spec's own loop and motion) as a still ghost for the 3-D view:
+    every link's polyline (:func:`screwkit.report.scene.link_polylines`) at the sample whose
+    input is nearest the synthesised θ01, in ``preferred_mode`` when it assembles there (else
+    the first mode that does); None when no mode assembles."""
+    from screwkit.report.scene import link_polylines
+
+    x = np.asarray(motion.inputs, dtype=float).reshape(len(motion.modes[0].assembles), -1)[:, 0]
+    gap = np.abs(wrap_angle(x - theta01))
+    order = [preferred_mode] + [k for k in range(len(motion.modes)) if k != preferred_mode]
+    for k in order:
+        if not 0 <= k < len(motion.modes):
+            continue
+        ok = np.asarray(motion.modes[k].assembles, dtype=bool)
+        if ok.any():
+            i = int(np.argmin(np.where(ok, gap, np.inf)))
+            return {"label": f"the synthesis start (the spec's [dimensions]), mode {k}, at "
+                             f"input {math.degrees(float(x[i])):.4g}°",
+                    "link_points": link_polylines(linkage, motion.modes[k])[i]}
+    return None
