@@ -78,3 +78,23 @@ def test_the_report_animates_the_synthesised_mechanism(name: str, build: object)
     assert any(np.allclose(np.roll(np.asarray(m.joint_centres)[i], -1, axis=0), ends, atol=1e-12)
                for m in spec_motion.modes for i in range(len(spec.inputs)))
     assert "synthesis start" in scene["ghost"]["label"]
+
+
+def test_a_synthesis_spec_with_masses_draws_no_dynamics_of_the_start(tmp_path: Path) -> None:
+    """Dynamics of the spec's [dimensions] beside the synthesised mechanism would mix two
+    mechanisms: the report leaves them out and says so."""
+    text = (EXAMPLES / "rssr_synthesis.toml").read_text(encoding="utf-8")
+    links = (EXAMPLES / "rssr_spatial.toml").read_text(encoding="utf-8")
+    links = links[links.index("[links.crank]"):]
+    path = tmp_path / "rssr_synthesis_masses.toml"
+    path.write_text(text.replace('angle = "deg"', 'angle = "deg"\ninertia = "kg*mm^2"', 1)
+                    + "\n" + links, encoding="utf-8")
+    spec = sk.load_spec(path)
+    assert all(link.mass is not None for link in spec.linkage.links)
+    scene = spec_scene(spec)
+    assert not [p for p in scene["plots"] if p["group"] in ("dynamics", "balancing")]
+    assert all(not m["arrows"] for m in scene["modes"])
+    notes = scene["text"]["validation"]
+    assert any("no dynamics or balancing" in n for n in notes)
+    assert not any(n.startswith("Dynamics and balancing are of [motion] mode") for n in notes)
+    assert any(p["id"] == "syn-follow-rot" for p in scene["plots"])

@@ -7,11 +7,17 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from screwkit.errors import ScrewkitError
 from screwkit.io.results import jsonable
 from screwkit.io.spec import Spec
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.pipeline import Pipeline
-from screwkit.report.synthesis_scene import SynthesisedMotion, add_synthesised_plots, start_ghost
+from screwkit.report.synthesis_scene import (
+    SynthesisedMotion,
+    add_synthesised_plots,
+    start_ghost,
+    synthesised_motion,
+)
 
 Named = dict[str, Any]
 
@@ -55,8 +61,10 @@ def spec_scene(spec: Spec | Pipeline, *, gravity: bool = False,
     text = Path(s.path).read_text(encoding="utf-8")
     shown = synthesised_view(s, synthesis_doc, notes) if synthesis_doc is not None else None
     if shown is not None and dynamics_doc is not None:
-        notes.append("Dynamics and balancing are of the spec's mechanism, which is not the one "
-                     "shown (the synthesised one): run them on a spec with its dimensions.")
+        notes[:] = [n for n in notes if not n.startswith("Dynamics and balancing are of")]
+        notes.append("The report draws no dynamics or balancing: they are of the spec's "
+                     "mechanism, not the synthesised one shown; run them on a spec with its "
+                     "dimensions.")
         dynamics_doc = balance_doc = dyn_mode = None
     motion = m if shown is None else shown.motion
     scene = scene_from_motion(s, motion, dynamics_doc=dynamics_doc, dynamics_mode=dyn_mode,
@@ -68,13 +76,12 @@ def spec_scene(spec: Spec | Pipeline, *, gravity: bool = False,
                               solver=[motion.solver] if motion.solver else None, notes=notes,
                               linkage=None if shown is None else shown.linkage,
                               initial_mode=None if shown is None else shown.mode)
-    if shown is not None and s.synthesis is not None:
+    if shown is not None and s.synthesis is not None and synthesis_doc is not None:
         add_synthesised_plots(scene, shown, s.synthesis)
-        ghost = start_ghost(s.linkage, m, s.mode, float(synthesis_doc["dimensions"]["theta01"])
-                            if synthesis_doc else 0.0)
+        ghost = start_ghost(s.linkage, m, s.mode, float(synthesis_doc["dimensions"]["theta01"]))
         if ghost is not None:
             scene["ghost"] = jsonable(ghost)
-        scene["description"] = synthesised_description(s, synthesis_doc or {}, shown)
+        scene["description"] = synthesised_description(s, synthesis_doc, shown)
     if s.drive is not None and dynamics_doc is not None:
         add_simulation_plots(scene, s)
     return scene
@@ -85,9 +92,6 @@ def synthesised_view(spec: Spec, synthesis_doc: dict[str, Any],
     """The synthesised mechanism the report animates (:mod:`screwkit.report.synthesis_scene`),
     with a note saying so; None (and a note why) when it cannot be followed, and the report
     shows the spec's mechanism, the synthesis start."""
-    from screwkit.errors import ScrewkitError
-    from screwkit.report.synthesis_scene import synthesised_motion
-
     if spec.synthesis is None:
         return None
     try:
