@@ -16,7 +16,7 @@ from screwkit.cli.main import app
 from screwkit.cli.progress import SWEEP_PROGRESS_SAMPLES, staged_progress
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
-STAGES = ["solving", "coupler curves and transmission", "tables", "output"]
+STAGES = ["solving", "coupler curves and transmission", "tables"]
 
 
 def _long_spec(tmp_path: Path, samples: int) -> Path:
@@ -42,11 +42,24 @@ def test_a_long_analyze_shows_its_stages_on_a_terminal_only(tmp_path: Path, monk
     assert r.exit_code == 0, r.output
     assert out.is_file() and r.stdout.startswith(f"wrote {out}")
     shown = err.getvalue()
+    assert "wrote" not in shown  # stdout stays stdout: the bar is gone before the output
     if terminal:
         for name in STAGES:
             assert f"analyze: {name}" in shown
     else:
         assert shown == ""
+
+
+def test_json_on_stdout_stays_whole_under_the_bar(tmp_path: Path, monkeypatch) -> None:
+    import json
+
+    err = io.StringIO()
+    monkeypatch.setattr(common, "err_console", Console(file=err, force_terminal=True, width=100))
+    r = CliRunner().invoke(app, ["analyze", str(_long_spec(tmp_path, SWEEP_PROGRESS_SAMPLES)),
+                                 "--json"])
+    assert r.exit_code == 0, r.output
+    assert len(json.loads(r.stdout)["input"]) == SWEEP_PROGRESS_SAMPLES
+    assert "analyze: solving" in err.getvalue() and "{" not in err.getvalue()
 
 
 def test_a_short_analyze_shows_no_bar(tmp_path: Path, monkeypatch) -> None:

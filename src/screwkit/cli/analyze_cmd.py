@@ -120,23 +120,22 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full, files={"--plot": plot})
         s = guard(lambda: load_spec(spec))
-        stages = ["solving", "coupler curves and transmission", "tables", "output"]
-        # a long sweep shows its stages (stderr, terminals only); the solver's own bar is off
+        stages = ["solving", "coupler curves and transmission", "tables"]
+        # a long sweep shows its stages (stderr, terminals only; the solver's own bar is off);
+        # the bar is gone before anything is printed on stdout
         with staged_progress("analyze", stages,
                              enabled=len(s.inputs) >= SWEEP_PROGRESS_SAMPLES) as stage:
             pipe = Pipeline(s, method=method, progress=stage("solving"))
             motion = guard(lambda: pipe.motion)
-            du = out.units_for(s.units)
             stage("coupler curves and transmission")
             doc = guard(pipe.analysis)
             stage("tables")
             table = guard(pipe.analysis_table)
-            stage("output")
-            if plot is not None:
-                from screwkit.report.plots import plot_analysis
+        du = out.units_for(s.units)
+        if plot is not None:
+            from screwkit.report.plots import plot_analysis
 
-                guard(lambda: plot_analysis(doc, plot, units=du))
-                out.note_written(plot)
-            out.deliver(document=lambda: doc, table=lambda: table,
-                        show=lambda: show_analysis(s, motion, du, out.full, doc, table),
-                        units=du)
+            guard(lambda: plot_analysis(doc, plot, units=du))
+            out.note_written(plot)
+        out.deliver(document=lambda: doc, table=lambda: table,
+                    show=lambda: show_analysis(s, motion, du, out.full, doc, table), units=du)

@@ -75,7 +75,8 @@ def staged_progress(description: str, stages: list[str],
     """A bar on stderr (terminals only, as :func:`progress_bar`) over a command's stages, each
     an equal share: ``stage(name)`` moves the bar to the start of stage ``name``, shows its name
     and returns the callback ``advance(done, total)`` that fills that share (a library's
-    progress, e.g. the solver's). Output printed meanwhile appears above the bar."""
+    progress, e.g. the solver's). Messages on stderr appear above the bar; stdout is left
+    alone (it may be a file or a pipe: print results after the bar is gone)."""
     from screwkit.cli.common import err_console
 
     def quiet(name: str) -> ProgressCallback:
@@ -88,7 +89,7 @@ def staged_progress(description: str, stages: list[str],
 
     columns = (TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(),
                TimeElapsedColumn())
-    with Progress(*columns, console=err_console, transient=True) as bar:
+    with Progress(*columns, console=err_console, transient=True, redirect_stdout=False) as bar:
         task = bar.add_task(description, total=len(stages) * _STAGE_UNITS)
 
         def stage(name: str) -> ProgressCallback:
