@@ -90,7 +90,9 @@ fig.tight_layout()
 
 # %% [markdown]
 # ## New mass properties (like Rahman's Table 5.1)
+# In the spec's units (`spec.display_units()`: in, lbf·s²·in); `mass_properties_table()` alone
+# gives SI.
 
 # %%
-for link, quantity, before, after in result.mass_properties_table()[:6]:
+for link, quantity, before, after in result.mass_properties_table(units)[:6]:
     print(f"{link:>6} {quantity:<24} {before:12.6g} -> {after:12.6g}")

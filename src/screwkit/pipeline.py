@@ -39,23 +39,26 @@ class Pipeline:
     """The jobs of one spec, sharing one solved motion.
 
     ``method`` chooses the solver (``"auto"``, ``"closed"``, ``"generic"``; see
-    :func:`~screwkit.kinematics.solve_motion.solve_motion`)."""
+    :func:`~screwkit.kinematics.solve_motion.solve_motion`); ``progress`` is the solver's
+    progress (a callback ``(done, total)``, ``False`` for none, ``None`` its default bar)."""
 
-    def __init__(self, spec: Spec, *, method: str = "auto") -> None:
+    def __init__(self, spec: Spec, *, method: str = "auto",
+                 progress: Callable[[int, int], None] | bool | None = None) -> None:
         if getattr(spec, "family", None) == "graph":  # io.mechanism_spec.GraphSpec
             raise SpecError(f"{spec.path}: a mechanism graph (bodies and joints): validate, "
-                            "analyze, mobility, limits and report work on it so far; loads, "
+                            "analyze, mobility, limits, report and dynamics work on it so far; "
                             "balancing, synthesis, simulation and sweeps of graphs are not "
                             "there yet (docs/mechanisms.md)")
         self.spec = spec
         self.method = method
+        self.progress = progress
 
     @cached_property
     def motion(self) -> Motion:
         """Every assembly mode over the spec's ``[motion]`` sweep (solved on first use only)."""
         s = self.spec
         return solve_motion(s.linkage, s.inputs, rates=s.speed, accelerations=s.acceleration,
-                            method=self.method)
+                            method=self.method, progress=self.progress)
 
     @property
     def gravity_vector(self) -> np.ndarray:

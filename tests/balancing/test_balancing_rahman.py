@@ -136,3 +136,21 @@ def test_cli_balance_json(tmp_path):
     doc = json.loads(r.stdout)  # the document alone on stdout; "wrote …" lines on stderr
     assert doc["measures"]["after"]["G"] < doc["measures"]["before"]["G"]
     assert (tmp_path / "balance_shaking_force.csv").is_file()
+
+
+def test_mass_properties_in_the_spec_units(rahman, result):
+    """Rahman's Table 5.1 shape in the spec's units (in, lbf·s²·in), SI by default; the values
+    are the SI ones divided by one unit (1 in = 0.0254 m, 1 lbf·s²·in = 0.11298482933 kg·m²)."""
+    spec, _ = rahman
+    si = result.mass_properties_table()
+    shown = result.mass_properties_table(spec.display_units())
+    lbf_s2_in = 0.45359237 * 9.80665 * 0.0254
+    assert [r[1] for r in si[:5]] == ["mass (kg)", "com x (m)", "com y (m)", "com z (m)",
+                                      "Ixx about CoM (kg*m^2)"]
+    assert [r[1] for r in shown[:5]] == ["mass (kg)", "com x (in)", "com y (in)", "com z (in)",
+                                         "Ixx about CoM (lbf*s^2*in)"]
+    for a, b in zip(si, shown, strict=True):
+        scale = 0.0254 if "(in)" in b[1] else lbf_s2_in if "lbf" in b[1] else 1.0
+        assert np.allclose(np.array(b[2:]) * scale, a[2:], rtol=1e-12, atol=0)
+    # the crank's centre of mass as the spec gives it: 1 in along x
+    assert shown[1][2] == pytest.approx(1.0, rel=1e-12)

@@ -10,9 +10,11 @@ from typing import Any
 import numpy as np
 import pytest
 
+from screwkit.io.documents import synthesis_document
 from screwkit.io.spec import load_spec
 from screwkit.pipeline import Pipeline
 from screwkit.report.spec_report import spec_scene
+from screwkit.report.synthesis_scene import synthesised_motion
 from screwkit.report.viewer import render_report_html
 
 EXAMPLES = sorted((Path(__file__).parents[2] / "examples").glob("*.toml"))
@@ -60,10 +62,15 @@ def test_example_report_in_browser(path: Path, tmp_path: Path, open_report: Any)
     spec = load_spec(path)
     pipe = Pipeline(spec)
     mot = pipe.motion
-    html_path = tmp_path / f"{path.stem}.html"
-    html_path.write_text(render_report_html(spec_scene(pipe)), encoding="utf-8")
-    page = open_report(html_path)
     n = len(spec.inputs)
+    docs = {}
+    if spec.synthesis is not None:  # the report shows the synthesised mechanism
+        docs["synthesis_doc"] = synthesis_document(pipe.synthesize(), spec.path)
+        shown = synthesised_motion(spec.synthesis, docs["synthesis_doc"], spec.family)
+        mot, n = shown.motion, len(shown.theta)
+    html_path = tmp_path / f"{path.stem}.html"
+    html_path.write_text(render_report_html(spec_scene(pipe, **docs)), encoding="utf-8")
+    page = open_report(html_path)
     assert page.evaluate("screwkitViewer.frameCount") == n
     assert page.evaluate("document.body.dataset.frames") == str(n)
     # autoplay: the frame advances by itself

@@ -82,3 +82,6 @@ def test_demo_writes_a_report_per_example_and_links_them(tmp_path: Path) -> None
     # the balancing and synthesis results reach their reports
     assert "bal-shaking_force" in (out / "rahman_cssp_balance.html").read_text(encoding="utf-8")
     assert "syn-rot-err" in (out / "bagci_example9_overlay.html").read_text(encoding="utf-8")
+    # a gallery: one card each, the synthesis spec's picture of the synthesised mechanism
+    assert index.count("<figure class='card'>") == 3
+    assert "Bagci Example 9 overlay (x^3/4 with an inflection dwell) (synthesised)</title>" in index

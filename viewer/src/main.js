@@ -4,6 +4,7 @@
 // setMode(k), setView(name), jointPositions(i) (the joint centres drawn at frame i, metres),
 // and for a mechanism with loops: loopCount, loop, setLoop(k) (-1: all), fullJoints() (the
 // joints drawn in full, not faint).
+// plotAxes() (each plot's axis limits and tick labels).
 import { decode, value } from './data.js';
 import { MechanismView } from './view3d.js';
 import { buildPlots } from './plots.js';
@@ -112,9 +113,11 @@ class ViewerApp {
     this.legend.textContent = '';
     const u = this.scene.display_units;
     this.legend.appendChild(el('div', {}, `lengths in ${u.length}; grid step ${this.view.gridStep}`));
+    if (this.scene.ghost) this.legend.appendChild(el('div', {}, `grey lines: ${this.scene.ghost.label}`));
     if (this.view.showArrows && this.view.arrows && this.view.arrows.length && this.view.arrowScale > 0) {
-      const per = 1 / (this.view.arrowScale * u.factor);
-      this.legend.appendChild(el('div', {}, `arrows: 1 ${u.length} = ${+per.toPrecision(3)} N`));
+      // forces in the spec's unit (display_units.force; N in older scenes)
+      const per = (u.force_factor || 1) / (this.view.arrowScale * u.factor);
+      this.legend.appendChild(el('div', {}, `arrows: 1 ${u.length} = ${+per.toPrecision(3)} ${u.force || 'N'}`));
       for (const a of this.view.arrows) {
         const row = el('div', { class: 'sk-arrow-key' });
         const sw = el('span', { class: 'sk-swatch' });
@@ -219,6 +222,8 @@ class ViewerApp {
       get loop() { return app.view.loopIndex; },
       setLoop: (k) => app.setLoop(k),
       fullJoints: () => app.view.fullJoints(),
+      // each plot's axes as drawn: {plot id: {x: {min, max, labels}, y: {…}}}
+      plotAxes: () => Object.fromEntries(app.plots.map((p) => [p.plot.id, p.axes()])),
     };
   }
 }

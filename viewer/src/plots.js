@@ -5,6 +5,7 @@ import {
   Chart, ScatterController, LineElement, PointElement, LinearScale, Legend, Title, Tooltip,
 } from 'chart.js';
 import { value } from './data.js';
+import { niceScale } from './axes.js';
 
 Chart.register(ScatterController, LineElement, PointElement, LinearScale, Legend, Title, Tooltip);
 
@@ -55,8 +56,11 @@ class LinkedPlot {
       };
     });
     const square = plot.kind === 'xy';
-    const ranges = square ? this.squareRanges(datasets) : {};
-    const xRange = square ? ranges : this.xExtent(datasets);
+    const [xs, ys] = this.extents(datasets);
+    const [lo, hi] = [Math.min(xs[0], ys[0]), Math.max(xs[1], ys[1])];
+    // an x–y plot (a hodograph) keeps one scale on both axes
+    const xScale = square ? niceScale(lo, hi) : niceScale(xs[0], xs[1]);
+    const yScale = square ? niceScale(lo, hi) : niceScale(ys[0], ys[1]);
     this.chart = new Chart(canvas, {
       type: 'scatter',
       data: { datasets },
@@ -71,9 +75,8 @@ class LinkedPlot {
           tooltip: { enabled: true },
         },
         scales: {
-          x: { type: 'linear', title: { display: true, text: plot.x_label }, ...xRange },
-          y: { type: 'linear', title: { display: true, text: plot.y_label }, ...ranges,
-            ticks: { callback: (v) => +(+v).toPrecision(6) } },
+          x: { type: 'linear', title: { display: true, text: plot.x_label }, ...xScale },
+          y: { type: 'linear', title: { display: true, text: plot.y_label }, ...yScale },
         },
         onClick: (evt) => this.pick(evt, onPick),
         onResize: () => requestAnimationFrame(() => this.moveCursor(this.lastFrame, this.lastMode)),
@@ -89,22 +92,25 @@ class LinkedPlot {
     }
   }
 
-  xExtent(datasets) {
-    let lo = Infinity, hi = -Infinity;
+  // [[x min, x max], [y min, y max]] of the finite points (Infinity/-Infinity for none)
+  extents(datasets) {
+    const x = [Infinity, -Infinity], y = [Infinity, -Infinity];
     for (const d of datasets) for (const p of d.data) {
-      if (p.x !== null && Number.isFinite(p.x)) { lo = Math.min(lo, p.x); hi = Math.max(hi, p.x); }
+      if (p.x === null || p.y === null || !Number.isFinite(p.x) || !Number.isFinite(p.y)) continue;
+      x[0] = Math.min(x[0], p.x); x[1] = Math.max(x[1], p.x);
+      y[0] = Math.min(y[0], p.y); y[1] = Math.max(y[1], p.y);
     }
-    return hi > lo ? { min: lo, max: hi } : {};
+    return [x, y];
   }
 
-  squareRanges(datasets) {
-    let lo = Infinity, hi = -Infinity;
-    for (const d of datasets) for (const p of d.data) {
-      for (const v of [p.x, p.y]) if (v !== null && Number.isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+  // the tick labels and limits drawn on each axis (for tests)
+  axes() {
+    const out = {};
+    for (const k of ['x', 'y']) {
+      const sc = this.chart.scales[k];
+      out[k] = { min: sc.min, max: sc.max, labels: sc.ticks.map((t) => t.label) };
     }
-    if (!(hi > lo)) return {};
-    const pad = 0.08 * (hi - lo);
-    return { min: lo - pad, max: hi + pad };
+    return out;
   }
 
   dot(k) {

@@ -128,6 +128,11 @@ export class MechanismView {
         if (Number.isFinite(v)) { lo[k % 3] = Math.min(lo[k % 3], v); hi[k % 3] = Math.max(hi[k % 3], v); }
       }
     }
+    for (const link of (this.sceneData.ghost ? this.sceneData.ghost.link_points : [])) {
+      for (const p of link) {
+        if (p) for (let a = 0; a < 3; a++) if (Number.isFinite(p[a])) { lo[a] = Math.min(lo[a], p[a]); hi[a] = Math.max(hi[a], p[a]); }
+      }
+    }
     for (let a = 0; a < 3; a++) if (!(hi[a] >= lo[a])) { lo[a] = -0.5; hi[a] = 0.5; }
     this.centre = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
     this.size = Math.max(Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]), 1e-6);
@@ -189,6 +194,15 @@ export class MechanismView {
     label.position.set(0.02 * s, -0.06 * s, 0);
     fixed.add(label);
     this.three.add(fixed);
+    // a still ghost of another mechanism (a synthesis's start): thin faded lines
+    const ghost = this.sceneData.ghost;
+    if (ghost) {
+      const mat = new THREE.LineBasicMaterial({ color: 0x8d8d8d, transparent: true, opacity: 0.6 });
+      for (const link of ghost.link_points) {
+        const pts = link.filter((p) => p && p.every(Number.isFinite)).map((p) => new THREE.Vector3(p[0], p[1], p[2]));
+        if (pts.length > 1) this.three.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(pts), mat));
+      }
+    }
   }
 
   jointObject(joint) {

@@ -127,18 +127,24 @@ class BalanceResult:
         b, a = self.per_sample_before[key], self.per_sample_after[key]
         return [[float(t), float(x), float(y)] for t, x, y in zip(self.inputs, b, a, strict=True)]
 
-    def mass_properties_table(self) -> list[list[Any]]:
-        """Rows (link, quantity, before, after) like Rahman's Table 5.1 (SI)."""
+    def mass_properties_table(self, units: UnitChoice | None = None) -> list[list[Any]]:
+        """Rows (link, quantity, before, after) like Rahman's Table 5.1: mass, centre of mass
+        and inertia about it, in ``units`` (e.g. ``spec.display_units()``; default SI)."""
+        from screwkit.tables import SIUnits
+
+        u = units if units is not None else SIUnits()
+        (ml, mf), (ll, lf), (il, jf) = (u.unit_of(k) for k in ("mass", "length", "inertia"))
         rows: list[list[Any]] = []
         for link, mp0 in self.mass_properties_before.items():
             mp1 = self.mass_properties_after[link]
-            rows.append([link, "mass (kg)", mp0.mass, mp1.mass])
+            rows.append([link, f"mass ({ml})", mp0.mass / mf, mp1.mass / mf])
             for k, axis in enumerate("xyz"):
-                rows.append([link, f"com {axis} (m)", float(mp0.com[k]), float(mp1.com[k])])
+                rows.append([link, f"com {axis} ({ll})", float(mp0.com[k]) / lf,
+                             float(mp1.com[k]) / lf])
             for i, j, lab in ((0, 0, "Ixx"), (1, 1, "Iyy"), (2, 2, "Izz"), (0, 1, "Ixy"),
                               (0, 2, "Ixz"), (1, 2, "Iyz")):
-                rows.append([link, f"{lab} about CoM (kg*m^2)", float(mp0.inertia[i, j]),
-                             float(mp1.inertia[i, j])])
+                rows.append([link, f"{lab} about CoM ({il})", float(mp0.inertia[i, j]) / jf,
+                             float(mp1.inertia[i, j]) / jf])
         return rows
 
     def table(self) -> ResultTable:

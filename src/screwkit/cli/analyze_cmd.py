@@ -113,6 +113,7 @@ def register(app: typer.Typer) -> None:
         """Positions, velocities and accelerations of every joint variable in every assembly mode, the coupler curves of the spec's coupler points and the transmission quality over the cycle."""
         from screwkit.cli.common import guard
         from screwkit.cli.outputs import Outputs
+        from screwkit.cli.progress import SWEEP_PROGRESS_SAMPLES, staged_progress
         from screwkit.io.spec import load_spec
         from screwkit.pipeline import Pipeline
 
@@ -123,12 +124,18 @@ def register(app: typer.Typer) -> None:
             from screwkit.cli.graph_views import analyze_graph
 
             return analyze_graph(s, out, plot)
-        pipe = Pipeline(s, method=method)
-        motion = guard(lambda: pipe.motion)
+        stages = ["solving", "coupler curves and transmission", "tables"]
+        # a long sweep shows its stages (stderr, terminals only; the solver's own bar is off);
+        # the bar is gone before anything is printed on stdout
+        with staged_progress("analyze", stages,
+                             enabled=len(s.inputs) >= SWEEP_PROGRESS_SAMPLES) as stage:
+            pipe = Pipeline(s, method=method, progress=stage("solving"))
+            motion = guard(lambda: pipe.motion)
+            stage("coupler curves and transmission")
+            doc = guard(pipe.analysis)
+            stage("tables")
+            table = guard(pipe.analysis_table)
         du = out.units_for(s.units)
-
-        doc = guard(pipe.analysis)
-        table = guard(pipe.analysis_table)
         if plot is not None:
             from screwkit.report.plots import plot_analysis
 

@@ -1,7 +1,7 @@
 """``screwkit demo [EXAMPLES]``: the main job on every bundled example — validate, analyse,
 and every job the spec supports — writing ``<name>.<job>.json`` (SI), ``<name>.analysis.csv``
-and the plot in the spec's units, and an animated HTML report per example; ``index.html`` links
-them. A progress bar counts the examples (on a terminal)."""
+and the plot in the spec's units, and an animated HTML report per example; ``index.html`` shows
+them as a gallery (a small picture and one line each) linking to the reports. A progress bar counts the examples (on a terminal)."""
 
 from __future__ import annotations
 
@@ -80,11 +80,32 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
                                "simulation": sim, "synthesis": syn})
     entry = {
         "name": f.stem, "family": spec.family, "description": spec.describe(),
+        "thumbnail": guard(lambda: thumbnail(spec, motion, syn)),
+        # every example has analysis and mobility: the line names the other jobs
+        "line": " · ".join([spec.family, f"{len(motion.modes)} mode(s)",
+                            *[j for j in jobs if j not in ("analysis", "mobility")]]),
         "jobs": [(j, f"{f.stem}.{j}.json") for j in jobs], "summary": summary,
         "picture": f"{f.stem}.analysis.png" if plots else None,
         "report": f"{f.stem}.html" if reports else None,
     }
     return row, entry
+
+
+def thumbnail(spec: Any, motion: Any, synthesis_doc: dict[str, Any] | None) -> str:
+    """The gallery picture of an example: the mechanism its report animates — the synthesised
+    one for a synthesis spec (:mod:`screwkit.report.synthesis_scene`), else the spec's."""
+    from screwkit.errors import ScrewkitError
+    from screwkit.report.synthesis_scene import synthesised_motion
+    from screwkit.report.thumbnail import mechanism_svg
+
+    if synthesis_doc is not None and spec.synthesis is not None:
+        try:
+            shown = synthesised_motion(spec.synthesis, synthesis_doc, spec.family or "LOOP")
+            return mechanism_svg(shown.linkage, shown.motion, shown.mode,
+                                 f"{spec.name} (synthesised)")
+        except ScrewkitError:
+            pass  # the report shows the spec's mechanism then, and so does the picture
+    return mechanism_svg(spec.linkage, motion, spec.mode, spec.name)
 
 
 def example_summary(spec: Any, motion: Any, doc: dict[str, Any], mob: dict[str, Any], asm: str,

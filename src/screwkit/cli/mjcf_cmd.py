@@ -1,12 +1,13 @@
 """``screwkit export-mjcf SPEC -o model.xml``: the loop of a spec as a MuJoCo model — bodies
 with the spec's mass properties, hinge/slide/ball joints, the loop cut at a joint and closed by
-equality constraints, a motor on the input (:mod:`screwkit.simulation.mjcf`, docs/simulation.md).
+equality constraints, a motor on the input, the ``[drive]`` flywheel as the input's armature and
+the gravity ``screwkit simulate`` uses (:mod:`screwkit.simulation.mjcf`, docs/simulation.md).
 Registered on the main app by ``register(app)``."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -18,10 +19,10 @@ def register(app: typer.Typer) -> None:
     def export_mjcf(
         spec: Annotated[Path, typer.Argument(help="Spec file (TOML) with mass properties for every link.")],
         output: Annotated[Path, typer.Option("--output", "-o", help="The MJCF (XML) file to write.")],
-        gravity: Annotated[bool, typer.Option("--gravity/--no-gravity", help="Include the spec's gravity in the model.")] = False,
+        gravity: Annotated[bool | None, typer.Option("--gravity/--no-gravity", help="Include the spec's gravity (its gravity, default 9.80665 m/s², along gravity_direction) or leave it out. Default: as screwkit simulate has it ([drive] gravity); on for a spec without [drive].", show_default=False)] = None,
         timestep: Annotated[float, typer.Option("--timestep", help="MuJoCo time step (s); the equality constraints' time constant is 20 steps.", min=1e-9, max=1.0)] = 1e-5,
     ) -> None:
-        """Write a MuJoCo model (MJCF) of the spec's loop at its [motion] start, in its [motion] mode."""
+        """Write a MuJoCo model (MJCF) of the spec's loop at its [motion] start, in its [motion] mode, with its [drive] flywheel (the input's armature), friction and gravity: the model screwkit simulate integrates, less the motor law and the load."""
         from rich.markup import escape
 
         from screwkit.cli.common import check_paths, console, guard, loop_only
@@ -32,9 +33,21 @@ def register(app: typer.Typer) -> None:
 
         check_paths([spec], {"--output": output})
         s = loop_only(guard(lambda: load_spec(spec)), "export-mjcf")
+        with_gravity = export_gravity(s) if gravity is None else gravity
+        flywheel = s.drive.flywheel if s.drive else 0.0
         text = guard(lambda: mjcf_model(s.linkage, start=float(s.inputs[0]), mode=s.mode,
-                                        gravity=spec_gravity(s) if gravity else None,
+                                        gravity=spec_gravity(s) if with_gravity else None,
                                         timestep=timestep, solref=(20 * timestep, 1.0),
-                                        friction=s.drive.friction if s.drive else ()))
+                                        friction=s.drive.friction if s.drive else (),
+                                        flywheel=flywheel))
         guard(lambda: write_atomic(output, text, [spec], "--output"))
-        console.print(f"wrote {escape(str(output))}", highlight=False)
+        g = (f"gravity {float(sum(v * v for v in spec_gravity(s))) ** 0.5:.6g} m/s²" if with_gravity
+             else "no gravity")
+        console.print(f"wrote {escape(str(output))} (flywheel {flywheel:.6g} kg·m² as the "
+                      f"input's armature; {g})", highlight=False)
+
+
+def export_gravity(spec: Any) -> bool:
+    """Whether the export has the spec's gravity by default: as ``screwkit simulate`` has it
+    (the ``[drive]`` table's ``gravity``) and always for a spec without ``[drive]``."""
+    return bool(spec.drive.gravity) if spec.drive is not None else True

@@ -62,3 +62,45 @@ def progress_bar(description: str, total: int | None = None,
             bar.update(task, completed=done, total=new_total)
 
         yield advance
+
+
+#: input samples from which a command over the whole sweep (``analyze``) shows its stages
+SWEEP_PROGRESS_SAMPLES = 10_000
+_STAGE_UNITS = 1000
+
+
+@contextmanager
+def staged_progress(description: str, stages: list[str],
+                    enabled: bool = True) -> Iterator[Callable[[str], ProgressCallback]]:
+    """A bar on stderr (terminals only, as :func:`progress_bar`) over a command's stages, each
+    an equal share: ``stage(name)`` moves the bar to the start of stage ``name``, shows its name
+    and returns the callback ``advance(done, total)`` that fills that share (a library's
+    progress, e.g. the solver's). Messages on stderr appear above the bar; stdout is left
+    alone (it may be a file or a pipe: print results after the bar is gone)."""
+    from screwkit.cli.common import err_console
+
+    def quiet(name: str) -> ProgressCallback:
+        return _silent
+
+    if not (enabled and err_console.is_terminal):
+        yield quiet
+        return
+    from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
+
+    columns = (TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(),
+               TimeElapsedColumn())
+    with Progress(*columns, console=err_console, transient=True, redirect_stdout=False) as bar:
+        task = bar.add_task(description, total=len(stages) * _STAGE_UNITS)
+
+        def stage(name: str) -> ProgressCallback:
+            start = stages.index(name) * _STAGE_UNITS
+            bar.update(task, completed=start, description=f"{description}: {name}")
+            bar.refresh()  # a few stages: each is drawn, however short
+
+            def advance(done: int, total: int) -> None:
+                share = min(max(done / total, 0.0), 1.0) if total > 0 else 1.0
+                bar.update(task, completed=start + share * _STAGE_UNITS)
+
+            return advance
+
+        yield stage

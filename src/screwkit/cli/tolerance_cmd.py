@@ -72,6 +72,7 @@ def _plot(doc: dict[str, Any], path: Path, inputs: list[Path], units: Any,
     import matplotlib.pyplot as plt
 
     from screwkit.io.outputs import atomic_path
+    from screwkit.report.plots import tidy_axes
 
     outs = list(doc["outputs"])
     fig, axes = plt.subplots(len(outs), 1, figsize=(7, 2.6 * len(outs)), sharex=True,
@@ -94,6 +95,7 @@ def _plot(doc: dict[str, Any], path: Path, inputs: list[Path], units: Any,
     axes[0, 0].legend(fontsize=8)
     axes[-1, 0].set_xlabel(f"input ({units.pretty(input_kind)})")
     fig.suptitle(f"{doc['mechanism']}: tolerance stack-up", fontsize=10)
+    tidy_axes(fig)
     with atomic_path(path, inputs, "--plot") as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
     plt.close(fig)

@@ -85,6 +85,8 @@ def write_pareto_plot(front: Any, path: str | Path, x: str = "F", y: str = "T",
 def _save(fig: Any, path: Path) -> None:
     """PNG through a temporary file and a rename (screwkit.io.outputs: no partial file)."""
     from screwkit.io.outputs import atomic_path
+    from screwkit.report.plots import tidy_axes
 
+    tidy_axes(fig)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")

@@ -24,13 +24,42 @@ def pyplot() -> Any:
     return plt
 
 
+def tidy_axes(fig: Any) -> None:
+    """Axes a person can read, on every linear 2-D axes of ``fig``: limits rounded outward to
+    the tick step where matplotlib chose them (no margin past a round number), tick labels
+    without an offset ("90", not "+9e1" and "0.000003") and with a ×10ⁿ multiplier outside
+    10⁻³…10⁵ (2×10⁶ deg/s², not 2000000). Equal-aspect axes (coupler curves) keep their
+    limits."""
+    import matplotlib as mpl
+    from matplotlib.ticker import ScalarFormatter
+
+    with mpl.rc_context({"axes.autolimit_mode": "round_numbers"}):
+        for ax in fig.axes:
+            if hasattr(ax, "zaxis") or ax.name != "rectilinear":
+                continue
+            for axis, auto, margin in ((ax.xaxis, ax.get_autoscalex_on(), ax.set_xmargin),
+                                       (ax.yaxis, ax.get_autoscaley_on(), ax.set_ymargin)):
+                if axis.get_scale() != "linear":
+                    continue
+                fmt = ScalarFormatter(useOffset=False, useMathText=True)
+                fmt.set_powerlimits((-3, 5))
+                axis.set_major_formatter(fmt)
+                if auto and ax.get_aspect() == "auto":
+                    margin(0)
+            if ax.get_aspect() == "auto":
+                ax.relim()
+                ax.autoscale_view()
+
+
 def save_figure(fig: Any, path: str | Path, inputs: Any = (), option: str | None = None) -> None:
     """Save through a temporary file and a rename (no half-written picture on error; links,
-    FIFOs, folders and the command's inputs are refused: screwkit.io.outputs)."""
+    FIFOs, folders and the command's inputs are refused: screwkit.io.outputs), the axes tidied
+    (:func:`tidy_axes`)."""
     from screwkit.io.outputs import atomic_path
 
     p = Path(path)
     fmt = p.suffix[1:].lower() or "png"
+    tidy_axes(fig)
     with atomic_path(p, inputs, option) as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight", format=fmt)
 

@@ -11,8 +11,10 @@ same table):
 ``name``, ``family``, ``source``, ``description``
     Text about the mechanism (``family`` and ``source`` may be ``None``).
 ``display_units``
-    ``{"length": "mm", "factor": 1000.0, "angle": "deg"}``: how lengths are shown (metres ×
-    ``factor``); angles are shown in degrees. Data stay SI.
+    ``{"length": "mm", "factor": 1000.0, "angle": "deg", "force": "N", "force_factor": 1.0}``:
+    how lengths are shown (metres × ``factor``) and forces (newtons × ``force_factor``, the
+    spec's ``[units] force``; absent for a bare linkage: N); angles are shown in degrees. Data
+    stay SI.
 ``input``
     ``{"name", "kind": "angle" | "length", "values": [N], "periodic": bool}``, the driven
     freedom over the N frames (rad or m); ``periodic`` closes traces over a full turn.
@@ -43,6 +45,9 @@ same table):
     ``[{"id", "title", "note"}]`` in the order the report shows them.
 ``text``
     ``{"spec": str | None, "units": [str], "solver": [str], "validation": [str]}``.
+``ghost`` (optional)
+    ``{"label", "link_points": [n][3][3]}``: another loop drawn still, as thin grey lines (the
+    synthesis start behind a synthesised mechanism; :mod:`screwkit.report.spec_report`).
 
 ``None`` stands wherever a value does not exist (a mode that does not assemble, a singular
 velocity). The adapter reads only these attributes of a motion: ``inputs`` and ``modes``, and of
@@ -85,6 +90,18 @@ def display_length(spec_unit: str | None, extent: float) -> dict[str, Any]:
     if unit not in LENGTH_UNITS:
         unit = "mm" if extent < 1.0 else "m"
     return {"length": unit, "factor": 1.0 / LENGTH_UNITS[unit], "angle": "deg"}
+
+
+def _display_units(spec: Any, extent: float) -> tuple[dict[str, Any], Any]:
+    """The scene's ``display_units`` (:func:`display_length`, and the spec's force unit) and
+    the spec's :class:`~screwkit.io.display_units.DisplayUnits` for forces and moments (the
+    tables' units), None for a bare linkage (SI)."""
+    units = display_length(getattr(spec, "units", {}).get("length") if spec else None, extent)
+    du = spec.display_units() if spec is not None and hasattr(spec, "display_units") else None
+    if du is not None:
+        units["force"] = du.pretty("force")
+        units["force_factor"] = 1.0 / du.unit_of("force")[1]
+    return units, du
 
 
 def _input_values(motion: Any, n: int) -> Array:
@@ -186,6 +203,8 @@ def scene_from_motion(
     seed_variables: list[tuple[dict[str, Array], dict[str, Array], dict[str, Array]]] | None = None,
     solver: list[str] | None = None,
     notes: list[str] | None = None,
+    linkage: Any = None,
+    initial_mode: int | None = None,
 ) -> dict[str, Any]:
     """Build the scene (module docstring) of a solved motion.
 
@@ -196,9 +215,12 @@ def scene_from_motion(
     synthesize`` document. ``coupler_points``: extra traces {name: (moving link index, point
     in that link's frame, m)}. ``seed_variables``: per mode the (variables, velocities,
     accelerations) under the seed's names, plotted instead of the joint variables.
+    ``linkage``: the loop the motion is of, when it is not the spec's (the synthesised one);
+    ``initial_mode``: the mode shown first (default: the mode with dynamics, else 0).
     """
-    linkage = getattr(spec_or_linkage, "linkage", spec_or_linkage)
-    spec = spec_or_linkage if spec_or_linkage is not linkage else None
+    spec_linkage = getattr(spec_or_linkage, "linkage", spec_or_linkage)
+    spec = spec_or_linkage if spec_or_linkage is not spec_linkage else None
+    linkage = spec_linkage if linkage is None else linkage
     modes = list(motion.modes)
     if not modes:
         raise InputError(f"{linkage.name}: the motion has no assembly mode to show")
@@ -208,7 +230,7 @@ def scene_from_motion(
     kind = "length" if input_name.endswith(".s") else "angle"
     all_c = np.concatenate([np.asarray(m.joint_centres, dtype=float).reshape(-1, 3) for m in modes])
     extent = float(np.nanmax(np.abs(all_c))) if np.isfinite(all_c).any() else 1.0
-    units = display_length(getattr(spec, "units", {}).get("length") if spec else None, extent)
+    units, du = _display_units(spec, extent)
     points = dict(coupler_points or {})
     mode_entries = []
     for k, md in enumerate(modes):
@@ -225,15 +247,15 @@ def scene_from_motion(
                              f"{len(modes)} mode(s)")
         centres = np.asarray(modes[dyn_mode].joint_centres, dtype=float)
         mode_entries[dyn_mode]["arrows"] = dynamics_arrows(dynamics_doc, centres, linkage)
-        p, g = dynamics_plots(dynamics_doc, dyn_mode, x, input_name, kind)
+        p, g = dynamics_plots(dynamics_doc, dyn_mode, x, input_name, kind, du)
         plots += p
         groups += g
     if balance_doc is not None:
-        p, g = balancing_plots(balance_doc, dyn_mode, x, input_name, kind)
+        p, g = balancing_plots(balance_doc, dyn_mode, x, input_name, kind, du)
         plots += p
         groups += g
     if synthesis_doc is not None:
-        p, g = synthesis_plots(synthesis_doc, units)
+        p, g = synthesis_plots(synthesis_doc, units, synthesised=linkage is not spec_linkage)
         plots += p
         groups += g
     base_R = np.asarray(linkage.base.real, dtype=float)
@@ -255,7 +277,7 @@ def scene_from_motion(
         "fixed_frame": {"origin": np.asarray(linkage.base.translation, dtype=float),
                         "rotation": base_R},
         "modes": mode_entries,
-        "initial_mode": dyn_mode or 0,
+        "initial_mode": initial_mode if initial_mode is not None else dyn_mode or 0,
         "plots": plots,
         "plot_groups": groups,
         "text": text_sections(linkage, mode_entries, units, kind, spec_text=spec_text,

@@ -129,41 +129,56 @@ def _components(label: str, v: Array, mode: int | None) -> list[dict[str, Any]]:
         _series(f"{label} {a}", v[:, i], mode) for i, a in enumerate("xyz")]
 
 
+def _load_units(du: Any) -> dict[str, tuple[str, float]]:
+    """(label, factor SI → shown) of force and moment in the display units ``du``
+    (:class:`~screwkit.io.display_units.DisplayUnits`; None: SI)."""
+    if du is None:
+        return {"force": ("N", 1.0), "moment": ("N·m", 1.0), "1": ("", 1.0)}
+    return {k: (du.pretty(k), 1.0 / du.unit_of(k)[1]) for k in ("force", "moment")} | {
+        "1": ("", 1.0)}
+
+
 def dynamics_plots(doc: dict[str, Any], mode: int, x: Array, input_name: str, kind: str,
-                   ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+                   du: Any = None) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Shaking force (hodographs and against the input), shaking moment, every joint reaction
-    and the driven efforts (the input torque), all of assembly mode ``mode``."""
+    and the driven efforts (the input torque), all of assembly mode ``mode``; forces and moments
+    in the display units ``du`` (the spec's ``[units]``; None: SI)."""
     n = len(x)
     x_label, x_scale = _input_axis(input_name, kind)
+    lu = _load_units(du)
+    (fu, ff), (mu, mf) = lu["force"], lu["moment"]
     sf = _vectors(doc["shaking_force"], n)
     sm = _vectors(doc["shaking_moment"], n)
     g = "dynamics"
     plots = [
-        _plot("dyn-sf-xy", g, "shaking force hodograph (x–y)", "xy", "Fx (N)", "Fy (N)",
-              [_series("shaking force", sf[:, 1], mode, x=sf[:, 0])]),
-        _plot("dyn-sf-xz", g, "shaking force hodograph (x–z)", "xy", "Fx (N)", "Fz (N)",
-              [_series("shaking force", sf[:, 2], mode, x=sf[:, 0])]),
-        _plot("dyn-sf", g, "shaking force", "line", x_label, "force (N)",
-              _components("F", sf, mode), x_scale=x_scale),
+        _plot("dyn-sf-xy", g, "shaking force hodograph (x–y)", "xy", f"Fx ({fu})", f"Fy ({fu})",
+              [_series("shaking force", sf[:, 1], mode, x=sf[:, 0])], x_scale=ff, y_scale=ff),
+        _plot("dyn-sf-xz", g, "shaking force hodograph (x–z)", "xy", f"Fx ({fu})", f"Fz ({fu})",
+              [_series("shaking force", sf[:, 2], mode, x=sf[:, 0])], x_scale=ff, y_scale=ff),
+        _plot("dyn-sf", g, "shaking force", "line", x_label, f"force ({fu})",
+              _components("F", sf, mode), x_scale=x_scale, y_scale=ff),
         _plot("dyn-sm", g, "shaking moment (about the moment point)", "line", x_label,
-              "moment (N·m)", _components("M", sm, mode), x_scale=x_scale),
+              f"moment ({mu})", _components("M", sm, mode), x_scale=x_scale, y_scale=mf),
     ]
     for name, e in doc["efforts"].items():
-        unit = "N" if name.endswith(".s") else "N·m"
-        plots.append(_plot(f"dyn-effort-{name}", g, f"input {'force' if unit == 'N' else 'torque'}"
+        slide = name.endswith(".s")
+        unit, factor = (fu, ff) if slide else (mu, mf)
+        plots.append(_plot(f"dyn-effort-{name}", g, f"input {'force' if slide else 'torque'}"
                            f" ({name})", "line", x_label, f"effort ({unit})",
-                           [_series(name, _scalars(e), mode)], x_scale=x_scale))
+                           [_series(name, _scalars(e), mode)], x_scale=x_scale, y_scale=factor))
     for joint, r in doc["reactions"].items():
         plots.append(_plot(f"dyn-reaction-{joint}", g, f"reaction force at {joint}", "line",
-                           x_label, "force (N)", _components("f", _vectors(r["force"], n), mode),
-                           x_scale=x_scale))
+                           x_label, f"force ({fu})",
+                           _components("f", _vectors(r["force"], n), mode),
+                           x_scale=x_scale, y_scale=ff))
     plots.append(_plot("dyn-reaction-moments", g, "reaction moments (about each joint centre)",
-                       "line", x_label, "|moment| (N·m)",
+                       "line", x_label, f"|moment| ({mu})",
                        [_series(j, np.linalg.norm(_vectors(r["moment"], n), axis=-1), mode)
-                        for j, r in doc["reactions"].items()], x_scale=x_scale))
-    note = (f"Assembly mode {mode}. World frame, SI. A reaction is the force on the distal link "
-            "by the proximal link; the shaking force is what the moving links exert on the "
-            "ground. Arrows on the 3-D view show them at the current frame.")
+                        for j, r in doc["reactions"].items()], x_scale=x_scale, y_scale=mf))
+    note = (f"Assembly mode {mode}. World frame; forces in {fu}, moments in {mu}. A reaction is "
+            "the force on the distal link by the proximal link; the shaking force is what the "
+            "moving links exert on the ground. Arrows on the 3-D view show them at the current "
+            "frame.")
     indet = doc.get("indeterminacy", {}).get("description")
     if indet:
         note += f" {indet}."
@@ -171,31 +186,39 @@ def dynamics_plots(doc: dict[str, Any], mode: int, x: Array, input_name: str, ki
 
 
 def balancing_plots(doc: dict[str, Any], mode: int | None, x: Array, input_name: str,
-                    kind: str) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """Before/after curves of every per-sample load of a balancing run."""
+                    kind: str, du: Any = None,
+                    ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Before/after curves of every per-sample load of a balancing run, in the display units
+    ``du`` (None: SI)."""
     from screwkit.balancing.result import SAMPLE_LOADS
 
     ps = doc["per_sample"]
     bx = np.asarray(ps["input"], dtype=float)
     linked = bx.shape == x.shape and bool(np.allclose(bx, x, rtol=0, atol=1e-12))
     x_label, x_scale = _input_axis(input_name, kind)
+    lu = _load_units(du)
+    kinds = {"N": "force", "N*m": "moment", "1": "1"}
     plots = []
     for key, title, unit in SAMPLE_LOADS:
+        # a driven slide's "torque" is a force (balancing/result_table.py)
+        slide_force = key == "input_torque" and input_name.endswith(".s")
+        label, factor = lu["force" if slide_force else kinds[unit]]
         series = [_series(when, ps[key][when], mode, x=None if linked else bx)
                   for when in ("before", "after")]
         plots.append(_plot(f"bal-{key}", "balancing", f"{title}: before / after", "line",
-                           x_label, f"{key} ({unit.replace('*', '·')})", series,
-                           x_scale=x_scale, linked=linked))
+                           x_label, f"{key} ({label or '1'})", series,
+                           x_scale=x_scale, y_scale=factor, linked=linked))
     g = doc["measures"]
     note = (f"Optimum balancing: objective G {g['before']['G']:.6g} → {g['after']['G']:.6g}; "
             f"unique optimum: {doc['unique']}.")
     return plots, [{"id": "balancing", "title": "Balancing (before / after)", "note": note}]
 
 
-def synthesis_plots(doc: dict[str, Any], units: dict[str, Any],
+def synthesis_plots(doc: dict[str, Any], units: dict[str, Any], synthesised: bool = False,
                     ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Desired vs generated output rotation and translation at the design points, and the
-    error curves (not linked: the synthesised mechanism is not the one animated)."""
+    error curves, against the design parameter θ (not linked to the animation). ``synthesised``:
+    whether the 3-D view shows the synthesised mechanism (else the synthesis start)."""
     rows = sorted(doc["rows"], key=lambda r: r["theta"])
 
     def col(key: str) -> Array:
@@ -232,6 +255,8 @@ def synthesis_plots(doc: dict[str, Any], units: dict[str, Any],
 
     note = (f"{doc.get('method', 'least_squares')}: status {doc.get('status')}; RMSE ψ "
             f"{num(doc.get('rmse_phi'), DEG)}°, S {num(doc.get('rmse_S'))} m; {len(rows)} design "
-            "points. The 3-D view shows the spec's mechanism (the synthesis start), not the "
-            "synthesised one.")
+            "points. " + ("The 3-D view shows the synthesised mechanism; the plots of its output "
+                          "from θ01 follow the animation." if synthesised else
+                          "The 3-D view shows the spec's mechanism (the synthesis start), not "
+                          "the synthesised one."))
     return plots, [{"id": g, "title": "Synthesis", "note": note}]

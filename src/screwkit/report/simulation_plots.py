@@ -84,6 +84,7 @@ def write_simulation_png(doc: dict[str, Any], path: str | Path) -> None:
     except ImportError as exc:
         raise InputError("--plot needs matplotlib: pip install 'screwkit[plot]'") from exc
     from screwkit.io.outputs import atomic_path
+    from screwkit.report.plots import tidy_axes
 
     plots, _ = simulation_scene_plots(doc)
     fig, axes = plt.subplots(2, 2, figsize=(11, 7.5))
@@ -100,6 +101,7 @@ def write_simulation_png(doc: dict[str, Any], path: str | Path) -> None:
         if len(p["series"]) <= 6:
             ax.legend(fontsize=7)
     fig.suptitle(f"{doc['name']}: simulation", fontsize=11)
+    tidy_axes(fig)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png", dpi=110)

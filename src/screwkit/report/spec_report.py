@@ -7,10 +7,18 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from screwkit.errors import ScrewkitError
 from screwkit.io.mechanism_spec import GraphSpec
+from screwkit.io.results import jsonable
 from screwkit.io.spec import Spec
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.pipeline import Pipeline
+from screwkit.report.synthesis_scene import (
+    SynthesisedMotion,
+    add_synthesised_plots,
+    start_ghost,
+    synthesised_motion,
+)
 
 Named = dict[str, Any]
 
@@ -58,15 +66,66 @@ def spec_scene(spec: Spec | Pipeline | GraphSpec, *, gravity: bool = False,
     if synthesis_doc is None and s.synthesis is not None:
         synthesis_doc = synthesis_document(pipe.synthesize(), s.path)
     text = Path(s.path).read_text(encoding="utf-8")
-    scene = scene_from_motion(s, m, dynamics_doc=dynamics_doc, dynamics_mode=dyn_mode,
+    shown = synthesised_view(s, synthesis_doc, notes) if synthesis_doc is not None else None
+    if shown is not None and dynamics_doc is not None:
+        notes[:] = [n for n in notes if not n.startswith("Dynamics and balancing are of")]
+        notes.append("The report draws no dynamics or balancing: they are of the spec's "
+                     "mechanism, not the synthesised one shown; run them on a spec with its "
+                     "dimensions.")
+        dynamics_doc = balance_doc = dyn_mode = None
+    motion = m if shown is None else shown.motion
+    scene = scene_from_motion(s, motion, dynamics_doc=dynamics_doc, dynamics_mode=dyn_mode,
                               balance_doc=balance_doc, synthesis_doc=synthesis_doc,
-                              spec_text=text, seed_variables=[seed_tables(md) for md in m.modes],
+                              spec_text=text,
+                              seed_variables=[seed_tables(md) for md in motion.modes],
                               coupler_points={p.name: (p.link, p.point)
                                               for p in s.coupler_points},
-                              solver=[m.solver] if m.solver else None, notes=notes)
+                              solver=[motion.solver] if motion.solver else None, notes=notes,
+                              linkage=None if shown is None else shown.linkage,
+                              initial_mode=None if shown is None else shown.mode)
+    if shown is not None and s.synthesis is not None and synthesis_doc is not None:
+        add_synthesised_plots(scene, shown, s.synthesis)
+        ghost = start_ghost(s.linkage, m, s.mode, float(synthesis_doc["dimensions"]["theta01"]))
+        if ghost is not None:
+            scene["ghost"] = jsonable(ghost)
+        scene["description"] = synthesised_description(s, synthesis_doc, shown)
     if s.drive is not None and dynamics_doc is not None:
         add_simulation_plots(scene, s)
     return scene
+
+
+def synthesised_view(spec: Spec, synthesis_doc: dict[str, Any],
+                     notes: list[str]) -> SynthesisedMotion | None:
+    """The synthesised mechanism the report animates (:mod:`screwkit.report.synthesis_scene`),
+    with a note saying so; None (and a note why) when it cannot be followed, and the report
+    shows the spec's mechanism, the synthesis start."""
+    if spec.synthesis is None:
+        return None
+    try:
+        shown = synthesised_motion(spec.synthesis, synthesis_doc, spec.family or "LOOP")
+    except ScrewkitError as exc:
+        notes.append(f"The 3-D view shows the spec's mechanism (the synthesis start), not the "
+                     f"synthesised one: {exc}.")
+        return None
+    notes.append(f"The 3-D view and the kinematic plots show the synthesised mechanism (the "
+                 f"synthesis's best result) over its design range, θ01 {'+' if shown.direction > 0 else '−'} θ; "
+                 f"its mode {shown.mode} generates the synthesis's output at every design point "
+                 "(to round-off).")
+    return shown
+
+
+def synthesised_description(spec: Spec, doc: dict[str, Any], shown: SynthesisedMotion) -> str:
+    """One line on the synthesised mechanism: its dimensions in the spec's units, the design
+    range of its input."""
+    du = spec.display_units()
+    angles = spec.synthesis.angles if spec.synthesis else frozenset()
+    kinds = {k: "angle" if k in angles else "length" for k in doc["dimensions"]}
+    dims = ", ".join(f"{k}={du.show(kinds[k], v):.6g} {du.label(kinds[k])}"
+                     for k, v in doc["dimensions"].items())
+    x = shown.motion.inputs.reshape(len(shown.theta), -1)[:, 0]
+    return (f"{spec.name}: the synthesised {spec.family} ({''.join(j.kind for j in shown.linkage.joints)}) "
+            f"{dims}; {len(x)} input samples {du.show('angle', x[0]):.6g}…"
+            f"{du.show('angle', x[-1]):.6g} {du.label('angle')} (the design range)")
 
 
 def add_simulation_plots(scene: dict[str, Any], spec: Spec) -> None:

@@ -14,9 +14,12 @@ equality constraint:
   fullinertia="Ixx Iyy Izz Ixy Ixz Iyz">`` about the centre of mass in body axes;
 * R → ``hinge``, P → ``slide``, C → ``hinge`` + ``slide`` on one axis, S → ``ball``
   (H and U joints are not exported);
-* the input joint has a ``motor`` actuator (torque, no limits) named ``input``; contacts are
-  disabled; capsules between the joint centres are drawn for viewing only (no mass, no
-  contact).
+* the input joint has a ``motor`` actuator (torque, no limits) named ``input``, and the
+  flywheel on the input shaft (``[drive] flywheel``) as its ``armature`` — MuJoCo adds a
+  joint's armature to the diagonal of the mass matrix at its freedom, which is exactly a rotor
+  turning with the input crank relative to the ground; contacts are disabled; capsules between
+  the joint centres are drawn for viewing only (no mass, no contact);
+* ``gravity`` is the option's gravity vector (the spec's, when the caller gives it).
 
 An S–S rod spins freely about the line of its ball centres in MuJoCo, while screwkit's
 kinematics gives it no spin: give such a rod an axisymmetric inertia about that line with its
@@ -117,7 +120,7 @@ def start_configuration(linkage: Linkage, start: float, mode: int) -> ModeMotion
 
 
 def _joint_xml(linkage: Linkage, k: int, layout: MjcfLayout, centre: Array, axis: Array,
-               indent: str, damping: Damping) -> list[str]:
+               indent: str, damping: Damping, armature: Mapping[str, float]) -> list[str]:
     j = linkage.joints[k]
     lines = []
     tags = {"R": ("hinge",), "P": ("slide",), "C": ("hinge", "slide"), "S": ("ball",)}[j.kind]
@@ -126,12 +129,14 @@ def _joint_xml(linkage: Linkage, k: int, layout: MjcfLayout, centre: Array, axis
         extra = "" if tag == "ball" else f' axis="{_f(axis)}"'
         c = translation if tag == "slide" else rotation
         lines.append(f'{indent}<joint name={quoteattr(name)} type="{tag}" pos="{_f(centre)}"'
-                     f'{extra} limited="false" damping="{float(c)!r}" armature="0"/>')
+                     f'{extra} limited="false" damping="{float(c)!r}" '
+                     f'armature="{float(armature.get(name, 0.0))!r}"/>')
     return lines
 
 
 def _body_xml(linkage: Linkage, md: ModeMotion, link: int, joint: int, parent: int | None,
-              layout: MjcfLayout, indent: str, damping: Damping) -> list[str]:
+              layout: MjcfLayout, indent: str, damping: Damping,
+              armature: Mapping[str, float]) -> list[str]:
     R, o = md.link_rotation[0, link], md.link_origin[0, link]
     if parent is None:
         pos, rot = o, R
@@ -149,7 +154,7 @@ def _body_xml(linkage: Linkage, md: ModeMotion, link: int, joint: int, parent: i
     lines = [f'{indent}<body name={quoteattr(lk.name)} pos="{_f(pos)}" quat="{_f(_quat(rot))}">',
              f'{indent}  <inertial pos="{_f(mp.com)}" mass="{mp.mass:.17g}" fullinertia="'
              f'{_f([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>']
-    lines += _joint_xml(linkage, joint, layout, centre, axis, indent + "  ", damping)
+    lines += _joint_xml(linkage, joint, layout, centre, axis, indent + "  ", damping, armature)
     ends = [R.T @ (md.joint_centres[0, k] - o) for k in (link, link + 1)]
     if np.linalg.norm(ends[1] - ends[0]) > 1e-9:
         lines.append(f'{indent}  <geom type="capsule" fromto="{_f(ends[0])} {_f(ends[1])}" '
@@ -159,14 +164,14 @@ def _body_xml(linkage: Linkage, md: ModeMotion, link: int, joint: int, parent: i
 
 
 def _chain(linkage: Linkage, md: ModeMotion, steps: list[tuple[int, int]],
-           layout: MjcfLayout, damping: Damping) -> list[str]:
+           layout: MjcfLayout, damping: Damping, armature: Mapping[str, float]) -> list[str]:
     """Nested bodies for (link, joint) pairs from the world outwards."""
     opened: list[str] = []
     lines: list[str] = []
     parent = None
     for depth, (link, joint) in enumerate(steps):
         indent = "    " + "  " * depth
-        lines += _body_xml(linkage, md, link, joint, parent, layout, indent, damping)
+        lines += _body_xml(linkage, md, link, joint, parent, layout, indent, damping, armature)
         opened.append(indent + "</body>")
         parent = link
     return lines + opened[::-1]
@@ -194,13 +199,18 @@ def _equality(linkage: Linkage, md: ModeMotion, layout: MjcfLayout, solref: tupl
 def mjcf_model(linkage: Linkage, *, start: float = 0.0, mode: int = 0,
                gravity: Array | None = None, timestep: float = DEFAULT_TIMESTEP,
                integrator: str = "RK4", solref: tuple[float, ...] = DEFAULT_SOLREF,
-               solimp: tuple[float, ...] = DEFAULT_SOLIMP, friction: Sequence[Any] = ()
-               ) -> str:
+               solimp: tuple[float, ...] = DEFAULT_SOLIMP, friction: Sequence[Any] = (),
+               flywheel: float = 0.0) -> str:
     """The MJCF text of ``linkage`` in assembly ``mode`` posed at input ``start`` (module
     docstring). SI units; ``gravity`` (m/s², world) zero if omitted; ``friction``
     (:class:`~screwkit.io.drive_table.JointFriction` items) becomes the joints' viscous
     ``damping`` — MuJoCo's damping of a hinge, slide or ball is exactly this friction (a ball's
-    on its relative angular velocity)."""
+    on its relative angular velocity); ``flywheel`` (kg·m² on the input shaft; kg on a driven
+    slide) the input freedom's ``armature``, the J_f of ``screwkit simulate``'s equation of
+    motion (docs/simulation.md)."""
+    if not (np.isfinite(flywheel) and flywheel >= 0):
+        raise SimulationError(f"{linkage.name}: the flywheel is an inertia >= 0; got "
+                              f"{flywheel!r}")
     if len(linkage.inputs) != 1:
         raise SimulationError(f"{linkage.name}: MJCF export drives one input; this loop has "
                               f"{list(linkage.inputs)}")
@@ -228,8 +238,9 @@ def mjcf_model(linkage: Linkage, *, start: float = 0.0, mode: int = 0,
              '    <flag contact="disable"/>',
              "  </option>",
              "  <worldbody>"]
-    lines += _chain(linkage, md, forward, layout, damping)
-    lines += _chain(linkage, md, backward, layout, damping)
+    armature = {input_dof: float(flywheel)}
+    lines += _chain(linkage, md, forward, layout, damping, armature)
+    lines += _chain(linkage, md, backward, layout, damping, armature)
     lines += ["  </worldbody>", "  <equality>"]
     lines += _equality(linkage, md, layout, solref, solimp)
     lines += ["  </equality>", "  <actuator>",

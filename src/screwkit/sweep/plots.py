@@ -17,6 +17,7 @@ import numpy as np
 
 from screwkit.errors import InputError
 from screwkit.io.outputs import atomic_path
+from screwkit.report.plots import tidy_axes
 from screwkit.report.sweep_pictures import PICTURE_SOFTWARE
 
 Row = dict[str, Any]
@@ -141,6 +142,7 @@ def plot_sweep(rows: Sequence[Row], metadata: dict[str, Any], path: Path, column
     description = (f"{column} over {', '.join(labels)} ({metadata['sampling']}; spec "
                    f"{Path(metadata['spec']).name})")
     text = {"Title": title, "Description": description, "Software": PICTURE_SOFTWARE}
+    tidy_axes(fig)
     with atomic_path(path, inputs, "--plot") as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png", metadata=text)
     plt.close(fig)
