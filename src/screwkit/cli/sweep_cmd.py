@@ -39,7 +39,7 @@ def progress_bar(label: str, total: int | None = None
         yield lambda done, total, computed: advance(done, total)
 
 
-class Terminated(KeyboardInterrupt):
+class _Terminated(KeyboardInterrupt):
     """SIGTERM (a job scheduler's or ``kill``'s stop), raised in the main thread as Ctrl-C's
     KeyboardInterrupt is, so that the same clean-up runs: the cluster stopped, the checkpoint
     kept, one sentence printed."""
@@ -47,7 +47,7 @@ class Terminated(KeyboardInterrupt):
 
 @contextmanager
 def sigterm_as_interrupt() -> Iterator[None]:
-    """While the block runs, SIGTERM raises :class:`Terminated` (a second one ends the process
+    """While the block runs, SIGTERM raises :class:`_Terminated` (a second one ends the process
     at once, as SIGTERM does by default). Python's default is to die without clean-up: no
     message, worker processes and their semaphores left behind."""
     if threading.current_thread() is not threading.main_thread():  # signals go to main only
@@ -56,7 +56,7 @@ def sigterm_as_interrupt() -> Iterator[None]:
 
     def on_sigterm(signum: int, frame: Any) -> None:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        raise Terminated
+        raise _Terminated
 
     previous = signal.signal(signal.SIGTERM, on_sigterm)
     try:
@@ -91,7 +91,7 @@ def print_notes(notes: Iterable[str]) -> None:
 def stopped(exc: KeyboardInterrupt, what: str) -> NoReturn:
     """Ctrl-C (exit 130) or SIGTERM (exit 143, 128 + the signal's number, as a shell reports
     it): one line saying so and ``what`` is kept or written."""
-    how, code = ("terminated (SIGTERM)", 143) if isinstance(exc, Terminated) \
+    how, code = ("terminated (SIGTERM)", 143) if isinstance(exc, _Terminated) \
         else ("interrupted", 130)
     err_console.print(f"[yellow]{how}:[/] {what}", highlight=False)
     raise typer.Exit(code)
