@@ -7,7 +7,8 @@
 - SIGTERM to the command (as ``kill`` sends it), SIGTERM and SIGINT to its whole process group
   (as a batch system and Ctrl-C in a terminal send them): one line, the checkpoint kept,
   how to resume, no traceback, no leaked semaphores;
-- a task that kills every worker that runs it: one sentence;
+- a task that kills every worker that runs it, a scheduler lost mid-sweep: one sentence (and,
+  for the sweep, how to resume);
 - a rerun without ``--resume`` refuses a checkpoint holding finished designs (``--fresh``
   discards it, and says so).
 
@@ -17,6 +18,7 @@ fixed delays; each has a deadline so a fault in the fault handling fails instead
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -97,7 +99,7 @@ def _finish(proc: subprocess.Popen[str]) -> tuple[str, str]:
 
 #: designs of the mid-sweep tests: enough that a signal sent once two batches are kept lands
 #: long before the last (one design a task, some 10 ms each)
-DESIGNS = 150
+DESIGNS = 100
 
 
 def _reference(folder: Path, designs: int) -> list[dict]:
@@ -187,6 +189,65 @@ def test_a_stopped_sweep_says_so_in_one_line(tmp_path, request, name, group, cod
         r = runner.invoke(app, [*cmd[3:-4], "--workers", "0", "--resume"])
         assert r.exit_code == 0, r.output
         assert read_table(out) == request.getfixturevalue("reference")
+
+
+def test_a_scheduler_lost_mid_sweep_stops_with_one_sentence(tmp_path, reference):
+    dask_command = str(Path(sys.executable).with_name("dask"))
+    info, out = tmp_path / "scheduler.json", tmp_path / "t.csv"
+    env = {**os.environ, "PYTHONWARNINGS": "ignore"}
+    scheduler = subprocess.Popen(
+        [dask_command, "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+         "--scheduler-file", str(info)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        env=env, text=True)
+    worker = None
+    try:
+        _wait_for(lambda: info.exists() and "address" in info.read_text(), scheduler,
+                  "the scheduler's address")
+        address = json.loads(info.read_text())["address"]
+        worker = subprocess.Popen(
+            [dask_command, "worker", address, "--nthreads", "1", "--nworkers", "1", "--host",
+             "127.0.0.1", "--no-dashboard"], stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL, env=env)
+        cmd = _sweep_command(out, DESIGNS, 1)
+        proc = _start([*cmd[:-4], "--scheduler", address, "--batch-size", "1"])
+        _wait_for(lambda: _batches(out) >= 2, proc, "two finished batches")
+        scheduler.kill()
+        stdout, err = _finish(proc)
+    finally:
+        for p in (scheduler, worker):
+            if p is not None:
+                p.kill()
+                p.wait(timeout=30)
+    assert proc.returncode == 2, err
+    folder = checkpoint_folder(out)
+    [line] = err.splitlines()
+    assert line.startswith(f"error: the run lost its connection to the Dask scheduler "
+                           f"{address} ("), line
+    assert line.endswith("); check that the scheduler is running and run again; the finished "
+                         f"designs are kept in {folder} — run the same command with --resume "
+                         "to continue"), line
+    r = runner.invoke(app, [*cmd[3:-4], "--workers", "0", "--resume"])
+    assert r.exit_code == 0, r.output
+    assert read_table(out) == reference
+
+
+def test_sigterm_is_an_interrupt_with_its_own_exit_code():
+    """What ``tolerance`` and ``synthesize`` get too (their engine is entered with it)."""
+    import typer
+
+    from screwkit.cli.sweep_cmd import sigterm_as_interrupt, stopped
+
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(KeyboardInterrupt) as caught, sigterm_as_interrupt():
+        signal.raise_signal(signal.SIGTERM)
+        pytest.fail("SIGTERM did not interrupt")
+    assert signal.getsignal(signal.SIGTERM) == before  # restored
+    with pytest.raises(typer.Exit) as stop:
+        stopped(caught.value, "nothing written")
+    assert stop.value.exit_code == 143
+    with pytest.raises(typer.Exit) as stop:
+        stopped(KeyboardInterrupt(), "nothing written")  # Ctrl-C
+    assert stop.value.exit_code == 130
 
 
 def test_a_task_that_kills_every_worker_running_it_stops_with_one_sentence():

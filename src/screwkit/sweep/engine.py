@@ -20,6 +20,8 @@ counts such losses from the scheduler's event log and says so in one line
 
 from __future__ import annotations
 
+import asyncio
+import concurrent.futures
 import logging
 import os
 from collections.abc import Callable, Iterator, Sequence
@@ -32,6 +34,9 @@ from screwkit.sweep.worker_setup import PRELOAD
 
 #: environment variable naming an existing scheduler
 SCHEDULER_ENV = "SCREWKIT_SCHEDULER"
+#: Dask's cancellations: a request cut short as a connection ends (asyncio's), a future given up
+#: by the scheduler (distributed.FutureCancelledError derives from concurrent.futures')
+CANCELLED = (asyncio.CancelledError, concurrent.futures.CancelledError)
 #: tries to start the embedded cluster before giving up (bounded: a machine that cannot start a
 #: worker process three times in a row will not on the fourth)
 START_ATTEMPTS = 3
@@ -88,29 +93,32 @@ def _shared_value(value: Any) -> Any:
 
 
 class _ExpectedFaults(logging.Filter):
-    """Drops Dask's error logs about faults the engine recovers from and reports itself in
-    one line (:meth:`Engine.notes`): a result fetched from a worker that has just died is
-    fetched again from where it is computed anew."""
+    """Drops Dask's logs of faults the engine recovers from or reports itself in one sentence:
+    a result fetched from a worker that has just died (it is fetched again from where it is
+    computed anew), and connections that close or requests cancelled as a client, a cluster or
+    a lost scheduler's connection ends (``CommClosedError``, ``CancelledError``; logged with a
+    traceback, sometimes after the client has closed)."""
 
-    messages = ("Couldn't gather keys",)
+    messages = ("Couldn't gather keys", "Batched Comm Closed")
 
     def filter(self, record: logging.LogRecord) -> bool:
+        from distributed.comm.core import CommClosedError
+
+        exc = record.exc_info[1] if record.exc_info else None
+        while exc is not None:
+            if isinstance(exc, (CommClosedError, *CANCELLED)):
+                return False
+            exc = exc.__cause__ or exc.__context__
         text = record.getMessage()
         return not any(m in text for m in self.messages)
 
 
-@contextmanager
-def _dask_logs_filtered() -> Iterator[None]:
-    """:class:`_ExpectedFaults` on Dask's log handlers while the engine runs."""
-    handlers = logging.getLogger("distributed").handlers
-    expected = _ExpectedFaults()
-    for h in handlers:
-        h.addFilter(expected)
-    try:
-        yield
-    finally:
-        for h in handlers:
-            h.removeFilter(expected)
+def _filter_dask_logs() -> None:
+    """:class:`_ExpectedFaults` on Dask's log handlers, once; it stays, since Dask logs some of
+    this noise after the engine has stopped."""
+    for handler in logging.getLogger("distributed").handlers:
+        if not any(isinstance(f, _ExpectedFaults) for f in handler.filters):
+            handler.addFilter(_ExpectedFaults())
 
 
 def _ordinal(n: int) -> str:
@@ -148,12 +156,35 @@ class Engine:
             return 1
         return max(1, sum(self.client.nthreads().values()))
 
+    def _ask(self, call: Callable[[], Any], task: str = "") -> Any:
+        """``call()``, a request to Dask, with its faults as one sentence each: a task whose
+        workers all died under it (``task`` names it), a scheduler that went away."""
+        distributed = _dask()
+        try:
+            return call()
+        except distributed.KilledWorker:
+            raise EngineError(
+                f"{task} stopped every worker process that ran it (each died while running it: "
+                "out of memory, or killed), so the run stops; run again with fewer --workers or "
+                "a smaller --batch-size") from None
+        except (OSError, *CANCELLED) as exc:  # CommClosedError is an OSError
+            reason = getattr(exc, "reason", None) or _root_cause(exc).splitlines()[0]
+            if reason == "scheduler-connection-lost":
+                reason = "it stopped answering"
+            if isinstance(exc, OSError) or reason == "it stopped answering":
+                raise EngineError(
+                    f"the run lost its connection to the {self.description} ({reason}); check "
+                    "that the scheduler is running and run again") from None
+            raise EngineError(f"the {self.description} cancelled the work ({reason}); check "
+                              "the scheduler and its workers and run again") from None
+
     def map(self, function: Callable[..., Any], shared: Any, payloads: Sequence[tuple[Any, ...]],
             on_result: Callable[[int, Any], None]) -> None:
         """Run ``function(shared, *payloads[i])`` for every ``i`` and call
         ``on_result(i, result)`` as each finishes (in completion order). ``shared`` goes to each
         worker once (as the result of a task, fetched by each worker that needs it). An
-        exception in ``function`` is raised here.
+        exception in ``function`` is raised here; Dask's own faults as an
+        :class:`EngineError` with one sentence (:meth:`_ask`).
 
         The workers are listed at the start and after every result: one that has gone is
         counted lost, one that has come counted added (a worker lost and replaced between two
@@ -163,31 +194,26 @@ class Engine:
                 on_result(i, function(shared, *payload))
             return
         distributed = _dask()
-        start = set(self.client.nthreads())
+        client = self.client
+        start = set(self._ask(client.nthreads))
         seen = set(start)
         # a task, not scattered data: a task's result lost with its worker is computed again,
         # scattered data is gone (every task would then be cancelled)
-        shared_future = self.client.submit(_shared_value, shared, pure=False)
-        futures = [self.client.submit(function, shared_future, *payload, pure=False)
+        shared_future = client.submit(_shared_value, shared, pure=False)
+        futures = [client.submit(function, shared_future, *payload, pure=False)
                    for payload in payloads]
         index = {f.key: i for i, f in enumerate(futures)}
         try:
-            for future in distributed.as_completed(futures, loop=self.client.loop):
-                try:
-                    result = future.result()
-                except distributed.KilledWorker:
-                    raise EngineError(
-                        f"task {index[future.key] + 1} of {len(futures)} stopped every worker "
-                        "process that ran it (each died while running it: out of memory, or "
-                        "killed), so the run stops; run again with fewer --workers or a smaller "
-                        "--batch-size") from None
-                on_result(index[future.key], result)
+            for future in distributed.as_completed(futures, loop=client.loop):
+                i = index[future.key]
+                result = self._ask(future.result, f"task {i + 1} of {len(futures)}")
+                on_result(i, result)
                 future.release()
-                seen |= set(self.client.nthreads())
+                seen |= set(self._ask(client.nthreads))
         finally:
             for f in futures:
                 f.cancel()
-        now = set(self.client.nthreads())
+        now = set(self._ask(client.nthreads))
         self.lost_workers += len(seen - now)
         self.added_workers += len((seen | now) - start)
 
@@ -218,8 +244,8 @@ def start_engine(config: EngineConfig) -> Iterator[Engine]:
         yield Engine(None, "in this process (no Dask)")
         return
     distributed = _dask()
-    with _dask_logs_filtered():
-        yield from _dask_engine(distributed, config)
+    _filter_dask_logs()
+    yield from _dask_engine(distributed, config)
 
 
 def _dask_engine(distributed: Any, config: EngineConfig) -> Iterator[Engine]:

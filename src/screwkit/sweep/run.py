@@ -19,7 +19,13 @@ from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.kinematics.registry import require
 from screwkit.sweep.checkpoint import Checkpoint, check_resume_flags, fingerprint
 from screwkit.sweep.designs import DesignSet, make_designs
-from screwkit.sweep.engine import EngineConfig, batch_size, batches, start_engine
+from screwkit.sweep.engine import (
+    EngineConfig,
+    EngineError,
+    batch_size,
+    batches,
+    start_engine,
+)
 from screwkit.sweep.evaluate import STATUS_ERROR, STATUS_FAILED, SweepTask, evaluate_batch
 from screwkit.sweep.jobs import JobOptions, Row, check_job
 from screwkit.sweep.table import write_table
@@ -158,7 +164,13 @@ def compute_rows(definition: SweepDefinition, engine_config: EngineConfig, *,
             if progress is not None:
                 progress(len(done), n, len(done) - resumed)
 
-        engine.map(evaluate_batch, definition.task(), payloads, finished)
+        try:
+            engine.map(evaluate_batch, definition.task(), payloads, finished)
+        except EngineError as exc:
+            if checkpoint is None:
+                raise
+            raise EngineError(f"{exc}; the finished designs are kept in {checkpoint.folder} — "
+                              "run the same command with --resume to continue") from None
         notes.extend(engine.notes("design"))
         description = engine.description
     return ComputedRows([done[i] for i in range(n)], n - resumed, resumed, description,
