@@ -220,6 +220,7 @@ def test_a_scheduler_lost_mid_sweep_stops_with_one_sentence(tmp_path, reference)
                 p.wait(timeout=30)
     assert proc.returncode == 2, err
     folder = checkpoint_folder(out)
+    assert len(err.splitlines()) == 1, err
     [line] = err.splitlines()
     assert line.startswith(f"error: the run lost its connection to the Dask scheduler "
                            f"{address} ("), line

@@ -73,9 +73,11 @@ def machine_cores() -> int:
 
 
 def _dask_config(key: str) -> list[str]:
+    """A list-valued Dask setting (a single string is a list of one, as Dask reads it)."""
     import dask
 
-    return list(dask.config.get(key) or [])
+    value = dask.config.get(key, default=None) or []
+    return [value] if isinstance(value, str) else list(value)
 
 
 def _dask() -> Any:
@@ -224,8 +226,7 @@ class Engine:
         out = []
         if self.start_attempts > 1:
             out.append(f"the embedded Dask cluster started at the {_ordinal(self.start_attempts)} "
-                       f"attempt (a worker process stopped while starting: "
-                       f"{self.start_failure})")
+                       f"attempt ({self.start_failure})")
         if self.lost_workers:
             k = self.lost_workers
             workers = "1 worker process was" if k == 1 else f"{k} worker processes were"
@@ -310,11 +311,13 @@ def _local_cluster(distributed: Any, n: int) -> tuple[Any, int, str]:
                 preload=[*_dask_config("distributed.worker.preload"), PRELOAD])
         except (RuntimeError, OSError, TimeoutError) as exc:
             failure = _root_cause(exc)  # Dask closed what it had started
+            if "Nanny failed to start" in failure:
+                failure = f"a worker process stopped while starting: {failure}"
             continue
         return cluster, attempt, failure
     raise EngineError(
         f"the embedded Dask cluster of {n} worker process(es) did not start in "
-        f"{START_ATTEMPTS} attempts (a worker process stopped while starting: {failure}); "
+        f"{START_ATTEMPTS} attempts ({failure}); "
         "check the machine's free memory and run again, with fewer --workers, or with "
         "--workers 0 to run in this process")
 
