@@ -14,8 +14,10 @@ Faults (docs/sweeps.md, "Faults"): a worker process that dies while the embedded
 (killed, out of memory) fails Dask's whole start, so the start is tried again, at most
 :data:`START_ATTEMPTS` times, then refused with one sentence. A worker lost while the work runs
 is replaced by its nanny and its tasks are run again elsewhere (Dask does this); the engine
-counts such losses from the scheduler's event log and says so in one line
-(:meth:`Engine.notes`). A task whose workers keep dying under it is stopped with one sentence.
+counts such losses by listing the workers after every result and says so in one line
+(:meth:`Engine.notes`). A task whose workers keep dying under it, or a scheduler that goes
+away, stops the run with one sentence (:class:`EngineError`). Dask's logs that only narrate
+these faults are filtered out (:class:`_ExpectedFaults`).
 """
 
 from __future__ import annotations
@@ -97,19 +99,22 @@ def _shared_value(value: Any) -> Any:
 class _ExpectedFaults(logging.Filter):
     """Drops Dask's logs of faults the engine recovers from or reports itself in one sentence:
     a result fetched from a worker that has just died (it is fetched again from where it is
-    computed anew), and connections that close or requests cancelled as a client, a cluster or
-    a lost scheduler's connection ends (``CommClosedError``, ``CancelledError``; logged with a
-    traceback, sometimes after the client has closed)."""
+    computed anew), a client giving up on a scheduler that went away, and connections that close
+    or requests cancelled as a client, a cluster or a lost scheduler's connection ends
+    (``CommClosedError``, ``CancelledError``; logged with a traceback, sometimes after the
+    client has closed)."""
 
-    messages = ("Couldn't gather keys", "Batched Comm Closed")
+    messages = ("Couldn't gather keys", "Batched Comm Closed", "Failed to reconnect to scheduler")
 
     def filter(self, record: logging.LogRecord) -> bool:
         from distributed.comm.core import CommClosedError
 
         exc = record.exc_info[1] if record.exc_info else None
-        while exc is not None:
+        seen: set[int] = set()
+        while exc is not None and id(exc) not in seen:  # a chain, possibly with a cycle
             if isinstance(exc, (CommClosedError, *CANCELLED)):
                 return False
+            seen.add(id(exc))
             exc = exc.__cause__ or exc.__context__
         text = record.getMessage()
         return not any(m in text for m in self.messages)
