@@ -27,7 +27,7 @@ VALIDATION := bagci1969/analysis_tables bagci1969/synthesis rahman1996/kinematic
 demo: $(STAMP)
 	mkdir -p out
 	$(BIN)/screwkit sweep examples/rsrc_fig7_dynamics.toml --vary d2=4:5:9 --vary e=0.5:1.5:5 \
-		--job dynamics --output out/sweep_rsrc_dynamics.parquet --plot out/sweep_rsrc_dynamics.png
+		--job dynamics --output out/sweep_rsrc_dynamics.parquet --plot out/sweep_rsrc_dynamics.png --fresh
 	$(BIN)/screwkit demo examples --output-dir out
 	mkdir -p out/validation
 	@for v in $(VALIDATION); do \

@@ -54,8 +54,12 @@ def test_resume_refuses_a_checkpoint_of_another_sweep(tmp_path):
     other = define_sweep(SPEC, ["d2=4.2:4.9:4"], "dynamics")
     with pytest.raises(CheckpointError, match="belongs to another sweep"):
         run_sweep(other, out, IN_PROCESS, resume=True)
-    result = run_sweep(other, out, IN_PROCESS)  # without --resume it starts afresh
+    with pytest.raises(CheckpointError, match="another sweep writing the same output"):
+        run_sweep(other, out, IN_PROCESS)  # without --fresh it is not discarded silently
+    result = run_sweep(other, out, IN_PROCESS, fresh=True)
     assert result.resumed == 0 and out.exists()
+    assert result.notes == (f"--fresh: discarded the 1 finished design(s) of an earlier run "
+                            f"kept in {checkpoint_folder(out)}",)
 
 
 def test_ctrl_c_on_the_command_keeps_no_table(tmp_path):

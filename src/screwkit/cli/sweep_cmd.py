@@ -5,11 +5,13 @@ formats, the work is in :mod:`screwkit.sweep`."""
 
 from __future__ import annotations
 
+import signal
+import threading
 from collections import Counter
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, NoReturn
 
 import typer
 from rich.markup import escape
@@ -37,22 +39,68 @@ def progress_bar(label: str, total: int | None = None
         yield lambda done, total, computed: advance(done, total)
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM (a job scheduler's or ``kill``'s stop), raised in the main thread as Ctrl-C's
+    KeyboardInterrupt is, so that the same clean-up runs: the cluster stopped, the checkpoint
+    kept, one sentence printed."""
+
+
 @contextmanager
-def engine_for(scheduler: str | None, workers: int | None) -> Iterator[Any]:
+def sigterm_as_interrupt() -> Iterator[None]:
+    """While the block runs, SIGTERM raises :class:`_Terminated` (a second one ends the process
+    at once, as SIGTERM does by default). Python's default is to die without clean-up: no
+    message, worker processes and their semaphores left behind."""
+    if threading.current_thread() is not threading.main_thread():  # signals go to main only
+        yield
+        return
+
+    def on_sigterm(signum: int, frame: Any) -> None:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        raise _Terminated
+
+    previous = signal.signal(signal.SIGTERM, on_sigterm)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextmanager
+def engine_for(scheduler: str | None, workers: int | None, what: str = "task"
+               ) -> Iterator[Any]:
     """The running engine (:func:`screwkit.sweep.engine.start_engine`), stopped on exit; one
-    that cannot start (no Dask, no scheduler) is a user error (exit 2)."""
+    that cannot start (no Dask, no scheduler) is a user error (exit 2). SIGTERM stops it as
+    Ctrl-C does (:func:`sigterm_as_interrupt`); faults it recovered from are printed as notes
+    (``what``: the unit of work, for them) when the block ends normally."""
     from screwkit.sweep.engine import EngineConfig, start_engine
 
     with ExitStack() as stack:
-        yield guard(lambda: stack.enter_context(start_engine(EngineConfig(scheduler, workers))))
+        stack.enter_context(sigterm_as_interrupt())
+        engine = guard(lambda: stack.enter_context(start_engine(EngineConfig(scheduler,
+                                                                             workers))))
+        yield engine
+        print_notes(engine.notes(what))
 
 
-def interrupted(folder: Path, done: int | None = None) -> None:
-    """Ctrl-C: say what is kept and how to continue; exit 130."""
-    err_console.print(f"[yellow]interrupted:[/] no table written; the finished designs are "
-                      f"kept in {escape(str(folder))} — run the same command with --resume to "
-                      "continue", highlight=False)
-    raise typer.Exit(130)
+def print_notes(notes: Iterable[str]) -> None:
+    """One line per note on stderr."""
+    for note in notes:
+        err_console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
+
+
+def stopped(exc: KeyboardInterrupt, what: str) -> NoReturn:
+    """Ctrl-C (exit 130) or SIGTERM (exit 143, 128 + the signal's number, as a shell reports
+    it): one line saying so and ``what`` is kept or written."""
+    how, code = ("terminated (SIGTERM)", 143) if isinstance(exc, _Terminated) \
+        else ("interrupted", 130)
+    err_console.print(f"[yellow]{how}:[/] {what}", highlight=False)
+    raise typer.Exit(code)
+
+
+def interrupted(folder: Path, exc: KeyboardInterrupt) -> NoReturn:
+    """A sweep stopped by Ctrl-C or SIGTERM: say what is kept and how to continue."""
+    stopped(exc, f"no table written; the finished designs are kept in {escape(str(folder))} "
+                 "— run the same command with --resume to continue")
 
 
 def _summary(result: Any, output: Path, plot: Path | None) -> None:
@@ -68,6 +116,7 @@ def _summary(result: Any, output: Path, plot: Path | None) -> None:
     console.print(t)
     # a sentence, below the table: as a column it wrapped to one word a line in 80 columns
     console.print(f"engine: {escape(result.engine)}", highlight=False)
+    print_notes(result.notes)
     reasons = Counter(r["reason"] for r in rows if r["status"] != "ok")
     for reason, count in reasons.most_common(5):
         console.print(f"  • {count} × {escape(reason)}", highlight=False)
@@ -90,6 +139,7 @@ def register(app: typer.Typer) -> None:
         plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG: a line over one key, a heat map over two (grid), a scatter matrix otherwise.")] = None,
         plot_column: Annotated[str | None, typer.Option("--plot-column", help="The column the picture shows (default: the job's headline, e.g. shaking_force.rms).")] = None,
         resume: Annotated[bool, typer.Option("--resume", help="Continue an interrupted run of the same sweep from its checkpoint of finished designs.")] = False,
+        fresh: Annotated[bool, typer.Option("--fresh", help="Discard the checkpoint of an earlier run and start again (without --resume or --fresh, a checkpoint holding finished designs is refused, not lost).")] = False,
         scheduler: SchedulerOpt = None,
         workers: WorkersOpt = None,
         batch: Annotated[int | None, typer.Option("--batch-size", min=1, max=100000, help="Designs per task (default: about four tasks per worker, at most 64).")] = None,
@@ -113,11 +163,11 @@ def register(app: typer.Typer) -> None:
                                                 options=options))
         config = EngineConfig(scheduler, workers)
         try:
-            with progress_bar("sweep") as update:
+            with sigterm_as_interrupt(), progress_bar("sweep") as update:
                 result = guard(lambda: run_sweep(definition, output, config, resume=resume,
-                                                 batch=batch, progress=update))
-        except KeyboardInterrupt:
-            interrupted(checkpoint_folder(output))
+                                                 fresh=fresh, batch=batch, progress=update))
+        except KeyboardInterrupt as exc:
+            interrupted(checkpoint_folder(output), exc)
         if plot is not None:
             from screwkit.sweep.plots import default_column, plot_sweep
 

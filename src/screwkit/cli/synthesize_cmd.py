@@ -15,7 +15,7 @@ from rich.markup import escape
 from screwkit.cli.common import console, loop_only
 from screwkit.cli.common import guard as _guard
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
-from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for
+from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for, stopped
 from screwkit.errors import InputError
 
 __all__ = ["register", "synthesis_document"]
@@ -237,12 +237,11 @@ def global_synthesis(config: Any, starts: int, scheduler: str | None, workers: i
             return _guard(lambda: pipe.synthesize(starts, progress=advance))
     try:
         with progress_bar("synthesis starts", starts) as advance, \
-                engine_for(scheduler, workers) as engine:
+                engine_for(scheduler, workers, "synthesis start") as engine:
             return _guard(lambda: synthesize_on_engine(
                 config, starts, engine, lambda done, total, _: advance(done, total)))
-    except KeyboardInterrupt:
-        err_console.print("[yellow]interrupted:[/] nothing written")
-        raise typer.Exit(130) from None
+    except KeyboardInterrupt as exc:
+        stopped(exc, "nothing written")
 
 
 def register(app: typer.Typer) -> None:

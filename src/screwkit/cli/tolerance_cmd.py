@@ -12,9 +12,15 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from screwkit.cli.common import console, err_console, guard
+from screwkit.cli.common import console, guard
 from screwkit.cli.outputs import JsonOpt, Outputs, UnitOpt, UnitsOpt
-from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for, progress_bar
+from screwkit.cli.sweep_cmd import (
+    SchedulerOpt,
+    WorkersOpt,
+    engine_for,
+    progress_bar,
+    stopped,
+)
 
 
 def _is_angle(freedom: str) -> bool:
@@ -134,13 +140,12 @@ def register(app: typer.Typer) -> None:
         if monte_carlo:
             try:
                 with progress_bar("Monte Carlo") as update, \
-                        engine_for(scheduler, workers) as engine:
+                        engine_for(scheduler, workers, "Monte Carlo sample") as engine:
                     deviations = guard(lambda: run_monte_carlo(
                         engine, data, str(spec), tolerances, pipe.mode(), fo, monte_carlo,
                         seed, update))
-            except KeyboardInterrupt:
-                err_console.print("[yellow]interrupted:[/] nothing written")
-                raise typer.Exit(130) from None
+            except KeyboardInterrupt as exc:
+                stopped(exc, "nothing written")
             mc = compare(fo, tolerances, deviations, seed)
         doc = tolerance_document(spec, s, tolerances, fo, mc)
         du = out.units_for(s.units)

@@ -5,7 +5,9 @@ The folder holds ``sweep.json`` with the sweep's fingerprint (a hash of the spec
 designs, the job and its options, and the screwkit version) and one ``batch-<first>-<last>.json``
 per finished batch, each written through a temporary file and a rename, so an interruption
 leaves only whole batches. ``--resume`` reads them back and computes only the designs not yet
-done; a checkpoint of a different sweep is refused rather than mixed in.
+done; a checkpoint of a different sweep is refused rather than mixed in. A checkpoint holding
+finished designs is never discarded silently: a run without ``--resume`` refuses it unless
+``--fresh`` says to discard it.
 """
 
 from __future__ import annotations
@@ -32,6 +34,13 @@ def fingerprint(data: dict[str, Any], designs: str, job: str, options: dict[str,
     text = json.dumps({"spec": data, "designs": designs, "job": job, "options": options,
                        "version": __version__}, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def check_resume_flags(resume: bool, fresh: bool) -> None:
+    """``--resume`` and ``--fresh`` exclude each other."""
+    if resume and fresh:
+        raise CheckpointError("--resume continues the checkpoint and --fresh discards it: pass "
+                              "one of them")
 
 
 def checkpoint_folder(output: Path) -> Path:
@@ -61,8 +70,11 @@ class Checkpoint:
         if self._stored_key() != self.key:
             raise CheckpointError(
                 f"--resume: the checkpoint {self.folder} belongs to another sweep (the spec, "
-                "the designs, the job or its options differ); run without --resume to start "
-                "this sweep afresh (that replaces the checkpoint)")
+                "the designs, the job or its options differ); pass --fresh instead of "
+                "--resume to discard it and start this sweep afresh")
+        return self._rows()
+
+    def _rows(self) -> dict[int, Row]:
         rows: dict[int, Row] = {}
         for f in sorted(self.folder.glob("batch-*.json")):
             try:
@@ -73,14 +85,28 @@ class Checkpoint:
                 rows[int(row["design"])] = row
         return rows
 
-    def start(self, resume: bool) -> None:
-        """Create the folder for this sweep; without ``resume`` a checkpoint of an earlier run
-        is replaced."""
-        if self.exists() and (not resume or self._stored_key() != self.key):
+    def start(self, resume: bool, fresh: bool = False) -> int:
+        """Create the folder for this sweep and return how many finished designs of an earlier
+        run were discarded. ``resume`` keeps this sweep's checkpoint; ``fresh`` discards any;
+        without either, a checkpoint holding finished designs is refused (one that holds none
+        loses nothing and is replaced)."""
+        check_resume_flags(resume, fresh)
+        discarded = 0
+        same = self._stored_key() == self.key
+        if self.exists() and not (resume and same):
+            discarded = len(self._rows())
+            if discarded and not fresh:
+                whose = ("an interrupted run of this sweep" if same
+                         else "another sweep writing the same output")
+                resume_hint = "pass --resume to continue it, or " if same else "pass "
+                raise CheckpointError(
+                    f"{self.folder} holds {discarded} finished design(s) of {whose}; "
+                    f"{resume_hint}--fresh to discard them and start again")
             self.discard()
         self.folder.mkdir(exist_ok=True)
         write_text_atomic(self.folder / "sweep.json",
                           json.dumps({"fingerprint": self.key, "version": __version__}))
+        return discarded
 
     def save(self, rows: list[Row]) -> None:
         """Keep a finished batch (whole or not at all)."""

@@ -17,9 +17,15 @@ from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec, spec_from_data
 from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.kinematics.registry import require
-from screwkit.sweep.checkpoint import Checkpoint, fingerprint
+from screwkit.sweep.checkpoint import Checkpoint, check_resume_flags, fingerprint
 from screwkit.sweep.designs import DesignSet, make_designs
-from screwkit.sweep.engine import EngineConfig, batch_size, batches, start_engine
+from screwkit.sweep.engine import (
+    EngineConfig,
+    EngineError,
+    batch_size,
+    batches,
+    start_engine,
+)
 from screwkit.sweep.evaluate import STATUS_ERROR, STATUS_FAILED, SweepTask, evaluate_batch
 from screwkit.sweep.jobs import JobOptions, Row, check_job
 from screwkit.sweep.table import write_table
@@ -100,13 +106,15 @@ def define_sweep(spec_path: Path, vary: list[str], job: str, *, sample: str | No
 @dataclass(frozen=True)
 class SweepResult:
     """What a sweep did: its rows (design order), how many were computed now or resumed from a
-    checkpoint, how many failed or hit an internal error, the time and the engine."""
+    checkpoint, how many failed or hit an internal error, the time, the engine, and one
+    sentence per fault recovered from or checkpoint discarded (``notes``)."""
 
     rows: list[Row]
     computed: int
     resumed: int
     seconds: float
     engine: str
+    notes: tuple[str, ...] = ()
 
     @property
     def failed(self) -> int:
@@ -117,16 +125,35 @@ class SweepResult:
         return sum(1 for r in self.rows if r["status"] == STATUS_ERROR)
 
 
+@dataclass(frozen=True)
+class ComputedRows:
+    """:func:`compute_rows`' answer: the rows in design order, how many were computed now and
+    resumed, the engine's description and the notes (:class:`SweepResult`)."""
+
+    rows: list[Row]
+    computed: int
+    resumed: int
+    engine: str
+    notes: tuple[str, ...]
+
+
 def compute_rows(definition: SweepDefinition, engine_config: EngineConfig, *,
                  checkpoint: Checkpoint | None = None, resume: bool = False,
-                 batch: int | None = None, progress: Progress | None = None
-                 ) -> tuple[list[Row], int, int, str]:
-    """Every design's row in design order (rows, computed, resumed, engine description)."""
+                 fresh: bool = False, batch: int | None = None,
+                 progress: Progress | None = None) -> ComputedRows:
+    """Every design's row in design order. An earlier run's checkpoint is continued with
+    ``resume``, discarded with ``fresh``, and otherwise refused (``CheckpointError``) rather
+    than silently lost."""
     n = len(definition.designs)
     done: dict[int, Row] = {}
+    notes: list[str] = []
     if checkpoint is not None:
+        check_resume_flags(resume, fresh)
         done = checkpoint.resume() if resume else {}
-        checkpoint.start(resume)
+        discarded = checkpoint.start(resume, fresh)
+        if discarded:
+            notes.append(f"--fresh: discarded the {discarded} finished design(s) of an earlier "
+                         f"run kept in {checkpoint.folder}")
     resumed = len(done)
     todo = [i for i in range(n) if i not in done]
     values = definition.designs.values
@@ -143,22 +170,31 @@ def compute_rows(definition: SweepDefinition, engine_config: EngineConfig, *,
             if progress is not None:
                 progress(len(done), n, len(done) - resumed)
 
-        engine.map(evaluate_batch, definition.task(), payloads, finished)
+        try:
+            engine.map(evaluate_batch, definition.task(), payloads, finished)
+        except EngineError as exc:
+            if checkpoint is None:
+                raise
+            raise EngineError(f"{exc}; the finished designs are kept in {checkpoint.folder} — "
+                              "run the same command with --resume to continue") from None
+        notes.extend(engine.notes("design"))
         description = engine.description
-    return [done[i] for i in range(n)], n - resumed, resumed, description
+    return ComputedRows([done[i] for i in range(n)], n - resumed, resumed, description,
+                        tuple(notes))
 
 
 def run_sweep(definition: SweepDefinition, output: Path, engine_config: EngineConfig, *,
-              resume: bool = False, batch: int | None = None,
+              resume: bool = False, fresh: bool = False, batch: int | None = None,
               progress: Progress | None = None) -> SweepResult:
     """Run the sweep and write its table to ``output`` (atomically, rows in design order);
-    finished batches are checkpointed next to ``output`` until then (``resume`` continues
-    from them)."""
+    finished batches are checkpointed next to ``output`` until then. The checkpoint of an
+    earlier run is continued with ``resume``, discarded with ``fresh`` and otherwise refused
+    (docs/sweeps.md, "Resume")."""
     t0 = time.perf_counter()
     checkpoint = Checkpoint(output, definition.fingerprint())
-    rows, computed, resumed, engine = compute_rows(
-        definition, engine_config, checkpoint=checkpoint, resume=resume, batch=batch,
-        progress=progress)
-    write_table(output, rows, definition.metadata(), [definition.spec_path])
+    done = compute_rows(definition, engine_config, checkpoint=checkpoint, resume=resume,
+                        fresh=fresh, batch=batch, progress=progress)
+    write_table(output, done.rows, definition.metadata(), [definition.spec_path])
     checkpoint.discard()
-    return SweepResult(rows, computed, resumed, time.perf_counter() - t0, engine)
+    return SweepResult(done.rows, done.computed, done.resumed, time.perf_counter() - t0,
+                       done.engine, done.notes)
