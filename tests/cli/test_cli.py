@@ -169,7 +169,11 @@ def test_demo_runs_every_example(tmp_path):
                             "--no-reports"])
     assert r.exit_code == 0, r.output
     written = sorted(tmp_path.glob("*.analysis.json"))
-    assert len(written) == len(list(EXAMPLES.glob("*.toml")))
+    graphs = list(EXAMPLES.glob("mechanisms/*.toml"))
+    assert len(written) == len(list(EXAMPLES.glob("*.toml"))) + len(graphs) and graphs
+    # the graph examples too: their topology, and loads where every body has masses
+    assert json.loads((tmp_path / "jansen_leg.mobility.json").read_text())["mobility"] == 1
+    assert (tmp_path / "watt_sixbar.dynamics.json").exists()
     # the main job reproduces both seed systems: synthesis of Bagci's examples, dynamics and
     # balancing of Rahman's
     assert len(list(tmp_path.glob("bagci_example*_synthesis.synthesis.json"))) >= 7
@@ -179,6 +183,7 @@ def test_demo_runs_every_example(tmp_path):
     page = (tmp_path / "index.html").read_text()
     assert page.startswith("<!doctype html>") and "rahman_cssp_balance" in page
     assert "balancing objective G" in page and "shaking force RMS" in page
+    assert "stewart_platform" in page and "redundant constraints, idle freedoms" in page
 
 
 def test_dynamics_json_has_the_documented_keys():

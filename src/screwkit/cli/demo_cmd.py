@@ -28,6 +28,10 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
     def write(path: Path, result: Any) -> None:
         guard(lambda: write_json_atomic(path, result, files))
 
+    if f.parent.name == "mechanisms":  # any mechanism as a graph (docs/mechanisms.md)
+        from screwkit.cli.graph_views import demo_graph_example
+
+        return demo_graph_example(f, output_dir, files, plots, reports)
     spec = guard(lambda: load_spec(f))
     du = spec.display_units()
     console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
@@ -166,7 +170,7 @@ def register(app: typer.Typer) -> None:
         from screwkit.cli.progress import progress_bar
         from screwkit.io.outputs import make_output_folder
 
-        files = sorted(examples.glob("*.toml"))
+        files = sorted(examples.glob("*.toml")) + sorted(examples.glob("mechanisms/*.toml"))
         if not files:
             user_error(f"no spec files (*.toml) in {examples}")
         guard(lambda: make_output_folder(output_dir, "--output-dir"))

@@ -191,3 +191,66 @@ def _show_dynamics(spec: Any, dyn: Any, summary: dict[str, dict[str, Any]], unit
     if bad:
         console.print(f"  • no loads at {bad} sample(s) where the mode does not assemble or "
                       "is singular", highlight=False)
+
+
+def demo_graph_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
+                       reports: bool) -> tuple[list[str], dict[str, Any]]:
+    """``screwkit demo`` on a graph spec: analysis (JSON, CSV), topology, loads when every body
+    has mass properties, and the 3-D report; the demo table's row and the index entry."""
+    from rich.markup import escape
+
+    from screwkit.cli.common import console, guard
+    from screwkit.io.mechanism_documents import mechanism_document, mechanism_table
+    from screwkit.io.results import write_json_atomic
+    from screwkit.io.spec import load_spec
+    from screwkit.io.tables import write_table
+    from screwkit.report.thumbnail import graph_svg
+
+    def write(path: Path, result: Any) -> None:
+        guard(lambda: write_json_atomic(path, result, files))
+
+    spec = guard(lambda: load_spec(f))
+    du = spec.display_units()
+    console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+    motion = guard(lambda: solved(spec))
+    write(output_dir / f"{f.stem}.analysis.json", mechanism_document(motion, spec.topology))
+    guard(lambda: write_table(mechanism_table(motion), output_dir / f"{f.stem}.analysis.csv",
+                              "csv", du, files))
+    mob = guard(lambda: graph_mobility(spec))
+    write(output_dir / f"{f.stem}.mobility.json", mob)
+    jobs = ["analysis", "mobility"]
+    md = motion.modes[0]
+    res = float(np.nanmax(md.closure_residual))
+    summary: list[tuple[str, Any]] = [
+        ("input samples", len(spec.inputs)), ("analysis method", "graph continuation"),
+        ("samples assembling", int(np.sum(md.assembles))),
+        ("max loop-closure residual", f"{res:.1e}"),
+        ("loops", len(mob["loops"])),
+        ("mobility (Grübler–Kutzbach / Jacobian)", f"{mob['grubler_kutzbach']} / "
+                                                   f"{mob['mobility']}"),
+        ("redundant constraints, idle freedoms",
+         f"{len(mob['redundant_constraints'])}, {len(mob['idle_freedoms'])}")]
+    if all(b.mass is not None for b in spec.mechanism.bodies):
+        dyn = guard(lambda: graph_dynamics(spec, True))
+        doc = dyn.as_dict()
+        doc["summary"] = dynamics_summary(dyn)
+        write(output_dir / f"{f.stem}.dynamics.json", doc)
+        jobs.append("dynamics")
+        sf = doc["summary"]["shaking force"]
+        summary.append((f"shaking force RMS / peak, gravity on ({du.label('force')})",
+                        f"{du.show('force', sf['rms']):.6g} / {du.show('force', sf['peak']):.6g}"))
+    if reports:
+        from screwkit.report.spec_report import write_spec_report
+
+        guard(lambda: write_spec_report(spec, output_dir / f"{f.stem}.html"))
+    row = [f.stem, "graph", str(len(spec.inputs)), "1", str(int(np.sum(md.assembles))),
+           f"{res:.1e}", ", ".join(jobs)]
+    entry = {
+        "name": f.stem, "family": "graph", "description": spec.describe(),
+        "thumbnail": graph_svg(spec.mechanism, motion, spec.name),
+        "line": " · ".join(["graph", f"{len(mob['loops'])} loop(s)",
+                            *[j for j in jobs if j not in ("analysis", "mobility")]]),
+        "jobs": [(j, f"{f.stem}.{j}.json") for j in jobs], "summary": summary,
+        "picture": None, "report": f"{f.stem}.html" if reports else None,
+    }
+    return row, entry

@@ -95,3 +95,40 @@ def mechanism_svg(linkage: Any, motion: Any, preferred_mode: int = 0, title: str
                      f"fill='{colour}'><title>{html.escape(joint.name)}</title></circle>")
     parts.append("</svg>")
     return "".join(parts)
+
+
+def graph_svg(mechanism: Any, motion: Any, title: str = "") -> str:
+    """The gallery picture of a mechanism graph's drawn mode: each body as the polygon of its
+    joint centres at the first assembling frame, over the paths of the joint centres."""
+    box = (f"<svg xmlns='http://www.w3.org/2000/svg' width='{WIDTH}' height='{HEIGHT}' "
+           f"viewBox='0 0 {WIDTH} {HEIGHT}' role='img'>")
+    label = f"<title>{html.escape(title)}</title>" if title else ""
+    chosen = shown_mode_and_frame(motion, 0)
+    if chosen is None:
+        return (box + label + f"<text x='{WIDTH / 2}' y='{HEIGHT / 2}' text-anchor='middle' "
+                "font-size='11' fill='#777'>does not assemble</text></svg>")
+    k, frame = chosen
+    mode = motion.modes[k]
+    view = view_rotation()
+    centres = np.asarray(mode.joint_centres, dtype=float) @ view.T  # (N, n, 2)
+    fit = _fit(centres[np.isfinite(centres).all(axis=(1, 2))].reshape(-1, 2))
+    parts = [box, label]
+    for j in range(centres.shape[1]):
+        ok = np.isfinite(centres[:, j]).all(axis=1)
+        parts.append(f"<path d='{_path(centres[ok, j], fit)}' fill='none' stroke='#9ec5e8' "
+                     "stroke-width='1'/>")
+    for body in mechanism.body_names:
+        idx = [j for j, joint in enumerate(mechanism.joints) if body in joint.bodies]
+        pts = centres[frame, idx + idx[:1]] if len(idx) > 2 else centres[frame, idx]
+        parts.append(f"<path d='{_path(pts, fit)}' fill='none' stroke='#2f4f6f' "
+                     "stroke-width='2.2' stroke-linejoin='round'/>")
+    inputs = {name.split(".")[0] for name in mechanism.inputs}
+    scale, ox, oy = fit
+    for j, joint in enumerate(mechanism.joints):
+        x, y = centres[frame, j]
+        grounded = "ground" in joint.bodies
+        colour = "#e07020" if joint.name in inputs else ("#000" if grounded else "#37474f")
+        parts.append(f"<circle cx='{ox + scale * x:.1f}' cy='{oy - scale * y:.1f}' r='3.2' "
+                     f"fill='{colour}'><title>{html.escape(joint.name)}</title></circle>")
+    parts.append("</svg>")
+    return "".join(parts)
