@@ -209,7 +209,7 @@ def demo_graph_example(f: Path, output_dir: Path, files: list[Path], plots: bool
     def write(path: Path, result: Any) -> None:
         guard(lambda: write_json_atomic(path, result, files))
 
-    spec = guard(lambda: load_spec(f))
+    spec: Any = guard(lambda: load_spec(f))
     du = spec.display_units()
     console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
     motion = guard(lambda: solved(spec))
