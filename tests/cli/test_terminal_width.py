@@ -148,7 +148,7 @@ def test_sweep_summary_fits_80_columns(monkeypatch):
     rows = [{"status": "ok", "reason": ""}] * 11 + [{"status": "failed",
                                                        "reason": "does not assemble"}]
     result = SimpleNamespace(rows=rows, computed=12, resumed=0, failed=1, errors=0,
-                             seconds=3.81, engine=engine)
+                             seconds=3.81, engine=engine, notes=())
     sweep_cmd._summary(result, Path("sweep.csv"), None)
     lines = out.getvalue().splitlines()
     table = [line for line in lines if BOX & set(line)]

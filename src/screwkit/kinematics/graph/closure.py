@@ -145,17 +145,24 @@ def graph_forward(mech: Mechanism, lay: GraphLayout, conf: Configuration, exact:
     g = lay.body_of[GROUND]
     R[:, g] = np.eye(3)
     p[:, g] = 0.0
-    motions = {}
     for k, parent, child in mech.topology.tree:
         Mr, Mp = joint_motion(mech, lay, conf, k)
-        motions[k] = (Mr, Mp)
         a, b = lay.body_of[parent], lay.body_of[child]
         if mech.joints[k].bodies[0] != parent:  # the tree runs against the joint: M⁻¹
             Mr = np.swapaxes(Mr, -1, -2)
             Mp = -np.einsum("nij,nj->ni", Mr, Mp)
         R[:, b] = R[:, a] @ Mr
         p[:, b] = np.einsum("nij,nj->ni", R[:, a], Mp) + p[:, a]
-    residual = np.empty((N, len(mech.topology.chords), 6))
+    residual = loop_residuals(mech, lay, conf, R, p, exact)
+    screws, centres, axes = _screws(mech, lay, R, p)
+    return GraphFrames(R, p, screws, residual, centres, axes)
+
+
+def loop_residuals(mech: Mechanism, lay: GraphLayout, conf: Configuration, R: Array, p: Array,
+                   exact: bool = True) -> Array:
+    """Every loop's closure twist (N, L, 6) from the body poses: E_j = T_a M_j T_b⁻¹ at each
+    chord j, by the exact logarithm or its first-order form (:func:`graph_forward`)."""
+    residual = np.empty((conf.size, len(mech.topology.chords), 6))
     for l, k in enumerate(mech.topology.chords):
         Mr, Mp = joint_motion(mech, lay, conf, k)
         a, b = (lay.body_of[x] for x in mech.joints[k].bodies)
@@ -165,8 +172,7 @@ def graph_forward(mech: Mechanism, lay: GraphLayout, conf: Configuration, exact:
         ER = Ra @ Rbt
         Ep = pa - np.einsum("nij,nj->ni", ER, p[:, b])
         residual[:, l] = closure_twist(ER, Ep) if exact else closure_error(ER, Ep)
-    screws, centres, axes = _screws(mech, lay, R, p)
-    return GraphFrames(R, p, screws, residual, centres, axes)
+    return residual
 
 
 def _line_screw(u: Array, c: Array, pitch: float = 0.0) -> Array:

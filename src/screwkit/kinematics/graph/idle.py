@@ -40,7 +40,8 @@ def _spin_of(mech: Mechanism, lay: GraphLayout, lin: Linearised, q: Array,
     out = np.empty((q.shape[0], len(found)))
     for k, (body, j1, j2) in enumerate(found):
         u = lin.frames.centres[:, j2] - lin.frames.centres[:, j1]
-        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        size = np.linalg.norm(u, axis=1, keepdims=True)
+        u = np.where(size > 0.0, u / np.where(size > 0.0, size, 1.0), 0.0)  # 0: not reached
         out[:, k] = np.einsum("ni,ni->n", V[:, lay.body_of[body], :3], u)
     return out
 

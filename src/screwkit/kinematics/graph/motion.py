@@ -19,10 +19,12 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.dual.spatial import cross
 from screwkit.errors import InputError, UnknownNameError
 from screwkit.kinematics.graph.closure import (
+    GraphFrames,
     GraphLayout,
     body_accelerations,
     body_twists,
     graph_layout,
+    loop_residuals,
 )
 from screwkit.kinematics.graph.newton import (
     RANK_CUTOFF,
@@ -160,7 +162,7 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
         raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
                             f"first input row {_fmt(mech, lay, X[0])}: the mechanism stops "
                             "assembling before it")
-    mode = build_mode(mech, lay, followed.conf, followed.mask, X, Xd, Xdd)
+    mode = build_mode(mech, lay, followed.conf, followed.mask, X, Xd, Xdd, followed.frames)
     events = list(mode.events)
     if followed.stopped_after is not None and followed.stopped_after >= 0:
         k = followed.stopped_after
@@ -186,10 +188,17 @@ def _fmt(mech: Mechanism, lay: GraphLayout, x: Array) -> str:
 
 
 def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDArray[np.bool_],
-               X: Array, Xd: Array, Xdd: Array) -> MechanismMode:
-    """Everything about one mode from its configurations (module docstring)."""
+               X: Array, Xd: Array, Xdd: Array, tracked: GraphFrames | None = None
+               ) -> MechanismMode:
+    """Everything about one mode from its configurations (module docstring); ``tracked``, the
+    tracker's body poses and screws at those configurations, are reused when given (only the
+    loops' exact closure twists are evaluated anew)."""
     rank = expected_rank(mech, lay)
-    lin = linearise(mech, lay, conf, full_rank=rank == len(lay.passive))
+    if tracked is not None:
+        tracked = GraphFrames(tracked.R, tracked.p, tracked.screws,
+                              loop_residuals(mech, lay, conf, tracked.R, tracked.p),
+                              tracked.centres, tracked.axes)
+    lin = linearise(mech, lay, conf, tracked, full_rank=rank == len(lay.passive))
     fr = lin.frames
     qd = rates(mech, lay, lin, Xd)
     idle = rank < len(lay.passive)

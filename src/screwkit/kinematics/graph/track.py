@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.graph.closure import GraphLayout, body_twists, loop_bias
+from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, body_twists, loop_bias
 from screwkit.kinematics.graph.newton import (
     CLOSURE_TOL,
     Linearised,
@@ -129,6 +129,9 @@ class Followed:
     conf: Configuration
     mask: NDArray[np.bool_]
     stopped_after: int | None
+    #: the body poses, screws, joint centres and axes at every sample reached (the corrector's
+    #: last evaluation, at the closed configuration), for the motion build to reuse
+    frames: GraphFrames | None = None
 
 
 def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
@@ -151,6 +154,8 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
     else:
         scal[0], sph[0], mask[0] = 0.0, np.eye(3), True
         k = 1
+    frames = _frame_store(at.lin.frames, N)
+    _store(frames, 0, at.lin.frames, 0)
     wave = 8
     report = progress if callable(progress) else None
     while k < N:
@@ -162,11 +167,12 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
                 continue
             reached = _split_step(mech, lay, at, X[k], 1)
             if reached is None:
-                return Followed(Configuration(scal, sph), mask, k - 1)
+                return Followed(Configuration(scal, sph), mask, k - 1, frames)
             conf, lin, count = reached.conf, reached.lin, 1
         scal[k:k + count] = conf.scalars[:count]
         sph[k:k + count] = conf.spherical[:count]
         mask[k:k + count] = True
+        _store(frames, k, lin.frames, count)
         last = count - 1
         at = _Point(conf.take(slice(last, last + 1)), X[k + last].copy(),
                     lin.take(slice(last, last + 1)))
@@ -174,7 +180,28 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
         wave = min(2 * wave, MAX_WAVE) if count == X_wave.shape[0] else max(1, count)
         if report is not None:
             report(k, N)
-    return Followed(Configuration(scal, sph), mask, None)
+    return Followed(Configuration(scal, sph), mask, None, frames)
+
+
+def _frame_store(like: GraphFrames, N: int) -> GraphFrames:
+    def new(a: Array) -> Array:
+        out = np.zeros((N, *a.shape[1:]))
+        if a.ndim == 4:  # rotations: the identity where no sample is reached
+            out[:] = np.eye(3)
+        return out
+
+    return GraphFrames(*(new(a) for a in (like.R, like.p, like.screws, like.residual,
+                                          like.centres, like.axes)))
+
+
+def _store(store: GraphFrames, k: int, frames: GraphFrames, count: int) -> None:
+    """Samples k … k + count − 1 of ``store`` from the first ``count`` of ``frames`` (count 0:
+    sample k from frames' first)."""
+    n = max(count, 1)
+    for a, b in zip((store.R, store.p, store.screws, store.residual, store.centres, store.axes),
+                    (frames.R, frames.p, frames.screws, frames.residual, frames.centres,
+                     frames.axes), strict=True):
+        a[k:k + n] = b[:n]
 
 
 def _approach(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array) -> _Point | None:
