@@ -12,6 +12,7 @@ never reads a file path from a page, and writes only the spec it was started wit
 from __future__ import annotations
 
 import json
+import logging
 import math
 import secrets
 import socket
@@ -24,6 +25,8 @@ from urllib.parse import urlsplit
 
 from screwkit.studio.design import Design
 from screwkit.studio.session import Tab
+
+log = logging.getLogger("screwkit.studio")
 
 #: the static files a page may ask for, by name → (package folder, file, media type)
 STATIC = {
@@ -98,7 +101,12 @@ def create_app(studio: Studio) -> Any:
 
     def handle(tab: Tab, text: str) -> str:
         with save_lock:  # one file write at a time; solving is quick
-            reply = tab.handle(text)
+            try:
+                reply = tab.handle(text)
+            except Exception as exc:  # a bug, not the page's mistake: say so, keep serving
+                log.exception("studio: the answer to a message failed")
+                reply = {"type": "error", "seq": 0, "message": f"internal error ({exc!r}); "
+                         "the studio goes on — please report this with the spec"}
         return json.dumps(finite(reply), separators=(",", ":"))
 
     async def updates(ws: WebSocket) -> None:

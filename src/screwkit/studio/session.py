@@ -9,6 +9,9 @@ A page sends JSON objects with a ``type``:
     ``state``. Values and mode that are left out keep theirs.
 ``{"type": "undo" | "redo" | "state", "seq": n}``
     Step back or forward through the tab's history, or ask for the current state.
+``{"type": "numbers", "seq": n}``
+    The table of the CLI's numbers (limit positions, minimum transmission) of the current
+    state: slower than the curves, so a page asks for it once they are drawn.
 ``{"type": "save", "seq": n}``
     Write the tab's design into the spec file the studio was started with.
 ``{"type": "export", "seq": n, "what": "report" | "csv" | "spec"}``
@@ -18,7 +21,7 @@ A page sends JSON objects with a ``type``:
 Answers: ``{"type": "state", "seq", "values", "mode", "can_undo", "can_redo", "result"}``
 (``result`` is :func:`~screwkit.studio.solve.solve_spec`'s dictionary, or ``{"ok": false,
 "error": sentence}`` where the design cannot be solved), ``{"type": "saved", "seq", "path"}``,
-``{"type": "download", "seq", "name", "mime", "text"}`` and ``{"type": "error", "seq",
+``{"type": "numbers", "seq", "numbers"}``, ``{"type": "download", "seq", "name", "mime", "text"}`` and ``{"type": "error", "seq",
 "message"}``. No message carries a file path to the server.
 """
 
@@ -33,6 +36,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError
 
 from screwkit.errors import ScrewkitError
+from screwkit.pipeline import Pipeline
 from screwkit.studio.design import Design
 
 #: how many steps back a tab remembers
@@ -54,7 +58,7 @@ class SetMessage(_Message):
 
 
 class StepMessage(_Message):
-    type: Literal["undo", "redo", "state", "save"]
+    type: Literal["undo", "redo", "state", "save", "numbers"]
 
 
 class ExportMessage(_Message):
@@ -108,6 +112,7 @@ class Tab:
     def __post_init__(self) -> None:
         d = self.design
         self.state = DesignState(tuple(d.initial_values.items()), d.initial_mode)
+        self._solved: tuple[DesignState, Pipeline] | None = None
 
     def set(self, values: dict[str, float], mode: int | None) -> None:
         merged = {**self.state.as_dict, **values}
@@ -125,13 +130,21 @@ class Tab:
             target.append(self.state)
             self.state = source.pop()
 
+    def pipeline(self) -> Pipeline:
+        """The pipeline of the current state (solved once per state)."""
+        if self._solved is None or self._solved[0] != self.state:
+            self._solved = (self.state, Pipeline(self.design.spec_with(self.state.as_dict,
+                                                                       self.state.mode)))
+        return self._solved[1]
+
     def answer(self, seq: int) -> dict[str, Any]:
-        """The ``state`` answer: the values, the history flags and the solved design."""
+        """The ``state`` answer: the values, the history flags and the solved design (without
+        the numbers table, which a ``numbers`` message asks for)."""
         from screwkit.studio.solve import solve_spec
 
         values, mode = self.state.as_dict, self.state.mode
         try:
-            result = solve_spec(self.design.spec_with(values, mode))
+            result = solve_spec(self.pipeline(), numbers=False)
         except ScrewkitError as exc:
             result = {"ok": False, "error": str(exc)}
         except (FloatingPointError, np.linalg.LinAlgError) as exc:
@@ -153,6 +166,10 @@ class Tab:
                 return self.export(msg.what, seq)
             elif msg.type in ("undo", "redo"):
                 self.step(msg.type == "undo")
+            elif msg.type == "numbers":
+                from screwkit.studio.solve import numbers_table
+
+                return {"type": "numbers", "seq": seq, "numbers": numbers_table(self.pipeline())}
             elif msg.type == "save":
                 path = save_design(self.design, self.state.as_dict, self.state.mode)
                 return {"type": "saved", "seq": seq, "path": str(path)}

@@ -27,6 +27,15 @@ def _series(values: Any) -> list[float | None]:
     return [float(v) if np.isfinite(v) else None for v in a]
 
 
+def _floats(values: Any, width: int | None = None) -> np.ndarray:
+    """A document's series (a list with ``None`` where a mode does not assemble, or an
+    array) as floats, NaN for the ``None`` (rows of ``width`` NaN for a list of vectors)."""
+    if isinstance(values, np.ndarray):
+        return values.astype(float)
+    gap = np.nan if width is None else [np.nan] * width
+    return np.asarray([gap if v is None else v for v in values], dtype=float)
+
+
 def _kind_of(name: str) -> str:
     return "length" if name.endswith(".s") else "angle"
 
@@ -101,7 +110,7 @@ def _dynamics(pipe: Pipeline) -> tuple[dict[str, Any] | None, str | None]:
 def _loads(doc: dict[str, Any], mode: int, units: Any) -> dict[str, Any]:
     """The load curves and the peak and RMS of every load (``screwkit dynamics``'s table) in
     display units."""
-    reactions = np.stack([np.linalg.norm(np.asarray(r["force"], dtype=float), axis=1)
+    reactions = np.stack([np.linalg.norm(_floats(r["force"], 3), axis=1)
                           for r in doc["reactions"].values()])
     with np.errstate(invalid="ignore"):
         largest = np.where(np.isnan(reactions).all(axis=0), np.nan,
@@ -111,11 +120,11 @@ def _loads(doc: dict[str, Any], mode: int, units: Any) -> dict[str, Any]:
     f, m = units.label("force"), units.label("moment")
     curves = {
         f"input effort {name} [{units.label(effort_kind)}]":
-            _series(units.show(effort_kind, np.asarray(doc["efforts"][name], dtype=float))),
+            _series(units.show(effort_kind, _floats(doc["efforts"][name]))),
         f"shaking force [{f}]": _series(units.show(
-            "force", np.linalg.norm(np.asarray(doc["shaking_force"], dtype=float), axis=1))),
+            "force", np.linalg.norm(_floats(doc["shaking_force"], 3), axis=1))),
         f"shaking moment [{m}]": _series(units.show(
-            "moment", np.linalg.norm(np.asarray(doc["shaking_moment"], dtype=float), axis=1))),
+            "moment", np.linalg.norm(_floats(doc["shaking_moment"], 3), axis=1))),
         f"largest joint reaction force [{f}]": _series(units.show("force", largest)),
     }
     summary = []
@@ -137,10 +146,12 @@ def _summary_kind(key: str) -> str:
     return "force"
 
 
-def _numbers(pipe: Pipeline, units: Any, x_kind: str, trans: list[Any] | None) -> list[list[str]]:
+def numbers_table(pipe: Pipeline) -> list[list[str]]:
     """The table of numbers ``screwkit limits`` and ``screwkit analyze`` print: every limit
     position of the outputs (input, value, dwell order) and each mode's minimum transmission
     index and worst transmission angle."""
+    units = pipe.spec.display_units()
+    x_kind = _kind_of(pipe.motion.input_names[0])
     rows: list[list[str]] = []
     xl = units.label(x_kind)
     try:
@@ -155,30 +166,35 @@ def _numbers(pipe: Pipeline, units: Any, x_kind: str, trans: list[Any] | None) -
             rows.append(["limit positions", "none: the outputs turn fully"])
     except ScrewkitError as exc:
         rows.append(["limit positions", str(exc)])
-    if trans is not None:
-        x = np.asarray(pipe.spec.inputs, dtype=float).reshape(len(pipe.spec.inputs), -1)[:, 0]
-        for entry in pipe.transmission().summary(x):
-            for name, st in entry["index"].items():
-                if st["value"] is not None:
-                    rows.append([f"min transmission index of {name}, mode {entry['mode']}",
-                                 f"{st['value']:.4f} at input "
-                                 f"{units.show(x_kind, st['at']):.6g} {xl}"])
-            if "angle" in entry and entry["angle"]["value"] is not None:
-                st = entry["angle"]
-                rows.append([f"worst transmission angle, mode {entry['mode']}",
-                             f"{units.show('angle', st['value']):.6g} {units.label('angle')} "
-                             f"at input {units.show(x_kind, st['at']):.6g} {xl}"])
+    x = np.asarray(pipe.spec.inputs, dtype=float).reshape(len(pipe.spec.inputs), -1)[:, 0]
+    try:
+        summary = pipe.transmission().summary(x)
+    except ScrewkitError:
+        summary = []
+    for entry in summary:
+        for name, st in entry["index"].items():
+            if st["value"] is not None:
+                rows.append([f"min transmission index of {name}, mode {entry['mode']}",
+                             f"{st['value']:.4f} at input "
+                             f"{units.show(x_kind, st['at']):.6g} {xl}"])
+        if "angle" in entry and entry["angle"]["value"] is not None:
+            st = entry["angle"]
+            rows.append([f"worst transmission angle, mode {entry['mode']}",
+                         f"{units.show('angle', st['value']):.6g} {units.label('angle')} "
+                         f"at input {units.show(x_kind, st['at']):.6g} {xl}"])
     return rows
 
 
-def solve_spec(spec: Spec, *, numbers: bool = True) -> dict[str, Any]:
+def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True) -> dict[str, Any]:
     """Everything the page draws for ``spec`` (module docstring) as a JSON-able dictionary
-    (display units; the scene stays SI). ``numbers=False`` leaves out the limit positions (the
-    slowest part) for a quick first answer."""
+    (display units; the scene stays SI). ``numbers=False`` leaves out the table of
+    :func:`numbers_table` (the limit positions are the slowest part), which the page asks for
+    once the curves are drawn."""
     from screwkit.report.scene import scene_from_motion
     from screwkit.report.spec_report import seed_tables
 
-    pipe = Pipeline(spec)
+    pipe = spec if isinstance(spec, Pipeline) else Pipeline(spec)
+    spec = pipe.spec
     units = spec.display_units()
     mot = pipe.motion
     input_name = mot.input_names[0]
@@ -212,7 +228,7 @@ def solve_spec(spec: Spec, *, numbers: bool = True) -> dict[str, Any]:
         "length_unit": units.label("length"),
         "transmission": trans, "transmission_note": trans_note,
         "loads": loads, "loads_note": loads_note,
-        "numbers": _numbers(pipe, units, x_kind, trans) if numbers else None,
+        "numbers": numbers_table(pipe) if numbers else None,
         "assembly": assembly_notes(pipe, np.asarray(x_shown), units.label(x_kind)),
         "scene": packed,
     }

@@ -9,7 +9,7 @@
   const COLOURS = ['#2f6db5', '#d1495b', '#2a9d8f', '#8e6cc0', '#c9853a', '#4f8a3c'];
   const S = {
     state: null, result: null, frame: 0, mode: boot.mode, playing: false, seq: 0,
-    inflight: null, pending: null, latencies: [], viewLatencies: [], errors: [],
+    inflight: null, pending: null, lastChange: 0, latencies: [], viewLatencies: [], errors: [],
     messages: [], viewReady: false,
   };
   window.studio = S;
@@ -52,6 +52,7 @@
     const msg = { type: 'set', values };
     if (mode !== null && mode !== undefined) msg.mode = mode;
     S.inflight = { seq: S.send(msg), t0 };
+    S.lastChange = S.inflight.seq;
   }
 
   function receive(msg) {
@@ -60,12 +61,15 @@
     if (msg.type === 'state') showState(msg, timed);
     else if (msg.type === 'error') { S.errors.push(msg.message); say(msg.message, 'error'); }
     else if (msg.type === 'saved') say(`saved ${msg.path}`, 'ok');
+    else if (msg.type === 'numbers') { S.numbers = msg.numbers; drawNumbers(msg.numbers); $('numbers').classList.remove('stale'); document.body.dataset.numbers = String(msg.seq); }
     else if (msg.type === 'download') download(msg);
     if (S.inflight === null && S.pending) {
       const p = S.pending;
       S.pending = null;
       change(p.values, p.mode);
       if (S.inflight) S.inflight.t0 = p.t0;
+    } else if (S.inflight === null && msg.type === 'state' && msg.result.ok) {
+      S.send({ type: 'numbers' }); // the slower table, once the curves are drawn
     }
   }
 
@@ -99,8 +103,9 @@
   }
 
   // ---- controls ------------------------------------------------------------------------
-  $('undo').onclick = () => { S.inflight = { seq: S.send({ type: 'undo' }), t0: performance.now() }; };
-  $('redo').onclick = () => { S.inflight = { seq: S.send({ type: 'redo' }), t0: performance.now() }; };
+  const step = (type) => { S.inflight = { seq: S.send({ type }), t0: performance.now() }; S.lastChange = S.inflight.seq; };
+  $('undo').onclick = () => step('undo');
+  $('redo').onclick = () => step('redo');
   $('save').onclick = () => S.send({ type: 'save' });
   $('export-report').onclick = () => S.send({ type: 'export', what: 'report' });
   $('export-csv').onclick = () => S.send({ type: 'export', what: 'csv' });
@@ -245,10 +250,14 @@
     }
   }
 
-  function drawTables(r) {
+  function drawNumbers(rows) {
     const t = $('numbers');
     t.textContent = '';
-    for (const [k, v] of r.numbers || []) { const tr = el('tr'); tr.append(el('th', {}, k), el('td', {}, v)); t.appendChild(tr); }
+    for (const [k, v] of rows) { const tr = el('tr'); tr.append(el('th', {}, k), el('td', {}, v)); t.appendChild(tr); }
+  }
+
+  function drawTables(r) {
+    $('numbers').classList.add('stale'); // until the numbers of this state arrive
     const lt = $('loads-table');
     lt.textContent = r.loads_note || '';
     if (r.loads) {
@@ -305,6 +314,7 @@
       $('assembly').className = 'error';
       document.body.dataset.solved = 'error';
       S.result = r;
+      document.body.dataset.drawn = String(msg.seq);
       return;
     }
     say('', '');
