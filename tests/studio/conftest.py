@@ -3,7 +3,6 @@ example, and a headless Debian chromium driven by Playwright (never a downloaded
 
 from __future__ import annotations
 
-import shutil
 import threading
 import time
 from collections.abc import Iterator
