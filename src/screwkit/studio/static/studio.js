@@ -88,7 +88,7 @@
     const row = el('div', { class: 'dim', 'data-name': d.name });
     const slider = el('input', { type: 'range', min: d.low, max: d.high, step: d.step, value: d.value, 'aria-label': d.name });
     const box = el('input', { type: 'number', step: 'any', value: d.value, 'aria-label': `${d.name} value` });
-    row.append(el('label', {}, d.name), slider, box, el('span', { class: 'unit' }, d.unit));
+    row.append(el('label', { title: d.name }, d.name.replace(/^dimensions\./, '')), slider, box, el('span', { class: 'unit' }, d.unit));
     $('dims').appendChild(row);
     dimInputs[d.name] = { slider, box };
     slider.addEventListener('input', () => { box.value = slider.value; change({ [d.name]: +slider.value }); });
@@ -220,6 +220,17 @@
     return svg;
   }
 
+  // the coordinate plane on which the paths spread most (the sum of each path's bounding-box
+  // area there), so a circle is seen as a circle rather than edge-on
+  function widestPlane(paths) {
+    const spans = paths.map((p) => [0, 1, 2].map((j) => {
+      const v = p[j].filter((x) => x !== null);
+      return v.length ? Math.max(...v) - Math.min(...v) : 0;
+    }));
+    const area = (pr) => spans.reduce((a, s) => a + s[pr[0]] * s[pr[1]], 0);
+    return [[0, 1], [0, 2], [1, 2]].reduce((a, b) => (area(b) > area(a) ? b : a));
+  }
+
   function drawPlots(r) {
     $('plots').textContent = '';
     const x = r.input.values, xl = `${r.input.name} [${r.input.unit}]`;
@@ -229,9 +240,9 @@
         name: m.label, x, y: m.outputs[name], colour: COLOURS[k % COLOURS.length], bold: k === S.mode,
       })), { linked: true });
     }
-    const proj = S.projection || [0, 1];
     const axes = 'xyz';
     const m = r.paths.modes[Math.min(S.mode, r.paths.modes.length - 1)] || {};
+    const proj = S.projection || widestPlane(Object.values(m));
     const svg = plot(`${r.paths.title}, ${r.modes[S.mode] ? r.modes[S.mode].label : ''}, projected on ${axes[proj[0]]}${axes[proj[1]]}`,
       `${axes[proj[0]]} [${r.length_unit}]`, Object.entries(m).map(([n, p]) => ({ name: n, x: p[proj[0]], y: p[proj[1]] })), { square: true });
     const pick = el('select', { 'aria-label': 'projection', class: 'projection' });
