@@ -113,6 +113,13 @@ def test_design_keeps_comments_and_written_units(tmp_path: Path) -> None:
     assert "# the link lengths" in new and "# the end" in new
     assert load_spec(spec).dimensions["d2"] != d.spec_with({"dimensions.d2": 4.75}, 0).dimensions["d2"]
     assert d.spec_with({"dimensions.d2": 4.75}, 0).dimensions["d2"] == pytest.approx(4.75 * 0.0254)
+    # a value written with its unit is written back with it
+    spec.write_text(source.replace("d2 = 4.5", 'd2 = "114.3 mm"  # in millimetres'),
+                    encoding="utf-8")
+    mm = Design(spec)
+    assert mm.by_name["dimensions.d2"].key.unit == "mm" and mm.by_name["dimensions.d2"].value == 114.3
+    written = mm.text_with({**mm.initial_values, "dimensions.d2": 120.0}, 0)
+    assert 'd2 = "120.0 mm"  # in millimetres' in written
     with pytest.raises(StudioError, match="not a value this studio edits"):
         d.check({"../etc": 1.0}, 0)
     loop = Design(EXAMPLES / "rrsrr_loop.toml")
