@@ -6,6 +6,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -54,6 +55,9 @@ def serve(spec: Path, save_as: Path | None = None) -> Iterator[Served]:
         server.should_exit = True
         thread.join(10)
         sock.close()
+
+
+serving = contextmanager(serve)
 
 
 @pytest.fixture(scope="module")

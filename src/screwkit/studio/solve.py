@@ -37,7 +37,10 @@ def _floats(values: Any, width: int | None = None) -> np.ndarray:
 
 
 def _kind_of(name: str) -> str:
-    return "length" if name.endswith(".s") else "angle"
+    """``"length"`` for a slide (``<joint>.s``, Rahman's ``s4``), else ``"angle"``."""
+    from screwkit.kinematics.motion_table import variable_kind
+
+    return variable_kind(name)
 
 
 def assembly_runs(x_shown: np.ndarray, ok: np.ndarray, unit: str) -> str:
