@@ -99,7 +99,7 @@ def _transmission(pipe: Pipeline, units: Any) -> tuple[list[dict[str, Any]] | No
     return out, None
 
 
-def _dynamics(pipe: Pipeline) -> tuple[dict[str, Any] | None, str | None]:
+def dynamics_document(pipe: Pipeline) -> tuple[dict[str, Any] | None, str | None]:
     """The dynamics document of ``[motion] mode`` (no gravity, as ``screwkit dynamics``
     without ``--gravity``), or why there is none."""
     if any(link.mass is None for link in pipe.spec.linkage.links):
@@ -188,13 +188,25 @@ def numbers_table(pipe: Pipeline) -> list[list[str]]:
     return rows
 
 
+def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None) -> dict[str, Any]:
+    """The report's scene (:func:`~screwkit.report.scene.scene_from_motion`) of the pipeline's
+    motion with the loads of ``[motion] mode`` (``dyn_doc``, from :func:`dynamics_document`;
+    None: no loads). No balancing or synthesis: they are not redone on every change."""
+    from screwkit.report.scene import scene_from_motion
+    from screwkit.report.spec_report import seed_tables
+
+    mot = pipe.motion
+    return scene_from_motion(pipe.spec, mot, dynamics_doc=dyn_doc,
+                             dynamics_mode=None if dyn_doc is None else int(pipe.spec.mode),
+                             seed_variables=[seed_tables(md) for md in mot.modes])
+
+
 def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True) -> dict[str, Any]:
     """Everything the page draws for ``spec`` (module docstring) as a JSON-able dictionary
     (display units; the scene stays SI). ``numbers=False`` leaves out the table of
     :func:`numbers_table` (the limit positions are the slowest part), which the page asks for
     once the curves are drawn."""
-    from screwkit.report.scene import scene_from_motion
-    from screwkit.report.spec_report import seed_tables
+    from screwkit.report.viewer import pack_scene
 
     pipe = spec if isinstance(spec, Pipeline) else Pipeline(spec)
     spec = pipe.spec
@@ -215,14 +227,9 @@ def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True) -> dict[str, Any]
                 _kind_of(n), np.asarray(md.variables[n], dtype=float))) for n in outputs},
         })
     trans, trans_note = _transmission(pipe, units)
-    dyn_doc, loads_note = _dynamics(pipe)
+    dyn_doc, loads_note = dynamics_document(pipe)
     loads = None if dyn_doc is None else _loads(dyn_doc, int(spec.mode), units)
-    scene = scene_from_motion(spec, mot, dynamics_doc=dyn_doc,
-                              dynamics_mode=None if dyn_doc is None else int(spec.mode),
-                              seed_variables=[seed_tables(md) for md in mot.modes])
-    from screwkit.report.viewer import pack_scene
-
-    packed = pack_scene(scene)
+    packed = pack_scene(design_scene(pipe, dyn_doc))
     packed["plots"], packed["plot_groups"] = [], []
     return {
         "ok": True, "method": mot.method, "mode": int(spec.mode),
