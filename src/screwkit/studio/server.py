@@ -17,6 +17,7 @@ import math
 import secrets
 import socket
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -73,7 +74,7 @@ def create_app(studio: Studio) -> Any:
     from starlette.requests import Request
     from starlette.responses import HTMLResponse, PlainTextResponse, Response
     from starlette.routing import Route, WebSocketRoute
-    from starlette.websockets import WebSocket
+    from starlette.websockets import WebSocket, WebSocketDisconnect
 
     from screwkit.studio.page import render_page
 
@@ -99,15 +100,24 @@ def create_app(studio: Studio) -> Any:
 
     save_lock = threading.Lock()
 
-    def handle(tab: Tab, text: str) -> str:
+    def guarded(answer: Callable[[], dict[str, Any]]) -> dict[str, Any]:
         with save_lock:  # one file write at a time; solving is quick
             try:
-                reply = tab.handle(text)
+                return answer()
             except Exception as exc:  # a bug, not the page's mistake: say so, keep serving
                 log.exception("studio: the answer to a message failed")
-                reply = {"type": "error", "seq": 0, "message": f"internal error ({exc!r}); "
-                         "the studio goes on — please report this with the spec"}
-        return json.dumps(finite(reply), separators=(",", ":"))
+                return {"type": "error", "seq": 0, "message": f"internal error ({exc!r}); "
+                        "the studio goes on — please report this with the spec"}
+
+    def handle(tab: Tab, text: str) -> tuple[str, int | None]:
+        """The answer to ``text`` as JSON, and the seq of a solved state (its 3-D scene
+        follows) or None."""
+        reply = guarded(lambda: tab.handle(text))
+        solved = reply["type"] == "state" and bool(reply["result"].get("ok"))
+        return json.dumps(finite(reply), separators=(",", ":")), reply["seq"] if solved else None
+
+    def scene(tab: Tab, seq: int) -> str:
+        return json.dumps(finite(guarded(lambda: tab.scene(seq))), separators=(",", ":"))
 
     async def updates(ws: WebSocket) -> None:
         origin = ws.headers.get("origin")
@@ -117,10 +127,19 @@ def create_app(studio: Studio) -> Any:
             await ws.close(code=1008)
             return
         await ws.accept()
-        tab = Tab(studio.design, studio.save_as)
-        first = await anyio.to_thread.run_sync(tab.answer, 0)
-        await ws.send_text(json.dumps(finite(first), separators=(",", ":")))
+        try:
+            await serve_tab(ws, Tab(studio.design, studio.save_as))
+        except WebSocketDisconnect:  # the tab was closed while an answer was on its way
+            return
+
+    async def serve_tab(ws: WebSocket, tab: Tab) -> None:
+        text: str | None = '{"type": "state", "seq": 0}'
         while True:
+            if text is not None:
+                answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
+                await ws.send_text(answer)
+                if solved is not None:  # the 3-D scene right after the curves
+                    await ws.send_text(await anyio.to_thread.run_sync(scene, tab, solved))
             message = await ws.receive()
             if message["type"] == "websocket.disconnect":
                 return
@@ -128,8 +147,6 @@ def create_app(studio: Studio) -> Any:
             if text is None:
                 await ws.send_text(json.dumps({"type": "error", "seq": 0, "message":
                                                "send JSON text messages, not binary"}))
-                continue
-            await ws.send_text(await anyio.to_thread.run_sync(handle, tab, text))
 
     return Starlette(routes=[Route("/", page), Route("/static/{name}", static),
                              WebSocketRoute("/ws", updates)])

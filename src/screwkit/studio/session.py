@@ -19,8 +19,9 @@ A page sends JSON objects with a ``type``:
     page saves, and for ``spec`` the file given with ``--save-as`` when there is one.
 
 Answers: ``{"type": "state", "seq", "values", "mode", "can_undo", "can_redo", "result"}``
-(``result`` is :func:`~screwkit.studio.solve.solve_spec`'s dictionary, or ``{"ok": false,
-"error": sentence}`` where the design cannot be solved), ``{"type": "saved", "seq", "path"}``,
+(``result`` is :func:`~screwkit.studio.solve.solve_spec`'s dictionary without the scene and
+the numbers, or ``{"ok": false, "error": sentence}`` where the design cannot be solved),
+followed, when solved, by ``{"type": "scene", "seq", "scene"}`` (the 3-D view's scene), ``{"type": "saved", "seq", "path"}``,
 ``{"type": "numbers", "seq", "numbers"}``, ``{"type": "download", "seq", "name", "mime", "text"}`` and ``{"type": "error", "seq",
 "message"}``. No message carries a file path to the server.
 """
@@ -144,7 +145,7 @@ class Tab:
 
         values, mode = self.state.as_dict, self.state.mode
         try:
-            result = solve_spec(self.pipeline(), numbers=False)
+            result = solve_spec(self.pipeline(), numbers=False, scene=False)
         except ScrewkitError as exc:
             result = {"ok": False, "error": str(exc)}
         except (FloatingPointError, np.linalg.LinAlgError) as exc:
@@ -153,6 +154,13 @@ class Tab:
         return {"type": "state", "seq": seq, "values": values, "mode": mode,
                 "can_undo": bool(self.history), "can_redo": bool(self.future),
                 "result": result}
+
+    def scene(self, seq: int) -> dict[str, Any]:
+        """The ``scene`` message: the 3-D scene of the current state (sent after its
+        ``state``)."""
+        from screwkit.studio.solve import packed_scene
+
+        return {"type": "scene", "seq": seq, "scene": packed_scene(self.pipeline())}
 
     def handle(self, text: str) -> dict[str, Any]:
         """The answer to one message from the page (never raises for a page's mistake)."""

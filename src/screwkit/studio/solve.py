@@ -201,13 +201,23 @@ def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None) -> dict[str, An
                              seed_variables=[seed_tables(md) for md in mot.modes])
 
 
-def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True) -> dict[str, Any]:
-    """Everything the page draws for ``spec`` (module docstring) as a JSON-able dictionary
-    (display units; the scene stays SI). ``numbers=False`` leaves out the table of
-    :func:`numbers_table` (the limit positions are the slowest part), which the page asks for
-    once the curves are drawn."""
+def packed_scene(pipe: Pipeline) -> dict[str, Any]:
+    """The scene of :func:`design_scene` packed for the page's 3-D view (the report's plots
+    left out: the page draws its own)."""
     from screwkit.report.viewer import pack_scene
 
+    packed = pack_scene(design_scene(pipe, dynamics_document(pipe)[0]))
+    packed["plots"], packed["plot_groups"] = [], []
+    return packed
+
+
+def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True,
+               scene: bool = True) -> dict[str, Any]:
+    """Everything the page draws for ``spec`` (module docstring) as a JSON-able dictionary
+    (display units; the scene stays SI). ``numbers=False`` leaves out the table of
+    :func:`numbers_table` (the limit positions are the slowest part) and ``scene=False`` the 3-D
+    scene (:func:`packed_scene`): the server sends the scene right after the curves, and the
+    page asks for the numbers once they are drawn."""
     pipe = spec if isinstance(spec, Pipeline) else Pipeline(spec)
     spec = pipe.spec
     units = spec.display_units()
@@ -229,8 +239,6 @@ def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True) -> dict[str, Any]
     trans, trans_note = _transmission(pipe, units)
     dyn_doc, loads_note = dynamics_document(pipe)
     loads = None if dyn_doc is None else _loads(dyn_doc, int(spec.mode), units)
-    packed = pack_scene(design_scene(pipe, dyn_doc))
-    packed["plots"], packed["plot_groups"] = [], []
     return {
         "ok": True, "method": mot.method, "mode": int(spec.mode),
         "input": {"name": input_name, "unit": units.label(x_kind), "values": _series(x_shown)},
@@ -240,5 +248,5 @@ def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True) -> dict[str, Any]
         "loads": loads, "loads_note": loads_note,
         "numbers": numbers_table(pipe) if numbers else None,
         "assembly": assembly_notes(pipe, np.asarray(x_shown), units.label(x_kind)),
-        "scene": packed,
+        "scene": packed_scene(pipe) if scene else None,
     }

@@ -61,6 +61,7 @@
     if (msg.type === 'state') showState(msg, timed);
     else if (msg.type === 'error') { S.errors.push(msg.message); say(msg.message, 'error'); }
     else if (msg.type === 'saved') say(`saved ${msg.path}`, 'ok');
+    else if (msg.type === 'scene') { if (S.state && msg.seq === S.state.seq) loadView(msg.scene, S.stateT0); }
     else if (msg.type === 'numbers') { S.numbers = msg.numbers; drawNumbers(msg.numbers); $('numbers').classList.remove('stale'); document.body.dataset.numbers = String(msg.seq); }
     else if (msg.type === 'download') download(msg);
     if (S.inflight === null && S.pending) {
@@ -341,8 +342,8 @@
     drawPlots(r);
     drawTables(r);
     S.frame = Math.min(S.frame, r.input.values.length - 1);
-    const t0 = timed ? timed.t0 : performance.now();
-    loadView(r.scene, t0);
+    S.stateT0 = timed ? timed.t0 : performance.now();
+    S.viewReady = false; // until the scene that follows this state is loaded
     setFrame(S.frame);
     document.body.dataset.solved = String(msg.seq);
     requestAnimationFrame(() => {
