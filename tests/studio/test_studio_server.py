@@ -155,3 +155,20 @@ def test_the_command_prints_its_url_and_stops_on_ctrl_c(rssr_copy: Path) -> None
     assert proc.returncode == 0, err
     assert "studio stopped" in out
     assert "Traceback" not in err
+
+
+def test_the_command_refuses_bad_arguments_in_one_sentence(rssr_copy: Path) -> None:
+    from typer.testing import CliRunner
+
+    from screwkit.cli.main import app
+
+    runner = CliRunner()
+    cases = [(["studio", str(rssr_copy.with_name("missing.toml")), "--no-browser"],
+              "no such spec file"),
+             (["studio", str(rssr_copy), "--no-browser", "--save-as", str(rssr_copy)],
+              "input of the command"),
+             (["studio", str(rssr_copy), "--no-browser", "--host", "256.1.1.1"],
+              "cannot listen on 256.1.1.1")]
+    for args, words in cases:
+        result = runner.invoke(app, args)
+        assert result.exit_code == 2 and words in result.output, result.output

@@ -25,7 +25,11 @@
     for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
     return e;
   };
-  const fmt = (v) => (v === null || v === undefined ? '—' : (+v).toPrecision(6).replace(/\.?0+(e|$)/, '$1'));
+  const fmt = (v) => {
+    if (v === null || v === undefined) return '—';
+    const t = (+v).toPrecision(6);
+    return t.includes('.') ? t.replace(/\.?0+(e|$)/, '$1') : t; // 1.50000 → 1.5, 100000 stays
+  };
 
   // ---- the WebSocket -------------------------------------------------------------------
   const wsUrl = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws?token=${encodeURIComponent(boot.token)}`;
