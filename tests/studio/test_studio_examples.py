@@ -50,6 +50,9 @@ def test_example_in_the_studio(name: str, browser: Any) -> None:
             assert (r["loads"] is not None) == has_loads
             assert page.evaluate("document.getElementById('view').contentWindow"
                                  ".screwkitViewer.frameCount") == len(spec.inputs)
+            traces = page.evaluate("""Object.keys(JSON.parse(document.getElementById('view')
+                .contentDocument.getElementById('screwkit-scene').textContent).modes[0].traces)""")
+            assert traces == [p.name for p in spec.coupler_points]  # their 3-D paths
             assert not errors, errors
         finally:
             page.close()

@@ -190,15 +190,18 @@ def numbers_table(pipe: Pipeline) -> list[list[str]]:
 
 def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None) -> dict[str, Any]:
     """The report's scene (:func:`~screwkit.report.scene.scene_from_motion`) of the pipeline's
-    motion with the loads of ``[motion] mode`` (``dyn_doc``, from :func:`dynamics_document`;
-    None: no loads). No balancing or synthesis: they are not redone on every change."""
+    motion with the spec's coupler points as traces (their 3-D paths) and the loads of
+    ``[motion] mode`` (``dyn_doc``, from :func:`dynamics_document`; None: no loads), as
+    :func:`~screwkit.report.spec_report.spec_scene` builds it. No balancing or synthesis: they are not redone on every change."""
     from screwkit.report.scene import scene_from_motion
     from screwkit.report.spec_report import seed_tables
 
     mot = pipe.motion
     return scene_from_motion(pipe.spec, mot, dynamics_doc=dyn_doc,
                              dynamics_mode=None if dyn_doc is None else int(pipe.spec.mode),
-                             seed_variables=[seed_tables(md) for md in mot.modes])
+                             seed_variables=[seed_tables(md) for md in mot.modes],
+                             coupler_points={p.name: (p.link, p.point)
+                                             for p in pipe.spec.coupler_points})
 
 
 def packed_scene(pipe: Pipeline) -> dict[str, Any]:
