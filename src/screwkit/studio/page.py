@@ -34,7 +34,7 @@ def render_page(design: Design, token: str) -> str:
         "<button id='export-csv'>export CSV</button>",
         "<button id='export-spec'>export spec</button></nav></header>",
         "<div id='message' role='status'></div>",
-        "<main><section id='left'><iframe id='view' title='3-D view'></iframe>",
+        "<main><section id='left'><div id='view-box'></div>",
         "<div class='bar'><button id='play'>play</button>",
         "<input id='frame' type='range' min='0' max='0' value='0' aria-label='input'>",
         "<span id='input-readout' class='mono'></span>",

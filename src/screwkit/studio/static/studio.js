@@ -125,7 +125,7 @@
   S.pause = pause;
 
   function viewer() {
-    const w = $('view').contentWindow;
+    const f = $('view'), w = f && f.contentWindow;
     return S.viewReady && w && w.screwkitViewer ? w.screwkitViewer : null;
   }
 
@@ -287,15 +287,25 @@
   }
 
   // ---- the 3-D view (the report's viewer in an iframe) ---------------------------------
+  // the new scene loads in a second iframe on top of the shown one (transparent until its
+  // viewer is up), which then takes the id 'view': the picture never goes blank
   function loadView(scene, t0) {
-    const frame = $('view');
+    const old = document.getElementById('view-next');
+    if (old) old.remove();
+    const frame = el('iframe', { id: 'view-next', title: '3-D view', class: 'loading' });
+    $('view-box').appendChild(frame);
     S.viewReady = false;
     const json = JSON.stringify(scene).replace(/</g, '\\u003c');
     frame.onload = () => {
       const w = frame.contentWindow;
       const wait = () => {
+        if (!frame.isConnected) return; // replaced by a newer scene
         if (!w.screwkitViewer) { setTimeout(wait, 10); return; }
         w.screwkitViewer.pause();
+        const shown = $('view');
+        if (shown) shown.remove();
+        frame.id = 'view';
+        frame.className = '';
         S.viewReady = true;
         setFrame(S.frame);
         S.viewLatencies.push(performance.now() - t0);
