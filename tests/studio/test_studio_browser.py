@@ -119,7 +119,8 @@ def test_out_of_range_value_shows_where_it_assembles(open_studio: Any) -> None:
     page.wait_drawn()
     r = page.result()
     assert r["ok"] is False and "does not close" in r["error"]
-    assert "does not close" in page.evaluate("document.getElementById('assembly').textContent")
+    shown = page.evaluate("document.getElementById('assembly').textContent")
+    assert "does not close" in shown and "d2 closes the loop" in shown
     assert page.evaluate("document.body.dataset.solved") == "error"
     # a value where the loop closes over part of the turn: the page names the input ranges
     move_slider(page, D2, 150)

@@ -103,6 +103,35 @@ def test_a_tab_answers_with_the_pipelines_numbers(rssr_copy: Path) -> None:
     assert tab.handle(json.dumps({"type": "redo"}))["values"]["dimensions.b"] == 55
 
 
+def test_where_the_changed_dimension_closes_the_loop(rssr_copy: Path) -> None:
+    """A value where the loop closes nowhere: the answer names the values of that dimension
+    where it closes, and Pipeline agrees at the scanned values on either side of each end."""
+    from screwkit.kinematics.motion import AssemblyError
+    from screwkit.studio.solve import scan_grid
+
+    tab = Tab(Design(rssr_copy))
+    r = tab.handle(json.dumps({"type": "set", "values": {"dimensions.d2": 1000}}))["result"]
+    assert not r["ok"] and "does not close" in r["error"]
+    where = r["where"]
+    assert where.startswith("d2 closes the loop (somewhere over the input sweep) at ")
+    d = tab.design.by_name["dimensions.d2"]
+    grid = scan_grid(d)
+    values = tab.state.as_dict
+
+    def closes(v: float) -> bool:
+        try:
+            return any(np.asarray(m.assembles).any() for m in
+                       Pipeline(tab.design.spec_with({**values, d.name: v}, 0)).motion.modes)
+        except AssemblyError:
+            return False
+
+    first, last = (float(x) for x in where.split(" at ")[1].split(" mm")[0].split(" … "))
+    i, j = int(np.argmin(abs(grid - first))), int(np.argmin(abs(grid - last)))
+    assert closes(grid[i]) and closes(grid[j]) and closes(100.0)
+    assert i == 0 or not closes(grid[i - 1])
+    assert j == len(grid) - 1 or not closes(grid[j + 1])
+
+
 def test_design_keeps_comments_and_written_units(tmp_path: Path) -> None:
     spec = tmp_path / "fig7.toml"
     source = (EXAMPLES / "bagci_fig7_rsrc.toml").read_text(encoding="utf-8")

@@ -37,6 +37,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError
 
 from screwkit.errors import ScrewkitError
+from screwkit.kinematics.motion import AssemblyError
 from screwkit.pipeline import Pipeline
 from screwkit.studio.design import Design
 
@@ -146,6 +147,8 @@ class Tab:
         values, mode = self.state.as_dict, self.state.mode
         try:
             result = solve_spec(self.pipeline(), numbers=False, scene=False)
+        except AssemblyError as exc:
+            result = {"ok": False, "error": str(exc), "where": self.where_it_closes()}
         except ScrewkitError as exc:
             result = {"ok": False, "error": str(exc)}
         except (FloatingPointError, np.linalg.LinAlgError) as exc:
@@ -154,6 +157,19 @@ class Tab:
         return {"type": "state", "seq": seq, "values": values, "mode": mode,
                 "can_undo": bool(self.history), "can_redo": bool(self.future),
                 "result": result}
+
+    def where_it_closes(self) -> str | None:
+        """For a state where the loop closes nowhere: the values of the dimension changed
+        last at which it closes (:func:`~screwkit.studio.solve.assembling_values`)."""
+        from screwkit.studio.solve import assembling_values
+
+        if not self.history:
+            return None
+        before, now = self.history[-1].as_dict, self.state.as_dict
+        changed = [k for k in now if now[k] != before.get(k)]
+        if len(changed) != 1:
+            return None
+        return assembling_values(self.design, now, self.state.mode, changed[0])
 
     def scene(self, seq: int) -> dict[str, Any]:
         """The ``scene`` message: the 3-D scene of the current state (sent after its

@@ -253,3 +253,42 @@ def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True,
         "assembly": assembly_notes(pipe, np.asarray(x_shown), units.label(x_kind)),
         "scene": packed_scene(pipe) if scene else None,
     }
+
+
+#: values of a dimension tried by :func:`assembling_values`, and input samples per try
+SCAN_VALUES = 21
+SCAN_INPUTS = 36
+
+
+def scan_grid(dimension: Any) -> np.ndarray:
+    """The values :func:`assembling_values` tries: its slider's default range, evenly."""
+    return np.linspace(dimension.low, dimension.high, SCAN_VALUES)
+
+
+def assembling_values(design: Any, values: dict[str, float], mode: int, name: str) -> str:
+    """Where the dimension ``name`` lets the loop close, the other values held: a scan of
+    :data:`SCAN_VALUES` values over its slider's default range, each solved at
+    :data:`SCAN_INPUTS` inputs of the spec's sweep with the same solver as the page; a sentence
+    naming the intervals (to the scan's step) where some mode assembles somewhere."""
+    from screwkit.kinematics.solve_motion import solve_motion
+
+    d = design.by_name[name]
+    lo, hi = d.low, d.high
+    grid = scan_grid(d)
+    ok = np.zeros(SCAN_VALUES, dtype=bool)
+    for k, v in enumerate(grid):
+        try:
+            spec = design.spec_with({**values, name: float(v)}, mode)
+            every = max(1, len(spec.inputs) // SCAN_INPUTS)
+            mot = solve_motion(spec.linkage, spec.inputs[::every], rates=spec.speed)
+            ok[k] = any(np.asarray(md.assembles).any() for md in mot.modes)
+        except (ScrewkitError, FloatingPointError, np.linalg.LinAlgError):
+            ok[k] = False
+    short = name.removeprefix("dimensions.")
+    unit = d.key.unit or ""
+    if not ok.any():
+        return (f"no value of {short} from {lo:.6g} to {hi:.6g} {unit} closes the loop with "
+                "the other values as they are; change another dimension")
+    return (f"{short} closes the loop (somewhere over the input sweep) at "
+            f"{assembly_runs(grid, ok, unit)} (a scan of {SCAN_VALUES} values from {lo:.6g} to "
+            f"{hi:.6g} {unit}, the other values held)")

@@ -336,7 +336,7 @@
     S.mode = msg.mode;
     if (!r.ok) {
       say(r.error, 'error');
-      $('assembly').textContent = r.error;
+      $('assembly').textContent = r.where ? `${r.error}. ${r.where}.` : r.error;
       $('assembly').className = 'error';
       document.body.dataset.solved = 'error';
       S.result = r;
