@@ -34,7 +34,7 @@ def test_notebook_controls(tmp_path: Path) -> None:
     # beyond the slider: the box widens it; where the loop does not close: the sentence
     s.boxes["dimensions.d2"].value = 1000.0
     assert s.sliders["dimensions.d2"].max >= 1000.0
-    assert "does not close" in s.message.value
+    assert "does not close" in s.message.value and "d2 closes the loop" in s.message.value
     s.boxes["dimensions.d2"].value = 150.0
     assert "assembles only at input" in s.numbers.value and s.message.value == ""
     s.mode.value = 1

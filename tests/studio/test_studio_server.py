@@ -99,6 +99,9 @@ def test_a_tab_answers_with_the_pipelines_numbers(rssr_copy: Path) -> None:
     every = np.stack([np.linalg.norm(np.asarray(r.force, dtype=float), axis=1)
                       for r in dyn.reactions.values()])
     np.testing.assert_allclose(largest, every.max(axis=0), rtol=1e-12)
+    peaks = {row[0]: row[1] for row in loads["summary"]}
+    assert peaks["shaking_force [N]"] == pytest.approx(force.max(), rel=1e-12)
+    assert peaks["effort input.theta [N*m]"] == pytest.approx(np.abs(torque).max(), rel=1e-12)
     assert tab.handle(json.dumps({"type": "undo"}))["mode"] == 0
     assert tab.handle(json.dumps({"type": "redo"}))["values"]["dimensions.b"] == 55
 

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from screwkit.errors import InputError, ScrewkitError
+from screwkit.kinematics.motion import AssemblyError
 from screwkit.studio.design import Design
 from screwkit.studio.session import Tab, save_design
 
@@ -136,6 +137,10 @@ class StudioWidget:
                 self.view.value = report_iframe(scene, self.height)
                 self.numbers.value = _numbers_html(numbers_table(pipe), notes)
                 self.message.value = ""
+            except AssemblyError as exc:
+                where = self.tab.where_it_closes()
+                self.message.value = (f"<b style='color:#b71c1c'>{html.escape(str(exc))}</b>"
+                                      + (f"<p>{html.escape(where)}</p>" if where else ""))
             except ScrewkitError as exc:
                 self.message.value = f"<b style='color:#b71c1c'>{html.escape(str(exc))}</b>"
         finally:
