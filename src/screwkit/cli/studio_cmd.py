@@ -19,6 +19,7 @@ def _need_extra() -> None:
         import starlette  # noqa: F401
         import tomlkit  # noqa: F401
         import uvicorn  # noqa: F401
+        import websockets  # noqa: F401
     except ImportError as exc:
         raise InputError(f"`screwkit studio` needs the studio extra ({exc.name} is missing): "
                          "pip install 'screwkit[studio]'") from None
