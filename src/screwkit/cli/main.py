@@ -73,6 +73,7 @@ def _register_subcommands() -> None:
     from screwkit.cli.mjcf_cmd import register as register_mjcf
     from screwkit.cli.report_cmd import register as register_report
     from screwkit.cli.simulate_cmd import register as register_simulate
+    from screwkit.cli.studio_cmd import register as register_studio
     from screwkit.cli.sweep_cmd import register as register_sweep
     from screwkit.cli.synthesize_cmd import register as register_synthesize
     from screwkit.cli.tolerance_cmd import register as register_tolerance
@@ -89,6 +90,7 @@ def _register_subcommands() -> None:
     register_export(app)
     register_sweep(app)
     register_tolerance(app)
+    register_studio(app)
 
 
 _register_subcommands()

@@ -1,0 +1,183 @@
+"""The studio's local web server: one Starlette app on uvicorn serving the page, its three
+static files and one WebSocket per tab (docs/studio.md).
+
+Security (as Jupyter does it): every request must carry the per-session token in its URL
+(``?token=…``), compared in constant time; a request without it gets HTTP 403 and a WebSocket
+without it is refused before the handshake completes. A WebSocket whose ``Origin`` is not the
+server's own host is refused too. The server binds 127.0.0.1 unless ``--host`` says otherwise,
+never reads a file path from a page, and writes only the spec it was started with (Save) or the
+``--save-as`` file (export spec); both atomically, so Ctrl-C leaves no half-written file.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import secrets
+import socket
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlsplit
+
+from screwkit.studio.design import Design
+from screwkit.studio.session import Tab
+
+log = logging.getLogger("screwkit.studio")
+
+#: the static files a page may ask for, by name → (package folder, file, media type)
+STATIC = {
+    "viewer.js": ("screwkit.report", "screwkit-viewer.min.js", "text/javascript"),
+    "studio.js": ("screwkit.studio", "studio.js", "text/javascript"),
+    "studio.css": ("screwkit.studio", "studio.css", "text/css"),
+}
+
+
+def finite(doc: Any) -> Any:
+    """A copy of a JSON-able document with every NaN or infinite float as ``None`` (JSON has
+    no NaN)."""
+    if isinstance(doc, float):
+        return doc if math.isfinite(doc) else None
+    if isinstance(doc, dict):
+        return {k: finite(v) for k, v in doc.items()}
+    if isinstance(doc, list | tuple):
+        return [finite(v) for v in doc]
+    return doc
+
+
+@dataclass
+class Studio:
+    """What one studio process serves: the design, its token and the ``--save-as`` file."""
+
+    design: Design
+    token: str
+    save_as: Path | None = None
+
+    def allowed(self, token: str | None) -> bool:
+        return token is not None and secrets.compare_digest(token.encode(), self.token.encode())
+
+
+def _static(name: str) -> tuple[bytes, str]:
+    package, file, media = STATIC[name]
+    folder = "static"
+    return (resources.files(package) / folder / file).read_bytes(), media
+
+
+def create_app(studio: Studio) -> Any:
+    """The Starlette application of a studio."""
+    import anyio
+    from starlette.applications import Starlette
+    from starlette.requests import Request
+    from starlette.responses import HTMLResponse, PlainTextResponse, Response
+    from starlette.routing import Route, WebSocketRoute
+    from starlette.websockets import WebSocket, WebSocketDisconnect
+
+    from screwkit.studio.page import render_page
+
+    refused = "this studio needs its token: open the URL `screwkit studio` printed"
+
+    async def page(request: Request) -> Response:
+        if not studio.allowed(request.query_params.get("token")):
+            return PlainTextResponse(refused, status_code=403)
+        html = render_page(studio.design, studio.token)
+        return HTMLResponse(html, headers={"Cache-Control": "no-store",
+                                           "X-Content-Type-Options": "nosniff",
+                                           "Referrer-Policy": "no-referrer"})
+
+    async def static(request: Request) -> Response:
+        name = request.path_params["name"]
+        if not studio.allowed(request.query_params.get("token")):
+            return PlainTextResponse(refused, status_code=403)
+        if name not in STATIC:
+            return PlainTextResponse("not found", status_code=404)
+        body, media = _static(name)
+        return Response(body, media_type=media,
+                        headers={"Cache-Control": "private, max-age=3600"})
+
+    save_lock = threading.Lock()
+
+    def guarded(answer: Callable[[], dict[str, Any]]) -> dict[str, Any]:
+        with save_lock:  # one file write at a time; solving is quick
+            try:
+                return answer()
+            except Exception as exc:  # a bug, not the page's mistake: say so, keep serving
+                log.exception("studio: the answer to a message failed")
+                return {"type": "error", "seq": 0, "message": f"internal error ({exc!r}); "
+                        "the studio goes on — please report this with the spec"}
+
+    def handle(tab: Tab, text: str) -> tuple[str, int | None]:
+        """The answer to ``text`` as JSON, and the seq of a solved state (its 3-D scene
+        follows) or None."""
+        reply = guarded(lambda: tab.handle(text))
+        solved = reply["type"] == "state" and bool(reply["result"].get("ok"))
+        return json.dumps(finite(reply), separators=(",", ":")), reply["seq"] if solved else None
+
+    def scene(tab: Tab, seq: int) -> str:
+        return json.dumps(finite(guarded(lambda: tab.scene(seq))), separators=(",", ":"))
+
+    async def updates(ws: WebSocket) -> None:
+        origin = ws.headers.get("origin")
+        host = ws.headers.get("host", "")
+        if not studio.allowed(ws.query_params.get("token")) or (
+                origin is not None and urlsplit(origin).netloc != host):
+            await ws.close(code=1008)
+            return
+        await ws.accept()
+        try:
+            await serve_tab(ws, Tab(studio.design, studio.save_as))
+        except WebSocketDisconnect:  # the tab was closed while an answer was on its way
+            return
+
+    async def serve_tab(ws: WebSocket, tab: Tab) -> None:
+        text: str | None = '{"type": "state", "seq": 0}'
+        while True:
+            if text is not None:
+                answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
+                await ws.send_text(answer)
+                if solved is not None:  # the 3-D scene right after the curves
+                    await ws.send_text(await anyio.to_thread.run_sync(scene, tab, solved))
+            message = await ws.receive()
+            if message["type"] == "websocket.disconnect":
+                return
+            text = message.get("text")
+            if text is None:
+                await ws.send_text(json.dumps({"type": "error", "seq": 0, "message":
+                                               "send JSON text messages, not binary"}))
+
+    return Starlette(routes=[Route("/", page), Route("/static/{name}", static),
+                             WebSocketRoute("/ws", updates)])
+
+
+def bind(host: str, port: int) -> socket.socket:
+    """A listening socket on ``host:port`` (port 0: a free port chosen by the system)."""
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    sock.bind((host, port))
+    sock.listen(128)
+    sock.set_inheritable(True)
+    return sock
+
+
+def url_of(sock: socket.socket, token: str) -> str:
+    host, port = sock.getsockname()[:2]
+    shown = f"[{host}]" if ":" in host else host
+    return f"http://{shown}:{port}/?token={token}"
+
+
+def make_server(studio: Studio) -> Any:
+    """A uvicorn server of the studio's app (quiet; ``serve(sockets=[bind(...)])`` runs it)."""
+    import uvicorn
+
+    config = uvicorn.Config(create_app(studio), log_level="warning", ws="websockets-sansio",
+                            lifespan="off", ws_max_size=1 << 20)
+    return uvicorn.Server(config)
+
+
+def new_studio(spec: str | Path, save_as: Path | None = None) -> Studio:
+    """A studio of the spec file ``spec`` with a fresh random token."""
+    return Studio(Design(spec), secrets.token_urlsafe(24), save_as)

@@ -1,0 +1,245 @@
+"""One tab of the studio: the messages a page may send (validated with pydantic, anything else
+is answered with an error), the tab's design state with its undo and redo history, and the
+answers (docs/studio.md, "Messages").
+
+A page sends JSON objects with a ``type``:
+
+``{"type": "set", "seq": n, "values": {"dimensions.d2": 4.6}, "mode": 1}``
+    Change values (in the units the page shows) and/or the assembly mode; the answer is a
+    ``state``. Values and mode that are left out keep theirs.
+``{"type": "undo" | "redo" | "state", "seq": n}``
+    Step back or forward through the tab's history, or ask for the current state.
+``{"type": "numbers", "seq": n}``
+    The table of the CLI's numbers (limit positions, minimum transmission) of the current
+    state: slower than the curves, so a page asks for it once they are drawn.
+``{"type": "save", "seq": n}``
+    Write the tab's design into the spec file the studio was started with.
+``{"type": "export", "seq": n, "what": "report" | "csv" | "spec"}``
+    The HTML report, the CSV of the curves or the spec under a new name: a ``download`` the
+    page saves, and for ``spec`` the file given with ``--save-as`` when there is one.
+
+Answers: ``{"type": "state", "seq", "values", "mode", "can_undo", "can_redo", "result"}``
+(``result`` is :func:`~screwkit.studio.solve.solve_spec`'s dictionary without the scene and
+the numbers, or ``{"ok": false, "error": sentence}`` where the design cannot be solved),
+followed, when solved, by ``{"type": "scene", "seq", "scene"}`` (the 3-D view's scene), ``{"type": "saved", "seq", "path"}``,
+``{"type": "numbers", "seq", "numbers"}``, ``{"type": "download", "seq", "name", "mime", "text"}`` and ``{"type": "error", "seq",
+"message"}``. No message carries a file path to the server.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError
+
+from screwkit.errors import ScrewkitError
+from screwkit.kinematics.motion import AssemblyError
+from screwkit.pipeline import Pipeline
+from screwkit.studio.design import Design
+
+#: how many steps back a tab remembers
+HISTORY = 200
+#: the longest message a page may send (characters)
+MAX_MESSAGE = 100_000
+
+
+class _Message(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True)
+    seq: int = Field(0, ge=0, le=2**53)
+
+
+class SetMessage(_Message):
+    type: Literal["set"]
+    values: dict[Annotated[str, Field(max_length=200)], float] = Field(
+        default_factory=dict, max_length=1000)
+    mode: int | None = Field(None, ge=0, le=7)
+
+
+class StepMessage(_Message):
+    type: Literal["undo", "redo", "state", "save", "numbers"]
+
+
+class ExportMessage(_Message):
+    type: Literal["export"]
+    what: Literal["report", "csv", "spec"]
+
+
+Message = Annotated[SetMessage | StepMessage | ExportMessage, Field(discriminator="type")]
+MESSAGE = TypeAdapter(Message)
+
+
+def parse_message(text: str) -> SetMessage | StepMessage | ExportMessage:
+    """A page's message, validated; a :class:`~screwkit.studio.design.StudioError` naming
+    what is wrong otherwise."""
+    from screwkit.studio.design import StudioError
+
+    if len(text) > MAX_MESSAGE:
+        raise StudioError(f"message of {len(text)} characters; the limit is {MAX_MESSAGE}")
+    try:
+        data = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise StudioError(f"the message is not JSON ({exc})") from None
+    try:
+        return MESSAGE.validate_python(data)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        where = ".".join(str(p) for p in first["loc"]) or "message"
+        raise StudioError(f"bad message at {where}: {first['msg']}") from None
+
+
+@dataclass(frozen=True)
+class DesignState:
+    values: tuple[tuple[str, float], ...]
+    mode: int
+
+    @property
+    def as_dict(self) -> dict[str, float]:
+        return dict(self.values)
+
+
+@dataclass
+class Tab:
+    """One page's design and history (module docstring). ``save_as``: the file given on the
+    command line for *export spec* (None: a download only)."""
+
+    design: Design
+    save_as: Path | None = None
+    history: list[DesignState] = field(default_factory=list)
+    future: list[DesignState] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        d = self.design
+        self.state = DesignState(tuple(d.initial_values.items()), d.initial_mode)
+        self._solved: tuple[DesignState, Pipeline] | None = None
+
+    def set(self, values: dict[str, float], mode: int | None) -> None:
+        merged = {**self.state.as_dict, **values}
+        new = DesignState(tuple(merged.items()),
+                          self.state.mode if mode is None else mode)
+        self.design.check(new.as_dict, new.mode)
+        if new != self.state:
+            self.history = [*self.history, self.state][-HISTORY:]
+            self.future = []
+            self.state = new
+
+    def step(self, back: bool) -> None:
+        source, target = (self.history, self.future) if back else (self.future, self.history)
+        if source:
+            target.append(self.state)
+            self.state = source.pop()
+
+    def pipeline(self) -> Pipeline:
+        """The pipeline of the current state (solved once per state)."""
+        if self._solved is None or self._solved[0] != self.state:
+            self._solved = (self.state, Pipeline(self.design.spec_with(self.state.as_dict,
+                                                                       self.state.mode)))
+        return self._solved[1]
+
+    def answer(self, seq: int) -> dict[str, Any]:
+        """The ``state`` answer: the values, the history flags and the solved design (without
+        the numbers table, which a ``numbers`` message asks for)."""
+        from screwkit.studio.solve import solve_spec
+
+        values, mode = self.state.as_dict, self.state.mode
+        try:
+            result = solve_spec(self.pipeline(), numbers=False, scene=False)
+        except AssemblyError as exc:
+            result = {"ok": False, "error": str(exc), "where": self.where_it_closes()}
+        except ScrewkitError as exc:
+            result = {"ok": False, "error": str(exc)}
+        except (FloatingPointError, np.linalg.LinAlgError) as exc:
+            result = {"ok": False, "error": f"the solver failed numerically at these values "
+                                            f"({exc}); change a dimension"}
+        return {"type": "state", "seq": seq, "values": values, "mode": mode,
+                "can_undo": bool(self.history), "can_redo": bool(self.future),
+                "result": result}
+
+    def where_it_closes(self) -> str | None:
+        """For a state where the loop closes nowhere: the values of the dimension changed
+        last at which it closes (:func:`~screwkit.studio.solve.assembling_values`)."""
+        from screwkit.studio.solve import assembling_values
+
+        if not self.history:
+            return None
+        before, now = self.history[-1].as_dict, self.state.as_dict
+        changed = [k for k in now if now[k] != before.get(k)]
+        if len(changed) != 1:
+            return None
+        return assembling_values(self.design, now, self.state.mode, changed[0])
+
+    def scene(self, seq: int) -> dict[str, Any]:
+        """The ``scene`` message: the 3-D scene of the current state (sent after its
+        ``state``)."""
+        from screwkit.studio.solve import packed_scene
+
+        return {"type": "scene", "seq": seq, "scene": packed_scene(self.pipeline())}
+
+    def handle(self, text: str) -> dict[str, Any]:
+        """The answer to one message from the page (never raises for a page's mistake)."""
+        seq = 0
+        try:
+            msg = parse_message(text)
+            seq = msg.seq
+            if isinstance(msg, SetMessage):
+                self.set(msg.values, msg.mode)
+            elif isinstance(msg, ExportMessage):
+                return self.export(msg.what, seq)
+            elif msg.type in ("undo", "redo"):
+                self.step(msg.type == "undo")
+            elif msg.type == "numbers":
+                from screwkit.studio.solve import numbers_table
+
+                return {"type": "numbers", "seq": seq, "numbers": numbers_table(self.pipeline())}
+            elif msg.type == "save":
+                path = save_design(self.design, self.state.as_dict, self.state.mode)
+                return {"type": "saved", "seq": seq, "path": str(path)}
+            return self.answer(seq)
+        except ScrewkitError as exc:
+            return {"type": "error", "seq": seq, "message": str(exc)}
+
+    def export(self, what: str, seq: int) -> dict[str, Any]:
+        from screwkit.studio.exports import export_csv, export_report
+
+        values, mode = self.state.as_dict, self.state.mode
+        stem = self.design.path.stem
+        if what == "spec":
+            text = self.design.text_with(values, mode)
+            if self.save_as is not None:
+                write_spec(self.save_as, text, self.design)
+                return {"type": "saved", "seq": seq, "path": str(self.save_as)}
+            return {"type": "download", "seq": seq, "name": f"{stem}_studio.toml",
+                    "mime": "application/toml", "text": text}
+        spec = self.design.spec_with(values, mode)
+        if what == "csv":
+            return {"type": "download", "seq": seq, "name": f"{stem}_studio.csv",
+                    "mime": "text/csv", "text": export_csv(spec)}
+        return {"type": "download", "seq": seq, "name": f"{stem}_studio.html",
+                "mime": "text/html", "text": export_report(spec, self.design.text_with(values, mode))}
+
+
+def write_spec(path: Path, text: str, design: Design) -> None:
+    """Write a spec file's text atomically after checking it loads as the design's spec does
+    (a file that would not load is never written)."""
+    import tomlkit
+
+    from screwkit.io.results import write_atomic
+    from screwkit.io.spec import spec_from_data
+
+    spec_from_data(tomlkit.parse(text).unwrap(), path)
+    write_atomic(path, text)
+
+
+def save_design(design: Design, values: dict[str, float], mode: int) -> Path:
+    """Write the design into the spec file it was read from: the old file is first copied to
+    ``<name>.toml.bak``, then the new text replaces it atomically (docs/studio.md, "Save")."""
+    from screwkit.io.results import write_atomic
+
+    text = design.text_with(values, mode)
+    path = design.path
+    write_atomic(path.with_name(path.name + ".bak"), path.read_text(encoding="utf-8"))
+    write_spec(path, text, design)
+    return path

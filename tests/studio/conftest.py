@@ -1,0 +1,139 @@
+"""A studio served in-process on a free port (one per test module) of a copy of a bundled
+example, and a headless Debian chromium driven by Playwright (never a downloaded browser)."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from screwkit.studio.server import Studio, bind, make_server, new_studio, url_of
+
+EXAMPLES = Path(__file__).parents[2] / "examples"
+CHROMIUM = Path("/usr/bin/chromium")
+ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--no-first-run",
+        "--disable-default-apps", "--disable-extensions"]
+
+
+@dataclass
+class Served:
+    studio: Studio
+    url: str
+    spec: Path
+    server: Any
+
+    @property
+    def base(self) -> str:
+        return self.url.split("?")[0].rstrip("/")
+
+    @property
+    def ws_url(self) -> str:
+        return self.base.replace("http://", "ws://") + f"/ws?token={self.studio.token}"
+
+
+def serve(spec: Path, save_as: Path | None = None) -> Iterator[Served]:
+    studio = new_studio(spec, save_as)
+    sock = bind("127.0.0.1", 0)
+    server = make_server(studio)
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 20
+    while not server.started:
+        if time.monotonic() > deadline or not thread.is_alive():
+            pytest.fail("the studio server did not start")
+        time.sleep(0.02)
+    try:
+        yield Served(studio, url_of(sock, studio.token), spec, server)
+    finally:
+        server.should_exit = True
+        thread.join(10)
+        sock.close()
+
+
+serving = contextmanager(serve)
+
+
+@pytest.fixture(scope="module")
+def rssr_copy(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The spatial RSSR example (with its comments) at 360 input samples, in a temporary
+    folder the studio may overwrite."""
+    folder = tmp_path_factory.mktemp("studio")
+    text = (EXAMPLES / "rssr_spatial.toml").read_text(encoding="utf-8")
+    assert "step = 10\n" in text
+    spec = folder / "rssr_spatial.toml"
+    spec.write_text(text.replace("step = 10\n", "step = 1\n"), encoding="utf-8")
+    return spec
+
+
+@pytest.fixture(scope="module")
+def served(rssr_copy: Path) -> Iterator[Served]:
+    yield from serve(rssr_copy, save_as=rssr_copy.with_name("rssr_exported.toml"))
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
+    if not CHROMIUM.exists():
+        pytest.fail("the studio tests need Debian's chromium at /usr/bin/chromium: run "
+                    "`make test` (it installs it) or `apt-get install -y chromium`")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        context = p.chromium.launch_persistent_context(
+            str(tmp_path_factory.mktemp("chromium-profile")), executable_path=str(CHROMIUM),
+            headless=True, args=ARGS, viewport={"width": 1400, "height": 900},
+            accept_downloads=True)
+        try:
+            yield context
+        finally:
+            context.close()
+
+
+@dataclass
+class StudioPage:
+    page: Any
+    errors: list[str]
+
+    def evaluate(self, script: str, arg: Any = None) -> Any:
+        return self.page.evaluate(script, arg)
+
+    def wait_drawn(self) -> None:
+        """Until the answer to the page's last change is drawn (curves) and its 3-D view is
+        loaded."""
+        self.page.wait_for_function(
+            """() => { const s = window.studio; return s.inflight === null && !s.pending
+              && +document.body.dataset.drawn === s.lastChange && s.viewReady; }""",
+            timeout=30_000)
+
+    def wait_numbers(self) -> None:
+        """Until the numbers table of the last change has arrived."""
+        self.page.wait_for_function(
+            "() => +document.body.dataset.numbers > window.studio.lastChange", timeout=30_000)
+
+    def result(self) -> Any:
+        return self.evaluate("window.studio.result")
+
+
+@pytest.fixture
+def open_studio(browser: Any, served: Served) -> Iterator[Any]:
+    pages: list[Any] = []
+
+    def opener() -> StudioPage:
+        page = browser.new_page()
+        pages.append(page)
+        out = StudioPage(page, [])
+        page.on("console", lambda m: out.errors.append(m.text) if m.type == "error" else None)
+        page.on("pageerror", lambda e: out.errors.append(f"page error: {e}"))
+        page.goto(served.url)
+        out.wait_drawn()
+        return out
+
+    yield opener
+    for page in pages:
+        page.close()
