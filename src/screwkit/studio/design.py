@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from screwkit.errors import InputError
+from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec, spec_from_data
 from screwkit.io.toml_file import read_toml
 from screwkit.kinematics.registry import family
@@ -111,6 +112,12 @@ class Design:
         self.path = Path(path)
         self.data = read_toml(self.path)
         self.text = self.path.read_text(encoding="utf-8")
+        from screwkit.io.mechanism_spec import is_graph_spec
+
+        if is_graph_spec(self.data):
+            raise SpecError(f"{self.path}: the studio designs single loops (a family or a joint "
+                            "list) so far; a mechanism graph works with screwkit report, analyze "
+                            "and dynamics (docs/mechanisms.md)")
         self.spec = spec_from_data(self.data, self.path)
         keys = editable_keys(self.data, self.spec)
         values = [_number(self.data, self.spec, k) for k in keys]
