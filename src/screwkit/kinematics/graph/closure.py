@@ -86,10 +86,15 @@ def zero_configuration(lay: GraphLayout, count: int = 1) -> Configuration:
 
 
 def _axis_rotation(u: Array, th: Array) -> Array:
-    """Rotations (N, 3, 3) by angles θ (N,) about the fixed unit axis u (Rodrigues)."""
+    """Rotations (N, 3, 3) by angles θ (N,) about the fixed unit axis u (Rodrigues:
+    I + sin θ K + (1 − cos θ) K², K = [u]×, K² = u uᵀ − I)."""
     K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
-    s, c = np.sin(th)[:, None, None], np.cos(th)[:, None, None]
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    K2 = np.outer(u, u) - np.eye(3)
+    s, c = np.sin(th), np.cos(th)
+    out = np.multiply.outer(s, K)
+    out += np.multiply.outer(1.0 - c, K2)
+    out += np.eye(3)
+    return out
 
 
 def joint_motion(mech: Mechanism, lay: GraphLayout, conf: Configuration, i: int

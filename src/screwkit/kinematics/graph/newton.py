@@ -12,6 +12,7 @@ still.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property, lru_cache
 from typing import Any, cast
 
 import numpy as np
@@ -38,14 +39,29 @@ RANK_CUTOFF = 1e-9
 
 
 def row_scale(lay: GraphLayout, loops: int) -> Array:
+    """Per stacked row: 1 for rotations, 1/L for translations."""
+    return _row_scale(lay.length, loops)
+
+
+@lru_cache(maxsize=64)
+def _row_scale(length: float, loops: int) -> Array:
     s = np.ones(6 * loops)
     for l in range(loops):
-        s[6 * l + 3:6 * l + 6] = 1.0 / lay.length
+        s[6 * l + 3:6 * l + 6] = 1.0 / length
+    s.setflags(write=False)
     return s
 
 
 def column_scale(lay: GraphLayout) -> Array:
-    return np.where(np.array(lay.is_translation, dtype=bool), lay.length, 1.0)
+    """Per freedom: L for slides, 1 for rotations."""
+    return _column_scale(lay.is_translation, lay.length)
+
+
+@lru_cache(maxsize=64)
+def _column_scale(is_translation: tuple[bool, ...], length: float) -> Array:
+    s = np.where(np.array(is_translation, dtype=bool), length, 1.0)
+    s.setflags(write=False)
+    return s
 
 
 def set_inputs(conf: Configuration, lay: GraphLayout, X: Array) -> Configuration:
@@ -65,34 +81,58 @@ def difference(a: Configuration, b: Configuration, lay: GraphLayout) -> Array:
     return configuration_difference(a, b, cast(Any, lay))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Linearised:
     """The scaled stacked Jacobian at a batch of configurations and its passive pseudo-inverse.
 
-    ``J`` (N, 6L, m) scaled; ``pinv`` (N, m_p, 6L) of the passive columns; ``sigma`` (N, k) the
-    passive block's singular values, largest first."""
+    ``J`` (N, 6L, m) scaled and ``Jp`` its passive columns; ``pinv`` (N, m_p, 6L), given (SVD,
+    QR) or formed on first use from ``normal``, the regularised normal matrix JpᵀJp + μI of the
+    tracker's route (whose corrector only needs :meth:`solve` with one right-hand side);
+    ``sigma`` (N, k) the passive block's singular values, largest first (exact routes)."""
 
     frames: GraphFrames
     J: Array
-    pinv: Array
+    Jp: Array
     sigma: Array
+    given_pinv: Array | None = None
+    normal: Array | None = None
+
+    @cached_property
+    def pinv(self) -> Array:
+        if self.given_pinv is not None:
+            return self.given_pinv
+        assert self.normal is not None
+        return np.asarray(np.linalg.solve(self.normal, np.swapaxes(self.Jp, 1, 2)))
+
+    def solve(self, rhs: Array) -> Array:
+        """The passive solution (N, m_p) of J_p x = ``rhs`` (N, 6L) in the least-squares,
+        minimum-norm sense of the route."""
+        if self.normal is None or "pinv" in self.__dict__:
+            return np.einsum("nij,nj->ni", self.pinv, rhs)
+        b = np.einsum("nki,nk->ni", self.Jp, rhs)
+        return np.linalg.solve(self.normal, b[..., None])[..., 0]
 
     def overwrite(self, index: NDArray[np.intp], part: Linearised) -> None:
         """Replace the samples ``index`` by ``part``'s, in place (this object's arrays are its
-        own: Newton's work arrays)."""
+        own: Newton's work arrays of the normal-equation route)."""
+        assert self.normal is not None and part.normal is not None
+        self.__dict__.pop("pinv", None)
         for a, b in ((self.frames.R, part.frames.R), (self.frames.p, part.frames.p),
                      (self.frames.screws, part.frames.screws),
                      (self.frames.residual, part.frames.residual),
                      (self.frames.centres, part.frames.centres),
-                     (self.frames.axes, part.frames.axes), (self.J, part.J),
-                     (self.pinv, part.pinv), (self.sigma, part.sigma)):
+                     (self.frames.axes, part.frames.axes), (self.J, part.J), (self.Jp, part.Jp),
+                     (self.normal, part.normal)):
             a[index] = b
 
     def take(self, index: slice | NDArray[np.intp]) -> Linearised:
         f = self.frames
-        return Linearised(GraphFrames(f.R[index], f.p[index], f.screws[index], f.residual[index],
-                                      f.centres[index], f.axes[index]),
-                          self.J[index], self.pinv[index], self.sigma[index])
+        frames = GraphFrames(f.R[index], f.p[index], f.screws[index], f.residual[index],
+                             f.centres[index], f.axes[index])
+        pinv = self.pinv[index] if "pinv" in self.__dict__ or self.normal is None else None
+        normal = None if self.normal is None else self.normal[index]
+        return Linearised(frames, self.J[index], self.Jp[index], self.sigma[index], pinv,
+                          normal)
 
 
 def linearise(mech: Mechanism, lay: GraphLayout, conf: Configuration,
@@ -112,12 +152,13 @@ def linearise(mech: Mechanism, lay: GraphLayout, conf: Configuration,
     Jp = J[:, :, list(lay.passive)]
     if Jp.shape[1] == 0 or Jp.shape[2] == 0:
         N = conf.size
-        return Linearised(fr, J, np.zeros((N, Jp.shape[2], Jp.shape[1])), np.zeros((N, 0)))
+        return Linearised(fr, J, Jp, np.zeros((N, 0)),
+                          np.zeros((N, Jp.shape[2], Jp.shape[1])))
     if not exact:
         JtJ = np.einsum("nki,nkj->nij", Jp, Jp)
         mu = 1e-14 * np.einsum("nii->n", JtJ)[:, None, None] + 1e-300
-        pinv = np.linalg.solve(JtJ + mu * np.eye(Jp.shape[2]), np.swapaxes(Jp, 1, 2))
-        return Linearised(fr, J, pinv, np.zeros((conf.size, 0)))
+        return Linearised(fr, J, Jp, np.zeros((conf.size, 0)),
+                          normal=JtJ + mu * np.eye(Jp.shape[2]))
     if full_rank and Jp.shape[1] >= Jp.shape[2]:
         Q, R = np.linalg.qr(Jp)
         s = np.linalg.svd(R, compute_uv=False)
@@ -126,9 +167,9 @@ def linearise(mech: Mechanism, lay: GraphLayout, conf: Configuration,
         pinv = np.linalg.solve(R, np.swapaxes(Q, 1, 2))
         if bad.any():
             pinv[bad] = _svd_pinv(Jp[bad])[0]
-        return Linearised(fr, J, pinv, s)
+        return Linearised(fr, J, Jp, s, pinv)
     pinv, s = _svd_pinv(Jp)
-    return Linearised(fr, J, pinv, s)
+    return Linearised(fr, J, Jp, s, pinv)
 
 
 def _svd_pinv(Jp: Array) -> tuple[Array, Array]:
@@ -163,17 +204,30 @@ def newton(mech: Mechanism, lay: GraphLayout, conf: Configuration, X: Array,
         sub = lin if whole else lin.take(todo)
         r = scaled_residual(mech, lay, sub.frames)
         step = np.zeros((todo.size, lay.m))
-        step[:, passive] = -np.einsum("nij,nj->ni", sub.pinv, r) * cs
+        step[:, passive] = -sub.solve(r) * cs
         moved = increment(Configuration(scal[todo], sph[todo]), step, lay)
         scal[todo], sph[todo] = moved.scalars, moved.spherical
         new = linearise(mech, lay, moved, exact=exact)
-        if whole:
-            lin = new
+        if whole or lin.normal is None:
+            lin = new if whole else _merged(lin, todo, new)
         else:
             lin.overwrite(todo, new)
         err[todo] = np.linalg.norm(scaled_residual(mech, lay, new.frames), axis=1)
     err = np.where(np.isfinite(err), err, np.inf)
     return Configuration(scal, sph), err, lin
+
+
+def _merged(lin: Linearised, index: NDArray[np.intp], part: Linearised) -> Linearised:
+    """``lin`` with the samples ``index`` replaced by ``part``'s (exact routes: copies)."""
+    out = []
+    f, g = lin.frames, part.frames
+    for a, b in ((f.R, g.R), (f.p, g.p), (f.screws, g.screws), (f.residual, g.residual),
+                 (f.centres, g.centres), (f.axes, g.axes), (lin.J, part.J), (lin.Jp, part.Jp),
+                 (lin.sigma, part.sigma), (lin.pinv, part.pinv)):
+        a = a.copy()
+        a[index] = b
+        out.append(a)
+    return Linearised(GraphFrames(*out[:6]), out[6], out[7], out[8], out[9])
 
 
 def rates(mech: Mechanism, lay: GraphLayout, lin: Linearised, Xd: Array) -> Array:
@@ -184,7 +238,7 @@ def rates(mech: Mechanism, lay: GraphLayout, lin: Linearised, Xd: Array) -> Arra
     qd[:, list(lay.inputs)] = Xd
     rhs = -np.einsum("nij,nj->ni", lin.J[:, :, list(lay.inputs)],
                      Xd / cs[list(lay.inputs)])
-    qd[:, list(lay.passive)] = np.einsum("nij,nj->ni", lin.pinv, rhs) * cs[list(lay.passive)]
+    qd[:, list(lay.passive)] = lin.solve(rhs) * cs[list(lay.passive)]
     return qd
 
 
@@ -200,5 +254,5 @@ def accelerations(mech: Mechanism, lay: GraphLayout, lin: Linearised, qd: Array,
     qdd[:, list(lay.inputs)] = Xdd
     rhs = -(np.einsum("nij,nj->ni", lin.J[:, :, list(lay.inputs)], Xdd / cs[list(lay.inputs)])
             + loop_bias(mech, bias) * row_scale(lay, L))
-    qdd[:, list(lay.passive)] = np.einsum("nij,nj->ni", lin.pinv, rhs) * cs[list(lay.passive)]
+    qdd[:, list(lay.passive)] = lin.solve(rhs) * cs[list(lay.passive)]
     return qdd, bias

@@ -53,7 +53,8 @@ def _predict(mech: Mechanism, lay: GraphLayout, at: _Point, X: Array) -> Configu
     K = X.shape[0]
     d = X - at.x[None, :]
     lin = Linearised(at.lin.frames, np.broadcast_to(at.lin.J, (K, *at.lin.J.shape[1:])),
-                     np.broadcast_to(at.lin.pinv, (K, *at.lin.pinv.shape[1:])), at.lin.sigma)
+                     np.broadcast_to(at.lin.Jp, (K, *at.lin.Jp.shape[1:])), at.lin.sigma,
+                     np.broadcast_to(at.lin.pinv, (K, *at.lin.pinv.shape[1:])))
     qd = rates(mech, lay, lin, d)
     screws = np.broadcast_to(at.lin.frames.screws, (K, *at.lin.frames.screws.shape[1:]))
     _, bias = body_twists(mech, lay, screws, qd)
@@ -61,7 +62,7 @@ def _predict(mech: Mechanism, lay: GraphLayout, at: _Point, X: Array) -> Configu
     rhs = -loop_bias(mech, bias) * row_scale(lay, L)
     cs = column_scale(lay)
     qdd = np.zeros_like(qd)
-    qdd[:, list(lay.passive)] = np.einsum("nij,nj->ni", lin.pinv, rhs) * cs[list(lay.passive)]
+    qdd[:, list(lay.passive)] = lin.solve(rhs) * cs[list(lay.passive)]
     start = Configuration(np.repeat(at.conf.scalars, K, 0), np.repeat(at.conf.spherical, K, 0))
     return increment(start, qd + 0.5 * qdd, lay)
 
@@ -75,10 +76,11 @@ def _consistent(mech: Mechanism, lay: GraphLayout, prev: _Point, conf: Configura
     Xb = np.concatenate([prev.x[None, :], X[:-1]])
     piv = np.concatenate([prev.lin.pinv, lin.pinv[:-1]])
     Jb = np.concatenate([prev.lin.J, lin.J[:-1]])
+    Jpb = np.concatenate([prev.lin.Jp, lin.Jp[:-1]])
     d = X - Xb
     cs = column_scale(lay)
     rate_after = rates(mech, lay, lin, d)
-    rate_before = rates(mech, lay, Linearised(lin.frames, Jb, piv, lin.sigma), d)
+    rate_before = rates(mech, lay, Linearised(lin.frames, Jb, Jpb, lin.sigma, piv), d)
     actual = difference(conf, before, lay) / cs
     trap = 0.5 * (rate_after + rate_before) / cs
     passive = list(lay.passive)
