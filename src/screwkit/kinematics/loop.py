@@ -14,7 +14,9 @@ along u is (0; u) and a helical of pitch h is (u; c × u + h u).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -79,14 +81,33 @@ def constants(linkage: Linkage, lay: Layout) -> tuple[Array, Array, float]:
             linkage.length_scale)
 
 
-def layout(linkage: Linkage) -> Layout:
+@dataclass(frozen=True)
+class FreedomColumns:
+    """Where the freedoms of a list of joints live: their names ``"<joint>.<freedom>"`` in
+    joint order, each one's joint, its column among the scalar freedoms (−1 for a ball's), whether
+    it is a slide, each joint's first freedom and each ball joint's index among the balls."""
+
+    names: tuple[str, ...]
+    joint_of: tuple[int, ...]
+    scalar_col: tuple[int, ...]
+    is_translation: tuple[bool, ...]
+    first: tuple[int, ...]
+    spherical_of_joint: dict[int, int]
+    n_scalar: int
+
+
+def freedom_columns(joints: Sequence[Any]) -> FreedomColumns:
+    """The :class:`FreedomColumns` of ``joints`` (anything with ``name``, ``kind`` and
+    ``freedoms``: a loop's joints or a mechanism graph's)."""
     names: list[str] = []
     joint_of: list[int] = []
     scalar_col: list[int] = []
     is_tr: list[bool] = []
+    first: list[int] = []
     sph: dict[int, int] = {}
     col = 0
-    for i, j in enumerate(linkage.joints):
+    for i, j in enumerate(joints):
+        first.append(len(names))
         if j.kind == "S":
             sph[i] = len(sph)
         for f in j.freedoms:
@@ -98,11 +119,18 @@ def layout(linkage: Linkage) -> Layout:
             else:
                 scalar_col.append(col)
                 col += 1
+    return FreedomColumns(tuple(names), tuple(joint_of), tuple(scalar_col), tuple(is_tr),
+                          tuple(first), sph, col)
+
+
+def layout(linkage: Linkage) -> Layout:
+    fc = freedom_columns(linkage.joints)
     rotations = np.stack([np.asarray(t.real, dtype=float) for t in linkage.link_transforms])
     translations = np.stack([np.asarray(t.translation, dtype=float)
                              for t in linkage.link_transforms])
-    return Layout(tuple(names), tuple(joint_of), tuple(scalar_col), sph, tuple(is_tr), col, len(sph),
-                  linkage, rotations, translations, linkage.length_scale)
+    return Layout(fc.names, fc.joint_of, fc.scalar_col, fc.spherical_of_joint, fc.is_translation,
+                  fc.n_scalar, len(fc.spherical_of_joint), linkage, rotations, translations,
+                  linkage.length_scale)
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual.spatial import cross
-from screwkit.kinematics.loop import Configuration, closure_error, closure_twist, lie_bracket
+from screwkit.kinematics.loop import (
+    Configuration,
+    closure_error,
+    closure_twist,
+    freedom_columns,
+    lie_bracket,
+)
 from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]
@@ -50,33 +56,14 @@ class GraphLayout:
 
 
 def graph_layout(mech: Mechanism) -> GraphLayout:
-    names: list[str] = []
-    joint_of: list[int] = []
-    scalar_col: list[int] = []
-    first: list[int] = []
-    is_tr: list[bool] = []
-    sph: dict[int, int] = {}
-    col = 0
-    for i, j in enumerate(mech.joints):
-        first.append(len(names))
-        if j.kind == "S":
-            sph[i] = len(sph)
-        for f in j.freedoms:
-            names.append(f"{j.name}.{f}")
-            joint_of.append(i)
-            is_tr.append(f == "s")
-            if j.kind == "S":
-                scalar_col.append(-1)
-            else:
-                scalar_col.append(col)
-                col += 1
-    inputs = tuple(names.index(x) for x in mech.inputs)
-    passive = tuple(k for k in range(len(names)) if k not in inputs)
+    fc = freedom_columns(mech.joints)
+    inputs = tuple(fc.names.index(x) for x in mech.inputs)
+    passive = tuple(k for k in range(len(fc.names)) if k not in inputs)
     body_of = {b: k for k, b in enumerate(mech.body_names)}
     body_of[GROUND] = len(mech.bodies)
-    return GraphLayout(tuple(names), tuple(joint_of), tuple(scalar_col), tuple(first), sph,
-                       tuple(is_tr), col, len(sph), inputs, passive, body_of,
-                       mech.length_scale)
+    return GraphLayout(fc.names, fc.joint_of, fc.scalar_col, fc.first, fc.spherical_of_joint,
+                       fc.is_translation, fc.n_scalar, len(fc.spherical_of_joint), inputs,
+                       passive, body_of, mech.length_scale)
 
 
 def zero_configuration(lay: GraphLayout, count: int = 1) -> Configuration:
