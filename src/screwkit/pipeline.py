@@ -16,7 +16,7 @@ from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.result import BalanceResult
 from screwkit.constants import STANDARD_GRAVITY
 from screwkit.dynamics import Dynamics, inverse_dynamics
-from screwkit.errors import ScrewkitError
+from screwkit.errors import InputError, ScrewkitError, expect_instance
 from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec
 from screwkit.kinematics.coupler_curves import coupler_curves
@@ -42,6 +42,10 @@ class Pipeline:
     :func:`~screwkit.kinematics.solve_motion.solve_motion`)."""
 
     def __init__(self, spec: Spec, *, method: str = "auto") -> None:
+        expect_instance(spec, Spec, "Pipeline: spec", "a Spec (sk.load_spec(path))")
+        if method not in ("auto", "closed", "generic"):
+            raise InputError(f"Pipeline: method must be 'auto', 'closed' or 'generic'; got "
+                             f"{method!r}")
         self.spec = spec
         self.method = method
 

@@ -24,7 +24,7 @@ from typing import IO, Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.errors import InputError, UnknownNameError
+from screwkit.errors import InputError, InputTypeError, UnknownNameError
 
 #: the SI unit of every quantity kind a column can have; "flag", "index" and "text" columns
 #: have no unit, "ratio" ones are plain numbers and "percent" ones are in %
@@ -114,6 +114,9 @@ class ResultTable:
                   ) -> list[tuple[str, str, NDArray[Any]]]:
         """(name, unit label, values in that unit) per column."""
         u = units if units is not None else SIUnits()
+        if not callable(getattr(u, "unit_of", None)):
+            raise InputTypeError(f"units must be display units (spec.display_units() or "
+                                 f"screwkit.tables.SIUnits()); got {type(units).__name__}")
         out = []
         for c in self.columns:
             if c.kind in UNITLESS:

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.balancing.errors import BalancingError
+from screwkit.errors import expect_instance
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import (
     EQUIVALENT_POINT_LABELS,
@@ -106,6 +107,7 @@ class DesignVariables:
 
 
 def _link_index(linkage: Linkage, link: str) -> int:
+    expect_instance(linkage, Linkage, "linkage", "a screwkit Linkage (load_spec(...).linkage)")
     names = [lk.name for lk in linkage.links]
     if link not in names:
         raise BalancingError(f"no moving link named {link!r}; the links are {names}")

@@ -7,6 +7,7 @@ Every error names the file, the key, what is wrong and what would be right
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -24,7 +25,7 @@ from pydantic import (
 )
 
 from screwkit.constants import STANDARD_GRAVITY
-from screwkit.errors import ScrewkitError
+from screwkit.errors import InputTypeError, ScrewkitError
 from screwkit.io.errors import SpecError
 from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
@@ -455,6 +456,9 @@ def load_spec(path: str | Path) -> Spec:
     """Read and validate a spec file (TOML with units; docs/spec-format.md) into a :class:`Spec`
     in SI units, with its mechanism model and its ``[balancing]``/``[synthesis]`` tables parsed;
     raises :class:`SpecError` naming the file, the key and a fix."""
+    if not isinstance(path, str | os.PathLike) or not isinstance(os.fspath(path), str):
+        raise InputTypeError(f"load_spec: path must be a file name (a str or pathlib.Path); "
+                             f"got {type(path).__name__}")
     p = Path(path)
     try:
         data = read_toml(p)  # size, encoding, nesting and string-length checks

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.errors import InputError
+from screwkit.errors import InputError, expect_instance
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.kinematics.registry import coupler_link_index
@@ -47,13 +47,22 @@ def idle_axis(linkage: Linkage, link: int) -> Array | None:
     return np.asarray(centre / np.linalg.norm(centre))
 
 
+def _point(point: ArrayLike) -> Array:
+    """``point`` as floats; NaN for what is not numbers (the caller's message says what a
+    point is)."""
+    try:
+        return np.asarray(point, dtype=float)
+    except (TypeError, ValueError):
+        return np.full(1, np.nan)
+
+
 def coupler_point(linkage: Linkage, point: ArrayLike, link: str | None = None,
                   name: str = "coupler point") -> CouplerPoint:
     """A coupler point of ``linkage``: ``point`` (3 coordinates, m) in the body frame of the
     moving link called ``link`` (default: the family's coupler,
     :func:`~screwkit.kinematics.registry.coupler_link_index`). A ValueError says why a point
     has no defined path (module docstring)."""
-    p = np.asarray(point, dtype=float)
+    p = _point(point)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
         raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
     k = coupler_link_index(linkage, link)
@@ -76,7 +85,11 @@ def coupler_point_path(mode: ModeMotion, point: ArrayLike, link: int = 1) -> Arr
     """(N, 3) world positions (m) of ``point`` (3,), given in the body frame of moving link
     ``link`` (0-based; link k lies between joints k and k+1, its frame is joint k's frame after
     the joint motion), over one mode; NaN where the mode does not assemble."""
-    p = np.asarray(point, dtype=float)
+    expect_instance(mode, ModeMotion, "coupler_point_path: mode",
+                    "one mode of a solved motion (motion.mode(k))")
+    p = _point(point)
+    if isinstance(link, bool) or not isinstance(link, int | np.integer):
+        raise InputError(f"coupler_point_path: link must be a moving link's index; got {link!r}")
     if p.shape != (3,) or not np.all(np.isfinite(p)):
         raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
     n_links = mode.link_rotation.shape[1]

@@ -152,11 +152,14 @@ def as_input_array(linkage: Linkage, values: ArrayLike, name: str) -> Array:
     if not isinstance(linkage, Linkage):
         raise InputTypeError(f"linkage must be a screwkit Linkage (e.g. sk.rsrc(...) or "
                              f"load_spec(...).linkage); got {type(linkage).__name__}")
+    not_numbers = InputTypeError(f"{name}: give numbers (one per sample and input); got "
+                                 f"{type(values).__name__}")
+    if values is None or isinstance(values, str | bytes):  # np.asarray makes NaN of None
+        raise not_numbers
     try:
         a = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
-        raise InputTypeError(f"{name}: give numbers (one per sample and input); got "
-                             f"{type(values).__name__}") from None
+        raise not_numbers from None
     n_in = len(linkage.inputs)
     if a.ndim == 0:
         a = a[None, None]
