@@ -9,10 +9,11 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -29,7 +30,7 @@ from screwkit.errors import InputTypeError, ScrewkitError
 from screwkit.io.errors import SpecError
 from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
-from screwkit.io.validation import validation_lines
+from screwkit.io.validation import Name, refuse_formula, validation_lines
 from screwkit.kinematics.registry import family, require
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
@@ -72,7 +73,7 @@ class MotionTable(_Strict):
 
 
 class JointTable(_Strict):
-    name: str
+    name: Name
     kind: Literal["R", "P", "C", "H", "U", "S"]
     length: Value = 0.0
     twist: Value = 0.0
@@ -90,8 +91,9 @@ class LinkMassTable(_Strict):
 
 
 class CouplerPointTable(_Strict):
-    name: StrictStr | None = Field(None, max_length=80)
-    link: StrictStr | None = Field(None, description="moving link (default: the family's coupler)")
+    name: Annotated[StrictStr, AfterValidator(refuse_formula)] | None = Field(None, max_length=80)
+    link: Annotated[StrictStr, AfterValidator(refuse_formula)] | None = Field(
+        None, description="moving link (default: the family's coupler)")
     f: Value = 0.0
     g: Value = 0.0
     h: Value = 0.0
@@ -111,7 +113,7 @@ class SpecFile(_Strict):
     dimensions: dict[str, Value] = Field(default_factory=dict)
     joints: list[JointTable] = Field(default_factory=list)
     motion: MotionTable = Field(default_factory=MotionTable)  # type: ignore[arg-type]
-    links: dict[str, LinkMassTable] = Field(default_factory=dict)
+    links: dict[Name, LinkMassTable] = Field(default_factory=dict)
     coupler_point: CouplerPointTable | None = None
     coupler_points: list[CouplerPointTable] = Field(default_factory=list, max_length=100)
     limits: LimitsTable | None = None
