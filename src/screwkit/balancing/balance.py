@@ -30,6 +30,7 @@ from screwkit.balancing.variables import DesignVariables, VariableBlock, assembl
 from screwkit.dynamics import Dynamics, Regressor, regressor
 from screwkit.errors import expect_instance, expect_number
 from screwkit.kinematics.motion import ModeMotion, Motion
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 
@@ -99,7 +100,8 @@ def _rod_description(linkage: Linkage, mode: ModeMotion, k: int) -> str:
     r = np.asarray(mp.com) - p0
     offset = float(np.linalg.norm(r - (r @ u) * u))
     return (f"link {linkage.links[k].name!r} (transverse moments of inertia about its CoM "
-            f"{transverse[0]:.6g} and {transverse[1]:.6g} kg*m^2, CoM {offset:.3g} m off the line "
+            f"{shown(transverse[0], 'inertia')} and {shown(transverse[1], 'inertia')}, CoM "
+            f"{shown(offset, 'length', digits=3)} off the line "
             "of its ball centres)")
 
 

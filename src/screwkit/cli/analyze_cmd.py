@@ -119,9 +119,9 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full, files={"--plot": plot})
         s = guard(lambda: load_spec(spec))
-        pipe = Pipeline(s, method=method)
-        motion = guard(lambda: pipe.motion)
         du = out.units_for(s.units)
+        pipe = guard(lambda: Pipeline(s, method=method, units=du))
+        motion = guard(lambda: pipe.motion)
 
         doc = guard(pipe.analysis)
         table = guard(pipe.analysis_table)

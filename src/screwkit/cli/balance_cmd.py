@@ -139,7 +139,7 @@ def register(app: typer.Typer) -> None:
         pareto = s.balancing.pareto if s.balancing is not None else None
         total = None if pareto is None else pareto_size(pareto)
         with progress_bar("Pareto sweep", total, enabled=pareto is not None) as advance:
-            res = guard(lambda: Pipeline(s).balance(progress=advance))
+            res = guard(lambda: Pipeline(s, units=du).balance(progress=advance))
         doc = balance_document(res)
         written: list[str] = []
         if tables is not None:

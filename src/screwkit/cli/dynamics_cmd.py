@@ -102,10 +102,10 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full)
         s = guard(lambda: load_spec(spec))
-        pipe = Pipeline(s)
+        du = out.units_for(s.units)
+        pipe = Pipeline(s, units=du)
         dyn = guard(lambda: pipe.dynamics(gravity))
         note = guard(lambda: load_note(pipe))
-        du = out.units_for(s.units)
         out.deliver(document=lambda: dynamics_document(dyn, mode=s.mode, note=note),
                     table=lambda: dyn.table(mode=s.mode),
                     show=lambda: show_dynamics(s, pipe, dyn, du, note), units=du)

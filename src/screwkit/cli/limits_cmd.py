@@ -100,9 +100,10 @@ def register(app: typer.Typer) -> None:
         s = guard(lambda: load_spec(spec))
         where = None if at is None else [float(np.radians(x)) if s.input_is_angle else float(x)
                                          for x in at]
-        doc = guard(lambda: Pipeline(s).limits(dwell_tolerance, where, output=variable,
-                                               method=method).as_dict())
         du = out.units_for(s.units)
+        doc = guard(lambda: Pipeline(s, units=du).limits(dwell_tolerance, where,
+                                                         output=variable,
+                                                         method=method).as_dict())
         out.deliver(document=lambda: doc, table=lambda: limits_table(doc),
                     show=lambda: show_limits(s, doc, du), units=du)
 

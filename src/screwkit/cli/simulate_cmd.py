@@ -103,10 +103,14 @@ def register(app: typer.Typer) -> None:
             user_error(f"--plot {plot}: give a file ending in .png, .svg or .pdf")
         fw = None if flywheel is None else guard(
             lambda: to_si(flywheel, "inertia", "kg*m**2"))
+        from screwkit.messages import message_units
+
         s = guard(lambda: load_spec(spec))
-        run = guard(lambda: simulate_spec(s, fluctuation=fluctuation, cycles=cycles, flywheel=fw))
-        doc = guard(lambda: run.as_dict())
         du = out.units_for(s.units)
+        with message_units(du):
+            run = guard(lambda: simulate_spec(s, fluctuation=fluctuation, cycles=cycles,
+                                              flywheel=fw))
+        doc = guard(lambda: run.as_dict())
         if plot is not None:
             from screwkit.report.simulation_plots import write_simulation_png
 

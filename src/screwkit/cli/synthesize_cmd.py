@@ -279,7 +279,7 @@ def register(app: typer.Typer) -> None:
                               unit=unit, full=full, files={"--plot": plot})
         s = _guard(lambda: load_spec(spec))
         du = out.units_for(s.units)
-        pipe = Pipeline(s)
+        pipe = Pipeline(s, units=du)
         config = _guard(lambda: pipe.synthesis_config())
         problem = config.problem
         overlay = config.method == "overlay"

@@ -32,6 +32,7 @@ from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
 from screwkit.io.validation import Name, refuse_formula, validation_lines
 from screwkit.kinematics.registry import family, require
+from screwkit.messages import message_units
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
 if TYPE_CHECKING:
@@ -477,4 +478,16 @@ def spec_from_data(data: dict[str, Any], path: str | Path) -> Spec:
         raw = SpecFile.model_validate(data)
     except ValidationError as exc:
         raise SpecError(_format_validation(str(path), exc)) from exc
-    return Spec(raw, str(path))
+    with message_units(_units_of(raw)):  # messages about the model in the spec's units
+        return Spec(raw, str(path))
+
+
+def _units_of(raw: SpecFile) -> DisplayUnits | None:
+    """The display units of a validated spec's ``[units]`` for its messages; None where the
+    table is wrong (then the spec's own check reports it)."""
+    from screwkit.io.display_units import display_units
+
+    try:
+        return display_units(raw.units)
+    except ScrewkitError:
+        return None

@@ -9,6 +9,7 @@ from typing import Annotated, Any
 
 from pydantic import AfterValidator, ValidationError
 
+from screwkit.errors import InputError
 from screwkit.io.quantity import excerpt
 from screwkit.tables import FORMULA_STARTS
 
@@ -17,7 +18,7 @@ def refuse_formula(name: str) -> str:
     """``name`` unless it starts as a spreadsheet formula would (``=``, ``+``, ``-``, ``@``):
     names become CSV and Parquet column headers, where ``=HYPERLINK(…)`` would run."""
     if name.startswith(FORMULA_STARTS):
-        raise ValueError(f"the name {excerpt(name)} starts with {name[0]!r}, which a spreadsheet "
+        raise InputError(f"the name {excerpt(name)} starts with {name[0]!r}, which a spreadsheet "
                          "reads as a formula in the CSV headers; start it with a letter")
     return name
 

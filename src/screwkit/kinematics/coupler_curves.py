@@ -20,6 +20,7 @@ from screwkit.errors import InputError, expect_instance
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.kinematics.registry import coupler_link_index
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 
 __all__ = ["CouplerPoint", "coupler_curves", "coupler_point", "coupler_point_path"]
@@ -75,8 +76,9 @@ def coupler_point(linkage: Linkage, point: ArrayLike, link: str | None = None,
             raise InputError(
                 f"{linkage.name}: the {linkage.links[k].name} lies between the ball joints {j1} "
                 f"and {j2}, so it turns freely about the line of their centres and only points on "
-                f"that line have a defined path; this point is {off:.6g} m off it (the nearest "
-                f"point on it is {along:.6g} m along the line from {j1}, direction "
+                f"that line have a defined path; this point is {shown(off, 'length')} off it (the "
+                f"nearest point on it is {shown(along, 'length')} along the line from {j1}, "
+                "direction "
                 f"{np.round(axis, 9).tolist()} in the link frame)")
     return CouplerPoint(name, k, linkage.links[k].name, (float(p[0]), float(p[1]), float(p[2])))
 

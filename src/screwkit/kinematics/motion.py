@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.errors import InputError, InputTypeError, UnknownNameError
 from screwkit.kinematics.loop import Array, Configuration
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 
 if TYPE_CHECKING:
@@ -189,11 +190,10 @@ def per_sample(linkage: Linkage, values: ArrayLike, name: str, X: Array) -> Arra
 
 
 def format_inputs(linkage: Linkage, x: Array) -> str:
-    """Input values for a message: degrees for rotations, metres for translations."""
+    """Input values for a message, ``input.theta = 250 deg``, in the units of
+    :func:`screwkit.messages.message_units` (the spec's, through a Pipeline; else degrees and
+    metres)."""
     parts = []
     for name, v in zip(linkage.inputs, np.atleast_1d(x), strict=True):
-        if name.endswith(".s"):
-            parts.append(f"{name} = {float(v):.6g} m")
-        else:
-            parts.append(f"{name} = {float(np.degrees(v)):.6g} deg")
+        parts.append(f"{name} = {shown(v, 'length' if name.endswith('.s') else 'angle')}")
     return ", ".join(parts)

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.loop import forward
 from screwkit.kinematics.transmission import transmission
+from screwkit.messages import shown, shown_range
 from screwkit.synthesis.loop_route import LoopResidualModel, LoopSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled
 from screwkit.synthesis.solve import (
@@ -94,12 +95,12 @@ def loop_range_check(model: LoopResidualModel, ev: Evaluation, step: float = mat
         trans = float(min(np.nanmin(v) for v in values)) if values else float("nan")
     except ValueError:
         trans = float("nan")
-    deg = math.degrees
-    parts = [f"does not assemble (or is singular) on its branch for theta = {deg(a):.2f}.."
-             f"{deg(b):.2f} deg" for a, b in gaps]
+    parts = [f"does not assemble (or is singular) on its branch for theta in "
+             f"{shown_range(a, b, 'angle', digits=5)}" for a, b in gaps]
     if mismatch:
-        parts.append("design point(s) theta = " + ", ".join(f"{deg(t):.2f}" for t in mismatch)
-                     + " deg lie on another branch (the mechanism would have to be reassembled)")
+        parts.append("design point(s) theta = " + ", ".join(shown(t, "angle", digits=5)
+                                                            for t in mismatch)
+                     + " lie on another branch (the mechanism would have to be reassembled)")
     if math.isfinite(trans) and trans <= 1e-6:
         parts.append("passes a dead centre of the output (transmission index 0)")
     ok = not parts

@@ -23,6 +23,7 @@ from scipy.optimize import least_squares
 from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
+from screwkit.messages import shown, shown_range
 from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled, ResidualModel, dimensions_of
 
@@ -145,14 +146,15 @@ def check_range(problem: RSRCSynthesisProblem, ev: Evaluation, n_samples: int = 
     trans = float(np.nanmin(np.abs(np.sin(chi_b)))) if ok_mask.any() else 0.0
     ok = not gaps and not mismatch and trans > 1e-6
     parts = []
-    deg = math.degrees
     for a, b in gaps:
-        parts.append(f"does not assemble on its branch for theta = {deg(a):.2f}..{deg(b):.2f} deg "
-                     f"(theta0 = {deg(ev.params['theta01'] + problem.input_direction * a):.2f}.."
-                     f"{deg(ev.params['theta01'] + problem.input_direction * b):.2f} deg)")
+        t01, sense = ev.params["theta01"], problem.input_direction
+        parts.append(f"does not assemble on its branch for theta in "
+                     f"{shown_range(a, b, 'angle', digits=5)} (theta0 in "
+                     f"{shown_range(t01 + sense * a, t01 + sense * b, 'angle', digits=5)})")
     if mismatch:
-        parts.append("design point(s) theta = " + ", ".join(f"{deg(t):.2f}" for t in mismatch)
-                     + " deg lie on another branch (the mechanism would have to be reassembled)")
+        parts.append("design point(s) theta = " + ", ".join(shown(t, "angle", digits=5)
+                                                            for t in mismatch)
+                     + " lie on another branch (the mechanism would have to be reassembled)")
     if trans <= 1e-6:
         parts.append("passes a dead centre of the output (sin chi0 = 0)")
     msg = "; ".join(parts) if parts else (
@@ -269,12 +271,8 @@ def result_from_evaluation(
 
 
 def _show(name: str, value: float) -> str:
-    """A value of unknown ``name`` as a plain number with its SI unit (angles also in deg)."""
-    if name in LENGTH_NAMES:
-        return f"{float(value):.6g} m"
-    if not math.isfinite(value):
-        return f"{float(value)}"
-    return f"{float(value):.6g} rad ({math.degrees(value):.6g} deg)"
+    """A value of unknown ``name`` in the message units (:mod:`screwkit.messages`)."""
+    return shown(value, "length" if name in LENGTH_NAMES else "angle")
 
 
 def _check_start(problem: RSRCSynthesisProblem, x0: FloatArray, lo: FloatArray,
