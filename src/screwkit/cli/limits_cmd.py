@@ -32,13 +32,14 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
         return "angle" if x.get("kind", "rotation") == "rotation" else "length"
 
     def second(x: dict[str, Any]) -> str:
-        """d²y/dx²: rad/rad² for a rotation, the display length per rad² for a translation."""
+        """d²y/dx² with its unit: output unit per input unit squared, angles in rad (a
+        derivative by an angle is per radian), lengths in the display unit."""
         v = x["second_derivative"]
         if v is None:
             return "—"
-        if kind_of(x) == "angle":
-            return f"{number(v, 4)} rad"
-        return f"{number(units.show('length', v), 4)} {units.label('length')}"
+        out_label, out_factor = ("rad", 1.0) if kind_of(x) == "angle" else units.unit_of("length")
+        in_label, in_factor = ("rad", 1.0) if xk == "angle" else units.unit_of("length")
+        return f"{number(v / out_factor * in_factor**2, 4)} {out_label}/{in_label}²"
 
     generic = doc["method"] == "generic"
     lims = doc["limits"]
@@ -49,7 +50,7 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
             TextColumn(f"input\n[{units.label(xk)}]",
                        [number(units.show(xk, x["input"]), 7) for x in lims]),
             TextColumn("value", [shown(x["value"], kind_of(x)) for x in lims]),
-            TextColumn("2nd derivative\n[per rad²]", [second(x) for x in lims]),
+            TextColumn("2nd\nderivative", [second(x) for x in lims]),
             TextColumn("dwell\norder", ["—" if x["dwell_order"] is None else str(x["dwell_order"])
                                         for x in lims])]
     print_columns(console, f"limit positions (dwell tolerance {doc['dwell_tolerance']:g})", cols)

@@ -420,7 +420,8 @@ class Spec:
         kind = "angle" if self.input_is_angle else "length"
         span = (f"{du.show(kind, self.inputs[0]):.6g}…{du.show(kind, self.inputs[-1]):.6g} "
                 f"{du.label(kind)}")
-        return f"{self.name}: {self.family} ({joints}) {dims}; {n} input samples {span}{src}"
+        head = f"{self.name}: {self.family} ({joints})" + (f" {dims}" if dims else "")
+        return f"{head}; {n} input samples {span}{src}"
 
     def jobs(self) -> list[str]:
         """The jobs this spec asks for, each checked at load against what its family offers
