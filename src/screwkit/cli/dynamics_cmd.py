@@ -83,7 +83,7 @@ def show_dynamics(spec: Any, pipe: Any, dyn: Any, units: Any, note: str | None) 
     from rich.markup import escape
 
     from screwkit.cli.common import console
-    from screwkit.cli.formatting import TextColumn, print_columns
+    from screwkit.cli.formatting import print_columns
 
     console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
     console.print(f"assembly mode {spec.mode}; {gravity_sentence(dyn, pipe)}; "
