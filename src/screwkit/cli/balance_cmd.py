@@ -10,6 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
+from screwkit.cli.common import prose
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 
@@ -37,10 +38,9 @@ def show_balance(spec: Any, res: Any, doc: dict[str, Any], units: Any,
     from screwkit.cli.common import console
     from screwkit.cli.formatting import TextColumn, number, print_columns
 
-    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
+    prose(f"[bold]{escape(spec.describe(units))}[/]")
     gravity = "on" if res.dynamics_before.gravity_on else "off ([balancing] gravity = true adds it)"
-    console.print(f"assembly mode {spec.mode}; gravity {gravity}", highlight=False,
-                  markup=False)
+    prose(escape(f"assembly mode {spec.mode}; gravity {gravity}"))
     keys = (*MEASURES, "G")
     ch = res.changes()
     print_columns(console, "load measures, normalised mean squares (Rahman eq. 4.1)", [
@@ -83,26 +83,24 @@ def show_balance(spec: Any, res: Any, doc: dict[str, Any], units: Any,
         TextColumn("change %", [_change(res.link_mass_before[k], res.link_mass_after[k])
                                 for k in links])])
     if bounds:
-        console.print("active bounds: " + "; ".join(
-            escape(b["constraint"]) for b in doc["active_bounds"]), highlight=False)
+        prose("active bounds: " + "; ".join(
+            escape(b["constraint"]) for b in doc["active_bounds"]))
     verdict = ("could not be determined" if res.unique is None
                else "yes" if res.unique else f"no ({len(res.directions)} free direction(s))")
-    console.print(f"unique optimum: {verdict}", highlight=False)
+    prose(f"unique optimum: {verdict}")
     for d in res.directions:
         combo = " ".join(f"{c:+.4g}·{name}" for name, c in d.direction.items())
-        console.print(escape(f"  free direction {combo} ({direction_range(d)})"),
-                      highlight=False)
+        prose(escape(f"  free direction {combo} ({direction_range(d)})"))
     bound = doc.get("redistribution_bound")
     if bound:
-        console.print(f"bound over all consistent redistributions (SDP): G = "
-                      f"{bound['measures_after']['G']:.6g}", highlight=False)
+        prose(f"bound over all consistent redistributions (SDP): G = "
+                      f"{bound['measures_after']['G']:.6g}")
     if "pareto" in doc:
         eff = sum(doc["pareto"]["efficient"])
-        console.print(f"Pareto sweep over {doc['pareto']['measures']}: "
-                      f"{len(doc['pareto']['values'])} weightings, {eff} non-dominated",
-                      highlight=False)
+        prose(f"Pareto sweep over {doc['pareto']['measures']}: "
+                      f"{len(doc['pareto']['values'])} weightings, {eff} non-dominated")
     for note in res.notes:
-        console.print(escape(f"note: {note}"), highlight=False)
+        prose(escape(f"note: {note}"))
     for p in written:
         console.print(f"wrote {escape(p)}", highlight=False)
 

@@ -1,10 +1,11 @@
 """What every ``screwkit`` subcommand shares: the consoles and the rule that a user mistake
 exits with status 2 and a one-paragraph message (the output options: :mod:`screwkit.cli.outputs`).
 
-Messages are never wrapped (``soft_wrap``): one message is one line whatever ``COLUMNS`` says
-and whether or not the output is a terminal, so paths stay whole for grep and copy-paste. Only
-tables are fitted to the width (:mod:`screwkit.cli.formatting`): the terminal's, or ``COLUMNS``,
-or 80 for a pipe or a file."""
+Errors and ``wrote <path>`` lines are never wrapped (``soft_wrap``): one message is one line
+whatever ``COLUMNS`` says, so paths stay whole for grep and copy-paste. Everything else a
+command prints fits the width — the terminal's, or ``COLUMNS``, or 80 for a pipe or a file:
+tables by :mod:`screwkit.cli.formatting`, prose (headers, notes, bullets) by :func:`prose`,
+which breaks lines between words with a hanging indent and never inside a word."""
 
 from __future__ import annotations
 
@@ -15,11 +16,45 @@ from typing import NoReturn, TypeVar
 import typer
 from rich.console import Console
 from rich.markup import escape
+from rich.text import Text
 
 console = Console(soft_wrap=True)
 err_console = Console(stderr=True, soft_wrap=True)
 
 T = TypeVar("T")
+
+
+def prose(markup: str, *, hang: int | None = None, to: Console | None = None,
+          width: int | None = None) -> None:
+    """Print one paragraph of rich ``markup`` wrapped between words at the console's width;
+    continuation lines are indented by ``hang`` (default: up to the text after a leading
+    bullet ``  • ``, else 2). A word longer than a line (a path) is kept whole on its own
+    line."""
+    out = to if to is not None else console
+    text = out.render_str(markup, highlight=False)
+    plain = text.plain
+    if hang is None:
+        bullet = len(plain) - len(plain.lstrip(" •"))
+        hang = bullet if bullet else 2
+    limit = max(width or out.width, 20)
+    cuts: list[int] = []
+    start, last_space, pos = 0, -1, 0
+    while pos < len(plain):
+        if plain[pos] == " " and pos > start:
+            last_space = pos
+        room = limit - (hang if cuts else 0)
+        if pos - start >= room and last_space > start:
+            cuts.append(last_space)
+            start, last_space = last_space + 1, -1
+            pos = start
+            continue
+        pos += 1
+    pieces = text.divide(cuts) if cuts else [text]
+    for k, piece in enumerate(pieces):
+        if k:
+            piece = piece[1:] if piece.plain.startswith(" ") else piece
+            piece = Text(" " * hang) + piece
+        out.print(piece, soft_wrap=True, highlight=False)
 
 
 def user_errors() -> tuple[type[BaseException], ...]:

@@ -10,6 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
+from screwkit.cli.common import prose
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 
@@ -85,16 +86,16 @@ def show_dynamics(spec: Any, pipe: Any, dyn: Any, units: Any, note: str | None) 
     from screwkit.cli.common import console
     from screwkit.cli.formatting import print_columns
 
-    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
-    console.print(f"assembly mode {spec.mode}; {gravity_sentence(dyn, pipe)}; "
-                  f"{escape(dyn.indeterminacy.describe())}", highlight=False)
+    prose(f"[bold]{escape(spec.describe(units))}[/]")
+    prose(f"assembly mode {spec.mode}; {gravity_sentence(dyn, pipe)}; "
+                  f"{escape(dyn.indeterminacy.describe())}")
     if note is not None:
-        console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
+        prose(f"[yellow]note:[/] {escape(note)}")
     cols = summary_columns(dyn.summary(), units, spec.input_is_angle)
     print_columns(console, "loads over the cycle (vectors by magnitude)", cols)
-    console.print("reactions: on the distal link by the proximal link, world frame, moments "
+    prose("reactions: on the distal link by the proximal link, world frame, moments "
                   "about the joint centre (its path: --csv <joint>.point_x|y|z, or "
-                  "--json reactions.<joint>.point)", highlight=False)
+                  "--json reactions.<joint>.point)")
 
 
 def register(app: typer.Typer) -> None:

@@ -9,6 +9,7 @@ from typing import Annotated, Any
 
 import typer
 
+from screwkit.cli.common import prose
 from screwkit.cli.outputs import CsvOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 
@@ -20,9 +21,8 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
     from screwkit.cli.formatting import TextColumn, number, print_columns
     from screwkit.kinematics.motion_table import variable_kind
 
-    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
-    console.print(f"method: {doc['method']}; derivatives: {escape(doc['derivatives'])}",
-                  highlight=False)
+    prose(f"[bold]{escape(spec.describe(units))}[/]")
+    prose(f"method: {doc['method']}; derivatives: {escape(doc['derivatives'])}")
     xk = variable_kind(doc["input_name"] if doc["method"] == "generic" else "theta0")
 
     def shown(x: float | None, kind: str) -> str:
@@ -68,7 +68,7 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
                            [", ".join(f"{v:.3g}" for v in x["derivatives"]) for x in d], "left")]
         print_columns(console, "dwell order at given inputs", cols)
     for note in doc["notes"]:
-        console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
+        prose(f"[yellow]note:[/] {escape(note)}")
 
 
 def register(app: typer.Typer) -> None:
@@ -127,9 +127,9 @@ def register(app: typer.Typer) -> None:
         doc = guard(lambda: Pipeline(s).mobility().as_dict())
 
         def show() -> None:
-            console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
+            prose(f"[bold]{escape(s.describe())}[/]")
             for line in doc["summary"]:
-                console.print(escape(str(line)), highlight=False)
+                prose(escape(str(line)))
                 console.print()
 
         out.deliver(document=lambda: doc, table=None, show=show)
