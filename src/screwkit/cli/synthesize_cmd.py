@@ -77,11 +77,16 @@ def _tables(name: str, results: list[Any], doc: dict[str, Any], config: Any, du:
     if best.message:
         prose(f"  {escape(best.message)}")
     kinds = ["angle" if k in config.angles else "length" for k in best.dimensions]
-    print_columns(console, "optimised dimensions", [
+    dimension_columns = [
         TextColumn("name", list(best.dimensions), "left"),
         TextColumn("value", [number(du.show(k, v), 7) for k, v in
                              zip(kinds, best.dimensions.values(), strict=True)]),
-        TextColumn("unit", [du.label(k) for k in kinds], "left")])
+        TextColumn("unit", [du.label(k) for k in kinds], "left")]
+    if best.at_bounds:  # the synthesis ended on a bound: say which
+        dimension_columns.append(TextColumn(
+            "bound", [f"on {best.at_bounds[k][0]}" if k in best.at_bounds else ""
+                      for k in best.dimensions], "left"))
+    print_columns(console, "optimised dimensions", dimension_columns)
     rot, tra = config.outputs
     mode = (f"assembly mode {best.inversion} (sign of Q5 {best.mode_sign:+.0f})"
             if config.route == "closed" else

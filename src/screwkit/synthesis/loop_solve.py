@@ -24,6 +24,8 @@ from screwkit.synthesis.solve import (
     Status,
     SynthesisError,
     SynthesisResult,
+    bound_notes,
+    bounds_reached,
     fit_notes,
 )
 
@@ -138,8 +140,10 @@ def _result(model: LoopResidualModel, ev: Evaluation, iterations: int, evaluatio
              "S_g": float(ev.S[i] - ev.S[0]) if has_s else None, "S_d": float(s_all[i])}
             for i, th in enumerate(ev.theta)]
     check, branch = loop_range_check(model, ev)
+    on_bounds = bounds_reached(pr.unknowns, ev.x, lo, hi, unit)
     message = "; ".join(m for m in (message, *fit_notes(pr, psi_all, s_all, r_phi, r_s, check,
-                                                         status)) if m)
+                                                         status),
+                                    *bound_notes(on_bounds, pr.kinds)) if m)
     n_points = int(np.unique(np.concatenate([pr.target.theta_rotation,
                                              pr.target.theta_translation])).size)
     g_free = float(np.linalg.norm(grad[free])) if grad.size else 0.0
@@ -155,7 +159,7 @@ def _result(model: LoopResidualModel, ev: Evaluation, iterations: int, evaluatio
                                         * float(np.linalg.norm(r)), 1e-300) if grad.size else 0.0),
         iterations=iterations, evaluations=evaluations, time=elapsed, status=status,
         message=message, length_scale=pr.length_scale, rows=rows, range_check=check,
-        evaluation=ev)
+        evaluation=ev, at_bounds=on_bounds)
 
 
 def synthesize_loop(problem: LoopSynthesisProblem, *, mode: int | None = None,

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
@@ -79,6 +79,9 @@ class SynthesisResult:
         components at an active bound left out (0 at a local optimum).
     relative_gradient : gradient_norm / (2 |J| |r|): the cosine-like first-order optimality
         measure, independent of the size of E (<= 1e-6 is a local optimum to rounding).
+    at_bounds : the unknowns that ended on one of their bounds, by name: ``("lower" or
+        "upper", the bound)`` (SI, radians); the message says so too — the best design may lie
+        beyond the bound (:func:`bounds_reached`).
     """
 
     dimensions: dict[str, float]
@@ -103,6 +106,35 @@ class SynthesisResult:
     rows: list[dict[str, float | None]]
     range_check: RangeCheck
     evaluation: Evaluation = field(repr=False)
+    at_bounds: dict[str, tuple[str, float]] = field(default_factory=dict)
+
+
+#: an unknown within this fraction of its scale (L for lengths, 1 rad for angles) of a bound
+#: is on the bound
+ON_BOUND_RTOL = 1e-7
+
+
+def bounds_reached(unknowns: Sequence[str], x: FloatArray, lower: Sequence[float] | FloatArray,
+                   upper: Sequence[float] | FloatArray, scales: Sequence[float] | FloatArray
+                   ) -> dict[str, tuple[str, float]]:
+    """The unknowns whose final value ``x`` lies on a finite bound (within
+    :data:`ON_BOUND_RTOL` of its scale): name → ("lower" or "upper", the bound)."""
+    out: dict[str, tuple[str, float]] = {}
+    for name, v, lo, hi, s in zip(unknowns, x, lower, upper, scales, strict=True):
+        tol = ON_BOUND_RTOL * max(float(s), abs(float(v)))
+        if np.isfinite(lo) and float(v) - lo <= tol:
+            out[name] = ("lower", float(lo))
+        elif np.isfinite(hi) and hi - float(v) <= tol:
+            out[name] = ("upper", float(hi))
+    return out
+
+
+def bound_notes(at_bounds: Mapping[str, tuple[str, float]], kinds: Mapping[str, str]
+                ) -> list[str]:
+    """One sentence per unknown on a bound, the bound in the message units."""
+    return [f"{name} ended on its {side} bound ({shown(b, kinds.get(name, 'length'))}): the best "
+            f"design may lie beyond it; widen the bound to look" for name, (side, b) in
+            at_bounds.items()]
 
 
 def _n_points(problem: RSRCSynthesisProblem) -> int:
@@ -245,8 +277,14 @@ def result_from_evaluation(
             "S_d": float(s_all[i]),
         })
     check = check_range(problem, ev)
+    on_bounds = bounds_reached(
+        problem.unknowns, ev.x, [problem.bounds.get(n, (-np.inf, np.inf))[0]
+                                 for n in problem.unknowns],
+        [problem.bounds.get(n, (-np.inf, np.inf))[1] for n in problem.unknowns], unit)
+    kinds = {n: "length" if n in LENGTH_NAMES else "angle" for n in problem.unknowns}
     message = "; ".join(m for m in (message, *fit_notes(problem, psi_all, s_all, r_phi, r_s,
-                                                          check, status)) if m)
+                                                          check, status),
+                                    *bound_notes(on_bounds, kinds)) if m)
     # the program label (root ordering, Bagci's I8/I9) of the result's configuration at theta = 0
     pos = rsrc_positions(dimensions_of({k: np.array([v]) for k, v in ev.params.items()}),
                          ev.theta0[:1])
@@ -266,7 +304,7 @@ def result_from_evaluation(
             if grad.size else 0.0),
         iterations=iterations, evaluations=evaluations, time=elapsed, status=status,
         message=message, length_scale=problem.length_scale, rows=rows, range_check=check,
-        evaluation=ev,
+        evaluation=ev, at_bounds=on_bounds,
     )
 
 
