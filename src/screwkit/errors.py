@@ -9,6 +9,7 @@ screwkit is a bug.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from types import UnionType
 
 
@@ -61,3 +62,11 @@ def expect_number(value: object, name: str, *, positive: bool = False,
     if positive and not x > 0:
         raise InputError(f"{name} must be positive; got {value!r}")
     return x
+
+
+def did_you_mean(name: object, choices: Iterable[str]) -> str:
+    """``"did you mean 'length'? "`` for the choice closest to a misspelt ``name``, or ``""``."""
+    import difflib
+
+    close = difflib.get_close_matches(str(name), list(choices), n=1)
+    return f"did you mean {close[0]!r}? " if close else ""

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import did_you_mean
 from screwkit.io.units import KIND_UNITS, UnitError, unit_factor
 from screwkit.tables import SI_LABELS
 
@@ -96,7 +97,8 @@ def parse_unit_overrides(items: Iterable[str]) -> dict[str, str]:
         if kind == "torque":  # the [units] name of a moment (e.g. the drive's torques)
             kind = "moment"
         if kind not in DISPLAY_KINDS:
-            raise UnitError(f"--unit {item!r}: unknown kind {kind!r}; the kinds are "
+            raise UnitError(f"--unit {item!r}: unknown kind {kind!r}; "
+                            f"{did_you_mean(kind, DISPLAY_KINDS)}the kinds are "
                             f"{', '.join(DISPLAY_KINDS)}")
         try:
             unit_factor(unit, kind)

@@ -26,7 +26,7 @@ from pydantic import (
 )
 
 from screwkit.constants import STANDARD_GRAVITY
-from screwkit.errors import InputTypeError, ScrewkitError
+from screwkit.errors import InputTypeError, ScrewkitError, did_you_mean
 from screwkit.io.errors import SpecError
 from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
@@ -154,7 +154,8 @@ class Spec:
         for kind, unit in self.units.items():
             if kind not in KIND_UNITS or kind == "dimensionless":
                 kinds = ", ".join(k for k in KIND_UNITS if k != "dimensionless")
-                self._fail(f"units.{kind}", f"unknown kind {kind!r}; the kinds are {kinds}")
+                hint = did_you_mean(kind, [k for k in KIND_UNITS if k != "dimensionless"])
+                self._fail(f"units.{kind}", f"unknown kind {kind!r}; {hint}the kinds are {kinds}")
             try:
                 check_unit(unit, kind)
             except UnitError as exc:

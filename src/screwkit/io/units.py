@@ -13,7 +13,7 @@ import math
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
-from screwkit.errors import InputError, UnknownNameError
+from screwkit.errors import InputError, UnknownNameError, did_you_mean
 from screwkit.io.quantity import (
     MAX_QUANTITY_CHARS,
     QuantitySyntaxError,
@@ -227,12 +227,8 @@ def check_kind(kind: object) -> str:
     :class:`~screwkit.errors.UnknownNameError` listing the kinds and the closest one."""
     if isinstance(kind, str) and kind in KIND_UNITS:
         return kind
-    import difflib
-
-    close = difflib.get_close_matches(str(kind), list(KIND_UNITS), n=1)
-    hint = f"did you mean {close[0]!r}? " if close else ""
-    raise UnknownNameError(f"unknown quantity kind {kind!r}; {hint}the kinds are "
-                           f"{', '.join(KIND_UNITS)}")
+    raise UnknownNameError(f"unknown quantity kind {kind!r}; {did_you_mean(kind, KIND_UNITS)}"
+                           f"the kinds are {', '.join(KIND_UNITS)}")
 
 
 def check_unit(unit: str, kind: str) -> None:
