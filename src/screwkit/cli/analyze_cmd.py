@@ -80,8 +80,8 @@ def show_analysis(spec: Any, motion: Any, units: Any, full: bool,
         hidden = [n for n in md.variables if n not in shown and n != motion.input_names[0]]
         if hidden and all("." in n for n in shown):
             prose(f"  • {len(shown)} of {len(shown) + len(hidden)} variables shown; "
-                          f"the others ({', '.join(hidden[:4])}{', …' if len(hidden) > 4 else ''}) "
-                          "are in --csv and --json")
+                  f"the others ({', '.join(hidden[:4])}{', …' if len(hidden) > 4 else ''}) "
+                  "are in --csv and --json")
         entry = doc["modes"][md.index].get("transmission") if doc is not None else None
         for line in transmission_lines(entry, units, input_kind):
             prose(f"  • {escape(line)}")

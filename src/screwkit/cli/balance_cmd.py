@@ -94,11 +94,11 @@ def show_balance(spec: Any, res: Any, doc: dict[str, Any], units: Any,
     bound = doc.get("redistribution_bound")
     if bound:
         prose(f"bound over all consistent redistributions (SDP): G = "
-                      f"{bound['measures_after']['G']:.6g}")
+              f"{bound['measures_after']['G']:.6g}")
     if "pareto" in doc:
         eff = sum(doc["pareto"]["efficient"])
         prose(f"Pareto sweep over {doc['pareto']['measures']}: "
-                      f"{len(doc['pareto']['values'])} weightings, {eff} non-dominated")
+              f"{len(doc['pareto']['values'])} weightings, {eff} non-dominated")
     for note in res.notes:
         prose(escape(f"note: {note}"))
     for p in written:

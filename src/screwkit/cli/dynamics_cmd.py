@@ -88,14 +88,14 @@ def show_dynamics(spec: Any, pipe: Any, dyn: Any, units: Any, note: str | None) 
 
     prose(f"[bold]{escape(spec.describe(units))}[/]")
     prose(f"assembly mode {spec.mode}; {gravity_sentence(dyn, pipe)}; "
-                  f"{escape(dyn.indeterminacy.describe())}")
+          f"{escape(dyn.indeterminacy.describe())}")
     if note is not None:
         prose(f"[yellow]note:[/] {escape(note)}")
     cols = summary_columns(dyn.summary(), units, spec.input_is_angle)
     print_columns(console, "loads over the cycle (vectors by magnitude)", cols)
     prose("reactions: on the distal link by the proximal link, world frame, moments "
-                  "about the joint centre (its path: --csv <joint>.point_x|y|z, or "
-                  "--json reactions.<joint>.point)")
+          "about the joint centre (its path: --csv <joint>.point_x|y|z, or "
+          "--json reactions.<joint>.point)")
 
 
 def register(app: typer.Typer) -> None:

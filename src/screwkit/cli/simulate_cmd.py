@@ -27,9 +27,9 @@ def _table(doc: dict[str, Any], describe: str, units: Any) -> None:
     prose(f"[bold]{escape(describe)}[/]")
     m = doc["model"]
     prose(f"{escape(doc['message'])} ({doc['status']}); flywheel {doc['flywheel']:.6g} "
-                  f"kg·m²; J(θ) {m['inertia_min']:.6g}…{m['inertia_max']:.6g} kg·m² (mean "
-                  f"{m['inertia_mean']:.6g}), {m['harmonics']} harmonics on {m['grid_samples']} "
-                  f"samples; energy balance error {doc['energy_error']:.2g}")
+          f"kg·m²; J(θ) {m['inertia_min']:.6g}…{m['inertia_max']:.6g} kg·m² (mean "
+          f"{m['inertia_mean']:.6g}), {m['harmonics']} harmonics on {m['grid_samples']} "
+          f"samples; energy balance error {doc['energy_error']:.2g}")
     cycles = doc["cycles"]
     shown = cycles if len(cycles) <= 12 else cycles[:5] + cycles[-5:]
     tu = units.pretty("moment")
@@ -53,10 +53,10 @@ def _table(doc: dict[str, Any], describe: str, units: Any) -> None:
     if sizing:
         em = sizing["energy_method"]
         prose(f"flywheel for C_s = {sizing['requested_fluctuation']:g}: "
-                      f"[bold]{sizing['flywheel']:.6g} kg·m²[/] (steady C_s "
-                      f"{sizing['achieved_fluctuation']:.6g}); energy method: ΔE "
-                      f"{em['energy_fluctuation']:.6g} J at {em['speed'] * RPM:.6g} rpm → "
-                      f"{em['flywheel']:.6g} kg·m²")
+              f"[bold]{sizing['flywheel']:.6g} kg·m²[/] (steady C_s "
+              f"{sizing['achieved_fluctuation']:.6g}); energy method: ΔE "
+              f"{em['energy_fluctuation']:.6g} J at {em['speed'] * RPM:.6g} rpm → "
+              f"{em['flywheel']:.6g} kg·m²")
     loads = doc.get("loads")
     if loads:
         from screwkit.cli.dynamics_cmd import summary_kind
@@ -71,7 +71,7 @@ def _table(doc: dict[str, Any], describe: str, units: Any) -> None:
             TextColumn("peak", [number(units.show(summary_kind(n), st["peak"]))
                                 for n, st in zip(names, stats, strict=True)])])
         prose(f"shaft torque: inverse dynamics vs motor − flywheel·θ̈, max difference "
-                      f"{doc['shaft_torque_check']:.2g} of the largest")
+              f"{doc['shaft_torque_check']:.2g} of the largest")
 
 
 def register(app: typer.Typer) -> None:

@@ -73,7 +73,7 @@ def _tables(name: str, results: list[Any], doc: dict[str, Any], config: Any, du:
     best = results[0]
     a, lu = du.label("angle"), du.label("length")
     prose(f"[bold]{escape(name)}[/]: synthesis ({best.status}; {best.iterations} "
-                  f"iterations, {best.evaluations} evaluations, {best.time:.3f} s)")
+          f"iterations, {best.evaluations} evaluations, {best.time:.3f} s)")
     if best.message:
         prose(f"  {escape(best.message)}")
     kinds = ["angle" if k in config.angles else "length" for k in best.dimensions]
@@ -108,7 +108,7 @@ def _tables(name: str, results: list[Any], doc: dict[str, Any], config: Any, du:
                      full)
     for k, other in enumerate(results[1:], start=2):
         prose(f"alternative {k}: mode {other.inversion}, E = {other.objective:.6g}, "
-                      f"whole range {'ok' if other.range_check.ok else 'NOT ok'}")
+              f"whole range {'ok' if other.range_check.ok else 'NOT ok'}")
 
 
 def synthesis_document(s: Any, starts: int | None = None) -> dict[str, Any]:

@@ -32,7 +32,7 @@ def _show(units: Any, value: float, angle: bool) -> str:
 def _tables(doc: dict[str, Any], description: str, units: Any, input_is_angle: bool) -> None:
     prose(f"[bold]{escape(description)}[/]")
     prose(f"assembly mode {doc['mode']}; {doc['convention']}; angles in "
-                  f"{units.pretty('angle')}, lengths in {units.pretty('length')}")
+          f"{units.pretty('angle')}, lengths in {units.pretty('length')}")
     t = Table(title="stack-ups: the largest deviation over the cycle")
     for col in ("output", "worst case ±", "RSS ±", "at input", "dominant tolerance"):
         t.add_column(col, justify="right")
@@ -49,7 +49,7 @@ def _tables(doc: dict[str, Any], description: str, units: Any, input_is_angle: b
         return
     if not mc["points_compared"]:
         prose("[yellow]Monte Carlo:[/] no point to compare (the outputs do not depend "
-                      "on these tolerances)")
+              "on these tolerances)")
         return
     lo, hi = mc["std_ratio_range"]
     verdict = "[green]agrees[/]" if mc["agree"] else "[yellow]does NOT agree[/]"
