@@ -26,9 +26,14 @@ def _table(doc: dict[str, Any], describe: str, units: Any) -> None:
 
     prose(f"[bold]{escape(describe)}[/]")
     m = doc["model"]
-    prose(f"{escape(doc['message'])} ({doc['status']}); flywheel {doc['flywheel']:.6g} "
-          f"kg·m²; J(θ) {m['inertia_min']:.6g}…{m['inertia_max']:.6g} kg·m² (mean "
-          f"{m['inertia_mean']:.6g}), {m['harmonics']} harmonics on {m['grid_samples']} "
+    iu = units.pretty("inertia")
+
+    def inertia(si: float) -> str:
+        return number(units.show("inertia", si))
+
+    prose(f"{escape(doc['message'])} ({doc['status']}); flywheel {inertia(doc['flywheel'])} "
+          f"{iu}; J(θ) {inertia(m['inertia_min'])}…{inertia(m['inertia_max'])} {iu} (mean "
+          f"{inertia(m['inertia_mean'])}), {m['harmonics']} harmonics on {m['grid_samples']} "
           f"samples; energy balance error {doc['energy_error']:.2g}")
     cycles = doc["cycles"]
     shown = cycles if len(cycles) <= 12 else cycles[:5] + cycles[-5:]
@@ -53,10 +58,10 @@ def _table(doc: dict[str, Any], describe: str, units: Any) -> None:
     if sizing:
         em = sizing["energy_method"]
         prose(f"flywheel for C_s = {sizing['requested_fluctuation']:g}: "
-              f"[bold]{sizing['flywheel']:.6g} kg·m²[/] (steady C_s "
+              f"[bold]{inertia(sizing['flywheel'])} {iu}[/] (steady C_s "
               f"{sizing['achieved_fluctuation']:.6g}); energy method: ΔE "
               f"{em['energy_fluctuation']:.6g} J at {em['speed'] * RPM:.6g} rpm → "
-              f"{em['flywheel']:.6g} kg·m²")
+              f"{inertia(em['flywheel'])} {iu}")
     loads = doc.get("loads")
     if loads:
         from screwkit.cli.dynamics_cmd import summary_kind
