@@ -133,6 +133,23 @@ CASES = [
      "mass must be numbers"),
     ("text dimension", lambda f: sk.rsrc(d1="a", d2=1, d3=1, a=1, b=0, e=0, delta0=0,
                                          lambda0=0), InputError, "d1 must be a number"),
+    ("joints as a string", lambda f: sk.Linkage.from_hartenberg_denavit(
+        "L", "abcd", [1, 3, 2.5, 3], [0, 0, 0, 0], ["a.theta"]), InputError,
+     "joints must be Joint objects"),
+    ("links of numbers", lambda f: f[0].linkage.with_links([1, 2, 3]), InputError,
+     "links must be Link objects"),
+    ("text synthesis starts", lambda f: sk.synthesize(
+        sk.load_spec(EXAMPLES / "bagci_example1_synthesis.toml").synthesis, starts="x"),
+     InputTypeError, "synthesize: starts must be an integer"),
+    ("text coupler points", lambda f: f[1].table(coupler_points="x"), InputTypeError,
+     "coupler_points must be CouplerPoint objects"),
+    ("dynamics inputs of text", lambda f: sk.inverse_dynamics(f[1], 0, inputs="x"), InputError,
+     "inputs must have one column per input"),
+    ("text counterweight bound", lambda f: sk.counterweight_variables(
+        f[0].linkage, "coupler", "cw", mass_max="x"), InputTypeError,
+     "mass_max must be a number"),
+    ("misspelt unit override", lambda f: f[0].display_units(overrides={"lenght": "mm"}),
+     InputError, "did you mean 'length'?"),
 ]
 
 

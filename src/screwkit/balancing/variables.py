@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.balancing.errors import BalancingError
-from screwkit.errors import expect_instance
+from screwkit.errors import expect_instance, expect_number
 from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import (
@@ -229,6 +229,8 @@ def counterweight_variables(
     moment μ p pᵀ is not linear in (μ, μp): only the shaking force is exact for it (the problem
     refuses other weighted measures; see :mod:`screwkit.balancing.problem`)."""
     idx = _link_index(linkage, link)
+    expect_number(mass_max, f"counterweight {name!r}: mass_max")
+    expect_number(mass_min, f"counterweight {name!r}: mass_min")
     if not (np.isfinite(mass_max) and mass_max > 0 and 0 <= mass_min <= mass_max):
         raise BalancingError(
             f"counterweight {name!r}: need 0 <= mass_min <= mass_max and mass_max > 0; got "

@@ -105,7 +105,10 @@ def _setup(
             [mode.variables.get(name, np.full(N, np.nan)) for name in linkage.inputs], -1
         )
     else:
-        input_arr = np.asarray(inputs, dtype=float).reshape(N, -1)
+        try:
+            input_arr = np.asarray(inputs, dtype=float).reshape(N, -1)
+        except (TypeError, ValueError):
+            input_arr = np.zeros((N, 0))  # not N rows of numbers: named below
         if input_arr.shape[1] != len(linkage.inputs):
             raise DynamicsInputError(
                 f"inputs must have one column per input {list(linkage.inputs)}; "

@@ -120,6 +120,11 @@ def display_units(spec_units: Mapping[str, str] | None = None, *, system: str = 
             if system == "spec" and k in KIND_UNITS and k != "dimensionless"}
     if "torque" in base and "moment" not in base:  # [units] torque (the drive's) is a moment
         base["moment"] = base["torque"]
+    for kind in overrides or {}:
+        if kind not in DISPLAY_KINDS:
+            raise UnitError(f"unknown kind {kind!r} in the unit overrides; "
+                            f"{did_you_mean(kind, DISPLAY_KINDS)}the kinds are "
+                            f"{', '.join(DISPLAY_KINDS)}")
     base.update(overrides or {})
     length = base.get("length", "m")
     angle = base.get("angle", "rad")

@@ -11,7 +11,7 @@ import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from screwkit.errors import expect_instance
+from screwkit.errors import expect_instance, expect_number
 from screwkit.synthesis.loop_route import LoopSynthesisProblem
 from screwkit.synthesis.loop_solve import synthesize_loop, synthesize_loop_multistart
 from screwkit.synthesis.overlay_synthesis import OverlayOutcome, OverlayProblem, synthesize_overlay
@@ -97,6 +97,10 @@ def run_synthesis(config: SynthesisConfig | Problem, *, starts: int | None = Non
     expect_instance(config, (SynthesisConfig, RSRCSynthesisProblem, OverlayProblem,
                              LoopSynthesisProblem), "synthesize: config",
                     "a SynthesisConfig (load_spec(...).synthesis) or a synthesis problem")
+    if starts is not None:
+        expect_number(starts, "synthesize: starts", integer=True, positive=True)
+    if seed is not None:
+        expect_number(seed, "synthesize: seed", integer=True)
     if not isinstance(config, SynthesisConfig):
         config = SynthesisConfig(config)
     problem = config.problem
