@@ -36,28 +36,33 @@ def show_balance(spec: Any, res: Any, doc: dict[str, Any], units: Any,
 
     from screwkit.balancing.measures import MEASURE_TITLES, MEASURES
     from screwkit.cli.common import console
-    from screwkit.cli.formatting import TextColumn, number, print_columns
+    from screwkit.cli.formatting import TextColumn, noise_floor, number, print_columns
 
     prose(f"[bold]{escape(spec.describe(units))}[/]")
     gravity = "on" if res.dynamics_before.gravity_on else "off ([balancing] gravity = true adds it)"
     prose(escape(f"assembly mode {spec.mode}; gravity {gravity}"))
     keys = (*MEASURES, "G")
     ch = res.changes()
+    # round-off zeros (a measure balanced away) print as 0: each row's own scale
+    floor = {k: noise_floor([res.measures_before[k], res.measures_after[k]]) for k in keys}
     print_columns(console, "load measures, normalised mean squares (Rahman eq. 4.1)", [
         TextColumn("measure", [f"{MEASURE_TITLES.get(k, 'objective')} ({k})" for k in keys],
                    "left"),
-        TextColumn("before", [number(res.measures_before[k]) for k in keys]),
-        TextColumn("after", [number(res.measures_after[k]) for k in keys]),
+        TextColumn("before", [number(res.measures_before[k], floor=floor[k]) for k in keys]),
+        TextColumn("after", [number(res.measures_after[k], floor=floor[k]) for k in keys]),
         TextColumn("change %", ["n/a (round-off)" if ch[k] is None else f"{ch[k]:+.3f}"
                                 for k in keys])])
     rms = doc["measures_rms"]
+    rms_floor = {k: noise_floor([units.show(rms["kinds"][k], rms[s][k])
+                                 for s in ("before", "after") if rms[s][k] is not None])
+                 for k in MEASURES}
     print_columns(console, "RMS loads over the cycle", [
         TextColumn("load", [f"{MEASURE_TITLES[k]} ({k})" for k in MEASURES], "left"),
         TextColumn("unit", [units.label(rms["kinds"][k]) for k in MEASURES], "left"),
-        TextColumn("before", [number(units.show(rms["kinds"][k], rms["before"][k]))
-                              for k in MEASURES]),
-        TextColumn("after", [number(units.show(rms["kinds"][k], rms["after"][k]))
-                             for k in MEASURES]),
+        TextColumn("before", [number(units.show(rms["kinds"][k], rms["before"][k]),
+                                     floor=rms_floor[k]) for k in MEASURES]),
+        TextColumn("after", [number(units.show(rms["kinds"][k], rms["after"][k]),
+                                    floor=rms_floor[k]) for k in MEASURES]),
         TextColumn("change %", ["—" if rms["change_percent"][k] is None
                                 else f"{rms['change_percent'][k]:+.3f}" for k in MEASURES])])
     bounds = {b["variable"]: b["bound"] for b in doc["active_bounds"]}
