@@ -46,7 +46,7 @@ def test_the_bound_reaches_the_json_and_the_table(tmp_path):
     assert r.exit_code == 0, r.output
     row = next(line for line in r.output.splitlines() if line.startswith("│ a "))
     assert "on upper" in row
-    assert "ended on its upper bound" in r.output
+    assert "ended on its upper bound" in " ".join(line.strip() for line in r.output.splitlines())
 
 
 def test_an_interior_optimum_has_no_bound_note():
