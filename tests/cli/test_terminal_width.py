@@ -225,3 +225,17 @@ def test_prose_wraps_between_words_with_a_hanging_indent():
     assert all(len(line) <= 40 for line in lines if path not in line)
     assert " ".join(line.strip() for line in lines) == (
         f"• stops assembling after input input.theta = 250 deg in {path} (limit)")
+
+
+def test_prose_keeps_its_own_line_breaks():
+    import io
+
+    from rich.console import Console
+
+    from screwkit.cli.common import prose
+
+    out = io.StringIO()
+    console = Console(file=out, width=40, color_system=None)
+    prose("RSRC: F = 1\n  links n = 4; pairs 4; loops k = 1 (B.3) and a few more words", to=console)
+    assert out.getvalue().splitlines() == [
+        "RSRC: F = 1", "  links n = 4; pairs 4; loops k = 1", "    (B.3) and a few more words"]

@@ -26,35 +26,38 @@ T = TypeVar("T")
 
 def prose(markup: str, *, hang: int | None = None, to: Console | None = None,
           width: int | None = None) -> None:
-    """Print one paragraph of rich ``markup`` wrapped between words at the console's width;
-    continuation lines are indented by ``hang`` (default: up to the text after a leading
-    bullet ``  • ``, else 2). A word longer than a line (a path) is kept whole on its own
-    line."""
+    """Print rich ``markup`` wrapped between words at the console's width, each of its lines
+    on its own; continuation lines are indented by ``hang`` (default: under the text after a
+    leading bullet ``  • ``, else two more than the line's own indent). A word longer than a
+    line (a path) is kept whole on its own line."""
     out = to if to is not None else console
-    text = out.render_str(markup, highlight=False)
-    plain = text.plain
-    if hang is None:
-        bullet = len(plain) - len(plain.lstrip(" •"))
-        hang = bullet if bullet else 2
     limit = max(width or out.width, 20)
+    for line in out.render_str(markup, highlight=False).split("\n", allow_blank=True):
+        for piece in _wrapped(line, limit, hang):
+            out.print(piece, soft_wrap=True, highlight=False)
+
+
+def _wrapped(line: Text, limit: int, hang: int | None) -> list[Text]:
+    """One line of text cut between words into lines of at most ``limit`` cells (module
+    docstring of :func:`prose`)."""
+    plain = line.plain
+    if hang is None:  # under the text after a bullet; else two more than the line's indent
+        lead = len(plain) - len(plain.lstrip(" •"))
+        hang = lead if "•" in plain[:lead] else lead + 2
     cuts: list[int] = []
     start, last_space, pos = 0, -1, 0
     while pos < len(plain):
         if plain[pos] == " " and pos > start:
             last_space = pos
-        room = limit - (hang if cuts else 0)
-        if pos - start >= room and last_space > start:
+        if pos - start >= limit - (hang if cuts else 0) and last_space > start:
             cuts.append(last_space)
             start, last_space = last_space + 1, -1
             pos = start
             continue
         pos += 1
-    pieces = text.divide(cuts) if cuts else [text]
-    for k, piece in enumerate(pieces):
-        if k:
-            piece = piece[1:] if piece.plain.startswith(" ") else piece
-            piece = Text(" " * hang) + piece
-        out.print(piece, soft_wrap=True, highlight=False)
+    pieces = list(line.divide(cuts)) if cuts else [line]
+    return [pieces[0]] + [Text(" " * hang) + (p[1:] if p.plain.startswith(" ") else p)
+                          for p in pieces[1:]]
 
 
 def user_errors() -> tuple[type[BaseException], ...]:

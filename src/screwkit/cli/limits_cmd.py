@@ -120,11 +120,14 @@ def register(app: typer.Typer) -> None:
         from screwkit.cli.common import console, guard
         from screwkit.cli.outputs import Outputs
         from screwkit.io.spec import load_spec
+        from screwkit.messages import message_units
         from screwkit.pipeline import Pipeline
 
         out = Outputs.prepare([spec], as_json=as_json, output=output, formats=("json",))
         s = guard(lambda: load_spec(spec))
-        doc = guard(lambda: Pipeline(s).mobility().as_dict())
+        pipe = Pipeline(s)
+        with message_units(pipe.units):  # the summary's lines quote lengths: the spec's units
+            doc = guard(lambda: pipe.mobility().as_dict())
 
         def show() -> None:
             prose(f"[bold]{escape(s.describe())}[/]")
