@@ -141,9 +141,9 @@ def _result(model: LoopResidualModel, ev: Evaluation, iterations: int, evaluatio
             for i, th in enumerate(ev.theta)]
     check, branch = loop_range_check(model, ev)
     on_bounds = bounds_reached(pr.unknowns, ev.x, lo, hi, unit)
-    message = "; ".join(m for m in (message, *fit_notes(pr, psi_all, s_all, r_phi, r_s, check,
-                                                         status),
-                                    *bound_notes(on_bounds, pr.kinds)) if m)
+    notes = (*fit_notes(pr, psi_all, s_all, r_phi, r_s, check, status),
+             *bound_notes(on_bounds, pr.kinds))
+    message = "; ".join(m for m in (message.rstrip("."), *notes) if m)
     n_points = int(np.unique(np.concatenate([pr.target.theta_rotation,
                                              pr.target.theta_translation])).size)
     g_free = float(np.linalg.norm(grad[free])) if grad.size else 0.0

@@ -282,9 +282,9 @@ def result_from_evaluation(
                                  for n in problem.unknowns],
         [problem.bounds.get(n, (-np.inf, np.inf))[1] for n in problem.unknowns], unit)
     kinds = {n: "length" if n in LENGTH_NAMES else "angle" for n in problem.unknowns}
-    message = "; ".join(m for m in (message, *fit_notes(problem, psi_all, s_all, r_phi, r_s,
-                                                          check, status),
-                                    *bound_notes(on_bounds, kinds)) if m)
+    notes = (*fit_notes(problem, psi_all, s_all, r_phi, r_s, check, status),
+             *bound_notes(on_bounds, kinds))
+    message = "; ".join(m for m in (message.rstrip("."), *notes) if m)
     # the program label (root ordering, Bagci's I8/I9) of the result's configuration at theta = 0
     pos = rsrc_positions(dimensions_of({k: np.array([v]) for k, v in ev.params.items()}),
                          ev.theta0[:1])
