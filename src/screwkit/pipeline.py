@@ -5,9 +5,10 @@ run, whichever jobs run on it (docs/architecture.md)."""
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from functools import cached_property
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.result import BalanceResult
 from screwkit.constants import STANDARD_GRAVITY
 from screwkit.dynamics import Dynamics, inverse_dynamics
-from screwkit.errors import ScrewkitError
+from screwkit.errors import InputError, ScrewkitError, expect_instance
 from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec
 from screwkit.kinematics.coupler_curves import coupler_curves
@@ -31,8 +32,23 @@ from screwkit.kinematics.loop_mobility import LinkageMobility, mobility
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.kinematics.transmission import Transmission, transmission
+from screwkit.messages import message_units, number
 from screwkit.synthesis.config import SynthesisConfig, SynthesisRun, run_synthesis
-from screwkit.tables import ResultTable
+from screwkit.tables import ResultTable, UnitChoice
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def _in_spec_units(job: F) -> F:
+    """Run a job with the pipeline's display units for its notes and messages
+    (:func:`screwkit.messages.message_units`)."""
+
+    @functools.wraps(job)
+    def run(self: Pipeline, *args: Any, **kwargs: Any) -> Any:
+        with message_units(self.units):
+            return job(self, *args, **kwargs)
+
+    return run  # type: ignore[return-value]
 
 
 class Pipeline:
@@ -40,22 +56,39 @@ class Pipeline:
 
     ``method`` chooses the solver (``"auto"``, ``"closed"``, ``"generic"``; see
     :func:`~screwkit.kinematics.solve_motion.solve_motion`); ``progress`` is the solver's
-    progress (a callback ``(done, total)``, ``False`` for none, ``None`` its default bar)."""
+    progress (a callback ``(done, total)``, ``False`` for none, ``None`` its default bar).
+    ``units``: the display units of the numbers in notes and error messages (default: the
+    spec's ``[units]``, ``spec.display_units()``; the CLI passes those of ``--units``/``--unit``)."""
 
     def __init__(self, spec: Spec, *, method: str = "auto",
-                 progress: Callable[[int, int], None] | bool | None = None) -> None:
+                 progress: Callable[[int, int], None] | bool | None = None,
+                 units: UnitChoice | None = None) -> None:
         if getattr(spec, "family", None) == "graph":  # io.mechanism_spec.GraphSpec
             raise SpecError(f"{spec.path}: a mechanism graph (bodies and joints): validate, "
                             "analyze, mobility, limits, report and dynamics work on it so far; "
                             "balancing, synthesis, simulation and sweeps of graphs are not "
                             "there yet (docs/mechanisms.md)")
+        expect_instance(spec, Spec, "Pipeline: spec", "a Spec (sk.load_spec(path))")
+        if method not in ("auto", "closed", "generic"):
+            raise InputError(f"Pipeline: method must be 'auto', 'closed' or 'generic'; got "
+                             f"{method!r}")
         self.spec = spec
         self.method = method
         self.progress = progress
+        self._units = units
+
+    @cached_property
+    def units(self) -> UnitChoice:
+        """The display units of notes and messages (``units=``, else the spec's)."""
+        return self._units if self._units is not None else self.spec.display_units()
 
     @cached_property
     def motion(self) -> Motion:
         """Every assembly mode over the spec's ``[motion]`` sweep (solved on first use only)."""
+        return self._solve()
+
+    @_in_spec_units
+    def _solve(self) -> Motion:
         s = self.spec
         return solve_motion(s.linkage, s.inputs, rates=s.speed, accelerations=s.acceleration,
                             method=self.method, progress=self.progress)
@@ -66,6 +99,7 @@ class Pipeline:
         g = self.spec.gravity_magnitude or STANDARD_GRAVITY
         return np.asarray(g * self.spec.gravity_direction, dtype=float)
 
+    @_in_spec_units
     def mode(self) -> ModeMotion:
         """The assembly mode of ``[motion] mode`` (what dynamics and balancing use)."""
         try:
@@ -81,12 +115,13 @@ class Pipeline:
             return None
         s = self.spec
         x = np.asarray(s.inputs, dtype=float).reshape(len(ok), -1)[:, 0]
-        bad = np.degrees(x[~ok]) if s.input_is_angle else x[~ok]
-        unit = "deg" if s.input_is_angle else "m"
-        shown = ", ".join(f"{v:.6g}" for v in bad[:8]) + (" …" if bad.size > 8 else "")
+        label, factor = self.units.unit_of("angle" if s.input_is_angle else "length")
+        bad = x[~ok] / factor
+        listed = ", ".join(number(v) for v in bad[:8]) + (" …" if bad.size > 8 else "")
         return (f"mode {s.mode} does not assemble (or is singular) at {int(bad.size)} of "
-                f"{ok.size} inputs ({shown} {unit})")
+                f"{ok.size} inputs ({listed} {label})")
 
+    @_in_spec_units
     def dynamics(self, gravity: bool = False) -> Dynamics:
         """Shaking force and moment, joint reactions and input efforts of ``[motion] mode``
         (loads are null where the mode does not assemble)."""
@@ -105,6 +140,7 @@ class Pipeline:
             raise BalancingError(f"{self.spec.path}: no [balancing] table; see docs/balancing.md")
         return self.spec.balancing
 
+    @_in_spec_units
     def balance(self, mode: ModeMotion | None = None,
                 progress: Callable[[int, int], None] | None = None) -> BalanceResult:
         """The spec's ``[balancing]`` run on ``[motion] mode`` (or on ``mode`` if given);
@@ -131,12 +167,14 @@ class Pipeline:
             raise SpecError(f"{self.spec.path}: no [synthesis] table; see docs/synthesis.md")
         return self.spec.synthesis
 
+    @_in_spec_units
     def synthesize(self, starts: int | None = None,
                    progress: Callable[[int, int], None] | None = None) -> SynthesisRun:
         """The spec's ``[synthesis]`` run (either route), best result first;
         ``progress(done, total)`` follows a multistart."""
         return run_synthesis(self.synthesis_config(), starts=starts, progress=progress)
 
+    @_in_spec_units
     def limits(self, dwell_tolerance: float | None = None, at: list[float] | None = None, *,
                output: str | None = None, method: str | None = None,
                max_order: int | None = None) -> LimitPositions:
@@ -153,6 +191,7 @@ class Pipeline:
         source = self.spec.linkage if closed else self.motion
         return limit_positions(source, tol, order, where, output=out, method=how)
 
+    @_in_spec_units
     def analysis(self) -> dict[str, Any]:
         """The analysis document (io/documents.py) of the pipeline's motion: every mode, the
         spec's coupler points and the transmission quality (a note where a loop has none)."""
@@ -166,6 +205,7 @@ class Pipeline:
                                  coupler_points=self.spec.coupler_points, transmission=tr,
                                  transmission_note=note)
 
+    @_in_spec_units
     def analysis_table(self) -> ResultTable:
         """The motion as a column table (``Motion.table``) with the spec's coupler points and
         the transmission quality (where the loop has one)."""
@@ -175,15 +215,18 @@ class Pipeline:
             tr = None
         return self.motion.table(coupler_points=self.spec.coupler_points, transmission=tr)
 
+    @_in_spec_units
     def transmission(self) -> Transmission:
         """Transmission index, angle and ball-joint cone angles over every mode (a ValueError
         says why a loop has none)."""
         return transmission(self.motion)
 
+    @_in_spec_units
     def coupler_curves(self) -> list[dict[str, Array]]:
         """Per mode, the world path (N, 3) of every coupler point of the spec, by name."""
         return coupler_curves(self.motion, self.spec.coupler_points)
 
+    @_in_spec_units
     def export(self, fmt: str, at: Sequence[str] = (), *, mode: int | None = None,
                splines: bool = False, binary: bool = True, max_points: int = 5000) -> Any:
         """A CAD exchange file of the spec (:mod:`screwkit.exchange`, docs/exchange.md): DXF
@@ -203,6 +246,7 @@ class Pipeline:
         return export_motion(self.spec, motion, samples, kind, at_labels=labels, mode=mode,
                              splines=splines, binary=binary, max_points=max_points)
 
+    @_in_spec_units
     def simulate(self, fluctuation: float | None = None, cycles: int | None = None) -> Any:
         """The spec's ``[drive]`` run forward in time (docs/simulation.md): a
         :class:`~screwkit.simulation.spec_run.SpecSimulation`; with ``fluctuation`` the
@@ -211,6 +255,7 @@ class Pipeline:
 
         return simulate_spec(self.spec, fluctuation=fluctuation, cycles=cycles)
 
+    @_in_spec_units
     def mobility(self) -> LinkageMobility:
         """Formula and Jacobian mobility at the first input where the loop assembles."""
         return mobility(self.spec.linkage, self.spec.inputs)

@@ -24,7 +24,7 @@ from typing import IO, Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.errors import InputError, UnknownNameError
+from screwkit.errors import InputError, InputTypeError, UnknownNameError
 
 #: the SI unit of every quantity kind a column can have; "flag", "index" and "text" columns
 #: have no unit, "ratio" ones are plain numbers and "percent" ones are in %
@@ -114,6 +114,9 @@ class ResultTable:
                   ) -> list[tuple[str, str, NDArray[Any]]]:
         """(name, unit label, values in that unit) per column."""
         u = units if units is not None else SIUnits()
+        if not callable(getattr(u, "unit_of", None)):
+            raise InputTypeError(f"units must be display units (spec.display_units() or "
+                                 f"screwkit.tables.SIUnits()); got {type(units).__name__}")
         out = []
         for c in self.columns:
             if c.kind in UNITLESS:
@@ -173,7 +176,8 @@ class ResultTable:
                   for _, _, v in conv]
         meta = json.dumps({"title": self.title, "notes": list(self.notes),
                            "units": {n: label for n, label, _ in conv}})
-        table = pa.Table.from_arrays(arrays, names=[header(n, lb) for n, lb, _ in conv])
+        table = pa.Table.from_arrays(arrays, names=[safe_cell(header(n, lb))
+                                                    for n, lb, _ in conv])
         table = table.replace_schema_metadata({"screwkit": meta})
         # no dictionary encoding: measured floats rarely repeat, and building the dictionaries
         # took 10x the rest of the write (benchmarks/bench_outputs.py)
@@ -191,6 +195,18 @@ class ResultTable:
         np.savez(path, **arrays)  # type: ignore[arg-type]
 
 
+#: leading characters that make a spreadsheet read a cell as a formula (OWASP, "CSV
+#: injection"): names starting with them are refused in spec files and neutralised here
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
+
+
+def safe_cell(text: str) -> str:
+    """``text`` with a leading apostrophe when a spreadsheet would evaluate it as a formula
+    (it starts with one of :data:`FORMULA_STARTS`), so a name such as ``=HYPERLINK(…)`` given
+    through the Python API is shown, not run. Numbers are never passed here."""
+    return "'" + text if text.startswith(FORMULA_STARTS) else text
+
+
 def header(name: str, label: str) -> str:
     """``name [label]``, or ``name`` for a column without a unit."""
     return f"{name} [{label}]" if label else name
@@ -202,8 +218,18 @@ def _text(values: NDArray[Any]) -> list[str]:
         return np.where(values, "true", "false").tolist()
     if values.dtype.kind in "iu":
         return values.astype(str).tolist()
-    if values.dtype.kind in "US":
-        return [str(v) for v in values]
+    if values.dtype.kind in "USO":
+        import csv
+
+        buf = io.StringIO()  # quoted as CSV (a name may hold a comma), formulas neutralised
+        writer = csv.writer(buf, lineterminator="\n")
+        out = []
+        for v in values:
+            buf.seek(0)
+            buf.truncate()
+            writer.writerow([safe_cell(str(v))])
+            out.append(buf.getvalue()[:-1])
+        return out
     v = np.asarray(values, dtype=float)
     text = v.astype(str)  # numpy's shortest repr: reads back as the same double
     if np.isnan(v).any():
@@ -215,10 +241,11 @@ def write_csv_text(fh: IO[str], headers: Sequence[str], columns: Sequence[NDArra
     """Write a header line and the rows of ``columns`` to ``fh`` (module docstring)."""
     import csv
 
-    csv.writer(fh, lineterminator="\n").writerow(headers)
+    writer = csv.writer(fh, lineterminator="\n")
+    writer.writerow([safe_cell(h) for h in headers])
     if not columns or not len(columns[0]):
         return
-    if len(columns[0]) * len(columns) > 20_000:
+    if len(columns[0]) * len(columns) > 20_000 and all(c.dtype.kind in "biuf" for c in columns):
         try:
             fh.write(_arrow_csv_rows(columns))
             return

@@ -172,7 +172,7 @@ def test_non_assembly_message_and_partial_results() -> None:
     )
     theta = np.radians(np.arange(0.0, 360.0, 10.0))
     with pytest.raises(
-        CSSPAssemblyError, match=r"does not assemble for θ1 in \[0°, 40°\], \[320°, 350°\]"
+        CSSPAssemblyError, match=r"does not assemble for θ1 in \[0, 40\] deg, \[320, 350\] deg"
     ) as info:
         cssp_motion(dims, theta, 1.0)
     assert "it assembles for θ1 in [41.46" in str(info.value)

@@ -28,7 +28,9 @@ from screwkit.balancing.problem import (
 from screwkit.balancing.result import BalanceResult
 from screwkit.balancing.variables import DesignVariables, VariableBlock, assemble
 from screwkit.dynamics import Dynamics, Regressor, regressor
+from screwkit.errors import expect_instance, expect_number
 from screwkit.kinematics.motion import ModeMotion, Motion
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 
@@ -98,7 +100,8 @@ def _rod_description(linkage: Linkage, mode: ModeMotion, k: int) -> str:
     r = np.asarray(mp.com) - p0
     offset = float(np.linalg.norm(r - (r @ u) * u))
     return (f"link {linkage.links[k].name!r} (transverse moments of inertia about its CoM "
-            f"{transverse[0]:.6g} and {transverse[1]:.6g} kg*m^2, CoM {offset:.3g} m off the line "
+            f"{shown(transverse[0], 'inertia')} and {shown(transverse[1], 'inertia')}, CoM "
+            f"{shown(offset, 'length', digits=3)} off the line "
             "of its ball centres)")
 
 
@@ -215,6 +218,28 @@ def solve_setup(setup: BalancingSetup, weights: Mapping[str, float]) -> BalanceR
     )
 
 
+def _check_arguments(linkage: object, mode: object, blocks: object, weights: object,
+                     config_type: type, speed: object) -> None:
+    """A BalancingError naming the argument of :func:`balance` that has the wrong type."""
+    expect_instance(linkage, Linkage | Motion, "balance: linkage",
+                    "a solved Motion (sk.solve_motion(...)) or a Linkage")
+    if isinstance(linkage, Motion) and (isinstance(mode, bool)
+                                        or not isinstance(mode, int | np.integer)):
+        raise BalancingError(f"balance: with a Motion, give the assembly mode as an index "
+                             f"0…{len(linkage.modes) - 1}; got {mode!r}")
+    if not isinstance(blocks, config_type) and (
+            isinstance(blocks, str) or not isinstance(blocks, Sequence)
+            or not all(isinstance(b, VariableBlock) for b in blocks)):
+        raise BalancingError("balance: blocks must be a list of design variables "
+                             "([sk.point_mass_variables(linkage, 'coupler'), …]) or a "
+                             f"BalancingConfig; got {type(blocks).__name__}")
+    if speed is not None:
+        expect_number(speed, "balance: speed")
+    if weights is not None and not isinstance(weights, Mapping):
+        raise BalancingError(f"balance: weights must be a mapping by measure name, e.g. "
+                             f"{{'F': 1.0, 'T0': 0.5}}; got {type(weights).__name__}")
+
+
 def balance(
     linkage: Linkage | Motion,
     mode: ModeMotion | int,
@@ -244,6 +269,7 @@ def balance(
     """
     from screwkit.balancing.config import BalancingConfig, balance_with_config
 
+    _check_arguments(linkage, mode, blocks, weights, BalancingConfig, speed)
     if isinstance(linkage, Motion):
         motion = linkage
         linkage, mode = motion.linkage, motion.mode(int(mode))  # type: ignore[arg-type]

@@ -13,6 +13,7 @@ feasible whenever the optimum is) and returns its member nearest to the original
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -37,6 +38,10 @@ def check_weights(weights: Mapping[str, float]) -> dict[str, float]:
         raise BalancingError(f"unknown weight(s) {unknown}; the measures are {list(MEASURES)} "
                              "(F shaking force, T shaking moment, R bearing forces, "
                              "M bearing moments, T0 input torque)")
+    text = {k: v for k, v in weights.items() if isinstance(v, str | bytes | bool)
+            or not isinstance(v, numbers.Real)}
+    if text:
+        raise BalancingError(f"weights must be numbers; got {text}")
     w = {k: float(weights.get(k, 0.0)) for k in MEASURES}
     bad = {k: v for k, v in w.items() if not (np.isfinite(v) and v >= 0)}
     if bad:

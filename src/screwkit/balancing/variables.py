@@ -25,6 +25,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.balancing.errors import BalancingError
+from screwkit.errors import expect_instance, expect_number
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import (
     EQUIVALENT_POINT_LABELS,
@@ -106,6 +108,7 @@ class DesignVariables:
 
 
 def _link_index(linkage: Linkage, link: str) -> int:
+    expect_instance(linkage, Linkage, "linkage", "a screwkit Linkage (load_spec(...).linkage)")
     names = [lk.name for lk in linkage.links]
     if link not in names:
         raise BalancingError(f"no moving link named {link!r}; the links are {names}")
@@ -226,6 +229,8 @@ def counterweight_variables(
     moment μ p pᵀ is not linear in (μ, μp): only the shaking force is exact for it (the problem
     refuses other weighted measures; see :mod:`screwkit.balancing.problem`)."""
     idx = _link_index(linkage, link)
+    expect_number(mass_max, f"counterweight {name!r}: mass_max")
+    expect_number(mass_min, f"counterweight {name!r}: mass_min")
     if not (np.isfinite(mass_max) and mass_max > 0 and 0 <= mass_min <= mass_max):
         raise BalancingError(
             f"counterweight {name!r}: need 0 <= mass_min <= mass_max and mass_max > 0; got "
@@ -241,9 +246,9 @@ def counterweight_variables(
             raise BalancingError(f"counterweight {name!r}: at must be 3 finite coordinates")
         col = np.zeros((P, 1))
         col[rows, 0] = point_parameters(p)
-        cons = [LinearConstraint(f"{name}.mass >= {mass_min:g} kg", np.array([-1.0]), "le",
+        cons = [LinearConstraint(f"{name}.mass >= {shown(mass_min, 'mass')}", np.array([-1.0]), "le",
                                  -mass_min),
-                LinearConstraint(f"{name}.mass <= {mass_max:g} kg", np.array([1.0]), "le",
+                LinearConstraint(f"{name}.mass <= {shown(mass_max, 'mass')}", np.array([1.0]), "le",
                                  mass_max)]
         return VariableBlock((f"{name}.mass",), link, col, np.array([0.0]),
                              np.array([mass_max]), tuple(cons), kind="counterweight")
@@ -259,9 +264,9 @@ def counterweight_variables(
     for k in range(3):
         col[rows.start + 1 + k, 1 + k] = 1.0
     names = (f"{name}.mass", f"{name}.mx", f"{name}.my", f"{name}.mz")
-    cons = [LinearConstraint(f"{name}.mass >= {mass_min:g} kg", np.array([-1.0, 0, 0, 0]),
+    cons = [LinearConstraint(f"{name}.mass >= {shown(mass_min, 'mass')}", np.array([-1.0, 0, 0, 0]),
                              "le", -mass_min),
-            LinearConstraint(f"{name}.mass <= {mass_max:g} kg", np.array([1.0, 0, 0, 0]),
+            LinearConstraint(f"{name}.mass <= {shown(mass_max, 'mass')}", np.array([1.0, 0, 0, 0]),
                              "le", mass_max)]
     for k, axis in enumerate("xyz"):
         e = np.zeros(4)
@@ -270,8 +275,8 @@ def counterweight_variables(
         lo_row[0] = -lo[k]
         hi_row = e.copy()
         hi_row[0] = -hi[k]
-        cons.append(LinearConstraint(f"{name}.{axis} >= {lo[k]:g} m", -lo_row, "le", 0.0))
-        cons.append(LinearConstraint(f"{name}.{axis} <= {hi[k]:g} m", hi_row, "le", 0.0))
+        cons.append(LinearConstraint(f"{name}.{axis} >= {shown(lo[k], 'length')}", -lo_row, "le", 0.0))
+        cons.append(LinearConstraint(f"{name}.{axis} <= {shown(hi[k], 'length')}", hi_row, "le", 0.0))
     size = np.array([mass_max, *(mass_max * np.maximum(np.abs(lo), np.abs(hi)) + 1e-12)])
     return VariableBlock(names, link, col, np.zeros(4), size, tuple(cons), kind="free_counterweight")
 

@@ -9,6 +9,7 @@ from typing import Annotated, Any
 
 import typer
 
+from screwkit.cli.common import prose
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 
@@ -57,10 +58,10 @@ def show_analysis(spec: Any, motion: Any, units: Any, full: bool,
     from screwkit.cli.common import console
     from screwkit.cli.formatting import print_long_table, table_columns
 
-    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
-    console.print(f"method: {motion.method}; {units.describe()}", highlight=False)
+    prose(f"[bold]{escape(spec.describe(units))}[/]")
+    prose(f"method: {motion.method}; {units.describe()}")
     for note in motion.notes:
-        console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
+        prose(f"[yellow]note:[/] {escape(note)}")
     from screwkit.kinematics.motion_table import column_prefix, variable_kind
 
     whole = table if table is not None else motion.table()
@@ -78,21 +79,19 @@ def show_analysis(spec: Any, motion: Any, units: Any, full: bool,
         # a joint list shows its first four freedoms (a family its seed's variables)
         hidden = [n for n in md.variables if n not in shown and n != motion.input_names[0]]
         if hidden and all("." in n for n in shown):
-            console.print(f"  • {len(shown)} of {len(shown) + len(hidden)} variables shown; "
-                          f"the others ({', '.join(hidden[:4])}{', …' if len(hidden) > 4 else ''}) "
-                          "are in --csv and --json", highlight=False)
+            prose(f"  • {len(shown)} of {len(shown) + len(hidden)} variables shown; "
+                  f"the others ({', '.join(hidden[:4])}{', …' if len(hidden) > 4 else ''}) "
+                  "are in --csv and --json")
         entry = doc["modes"][md.index].get("transmission") if doc is not None else None
         for line in transmission_lines(entry, units, input_kind):
-            console.print(f"  • {escape(line)}", highlight=False)
+            prose(f"  • {escape(line)}")
         for ev in md.events:
-            console.print(f"  • {escape(ev)}", highlight=False)
+            prose(f"  • {escape(ev)}")
         missing = int((~np.asarray(md.assembles)).sum())
         if missing:
-            console.print(f"  • does not assemble at {missing} of {motion.samples} inputs",
-                          highlight=False)
+            prose(f"  • does not assemble at {missing} of {motion.samples} inputs")
     if doc is not None and "note" in doc.get("transmission", {}):
-        console.print(f"[yellow]transmission:[/] {escape(doc['transmission']['note'])}",
-                      highlight=False)
+        prose(f"[yellow]transmission:[/] {escape(doc['transmission']['note'])}")
 
 
 def register(app: typer.Typer) -> None:
@@ -124,18 +123,18 @@ def register(app: typer.Typer) -> None:
             from screwkit.cli.graph_views import analyze_graph
 
             return analyze_graph(s, out, plot)
+        du = out.units_for(s.units)
         stages = ["solving", "coupler curves and transmission", "tables"]
         # a long sweep shows its stages (stderr, terminals only; the solver's own bar is off);
         # the bar is gone before anything is printed on stdout
         with staged_progress("analyze", stages,
                              enabled=len(s.inputs) >= SWEEP_PROGRESS_SAMPLES) as stage:
-            pipe = Pipeline(s, method=method, progress=stage("solving"))
+            pipe = guard(lambda: Pipeline(s, method=method, progress=stage("solving"), units=du))
             motion = guard(lambda: pipe.motion)
             stage("coupler curves and transmission")
             doc = guard(pipe.analysis)
             stage("tables")
             table = guard(pipe.analysis_table)
-        du = out.units_for(s.units)
         if plot is not None:
             from screwkit.report.plots import plot_analysis
 

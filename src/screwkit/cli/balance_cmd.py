@@ -10,6 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
+from screwkit.cli.common import prose
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 
@@ -35,29 +36,33 @@ def show_balance(spec: Any, res: Any, doc: dict[str, Any], units: Any,
 
     from screwkit.balancing.measures import MEASURE_TITLES, MEASURES
     from screwkit.cli.common import console
-    from screwkit.cli.formatting import TextColumn, number, print_columns
+    from screwkit.cli.formatting import TextColumn, noise_floor, number, print_columns
 
-    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
+    prose(f"[bold]{escape(spec.describe(units))}[/]")
     gravity = "on" if res.dynamics_before.gravity_on else "off ([balancing] gravity = true adds it)"
-    console.print(f"assembly mode {spec.mode}; gravity {gravity}", highlight=False,
-                  markup=False)
+    prose(escape(f"assembly mode {spec.mode}; gravity {gravity}"))
     keys = (*MEASURES, "G")
     ch = res.changes()
+    # round-off zeros (a measure balanced away) print as 0: each row's own scale
+    floor = {k: noise_floor([res.measures_before[k], res.measures_after[k]]) for k in keys}
     print_columns(console, "load measures, normalised mean squares (Rahman eq. 4.1)", [
         TextColumn("measure", [f"{MEASURE_TITLES.get(k, 'objective')} ({k})" for k in keys],
                    "left"),
-        TextColumn("before", [number(res.measures_before[k]) for k in keys]),
-        TextColumn("after", [number(res.measures_after[k]) for k in keys]),
+        TextColumn("before", [number(res.measures_before[k], floor=floor[k]) for k in keys]),
+        TextColumn("after", [number(res.measures_after[k], floor=floor[k]) for k in keys]),
         TextColumn("change %", ["n/a (round-off)" if ch[k] is None else f"{ch[k]:+.3f}"
                                 for k in keys])])
     rms = doc["measures_rms"]
+    rms_floor = {k: noise_floor([units.show(rms["kinds"][k], rms[s][k])
+                                 for s in ("before", "after") if rms[s][k] is not None])
+                 for k in MEASURES}
     print_columns(console, "RMS loads over the cycle", [
         TextColumn("load", [f"{MEASURE_TITLES[k]} ({k})" for k in MEASURES], "left"),
         TextColumn("unit", [units.label(rms["kinds"][k]) for k in MEASURES], "left"),
-        TextColumn("before", [number(units.show(rms["kinds"][k], rms["before"][k]))
-                              for k in MEASURES]),
-        TextColumn("after", [number(units.show(rms["kinds"][k], rms["after"][k]))
-                             for k in MEASURES]),
+        TextColumn("before", [number(units.show(rms["kinds"][k], rms["before"][k]),
+                                     floor=rms_floor[k]) for k in MEASURES]),
+        TextColumn("after", [number(units.show(rms["kinds"][k], rms["after"][k]),
+                                    floor=rms_floor[k]) for k in MEASURES]),
         TextColumn("change %", ["—" if rms["change_percent"][k] is None
                                 else f"{rms['change_percent'][k]:+.3f}" for k in MEASURES])])
     bounds = {b["variable"]: b["bound"] for b in doc["active_bounds"]}
@@ -83,26 +88,24 @@ def show_balance(spec: Any, res: Any, doc: dict[str, Any], units: Any,
         TextColumn("change %", [_change(res.link_mass_before[k], res.link_mass_after[k])
                                 for k in links])])
     if bounds:
-        console.print("active bounds: " + "; ".join(
-            escape(b["constraint"]) for b in doc["active_bounds"]), highlight=False)
+        prose("active bounds: " + "; ".join(
+            escape(b["constraint"]) for b in doc["active_bounds"]))
     verdict = ("could not be determined" if res.unique is None
                else "yes" if res.unique else f"no ({len(res.directions)} free direction(s))")
-    console.print(f"unique optimum: {verdict}", highlight=False)
+    prose(f"unique optimum: {verdict}")
     for d in res.directions:
         combo = " ".join(f"{c:+.4g}·{name}" for name, c in d.direction.items())
-        console.print(escape(f"  free direction {combo} ({direction_range(d)})"),
-                      highlight=False)
+        prose(escape(f"  free direction {combo} ({direction_range(d)})"))
     bound = doc.get("redistribution_bound")
     if bound:
-        console.print(f"bound over all consistent redistributions (SDP): G = "
-                      f"{bound['measures_after']['G']:.6g}", highlight=False)
+        prose(f"bound over all consistent redistributions (SDP): G = "
+              f"{bound['measures_after']['G']:.6g}")
     if "pareto" in doc:
         eff = sum(doc["pareto"]["efficient"])
-        console.print(f"Pareto sweep over {doc['pareto']['measures']}: "
-                      f"{len(doc['pareto']['values'])} weightings, {eff} non-dominated",
-                      highlight=False)
+        prose(f"Pareto sweep over {doc['pareto']['measures']}: "
+              f"{len(doc['pareto']['values'])} weightings, {eff} non-dominated")
     for note in res.notes:
-        console.print(escape(f"note: {note}"), highlight=False)
+        prose(escape(f"note: {note}"))
     for p in written:
         console.print(f"wrote {escape(p)}", highlight=False)
 
@@ -139,7 +142,7 @@ def register(app: typer.Typer) -> None:
         pareto = s.balancing.pareto if s.balancing is not None else None
         total = None if pareto is None else pareto_size(pareto)
         with progress_bar("Pareto sweep", total, enabled=pareto is not None) as advance:
-            res = guard(lambda: Pipeline(s).balance(progress=advance))
+            res = guard(lambda: Pipeline(s, units=du).balance(progress=advance))
         doc = balance_document(res)
         written: list[str] = []
         if tables is not None:

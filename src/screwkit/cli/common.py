@@ -1,10 +1,11 @@
 """What every ``screwkit`` subcommand shares: the consoles and the rule that a user mistake
 exits with status 2 and a one-paragraph message (the output options: :mod:`screwkit.cli.outputs`).
 
-Messages are never wrapped (``soft_wrap``): one message is one line whatever ``COLUMNS`` says
-and whether or not the output is a terminal, so paths stay whole for grep and copy-paste. Only
-tables are fitted to the width (:mod:`screwkit.cli.formatting`): the terminal's, or ``COLUMNS``,
-or 80 for a pipe or a file."""
+Errors and ``wrote <path>`` lines are never wrapped (``soft_wrap``): one message is one line
+whatever ``COLUMNS`` says, so paths stay whole for grep and copy-paste. Everything else a
+command prints fits the width — the terminal's, or ``COLUMNS``, or 80 for a pipe or a file:
+tables by :mod:`screwkit.cli.formatting`, prose (headers, notes, bullets) by :func:`prose`,
+which breaks lines between words with a hanging indent and never inside a word."""
 
 from __future__ import annotations
 
@@ -15,11 +16,48 @@ from typing import NoReturn, TypeVar
 import typer
 from rich.console import Console
 from rich.markup import escape
+from rich.text import Text
 
 console = Console(soft_wrap=True)
 err_console = Console(stderr=True, soft_wrap=True)
 
 T = TypeVar("T")
+
+
+def prose(markup: str, *, hang: int | None = None, to: Console | None = None,
+          width: int | None = None) -> None:
+    """Print rich ``markup`` wrapped between words at the console's width, each of its lines
+    on its own; continuation lines are indented by ``hang`` (default: under the text after a
+    leading bullet ``  • ``, else two more than the line's own indent). A word longer than a
+    line (a path) is kept whole on its own line."""
+    out = to if to is not None else console
+    limit = max(width or out.width, 20)
+    for line in out.render_str(markup, highlight=False).split("\n", allow_blank=True):
+        for piece in _wrapped(line, limit, hang):
+            out.print(piece, soft_wrap=True, highlight=False)
+
+
+def _wrapped(line: Text, limit: int, hang: int | None) -> list[Text]:
+    """One line of text cut between words into lines of at most ``limit`` cells (module
+    docstring of :func:`prose`)."""
+    plain = line.plain
+    if hang is None:  # under the text after a bullet; else two more than the line's indent
+        lead = len(plain) - len(plain.lstrip(" •"))
+        hang = lead if "•" in plain[:lead] else lead + 2
+    cuts: list[int] = []
+    start, last_space, pos = 0, -1, 0
+    while pos < len(plain):
+        if plain[pos] == " " and pos > start:
+            last_space = pos
+        if pos - start >= limit - (hang if cuts else 0) and last_space > start:
+            cuts.append(last_space)
+            start, last_space = last_space + 1, -1
+            pos = start
+            continue
+        pos += 1
+    pieces = list(line.divide(cuts)) if cuts else [line]
+    return [pieces[0]] + [Text(" " * hang) + (p[1:] if p.plain.startswith(" ") else p)
+                          for p in pieces[1:]]
 
 
 def user_errors() -> tuple[type[BaseException], ...]:

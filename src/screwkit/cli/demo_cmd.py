@@ -10,6 +10,8 @@ from typing import Annotated, Any
 
 import typer
 
+from screwkit.cli.common import prose
+
 
 def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
                 reports: bool) -> tuple[list[str], dict[str, Any]]:
@@ -17,7 +19,7 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
     import numpy as np
     from rich.markup import escape
 
-    from screwkit.cli.common import console, guard
+    from screwkit.cli.common import guard
     from screwkit.cli.dynamics_cmd import dynamics_job
     from screwkit.io.documents import synthesis_document
     from screwkit.io.results import write_json_atomic
@@ -34,7 +36,7 @@ def run_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
         return demo_graph_example(f, output_dir, files, plots, reports)
     spec = guard(lambda: load_spec(f))
     du = spec.display_units()
-    console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+    prose(f"[green]ok[/] {escape(spec.describe())}")
     pipe = Pipeline(spec)
     motion = guard(lambda: pipe.motion)
     doc = guard(pipe.analysis)

@@ -10,6 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
+from screwkit.cli.common import prose
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 
@@ -51,31 +52,50 @@ def gravity_sentence(dyn: Any, pipe: Any) -> str:
     return f"gravity on: {size:.6g} m/s^2 along ({d})"
 
 
+def summary_columns(summary: dict[str, dict[str, float]], units: Any,
+                    input_is_angle: bool) -> list[Any]:
+    """The terminal columns of :meth:`Dynamics.summary`: quantity, unit, RMS, peak and the
+    input at the peak, in ``units``; a value below the noise floor of its kind (over every
+    load of that kind) prints as 0."""
+    from screwkit.cli.formatting import TextColumn, noise_floor, number
+
+    shown = {name: (summary_kind(name), st) for name, st in summary.items()}
+    floors = {kind: noise_floor([units.show(k, st["peak"]) for k, st in shown.values()
+                                 if k == kind])
+              for kind in {k for k, _ in shown.values()} if kind != "ratio"}
+    in_kind = "angle" if input_is_angle else "length"
+    names, unit, rms, peak, at = [], [], [], [], []
+    for name, (kind, st) in shown.items():
+        floor = floors.get(kind, 0.0)
+        names.append(name)
+        unit.append(units.label(kind))
+        rms.append(number(units.show(kind, st["rms"]), floor=floor))
+        peak.append(number(units.show(kind, st["peak"]), floor=floor))
+        at.append(number(units.show(in_kind, st["peak_at"]), 5) if st["peak"] >= floor > 0
+                  or kind == "ratio" and st["peak"] > 0 else "—")
+    return [TextColumn("quantity", names, "left"), TextColumn("unit", unit, "left"),
+            TextColumn("RMS", rms), TextColumn("peak", peak),
+            TextColumn(f"peak at\ninput [{units.label(in_kind)}]", at)]
+
+
 def show_dynamics(spec: Any, pipe: Any, dyn: Any, units: Any, note: str | None) -> None:
-    """RMS and peak of every load, in the display units."""
+    """RMS and peak of every load, and the input where the peak is reached, in the display
+    units; values below their quantity's noise floor print as 0."""
     from rich.markup import escape
 
     from screwkit.cli.common import console
-    from screwkit.cli.formatting import TextColumn, number, print_columns
+    from screwkit.cli.formatting import print_columns
 
-    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
-    console.print(f"assembly mode {spec.mode}; {gravity_sentence(dyn, pipe)}; "
-                  f"{escape(dyn.indeterminacy.describe())}", highlight=False)
+    prose(f"[bold]{escape(spec.describe(units))}[/]")
+    prose(f"assembly mode {spec.mode}; {gravity_sentence(dyn, pipe)}; "
+          f"{escape(dyn.indeterminacy.describe())}")
     if note is not None:
-        console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
-    names, unit, rms, peak = [], [], [], []
-    for name, st in dyn.summary().items():
-        kind = summary_kind(name)
-        names.append(name)
-        unit.append(units.label(kind))
-        rms.append(number(units.show(kind, st["rms"])))
-        peak.append(number(units.show(kind, st["peak"])))
-    cols = [TextColumn("quantity", names, "left"), TextColumn("unit", unit, "left"),
-            TextColumn("RMS", rms), TextColumn("peak", peak)]
+        prose(f"[yellow]note:[/] {escape(note)}")
+    cols = summary_columns(dyn.summary(), units, spec.input_is_angle)
     print_columns(console, "loads over the cycle (vectors by magnitude)", cols)
-    console.print("reactions: on the distal link by the proximal link, world frame, moments "
-                  "about the joint centre (its path: --csv <joint>.point_x|y|z, or "
-                  "--json reactions.<joint>.point)", highlight=False)
+    prose("reactions: on the distal link by the proximal link, world frame, moments "
+          "about the joint centre (its path: --csv <joint>.point_x|y|z, or "
+          "--json reactions.<joint>.point)")
 
 
 def register(app: typer.Typer) -> None:
@@ -106,10 +126,10 @@ def register(app: typer.Typer) -> None:
             from screwkit.cli.graph_views import dynamics_graph
 
             return dynamics_graph(s, out, gravity)
-        pipe = Pipeline(s)
+        du = out.units_for(s.units)
+        pipe = Pipeline(s, units=du)
         dyn = guard(lambda: pipe.dynamics(gravity))
         note = guard(lambda: load_note(pipe))
-        du = out.units_for(s.units)
         out.deliver(document=lambda: dynamics_document(dyn, mode=s.mode, note=note),
                     table=lambda: dyn.table(mode=s.mode),
                     show=lambda: show_dynamics(s, pipe, dyn, du, note), units=du)

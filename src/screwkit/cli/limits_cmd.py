@@ -9,6 +9,7 @@ from typing import Annotated, Any
 
 import typer
 
+from screwkit.cli.common import prose
 from screwkit.cli.outputs import CsvOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 
@@ -20,9 +21,8 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
     from screwkit.cli.formatting import TextColumn, number, print_columns
     from screwkit.kinematics.motion_table import variable_kind
 
-    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
-    console.print(f"method: {doc['method']}; derivatives: {escape(doc['derivatives'])}",
-                  highlight=False)
+    prose(f"[bold]{escape(spec.describe(units))}[/]")
+    prose(f"method: {doc['method']}; derivatives: {escape(doc['derivatives'])}")
     xk = variable_kind(doc["input_name"] if doc["method"] == "generic" else "theta0")
 
     def shown(x: float | None, kind: str) -> str:
@@ -32,13 +32,14 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
         return "angle" if x.get("kind", "rotation") == "rotation" else "length"
 
     def second(x: dict[str, Any]) -> str:
-        """d²y/dx²: rad/rad² for a rotation, the display length per rad² for a translation."""
+        """d²y/dx² with its unit: output unit per input unit squared, angles in rad (a
+        derivative by an angle is per radian), lengths in the display unit."""
         v = x["second_derivative"]
         if v is None:
             return "—"
-        if kind_of(x) == "angle":
-            return f"{number(v, 4)} rad"
-        return f"{number(units.show('length', v), 4)} {units.label('length')}"
+        out_label, out_factor = ("rad", 1.0) if kind_of(x) == "angle" else units.unit_of("length")
+        in_label, in_factor = ("rad", 1.0) if xk == "angle" else units.unit_of("length")
+        return f"{number(v / out_factor * in_factor**2, 4)} {out_label}/{in_label}²"
 
     generic = doc["method"] == "generic"
     lims = doc["limits"]
@@ -49,7 +50,7 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
             TextColumn(f"input\n[{units.label(xk)}]",
                        [number(units.show(xk, x["input"]), 7) for x in lims]),
             TextColumn("value", [shown(x["value"], kind_of(x)) for x in lims]),
-            TextColumn("2nd derivative\n[per rad²]", [second(x) for x in lims]),
+            TextColumn("2nd\nderivative", [second(x) for x in lims]),
             TextColumn("dwell\norder", ["—" if x["dwell_order"] is None else str(x["dwell_order"])
                                         for x in lims])]
     print_columns(console, f"limit positions (dwell tolerance {doc['dwell_tolerance']:g})", cols)
@@ -67,7 +68,7 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
                            [", ".join(f"{v:.3g}" for v in x["derivatives"]) for x in d], "left")]
         print_columns(console, "dwell order at given inputs", cols)
     for note in doc["notes"]:
-        console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
+        prose(f"[yellow]note:[/] {escape(note)}")
 
 
 def register(app: typer.Typer) -> None:
@@ -108,9 +109,10 @@ def register(app: typer.Typer) -> None:
             return
         where = None if at is None else [float(np.radians(x)) if s.input_is_angle else float(x)
                                          for x in at]
-        doc = guard(lambda: Pipeline(s).limits(dwell_tolerance, where, output=variable,
-                                               method=method).as_dict())
         du = out.units_for(s.units)
+        doc = guard(lambda: Pipeline(s, units=du).limits(dwell_tolerance, where,
+                                                         output=variable,
+                                                         method=method).as_dict())
         out.deliver(document=lambda: doc, table=lambda: limits_table(doc),
                     show=lambda: show_limits(s, doc, du), units=du)
 
@@ -126,6 +128,7 @@ def register(app: typer.Typer) -> None:
         from screwkit.cli.common import console, guard
         from screwkit.cli.outputs import Outputs
         from screwkit.io.spec import load_spec
+        from screwkit.messages import message_units
         from screwkit.pipeline import Pipeline
 
         out = Outputs.prepare([spec], as_json=as_json, output=output, formats=("json",))
@@ -135,12 +138,14 @@ def register(app: typer.Typer) -> None:
 
             doc = guard(lambda: graph_mobility(s))
         else:
-            doc = guard(lambda: Pipeline(s).mobility().as_dict())
+            pipe = Pipeline(s)
+            with message_units(pipe.units):  # the summary's lines quote lengths: spec units
+                doc = guard(lambda: pipe.mobility().as_dict())
 
         def show() -> None:
-            console.print(f"[bold]{escape(s.describe())}[/]", highlight=False)
+            prose(f"[bold]{escape(s.describe())}[/]")
             for line in doc["summary"]:
-                console.print(escape(str(line)), highlight=False)
+                prose(escape(str(line)))
                 console.print()
 
         out.deliver(document=lambda: doc, table=None, show=show)

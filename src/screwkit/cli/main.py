@@ -14,7 +14,7 @@ from typing import Annotated
 import typer
 
 from screwkit import __version__
-from screwkit.cli.common import attempt, console, err_console, guard
+from screwkit.cli.common import attempt, console, err_console, guard, prose
 
 app = typer.Typer(
     name="screwkit",
@@ -51,11 +51,11 @@ def validate(specs: Annotated[list[Path], typer.Argument(help="Spec files (TOML)
     for path in specs:  # every file is reported, good or bad
         ok, spec = attempt(lambda p=path: load_spec(p))  # type: ignore[misc]
         if ok and spec is not None:
-            console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
-            console.print(f"   jobs: {escape(', '.join(spec.jobs()))}", highlight=False)
+            prose(f"[green]ok[/] {escape(spec.describe())}")
+            prose(f"   jobs: {escape(', '.join(spec.jobs()))}")
             if getattr(spec, "family", None) == "graph":
                 for line in spec.topology.summary():  # type: ignore[attr-defined]
-                    console.print(f"   {escape(line)}", highlight=False)
+                    prose(f"   {escape(line)}")
         else:
             failed += 1
     if failed:

@@ -10,6 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
+from screwkit.cli.common import prose
 from screwkit.cli.outputs import JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 RPM = 60.0 / (2.0 * 3.141592653589793)
@@ -23,12 +24,17 @@ def _table(doc: dict[str, Any], describe: str, units: Any) -> None:
     from screwkit.cli.common import console
     from screwkit.cli.formatting import TextColumn, number, print_columns
 
-    console.print(f"[bold]{escape(describe)}[/]", highlight=False)
+    prose(f"[bold]{escape(describe)}[/]")
     m = doc["model"]
-    console.print(f"{escape(doc['message'])} ({doc['status']}); flywheel {doc['flywheel']:.6g} "
-                  f"kg·m²; J(θ) {m['inertia_min']:.6g}…{m['inertia_max']:.6g} kg·m² (mean "
-                  f"{m['inertia_mean']:.6g}), {m['harmonics']} harmonics on {m['grid_samples']} "
-                  f"samples; energy balance error {doc['energy_error']:.2g}", highlight=False)
+    iu = units.pretty("inertia")
+
+    def inertia(si: float) -> str:
+        return number(units.show("inertia", si))
+
+    prose(f"{escape(doc['message'])} ({doc['status']}); flywheel {inertia(doc['flywheel'])} "
+          f"{iu}; J(θ) {inertia(m['inertia_min'])}…{inertia(m['inertia_max'])} {iu} (mean "
+          f"{inertia(m['inertia_mean'])}), {m['harmonics']} harmonics on {m['grid_samples']} "
+          f"samples; energy balance error {doc['energy_error']:.2g}")
     cycles = doc["cycles"]
     shown = cycles if len(cycles) <= 12 else cycles[:5] + cycles[-5:]
     tu = units.pretty("moment")
@@ -51,11 +57,11 @@ def _table(doc: dict[str, Any], describe: str, units: Any) -> None:
     sizing = doc.get("flywheel_sizing")
     if sizing:
         em = sizing["energy_method"]
-        console.print(f"flywheel for C_s = {sizing['requested_fluctuation']:g}: "
-                      f"[bold]{sizing['flywheel']:.6g} kg·m²[/] (steady C_s "
-                      f"{sizing['achieved_fluctuation']:.6g}); energy method: ΔE "
-                      f"{em['energy_fluctuation']:.6g} J at {em['speed'] * RPM:.6g} rpm → "
-                      f"{em['flywheel']:.6g} kg·m²", highlight=False)
+        prose(f"flywheel for C_s = {sizing['requested_fluctuation']:g}: "
+              f"[bold]{inertia(sizing['flywheel'])} {iu}[/] (steady C_s "
+              f"{sizing['achieved_fluctuation']:.6g}); energy method: ΔE "
+              f"{em['energy_fluctuation']:.6g} J at {em['speed'] * RPM:.6g} rpm → "
+              f"{inertia(em['flywheel'])} {iu}")
     loads = doc.get("loads")
     if loads:
         from screwkit.cli.dynamics_cmd import summary_kind
@@ -69,8 +75,8 @@ def _table(doc: dict[str, Any], describe: str, units: Any) -> None:
                                for n, st in zip(names, stats, strict=True)]),
             TextColumn("peak", [number(units.show(summary_kind(n), st["peak"]))
                                 for n, st in zip(names, stats, strict=True)])])
-        console.print(f"shaft torque: inverse dynamics vs motor − flywheel·θ̈, max difference "
-                      f"{doc['shaft_torque_check']:.2g} of the largest", highlight=False)
+        prose(f"shaft torque: inverse dynamics vs motor − flywheel·θ̈, max difference "
+              f"{doc['shaft_torque_check']:.2g} of the largest")
 
 
 def register(app: typer.Typer) -> None:
@@ -103,10 +109,14 @@ def register(app: typer.Typer) -> None:
             user_error(f"--plot {plot}: give a file ending in .png, .svg or .pdf")
         fw = None if flywheel is None else guard(
             lambda: to_si(flywheel, "inertia", "kg*m**2"))
+        from screwkit.messages import message_units
+
         s = loop_only(guard(lambda: load_spec(spec)), "simulate")
-        run = guard(lambda: simulate_spec(s, fluctuation=fluctuation, cycles=cycles, flywheel=fw))
-        doc = guard(lambda: run.as_dict())
         du = out.units_for(s.units)
+        with message_units(du):
+            run = guard(lambda: simulate_spec(s, fluctuation=fluctuation, cycles=cycles,
+                                              flywheel=fw))
+        doc = guard(lambda: run.as_dict())
         if plot is not None:
             from screwkit.report.simulation_plots import write_simulation_png
 

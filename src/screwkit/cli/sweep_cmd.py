@@ -17,7 +17,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from screwkit.cli.common import check_paths, console, err_console, guard
+from screwkit.cli.common import check_paths, console, err_console, guard, prose
 
 SchedulerOpt = Annotated[str | None, typer.Option(
     "--scheduler", help="Run on an existing Dask scheduler (tcp://HOST:PORT) and its workers "
@@ -115,11 +115,11 @@ def _summary(result: Any, output: Path, plot: Path | None) -> None:
               str(result.failed), str(result.errors), f"{result.seconds:.2f}", f"{per:.3g}")
     console.print(t)
     # a sentence, below the table: as a column it wrapped to one word a line in 80 columns
-    console.print(f"engine: {escape(result.engine)}", highlight=False)
+    prose(f"engine: {escape(result.engine)}", to=console)
     print_notes(result.notes)
     reasons = Counter(r["reason"] for r in rows if r["status"] != "ok")
     for reason, count in reasons.most_common(5):
-        console.print(f"  • {count} × {escape(reason)}", highlight=False)
+        prose(f"  • {count} × {escape(reason)}", to=console)
     console.print(f"wrote {escape(str(output))}", highlight=False)
     if plot is not None:
         console.print(f"wrote {escape(str(plot))}", highlight=False)

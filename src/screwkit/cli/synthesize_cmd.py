@@ -12,7 +12,7 @@ from typing import Annotated, Any
 import typer
 from rich.markup import escape
 
-from screwkit.cli.common import console, loop_only
+from screwkit.cli.common import console, loop_only, prose
 from screwkit.cli.common import guard as _guard
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for, stopped
@@ -72,39 +72,43 @@ def _tables(name: str, results: list[Any], doc: dict[str, Any], config: Any, du:
     scale_unit = config.length_unit
     best = results[0]
     a, lu = du.label("angle"), du.label("length")
-    console.print(f"[bold]{escape(name)}[/]: synthesis ({best.status}; {best.iterations} "
-                  f"iterations, {best.evaluations} evaluations, {best.time:.3f} s)",
-                  highlight=False)
+    prose(f"[bold]{escape(name)}[/]: synthesis ({best.status}; {best.iterations} "
+          f"iterations, {best.evaluations} evaluations, {best.time:.3f} s)")
     if best.message:
-        console.print(f"  {escape(best.message)}", highlight=False)
+        prose(f"  {escape(best.message)}")
     kinds = ["angle" if k in config.angles else "length" for k in best.dimensions]
-    print_columns(console, "optimised dimensions", [
+    dimension_columns = [
         TextColumn("name", list(best.dimensions), "left"),
         TextColumn("value", [number(du.show(k, v), 7) for k, v in
                              zip(kinds, best.dimensions.values(), strict=True)]),
-        TextColumn("unit", [du.label(k) for k in kinds], "left")])
+        TextColumn("unit", [du.label(k) for k in kinds], "left")]
+    if best.at_bounds:  # the synthesis ended on a bound: say which
+        dimension_columns.append(TextColumn(
+            "bound", [f"on {best.at_bounds[k][0]}" if k in best.at_bounds else ""
+                      for k in best.dimensions], "left"))
+    print_columns(console, "optimised dimensions", dimension_columns)
     rot, tra = config.outputs
     mode = (f"assembly mode {best.inversion} (sign of Q5 {best.mode_sign:+.0f})"
             if config.route == "closed" else
             f"assembly mode {best.inversion} (generic route: the loop's screw Jacobian; outputs "
             f"{', '.join(o for o in (rot, tra) if o)})")
-    console.print(
+    prose(
         f"{mode}; "
         f"E = E_phi + E_S/L² = {best.objective:.6g} with L = {best.length_scale:g} m "
-        f"({scale_unit}); E_phi = {best.E_phi:.6g} rad², E_S = {best.E_S:.6g} m²", highlight=False)
-    console.print(
+        f"({scale_unit}); E_phi = {best.E_phi:.6g} rad², E_S = {best.E_S:.6g} m²")
+    prose(
         f"RMSE {best.rmse:.6g}; RMSE_phi {du.show('angle', best.rmse_phi):.5g} {a}; RMSE_S "
         f"{du.show('length', best.rmse_S):.6g} {lu}; max deviation "
         f"{du.show('angle', best.max_dev_phi):.5g} {a} / {du.show('length', best.max_dev_S):.4g} "
-        f"{lu}; |grad E| = {best.gradient_norm:.2g}", highlight=False)
-    console.print(f"whole range: {escape(best.range_check.message)}", highlight=False)
+        f"{lu}; |grad E| = {best.gradient_norm:.2g}")
+    prose(f"whole range: {escape(best.range_check.message)}")
     t = synthesis_table(doc)
     cols, values = table_columns(t, t.names, du)
     print_long_table(console, "desired vs generated (as Bagci's Tables I-XII)", cols, values,
                      full)
     for k, other in enumerate(results[1:], start=2):
-        console.print(f"alternative {k}: mode {other.inversion}, E = {other.objective:.6g}, "
-                      f"whole range {'ok' if other.range_check.ok else 'NOT ok'}", highlight=False)
+        prose(f"alternative {k}: mode {other.inversion}, E = {other.objective:.6g}, "
+              f"whole range {'ok' if other.range_check.ok else 'NOT ok'}")
 
 
 def synthesis_document(s: Any, starts: int | None = None) -> dict[str, Any]:
@@ -199,12 +203,11 @@ def _overlay_lines(docs: list[dict[str, Any]]) -> None:
         radii = ", ".join(f"{r:.6g}" for r in ov["dwell_curvature_radii"])
         d2_text = (f"d2 refined {ov['d2_chosen']:.6g} -> {ov['d2']:.6g} m" if ov["d2_refined"]
                    else f"d2 = {ov['d2']:.6g} m (as chosen)")
-        console.print(
+        prose(
             f"overlay {k}: {ov['output_direction']} output, centre ({ov['centre'][0]:.6g}, "
             f"{ov['centre'][1]:.6g}) m, d3 = {ov['d3']:.6g} m, {d2_text}, max circle miss "
             f"{ov['max_circle_miss']:.3g} m, RMSE_phi {math.degrees(d['rmse_phi']):.4g}°"
-            + (f"; ellipse curvature radius at the dwell(s): {radii} m" if radii else ""),
-            highlight=False)
+            + (f"; ellipse curvature radius at the dwell(s): {radii} m" if radii else ""))
 
 
 def plot_path(plot: Path) -> Path:
@@ -278,7 +281,7 @@ def register(app: typer.Typer) -> None:
                               unit=unit, full=full, files={"--plot": plot})
         s = loop_only(_guard(lambda: load_spec(spec)), "synthesize")
         du = out.units_for(s.units)
-        pipe = Pipeline(s)
+        pipe = Pipeline(s, units=du)
         config = _guard(lambda: pipe.synthesis_config())
         problem = config.problem
         overlay = config.method == "overlay"

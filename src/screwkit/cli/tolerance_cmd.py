@@ -12,7 +12,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from screwkit.cli.common import console, guard
+from screwkit.cli.common import console, guard, prose
 from screwkit.cli.outputs import JsonOpt, Outputs, UnitOpt, UnitsOpt
 from screwkit.cli.sweep_cmd import (
     SchedulerOpt,
@@ -36,10 +36,9 @@ def _show(units: Any, value: float, angle: bool) -> str:
 
 
 def _tables(doc: dict[str, Any], description: str, units: Any, input_is_angle: bool) -> None:
-    console.print(f"[bold]{escape(description)}[/]", highlight=False)
-    console.print(f"assembly mode {doc['mode']}; {doc['convention']}; angles in "
-                  f"{units.pretty('angle')}, lengths in {units.pretty('length')}",
-                  highlight=False)
+    prose(f"[bold]{escape(description)}[/]")
+    prose(f"assembly mode {doc['mode']}; {doc['convention']}; angles in "
+          f"{units.pretty('angle')}, lengths in {units.pretty('length')}")
     t = Table(title="stack-ups: the largest deviation over the cycle")
     for col in ("output", "worst case ±", "RSS ±", "at input", "dominant tolerance"):
         t.add_column(col, justify="right")
@@ -55,18 +54,18 @@ def _tables(doc: dict[str, Any], description: str, units: Any, input_is_angle: b
     if mc is None:
         return
     if not mc["points_compared"]:
-        console.print("[yellow]Monte Carlo:[/] no point to compare (the outputs do not depend "
-                      "on these tolerances)")
+        prose("[yellow]Monte Carlo:[/] no point to compare (the outputs do not depend "
+              "on these tolerances)")
         return
     lo, hi = mc["std_ratio_range"]
     verdict = "[green]agrees[/]" if mc["agree"] else "[yellow]does NOT agree[/]"
-    console.print(
+    prose(
         f"Monte Carlo ({mc['samples']} designs, seed {mc['seed']}, {mc['failed_designs']} "
         f"failed): σ_MC/σ_first-order {lo:.4f}…{hi:.4f}; first-order σ inside the 95% "
         f"interval at {mc['inside_95_percent_interval']} of {mc['points_compared']} points, "
         f"inside the Bonferroni-corrected interval at {mc['inside_bonferroni_interval']}; "
         f"first-order prediction error ≤ {mc['max_prediction_error_over_sigma']:.3g} σ — "
-        f"the first-order result {verdict}", highlight=False)
+        f"the first-order result {verdict}")
 
 
 def _plot(doc: dict[str, Any], path: Path, inputs: list[Path], units: Any,

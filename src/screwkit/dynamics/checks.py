@@ -50,7 +50,10 @@ def check_vector3(value: ArrayLike | None, name: str) -> Array:
     """A finite (3,) vector (zeros for ``None``)."""
     if value is None:
         return np.zeros(3)
-    arr = np.asarray(value, dtype=float)
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.full(1, np.nan)  # not numbers: the message below names the argument
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
         raise DynamicsInputError(
             f"{name} must be a finite 3-vector in the world frame (SI units); got {value!r}"
@@ -93,8 +96,11 @@ def check_external_loads(
     linkage: Linkage, loads: Mapping[str, ExternalLoad] | None
 ) -> dict[int, tuple[Array, Array, Array]]:
     """External loads by moving-link index: (force, moment, point)."""
-    if not loads:
+    if loads is None:
         return {}
+    if not isinstance(loads, Mapping):
+        raise DynamicsInputError(f"external_loads must be a mapping of link name to "
+                                 f"ExternalLoad; got {type(loads).__name__}")
     names = [lk.name for lk in linkage.links]
     out: dict[int, tuple[Array, Array, Array]] = {}
     for name, load in loads.items():
@@ -103,6 +109,9 @@ def check_external_loads(
                 f"external load on {name!r}: no such moving link in {linkage.name}; "
                 f"moving links are {names}"
             )
+        if not isinstance(load, ExternalLoad):
+            raise DynamicsInputError(f"external load on {name!r} must be an ExternalLoad(force, "
+                                     f"moment, point); got {type(load).__name__}")
         out[names.index(name)] = (
             check_vector3(load.force, f"external force on {name!r}"),
             check_vector3(load.moment, f"external moment on {name!r}"),

@@ -57,6 +57,7 @@ from screwkit.dynamics.sample_blocks import (
     joint_scale,
 )
 from screwkit.dynamics.screws import freedom_screws
+from screwkit.errors import expect_instance
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
@@ -104,7 +105,10 @@ def _setup(
             [mode.variables.get(name, np.full(N, np.nan)) for name in linkage.inputs], -1
         )
     else:
-        input_arr = np.asarray(inputs, dtype=float).reshape(N, -1)
+        try:
+            input_arr = np.asarray(inputs, dtype=float).reshape(N, -1)
+        except (TypeError, ValueError):
+            input_arr = np.zeros((N, 0))  # not N rows of numbers: named below
         if input_arr.shape[1] != len(linkage.inputs):
             raise DynamicsInputError(
                 f"inputs must have one column per input {list(linkage.inputs)}; "
@@ -229,6 +233,8 @@ def resolve_mode(linkage: Linkage | Motion, mode: ModeMotion | int,
                  inputs: ArrayLike | None) -> tuple[Linkage, ModeMotion, ArrayLike | None]:
     """(linkage, mode_motion, inputs) from either calling form of :func:`inverse_dynamics`:
     a Motion and a mode index, or a linkage and one mode's ModeMotion."""
+    expect_instance(linkage, Linkage | Motion, "linkage",
+                    "a solved Motion (sk.solve_motion(...)) or a Linkage")
     if isinstance(linkage, Motion):
         if not isinstance(mode, int | np.integer) or isinstance(mode, bool):
             raise DynamicsInputError(f"with a Motion, give the assembly mode as an index "
@@ -297,6 +303,8 @@ def inverse_dynamics(
     linkage, mode_motion, inputs = resolve_mode(linkage, mode_motion, inputs)
     if not isinstance(block_size, int | np.integer) or block_size < 1:
         raise DynamicsInputError(f"block_size must be a positive integer, got {block_size!r}")
+    check_vector3(gravity, "gravity")  # argument mistakes before the model's
+    check_vector3(moment_point, "moment_point")
     masses = check_link_masses(linkage)
     args = (linkage, mode_motion, masses, gravity, moment_point, external_loads, inputs,
             allow_partial, closed_form, int(block_size))
@@ -412,8 +420,8 @@ class Regressor:
 
 
 def regressor(
-    linkage: Linkage,
-    mode_motion: ModeMotion,
+    linkage: Linkage | Motion,
+    mode_motion: ModeMotion | int,
     gravity: ArrayLike | None = None,
     moment_point: ArrayLike | None = None,
     *,
@@ -424,6 +432,7 @@ def regressor(
     """The regressor Y of every load of :func:`inverse_dynamics` in the stacked inertial
     parameters π of the moving links (load = Y·π + constant). Mass properties on the links are
     not needed (they are what π describes). Same arguments as :func:`inverse_dynamics`."""
+    linkage, mode_motion, inputs = resolve_mode(linkage, mode_motion, inputs)
     s = _setup(linkage, mode_motion, gravity, moment_point, inputs, allow_partial)
     sub = mode_motion if s.valid.all() else _subset(mode_motion, np.flatnonzero(s.valid))
     Y = inertia_wrench_regressor(sub, s.gravity, s.reference)  # (Nv, L, 6, 10)

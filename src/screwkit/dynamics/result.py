@@ -80,13 +80,16 @@ def _listify(a: Array, valid: NDArray[np.bool_]) -> list[Any]:
     return out
 
 
-def _stats(values: Array, valid: NDArray[np.bool_]) -> dict[str, float]:
-    """RMS and peak of a load over the valid samples (vector loads by their magnitude)."""
+def _stats(values: Array, valid: NDArray[np.bool_], inputs: Array) -> dict[str, float]:
+    """RMS and peak of a load over the valid samples (vector loads by their magnitude), and
+    ``peak_at``: the (first) input where the peak is reached (rad or m)."""
     v = values[valid]
     mag = np.abs(v) if v.ndim == 1 else np.linalg.norm(v, axis=-1)
     if mag.size == 0:
-        return {"rms": float("nan"), "peak": float("nan")}
-    return {"rms": float(np.sqrt(np.mean(mag**2))), "peak": float(np.max(mag))}
+        return {"rms": float("nan"), "peak": float("nan"), "peak_at": float("nan")}
+    k = int(np.argmax(mag))
+    return {"rms": float(np.sqrt(np.mean(mag**2))), "peak": float(mag[k]),
+            "peak_at": float(np.asarray(inputs).reshape(len(valid), -1)[valid][k, 0])}
 
 
 @dataclass(frozen=True, eq=False)
@@ -135,17 +138,18 @@ class Dynamics:
         return self.residual / max(self.residual_scale, np.finfo(float).tiny)
 
     def summary(self) -> dict[str, dict[str, float]]:
-        """RMS and peak over the valid samples of every load (vectors by magnitude)."""
+        """RMS and peak over the valid samples of every load (vectors by magnitude), with the
+        input where the peak is reached (``peak_at``, rad or m: the first input)."""
         out = {
-            "shaking_force": _stats(self.shaking_force, self.valid),
-            "shaking_moment": _stats(self.shaking_moment, self.valid),
+            "shaking_force": _stats(self.shaking_force, self.valid, self.inputs),
+            "shaking_moment": _stats(self.shaking_moment, self.valid, self.inputs),
         }
         for name, r in self.reactions.items():
-            out[f"{name}.force"] = _stats(r.force, self.valid)
-            out[f"{name}.moment"] = _stats(r.moment, self.valid)
+            out[f"{name}.force"] = _stats(r.force, self.valid, self.inputs)
+            out[f"{name}.moment"] = _stats(r.moment, self.valid, self.inputs)
         for name, e in self.efforts.items():
-            out[f"effort {name}"] = _stats(e, self.valid)
-        out["relative_residual"] = _stats(self.relative_residual, self.valid)
+            out[f"effort {name}"] = _stats(e, self.valid, self.inputs)
+        out["relative_residual"] = _stats(self.relative_residual, self.valid, self.inputs)
         return out
 
     @property

@@ -24,6 +24,7 @@ from screwkit.balancing.variables import (
     point_mass_variables,
 )
 from screwkit.io.errors import SpecError
+from screwkit.io.validation import Name
 
 Value = float | int | str
 
@@ -51,8 +52,8 @@ class LinkVariablesTable(_Strict):
 
 
 class CounterweightTable(_Strict):
-    name: str
-    link: str
+    name: Name
+    link: Name
     mass_max: Value
     mass_min: Value = 0.0
     at: list[Value] | None = None

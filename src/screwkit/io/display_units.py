@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import did_you_mean
 from screwkit.io.units import KIND_UNITS, UnitError, unit_factor
 from screwkit.tables import SI_LABELS
 
@@ -96,7 +97,8 @@ def parse_unit_overrides(items: Iterable[str]) -> dict[str, str]:
         if kind == "torque":  # the [units] name of a moment (e.g. the drive's torques)
             kind = "moment"
         if kind not in DISPLAY_KINDS:
-            raise UnitError(f"--unit {item!r}: unknown kind {kind!r}; the kinds are "
+            raise UnitError(f"--unit {item!r}: unknown kind {kind!r}; "
+                            f"{did_you_mean(kind, DISPLAY_KINDS)}the kinds are "
                             f"{', '.join(DISPLAY_KINDS)}")
         try:
             unit_factor(unit, kind)
@@ -118,6 +120,11 @@ def display_units(spec_units: Mapping[str, str] | None = None, *, system: str = 
             if system == "spec" and k in KIND_UNITS and k != "dimensionless"}
     if "torque" in base and "moment" not in base:  # [units] torque (the drive's) is a moment
         base["moment"] = base["torque"]
+    for kind in overrides or {}:
+        if kind not in DISPLAY_KINDS:
+            raise UnitError(f"unknown kind {kind!r} in the unit overrides; "
+                            f"{did_you_mean(kind, DISPLAY_KINDS)}the kinds are "
+                            f"{', '.join(DISPLAY_KINDS)}")
     base.update(overrides or {})
     length = base.get("length", "m")
     angle = base.get("angle", "rad")

@@ -153,6 +153,8 @@ def result_document(result: Any) -> dict[str, Any]:
         "time": result.time,
         "status": result.status,
         "message": result.message,
+        "at_bounds": {name: {"side": side, "bound": b}
+                      for name, (side, b) in result.at_bounds.items()},
         "range_check": {"ok": rc.ok, "gaps": [list(g) for g in rc.gaps],
                         "branch_mismatch": list(rc.branch_mismatch),
                         "min_transmission": rc.min_transmission, "message": rc.message},

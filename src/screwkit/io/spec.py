@@ -7,11 +7,13 @@ Every error names the file, the key, what is wrong and what would be right
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -24,12 +26,13 @@ from pydantic import (
 )
 
 from screwkit.constants import STANDARD_GRAVITY
-from screwkit.errors import ScrewkitError
+from screwkit.errors import InputTypeError, ScrewkitError, did_you_mean
 from screwkit.io.errors import SpecError
 from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
-from screwkit.io.validation import validation_lines
+from screwkit.io.validation import Name, refuse_formula, validation_lines
 from screwkit.kinematics.registry import family, require
+from screwkit.messages import message_units
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
 if TYPE_CHECKING:
@@ -71,7 +74,7 @@ class MotionTable(_Strict):
 
 
 class JointTable(_Strict):
-    name: str
+    name: Name
     kind: Literal["R", "P", "C", "H", "U", "S"]
     length: Value = 0.0
     twist: Value = 0.0
@@ -89,8 +92,9 @@ class LinkMassTable(_Strict):
 
 
 class CouplerPointTable(_Strict):
-    name: StrictStr | None = Field(None, max_length=80)
-    link: StrictStr | None = Field(None, description="moving link (default: the family's coupler)")
+    name: Annotated[StrictStr, AfterValidator(refuse_formula)] | None = Field(None, max_length=80)
+    link: Annotated[StrictStr, AfterValidator(refuse_formula)] | None = Field(
+        None, description="moving link (default: the family's coupler)")
     f: Value = 0.0
     g: Value = 0.0
     h: Value = 0.0
@@ -110,7 +114,7 @@ class SpecFile(_Strict):
     dimensions: dict[str, Value] = Field(default_factory=dict)
     joints: list[JointTable] = Field(default_factory=list)
     motion: MotionTable = Field(default_factory=MotionTable)  # type: ignore[arg-type]
-    links: dict[str, LinkMassTable] = Field(default_factory=dict)
+    links: dict[Name, LinkMassTable] = Field(default_factory=dict)
     coupler_point: CouplerPointTable | None = None
     coupler_points: list[CouplerPointTable] = Field(default_factory=list, max_length=100)
     limits: LimitsTable | None = None
@@ -150,7 +154,8 @@ class Spec:
         for kind, unit in self.units.items():
             if kind not in KIND_UNITS or kind == "dimensionless":
                 kinds = ", ".join(k for k in KIND_UNITS if k != "dimensionless")
-                self._fail(f"units.{kind}", f"unknown kind {kind!r}; the kinds are {kinds}")
+                hint = did_you_mean(kind, [k for k in KIND_UNITS if k != "dimensionless"])
+                self._fail(f"units.{kind}", f"unknown kind {kind!r}; {hint}the kinds are {kinds}")
             try:
                 check_unit(unit, kind)
             except UnitError as exc:
@@ -416,7 +421,8 @@ class Spec:
         kind = "angle" if self.input_is_angle else "length"
         span = (f"{du.show(kind, self.inputs[0]):.6g}…{du.show(kind, self.inputs[-1]):.6g} "
                 f"{du.label(kind)}")
-        return f"{self.name}: {self.family} ({joints}) {dims}; {n} input samples {span}{src}"
+        head = f"{self.name}: {self.family} ({joints})" + (f" {dims}" if dims else "")
+        return f"{head}; {n} input samples {span}{src}"
 
     def jobs(self) -> list[str]:
         """The jobs this spec asks for, each checked at load against what its family offers
@@ -455,6 +461,9 @@ def load_spec(path: str | Path) -> Spec:
     """Read and validate a spec file (TOML with units; docs/spec-format.md) into a :class:`Spec`
     in SI units, with its mechanism model and its ``[balancing]``/``[synthesis]`` tables parsed;
     raises :class:`SpecError` naming the file, the key and a fix."""
+    if not isinstance(path, str | os.PathLike) or not isinstance(os.fspath(path), str):
+        raise InputTypeError(f"load_spec: path must be a file name (a str or pathlib.Path); "
+                             f"got {type(path).__name__}")
     p = Path(path)
     try:
         data = read_toml(p)  # size, encoding, nesting and string-length checks
@@ -475,4 +484,16 @@ def spec_from_data(data: dict[str, Any], path: str | Path) -> Spec:
         raw = SpecFile.model_validate(data)
     except ValidationError as exc:
         raise SpecError(_format_validation(str(path), exc)) from exc
-    return Spec(raw, str(path))
+    with message_units(_units_of(raw)):  # messages about the model in the spec's units
+        return Spec(raw, str(path))
+
+
+def _units_of(raw: SpecFile) -> DisplayUnits | None:
+    """The display units of a validated spec's ``[units]`` for its messages; None where the
+    table is wrong (then the spec's own check reports it)."""
+    from screwkit.io.display_units import display_units
+
+    try:
+        return display_units(raw.units)
+    except ScrewkitError:
+        return None

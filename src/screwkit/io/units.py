@@ -13,7 +13,7 @@ import math
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
-from screwkit.errors import InputError
+from screwkit.errors import InputError, UnknownNameError, did_you_mean
 from screwkit.io.quantity import (
     MAX_QUANTITY_CHARS,
     QuantitySyntaxError,
@@ -222,8 +222,18 @@ def _has_hertz(names: tuple[tuple[str, int], ...]) -> bool:
     return any(_unit(((n, 1),)) == hertz for n, _ in names)
 
 
+def check_kind(kind: object) -> str:
+    """``kind`` if it is a quantity kind of :data:`KIND_UNITS`; otherwise an
+    :class:`~screwkit.errors.UnknownNameError` listing the kinds and the closest one."""
+    if isinstance(kind, str) and kind in KIND_UNITS:
+        return kind
+    raise UnknownNameError(f"unknown quantity kind {kind!r}; {did_you_mean(kind, KIND_UNITS)}"
+                           f"the kinds are {', '.join(KIND_UNITS)}")
+
+
 def check_unit(unit: str, kind: str) -> None:
     """Raise :class:`UnitError` unless ``unit`` is a unit expression of the right kind."""
+    check_kind(kind)
     if not isinstance(unit, str):
         raise UnitError(f"a unit is a string such as \"in\" or \"deg\"; got {unit!r}")
     try:
@@ -269,11 +279,15 @@ def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
     A bare number (or a string holding only a number) takes ``default_unit`` (from the spec's
     ``[units]`` table), or SI if none. A unit written in the value wins over the default.
     """
+    check_kind(kind)
     if default_unit is not None:
         check_unit(default_unit, kind)
     if isinstance(value, bool) or not isinstance(value, int | float | str):
-        raise UnitError(f"expected {_a(kind)}, e.g. {EXAMPLES[kind]}; got "
-                        f"{excerpt(repr(value)) if not isinstance(value, bool) else value!r}")
+        shown_value = repr(value)
+        if len(shown_value) > 40:
+            shown_value = shown_value[:40] + "…"
+        raise UnitError(f"expected {_a(kind)}, e.g. {EXAMPLES[kind]}; got {shown_value} "
+                        f"({type(value).__name__})")
     shown = excerpt(str(value)) if isinstance(value, str) else repr(value)
     if isinstance(value, str):
         try:

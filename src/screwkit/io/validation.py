@@ -5,11 +5,26 @@ excerpt (docs/reliability.md)."""
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Annotated, Any
 
-from pydantic import ValidationError
+from pydantic import AfterValidator, ValidationError
 
+from screwkit.errors import InputError
 from screwkit.io.quantity import excerpt
+from screwkit.tables import FORMULA_STARTS
+
+
+def refuse_formula(name: str) -> str:
+    """``name`` unless it starts as a spreadsheet formula would (``=``, ``+``, ``-``, ``@``):
+    names become CSV and Parquet column headers, where ``=HYPERLINK(…)`` would run."""
+    if name.startswith(FORMULA_STARTS):
+        raise InputError(f"the name {excerpt(name)} starts with {name[0]!r}, which a spreadsheet "
+                         "reads as a formula in the CSV headers; start it with a letter")
+    return name
+
+
+#: a joint, link, point or counterweight name of a spec file (see :func:`refuse_formula`)
+Name = Annotated[str, AfterValidator(refuse_formula)]
 
 #: validation errors listed in one message (the rest are counted)
 MAX_LISTED_ERRORS = 12

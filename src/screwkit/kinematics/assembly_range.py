@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
+from screwkit.messages import shown
 
 #: samples per turn of the assembly scan (0.25° apart)
 SCAN_SAMPLES = 1440
@@ -41,14 +42,15 @@ def runs_over_a_turn(theta: np.ndarray, ok: np.ndarray) -> list[tuple[float, flo
 
 
 def describe_intervals(runs: list[tuple[float, float]]) -> str:
-    """``"for θ0 from 12.5° to 80.25°, from 200° through 0° to 20°"`` (degrees, as the CLI
-    prints inputs; the ends are the scan's outermost assembling samples)."""
+    """``"for θ0 from 12.5 deg to 80.25 deg, from 200 deg through 0 to 20 deg"`` (in the
+    message units, :mod:`screwkit.messages`; the ends are the scan's outermost assembling
+    samples)."""
     if not runs:
         return "at no input angle"
     if runs == [(0.0, 2 * math.pi)]:
         return "at every input angle"
-    parts = [f"from {math.degrees(a):.6g}° to {math.degrees(b):.6g}°" if b < 2 * math.pi else
-             f"from {math.degrees(a):.6g}° through 0° to {math.degrees(b - 2 * math.pi):.6g}°"
+    parts = [f"from {shown(a, 'angle')} to {shown(b, 'angle')}" if b < 2 * math.pi else
+             f"from {shown(a, 'angle')} through 0 to {shown(b - 2 * math.pi, 'angle')}"
              for a, b in runs[:6]]
     more = f" and {len(runs) - 6} more intervals" if len(runs) > 6 else ""
     return "for θ0 " + ", ".join(parts) + more

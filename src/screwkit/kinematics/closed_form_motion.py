@@ -112,8 +112,8 @@ def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         phi = np.where(ok, mot.phi0[:, j], 0.0)
         chi = np.where(ok, mot.chi0[:, j], 0.0)
         s = np.where(ok, mot.S[:, j], 0.0)
-        events = [f"{e.kind} assembling at input [{e.theta0!r}] (limit position or dead centre)"
-                  for e in mot.events if e.branch == j]
+        events = [f"{e.kind} assembling at input {format_inputs(linkage, np.array([e.theta0]))} "
+                  "(limit position or dead centre)" for e in mot.events if e.branch == j]
         if planar:
             conf = _fourbar_configuration(p, theta, phi)
         else:
@@ -189,9 +189,9 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
                 seed_v[key] = unwrap_runs(np.where(ok, seed_v[key], np.nan), ok)
         stops = np.nonzero(ok[:-1] & ~ok[1:])[0]
         starts = np.nonzero(~ok[:-1] & ok[1:])[0] + 1
-        events = [f"stops assembling after input [{theta[i]!r}] (branch point before "
-                  f"[{theta[i + 1]!r}])" for i in stops]
-        events += [f"starts assembling at input [{theta[i]!r}]" for i in starts]
+        events = [f"stops assembling after input {format_inputs(linkage, X[i])} (branch point "
+                  f"before {format_inputs(linkage, X[i + 1])})" for i in stops]
+        events += [f"starts assembling at input {format_inputs(linkage, X[i])}" for i in starts]
         md = replace(md, events=events)
         modes.append(_with_seed(md, len(modes), label, (seed_v, seed_d, seed_dd)))
     if not modes:
@@ -203,13 +203,14 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=CSSP_SOLVER)
 
 
-def _branch_events(theta: Array, ok: NDArray[np.bool_]) -> list[str]:
+def _branch_events(linkage: Linkage, X: Array, ok: NDArray[np.bool_]) -> list[str]:
+    """Where a mode stops and starts assembling, the inputs in the message units."""
     stops = np.nonzero(ok[:-1] & ~ok[1:])[0]
     starts = np.nonzero(~ok[:-1] & ok[1:])[0] + 1
-    return ([f"stops assembling after input [{theta[i]!r}] (limit position or dead centre "
-             f"before [{theta[i + 1]!r}])" for i in stops]
-            + [f"starts assembling at input [{theta[i]!r}] (limit position or dead centre "
-               f"after [{theta[i - 1]!r}])" for i in starts])
+    return ([f"stops assembling after input {format_inputs(linkage, X[i])} (limit position or "
+             f"dead centre before {format_inputs(linkage, X[i + 1])})" for i in stops]
+            + [f"starts assembling at input {format_inputs(linkage, X[i])} (limit position or "
+               f"dead centre after {format_inputs(linkage, X[i - 1])})" for i in starts])
 
 
 def rssr_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
@@ -236,7 +237,7 @@ def rssr_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         rod = np.where(ok[:, None], mot.coupler_ball[:, j] - mot.crank_ball, [1.0, 0.0, 0.0])
         conf = _two_ball_configuration(linkage, scalars, rod @ base)
         md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd,
-                                     _branch_events(theta, ok))
+                                     _branch_events(linkage, X, ok))
         rate = mot.dphi[:, j]
         seed = ({"theta0": theta, "phi0": phi}, {"theta0": Xd[:, 0], "phi0": rate * Xd[:, 0]},
                 {"theta0": Xdd[:, 0],
@@ -305,7 +306,7 @@ def rccc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
             scalars[:, c] = np.where(ok, unwrap_runs(scalars[:, c], ok), 0.0)
         conf = Configuration(scalars, np.zeros((len(theta), 0, 3, 3)))
         md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd,
-                                     _branch_events(theta, ok))
+                                     _branch_events(linkage, X, ok))
         modes.append(_with_seed(md, len(modes), label, ({}, {}, {}),
                                 singular=mot.dead_centre[:, j]))
     if not modes:

@@ -9,6 +9,7 @@ import numpy as np
 
 from screwkit.kinematics.limit_results import DwellAt, LimitPosition, LimitPositions
 from screwkit.kinematics.motion import AssemblyError
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 
 CLOSED_DERIVATIVES = ("exact Taylor coefficients of the RSRC loop equation 3.61 (Bagci 1969 "
@@ -58,9 +59,9 @@ def rsrc_limit_positions(linkage: Linkage, dwell_tolerance: float, max_order: in
         pos = rsrc_positions(dims, th)
         nowhere = ~np.asarray(pos.assembles).any(axis=1)
         if nowhere.any():
-            shown = ", ".join(f"{np.degrees(t):.6g}°" for t in th[nowhere][:8])
+            listed = ", ".join(shown(t, "angle") for t in th[nowhere][:8])
             raise AssemblyError(f"{linkage.name}: the mechanism does not assemble at the input "
-                                f"angle(s) {shown} asked for; it assembles "
+                                f"angle(s) {listed} asked for; it assembles "
                                 f"{describe_intervals(runs)} (sampled every 0.25°)")
         for j in range(pos.phi0.shape[1]):
             ok = pos.assembles[:, j]

@@ -16,10 +16,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.errors import InputError
+from screwkit.errors import InputError, expect_instance
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.kinematics.registry import coupler_link_index
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 
 __all__ = ["CouplerPoint", "coupler_curves", "coupler_point", "coupler_point_path"]
@@ -47,13 +48,22 @@ def idle_axis(linkage: Linkage, link: int) -> Array | None:
     return np.asarray(centre / np.linalg.norm(centre))
 
 
+def _point(point: ArrayLike) -> Array:
+    """``point`` as floats; NaN for what is not numbers (the caller's message says what a
+    point is)."""
+    try:
+        return np.asarray(point, dtype=float)
+    except (TypeError, ValueError):
+        return np.full(1, np.nan)
+
+
 def coupler_point(linkage: Linkage, point: ArrayLike, link: str | None = None,
                   name: str = "coupler point") -> CouplerPoint:
     """A coupler point of ``linkage``: ``point`` (3 coordinates, m) in the body frame of the
     moving link called ``link`` (default: the family's coupler,
     :func:`~screwkit.kinematics.registry.coupler_link_index`). A ValueError says why a point
     has no defined path (module docstring)."""
-    p = np.asarray(point, dtype=float)
+    p = _point(point)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
         raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
     k = coupler_link_index(linkage, link)
@@ -66,8 +76,9 @@ def coupler_point(linkage: Linkage, point: ArrayLike, link: str | None = None,
             raise InputError(
                 f"{linkage.name}: the {linkage.links[k].name} lies between the ball joints {j1} "
                 f"and {j2}, so it turns freely about the line of their centres and only points on "
-                f"that line have a defined path; this point is {off:.6g} m off it (the nearest "
-                f"point on it is {along:.6g} m along the line from {j1}, direction "
+                f"that line have a defined path; this point is {shown(off, 'length')} off it (the "
+                f"nearest point on it is {shown(along, 'length')} along the line from {j1}, "
+                "direction "
                 f"{np.round(axis, 9).tolist()} in the link frame)")
     return CouplerPoint(name, k, linkage.links[k].name, (float(p[0]), float(p[1]), float(p[2])))
 
@@ -76,7 +87,11 @@ def coupler_point_path(mode: ModeMotion, point: ArrayLike, link: int = 1) -> Arr
     """(N, 3) world positions (m) of ``point`` (3,), given in the body frame of moving link
     ``link`` (0-based; link k lies between joints k and k+1, its frame is joint k's frame after
     the joint motion), over one mode; NaN where the mode does not assemble."""
-    p = np.asarray(point, dtype=float)
+    expect_instance(mode, ModeMotion, "coupler_point_path: mode",
+                    "one mode of a solved motion (motion.mode(k))")
+    p = _point(point)
+    if isinstance(link, bool) or not isinstance(link, int | np.integer):
+        raise InputError(f"coupler_point_path: link must be a moving link's index; got {link!r}")
     if p.shape != (3,) or not np.all(np.isfinite(p)):
         raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
     n_links = mode.link_rotation.shape[1]

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dual.spatial import elevation_azimuth, rot_x, wrap_angle
 from screwkit.errors import InputError
+from screwkit.messages import shown, shown_range
 
 Array = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -258,14 +259,13 @@ def assembly_message(dims: CSSPDimensions, theta1: ArrayLike, assembles: ArrayLi
     ok = np.atleast_1d(np.asarray(assembles, dtype=bool))
     bad = ~ok
     parts = [
-        f"[{np.degrees(th[i]):.4g}°, {np.degrees(th[j]):.4g}°]"
-        if i != j
-        else f"{np.degrees(th[i]):.4g}°"
+        shown_range(th[i], th[j], "angle") if i != j else shown(th[i], "angle")
         for i, j in _runs(bad)
     ]
     head = (
-        f"CSSP (a1={dims.a1:.6g} m, a2={dims.a2:.6g} m, a4={dims.a4:.6g} m, "
-        f"alpha4={np.degrees(dims.alpha4):.6g}°, s1={dims.s1:.6g} m) "
+        f"CSSP (a1={shown(dims.a1, 'length')}, a2={shown(dims.a2, 'length')}, "
+        f"a4={shown(dims.a4, 'length')}, alpha4={shown(dims.alpha4, 'angle')}, "
+        f"s1={shown(dims.s1, 'length')}) "
     )
     if not parts:
         return head + "assembles at every requested crank angle."
@@ -279,8 +279,8 @@ def assembly_message(dims: CSSPDimensions, theta1: ArrayLike, assembles: ArrayLi
             msg + "; it assembles for no crank angle: the rod a2 is too short or too long "
             "for a1, a4, s1 (need |P − D1| = a2 to have a solution)."
         )
-    ranges = ", ".join(f"[{np.degrees(s):.4f}°, {np.degrees(e):.4f}°]" for s, e in intervals)
-    return msg + f"; it assembles for θ1 in {ranges} (mod 360°)."
+    ranges = ", ".join(shown_range(s, e, "angle") for s, e in intervals)
+    return msg + f"; it assembles for θ1 in {ranges} (mod one turn)."
 
 
 # --------------------------------------------------------------------------------------------

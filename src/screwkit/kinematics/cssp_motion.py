@@ -52,6 +52,7 @@ from screwkit.kinematics.cssp import (
 )
 from screwkit.kinematics.loop import Configuration
 from screwkit.kinematics.motion import ModeMotion
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 
 Array = NDArray[np.float64]
@@ -385,7 +386,7 @@ def cssp_sweep(
     ):
         raise InputError(
             f"{linkage.name}: the crank offset s1 is a constant of this CSSP "
-            f"(s1 = {dims.s1!r} m); build it with cssp(..., s1_is_input=True) to drive s1"
+            f"(s1 = {shown(dims.s1, 'length')}); build it with cssp(..., s1_is_input=True) to drive s1"
         )
     root = check_root(root)
     th = np.atleast_1d(np.asarray(theta1, dtype=float))

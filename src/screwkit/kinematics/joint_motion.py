@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.budget import check_memory
-from screwkit.errors import InputError, InputTypeError, UnknownNameError
+from screwkit.errors import InputError, InputTypeError, UnknownNameError, expect_number
 from screwkit.kinematics.generic_motion import (
     Progress,
     all_branches,
@@ -103,8 +103,10 @@ def solve_joints(
     frames and twists: for long sweeps where only the joints matter. SI units and radians;
     arguments as :func:`~screwkit.kinematics.solve_motion.solve_motion`'s. The modes are the
     generic solver's, in its order (``solve_motion`` renumbers them as a closed form's)."""
+    expect_number(starts, "starts", integer=True, positive=True)
+    expect_number(seed, "seed", integer=True)
+    X = as_input_array(linkage, inputs, "inputs")  # checks the linkage's type first
     lay = layout(linkage)
-    X = as_input_array(linkage, inputs, "inputs")
     N = X.shape[0]
     m = len(lay.names)
     per_mode_sample = 8 * (lay.n_scalar + 9 * lay.n_spherical + 2 * m + 2)

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from screwkit.errors import InputError
+from screwkit.errors import InputError, expect_instance, expect_number
 from screwkit.kinematics.generic_limits import generic_limit_positions
 from screwkit.kinematics.limit_results import DwellAt, LimitPosition, LimitPositions
 from screwkit.kinematics.motion import Motion
@@ -38,6 +38,11 @@ class LimitsConfig:
 def check_limits_config(linkage: Linkage, config: LimitsConfig) -> None:
     """A ValueError naming what ``config`` asks that the loop cannot give."""
     require(linkage, "limits")
+    expect_number(config.max_order, "max_order", integer=True)
+    expect_number(config.dwell_tolerance, "dwell_tolerance", positive=True)
+    if config.at:
+        for x in config.at:
+            expect_number(x, "at")
     if not 1 <= int(config.max_order) <= 10:
         raise InputError(f"max_order must be 1 … 10; got {config.max_order}")
     if not config.dwell_tolerance > 0:
@@ -78,7 +83,11 @@ def limit_positions(source: Linkage | Motion, dwell_tolerance: float = 1e-6, max
     translation limits by the corrected eq. D.3, over a full input turn), ``"generic"`` the
     generic route (any loop), ``"auto"`` the closed form where it answers the outputs asked for.
     ``at``: inputs (rad or m) where the dwell order of every mode is wanted too."""
+    expect_instance(source, Linkage | Motion, "limit_positions: source",
+                    "a Linkage or a solved Motion (sk.solve_motion(...))")
     linkage = source.linkage if isinstance(source, Motion) else source
+    if at is not None and (isinstance(at, str) or not np.iterable(at)):
+        at = [at]  # type: ignore[list-item]  # one input value; expect_number names a wrong one
     check_limits_config(linkage, LimitsConfig(output, dwell_tolerance, max_order,
                                               tuple(at or ()), method))
     fam = family_of(linkage)

@@ -10,9 +10,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.errors import CapabilityError
+from screwkit.errors import CapabilityError, expect_instance
 from screwkit.kinematics.loop import Array, forward, layout
-from screwkit.kinematics.motion import AssemblyError
+from screwkit.kinematics.motion import AssemblyError, as_input_array
 from screwkit.kinematics.registry import output_joint
 from screwkit.kinematics.solve import find_assemblies
 from screwkit.mobility import (
@@ -60,8 +60,11 @@ def mobility(linkage: Linkage, inputs: ArrayLike | None = None) -> LinkageMobili
     where the loop assembles (the first assembly found there), searching ``inputs`` a few at a
     time (default: the input at 0). Redundant constraints and passive motions are named by
     joint."""
+    expect_instance(linkage, Linkage, "mobility: linkage",
+                    "a screwkit Linkage (e.g. sk.rsrc(...) or load_spec(...).linkage)")
     lay = layout(linkage)
-    values = np.zeros((1, len(linkage.inputs))) if inputs is None else np.asarray(inputs, float)
+    values = (np.zeros((1, len(linkage.inputs))) if inputs is None
+              else as_input_array(linkage, inputs, "mobility: inputs"))
     X = np.atleast_2d(values.reshape(len(values), -1))
     asm = None
     i = -1

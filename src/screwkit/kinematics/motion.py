@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.errors import InputError, InputTypeError, UnknownNameError
 from screwkit.kinematics.loop import Array, Configuration
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 
 if TYPE_CHECKING:
@@ -152,11 +153,14 @@ def as_input_array(linkage: Linkage, values: ArrayLike, name: str) -> Array:
     if not isinstance(linkage, Linkage):
         raise InputTypeError(f"linkage must be a screwkit Linkage (e.g. sk.rsrc(...) or "
                              f"load_spec(...).linkage); got {type(linkage).__name__}")
+    not_numbers = InputTypeError(f"{name}: give numbers (one per sample and input); got "
+                                 f"{type(values).__name__}")
+    if values is None or isinstance(values, str | bytes):  # np.asarray makes NaN of None
+        raise not_numbers
     try:
         a = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
-        raise InputTypeError(f"{name}: give numbers (one per sample and input); got "
-                             f"{type(values).__name__}") from None
+        raise not_numbers from None
     n_in = len(linkage.inputs)
     if a.ndim == 0:
         a = a[None, None]
@@ -186,11 +190,10 @@ def per_sample(linkage: Linkage, values: ArrayLike, name: str, X: Array) -> Arra
 
 
 def format_inputs(linkage: Linkage, x: Array) -> str:
-    """Input values for a message: degrees for rotations, metres for translations."""
+    """Input values for a message, ``input.theta = 250 deg``, in the units of
+    :func:`screwkit.messages.message_units` (the spec's, through a Pipeline; else degrees and
+    metres)."""
     parts = []
     for name, v in zip(linkage.inputs, np.atleast_1d(x), strict=True):
-        if name.endswith(".s"):
-            parts.append(f"{name} = {float(v):.6g} m")
-        else:
-            parts.append(f"{name} = {float(np.degrees(v)):.6g} deg")
+        parts.append(f"{name} = {shown(v, 'length' if name.endswith('.s') else 'angle')}")
     return ", ".join(parts)

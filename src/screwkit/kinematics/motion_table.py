@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from screwkit.errors import InputTypeError
 from screwkit.tables import Column, ResultTable, stack_tables
 
 if TYPE_CHECKING:
@@ -85,11 +86,16 @@ def motion_table(motion: Motion, coupler_point: Sequence[float] | None = None,
     """Every mode of ``motion`` one under the other (module docstring); ``coupler_point``
     (f, g, h) in the body frame of moving link ``coupler_link`` adds its world path, as does
     each of ``coupler_points``; ``transmission`` adds the transmission quality."""
-    from screwkit.kinematics.coupler_curves import coupler_point_path
+    from screwkit.kinematics.coupler_curves import CouplerPoint, coupler_point_path
 
     input_kind = variable_kind(motion.input_names[0])
     x = motion.input_values
     points = [("coupler", coupler_link, coupler_point)] if coupler_point is not None else []
+    if isinstance(coupler_points, str) or not all(isinstance(cp, CouplerPoint)
+                                                  for cp in coupler_points):
+        raise InputTypeError("coupler_points must be CouplerPoint objects (spec.coupler_points "
+                             f"or coupler_point(linkage, (f, g, h), link)); got "
+                             f"{coupler_points!r:.60}")
     points += [(column_prefix(cp.name), cp.link, cp.point) for cp in coupler_points]
     tables = []
     for k, md in enumerate(motion.modes):

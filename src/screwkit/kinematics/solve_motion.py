@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from screwkit.budget import check_memory
-from screwkit.errors import CapabilityError, InputError
+from screwkit.errors import CapabilityError, InputError, expect_number
 from screwkit.kinematics.generic_motion import Progress, generic_motion, progress_reporter
 from screwkit.kinematics.loop import Array
 from screwkit.kinematics.mode_frames import build_progress
@@ -65,6 +65,8 @@ def solve_motion(
     """
     if method not in METHODS:
         raise InputError(f"method must be 'auto', 'closed' or 'generic'; got {method!r}")
+    expect_number(starts, "starts", integer=True, positive=True)
+    expect_number(seed, "seed", integer=True)
     X = as_input_array(linkage, inputs, "inputs")
     fam = family_of(linkage)
     check_memory(motion_bytes(linkage, X.shape[0], fam.max_modes or MODES_ESTIMATE),

@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.errors import expect_instance
 from screwkit.kinematics.loop import Array, forward, layout
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.kinematics.registry import default_outputs, output_freedom, output_joint
@@ -230,6 +231,7 @@ def transmission(motion: Motion) -> Transmission:
     """Transmission index of every output, transmission angle (planar loops) and ball-joint
     cone angles over every mode of ``motion`` (module docstring). A ValueError says why a loop
     has none (its input is not on the ground, so it has no output joint)."""
+    expect_instance(motion, Motion, "transmission: motion", "a solved Motion (sk.solve_motion(...))")
     linkage = motion.linkage
     lay = layout(linkage)
     n = len(linkage.joints)

@@ -46,6 +46,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.messages import shown
 from screwkit.mobility.errors import MobilityInputError
 from screwkit.mobility.general_constraints import (
     GeneralConstraints,
@@ -312,7 +313,8 @@ class NumericMobility:
             f"  {self.freedom_count} pair freedoms, {k} loop{'s' if k > 1 else ''}: rank "
             f"{self.rank} of {6 * k} loop equations, {self.redundant_constraints} redundant "
             "constraint(s)",
-            f"  singular values (L = {self.length_scale:.6g}, rtol = {self.rtol:g}): smallest kept "
+            f"  singular values (L = {shown(self.length_scale, 'length')}, rtol = {self.rtol:g}): "
+            "smallest kept "
             f"{kept:.3g}, largest dropped {dropped:.3g}",
             f"  Kolchin terms (Bagci B.8): F0 = {self.malytcheff}, M = "
             f"{self.total_general_constraints}, F_c = {self.overclosing_constraints}",

@@ -10,6 +10,8 @@ The parameter sketch of each family is a module constant (``RSRC_SKETCH`` …), 
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 
 from screwkit.dual import ScrewMatrix
@@ -50,8 +52,16 @@ def _rt(R: np.ndarray, p: np.ndarray | list[float]) -> ScrewMatrix:
     return ScrewMatrix.from_rotation_translation(R, np.asarray(p, dtype=float))
 
 
+def _number(family: str, key: str, v: object) -> None:
+    """A LinkageError naming ``key`` unless ``v`` is a real number."""
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        raise LinkageError(f"{family}: {key} must be a number (SI units, radians); got "
+                           f"{type(v).__name__} {v!r:.40}")
+
+
 def _positive(name: str, family: str, **values: float) -> None:
     for key, v in values.items():
+        _number(family, key, v)
         if not np.isfinite(v):
             raise LinkageError(f"{family}: {key} must be a finite number; got {v}")
         if v <= 0:
@@ -63,6 +73,7 @@ def _positive(name: str, family: str, **values: float) -> None:
 
 def _finite(family: str, **values: float) -> None:
     for key, v in values.items():
+        _number(family, key, v)
         if not np.isfinite(v):
             raise LinkageError(f"{family}: {key} must be a finite number; got {v}")
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from screwkit.errors import InputError
+from screwkit.errors import InputError, InputTypeError
 
 JointKind = Literal["R", "P", "C", "H", "U", "S"]
 
@@ -71,6 +71,9 @@ class Joint:
     pitch: float = 0.0
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not isinstance(self.kind, str):
+            raise InputTypeError(f"Joint(name, kind): both are strings, e.g. Joint('crank', 'R'); "
+                                 f"got {type(self.name).__name__}, {type(self.kind).__name__}")
         if self.kind not in JOINT_FREEDOMS:
             raise InputError(
                 f"joint {self.name!r}: unknown kind {self.kind!r}; use one of "

@@ -57,6 +57,16 @@ class Linkage:
     parameters: Mapping[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        for what, items, kind in (("joints", self.joints, Joint), ("links", self.links, Link)):
+            if isinstance(items, str) or not all(isinstance(x, kind) for x in items):
+                bad = items if isinstance(items, str) else next(
+                    x for x in items if not isinstance(x, kind))
+                raise LinkageError(f"linkage {self.name!r}: {what} must be {kind.__name__} "
+                                   f"objects (sk.{kind.__name__}(...)); got "
+                                   f"{type(bad).__name__} {bad!r:.40}")
+        if isinstance(self.inputs, str) or not all(isinstance(x, str) for x in self.inputs):
+            raise LinkageError(f"linkage {self.name!r}: inputs must be a list of freedom names "
+                               f"such as ['crank.theta']; got {self.inputs!r:.60}")
         n = len(self.joints)
         if n < 2:
             raise LinkageError(f"linkage {self.name!r}: a closed loop needs at least 2 joints; got {n}")

@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.constants import STANDARD_GRAVITY
-from screwkit.errors import InputError
+from screwkit.errors import InputError, InputTypeError
 
 Array = NDArray[np.float64]
 
@@ -66,8 +66,16 @@ def _clip_second_moment(inertia: Array) -> Array:
     return np.asarray(np.trace(second) * np.eye(3) - second)
 
 
+def _floats(value: ArrayLike, name: str) -> Array:
+    """``value`` as floats, or an InputTypeError naming ``name``."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputTypeError(f"{name} must be numbers (SI units); got {value!r:.60}") from None
+
+
 def _vector3(value: ArrayLike, name: str) -> Array:
-    arr = np.asarray(value, dtype=float)
+    arr = _floats(value, name)
     if arr.shape != (3,):
         raise InputError(f"{name} must have shape (3,), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
@@ -76,7 +84,7 @@ def _vector3(value: ArrayLike, name: str) -> Array:
 
 
 def _matrix33(value: ArrayLike, name: str) -> Array:
-    arr = np.asarray(value, dtype=float)
+    arr = _floats(value, name)
     if arr.shape != (3, 3):
         raise InputError(f"{name} must have shape (3, 3), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
@@ -172,7 +180,7 @@ class MassProperties:
     inertia: Array
 
     def __init__(self, mass: float, com: ArrayLike, inertia: ArrayLike) -> None:
-        mass = float(mass)
+        mass = float(_floats(mass, "mass"))
         com = _vector3(com, "com")
         inertia = _matrix33(inertia, "inertia")
         check_physical_consistency(mass, inertia)

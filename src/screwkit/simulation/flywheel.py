@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import brentq
 
+from screwkit.messages import shown
 from screwkit.simulation.drive import EquationOfMotion, motor_torque, output_force
 from screwkit.simulation.integrate import simulate_cycles
 from screwkit.simulation.reduced import Array, SimulationError
@@ -55,7 +56,7 @@ def balanced_speed(eom: EquationOfMotion, guess: float) -> float | None:
         if abs(f[1]) > 1e-6 * max(scale, probe):
             raise SimulationError(
                 f"no steady state: the motor's work per turn does not balance the load's at any "
-                f"speed (mean net torque {f[1]:.6g} N·m, independent of speed); use a motor "
+                f"speed (mean net torque {shown(f[1], 'moment')}, independent of speed); use a motor "
                 "whose torque falls with speed (kind = \"linear\" or \"table\"), a damping "
                 "load, or a motor torque that balances the load")
         return None
@@ -93,7 +94,7 @@ def steady_simulation(eom: EquationOfMotion, guess: float, *, rtol: float = 1e-1
                 hi, f_hi = hi * 1.25, after_one_turn(hi * 1.25)
         else:
             raise SimulationError("no steady state found by shooting around the balanced "
-                                  f"speed {w_m:.6g} rad/s")
+                                  f"speed {shown(w_m, 'angular_velocity')}")
         w0 = float(brentq(after_one_turn, lo, hi, xtol=1e-13 * hi, rtol=1e-13))
     run = simulate_cycles(eom, cycles=1, initial_speed=w0, rtol=rtol)
     if run.status != "completed":
@@ -170,7 +171,7 @@ def size_flywheel(eom: EquationOfMotion, fluctuation: float, guess_speed: float
     achieved = cache[b].steady()["fluctuation"]
     if abs(achieved / fluctuation - 1.0) > 10 * SIZING_RTOL:
         raise SimulationError(f"flywheel sizing did not converge: fluctuation {achieved:.6g} "
-                              f"with {b:.6g} kg·m² for a request of {fluctuation}")
+                              f"with {shown(b, 'inertia')} for a request of {fluctuation}")
     return FlywheelSizing(fluctuation, b, achieved, estimate, history, cache[b])
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.integrate import OdeSolution, solve_ivp
 from scipy.optimize import brentq
 
+from screwkit.messages import shown
 from screwkit.simulation.drive import EquationOfMotion, motor_torque
 from screwkit.simulation.reduced import Array, SimulationError
 
@@ -198,7 +199,7 @@ def simulate_cycles(eom: EquationOfMotion, *, cycles: int, initial_speed: float,
         t_s, th_s = float(res.t_events[2][0]), float(res.y_events[2][0][0])
         status = "stalled"
         message = (f"the input stopped (speed 0) at t = {t_s:.6g} s, input angle "
-                   f"{np.degrees(th_s - start):.6g} deg after the start, during cycle "
+                   f"{shown(th_s - start, 'angle')} after the start, during cycle "
                    f"{len(ends) + 1}: the motor cannot drive the machine through its load")
     elif not res.t_events[1].size:
         status = "max_time"

@@ -42,6 +42,7 @@ from scipy.spatial.transform import Rotation
 
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 from screwkit.simulation.reduced import Array, SimulationError, joint_friction
 
@@ -115,7 +116,7 @@ def start_configuration(linkage: Linkage, start: float, mode: int) -> ModeMotion
     md = motion.mode(mode)
     if not (md.assembles[0] and not md.singular[0]):
         raise SimulationError(f"{linkage.name}: mode {mode} does not assemble at the start "
-                              f"angle {np.degrees(start):.6g} deg")
+                              f"angle {shown(start, 'angle')}")
     return md
 
 

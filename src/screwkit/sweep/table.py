@@ -21,6 +21,7 @@ from typing import Any
 
 from screwkit.errors import InputError
 from screwkit.io.outputs import atomic_path, write_text_atomic
+from screwkit.tables import safe_cell
 
 Row = dict[str, Any]
 
@@ -102,7 +103,7 @@ def _csv_cell(value: Any, kind: str) -> str:
         return "true" if value else "false"
     if kind == "float":
         return "nan" if math.isnan(value) else repr(value)
-    return str(value)
+    return safe_cell(str(value)) if kind == "str" else str(value)
 
 
 def csv_text(rows: Sequence[Row]) -> str:
@@ -110,7 +111,7 @@ def csv_text(rows: Sequence[Row]) -> str:
     cols = typed_columns(rows)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(list(cols))
+    w.writerow([safe_cell(name) for name in cols])
     for i in range(len(rows)):
         w.writerow([_csv_cell(values[i], kind) for kind, values in cols.values()])
     return buf.getvalue()
@@ -128,7 +129,8 @@ def write_table(path: Path, rows: Sequence[Row], metadata: dict[str, Any],
     types = {"bool": pa.bool_(), "int": pa.int64(), "float": pa.float64(), "str": pa.string()}
     cols = typed_columns(rows)
     arrays = [pa.array(values, type=types[kind]) for kind, values in cols.values()]
-    schema = pa.schema([pa.field(name, types[kind]) for name, (kind, _) in cols.items()],
+    schema = pa.schema([pa.field(safe_cell(name), types[kind])
+                        for name, (kind, _) in cols.items()],
                        metadata={"screwkit.sweep": json.dumps(metadata, sort_keys=True)})
     table = pa.Table.from_arrays(arrays, schema=schema)
     with atomic_path(path, inputs, "--output") as tmp:

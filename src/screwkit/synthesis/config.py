@@ -11,6 +11,7 @@ import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from screwkit.errors import expect_instance, expect_number
 from screwkit.synthesis.loop_route import LoopSynthesisProblem
 from screwkit.synthesis.loop_solve import synthesize_loop, synthesize_loop_multistart
 from screwkit.synthesis.overlay_synthesis import OverlayOutcome, OverlayProblem, synthesize_overlay
@@ -93,6 +94,13 @@ def run_synthesis(config: SynthesisConfig | Problem, *, starts: int | None = Non
     constraint) is a single solve. ``progress(done, total)`` is called after each start of a
     multistart. ``multistart`` replaces `synthesize_multistart` for the least-squares route
     (same arguments and results; screwkit.sweep runs its starts on a cluster)."""
+    expect_instance(config, (SynthesisConfig, RSRCSynthesisProblem, OverlayProblem,
+                             LoopSynthesisProblem), "synthesize: config",
+                    "a SynthesisConfig (load_spec(...).synthesis) or a synthesis problem")
+    if starts is not None:
+        expect_number(starts, "synthesize: starts", integer=True, positive=True)
+    if seed is not None:
+        expect_number(seed, "synthesize: seed", integer=True)
     if not isinstance(config, SynthesisConfig):
         config = SynthesisConfig(config)
     problem = config.problem

@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 from scipy.optimize import minimize
 
 from screwkit.errors import InputError
+from screwkit.messages import shown
 from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
 from screwkit.synthesis.residuals import (
     NotAssembled,
@@ -132,7 +133,7 @@ def synthesize_equality_constrained(
     def find(th: float) -> int:
         k = int(np.argmin(np.abs(model.theta - th)))
         if abs(model.theta[k] - th) > 1e-9:
-            raise InputError(f"constraint at theta = {math.degrees(th):.6g} deg is not a design "
+            raise InputError(f"constraint at theta = {shown(th, 'angle')} is not a design "
                              "point; add it to the target's design points")
         return k
 

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.loop import forward
 from screwkit.kinematics.transmission import transmission
+from screwkit.messages import shown, shown_range
 from screwkit.synthesis.loop_route import LoopResidualModel, LoopSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled
 from screwkit.synthesis.solve import (
@@ -23,6 +24,8 @@ from screwkit.synthesis.solve import (
     Status,
     SynthesisError,
     SynthesisResult,
+    bound_notes,
+    bounds_reached,
     fit_notes,
 )
 
@@ -94,12 +97,12 @@ def loop_range_check(model: LoopResidualModel, ev: Evaluation, step: float = mat
         trans = float(min(np.nanmin(v) for v in values)) if values else float("nan")
     except ValueError:
         trans = float("nan")
-    deg = math.degrees
-    parts = [f"does not assemble (or is singular) on its branch for theta = {deg(a):.2f}.."
-             f"{deg(b):.2f} deg" for a, b in gaps]
+    parts = [f"does not assemble (or is singular) on its branch for theta in "
+             f"{shown_range(a, b, 'angle', digits=5)}" for a, b in gaps]
     if mismatch:
-        parts.append("design point(s) theta = " + ", ".join(f"{deg(t):.2f}" for t in mismatch)
-                     + " deg lie on another branch (the mechanism would have to be reassembled)")
+        parts.append("design point(s) theta = " + ", ".join(shown(t, "angle", digits=5)
+                                                            for t in mismatch)
+                     + " lie on another branch (the mechanism would have to be reassembled)")
     if math.isfinite(trans) and trans <= 1e-6:
         parts.append("passes a dead centre of the output (transmission index 0)")
     ok = not parts
@@ -137,8 +140,10 @@ def _result(model: LoopResidualModel, ev: Evaluation, iterations: int, evaluatio
              "S_g": float(ev.S[i] - ev.S[0]) if has_s else None, "S_d": float(s_all[i])}
             for i, th in enumerate(ev.theta)]
     check, branch = loop_range_check(model, ev)
-    message = "; ".join(m for m in (message, *fit_notes(pr, psi_all, s_all, r_phi, r_s, check,
-                                                         status)) if m)
+    on_bounds = bounds_reached(pr.unknowns, ev.x, lo, hi, unit)
+    notes = (*fit_notes(pr, psi_all, s_all, r_phi, r_s, check, status),
+             *bound_notes(on_bounds, pr.kinds))
+    message = "; ".join(m for m in (message.rstrip("."), *notes) if m)
     n_points = int(np.unique(np.concatenate([pr.target.theta_rotation,
                                              pr.target.theta_translation])).size)
     g_free = float(np.linalg.norm(grad[free])) if grad.size else 0.0
@@ -154,7 +159,7 @@ def _result(model: LoopResidualModel, ev: Evaluation, iterations: int, evaluatio
                                         * float(np.linalg.norm(r)), 1e-300) if grad.size else 0.0),
         iterations=iterations, evaluations=evaluations, time=elapsed, status=status,
         message=message, length_scale=pr.length_scale, rows=rows, range_check=check,
-        evaluation=ev)
+        evaluation=ev, at_bounds=on_bounds)
 
 
 def synthesize_loop(problem: LoopSynthesisProblem, *, mode: int | None = None,

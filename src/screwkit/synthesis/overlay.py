@@ -42,6 +42,7 @@ from scipy.optimize import least_squares
 from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
+from screwkit.messages import shown, shown_range
 
 __all__ = [
     "OverlayCircle",
@@ -150,7 +151,7 @@ class _Geometry:
         for dw in dwells:
             hit = np.flatnonzero(np.abs(theta - dw.theta) <= 1e-12 * max(1.0, abs(dw.theta)))
             if hit.size == 0:
-                raise InputError(f"dwell at theta = {math.degrees(dw.theta):.6g} deg is not one "
+                raise InputError(f"dwell at theta = {shown(dw.theta, 'angle')} is not one "
                                  "of the rotation design points; add it to design_points")
             j = int(hit[0])
             self.dwell_index.append(j)
@@ -162,8 +163,8 @@ class _Geometry:
             if abs(math.sin(0.5 * (self.ang[k] - self.ang[j]))) < 1e-9:
                 raise InputError(
                     "contradictory constraints: the desired output rotation between the two "
-                    f"dwell points is {math.degrees(self.ang[k] - self.ang[j]):.6g} deg, a "
-                    "multiple of 360 deg, so no output circle carries one overlay point to the "
+                    f"dwell points is {shown(self.ang[k] - self.ang[j], 'angle')}, a "
+                    "multiple of a full turn, so no output circle carries one overlay point to the "
                     "other; drop a dwell or change the target")
         self.n_free = {0: 4, 1: 2, 2: 0}[len(self.dwell_index)] + (1 if refine_d2 else 0)
 
@@ -301,8 +302,8 @@ def fit_overlay_circles(*, d1: float, d2: float, lambda0: float, theta01: float,
                          "points: give more rotation design points")
     lo, hi = d3_range if d3_range is not None else (0.05 * d1, 20.0 * d1)
     if not 0 < lo < hi:
-        raise InputError(f"d3_range must be 0 < lower < upper, got ({float(lo):.6g} m, "
-                         f"{float(hi):.6g} m)")
+        raise InputError(f"d3_range must be 0 < lower < upper, got "
+                         f"{shown_range(lo, hi, 'length')}")
     starts = _grid_starts(geo, lo, hi, n_starts)
     lower = np.full(geo.n_free, -np.inf)
     upper = np.full(geo.n_free, np.inf)

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
+from screwkit.messages import shown
 from screwkit.synthesis.overlay import (
     OverlayCircle,
     OverlayDwell,
@@ -182,7 +183,7 @@ def synthesize_overlay(problem: OverlayProblem) -> list[OverlayOutcome]:
             label = _label_at_start(dims, theta01, phi01)
             sense_name = "ccw" if sense > 0 else "cw"
             if label is None:
-                failures.append(f"{sense_name} circle d3 = {circle.d3:.4g} m: does not assemble "
+                failures.append(f"{sense_name} circle d3 = {shown(circle.d3, 'length', digits=4)}: does not assemble "
                                 "at theta = 0")
                 continue
             start = {"e": dims.e, "d1": dims.d1, "d2": dims.d2, "d3": dims.d3, "a": dims.a,
@@ -193,7 +194,7 @@ def synthesize_overlay(problem: OverlayProblem) -> list[OverlayOutcome]:
             try:
                 result = evaluate_design(analysis)
             except SynthesisError as exc:
-                failures.append(f"{sense_name} circle d3 = {circle.d3:.4g} m: {exc}")
+                failures.append(f"{sense_name} circle d3 = {shown(circle.d3, 'length', digits=4)}: {exc}")
                 continue
             outcomes.append(OverlayOutcome(result, sense, circle, pr.d2, radii))
     elapsed = time.perf_counter() - t_start

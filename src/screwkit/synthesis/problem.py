@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.errors import InputError
+from screwkit.messages import shown
 from screwkit.synthesis.constraints import output_crank_from_constraints, q_from_dwell
 from screwkit.synthesis.targets import ScrewTarget
 
@@ -166,8 +167,8 @@ class RSRCSynthesisProblem:
             if abs(math.sin(0.5 * self.rotation_between())) < 1e-9:
                 raise InputError(
                     "contradictory constraints: the output rotation between the two constraint "
-                    f"points is {math.degrees(self.rotation_between()):.6g} deg, a multiple of "
-                    "360 deg, so no output crank takes C1 to C2 (eq. 5.21); move a point or "
+                    f"points is {shown(self.rotation_between(), 'angle')}, a multiple of "
+                    "a full turn, so no output crank takes C1 to C2 (eq. 5.21); move a point or "
                     "change rotation_between")
 
     # ---------------------------------------------------------------------------------------

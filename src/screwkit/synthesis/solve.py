@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
@@ -23,6 +23,7 @@ from scipy.optimize import least_squares
 from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
 from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
+from screwkit.messages import shown, shown_range
 from screwkit.synthesis.problem import LENGTH_NAMES, RSRCSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled, ResidualModel, dimensions_of
 
@@ -78,6 +79,9 @@ class SynthesisResult:
         components at an active bound left out (0 at a local optimum).
     relative_gradient : gradient_norm / (2 |J| |r|): the cosine-like first-order optimality
         measure, independent of the size of E (<= 1e-6 is a local optimum to rounding).
+    at_bounds : the unknowns that ended on one of their bounds, by name: ``("lower" or
+        "upper", the bound)`` (SI, radians); the message says so too — the best design may lie
+        beyond the bound (:func:`bounds_reached`).
     """
 
     dimensions: dict[str, float]
@@ -102,6 +106,35 @@ class SynthesisResult:
     rows: list[dict[str, float | None]]
     range_check: RangeCheck
     evaluation: Evaluation = field(repr=False)
+    at_bounds: dict[str, tuple[str, float]] = field(default_factory=dict)
+
+
+#: an unknown within this fraction of its scale (L for lengths, 1 rad for angles) of a bound
+#: is on the bound
+ON_BOUND_RTOL = 1e-7
+
+
+def bounds_reached(unknowns: Sequence[str], x: FloatArray, lower: Sequence[float] | FloatArray,
+                   upper: Sequence[float] | FloatArray, scales: Sequence[float] | FloatArray
+                   ) -> dict[str, tuple[str, float]]:
+    """The unknowns whose final value ``x`` lies on a finite bound (within
+    :data:`ON_BOUND_RTOL` of its scale): name → ("lower" or "upper", the bound)."""
+    out: dict[str, tuple[str, float]] = {}
+    for name, v, lo, hi, s in zip(unknowns, x, lower, upper, scales, strict=True):
+        tol = ON_BOUND_RTOL * max(float(s), abs(float(v)))
+        if np.isfinite(lo) and float(v) - lo <= tol:
+            out[name] = ("lower", float(lo))
+        elif np.isfinite(hi) and hi - float(v) <= tol:
+            out[name] = ("upper", float(hi))
+    return out
+
+
+def bound_notes(at_bounds: Mapping[str, tuple[str, float]], kinds: Mapping[str, str]
+                ) -> list[str]:
+    """One sentence per unknown on a bound, the bound in the message units."""
+    return [f"{name} ended on its {side} bound ({shown(b, kinds.get(name, 'length'))}): the best "
+            f"design may lie beyond it; widen the bound to look" for name, (side, b) in
+            at_bounds.items()]
 
 
 def _n_points(problem: RSRCSynthesisProblem) -> int:
@@ -145,14 +178,15 @@ def check_range(problem: RSRCSynthesisProblem, ev: Evaluation, n_samples: int = 
     trans = float(np.nanmin(np.abs(np.sin(chi_b)))) if ok_mask.any() else 0.0
     ok = not gaps and not mismatch and trans > 1e-6
     parts = []
-    deg = math.degrees
     for a, b in gaps:
-        parts.append(f"does not assemble on its branch for theta = {deg(a):.2f}..{deg(b):.2f} deg "
-                     f"(theta0 = {deg(ev.params['theta01'] + problem.input_direction * a):.2f}.."
-                     f"{deg(ev.params['theta01'] + problem.input_direction * b):.2f} deg)")
+        t01, sense = ev.params["theta01"], problem.input_direction
+        parts.append(f"does not assemble on its branch for theta in "
+                     f"{shown_range(a, b, 'angle', digits=5)} (theta0 in "
+                     f"{shown_range(t01 + sense * a, t01 + sense * b, 'angle', digits=5)})")
     if mismatch:
-        parts.append("design point(s) theta = " + ", ".join(f"{deg(t):.2f}" for t in mismatch)
-                     + " deg lie on another branch (the mechanism would have to be reassembled)")
+        parts.append("design point(s) theta = " + ", ".join(shown(t, "angle", digits=5)
+                                                            for t in mismatch)
+                     + " lie on another branch (the mechanism would have to be reassembled)")
     if trans <= 1e-6:
         parts.append("passes a dead centre of the output (sin chi0 = 0)")
     msg = "; ".join(parts) if parts else (
@@ -243,8 +277,14 @@ def result_from_evaluation(
             "S_d": float(s_all[i]),
         })
     check = check_range(problem, ev)
-    message = "; ".join(m for m in (message, *fit_notes(problem, psi_all, s_all, r_phi, r_s,
-                                                          check, status)) if m)
+    on_bounds = bounds_reached(
+        problem.unknowns, ev.x, [problem.bounds.get(n, (-np.inf, np.inf))[0]
+                                 for n in problem.unknowns],
+        [problem.bounds.get(n, (-np.inf, np.inf))[1] for n in problem.unknowns], unit)
+    kinds = {n: "length" if n in LENGTH_NAMES else "angle" for n in problem.unknowns}
+    notes = (*fit_notes(problem, psi_all, s_all, r_phi, r_s, check, status),
+             *bound_notes(on_bounds, kinds))
+    message = "; ".join(m for m in (message.rstrip("."), *notes) if m)
     # the program label (root ordering, Bagci's I8/I9) of the result's configuration at theta = 0
     pos = rsrc_positions(dimensions_of({k: np.array([v]) for k, v in ev.params.items()}),
                          ev.theta0[:1])
@@ -264,17 +304,13 @@ def result_from_evaluation(
             if grad.size else 0.0),
         iterations=iterations, evaluations=evaluations, time=elapsed, status=status,
         message=message, length_scale=problem.length_scale, rows=rows, range_check=check,
-        evaluation=ev,
+        evaluation=ev, at_bounds=on_bounds,
     )
 
 
 def _show(name: str, value: float) -> str:
-    """A value of unknown ``name`` as a plain number with its SI unit (angles also in deg)."""
-    if name in LENGTH_NAMES:
-        return f"{float(value):.6g} m"
-    if not math.isfinite(value):
-        return f"{float(value)}"
-    return f"{float(value):.6g} rad ({math.degrees(value):.6g} deg)"
+    """A value of unknown ``name`` in the message units (:mod:`screwkit.messages`)."""
+    return shown(value, "length" if name in LENGTH_NAMES else "angle")
 
 
 def _check_start(problem: RSRCSynthesisProblem, x0: FloatArray, lo: FloatArray,

@@ -1,0 +1,93 @@
+"""Numbers for people in notes and error messages: one helper, :func:`shown`, formats an SI
+value of a quantity kind in the units the reader chose (issue 30: notes printed
+``[np.float64(4.363323129985823)]`` in radians for a spec in degrees).
+
+The units come from the caller (``units=``) or, where a message is built deep inside a solver
+that knows no units, from :func:`message_units`: a context that :class:`screwkit.Pipeline`
+enters with the spec's display units around every job (the CLI passes the units of
+``--units``/``--unit``), so a note or an error of a mm/deg spec quotes mm and degrees. With no
+units anywhere, angles are shown in degrees and everything else in SI.
+
+Like :mod:`screwkit.tables`, this module needs numpy only; every layer may use it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from typing import Any
+
+import numpy as np
+
+from screwkit.tables import SI_LABELS, UNITLESS, UnitChoice
+
+#: significant digits of a number in a message
+DIGITS = 6
+
+
+class ReadableUnits:
+    """The default for messages without a spec: angles (and their rates) in degrees, every
+    other kind in SI."""
+
+    _DEG = {"angle": ("deg", math.pi / 180), "angular_velocity": ("deg/s", math.pi / 180),
+            "angular_acceleration": ("deg/s^2", math.pi / 180)}
+
+    def unit_of(self, kind: str) -> tuple[str, float]:
+        return self._DEG.get(kind) or (SI_LABELS.get(kind, ""), 1.0)
+
+
+_UNITS: ContextVar[UnitChoice | None] = ContextVar("screwkit_message_units", default=None)
+
+
+@contextmanager
+def message_units(units: UnitChoice | None) -> Iterator[None]:
+    """Within the block, :func:`shown` (and every note and message built with it) uses
+    ``units`` where its caller gives none; ``None`` keeps the units already in force."""
+    if units is None:
+        yield
+        return
+    token = _UNITS.set(units)
+    try:
+        yield
+    finally:
+        _UNITS.reset(token)
+
+
+def current_units() -> UnitChoice:
+    """The units messages use here: those of :func:`message_units`, else degrees and SI."""
+    return _UNITS.get() or ReadableUnits()
+
+
+def number(value: Any, digits: int = DIGITS) -> str:
+    """A plain float as text with ``digits`` significant digits (no numpy repr, ``-0`` as
+    ``0``)."""
+    x = float(value)
+    if x == 0.0:
+        return "0"
+    return f"{x:.{digits}g}"
+
+
+def shown(value_si: Any, kind: str, units: UnitChoice | None = None,
+          digits: int = DIGITS) -> str:
+    """``value_si`` (SI; radians for angles) of quantity ``kind`` (a key of
+    :data:`screwkit.tables.SI_LABELS`) as ``"250 deg"`` or ``"12.7 mm"``, in ``units`` (else
+    those of :func:`message_units`, else degrees and SI). A non-finite value is ``"nan"``."""
+    if kind in UNITLESS:
+        return number(value_si, digits)
+    label, factor = (units or current_units()).unit_of(kind)
+    x = float(value_si)
+    if not np.isfinite(x):
+        return f"{x} {label}".rstrip()
+    return f"{number(x / factor, digits)} {label}".rstrip()
+
+
+def shown_range(low_si: Any, high_si: Any, kind: str, units: UnitChoice | None = None,
+                digits: int = DIGITS) -> str:
+    """``"[10, 250] deg"``: two values of one kind with the unit once."""
+    label, factor = (units or current_units()).unit_of(kind)
+    if kind in UNITLESS:
+        label, factor = "", 1.0
+    return (f"[{number(float(low_si) / factor, digits)}, "
+            f"{number(float(high_si) / factor, digits)}] {label}").rstrip()
