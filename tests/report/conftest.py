@@ -19,20 +19,19 @@ ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
 
 
 @pytest.fixture(scope="session")
-def browser_context(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
+def browser_context(tmp_path_factory: pytest.TempPathFactory,
+                    playwright_driver: Any) -> Iterator[Any]:
     if not CHROMIUM.exists():
         pytest.fail("the report tests need Debian's chromium at /usr/bin/chromium: run "
                     "`make test` (it installs it) or `apt-get install -y chromium`")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        context = p.chromium.launch_persistent_context(
-            str(tmp_path_factory.mktemp("chromium-profile")), executable_path=str(CHROMIUM),
-            headless=True, args=ARGS, viewport={"width": 1280, "height": 800})
-        try:
-            yield context
-        finally:
-            context.close()
+    p = playwright_driver
+    context = p.chromium.launch_persistent_context(
+        str(tmp_path_factory.mktemp("chromium-profile")), executable_path=str(CHROMIUM),
+        headless=True, args=ARGS, viewport={"width": 1280, "height": 800})
+    try:
+        yield context
+    finally:
+        context.close()
 
 
 @dataclass

@@ -78,21 +78,20 @@ def served(rssr_copy: Path) -> Iterator[Served]:
 
 
 @pytest.fixture(scope="module")
-def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
+def browser(tmp_path_factory: pytest.TempPathFactory,
+            playwright_driver: Any) -> Iterator[Any]:
     if not CHROMIUM.exists():
         pytest.fail("the studio tests need Debian's chromium at /usr/bin/chromium: run "
                     "`make test` (it installs it) or `apt-get install -y chromium`")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        context = p.chromium.launch_persistent_context(
-            str(tmp_path_factory.mktemp("chromium-profile")), executable_path=str(CHROMIUM),
-            headless=True, args=ARGS, viewport={"width": 1400, "height": 900},
-            accept_downloads=True)
-        try:
-            yield context
-        finally:
-            context.close()
+    p = playwright_driver
+    context = p.chromium.launch_persistent_context(
+        str(tmp_path_factory.mktemp("chromium-profile")), executable_path=str(CHROMIUM),
+        headless=True, args=ARGS, viewport={"width": 1400, "height": 900},
+        accept_downloads=True)
+    try:
+        yield context
+    finally:
+        context.close()
 
 
 @dataclass

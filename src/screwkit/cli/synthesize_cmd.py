@@ -238,9 +238,12 @@ def global_synthesis(config: Any, starts: int, scheduler: str | None, workers: i
                           "installed; the starts run in this process", highlight=False)
         with progress_bar("synthesis starts", None) as advance:
             return _guard(lambda: pipe.synthesize(starts, progress=advance))
+    from screwkit.messages import message_units
+
     try:
         with progress_bar("synthesis starts", starts) as advance, \
-                engine_for(scheduler, workers, "synthesis start") as engine:
+                engine_for(scheduler, workers, "synthesis start") as engine, \
+                message_units(pipe.units):  # notes in the spec's units, as the serial run's
             return _guard(lambda: synthesize_on_engine(
                 config, starts, engine, lambda done, total, _: advance(done, total)))
     except KeyboardInterrupt as exc:

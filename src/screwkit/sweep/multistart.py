@@ -32,9 +32,14 @@ STARTS_PER_TASK = 4
 
 
 def solve_starts(problem: RSRCSynthesisProblem, indices: np.ndarray,
-                 starts: list[dict[str, float]]) -> list[tuple[list[SynthesisResult], list[str]]]:
-    """One engine task: a batch of starts, each solved on every mode (``solve_start``)."""
-    return [solve_start(problem, start) for start in starts]
+                 starts: list[dict[str, float]], units: Any = None
+                 ) -> list[tuple[list[SynthesisResult], list[str]]]:
+    """One engine task: a batch of starts, each solved on every mode (``solve_start``), its
+    notes in ``units`` (the caller's message units: a worker process has none of its own)."""
+    from screwkit.messages import message_units
+
+    with message_units(units):
+        return [solve_start(problem, start) for start in starts]
 
 
 def distributed_multistart(problem: RSRCSynthesisProblem, engine: Engine, *, n_starts: int,
@@ -47,7 +52,10 @@ def distributed_multistart(problem: RSRCSynthesisProblem, engine: Engine, *, n_s
     starts, scale = multistart_starts(problem, n_starts, seed, spread)
     size = batch_size(n_starts, engine.workers, None, largest=STARTS_PER_TASK)
     groups = batches(list(range(n_starts)), size)
-    payloads = [(np.array(g, dtype=np.int64), [starts[i] for i in g]) for g in groups]
+    from screwkit.messages import current_units
+
+    units = current_units()
+    payloads = [(np.array(g, dtype=np.int64), [starts[i] for i in g], units) for g in groups]
     outcome: list[Any] = [None] * n_starts
     done = [0]
 
