@@ -7,13 +7,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from screwkit.balancing.config import BalancingConfig, balance_with_config
-from screwkit.balancing.errors import BalancingError
-from screwkit.balancing.result import BalanceResult
 from screwkit.constants import STANDARD_GRAVITY
 from screwkit.dynamics import Dynamics, inverse_dynamics
 from screwkit.errors import ScrewkitError
@@ -31,8 +28,12 @@ from screwkit.kinematics.loop_mobility import LinkageMobility, mobility
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.kinematics.transmission import Transmission, transmission
-from screwkit.synthesis.config import SynthesisConfig, SynthesisRun, run_synthesis
 from screwkit.tables import ResultTable
+
+if TYPE_CHECKING:  # balancing and synthesis load scipy.optimize: imported where they are used
+    from screwkit.balancing.config import BalancingConfig
+    from screwkit.balancing.result import BalanceResult
+    from screwkit.synthesis.config import SynthesisConfig, SynthesisRun
 
 
 class Pipeline:
@@ -93,6 +94,8 @@ class Pipeline:
                                 inputs=s.inputs, allow_partial=partial)
 
     def balancing_config(self) -> BalancingConfig:
+        from screwkit.balancing.errors import BalancingError
+
         if self.spec.balancing is None:
             raise BalancingError(f"{self.spec.path}: no [balancing] table; see docs/balancing.md")
         return self.spec.balancing
@@ -101,6 +104,9 @@ class Pipeline:
                 progress: Callable[[int, int], None] | None = None) -> BalanceResult:
         """The spec's ``[balancing]`` run on ``[motion] mode`` (or on ``mode`` if given);
         ``progress(done, total)`` follows a Pareto sweep."""
+        from screwkit.balancing.config import balance_with_config
+        from screwkit.balancing.errors import BalancingError
+
         s = self.spec
         config = self.balancing_config()
         if mode is None:
@@ -127,6 +133,8 @@ class Pipeline:
                    progress: Callable[[int, int], None] | None = None) -> SynthesisRun:
         """The spec's ``[synthesis]`` run (either route), best result first;
         ``progress(done, total)`` follows a multistart."""
+        from screwkit.synthesis.config import run_synthesis
+
         return run_synthesis(self.synthesis_config(), starts=starts, progress=progress)
 
     def limits(self, dwell_tolerance: float | None = None, at: list[float] | None = None, *,
@@ -150,10 +158,7 @@ class Pipeline:
         spec's coupler points and the transmission quality (a note where a loop has none)."""
         from screwkit.io.documents import analysis_document
 
-        try:
-            tr, note = self.transmission(), None
-        except ScrewkitError as exc:
-            tr, note = None, str(exc)
+        tr, note = self._transmission
         return analysis_document(self.motion, name=self.spec.name,
                                  coupler_points=self.spec.coupler_points, transmission=tr,
                                  transmission_note=note)
@@ -161,16 +166,30 @@ class Pipeline:
     def analysis_table(self) -> ResultTable:
         """The motion as a column table (``Motion.table``) with the spec's coupler points and
         the transmission quality (where the loop has one)."""
-        try:
-            tr = self.transmission()
-        except ScrewkitError:
-            tr = None
+        tr, _ = self._transmission
         return self.motion.table(coupler_points=self.spec.coupler_points, transmission=tr)
 
     def transmission(self) -> Transmission:
         """Transmission index, angle and ball-joint cone angles over every mode (a ValueError
-        says why a loop has none)."""
-        return transmission(self.motion)
+        says why a loop has none); computed once per pipeline, like the motion."""
+        tr, why = self._transmission_or_why
+        if tr is None:
+            raise why  # type: ignore[misc]
+        return tr
+
+    @property
+    def _transmission(self) -> tuple[Transmission | None, str | None]:
+        tr, why = self._transmission_or_why
+        return tr, None if why is None else str(why)
+
+    @cached_property
+    def _transmission_or_why(self) -> tuple[Transmission | None, ScrewkitError | None]:
+        """The transmission of the motion, or None and the error saying why the loop has none
+        (the analysis document and table share one computation)."""
+        try:
+            return transmission(self.motion), None
+        except ScrewkitError as exc:
+            return None, exc
 
     def coupler_curves(self) -> list[dict[str, Array]]:
         """Per mode, the world path (N, 3) of every coupler point of the spec, by name."""

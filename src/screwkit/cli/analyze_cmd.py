@@ -4,12 +4,15 @@ in every assembly mode, in the spec's units (tables, CSV, plots) or as the SI JS
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, TypeVar
 
 import typer
 
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
+
+T = TypeVar("T")
 
 
 def shown_variables(mode: Any, input_name: str) -> list[str]:
@@ -95,6 +98,18 @@ def show_analysis(spec: Any, motion: Any, units: Any, full: bool,
                       highlight=False)
 
 
+def cache(build: Callable[[], T]) -> Callable[[], T]:
+    """``build`` run on the first call only; later calls return its result."""
+    memo: list[T] = []
+
+    def get() -> T:
+        if not memo:
+            memo.append(build())
+        return memo[0]
+
+    return get
+
+
 def register(app: typer.Typer) -> None:
     """Add the ``analyze`` command to ``app``."""
 
@@ -123,12 +138,14 @@ def register(app: typer.Typer) -> None:
         motion = guard(lambda: pipe.motion)
         du = out.units_for(s.units)
 
-        doc = guard(pipe.analysis)
-        table = guard(pipe.analysis_table)
+        # built on first use only: `-o out.npz` needs the table, never the document (issue 30)
+        doc = cache(lambda: guard(pipe.analysis))
+        table = cache(lambda: guard(pipe.analysis_table))
         if plot is not None:
             from screwkit.report.plots import plot_analysis
 
-            guard(lambda: plot_analysis(doc, plot, units=du))
+            guard(lambda: plot_analysis(doc(), plot, units=du))
             out.note_written(plot)
-        out.deliver(document=lambda: doc, table=lambda: table,
-                    show=lambda: show_analysis(s, motion, du, out.full, doc, table), units=du)
+        out.deliver(document=doc, table=table,
+                    show=lambda: show_analysis(s, motion, du, out.full, doc(), table()),
+                    units=du)
