@@ -391,7 +391,7 @@ def check_root(root: int) -> int:
     return int(root)
 
 
-def _rod_and_slider_angles(
+def rod_and_slider_angles(
     dims: CSSPDimensions,
     th: Array,
     w: Array,
@@ -499,7 +499,7 @@ def _solve(
         "crank_pin": core["crank_pin"],
         "slider_ball": core["slider_ball"],
         "rod_direction": u,
-        **_rod_and_slider_angles(dims, th, w, wd, u, ud, udd, assembles, need_rates),
+        **rod_and_slider_angles(dims, th, w, wd, u, ud, udd, assembles, need_rates),
     }
     if need_rates:
         out.update(
