@@ -80,9 +80,12 @@ def _as_list(a: Array, valid: NDArray[np.bool_]) -> list[Any]:
     return out
 
 
-def _as_array(a: Array, valid: NDArray[np.bool_]) -> Array:
-    a = np.asarray(a, dtype=float)
-    return np.where(np.asarray(valid, dtype=bool).reshape(-1, *(1,) * (a.ndim - 1)), a, np.nan)
+def _as_array(a: Array, valid: NDArray[np.bool_]) -> Array | list[Any]:
+    """The array itself where every sample is valid; else the list with ``None`` rows (a
+    vector sample that is not valid is one ``null``, as docs/cli.md says)."""
+    if np.all(valid):
+        return np.asarray(a, dtype=float)
+    return _as_list(a, valid)
 
 
 def _stats(values: Array, valid: NDArray[np.bool_]) -> dict[str, float]:
@@ -176,9 +179,9 @@ class Dynamics:
     def as_dict(self, arrays: bool = False) -> dict[str, Any]:
         """JSON-able dictionary (SI units, lists, ``None`` where a sample is not valid).
 
-        With ``arrays`` every per-sample value stays a float array (one column operation each,
-        NaN where a sample is not valid, whole rows of NaN for vectors): what the io layer's
-        orjson writer takes directly (NaN as ``null``), instead of a Python float per value."""
+        With ``arrays`` the per-sample values of a mode valid at every sample stay float arrays
+        (what the io layer's orjson writer takes directly, column by column, instead of a
+        Python float per value); the JSON written is the same."""
         v = self.valid
         _listify: Callable[[Array, NDArray[np.bool_]], Any] = _as_array if arrays else _as_list
         return {

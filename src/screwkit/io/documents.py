@@ -121,7 +121,7 @@ def dynamics_document(dyn: Dynamics, *, mode: int, note: str | None = None) -> d
     """The document of ``screwkit dynamics``: the loads (:meth:`Dynamics.as_dict`), the mode,
     the RMS/peak summary, what is indeterminate, and a note on non-assembling samples. The
     per-sample loads stay arrays (``as_dict(arrays=True)``), written column by column by the
-    JSON writer, NaN (``null``) where a sample is not valid."""
+    JSON writer."""
     doc = dyn.as_dict(arrays=True)
     if note is not None:
         doc["note"] = note
