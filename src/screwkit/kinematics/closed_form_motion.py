@@ -213,11 +213,15 @@ def _cssp_seed_angles(linkage: Linkage, dims: Any, md: ModeMotion, theta: Array,
     (ω, α the rod's, whatever its spin about u), instead of solving the closed form again."""
     from screwkit.kinematics.cssp import rod_and_slider_angles
 
-    base = linkage.base.real  # world → loop frame: x ↦ baseᵀ x, for rows x @ base
+    base = np.asarray(linkage.base.real, dtype=float)
+
+    def loop_frame(x: Array) -> Array:  # world → loop frame: x ↦ baseᵀ x (rows: x @ base)
+        return np.ascontiguousarray(x) if np.array_equal(base, np.eye(3)) else x @ base
+
     c = md.joint_centres
-    u = ((c[:, 2] - c[:, 1]) @ base) / dims.a2
-    om = md.link_angular_velocity[:, 1] @ base
-    al = md.link_angular_acceleration[:, 1] @ base
+    u = loop_frame(c[:, 2] - c[:, 1]) / dims.a2
+    om = loop_frame(md.link_angular_velocity[:, 1])
+    al = loop_frame(md.link_angular_acceleration[:, 1])
     ud = _cross(om, u)
     udd = _cross(al, u) + _cross(om, ud)
     return rod_and_slider_angles(dims, theta, w, wd, u, ud, udd, np.asarray(md.assembles),

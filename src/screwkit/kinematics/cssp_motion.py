@@ -442,11 +442,11 @@ def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
         accelerations[f"{first}.s"] = sw.full("s1_ddot")
     vectors: list[Array | None] = [None, None]
     if rotations is not None:
-        safe = np.where(ok[:, None, None], 1.0, 0.0)
-        eye = np.where(ok[:, None, None], 0.0, 1.0) * np.eye(3)
         # the relative rotations are orthonormal products: their vector from the skew part and
         # the trace (scipy's from_matrix would re-orthonormalise each first, 4x the cost)
-        vectors = [rotation_vector(np.nan_to_num(rel) * safe + eye) for rel in rotations]
+        vectors = [rotation_vector(rel if ok.all() else
+                                   np.where(ok[:, None, None], np.nan_to_num(rel), np.eye(3)))
+                   for rel in rotations]
     for name, r, rv in ((pin, 0, vectors[0]), (ball, 2, vectors[1])):
         if rates is None:
             break
