@@ -225,7 +225,7 @@ def _cssp_seed_angles(linkage: Linkage, dims: Any, md: ModeMotion, theta: Array,
     ud = _cross(om, u)
     udd = _cross(al, u) + _cross(om, ud)
     return rod_and_slider_angles(dims, theta, w, wd, u, ud, udd, np.asarray(md.assembles),
-                                 True)
+                                 True, frame=False)
 
 
 def _cross(a: Array, b: Array) -> Array:
