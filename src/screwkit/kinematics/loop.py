@@ -160,10 +160,12 @@ def _slide(u: Array) -> Array:
 
 
 def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
-            frames: bool = True) -> LoopFrames:
+            frames: bool = True, points: bool | None = None) -> LoopFrames:
     """Walk the loop J_1 L_1 ··· J_n L_n for every sample (vectorised over samples). With
     ``frames=False`` only the closure and the screws are filled (a Newton step's needs; the
-    frame arrays are then left unset)."""
+    frame arrays are then left unset); ``points=True`` fills the joint centres and axes all the
+    same (the transmission's needs; by default they follow ``frames``)."""
+    points = frames if points is None else points
     lay = lay or layout(linkage)
     link_R, link_p, _ = constants(linkage, lay)
     N = conf.size
@@ -175,8 +177,8 @@ def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
     bp = np.empty((*shape, 3))
     aR = np.empty((*shape, 3, 3))
     ap = np.empty((*shape, 3))
-    centres = np.empty((*shape, 3))
-    axes = np.empty((*shape, 3))
+    centres = np.empty(((N, n) if points else (1, n)) + (3,))
+    axes = np.empty_like(centres)
     screws = np.empty((N, 6, len(lay.names)))
     q = conf.scalars
     fi = 0  # running freedom index
@@ -187,6 +189,7 @@ def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
         if frames:
             bR[:, i] = R
             bp[:, i] = p
+        if points:
             centres[:, i] = centre
             axes[:, i] = u
         col = lay.scalar_col[fi]

@@ -333,7 +333,8 @@ def transmission(motion: Motion) -> Transmission:
     planar = False
     for md in motion.modes:
         planar = _planar(linkage, md)
-        fr = forward(linkage, md.conf, lay)  # screws, centres and axes in the ground frame
+        # screws, centres and axes in the ground frame (the link frames are not needed)
+        fr = forward(linkage, md.conf, lay, frames=False, points=True)
         S = fr.screws
         U = _twist_space(S, L)
         index: dict[str, Array] = {}
