@@ -268,14 +268,41 @@ def smallest_cone(directions: Array) -> tuple[Array, float]:
 
 
 def _hull_min_norm_point(V: Array) -> Array:
-    """The minimum-norm point of the convex hull of the rows of V, by non-negative least
-    squares with the weights' sum held to 1 by a heavy row."""
-    from scipy.optimize import nnls  # on first use: start-up stays light
-
+    """The minimum-norm point of the convex hull of the rows of V: non-negative least squares
+    with the weights' sum held to 1 by a heavy row (:func:`nonnegative_least_squares`)."""
     big = 1e4
     A = np.vstack([V.T, big * np.ones((1, V.shape[0]))])
-    lam, _ = nnls(A, np.array([0.0, 0.0, 0.0, big]), maxiter=50 * V.shape[0])
+    lam = nonnegative_least_squares(A, np.array([0.0, 0.0, 0.0, big]), 50 * V.shape[0])
     return np.asarray(V.T @ (lam / lam.sum()))
+
+
+def nonnegative_least_squares(A: Array, b: Array, max_iterations: int) -> Array:
+    """min ‖Ax − b‖ over x ≥ 0: the active-set method of Lawson & Hanson ("Solving Least
+    Squares Problems", 1974, ch. 23; scipy.optimize.nnls implements the same method). Written
+    here for the few rows of the smallest-cone problem, whose passive set stays small, so that
+    analyze does not import scipy.optimize (0.3 s of start-up)."""
+    m, n = A.shape
+    x = np.zeros(n)
+    passive = np.zeros(n, dtype=bool)
+    tol = 10 * np.finfo(float).eps * np.linalg.norm(A, 1) * max(m, n)
+    w = A.T @ (b - A @ x)
+    for _ in range(max_iterations):
+        if passive.all() or not (w[~passive] > tol).any():
+            break
+        passive[int(np.argmax(np.where(passive, -np.inf, w)))] = True
+        while True:
+            z = np.zeros(n)
+            z[passive] = np.linalg.lstsq(A[:, passive], b, rcond=None)[0]
+            if (z[passive] > 0).all():
+                x = z
+                break
+            shrink = passive & (z <= 0)
+            alpha = np.min(x[shrink] / (x[shrink] - z[shrink]))
+            x = x + alpha * (z - x)
+            passive &= x > tol
+            x[~passive] = 0.0
+        w = A.T @ (b - A @ x)
+    return x
 
 
 def _idle(linkage: Linkage, link: int) -> bool:
