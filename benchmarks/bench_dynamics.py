@@ -278,16 +278,83 @@ def pinocchio_peer(n: int = 200_000) -> dict[str, Any]:
                     "finite, own process"}
 
 
-def _pinocchio() -> dict[str, Any]:
-    """:func:`pinocchio_peer` in a process of its own (numba or anything another benchmark
-    loaded cannot slow it, nor it them)."""
+def pinocchio_constraint_peer(n: int = 100_000) -> dict[str, Any]:
+    """Pinocchio ``constraintDynamics`` on a CSSP-like closed loop, per call: the crank (RZ)
+    and the rod (spherical at the pin) as one chain, the slider (PX) as another, closed by a
+    3-D point constraint at the ball; one call per sample from Python (issue 30's yardstick)."""
+    name = "pinocchio constraintDynamics, CSSP-like closed loop, per call"
+    try:
+        import pinocchio as pin
+    except ImportError:
+        return {"name": name, "value": None, "unit": "us/sample", "target": None,
+                "note": "pin not installed (pip install pin to compare)"}
+    model = pin.Model()
+    crank = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "crank")
+    model.appendBodyToJoint(crank, pin.Inertia.Random(), pin.SE3.Identity())
+    rod = model.addJoint(crank, pin.JointModelSpherical(),
+                         pin.SE3(np.eye(3), np.array([2 * INCH, 0.0, 0.0])), "pin")
+    model.appendBodyToJoint(rod, pin.Inertia.Random(), pin.SE3.Identity())
+    slider = model.addJoint(0, pin.JointModelPX(),
+                            pin.SE3(np.eye(3), np.array([0.0, INCH, 0.0])), "slider")
+    model.appendBodyToJoint(slider, pin.Inertia.Random(), pin.SE3.Identity())
+    data = model.createData()
+    ball = pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, model, rod,
+                                    pin.SE3(np.eye(3), np.array([8 * INCH, 0.0, 0.0])), slider,
+                                    pin.SE3.Identity(), pin.ReferenceFrame.LOCAL)
+    models = pin.StdVec_RigidConstraintModel()
+    models.append(ball)
+    datas = pin.StdVec_RigidConstraintData()
+    datas.append(ball.createData())
+    pin.initConstraintDynamics(model, data, models, datas)
+    rng = np.random.default_rng(0)
+    q = pin.neutral(model)
+    v, tau = rng.normal(size=model.nv), rng.normal(size=model.nv)
+    if not np.all(np.isfinite(pin.constraintDynamics(model, data, q, v, tau, models, datas))):
+        raise RuntimeError("pinocchio constraint peer: non-finite accelerations")
+
+    def calls() -> None:
+        for _ in range(n):
+            pin.constraintDynamics(model, data, q, v, tau, models, datas)
+
+    per = _best_time(calls) / n * 1e6
+    return {"name": name, "value": per, "unit": "us/sample", "target": None,
+            "note": f"pinocchio {pin.__version__}, one Python call per sample (C++ inside), "
+                    f"best of {REPEATS} x {n} calls, own process"}
+
+
+def _pinocchio(peer: str = "pinocchio") -> dict[str, Any]:
+    """:func:`pinocchio_peer` (or, for ``"constraint"``, :func:`pinocchio_constraint_peer`) in
+    a process of its own (numba or anything another benchmark loaded cannot slow it, nor it
+    them)."""
     import json
     import subprocess
 
-    out = subprocess.run([sys.executable, __file__, "--peer", "pinocchio"], check=True,
+    out = subprocess.run([sys.executable, __file__, "--peer", peer], check=True,
                          capture_output=True, text=True)
     row: dict[str, Any] = json.loads(out.stdout.strip().splitlines()[-1])
     return row
+
+
+def solve_motion_rows(lk: Any, theta: np.ndarray, omega: float, dyn: float,
+                      peer: dict[str, Any]) -> list[dict[str, Any]]:
+    """CSSP kinematics through ``solve_motion`` (both modes, every field: the route the
+    pipeline and the CLI take), and with one mode's inverse dynamics against Pinocchio's
+    ``constraintDynamics`` per sample (issue 30: target <= 0.5x)."""
+    from screwkit.kinematics.solve_motion import solve_motion
+
+    solve_motion(lk, theta[:2000], rates=omega)  # warm-up
+    both = _best_time(lambda: solve_motion(lk, theta, rates=omega)) / theta.size * 1e6
+    per_mode = both / 2
+    rows = [{"name": "CSSP kinematics through solve_motion (both modes, every field)",
+             "value": both, "unit": "us/sample", "target": None,
+             "note": f"{per_mode:.2f} per mode; 6.2 before issue 30's fixes (5.6 in the issue)"}]
+    if peer.get("value"):
+        rows.append({"name": "CSSP solve_motion + inverse_dynamics / pinocchio "
+                             "constraintDynamics, per sample", "value": (both + dyn)
+                     / peer["value"], "unit": "ratio", "target": 0.5,
+                     "note": f"one mode's kinematics: {(per_mode + dyn) / peer['value']:.2f}x; "
+                             f"peer {peer['value']:.2f} us/call"})
+    return rows
 
 
 def _check_finite(label: str, values: dict[str, np.ndarray] | Any) -> None:
@@ -449,16 +516,19 @@ def run(samples: int = SAMPLES, families: bool = True) -> list[dict[str, Any]]:
          "note": f"axisymmetric rod only; max |Δ| vs library {agreement:.1e} of peak"},
         _pinocchio(),
     ]
+    constraint = _pinocchio("constraint")
+    rows += [constraint, *solve_motion_rows(lk, theta, omega, dyn, constraint)]
     if families:
         rows += every_family_memory(samples)
     return rows
 
 
 if __name__ == "__main__":
-    if sys.argv[1:3] == ["--peer", "pinocchio"]:
+    if sys.argv[1:2] == ["--peer"]:
         import json
 
-        print(json.dumps(pinocchio_peer()))
+        print(json.dumps(pinocchio_peer() if sys.argv[2] == "pinocchio"
+                         else pinocchio_constraint_peer()))
         sys.exit(0)
     for row in run(families="--no-families" not in sys.argv[1:]):
         value = row["value"]

@@ -8,13 +8,10 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Sequence
 from functools import cached_property
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
-from screwkit.balancing.config import BalancingConfig, balance_with_config
-from screwkit.balancing.errors import BalancingError
-from screwkit.balancing.result import BalanceResult
 from screwkit.constants import STANDARD_GRAVITY
 from screwkit.dynamics import Dynamics, inverse_dynamics
 from screwkit.errors import InputError, ScrewkitError, expect_instance
@@ -33,7 +30,6 @@ from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.kinematics.transmission import Transmission, transmission
 from screwkit.messages import message_units, number
-from screwkit.synthesis.config import SynthesisConfig, SynthesisRun, run_synthesis
 from screwkit.tables import ResultTable, UnitChoice
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -49,6 +45,12 @@ def _in_spec_units(job: F) -> F:
             return job(self, *args, **kwargs)
 
     return run  # type: ignore[return-value]
+
+
+if TYPE_CHECKING:  # balancing and synthesis load scipy.optimize: imported where they are used
+    from screwkit.balancing.config import BalancingConfig
+    from screwkit.balancing.result import BalanceResult
+    from screwkit.synthesis.config import SynthesisConfig, SynthesisRun
 
 
 class Pipeline:
@@ -136,6 +138,8 @@ class Pipeline:
                                 inputs=s.inputs, allow_partial=partial)
 
     def balancing_config(self) -> BalancingConfig:
+        from screwkit.balancing.errors import BalancingError
+
         if self.spec.balancing is None:
             raise BalancingError(f"{self.spec.path}: no [balancing] table; see docs/balancing.md")
         return self.spec.balancing
@@ -145,6 +149,9 @@ class Pipeline:
                 progress: Callable[[int, int], None] | None = None) -> BalanceResult:
         """The spec's ``[balancing]`` run on ``[motion] mode`` (or on ``mode`` if given);
         ``progress(done, total)`` follows a Pareto sweep."""
+        from screwkit.balancing.config import balance_with_config
+        from screwkit.balancing.errors import BalancingError
+
         s = self.spec
         config = self.balancing_config()
         if mode is None:
@@ -172,6 +179,8 @@ class Pipeline:
                    progress: Callable[[int, int], None] | None = None) -> SynthesisRun:
         """The spec's ``[synthesis]`` run (either route), best result first;
         ``progress(done, total)`` follows a multistart."""
+        from screwkit.synthesis.config import run_synthesis
+
         return run_synthesis(self.synthesis_config(), starts=starts, progress=progress)
 
     @_in_spec_units
@@ -197,10 +206,7 @@ class Pipeline:
         spec's coupler points and the transmission quality (a note where a loop has none)."""
         from screwkit.io.documents import analysis_document
 
-        try:
-            tr, note = self.transmission(), None
-        except ScrewkitError as exc:
-            tr, note = None, str(exc)
+        tr, note = self._transmission
         return analysis_document(self.motion, name=self.spec.name,
                                  coupler_points=self.spec.coupler_points, transmission=tr,
                                  transmission_note=note)
@@ -209,17 +215,31 @@ class Pipeline:
     def analysis_table(self) -> ResultTable:
         """The motion as a column table (``Motion.table``) with the spec's coupler points and
         the transmission quality (where the loop has one)."""
-        try:
-            tr = self.transmission()
-        except ScrewkitError:
-            tr = None
+        tr, _ = self._transmission
         return self.motion.table(coupler_points=self.spec.coupler_points, transmission=tr)
 
     @_in_spec_units
     def transmission(self) -> Transmission:
         """Transmission index, angle and ball-joint cone angles over every mode (a ValueError
-        says why a loop has none)."""
-        return transmission(self.motion)
+        says why a loop has none); computed once per pipeline, like the motion."""
+        tr, why = self._transmission_or_why
+        if tr is None:
+            raise why  # type: ignore[misc]
+        return tr
+
+    @property
+    def _transmission(self) -> tuple[Transmission | None, str | None]:
+        tr, why = self._transmission_or_why
+        return tr, None if why is None else str(why)
+
+    @cached_property
+    def _transmission_or_why(self) -> tuple[Transmission | None, ScrewkitError | None]:
+        """The transmission of the motion, or None and the error saying why the loop has none
+        (the analysis document and table share one computation)."""
+        try:
+            return transmission(self.motion), None
+        except ScrewkitError as exc:
+            return None, exc
 
     @_in_spec_units
     def coupler_curves(self) -> list[dict[str, Array]]:

@@ -102,6 +102,41 @@ def test_smallest_cone_of_a_circle_of_directions():
     assert np.linalg.norm(got_axis - axis) < 1e-5
 
 
+def test_nonnegative_least_squares_matches_scipy():
+    """The Lawson–Hanson solver written for the smallest cone (so that analyze need not import
+    scipy.optimize) gives scipy's residual on random problems, with x ≥ 0."""
+    from scipy.optimize import nnls
+
+    from screwkit.kinematics.transmission import nonnegative_least_squares
+
+    rng = np.random.default_rng(11)
+    for _ in range(200):
+        A = rng.normal(size=(int(rng.integers(2, 8)), int(rng.integers(1, 40))))
+        b = rng.normal(size=A.shape[0])
+        x = nonnegative_least_squares(A, b, 100 * A.shape[1])
+        ref, _ = nnls(A, b)
+        assert (x >= 0).all()
+        assert np.linalg.norm(A @ x - b) == pytest.approx(np.linalg.norm(A @ ref - b), abs=1e-10)
+
+
+def test_smallest_cone_of_many_directions_grows_its_working_set():
+    """10 000 directions (the working set starts at 256 and must take in those its first cone
+    leaves out): the cone holds every direction and touches the rim of a known cone."""
+    rng = np.random.default_rng(4)
+    axis = _unit(rng.normal(size=3))
+    e1 = _unit(np.cross(axis, [0.0, 0.0, 1.0]))
+    e2 = np.cross(axis, e1)
+    half = math.radians(40.0)
+    phi = rng.uniform(0, 2 * np.pi, 10_000)
+    tilt = half * np.sqrt(rng.uniform(0, 1, 10_000))
+    tilt[rng.choice(10_000, 7, replace=False)] = half  # a few on the rim, spread at random
+    v = (np.cos(tilt)[:, None] * axis + np.sin(tilt)[:, None]
+         * (np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2))
+    got_axis, got_half = smallest_cone(v)
+    assert np.min(v @ got_axis) >= math.cos(got_half) - 1e-12
+    assert got_half <= half + 1e-9
+
+
 def test_rssr_ball_cone_angles_are_tilts_of_the_rod():
     s = load_spec(f"{EXAMPLES}/rssr_spatial.toml")
     motion = sk.solve_motion(s.linkage, s.inputs)

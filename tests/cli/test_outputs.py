@@ -182,6 +182,35 @@ def test_dynamics_table_does_not_build_the_json_document(tmp_path, monkeypatch):
     assert "loads over the cycle" in _run("dynamics", _spec(tmp_path))
 
 
+def test_analyze_to_a_binary_file_builds_no_document_and_one_transmission(tmp_path,
+                                                                           monkeypatch):
+    """Issue 30: `analyze -o out.npz` cost 9x the solve, building the JSON document it does not
+    write and computing the transmission twice (once for the document, once for the table)."""
+    import screwkit.io.documents as documents
+    import screwkit.pipeline as pipeline
+
+    def refuse(*a, **k):
+        raise AssertionError("the JSON document was built for a binary output")
+
+    calls = []
+
+    def counted(motion):
+        calls.append(1)
+        return transmission(motion)
+
+    transmission = pipeline.transmission
+    spec = str(EXAMPLES / "bagci_fig7_rsrc.toml")
+    with monkeypatch.context() as m:
+        m.setattr(documents, "analysis_document", refuse)
+        m.setattr(pipeline, "transmission", counted)
+        r = runner.invoke(app, ["analyze", spec, "-o", str(tmp_path / "a.npz")])
+        assert r.exit_code == 0, r.output
+    assert calls == [1]
+    monkeypatch.setattr(pipeline, "transmission", counted)
+    r = runner.invoke(app, ["analyze", spec, "--json", "--csv", str(tmp_path / "a.csv")])
+    assert r.exit_code == 0 and calls == [1, 1]  # the document and the CSV table share one
+
+
 def test_limits_csv_in_spec_units(tmp_path):
     spec = _spec(tmp_path)
     doc = json.loads(_run("limits", spec, "--json"))

@@ -52,6 +52,15 @@ def test_non_assembling_samples_are_named_by_their_inputs() -> None:
     out = json.loads(json.dumps(partial.as_dict()))
     assert out["shaking_force"][3] is None and out["reactions"]["input"]["force"][4] is None
     assert out["efforts"]["input.theta"][5] is not None
+    # the document's array form (issue 30: built column by column, no float per value) writes
+    # the same JSON, a non-assembling vector sample as one null
+    from screwkit.io.results import dumps_bytes
+
+    arrays = json.loads(dumps_bytes(partial.as_dict(arrays=True)))
+    assert arrays == json.loads(dumps_bytes(partial.as_dict()))
+    full = inverse_dynamics(linkage, mode, inputs=motion.inputs)
+    assert isinstance(full.as_dict(arrays=True)["shaking_force"], np.ndarray)
+    assert json.loads(dumps_bytes(full.as_dict(arrays=True))) == json.loads(json.dumps(full.as_dict()))
 
 
 def test_other_bad_input() -> None:

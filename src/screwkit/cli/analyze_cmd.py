@@ -4,13 +4,16 @@ in every assembly mode, in the spec's units (tables, CSV, plots) or as the SI JS
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, TypeVar
 
 import typer
 
 from screwkit.cli.common import prose
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
+
+T = TypeVar("T")
 
 
 def shown_variables(mode: Any, input_name: str) -> list[str]:
@@ -94,6 +97,18 @@ def show_analysis(spec: Any, motion: Any, units: Any, full: bool,
         prose(f"[yellow]transmission:[/] {escape(doc['transmission']['note'])}")
 
 
+def cache(build: Callable[[], T]) -> Callable[[], T]:
+    """``build`` run on the first call only; later calls return its result."""
+    memo: list[T] = []
+
+    def get() -> T:
+        if not memo:
+            memo.append(build())
+        return memo[0]
+
+    return get
+
+
 def register(app: typer.Typer) -> None:
     """Add the ``analyze`` command to ``app``."""
 
@@ -126,19 +141,25 @@ def register(app: typer.Typer) -> None:
         du = out.units_for(s.units)
         stages = ["solving", "coupler curves and transmission", "tables"]
         # a long sweep shows its stages (stderr, terminals only; the solver's own bar is off);
-        # the bar is gone before anything is printed on stdout
+        # the bar is gone before anything is printed on stdout. The document and the table are
+        # built only when asked for: `-o out.npz` needs the table, never the document (issue 30)
         with staged_progress("analyze", stages,
                              enabled=len(s.inputs) >= SWEEP_PROGRESS_SAMPLES) as stage:
             pipe = guard(lambda: Pipeline(s, method=method, progress=stage("solving"), units=du))
             motion = guard(lambda: pipe.motion)
+            doc = cache(lambda: guard(pipe.analysis))
+            table = cache(lambda: guard(pipe.analysis_table))
             stage("coupler curves and transmission")
-            doc = guard(pipe.analysis)
+            if plot is not None or out.needs_document():
+                doc()
             stage("tables")
-            table = guard(pipe.analysis_table)
+            if out.needs_table():
+                table()
         if plot is not None:
             from screwkit.report.plots import plot_analysis
 
-            guard(lambda: plot_analysis(doc, plot, units=du))
+            guard(lambda: plot_analysis(doc(), plot, units=du))
             out.note_written(plot)
-        out.deliver(document=lambda: doc, table=lambda: table,
-                    show=lambda: show_analysis(s, motion, du, out.full, doc, table), units=du)
+        out.deliver(document=doc, table=table,
+                    show=lambda: show_analysis(s, motion, du, out.full, doc(), table()),
+                    units=du)

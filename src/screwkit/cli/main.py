@@ -31,10 +31,12 @@ app = typer.Typer(
 def main(
     version: Annotated[bool, typer.Option("--version", help="Print the version.")] = False,
     max_memory: Annotated[str | None, typer.Option("--max-memory", help="Refuse work estimated to need more memory than this (e.g. 16GB; default: half the machine's memory, at most 16 GiB; also SCREWKIT_MAX_MEMORY).")] = None,
+    max_time: Annotated[str | None, typer.Option("--max-time", help="Refuse a solve estimated to need more computing time than this (e.g. 10min; default 60 s; also SCREWKIT_MAX_TIME).")] = None,
 ) -> None:
-    from screwkit.budget import set_memory_limit
+    from screwkit.budget import set_memory_limit, set_time_limit
 
     guard(lambda: set_memory_limit(max_memory))  # None: the default (or SCREWKIT_MAX_MEMORY)
+    guard(lambda: set_time_limit(max_time))  # None: the default (or SCREWKIT_MAX_TIME)
     if version:
         console.print(f"screwkit {__version__}")
         raise typer.Exit(0)

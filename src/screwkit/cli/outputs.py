@@ -83,6 +83,22 @@ class Outputs:
         return guard(lambda: display_units(spec_units, system=self.system,
                                            overrides=self.overrides))
 
+    def needs_document(self) -> bool:
+        """Whether :meth:`deliver` will build the document: ``-o`` JSON, ``--json``, or the
+        terminal view (which reads it)."""
+        if self.output is not None:
+            return (self.output_format or "json") == "json"
+        return True
+
+    def needs_table(self) -> bool:
+        """Whether :meth:`deliver` will build the table: ``-o`` CSV/Parquet/NPZ, ``--csv``, or
+        the terminal view."""
+        if self.csv is not None:
+            return True
+        if self.output is not None:
+            return (self.output_format or "json") != "json"
+        return not self.as_json
+
     def deliver(self, *, document: Callable[[], dict[str, Any]],
                 table: Callable[[], Any] | None, show: Callable[[], None],
                 units: Any = None) -> None:

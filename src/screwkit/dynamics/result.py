@@ -10,7 +10,7 @@ hold NaN in the arrays and ``None`` in :meth:`Dynamics.as_dict`.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -73,11 +73,19 @@ class Indeterminacy:
         return "; ".join(parts) if parts else "statically determinate"
 
 
-def _listify(a: Array, valid: NDArray[np.bool_]) -> list[Any]:
+def _as_list(a: Array, valid: NDArray[np.bool_]) -> list[Any]:
     out: list[Any] = np.asarray(a).tolist()  # one C call; then None at the invalid samples
     for i in np.flatnonzero(~np.asarray(valid, dtype=bool)).tolist():
         out[i] = None
     return out
+
+
+def _as_array(a: Array, valid: NDArray[np.bool_]) -> Array | list[Any]:
+    """The array itself where every sample is valid; else the list with ``None`` rows (a
+    vector sample that is not valid is one ``null``, as docs/cli.md says)."""
+    if np.all(valid):
+        return np.asarray(a, dtype=float)
+    return _as_list(a, valid)
 
 
 def _stats(values: Array, valid: NDArray[np.bool_], inputs: Array) -> dict[str, float]:
@@ -172,14 +180,19 @@ class Dynamics:
         """:meth:`table` as CSV (``shaking_force_x [N]`` …; empty cells where not valid)."""
         self.table().to_csv(path, units)
 
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-able dictionary (SI units, lists, ``None`` where a sample is not valid)."""
+    def as_dict(self, arrays: bool = False) -> dict[str, Any]:
+        """JSON-able dictionary (SI units, lists, ``None`` where a sample is not valid).
+
+        With ``arrays`` the per-sample values of a mode valid at every sample stay float arrays
+        (what the io layer's orjson writer takes directly, column by column, instead of a
+        Python float per value); the JSON written is the same."""
         v = self.valid
+        _listify: Callable[[Array, NDArray[np.bool_]], Any] = _as_array if arrays else _as_list
         return {
             "units": {"force": "N", "moment": "N*m", "effort": "N*m or N", "length": "m"},
             "input_names": list(self.input_names),
             "inputs": _listify(self.inputs, v),
-            "valid": v.tolist(),
+            "valid": np.asarray(v, dtype=bool) if arrays else v.tolist(),
             "moment_point": self.moment_point.tolist(),
             "gravity": self.gravity.tolist(),
             "shaking_force": _listify(self.shaking_force, v),

@@ -119,8 +119,10 @@ def analysis_document(motion: Motion, *, name: str | None = None,
 
 def dynamics_document(dyn: Dynamics, *, mode: int, note: str | None = None) -> dict[str, Any]:
     """The document of ``screwkit dynamics``: the loads (:meth:`Dynamics.as_dict`), the mode,
-    the RMS/peak summary, what is indeterminate, and a note on non-assembling samples."""
-    doc = dyn.as_dict()
+    the RMS/peak summary, what is indeterminate, and a note on non-assembling samples. The
+    per-sample loads stay arrays (``as_dict(arrays=True)``), written column by column by the
+    JSON writer."""
+    doc = dyn.as_dict(arrays=True)
     if note is not None:
         doc["note"] = note
     doc["mode"] = mode

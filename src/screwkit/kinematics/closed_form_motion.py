@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -157,7 +157,7 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     (:func:`~screwkit.kinematics.cssp_motion.cssp_mode_motion`), with the seed's angles θ2, η2
     (rod) and θ3, η3 (slider ball) and their exact rates. The two roots stay separate: they meet
     only at a branch point, where the mode stops."""
-    from screwkit.kinematics.cssp import CSSPDimensions, cssp_motion
+    from screwkit.kinematics.cssp import CSSPDimensions
     from screwkit.kinematics.cssp_motion import cssp_mode_motion
 
     p = dict(linkage.parameters)
@@ -175,16 +175,19 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
             continue
         # the seed's angles with their closed-form rates (for a fixed crank offset; with a
         # driven one the registry's names from the link frames are used)
-        cf = None if driven else cssp_motion(dims, theta, Xd[:, 0], Xdd[:, 0], root=root,
-                                             allow_partial=True)
+        cf = None if driven else _cssp_seed_angles(linkage, dims, md, theta, Xd[:, 0],
+                                                   Xdd[:, 0])
         seed_v: dict[str, Array] = {"theta1": theta}
         seed_d: dict[str, Array] = {"theta1": Xd[:, 0]}
         seed_dd: dict[str, Array] = {"theta1": Xdd[:, 0]}
         if cf is not None:
+            s4 = md.variables[f"{linkage.joints[3].name}.s"]
+            cf.update(s4=s4, s4_dot=md.velocities[f"{linkage.joints[3].name}.s"],
+                      s4_ddot=md.accelerations[f"{linkage.joints[3].name}.s"])
             for n in names:
-                seed_v[n] = getattr(cf, n)
-                seed_d[n] = getattr(cf, f"{n}_dot")
-                seed_dd[n] = getattr(cf, f"{n}_ddot")
+                seed_v[n] = cf[n]
+                seed_d[n] = cf[f"{n}_dot"]
+                seed_dd[n] = cf[f"{n}_ddot"]
             for key in ("theta2", "eta2", "theta3", "eta3"):
                 seed_v[key] = unwrap_runs(np.where(ok, seed_v[key], np.nan), ok)
         stops = np.nonzero(ok[:-1] & ~ok[1:])[0]
@@ -201,6 +204,36 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         raise _no_modes(linkage, X, describe_intervals(
             [(a % (2 * np.pi), a % (2 * np.pi) + (b - a)) for a, b in assembly_intervals(dims)]))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=CSSP_SOLVER)
+
+
+def _cssp_seed_angles(linkage: Linkage, dims: Any, md: ModeMotion, theta: Array, w: Array,
+                      wd: Array) -> dict[str, Any]:
+    """Rahman's θ2, η2, θ3, η3 with their rates (cssp.rod_and_slider_angles) from the rod of a
+    solved mode: u = (ball − pin)/a2 in the loop frame {1}, u̇ = ω × u, ü = α × u + ω × u̇
+    (ω, α the rod's, whatever its spin about u), instead of solving the closed form again."""
+    from screwkit.kinematics.cssp import rod_and_slider_angles
+
+    base = np.asarray(linkage.base.real, dtype=float)
+
+    def loop_frame(x: Array) -> Array:  # world → loop frame: x ↦ baseᵀ x (rows: x @ base)
+        return np.ascontiguousarray(x) if np.array_equal(base, np.eye(3)) else x @ base
+
+    c = md.joint_centres
+    u = loop_frame(c[:, 2] - c[:, 1]) / dims.a2
+    om = loop_frame(md.link_angular_velocity[:, 1])
+    al = loop_frame(md.link_angular_acceleration[:, 1])
+    ud = _cross(om, u)
+    udd = _cross(al, u) + _cross(om, ud)
+    return rod_and_slider_angles(dims, theta, w, wd, u, ud, udd, np.asarray(md.assembles),
+                                 True, frame=False)
+
+
+def _cross(a: Array, b: Array) -> Array:
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
 
 
 def _branch_events(linkage: Linkage, X: Array, ok: NDArray[np.bool_]) -> list[str]:

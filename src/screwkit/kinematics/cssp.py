@@ -28,7 +28,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.dual.spatial import elevation_azimuth, rot_x, wrap_angle
+from screwkit.dual.spatial import elevation_azimuth, wrap_angle
 from screwkit.errors import InputError
 from screwkit.messages import shown, shown_range
 
@@ -391,7 +391,7 @@ def check_root(root: int) -> int:
     return int(root)
 
 
-def _rod_and_slider_angles(
+def rod_and_slider_angles(
     dims: CSSPDimensions,
     th: Array,
     w: Array,
@@ -401,22 +401,24 @@ def _rod_and_slider_angles(
     udd: Array,
     assembles: BoolArray,
     need_rates: bool,
+    frame: bool = True,
 ) -> dict[str, object]:
     """Rahman's joint angles from the rod direction u (SPEC §1.1, L2): θ2 = azimuth of u − θ1 and
     η2 = −elevation of u (rod), θ3, η3 the azimuth and elevation of u seen in the slider frame
-    {4} = X(α4), with their rates when ``need_rates``, and the rod frame {3} = Z(θ1 + θ2) Y(η2)."""
+    {4} = X(α4), with their rates when ``need_rates``, and (with ``frame``) the rod frame {3} =
+    Z(θ1 + θ2) Y(η2)."""
     rod_ok, elev, e_d, e_dd, phi, phi_d, phi_dd = elevation_azimuth(u, ud, udd)
-    to_slider = rot_x(dims.alpha4)  # X(α4) = R_{4←1}
-    slider_ok, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = elevation_azimuth(
-        u @ to_slider.T, ud @ to_slider.T, udd @ to_slider.T
-    )
+    ca, sa = float(np.cos(dims.alpha4)), float(np.sin(dims.alpha4))  # X(α4) = R_{4←1}, by rows:
+    slider_ok, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = elevation_azimuth(*(np.stack(
+        [v[..., 0], ca * v[..., 1] - sa * v[..., 2], sa * v[..., 1] + ca * v[..., 2]], -1)
+        for v in (u, ud, udd)))
     rod_ok &= assembles
     slider_ok &= assembles
-
-    # Rahman's rod frame {3}: R_{1←3} = Z(θ1 + θ2) Y(η2), x3 = u (SPEC §1.1, L2).
-    phi_frame = np.where(rod_ok, phi, 0.0)
-    y3 = np.stack([-np.sin(phi_frame), np.cos(phi_frame), np.zeros(th.shape[0])], axis=-1)
-    rod_frame = np.stack([u, y3, np.cross(u, y3)], axis=-1)
+    rod_frame = None
+    if frame:  # Rahman's rod frame {3}: R_{1←3} = Z(θ1 + θ2) Y(η2), x3 = u (SPEC §1.1, L2)
+        phi_frame = np.where(rod_ok, phi, 0.0)
+        y3 = np.stack([-np.sin(phi_frame), np.cos(phi_frame), np.zeros(th.shape[0])], axis=-1)
+        rod_frame = np.stack([u, y3, np.cross(u, y3)], axis=-1)
     out: dict[str, object] = {
         "theta2": np.where(rod_ok, wrap_angle(phi - th), np.nan),
         "eta2": -elev,
@@ -499,7 +501,7 @@ def _solve(
         "crank_pin": core["crank_pin"],
         "slider_ball": core["slider_ball"],
         "rod_direction": u,
-        **_rod_and_slider_angles(dims, th, w, wd, u, ud, udd, assembles, need_rates),
+        **rod_and_slider_angles(dims, th, w, wd, u, ud, udd, assembles, need_rates),
     }
     if need_rates:
         out.update(

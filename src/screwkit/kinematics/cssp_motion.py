@@ -50,7 +50,7 @@ from screwkit.kinematics.cssp import (
     assembly_message,
     check_root,
 )
-from screwkit.kinematics.loop import Configuration
+from screwkit.kinematics.loop import Configuration, rotation_vector
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
@@ -443,10 +443,10 @@ def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
         accelerations[f"{first}.s"] = sw.full("s1_ddot")
     vectors: list[Array | None] = [None, None]
     if rotations is not None:
-        safe = np.where(ok[:, None, None], 1.0, 0.0)
-        eye = np.where(ok[:, None, None], 0.0, 1.0) * np.eye(3)
-        from scipy.spatial.transform import Rotation  # on first use (start-up time)
-        vectors = [Rotation.from_matrix(np.nan_to_num(rel) * safe + eye).as_rotvec()
+        # the relative rotations are orthonormal products: their vector from the skew part and
+        # the trace (scipy's from_matrix would re-orthonormalise each first, 4x the cost)
+        vectors = [rotation_vector(rel if ok.all() else
+                                   np.where(ok[:, None, None], np.nan_to_num(rel), np.eye(3)))
                    for rel in rotations]
     for name, r, rv in ((pin, 0, vectors[0]), (ball, 2, vectors[1])):
         if rates is None:

@@ -12,9 +12,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.dual.spatial import rot_z
 from screwkit.kinematics.cssp import CSSPDimensions
-from screwkit.kinematics.idle_spin import zero_spin_angle
+from screwkit.kinematics.idle_spin import perpendicular, spin_from_frames
 from screwkit.kinematics.loop import Array
 
 
@@ -31,12 +30,24 @@ def rod_turn(dims: CSSPDimensions, root: int, theta1: Array, ct: Array, st: Arra
     steps = np.concatenate([[0.0], np.diff(theta1)])
     s1_steps = np.concatenate([[0.0], np.diff(s1v)])
     k = cssp_closed_form_block(dims, root, ct, st, steps, 0.0, s1, s1_steps, 0.0, disc)
-    u, u_dot, u_ddot = (np.stack(k[name], axis=-1) for name in ("u", "u_dot", "u_ddot"))
-    y3, z3 = rahman_rod_axes(k["u"])
-    rod = np.stack([u, np.stack(y3, axis=-1), np.stack(z3, axis=-1)], axis=-1)
-    crank = rot_z(theta1)
     good = ok[:, None]
-    safe_u = np.where(good, u, [1.0, 0.0, 0.0])
-    phi = zero_spin_angle(safe_u, np.where(good, u_dot, 0.0), np.where(good, u_ddot, 0.0),
-                          np.where(good[..., None], rod, np.eye(3)), crank, ok, ok)
+    u, u_dot, u_ddot = (np.where(good, np.stack(k[name], axis=-1), fill) for name, fill in
+                        (("u", [1.0, 0.0, 0.0]), ("u_dot", 0.0), ("u_ddot", 0.0)))
+    y3, z3 = rahman_rod_axes(k["u"])
+    # the rod frame {3} = (u, y3, z3) (the identity where it does not assemble) and the crank's
+    # Z(θ1), by components: zero_spin_angle's pieces without (N, 3, 3) stacks
+    first = int(np.argmax(ok))
+    rod_first = np.array([[k["u"][i][first], y3[i][first], z3[i][first]] for i in range(3)])
+    u_body = rod_first.T @ u[first]
+    e_body = perpendicular(u_body)
+    frame_x = np.where(good, np.stack([k["u"][i] * e_body[0] + y3[i] * e_body[1]
+                                       + z3[i] * e_body[2] for i in range(3)], -1), e_body)
+    ux, uy, uz = u[:, 0], u[:, 1], u[:, 2]
+
+    def from_crank(x: Array) -> Array:  # Z(θ1)·x
+        return np.stack([ct * x[:, 0] - st * x[:, 1], st * x[:, 0] + ct * x[:, 1], x[:, 2]], -1)
+
+    u_in_crank = np.stack([ct * ux + st * uy, ct * uy - st * ux, uz], -1)  # Z(θ1)ᵀ·u
+    phi = spin_from_frames(u, u_dot, u_ddot, frame_x, u_body, e_body, u_in_crank, from_crank,
+                           ok, ok)
     return np.where(ok, phi, 0.0)

@@ -59,6 +59,8 @@ from screwkit.model.linkage import Linkage
 ANCHOR_SPAN = np.radians(15.0)
 #: a sweep at least this long shows a progress bar on a terminal (when no callback is given)
 PROGRESS_SAMPLES = 50_000
+#: ... or a solve estimated (solve_motion.motion_seconds) to take this long, seconds
+PROGRESS_SECONDS = 1.0
 #: how far (signature units) two overlapping tracks may move between the samples where they
 #: are compared first (:func:`_same_samples`)
 MERGE_MOVE = 0.25
@@ -82,14 +84,16 @@ def anchor_samples(linkage: Linkage, X: Array) -> NDArray[np.intp]:
 
 @contextmanager
 def progress_reporter(progress: Progress | bool | None, N: int,
-                      label: str = "following assembly modes") -> Iterator[Progress | None]:
+                      label: str = "following assembly modes",
+                      seconds: float = 0.0) -> Iterator[Progress | None]:
     """The progress callback to use: the caller's, none, or a rich bar (``label``) on stderr
-    for a sweep of :data:`PROGRESS_SAMPLES` samples or more on a terminal."""
+    for a sweep of :data:`PROGRESS_SAMPLES` samples or more, or estimated to take
+    :data:`PROGRESS_SECONDS` or more (``seconds``), on a terminal."""
     if callable(progress):
         yield progress
         return
-    if progress is False or (progress is None and (N < PROGRESS_SAMPLES
-                                                   or not sys.stderr.isatty())):
+    long = N >= PROGRESS_SAMPLES or seconds >= PROGRESS_SECONDS
+    if progress is False or (progress is None and (not long or not sys.stderr.isatty())):
         yield None
         return
     from rich.console import Console

@@ -22,6 +22,8 @@ relative rotation turns the rod's rest direction into u with no turn about u).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -59,7 +61,7 @@ def minimal_rotation_apply(a: Array, b: Array, v: Array) -> Array:
     out = np.asarray(c[:, None] * v + cross(k, v)
                      + (_dot(k, v) / np.where(opposite, 1.0, 1.0 + c))[:, None] * k)
     for r in np.nonzero(opposite)[0]:
-        n = _perpendicular(a[r])
+        n = perpendicular(a[r])
         out[r] = 2.0 * (n @ v[r]) * n - v[r]
     return out
 
@@ -79,7 +81,7 @@ def geodesic_spin_correction(u0: Array, u1: Array, u1_dot: Array, u1_ddot: Array
     return np.asarray(-(0.5 * f1 - f1_dot / 12.0))
 
 
-def _perpendicular(u: Array) -> Array:
+def perpendicular(u: Array) -> Array:
     """A unit vector perpendicular to unit ``u`` (3,)."""
     e = np.eye(3)[int(np.argmin(np.abs(u)))]
     p = e - (e @ u) * u
@@ -125,16 +127,26 @@ def zero_spin_angle(u: Array, u_dot: Array, u_ddot: Array, rod: Array, before: A
     along the step arriving at each sample, ``before`` the frame of its proximal ball joint
     before the joint's motion (the rod's rest frame), ``mask`` where it holds, ``exact``
     where the derivatives are known. The turned frame is Rot(u, φ)·rod."""
-    N = u.shape[0]
     first = int(np.argmax(mask))
     u_body = rod[first].T @ u[first]
-    e_body = _perpendicular(u_body)
-    frame_x = rod @ e_body
+    e_body = perpendicular(u_body)
+    return spin_from_frames(u, u_dot, u_ddot, rod @ e_body, u_body, e_body,
+                            np.einsum("nji,nj->ni", before, u),
+                            lambda x: np.asarray(np.einsum("nij,nj->ni", before, x)), mask, exact)
+
+
+def spin_from_frames(u: Array, u_dot: Array, u_ddot: Array, frame_x: Array, u_body: Array,
+                     e_body: Array, u_in_before: Array, from_before: Callable[[Array], Array],
+                     mask: NDArray[np.bool_], exact: NDArray[np.bool_]) -> Array:
+    """:func:`zero_spin_angle` from its pieces, for a caller that has them without (N, 3, 3)
+    frames (the CSSP closed form): the rod's body vector ``e_body`` ⟂ its axis ``u_body`` (body
+    frame, taken at the first sample), ``frame_x`` = rod·e_body (N, 3), ``u_in_before`` =
+    beforeᵀ·u and ``from_before(x)`` = before·x."""
+    N = u.shape[0]
     # wanted frame at a run's start: the proximal ball is a pure swing from rest
-    u_in_before = np.einsum("nji,nj->ni", before, u)
     swing_x = minimal_rotation_apply(np.broadcast_to(u_body, (N, 3)), u_in_before,
                                      np.broadcast_to(e_body, (N, 3)))
-    start_x = np.einsum("nij,nj->ni", before, swing_x)
+    start_x = from_before(swing_x)
     continues = np.zeros(N, dtype=bool)
     continues[1:] = mask[1:] & mask[:-1]
     return transported_spin(u, u_dot, u_ddot, frame_x, start_x, mask, continues, exact)

@@ -30,7 +30,7 @@ from screwkit.kinematics.mode_frames import idle_spin_held
 from screwkit.kinematics.motion import AssemblyError, as_input_array, per_sample
 from screwkit.kinematics.rates import joint_rates, rate_equations, spin_links
 from screwkit.kinematics.registry import family_of
-from screwkit.kinematics.solve_motion import MODES_ESTIMATE
+from screwkit.kinematics.solve_motion import MODES_ESTIMATE, check_motion_time
 from screwkit.model.linkage import Linkage
 
 
@@ -112,9 +112,12 @@ def solve_joints(
     per_mode_sample = 8 * (lay.n_scalar + 9 * lay.n_spherical + 2 * m + 2)
     check_memory(3.0 * per_mode_sample * (family_of(linkage).max_modes or MODES_ESTIMATE) * N,
                  f"the joint motion of {N} samples", "use fewer input samples")
+    # the root searches are the generic Motion's; the per-sample cost is a fraction of it
+    seconds = check_motion_time(linkage, N, family_of(linkage).max_modes or MODES_ESTIMATE,
+                                generic=True, closed=False)
     Xd = per_sample(linkage, rates, "rates", X)
     Xdd = per_sample(linkage, accelerations, "accelerations", X)
-    with progress_reporter(progress, N) as report:
+    with progress_reporter(progress, N, seconds=seconds) as report:
         tracks = all_branches(linkage, lay, X, starts, seed, report, (Xd, Xdd))
     if not tracks:
         raise closes_nowhere(linkage, X)

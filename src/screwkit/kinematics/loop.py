@@ -188,10 +188,12 @@ def _slide(u: Array) -> Array:
 
 
 def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
-            frames: bool = True) -> LoopFrames:
+            frames: bool = True, points: bool | None = None) -> LoopFrames:
     """Walk the loop J_1 L_1 ··· J_n L_n for every sample (vectorised over samples). With
     ``frames=False`` only the closure and the screws are filled (a Newton step's needs; the
-    frame arrays are then left unset)."""
+    frame arrays are then left unset); ``points=True`` fills the joint centres and axes all the
+    same (the transmission's needs; by default they follow ``frames``)."""
+    points = frames if points is None else points
     lay = lay or layout(linkage)
     link_R, link_p, _ = constants(linkage, lay)
     N = conf.size
@@ -203,8 +205,8 @@ def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
     bp = np.empty((*shape, 3))
     aR = np.empty((*shape, 3, 3))
     ap = np.empty((*shape, 3))
-    centres = np.empty((*shape, 3))
-    axes = np.empty((*shape, 3))
+    centres = np.empty(((N, n) if points else (1, n)) + (3,))
+    axes = np.empty_like(centres)
     screws = np.empty((N, 6, len(lay.names)))
     q = conf.scalars
     fi = 0  # running freedom index
@@ -215,6 +217,7 @@ def forward(linkage: Linkage, conf: Configuration, lay: Layout | None = None,
         if frames:
             bR[:, i] = R
             bp[:, i] = p
+        if points:
             centres[:, i] = centre
             axes[:, i] = u
         col = lay.scalar_col[fi]
@@ -279,7 +282,9 @@ def closure_twist(R: Array, p: Array) -> Array:
 
 def rotation_vector(R: Array) -> Array:
     """The rotation vector (axis × angle, angle in [0, π]) of rotation matrices (..., 3, 3):
-    from the skew part and the trace, and by scipy near a half turn where that loses digits."""
+    from the skew part and the trace, and near a half turn, where the skew part loses digits,
+    the axis from the symmetric part, (R + Rᵀ)/2 − cos θ·I = (1 − cos θ) u uᵀ (its largest
+    column, signed by the skew part; no scipy, whose import costs 0.3 s of start-up)."""
     vee = 0.5 * np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
                           R[..., 1, 0] - R[..., 0, 1]], -1)
     cos = np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0)
@@ -289,9 +294,13 @@ def rotation_vector(R: Array) -> Array:
     w = vee * scale[..., None]
     near_half = cos < -0.9
     if np.any(near_half):
-        from scipy.spatial.transform import Rotation  # on first use (start-up time)
-
-        w[near_half] = Rotation.from_matrix(R[near_half]).as_rotvec()
+        Rh, c = R[near_half], cos[near_half]
+        B = 0.5 * (Rh + np.swapaxes(Rh, -1, -2)) - c[:, None, None] * np.eye(3)
+        k = np.argmax(np.diagonal(B, axis1=-2, axis2=-1), axis=-1)
+        u = np.take_along_axis(B, k[:, None, None], axis=-1)[..., 0]
+        u /= np.linalg.norm(u, axis=-1, keepdims=True)
+        sign = np.where(np.einsum("...i,...i->...", u, vee[near_half]) < 0, -1.0, 1.0)
+        w[near_half] = u * (sign * angle[near_half])[:, None]
     return np.asarray(w)
 
 

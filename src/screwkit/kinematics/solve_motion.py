@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.budget import check_memory
+from screwkit.budget import check_memory, check_time
 from screwkit.errors import CapabilityError, InputError, expect_number
 from screwkit.kinematics.generic_motion import Progress, generic_motion, progress_reporter
 from screwkit.kinematics.loop import Array
@@ -69,26 +69,32 @@ def solve_motion(
     expect_number(seed, "seed", integer=True)
     X = as_input_array(linkage, inputs, "inputs")
     fam = family_of(linkage)
-    check_memory(motion_bytes(linkage, X.shape[0], fam.max_modes or MODES_ESTIMATE),
-                 f"a motion of {X.shape[0]} samples",
+    N = X.shape[0]
+    modes_bound = fam.max_modes or MODES_ESTIMATE
+    check_memory(motion_bytes(linkage, N, modes_bound), f"a motion of {N} samples",
                  "use fewer input samples (a larger [motion] step or a shorter range)")
     Xd = per_sample(linkage, rates, "rates", X)
     Xdd = per_sample(linkage, accelerations, "accelerations", X)
-    closed = fam.closed_form_for(linkage) if X.shape[0] >= 2 else None
+    closed = fam.closed_form_for(linkage) if N >= 2 else None
     if method == "closed" and closed is None:
         with_closed = ", ".join(f.name for f in _families_with_closed_forms())
         raise CapabilityError(
-            f"no closed form for a {fam.name} with {X.shape[0]} input sample(s) (closed forms: "
+            f"no closed form for a {fam.name} with {N} input sample(s) (closed forms: "
             f"{with_closed}, with at least 2 input samples); use method 'generic'")
-    if method in ("auto", "closed") and closed is not None:
-        N = X.shape[0]
-        with progress_reporter(progress, N, "building assembly modes (closed form)") as report, \
-                build_progress(report, N):
+    use_closed = method in ("auto", "closed") and closed is not None
+    seconds = check_motion_time(linkage, N, modes_bound, generic=not use_closed,
+                                closed=closed is not None)
+    if use_closed:
+        assert closed is not None
+        with progress_reporter(progress, N, "building assembly modes (closed form)",
+                               seconds) as report, build_progress(report, N):
             motion = closed(linkage, X, Xd, Xdd)
         if callable(progress):
             progress(len(motion.modes) * N, len(motion.modes) * N)
         return motion
-    motion = generic_motion(linkage, X, Xd, Xdd, starts=starts, seed=seed, progress=progress)
+    with progress_reporter(progress, N, seconds=seconds) as report:
+        motion = generic_motion(linkage, X, Xd, Xdd, starts=starts, seed=seed,
+                                progress=report if report is not None else False)
     modes = tuple(_with_seed_names(linkage, md) for md in motion.modes)
     notes = motion.notes
     if closed is not None:
@@ -113,6 +119,54 @@ def motion_bytes(linkage: Linkage, samples: int, modes: int = MODES_ESTIMATE) ->
     freedoms = sum(j.dof for j in linkage.joints)
     floats = 24 * links + 6 * n + 4 * (freedoms + 8) + 9 * n
     return 2.8 * 8 * floats * modes * samples
+
+
+#: seconds of computing per sample and mode: a closed form's Motion (measured ~8–9 µs on the
+#: RSRC, ~2 on the CSSP), and the generic solver's per joint freedom (~2 µs × 7 freedoms on
+#: the RSRC, ~17 µs × 40 on an underdriven 40R); both rounded up (docs/reliability.md)
+CLOSED_SECONDS = 12e-6
+GENERIC_SECONDS_PER_FREEDOM = 4e-6
+
+
+def search_seconds(freedoms: int) -> float:
+    """The generic solver's root searches (first sample, anchors, branch ends) over a sweep, in
+    seconds: Newton on ``freedoms`` unknowns from 48 starts, with the continuum checks, grows as
+    the square to the cube of the freedoms (measured 0.35, 0.9, 2.2 and 11.6 s for planar loops
+    of 5, 40, 80 and 160 R joints; the fit 0.3 + 2.9e-4 m² + 1e-6 m³ bounds them)."""
+    return 0.3 + 2.9e-4 * freedoms**2 + 1e-6 * freedoms**3
+
+
+def motion_seconds(linkage: Linkage, samples: int, modes: int = MODES_ESTIMATE, *,
+                   generic: bool = False, closed: bool = False) -> float:
+    """About how many seconds of computing :func:`solve_motion` needs (known before it
+    starts): ``samples`` × ``modes`` × the per-sample cost of the route, plus the generic
+    solver's root searches; ``closed`` adds the closed form that numbers a generic run's modes
+    as its own."""
+    freedoms = sum(j.dof for j in linkage.joints)
+    seconds = CLOSED_SECONDS * samples * modes if closed else 0.0
+    if generic:
+        seconds += (search_seconds(freedoms)
+                    + GENERIC_SECONDS_PER_FREEDOM * freedoms * samples * modes)
+    return seconds
+
+
+def check_motion_time(linkage: Linkage, samples: int, modes: int, *, generic: bool,
+                      closed: bool) -> float:
+    """:func:`motion_seconds`, refused over the time limit (:func:`screwkit.budget.check_time`)
+    with what to change: fewer samples, or fewer joints where the root searches dominate."""
+    seconds = motion_seconds(linkage, samples, modes, generic=generic, closed=closed)
+    freedoms = sum(j.dof for j in linkage.joints)
+    if generic and search_seconds(freedoms) > seconds / 2:
+        advice = (f"its root searches grow as the cube of the loop's {freedoms} joint freedoms: "
+                  "describe the mechanism with fewer joints")
+    else:
+        advice = "use fewer input samples (a larger [motion] step or a shorter range)"
+        if generic and closed:
+            advice += ", or its closed form (method 'auto')"
+    check_time(seconds, f"a motion of {samples} samples"
+               + (f" by the generic solver ({freedoms} joint freedoms)" if generic else ""),
+               advice)
+    return seconds
 
 
 def _families_with_closed_forms() -> list:  # type: ignore[type-arg]

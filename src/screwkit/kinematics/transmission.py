@@ -119,22 +119,89 @@ def _planar(linkage: Linkage, mode: ModeMotion) -> bool:
     return bool(par and perp)
 
 
-def _wrench_nullspace(S: Array, cons: list[int], L: float) -> Array:
-    """(N, 6) the transmission wrench (f; m about the ground origin) reciprocal to the
-    constraint freedoms ``cons`` within the loop's twist space; NaN where not unique."""
-    scale = np.array([1, 1, 1, 1 / L, 1 / L, 1 / L])
-    Ss = S * scale[None, :, None]
+def _twist_space(S: Array, L: float) -> Array | None:
+    """(N, 6, r) an orthonormal basis of the loop's (scaled) twist space at each sample, r its
+    largest rank over the sweep; None when r = 6 (the whole space: any basis will do, and the
+    wrench is sought in R⁶ directly, without a decomposition per sample)."""
+    Ss = S * _scale(L)[None, :, None]
+    # rank 6 on a few samples is rank 6 of the sweep (r is the largest rank, at most 6)
+    few = Ss[np.linspace(0, Ss.shape[0] - 1, min(Ss.shape[0], 64)).astype(int)]
+    if _rank(np.linalg.svd(np.nan_to_num(few), compute_uv=False)).max() == 6:
+        return None
     U, sv, _ = np.linalg.svd(Ss)
-    r = int(np.max(np.sum(sv > 1e-9 * sv[:, :1], axis=-1)))
-    U = U[:, :, :r]  # the loop's twist space (scaled)
-    M = np.einsum("nir,nik->nrk", U, Ss[:, :, cons])  # (N, r, k)
-    _, sm, Vt = np.linalg.svd(np.swapaxes(M, 1, 2))  # g ⟂ columns of M
-    rank = np.sum(sm > 1e-9 * np.maximum(sm[:, :1], 1e-300), axis=-1)
-    g = Vt[:, -1, :]  # (N, r)
+    return np.asarray(U[:, :, :int(np.max(_rank(sv)))])
+
+
+def _scale(L: float) -> Array:
+    return np.array([1, 1, 1, 1 / L, 1 / L, 1 / L])
+
+
+def _rank(sv: Array) -> Array:
+    """Numerical rank of each matrix from its singular values (descending): those over
+    10⁻⁹ of the largest."""
+    return np.asarray(np.sum(sv > 1e-9 * np.maximum(sv[..., :1], 1e-300), axis=-1))
+
+
+def _maximal_minors(M: Array) -> dict[tuple[int, ...], Array]:
+    """Every k×k minor (N,) of the (N, r, k) matrices M, by its rows (sorted), built column by
+    column with the Laplace expansion along the last column: det M[T, :j+1] =
+    Σ_p (−1)^(p+j) M[T_p, j] det M[T∖T_p, :j] (a handful of array operations per minor, where
+    a determinant per minor and sample costs a LAPACK call each)."""
+    from itertools import combinations
+
+    r, k = M.shape[1], M.shape[2]
+    minors: dict[tuple[int, ...], Array] = {(i,): M[:, i, 0] for i in range(r)}
+    for j in range(1, k):
+        nxt: dict[tuple[int, ...], Array] = {}
+        for rows in combinations(range(r), j + 1):
+            total = np.zeros(M.shape[0])
+            for pos, row in enumerate(rows):
+                rest = rows[:pos] + rows[pos + 1:]
+                term = M[:, row, j] * minors[rest]
+                total = total + term if (pos + j) % 2 == 0 else total - term
+            nxt[rows] = total
+        minors = nxt
+    return minors
+
+
+def _null_vector(M: Array) -> tuple[Array, np.ndarray[Any, np.dtype[np.bool_]]]:
+    """(N, r) a unit vector orthogonal to the k < r columns of each M (N, r, k), and whether it
+    is unique (rank k, by the SVD's test: every singular value over 10⁻⁹ of the largest).
+
+    For k = r − 1 the vector is the generalised cross product of the columns, g_i =
+    (−1)^i det M₍ᵢ₎ (M without row i): it is orthogonal to every column (expanding a
+    determinant with a repeated column) and, by Cauchy–Binet, |g| = √det(MᵀM) = ∏σ. As σ_max ≤
+    ‖M‖_F, σ_min/σ_max ≥ |g| / ‖M‖_F^k, so a sample with |g| > 10⁻⁶ ‖M‖_F^k has rank k and a
+    well-defined g; the SVD decides the others and gives their vector."""
+    N, r, k = M.shape
+    g = np.zeros((N, r))
+    doubt = np.ones(N, dtype=bool)
+    if k == r - 1:
+        minors = _maximal_minors(M)
+        for i in range(r):  # the minor without row i is the one on rows {0..r-1} \ {i}
+            g[:, i] = (-1) ** i * minors[(*range(i), *range(i + 1, r))]
+        volume = np.linalg.norm(g, axis=-1)
+        doubt = ~(volume > 1e-6 * np.linalg.norm(M, axis=(1, 2)) ** k)
+        g /= np.where(doubt, 1.0, volume)[:, None]
+    unique = ~doubt
+    if doubt.any():
+        _, sm, Vt = np.linalg.svd(np.swapaxes(M[doubt], 1, 2))
+        g[doubt] = Vt[:, -1, :]
+        unique[doubt] = _rank(sm) == r - 1
+    return g, unique
+
+
+def _wrench_nullspace(S: Array, cons: list[int], L: float, U: Array | None) -> Array:
+    """(N, 6) the transmission wrench (f; m about the ground origin) reciprocal to the
+    constraint freedoms ``cons`` within the loop's twist space (basis ``U`` from
+    :func:`_twist_space`, None for the whole space); NaN where not unique."""
+    Ss = S[:, :, cons] * _scale(L)[None, :, None]
+    M = Ss if U is None else np.einsum("nir,nik->nrk", U, Ss)  # (N, r, k)
+    g, unique = _null_vector(M)  # g ⟂ columns of M
     swap = np.concatenate([np.arange(3, 6), np.arange(3)])
-    w_scaled = np.einsum("nir,nr->ni", U, g)[:, swap]  # Δ U g
+    w_scaled = (g if U is None else np.einsum("nir,nr->ni", U, g))[:, swap]  # Δ U g
     w = w_scaled * np.array([1, 1, 1, L, L, L])[None, :]
-    w[rank != r - 1] = np.nan
+    w[~unique] = np.nan
     return np.asarray(w)
 
 
@@ -172,20 +239,71 @@ def _index(w: Array, twist: Array, joint_point: Array, joint_axis: Array | None,
 def smallest_cone(directions: Array) -> tuple[Array, float]:
     """The axis (3,) and half-angle (rad) of the smallest cone containing unit ``directions``
     (K, 3): the axis is the normalised minimum-norm point of their convex hull (that point
-    maximises the smallest a·v_i over unit a), found as a non-negative least-squares problem."""
-    from scipy.optimize import nnls  # on first use: start-up stays light
+    maximises the smallest a·v_i over unit a), found as a non-negative least-squares problem.
 
+    The problem is solved on a working set (a few hundred evenly spread directions, then every
+    direction the cone leaves out, until it leaves none out): an axis a that maximises the
+    smallest a·v over a subset and gives no smaller a·v over the whole set maximises it over the
+    whole set (a subset's optimum is at least the set's), so the answer is the whole set's
+    while the least-squares problem stays small on a sweep of 10⁵ samples."""
     V = directions[np.isfinite(directions).all(axis=1)]
     if V.shape[0] == 0:
         return np.full(3, np.nan), float("nan")
-    big = 1e4
-    A = np.vstack([V.T, big * np.ones((1, V.shape[0]))])
-    lam, _ = nnls(A, np.array([0.0, 0.0, 0.0, big]), maxiter=50 * V.shape[0])
-    p = V.T @ (lam / lam.sum())
-    if np.linalg.norm(p) < 1e-9:  # the directions surround the centre: a cone wider than 90°
-        p = V.mean(axis=0) if np.linalg.norm(V.mean(axis=0)) > 1e-9 else V[0]
+    work = np.unique(np.linspace(0, V.shape[0] - 1, min(V.shape[0], 256)).astype(int))
+    while True:
+        p = _hull_min_norm_point(V[work])
+        if np.linalg.norm(p) < 1e-9:  # the directions surround the centre: wider than 90°
+            p = _hull_min_norm_point(V) if work.size < V.shape[0] else p
+            if np.linalg.norm(p) < 1e-9:
+                p = V.mean(axis=0) if np.linalg.norm(V.mean(axis=0)) > 1e-9 else V[0]
+            break
+        a = p / np.linalg.norm(p)
+        dots = V @ a
+        outside = np.flatnonzero(dots < np.min(dots[work]) - 1e-12)
+        if outside.size == 0:
+            break
+        worst = outside[np.argsort(dots[outside])[:256]]
+        work = np.union1d(work, worst)
     axis = p / np.linalg.norm(p)
     return axis, float(np.arccos(np.clip(np.min(V @ axis), -1.0, 1.0)))
+
+
+def _hull_min_norm_point(V: Array) -> Array:
+    """The minimum-norm point of the convex hull of the rows of V: non-negative least squares
+    with the weights' sum held to 1 by a heavy row (:func:`nonnegative_least_squares`)."""
+    big = 1e4
+    A = np.vstack([V.T, big * np.ones((1, V.shape[0]))])
+    lam = nonnegative_least_squares(A, np.array([0.0, 0.0, 0.0, big]), 50 * V.shape[0])
+    return np.asarray(V.T @ (lam / lam.sum()))
+
+
+def nonnegative_least_squares(A: Array, b: Array, max_iterations: int) -> Array:
+    """min ‖Ax − b‖ over x ≥ 0: the active-set method of Lawson & Hanson ("Solving Least
+    Squares Problems", 1974, ch. 23; scipy.optimize.nnls implements the same method). Written
+    here for the few rows of the smallest-cone problem, whose passive set stays small, so that
+    analyze does not import scipy.optimize (0.3 s of start-up)."""
+    m, n = A.shape
+    x = np.zeros(n)
+    passive = np.zeros(n, dtype=bool)
+    tol = 10 * np.finfo(float).eps * np.linalg.norm(A, 1) * max(m, n)
+    w = A.T @ (b - A @ x)
+    for _ in range(max_iterations):
+        if passive.all() or not (w[~passive] > tol).any():
+            break
+        passive[int(np.argmax(np.where(passive, -np.inf, w)))] = True
+        while True:
+            z = np.zeros(n)
+            z[passive] = np.linalg.lstsq(A[:, passive], b, rcond=None)[0]
+            if (z[passive] > 0).all():
+                x = z
+                break
+            shrink = passive & (z <= 0)
+            alpha = np.min(x[shrink] / (x[shrink] - z[shrink]))
+            x = x + alpha * (z - x)
+            passive &= x > tol
+            x[~passive] = 0.0
+        w = A.T @ (b - A @ x)
+    return x
 
 
 def _idle(linkage: Linkage, link: int) -> bool:
@@ -244,15 +362,17 @@ def transmission(motion: Motion) -> Transmission:
     planar = False
     for md in motion.modes:
         planar = _planar(linkage, md)
-        fr = forward(linkage, md.conf, lay)  # screws, centres and axes in the ground frame
+        # screws, centres and axes in the ground frame (the link frames are not needed)
+        fr = forward(linkage, md.conf, lay, frames=False, points=True)
         S = fr.screws
+        U = _twist_space(S, L)
         index: dict[str, Array] = {}
         for name in outputs:
             freedom, _ = output_freedom(linkage, name)
             f_out = lay.names.index(freedom)
             cons = [k for k, fname in enumerate(lay.names)
                     if fname.split(".")[0] not in in_joints and k != f_out]
-            w = _wrench_nullspace(S, cons, L)
+            w = _wrench_nullspace(S, cons, L, U)
             kind = linkage.joints[drive].kind
             axis = None if kind in ("S", "U") else fr.axes[:, drive]
             ti = _index(w, S[:, :, f_out], fr.centres[:, drive], axis, L)
