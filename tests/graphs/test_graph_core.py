@@ -172,3 +172,13 @@ def test_outputs_body_angle_and_point_travel() -> None:
     with pytest.raises(sk.ScrewkitError, match="lies along 'about'"):
         Mechanism(base.name, base.bodies, base.joints, base.inputs, base.points,
                   outputs=(BodyAngle("bad", "rocker", x, x),))
+
+
+def test_a_motion_over_the_time_limit_is_refused_up_front() -> None:
+    import time
+
+    spec = sk.load_spec(FOURBAR)
+    t = time.perf_counter()
+    with pytest.raises(sk.ScrewkitError, match="over the .* time limit; use fewer input samples"):
+        solve_mechanism(spec.mechanism, np.zeros(20_000_000))
+    assert time.perf_counter() - t < 5.0  # refused before any solving
