@@ -183,9 +183,10 @@ class GraphSpec:
         raise AssertionError  # unreachable
 
     def coordinate(self, value: Any, kind: str, key: str) -> float:
-        """A coordinate or an input measured from the drawing, in SI: like :meth:`quantity`,
-        but a plain number whose size is below the smallest accepted (CAD's round-off, such as
-        1e-15 mm) is 0, since a position or an offset from the drawing may be nought."""
+        """A coordinate, an inertia entry or an input measured from the drawing, in SI: like
+        :meth:`quantity`, but a plain number whose size is below the smallest accepted (CAD's
+        round-off, such as 1e-15 mm or a 1e-35 product of inertia) is 0, since such a value may
+        be nought."""
         if isinstance(value, int | float) and not isinstance(value, bool):
             from screwkit.io.units import MAGNITUDE_LIMITS, unit_factor
 
@@ -298,7 +299,7 @@ class GraphSpec:
             if len(b.inertia) != 3 or any(len(r) != 3 for r in b.inertia):
                 self._fail(f"{key}.inertia", "the inertia about the centre of mass is a 3×3 "
                                              "matrix [[Ixx, Ixy, Ixz], [..], [..]]")
-            inertia = np.array([[self.quantity(v, "inertia", f"{key}.inertia")
+            inertia = np.array([[self.coordinate(v, "inertia", f"{key}.inertia")
                                  for v in row] for row in b.inertia])
         try:
             return MassProperties(mass, com, inertia)
