@@ -182,3 +182,14 @@ def test_a_motion_over_the_time_limit_is_refused_up_front() -> None:
     with pytest.raises(sk.ScrewkitError, match="over the .* time limit; use fewer input samples"):
         solve_mechanism(spec.mechanism, np.zeros(20_000_000))
     assert time.perf_counter() - t < 5.0  # refused before any solving
+
+
+@pytest.mark.parametrize("command", ["validate", "analyze", "mobility", "dynamics", "limits"])
+def test_graph_commands_fit_80_columns(command: str) -> None:
+    """Every line a graph command prints fits 80 columns (errors excepted: one line each)."""
+    examples = sorted(FOURBAR.parent.glob("*.toml"))
+    for path in examples:
+        r = CliRunner(env={"COLUMNS": "80"}).invoke(app, [command, str(path)])
+        lines = [line for line in r.output.splitlines() if not line.startswith("error:")]
+        too_long = [line for line in lines if len(line) > 80]
+        assert not too_long, (path.name, too_long[:2])

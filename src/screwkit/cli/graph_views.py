@@ -58,12 +58,12 @@ def analyze_graph(spec: Any, out: Any, plot: Path | None) -> None:
 def _show(spec: Any, motion: Any, units: Any, full: bool) -> None:
     from rich.markup import escape
 
-    from screwkit.cli.common import console
+    from screwkit.cli.common import console, prose
     from screwkit.cli.formatting import print_long_table, table_columns
     from screwkit.io.mechanism_documents import mechanism_table
 
-    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
-    console.print(f"method: {motion.method}; {units.describe()}", highlight=False)
+    prose(f"[bold]{escape(spec.describe(units))}[/]")
+    prose(f"method: {motion.method}; {units.describe()}")
     table = mechanism_table(motion)
     mech = spec.mechanism
     for md in motion.modes:
@@ -75,18 +75,17 @@ def _show(spec: Any, motion: Any, units: Any, full: bool) -> None:
         for p in list(md.points)[:2]:
             names += [f"{p}_{a}" for a in "xyz"]
         cols, values = table_columns(table, [n for n in names if n in table.names], units)
-        print_long_table(console, f"assembly mode {md.index} (the drawn mode)", cols, values,
+        print_long_table(console, f"assembly mode {md.index} (drawn)", cols, values,
                          full)
         hidden = len(md.variables) - len(shown) - len(mech.inputs)
         if hidden > 0:
-            console.print(f"  • {len(shown)} of {len(shown) + hidden} variables shown; every "
-                          "variable and point is in --csv and --json", highlight=False)
+            prose(f"  • {len(shown)} of {len(shown) + hidden} variables shown; every "
+                  "variable and point is in --csv and --json")
         for ev in md.events:
-            console.print(f"  • {escape(ev)}", highlight=False)
+            prose(f"  • {escape(ev)}")
         missing = int((~np.asarray(md.assembles)).sum())
         if missing:
-            console.print(f"  • does not assemble at {missing} of {motion.samples} inputs",
-                          highlight=False)
+            prose(f"  • does not assemble at {missing} of {motion.samples} inputs")
 
 
 def graph_dynamics(spec: Any, gravity: bool) -> Any:
@@ -164,12 +163,11 @@ def _show_dynamics(spec: Any, dyn: Any, summary: dict[str, dict[str, Any]], unit
                    gravity: bool) -> None:
     from rich.markup import escape
 
-    from screwkit.cli.common import console
+    from screwkit.cli.common import console, prose
     from screwkit.cli.formatting import TextColumn, number, print_columns
 
-    console.print(f"[bold]{escape(spec.describe(units))}[/]", highlight=False)
-    console.print("gravity on" if gravity else "gravity off (add it with --gravity)",
-                  highlight=False)
+    prose(f"[bold]{escape(spec.describe(units))}[/]")
+    prose("gravity on" if gravity else "gravity off (add it with --gravity)")
     kind0 = "length" if spec.mechanism.inputs[0].endswith(".s") else "angle"
     names = list(summary)
     cols = [TextColumn("load", names, "left"),
@@ -183,14 +181,14 @@ def _show_dynamics(spec: Any, dyn: Any, summary: dict[str, dict[str, Any]], unit
                         for n in names])]
     print_columns(console, "loads of the drawn mode (RMS and peak over the motion)", cols)
     if dyn.indeterminate:
-        console.print(f"  • {dyn.indeterminate} statically indeterminate reaction component(s) "
-                      f"(joints {', '.join(dyn.indeterminate_joints[:6])}"
-                      f"{', …' if len(dyn.indeterminate_joints) > 6 else ''}): the least-norm "
-                      "reactions are shown", highlight=False)
+        prose(f"  • {dyn.indeterminate} statically indeterminate reaction component(s) "
+              f"(joints {', '.join(dyn.indeterminate_joints[:6])}"
+              f"{', …' if len(dyn.indeterminate_joints) > 6 else ''}): the least-norm "
+              "reactions are shown")
     bad = int((~dyn.ok).sum())
     if bad:
-        console.print(f"  • no loads at {bad} sample(s) where the mode does not assemble or "
-                      "is singular", highlight=False)
+        prose(f"  • no loads at {bad} sample(s) where the mode does not assemble or "
+              "is singular")
 
 
 def demo_graph_example(f: Path, output_dir: Path, files: list[Path], plots: bool,
@@ -199,7 +197,7 @@ def demo_graph_example(f: Path, output_dir: Path, files: list[Path], plots: bool
     has mass properties, and the 3-D report; the demo table's row and the index entry."""
     from rich.markup import escape
 
-    from screwkit.cli.common import console, guard
+    from screwkit.cli.common import guard, prose
     from screwkit.io.mechanism_documents import mechanism_document, mechanism_table
     from screwkit.io.results import write_json_atomic
     from screwkit.io.spec import load_spec
@@ -211,7 +209,7 @@ def demo_graph_example(f: Path, output_dir: Path, files: list[Path], plots: bool
 
     spec: Any = guard(lambda: load_spec(f))
     du = spec.display_units()
-    console.print(f"[green]ok[/] {escape(spec.describe())}", highlight=False)
+    prose(f"[green]ok[/] {escape(spec.describe())}")
     motion = guard(lambda: solved(spec))
     write(output_dir / f"{f.stem}.analysis.json", mechanism_document(motion, spec.topology))
     guard(lambda: write_table(mechanism_table(motion), output_dir / f"{f.stem}.analysis.csv",
