@@ -193,3 +193,11 @@ def test_graph_commands_fit_80_columns(command: str) -> None:
         lines = [line for line in r.output.splitlines() if not line.startswith("error:")]
         too_long = [line for line in lines if len(line) > 80]
         assert not too_long, (path.name, too_long[:2])
+
+
+def test_analyze_plot_of_a_graph(tmp_path: Path) -> None:
+    png = tmp_path / "watt.png"
+    r = CliRunner().invoke(app, ["analyze", str(FOURBAR), "--plot", str(png), "-o",
+                                 str(tmp_path / "a.npz")])
+    assert r.exit_code == 0, r.output
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000

@@ -46,10 +46,12 @@ def analyze_graph(spec: Any, out: Any, plot: Path | None) -> None:
 
     motion = guard(lambda: solved(spec))
     du = out.units_for(spec.units)
-    if plot is not None:
-        from screwkit.cli.common import user_error
+    if plot is not None:  # the loops' picture of every variable and point path fits a graph
+        from screwkit.report.plots import plot_analysis
 
-        user_error("--plot is not offered for graph specs yet; use `screwkit report` or --csv")
+        document = mechanism_document(motion, spec.topology)
+        guard(lambda: plot_analysis(document, plot, units=du))
+        out.note_written(plot)
     out.deliver(document=lambda: mechanism_document(motion, spec.topology),
                 table=lambda: mechanism_table(motion),
                 show=lambda: _show(spec, motion, du, out.full), units=du)
