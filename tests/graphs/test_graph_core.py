@@ -201,3 +201,43 @@ def test_analyze_plot_of_a_graph(tmp_path: Path) -> None:
                                  str(tmp_path / "a.npz")])
     assert r.exit_code == 0, r.output
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+
+
+def test_review_findings_stay_fixed() -> None:
+    """What an independent review found: limits on a falling sweep, a long step away from a
+    fold, an idle motion that is no rod spin, an unnormalised axis, a point off an idle rod."""
+    spec = sk.load_spec(FOURBAR)
+    down = solve_mechanism(spec.mechanism, np.radians(np.arange(360.0, -1.0, -5.0)))
+    up = solve_mechanism(spec.mechanism, np.radians(np.arange(0.0, 361.0, 5.0)))
+    got = [round(lim.input, 9) for lim in graph_limit_positions(down, "D.theta").limits]
+    want = [round(lim.input, 9) for lim in graph_limit_positions(up, "D.theta").limits]
+    assert got == want
+    # a non-Grashof four-bar (crank 3, coupler 3, rocker 3, ground 4): from next to the crank's
+    # limit at 117.28° straight back to −50° on the same branch
+    c = [3.5, float(np.sqrt(9 - 0.25)), 0.0]
+    ng = Mechanism("non-Grashof", (Body("crank"), Body("coupler"), Body("rocker")),
+                   (joint("A", "R", "ground", "crank", [0, 0, 0]),
+                    joint("B", "R", "crank", "coupler", [3, 0, 0]),
+                    joint("C", "R", "coupler", "rocker", c),
+                    joint("D", "R", "rocker", "ground", [4, 0, 0])), ("A.theta",))
+    far = solve_mechanism(ng, np.radians([0.0, 116.0, -50.0])).modes[0]
+    near = solve_mechanism(ng, np.radians(np.r_[0.0:117.0:1.0, 116.0:-51.0:-1.0])).modes[0]
+    assert far.assembles.all() and not far.events
+    np.testing.assert_allclose(far.variables["D.theta"][-1], near.variables["D.theta"][-1],
+                               atol=1e-10)
+    # a U joint whose rod lies in the plane of its axes: a singular drawing, not an idle spin
+    rsur = Mechanism("RSUR", (Body("crank"), Body("rod"), Body("rocker")),
+                     (joint("A", "R", "ground", "crank", [0, 0, 0]),
+                      joint("B", "S", "crank", "rod", [1, 0, 0]),
+                      joint("C", "U", "rod", "rocker", [3, 2, 1], [0, 1, 0.3],
+                            axis2=np.array([1.0, 0.0, 0.2])),
+                      joint("D", "R", "rocker", "ground", [3, 0, 1], [1, 0, 0])), ("A.theta",))
+    assert "the drawing is at a dead centre" in mechanism_topology(rsur).verdict
+    # an axis of any length is a direction
+    long_axis = joint("A", "R", "ground", "crank", [0, 0, 0], 2 * Z)
+    np.testing.assert_allclose(long_axis.axis, Z)
+    # a point off an idle rod's line has no path
+    base = rssr()
+    with pytest.raises(sk.ScrewkitError, match="off their line"):
+        Mechanism(base.name, base.bodies, base.joints, base.inputs,
+                  (BodyPoint("off", "rod", np.array([2.0, 1.0, 0.0])),))

@@ -291,8 +291,10 @@ class GraphSpec:
                 self._fail(f"{key}.mass", f"body {b.name!r} has 'com' or 'inertia' but no mass")
             return None
         mass = self.quantity(b.mass, "mass", f"{key}.mass")
-        com = (self._vector(b.com, "length", f"{key}.com") if b.com is not None
-               else np.zeros(3))
+        if b.com is None:  # the drawing's origin is no default for a body's centre of mass
+            self._fail(f"{key}.com", f"body {b.name!r} has a mass: give its centre of mass in "
+                                     "the drawing, com = [x, y, z]")
+        com = self._vector(b.com or [], "length", f"{key}.com")
         if b.inertia is None:
             inertia = np.zeros((3, 3))
         else:

@@ -22,13 +22,14 @@ S     wx, wy, wz (body increments)            any rotation about c
 ====  ======================================  ====================================
 
 Input values are measured from the drawing (every freedom is 0 there). A single loop is the case
-with one independent loop (:meth:`Mechanism.from_linkage`).
+with one independent loop (:func:`screwkit.kinematics.graph.from_loop.mechanism_from_loop`
+redraws a solved loop as a graph).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
@@ -79,6 +80,15 @@ class MechanismJoint:
     axis2: Array | None = None
     pitch: float = 0.0
 
+    def __post_init__(self) -> None:
+        where = f"joint {self.name!r}"
+        object.__setattr__(self, "at", point3(self.at, f"{where}: 'at'"))
+        object.__setattr__(self, "axis", unit_vector(self.axis, f"{where}: 'axis'"))
+        if self.axis2 is not None:
+            object.__setattr__(self, "axis2", unit_vector(self.axis2, f"{where}: 'axis2'"))
+        if not np.isfinite(self.pitch):
+            raise MechanismError(f"{where}: the pitch must be a finite number")
+
     @property
     def freedoms(self) -> tuple[str, ...]:
         return JOINT_FREEDOMS[self.kind]
@@ -94,6 +104,9 @@ class BodyPoint:
     name: str
     body: str
     at: Array
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "at", point3(self.at, f"point {self.name!r}: 'at'"))
 
 
 @dataclass(frozen=True)
@@ -125,9 +138,13 @@ def _name_ok(kind: str, name: object) -> str:
 
 def unit_vector(value: ArrayLike, what: str) -> Array:
     """A 3-vector scaled to unit length; a clear error for a wrong shape or zero length."""
-    v = np.asarray(value, dtype=float)
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise MechanismError(f"{what} must be three numbers; got {value!r}") from None
     if v.shape != (3,) or not np.all(np.isfinite(v)):
         raise MechanismError(f"{what} must be three finite numbers; got {value!r}")
+    v = v / max(float(np.max(np.abs(v))), 1e-300)  # scaled first: no overflow in the norm
     n = float(np.linalg.norm(v))
     if n == 0.0:
         raise MechanismError(f"{what} has zero length; give a direction such as [0, 0, 1]")
@@ -135,7 +152,10 @@ def unit_vector(value: ArrayLike, what: str) -> Array:
 
 
 def point3(value: ArrayLike, what: str) -> Array:
-    v = np.asarray(value, dtype=float)
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise MechanismError(f"{what} must be three numbers [x, y, z]; got {value!r}") from None
     if v.shape != (3,) or not np.all(np.isfinite(v)):
         raise MechanismError(f"{what} must be three finite numbers [x, y, z]; got {value!r}")
     return v
@@ -179,6 +199,7 @@ class Mechanism:
             pts = np.array([j.at for j in self.joints])
             spread = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
             object.__setattr__(self, "length_scale", max(spread, 1e-9))
+        self._check_rods()
         _ = self.topology  # bodies attached to nothing are refused here
 
     def _check_joint(self, j: MechanismJoint, known: set[str]) -> None:
@@ -203,8 +224,39 @@ class Mechanism:
                 raise MechanismError(f"joint {j.name!r}: a U joint's two axes must not be "
                                      "parallel")
 
+    def _check_rods(self) -> None:
+        """A body held by exactly two ball joints spins idly about the line through them: a
+        point off that line, or an angle of that body, has no defined motion."""
+        for b in self.body_names:
+            joints = [j for j in self.joints if b in j.bodies]
+            if len(joints) != 2 or any(j.kind != "S" for j in joints):
+                continue
+            a, c = joints[0].at, joints[1].at
+            u = (c - a) / max(float(np.linalg.norm(c - a)), 1e-300)
+            for p in self.points:
+                off = p.at - a - ((p.at - a) @ u) * u
+                if p.body == b and float(np.linalg.norm(off)) > 1e-9 * self.length_scale:
+                    raise MechanismError(
+                        f"point {p.name!r} is on {b!r}, a rod between the balls "
+                        f"{joints[0].name!r} and {joints[1].name!r}, off their line: the rod's "
+                        "spin about that line is idle, so the point has no defined path; put it "
+                        "on the line, or join the rod by a U joint at one end")
+            for o in self.outputs:
+                if isinstance(o, BodyAngle) and o.body == b:
+                    raise MechanismError(
+                        f"output {o.name!r}: {b!r} is a rod between two balls, whose spin is "
+                        "idle; measure the angle on a body the joints hold fully")
+
     def _check_outputs(self, known: set[str]) -> None:
         _unique("output", [_name_ok("output", o.name) for o in self.outputs], self.name)
+        unit: list[Output] = []  # directions as unit vectors (a clear error for a bad one)
+        for o in self.outputs:
+            if isinstance(o, BodyAngle):
+                unit.append(replace(o, vector=unit_vector(o.vector, f"output {o.name!r}: vector"),
+                                    about=unit_vector(o.about, f"output {o.name!r}: about")))
+            else:
+                unit.append(replace(o, along=unit_vector(o.along, f"output {o.name!r}: along")))
+        object.__setattr__(self, "outputs", tuple(unit))
         points = {p.name for p in self.points}
         taken = set(self.freedom_names) | points
         for o in self.outputs:

@@ -56,10 +56,16 @@ def graph_limit_positions(motion: MechanismMotion, output: str | None = None,
     x = motion.inputs[:, 0]
     found = []
     h = 1e-3 * (lay.length if lay.is_translation[lay.inputs[0]] else 1.0)
+    ok_samples = md.assembles & ~md.singular
+    # d output / d input at every sample (unit input rate: independent of the motion's speed)
+    lin = linearise(mech, lay, md.conf.take(np.nonzero(ok_samples)[0]), exact=False)
+    unit = np.full((int(ok_samples.sum()), lay.m), np.nan)
+    unit[:] = rates(mech, lay, lin, np.ones((unit.shape[0], 1)))
     for name in outputs:
         f = lay.names.index(name)
-        d1 = md.velocities[name] / motion.input_rates[:, 0]
-        ok = md.assembles & ~md.singular & np.isfinite(d1)
+        d1 = np.full(md.samples, np.nan)
+        d1[ok_samples] = unit[:, f]
+        ok = ok_samples & np.isfinite(d1)
         for k in np.nonzero(ok[:-1] & ok[1:] & (np.sign(d1[:-1]) * np.sign(d1[1:]) < 0))[0]:
             lim = _refine(motion, lay, md.conf.take(slice(k, k + 1)), x[k], x[k + 1], f, h,
                           dwell_tolerance)
@@ -83,7 +89,7 @@ def _refine(motion: MechanismMotion, lay: GraphLayout, conf: Configuration, xa: 
         value, d1, d2 = _jet(motion, lay, here, f)
         at, x_at = here, x
         step = -d1 / d2 if d2 != 0 else 0.0
-        x_new = min(max(x + step, xa), xb)  # stay inside the bracket
+        x_new = min(max(x + step, min(xa, xb)), max(xa, xb))  # inside the bracket, either way
         if abs(x_new - x) < 1e-14 * max(1.0, abs(x)):
             break
         x = x_new

@@ -172,9 +172,15 @@ def _null_freedoms(mech: Mechanism, lay: GraphLayout, lin: Any) -> tuple[list[st
         return [names[k] for k in piv[: dirs.shape[0]]]
 
     rods = _rods(mech)
-    idle = ([f"{body} spin (about the line {a}–{b})" for body, a, b in rods]
-            if len(rods) == idle_dirs.shape[0] else pick(idle_dirs))
-    return idle, pick(free_dirs)
+    d = idle_dirs.shape[0]
+    if len(rods) > d:  # some rods cannot spin here (loaded by other constraints)
+        return pick(idle_dirs), pick(free_dirs)
+    idle = [f"{body} spin (about the line {a}–{b})" for body, a, b in rods]
+    # an idle motion beyond the rods' spins is no structural freedom: the drawing is singular
+    # there (a U joint with its rod in the plane of its axes …), so it counts as free
+    balls = {j for _, a, b in rods for j in (a, b)}
+    extra = [n for n in pick(idle_dirs) if n.split(".")[0] not in balls][:d - len(rods)]
+    return idle, pick(free_dirs) + extra
 
 
 def _rods(mech: Mechanism) -> list[tuple[str, str, str]]:

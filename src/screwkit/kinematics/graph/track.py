@@ -7,8 +7,8 @@ along each sample's input increment), corrects them all by one batched Newton so
 longest run that (a) closes and (b) is consistent with its own rates: consecutive samples must
 differ by the trapezoid rule's ½(q̇ₖ + q̇ₖ₊₁)Δx up to a fraction of the step, which a jump onto
 another branch cannot meet. K doubles after a full wave and shrinks after a short one; where a
-single sample fails, the input step is split (up to 2⁶ parts) before the mode is declared to stop
-assembling there (a fold: the branch turns back, a dead centre or limit position).
+single sample fails, the input step is halved where it fails, down to 1e-7 rad (or 1e-7 of the
+length scale), before the mode is declared to stop assembling there (a fold: the branch turns back, a dead centre or limit position).
 """
 
 from __future__ import annotations
@@ -38,7 +38,10 @@ Array = NDArray[np.float64]
 MAX_WAVE = 512
 #: a step is consistent when its trapezoid-rule error is below this fraction of the step
 CONSISTENCY = 0.05
-MAX_SPLIT_DEPTH = 6
+#: a failed step is halved until its sub-steps are this small (rad, or this fraction of the
+#: length scale for a slide): a step that starts next to a fold needs many halvings there
+SMALLEST_STEP = 1e-7
+MAX_SPLIT_DEPTH = 60
 
 
 @dataclass
@@ -107,8 +110,10 @@ def _wave(mech: Mechanism, lay: GraphLayout, at: _Point, X: Array
 
 def _split_step(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array, depth: int
                 ) -> _Point | None:
-    """Reach input ``x`` from ``at`` in 2, then 4 … sub-steps; None where it cannot."""
-    if depth > MAX_SPLIT_DEPTH:
+    """Reach input ``x`` from ``at`` in 2, then 4 … sub-steps, halving where a sub-step fails
+    until it is :data:`SMALLEST_STEP` long; None where it cannot (a fold in between)."""
+    scale = np.where(np.array([lay.is_translation[f] for f in lay.inputs]), lay.length, 1.0)
+    if depth > MAX_SPLIT_DEPTH or float(np.max(np.abs(x - at.x) / scale)) < SMALLEST_STEP:
         return None
     mid = 0.5 * (at.x + x)
     for target in (mid, x):
