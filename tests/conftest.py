@@ -20,3 +20,4 @@ def playwright_driver() -> Iterator[Any]:
 
     with sync_playwright() as p:
         yield p
+

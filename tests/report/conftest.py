@@ -12,22 +12,14 @@ from typing import Any
 import numpy as np
 import pytest
 
-CHROMIUM = Path("/usr/bin/chromium")
-ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run",
-        "--disable-default-apps", "--disable-extensions"]
+from browser_helpers import launch_chromium
 
 
 @pytest.fixture(scope="session")
 def browser_context(tmp_path_factory: pytest.TempPathFactory,
                     playwright_driver: Any) -> Iterator[Any]:
-    if not CHROMIUM.exists():
-        pytest.fail("the report tests need Debian's chromium at /usr/bin/chromium: run "
-                    "`make test` (it installs it) or `apt-get install -y chromium`")
-    p = playwright_driver
-    context = p.chromium.launch_persistent_context(
-        str(tmp_path_factory.mktemp("chromium-profile")), executable_path=str(CHROMIUM),
-        headless=True, args=ARGS, viewport={"width": 1280, "height": 800})
+    context = launch_chromium(playwright_driver, tmp_path_factory.mktemp("chromium-profile"),
+                             "report", viewport={"width": 1280, "height": 800})
     try:
         yield context
     finally:

@@ -13,13 +13,10 @@ from typing import Any
 
 import pytest
 
+from browser_helpers import launch_chromium
 from screwkit.studio.server import Studio, bind, make_server, new_studio, url_of
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
-CHROMIUM = Path("/usr/bin/chromium")
-ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run",
-        "--disable-default-apps", "--disable-extensions"]
 
 
 @dataclass
@@ -80,14 +77,9 @@ def served(rssr_copy: Path) -> Iterator[Served]:
 @pytest.fixture(scope="module")
 def browser(tmp_path_factory: pytest.TempPathFactory,
             playwright_driver: Any) -> Iterator[Any]:
-    if not CHROMIUM.exists():
-        pytest.fail("the studio tests need Debian's chromium at /usr/bin/chromium: run "
-                    "`make test` (it installs it) or `apt-get install -y chromium`")
-    p = playwright_driver
-    context = p.chromium.launch_persistent_context(
-        str(tmp_path_factory.mktemp("chromium-profile")), executable_path=str(CHROMIUM),
-        headless=True, args=ARGS, viewport={"width": 1400, "height": 900},
-        accept_downloads=True)
+    context = launch_chromium(playwright_driver, tmp_path_factory.mktemp("chromium-profile"),
+                             "studio", viewport={"width": 1400, "height": 900},
+                             accept_downloads=True)
     try:
         yield context
     finally:

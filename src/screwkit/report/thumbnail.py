@@ -61,16 +61,26 @@ def _path(points: Array, fit: tuple[float, float, float]) -> str:
     return " ".join(out)
 
 
+def _opening(title: str) -> tuple[str, str]:
+    """The SVG element's opening tag and its title."""
+    box = (f"<svg xmlns='http://www.w3.org/2000/svg' width='{WIDTH}' height='{HEIGHT}' "
+           f"viewBox='0 0 {WIDTH} {HEIGHT}' role='img'>")
+    return box, f"<title>{html.escape(title)}</title>" if title else ""
+
+
+def _empty(box: str, label: str) -> str:
+    """The picture of a mechanism that assembles nowhere: a frame saying so."""
+    return (box + label + f"<text x='{WIDTH / 2}' y='{HEIGHT / 2}' text-anchor='middle' "
+            "font-size='11' fill='#777'>does not assemble</text></svg>")
+
+
 def mechanism_svg(linkage: Any, motion: Any, preferred_mode: int = 0, title: str = "") -> str:
     """The gallery picture (module docstring) of ``motion`` (a solved motion of ``linkage``);
     an empty frame saying so when no mode assembles."""
-    box = (f"<svg xmlns='http://www.w3.org/2000/svg' width='{WIDTH}' height='{HEIGHT}' "
-           f"viewBox='0 0 {WIDTH} {HEIGHT}' role='img'>")
-    label = f"<title>{html.escape(title)}</title>" if title else ""
+    box, label = _opening(title)
     chosen = shown_mode_and_frame(motion, preferred_mode)
     if chosen is None:
-        return (box + label + f"<text x='{WIDTH / 2}' y='{HEIGHT / 2}' text-anchor='middle' "
-                "font-size='11' fill='#777'>does not assemble</text></svg>")
+        return _empty(box, label)
     k, frame = chosen
     mode = motion.modes[k]
     view = view_rotation()
@@ -100,13 +110,10 @@ def mechanism_svg(linkage: Any, motion: Any, preferred_mode: int = 0, title: str
 def graph_svg(mechanism: Any, motion: Any, title: str = "") -> str:
     """The gallery picture of a mechanism graph's drawn mode: each body as the polygon of its
     joint centres at the first assembling frame, over the paths of the joint centres."""
-    box = (f"<svg xmlns='http://www.w3.org/2000/svg' width='{WIDTH}' height='{HEIGHT}' "
-           f"viewBox='0 0 {WIDTH} {HEIGHT}' role='img'>")
-    label = f"<title>{html.escape(title)}</title>" if title else ""
+    box, label = _opening(title)
     chosen = shown_mode_and_frame(motion, 0)
     if chosen is None:
-        return (box + label + f"<text x='{WIDTH / 2}' y='{HEIGHT / 2}' text-anchor='middle' "
-                "font-size='11' fill='#777'>does not assemble</text></svg>")
+        return _empty(box, label)
     k, frame = chosen
     mode = motion.modes[k]
     view = view_rotation()
