@@ -33,8 +33,8 @@ def run() -> list[dict[str, Any]]:
     from screwkit.balancing.qp import solve_qp
     from screwkit.io.balancing_table import balancing_table, blocks_from_table
     from screwkit.io.spec import load_spec
-    from screwkit.kinematics.cssp_motion import cssp_mode_motion
-    from screwkit.kinematics.generic_motion import generic_motion as motion
+    from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
+    from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
     from screwkit.pipeline import balance_from_spec
 
     out: list[dict[str, Any]] = []

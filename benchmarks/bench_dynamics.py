@@ -201,7 +201,7 @@ def fused_cssp_dynamics(linkage: Any, theta: np.ndarray, omega: float, omega_dot
 def _check_fused(lk: Any, omega: float, gravity: list[float]) -> float:
     """Largest difference of the prototype from the library, relative to the peak load."""
     from screwkit.dynamics import inverse_dynamics
-    from screwkit.kinematics.cssp_motion import cssp_mode_motion
+    from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
 
     theta = np.linspace(0.0, 2 * np.pi, 20_000, endpoint=False)
     ref = inverse_dynamics(lk, cssp_mode_motion(lk, theta, omega, 0.0), gravity=gravity)
@@ -224,7 +224,7 @@ def _check_fused(lk: Any, omega: float, gravity: list[float]) -> float:
 
 # ---------------------------------------------------------------------------------------------
 def _generic_kinematics(lk: Any, omega: float) -> float:
-    from screwkit.kinematics.generic_motion import generic_motion as motion
+    from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
 
     base = 72
     theta = np.linspace(0.0, 2 * np.pi, base, endpoint=False)
@@ -421,7 +421,7 @@ def every_family_memory(samples: int = SAMPLES) -> list[dict[str, Any]]:
 def profile_dynamics(samples: int = SAMPLES, top: int = 14) -> str:
     """cProfile of ``inverse_dynamics`` on the closed-form ModeMotion (sorted by own time)."""
     from screwkit.dynamics import inverse_dynamics
-    from screwkit.kinematics.cssp_motion import cssp_mode_motion
+    from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
 
     lk, omega = _cssp()
     theta = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
@@ -439,7 +439,7 @@ def _dynamics_on_modes(lk: Any, theta: np.ndarray, omega: float) -> tuple[float,
     """inverse_dynamics on the lean and on the default-kinematics ModeMotion: µs/sample of
     each and the peak memory (MiB) of the first."""
     from screwkit.dynamics import inverse_dynamics
-    from screwkit.kinematics.cssp_motion import cssp_mode_motion
+    from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
 
     lean = cssp_mode_motion(lk, theta, omega, 0.0, ball_joints=False)
     dyn = _best_time(lambda: inverse_dynamics(lk, lean, GRAVITY)) / theta.size * 1e6
@@ -451,7 +451,7 @@ def _dynamics_on_modes(lk: Any, theta: np.ndarray, omega: float) -> tuple[float,
 
 def run(samples: int = SAMPLES, families: bool = True) -> list[dict[str, Any]]:
     from screwkit.dynamics import cssp_inverse_dynamics, inverse_dynamics
-    from screwkit.kinematics.cssp_motion import cssp_mode_motion
+    from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
 
     lk, omega = _cssp()
     theta = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)

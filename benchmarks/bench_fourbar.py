@@ -16,7 +16,11 @@ from typing import Any
 
 import numpy as np
 
-from screwkit.kinematics.fourbar import fourbar, fourbar_output_angles, fourbar_positions
+from screwkit.kinematics.closed_forms.fourbar import (
+    fourbar,
+    fourbar_output_angles,
+    fourbar_positions,
+)
 
 N_INPUTS = 1_000_000
 REPEATS = 5

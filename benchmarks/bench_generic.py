@@ -65,10 +65,10 @@ def _in_a_fresh_process(code: str) -> dict[str, float]:
 
 def _rsrc_rows() -> list[dict[str, Any]]:
     from screwkit.io.spec import load_spec
-    from screwkit.kinematics.closed_form_motion import rsrc_dimensions
-    from screwkit.kinematics.joint_motion import solve_joints
-    from screwkit.kinematics.rsrc import rsrc_motion
+    from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
+    from screwkit.kinematics.closed_forms.rsrc import rsrc_motion
     from screwkit.kinematics.solve_motion import solve_motion
+    from screwkit.kinematics.tracker.joint_motion import solve_joints
 
     lk = load_spec(ROOT / "examples" / "bagci_fig7_rsrc.toml").linkage
     theta = np.linspace(0.0, 2 * np.pi, SAMPLES, endpoint=False)

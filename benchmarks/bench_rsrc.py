@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from screwkit.kinematics.rsrc import (
+from screwkit.kinematics.closed_forms.rsrc import (
     RSRCDimensions,
     rsrc_kinematics,
     rsrc_motion,

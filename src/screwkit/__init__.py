@@ -55,14 +55,14 @@ _EXPORTS: dict[str, str] = {
     "family": "screwkit.kinematics.registry",
     # kinematics
     "solve_motion": "screwkit.kinematics.solve_motion",
-    "solve_joints": "screwkit.kinematics.joint_motion",
-    "JointMotion": "screwkit.kinematics.joint_motion",
+    "solve_joints": "screwkit.kinematics.tracker.joint_motion",
+    "JointMotion": "screwkit.kinematics.tracker.joint_motion",
     "Motion": "screwkit.kinematics.motion",
     "ModeMotion": "screwkit.kinematics.motion",
     "AssemblyError": "screwkit.kinematics.motion",
-    "limit_positions": "screwkit.kinematics.limit_positions",
-    "coupler_point_path": "screwkit.kinematics.coupler_curves",
-    "transmission": "screwkit.kinematics.transmission",
+    "limit_positions": "screwkit.kinematics.analysis.limit_positions",
+    "coupler_point_path": "screwkit.kinematics.analysis.coupler_curves",
+    "transmission": "screwkit.kinematics.analysis.transmission",
     "mobility": "screwkit.mobility",   # the package, callable: screwkit.mobility(linkage)
     # dynamics
     "inverse_dynamics": "screwkit.dynamics.inverse",
@@ -160,16 +160,16 @@ if TYPE_CHECKING:
     from screwkit.errors import ScrewkitError
     from screwkit.io.errors import SpecError
     from screwkit.io.spec import Spec, load_spec
-    from screwkit.kinematics.coupler_curves import coupler_point_path
+    from screwkit.kinematics.analysis.coupler_curves import coupler_point_path
+    from screwkit.kinematics.analysis.limit_positions import limit_positions
+    from screwkit.kinematics.analysis.loop_mobility import mobility
+    from screwkit.kinematics.analysis.transmission import transmission
     from screwkit.kinematics.graph.motion import MechanismMotion, solve_mechanism
     from screwkit.kinematics.graph.topology import mechanism_topology
-    from screwkit.kinematics.joint_motion import JointMotion, solve_joints
-    from screwkit.kinematics.limit_positions import limit_positions
-    from screwkit.kinematics.loop_mobility import mobility
     from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
     from screwkit.kinematics.registry import family
     from screwkit.kinematics.solve_motion import solve_motion
-    from screwkit.kinematics.transmission import transmission
+    from screwkit.kinematics.tracker.joint_motion import JointMotion, solve_joints
     from screwkit.model.families import cssp, fourbar, rccc, rsrc, rssr
     from screwkit.model.joints import Joint
     from screwkit.model.linkage import Link, Linkage

@@ -17,18 +17,18 @@ from screwkit.dynamics import Dynamics, inverse_dynamics
 from screwkit.errors import InputError, ScrewkitError, expect_instance
 from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec
-from screwkit.kinematics.coupler_curves import coupler_curves
-from screwkit.kinematics.limit_positions import (
+from screwkit.kinematics.analysis.coupler_curves import coupler_curves
+from screwkit.kinematics.analysis.limit_positions import (
     LimitPositions,
     LimitsConfig,
     limit_positions,
     uses_closed_form,
 )
-from screwkit.kinematics.loop import Array
-from screwkit.kinematics.loop_mobility import LinkageMobility, mobility
+from screwkit.kinematics.analysis.loop_mobility import LinkageMobility, mobility
+from screwkit.kinematics.analysis.transmission import Transmission, transmission
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
-from screwkit.kinematics.transmission import Transmission, transmission
+from screwkit.kinematics.tracker.loop import Array
 from screwkit.messages import message_units, number
 from screwkit.tables import ResultTable, UnitChoice
 

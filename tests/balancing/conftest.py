@@ -25,7 +25,7 @@ def fourbar_spec(tmp_path: Path, balancing: str, direction: str = "[0, -1, 0]") 
 @cache
 def _rahman() -> tuple:
     from screwkit.io.spec import load_spec
-    from screwkit.kinematics.generic_motion import generic_motion as motion
+    from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
 
     spec = load_spec(EXAMPLE)
     m = motion(spec.linkage, spec.inputs, spec.speed, spec.acceleration)

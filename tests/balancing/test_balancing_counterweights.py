@@ -19,7 +19,7 @@ from screwkit.balancing.pareto import pareto_front
 from screwkit.balancing.problem import solve_balancing
 from screwkit.balancing.variables import LinearConstraint
 from screwkit.dynamics import inverse_dynamics
-from screwkit.kinematics.generic_motion import generic_motion as motion
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
 from screwkit.model.families import fourbar
 from screwkit.model.linkage import Link
 from screwkit.model.mass import MassProperties

@@ -13,8 +13,8 @@ import pytest
 import screwkit as sk
 from screwkit.io.errors import SpecError
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.coupler_curves import coupler_point, coupler_point_path
-from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_coupler_point, rsrc_positions
+from screwkit.kinematics.analysis.coupler_curves import coupler_point, coupler_point_path
+from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, rsrc_coupler_point, rsrc_positions
 from screwkit.pipeline import Pipeline
 
 EXAMPLES = Path("examples")

@@ -12,7 +12,7 @@ import pytest
 import screwkit as sk
 from screwkit.errors import UnknownNameError
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.limit_positions import limit_positions
+from screwkit.kinematics.analysis.limit_positions import limit_positions
 from screwkit.model.joints import Joint
 from screwkit.model.linkage import Linkage
 

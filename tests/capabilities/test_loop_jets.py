@@ -1,4 +1,4 @@
-"""Taylor coefficients of the loop closure (kinematics/loop_jets.py) against Bagci's exact
+"""Taylor coefficients of the loop closure (kinematics/tracker/loop_jets.py) against Bagci's exact
 App. D coefficients of the RSRC, the motion's rate equations, and differences of the exact
 second derivative; branch following against the closed form."""
 
@@ -11,8 +11,12 @@ import pytest
 
 import screwkit as sk
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.loop_jets import close_loop, closure_error, follow, taylor_jets
-from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_output_derivatives, rsrc_positions
+from screwkit.kinematics.closed_forms.rsrc import (
+    RSRCDimensions,
+    rsrc_output_derivatives,
+    rsrc_positions,
+)
+from screwkit.kinematics.tracker.loop_jets import close_loop, closure_error, follow, taylor_jets
 
 EXAMPLES = "examples"
 THETA = np.radians(np.arange(0.0, 360.0, 30.0))

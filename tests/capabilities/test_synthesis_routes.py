@@ -230,7 +230,7 @@ def test_closure_sensitivity_of_a_length_is_a_translation_along_its_common_norma
     problem = _fourbar_problem(("d3",))
     model = LoopResidualModel(problem, 0)
     d = problem.dimensions(problem.start_vector())
-    from screwkit.kinematics.loop import forward
+    from screwkit.kinematics.tracker.loop import forward
     from screwkit.synthesis.loop_route import closure_sensitivities
 
     fr = forward(model.linkage, model.conf)

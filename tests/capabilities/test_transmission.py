@@ -11,7 +11,7 @@ import pytest
 
 import screwkit as sk
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.transmission import smallest_cone, transmission
+from screwkit.kinematics.analysis.transmission import smallest_cone, transmission
 
 EXAMPLES = "examples"
 THETA = np.radians(np.arange(0.0, 360.0, 5.0))
@@ -107,7 +107,7 @@ def test_nonnegative_least_squares_matches_scipy():
     scipy.optimize) gives scipy's residual on random problems, with x ≥ 0."""
     from scipy.optimize import nnls
 
-    from screwkit.kinematics.transmission import nonnegative_least_squares
+    from screwkit.kinematics.analysis.transmission import nonnegative_least_squares
 
     rng = np.random.default_rng(11)
     for _ in range(200):

@@ -16,8 +16,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from screwkit.dynamics import Dynamics
-from screwkit.kinematics.generic_motion import generic_motion as motion
 from screwkit.kinematics.motion import ModeMotion, Motion
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
 from screwkit.model.families import cssp, fourbar, rccc, rsrc, rssr
 from screwkit.model.linkage import Link, Linkage
 from screwkit.model.mass import MassProperties
@@ -96,7 +96,7 @@ def with_world_rotations(linkage: Linkage, mode: ModeMotion) -> ModeMotion:
     """
     from dataclasses import replace
 
-    from screwkit.kinematics.loop import forward
+    from screwkit.kinematics.tracker.loop import forward
 
     fr = forward(linkage, mode.conf)
     L = len(linkage.links)
@@ -124,8 +124,8 @@ def fine_sweep(linkage: Linkage, mode: ModeMotion, refine: int) -> tuple[np.ndar
     """World rotation (Nf, L, 3, 3) and origin (Nf, L, 3) of every moving link on a sweep
     ``refine`` times finer than the mode's (full turn, uniform; fine sample i·refine is coarse
     sample i). Positions only: each fine sample is closed by Newton from the nearest coarse one."""
-    from screwkit.kinematics.loop import Configuration, forward, layout
-    from screwkit.kinematics.solve import newton, set_inputs
+    from screwkit.kinematics.tracker.loop import Configuration, forward, layout
+    from screwkit.kinematics.tracker.solve import newton, set_inputs
 
     lay = layout(linkage)
     n_coarse = mode.assembles.size

@@ -25,7 +25,7 @@ from mechanisms import assert_same_dynamics, full_cycle, random_mass
 from screwkit.dual import ScrewMatrix
 from screwkit.dynamics import ExternalLoad, cssp_inverse_dynamics, inverse_dynamics
 from screwkit.dynamics.cssp_statics import cssp_statics_for
-from screwkit.kinematics.cssp_motion import cssp_mode_motion
+from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
 from screwkit.model.families import cssp, fourbar
 from screwkit.model.linkage import Link, Linkage
 from screwkit.model.mass import MassProperties

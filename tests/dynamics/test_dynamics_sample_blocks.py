@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from mechanisms import assert_same_dynamics, full_cycle, random_mass
 
-import screwkit.kinematics.cssp_motion as cssp_motion_module
+import screwkit.kinematics.closed_forms.cssp_motion as cssp_motion_module
 from screwkit.dynamics import cssp_inverse_dynamics, inverse_dynamics
-from screwkit.kinematics.cssp_motion import cssp_mode_motion
+from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
 from screwkit.model.families import cssp
 from screwkit.model.linkage import Link
 

@@ -17,8 +17,8 @@ import pytest
 
 from screwkit.dynamics import inverse_dynamics
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.cssp_motion import cssp_mode_motion
-from screwkit.kinematics.generic_motion import generic_motion as motion
+from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "rahman_cssp.toml"
 

@@ -147,8 +147,8 @@ def test_fine_sweeps_are_estimated_before_solving(tmp_path):
     """Issue 30's other two hangs: a 0.001° step with the generic solver and a 0.01° step
     with the closed form are estimated before any work: under the default limit they run with
     a progress bar (over PROGRESS_SECONDS); under a lower limit they are refused at once."""
-    from screwkit.kinematics.generic_motion import PROGRESS_SECONDS
     from screwkit.kinematics.solve_motion import motion_seconds
+    from screwkit.kinematics.tracker.generic_motion import PROGRESS_SECONDS
 
     fine = sk.load_spec(_rsrc_step(tmp_path, "0.001 deg"))
     assert len(fine.inputs) == 360_000
@@ -171,7 +171,7 @@ def test_fine_sweeps_are_estimated_before_solving(tmp_path):
 def test_a_long_solve_shows_a_bar_on_a_terminal(monkeypatch):
     import sys
 
-    from screwkit.kinematics.generic_motion import progress_reporter
+    from screwkit.kinematics.tracker.generic_motion import progress_reporter
 
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
     with progress_reporter(None, 36_000, seconds=1.7) as report:

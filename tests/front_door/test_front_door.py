@@ -41,7 +41,7 @@ def test_mobility_verb_survives_importing_the_mobility_package():
             "lk = sk.load_spec(r'{spec}').linkage\n"
             "assert m is sk.mobility\nprint(sk.mobility(lk).numeric.mobility)")
     for pre in ("", "import screwkit.mobility", "from screwkit.mobility import formula_mobility",
-                "import screwkit.kinematics.loop_mobility"):
+                "import screwkit.kinematics.analysis.loop_mobility"):
         out = subprocess.run([sys.executable, "-c", code.format(
             pre=pre, spec=EXAMPLES / "bagci_fig7_rsrc.toml")], capture_output=True, text=True,
             timeout=120)
@@ -116,7 +116,7 @@ class _Counter:
     ("dynamics", "rsrc_fig7_dynamics"), ("dynamics", "rahman_cssp"),
     ("balance", "rahman_cssp_balance"), ("analyze", "bagci_fig7_rsrc")])
 def test_each_command_solves_the_motion_once(monkeypatch, command, example):
-    import screwkit.kinematics.closed_form_motion as closed
+    import screwkit.kinematics.closed_forms.closed_form_motion as closed
     import screwkit.kinematics.solve_motion as solver
     import screwkit.pipeline as pipeline
 
@@ -136,7 +136,7 @@ def test_each_command_solves_the_motion_once(monkeypatch, command, example):
 @pytest.mark.parametrize("at", [[], ["40"], ["45", "90"]])
 def test_export_solves_the_motion_once(monkeypatch, tmp_path, at):
     """An input between samples (45) is solved with the sweep, in the same single solve."""
-    import screwkit.kinematics.closed_form_motion as closed
+    import screwkit.kinematics.closed_forms.closed_form_motion as closed
     import screwkit.pipeline as pipeline
 
     solve = _Counter(pipeline.solve_motion)

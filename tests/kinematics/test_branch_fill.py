@@ -5,15 +5,15 @@ accelerations without link frames): each checked against an independent computat
 import numpy as np
 import pytest
 
-import screwkit.kinematics.continuation as continuation
+import screwkit.kinematics.tracker.continuation as continuation
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.branch_fill import quintic_hermite, spherical_end_conditions
-from screwkit.kinematics.generic_motion import _same_samples, all_branches, generic_motion
-from screwkit.kinematics.joint_motion import solve_joints
-from screwkit.kinematics.loop import closure_twist, forward, layout
-from screwkit.kinematics.rates import joint_rates, rate_equations, solve_rates
 from screwkit.kinematics.solve_motion import solve_motion
-from screwkit.kinematics.tracks import Track
+from screwkit.kinematics.tracker.branch_fill import quintic_hermite, spherical_end_conditions
+from screwkit.kinematics.tracker.generic_motion import _same_samples, all_branches, generic_motion
+from screwkit.kinematics.tracker.joint_motion import solve_joints
+from screwkit.kinematics.tracker.loop import closure_twist, forward, layout
+from screwkit.kinematics.tracker.rates import joint_rates, rate_equations, solve_rates
+from screwkit.kinematics.tracker.tracks import Track
 from screwkit.model import Joint, Linkage
 from screwkit.model.families import fourbar, rssr
 
@@ -274,8 +274,8 @@ def test_bare_route_on_long_sweeps_of_loops_with_closed_forms(family):
 
 @pytest.mark.parametrize("name", ["RSRC", "RSSR", "RCCC", "RSHC", "RUSR"])
 def test_signature_moves_bound_how_far_the_signature_moves(name):
-    from screwkit.kinematics.generic_motion import _signature_moves
-    from screwkit.kinematics.solve import signature
+    from screwkit.kinematics.tracker.generic_motion import _signature_moves
+    from screwkit.kinematics.tracker.solve import signature
 
     lk = _loops()[name]
     lay = layout(lk)
@@ -365,8 +365,8 @@ def _rpscr():
 
 
 def test_signature_moves_count_the_slides_of_the_loop():
-    from screwkit.kinematics.generic_motion import _signature_moves
-    from screwkit.kinematics.solve import signature
+    from screwkit.kinematics.tracker.generic_motion import _signature_moves
+    from screwkit.kinematics.tracker.solve import signature
 
     lk = _rpscr()
     lay = layout(lk)

@@ -5,9 +5,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from screwkit.kinematics.cssp import CSSPDimensions, cssp_motion
-from screwkit.kinematics.generic_motion import generic_motion as motion
+from screwkit.kinematics.closed_forms.cssp import CSSPDimensions, cssp_motion
 from screwkit.kinematics.registry import seed_variables
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
 from screwkit.model.families import cssp
 
 deg = np.radians
@@ -62,8 +62,8 @@ def test_rahman_example_range():
        b=st.floats(-1.0, 3.0), e=st.floats(-1.0, 1.0), delta0=st.floats(-0.6, 0.6),
        lambda0=st.floats(0.2, 1.3), theta=st.floats(0.0, 6.28))
 def test_rsrc_quartic_roots_equal_generic_solver_roots(d1, d2, d3, a, b, e, delta0, lambda0, theta):
-    from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
-    from screwkit.kinematics.solve import find_assemblies
+    from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, rsrc_positions
+    from screwkit.kinematics.tracker.solve import find_assemblies
     from screwkit.model.families import rsrc, rsrc_seed_variables
 
     cf = rsrc_positions(RSRCDimensions(d1, d2, d3, a, b, e, delta0, lambda0), np.array([theta]))

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from screwkit.kinematics.cssp import (
+from screwkit.kinematics.closed_forms.cssp import (
     SEED_ROOT,
     CSSPAssemblyError,
     CSSPDimensions,

@@ -1,4 +1,4 @@
-"""The closed-form CSSP ModeMotion (screwkit.kinematics.cssp_motion) equals the generic solver's.
+"""The closed-form CSSP ModeMotion (screwkit.kinematics.closed_forms.cssp_motion) equals the generic solver's.
 
 The rod of a CSSP is an S–S link: its spin angle about its own axis is not fixed by the loop,
 so the two paths may give rod rotations that differ by a turn about the rod axis. Compared here
@@ -18,10 +18,14 @@ from hypothesis import strategies as st
 
 from screwkit.dual import ScrewMatrix
 from screwkit.dynamics import inverse_dynamics
-from screwkit.kinematics.cssp import CSSPAssemblyError
-from screwkit.kinematics.cssp_motion import NotACSSPError, cssp_dimensions, cssp_mode_motion
-from screwkit.kinematics.generic_motion import generic_motion as motion
+from screwkit.kinematics.closed_forms.cssp import CSSPAssemblyError
+from screwkit.kinematics.closed_forms.cssp_motion import (
+    NotACSSPError,
+    cssp_dimensions,
+    cssp_mode_motion,
+)
 from screwkit.kinematics.motion import ModeMotion
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
 from screwkit.model.families import cssp, fourbar
 from screwkit.model.linkage import Link, Linkage
 from screwkit.model.mass import MassProperties

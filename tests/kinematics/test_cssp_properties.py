@@ -10,7 +10,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from screwkit.kinematics.cssp import (
+from screwkit.kinematics.closed_forms.cssp import (
     CSSPDimensions,
     assembly_discriminant,
     cssp_motion,

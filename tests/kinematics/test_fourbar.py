@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from screwkit.kinematics.fourbar import fourbar, fourbar_positions, fourbar_rates
-from screwkit.kinematics.rsrc import rsrc_positions, rsrc_rates
+from screwkit.kinematics.closed_forms.fourbar import fourbar, fourbar_positions, fourbar_rates
+from screwkit.kinematics.closed_forms.rsrc import rsrc_positions, rsrc_rates
 
 CRANK_ROCKER = fourbar(a=3.0, d1=1.0, d2=3.5, d3=2.0)
 
@@ -121,7 +121,7 @@ def test_property_loop_closes(a: float, d1: float, d2: float, d3: float,
 
 
 def test_output_angles_equal_fourbar_positions():
-    from screwkit.kinematics.fourbar import fourbar_output_angles
+    from screwkit.kinematics.closed_forms.fourbar import fourbar_output_angles
 
     for dims in (fourbar(3.0, 1.0, 3.5, 2.0), fourbar(2.0, 1.8, 2.2, 1.5), fourbar(1.0, 3.0, 3.0, 1.0)):
         th = np.linspace(0.0, 2 * np.pi, 2001)

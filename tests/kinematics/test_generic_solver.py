@@ -6,9 +6,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from screwkit.kinematics.generic_motion import generic_motion as motion
 from screwkit.kinematics.motion import AssemblyError
-from screwkit.kinematics.solve import find_assemblies
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
+from screwkit.kinematics.tracker.solve import find_assemblies
 from screwkit.model.families import cssp, fourbar, rccc, rsrc, rsrc_seed_variables, rssr
 
 deg = np.radians
@@ -137,7 +137,7 @@ def test_random_rsrc_closes_in_every_mode(d1, d2, d3, a, b, e, delta0, lambda0, 
     lk = rsrc(d1, d2, d3, a, b, e, delta0, lambda0)
     asm = find_assemblies(lk, np.array([[theta]]))
     for k in np.nonzero(asm.found[0])[0]:
-        from screwkit.kinematics.loop import closure_twist, forward
+        from screwkit.kinematics.tracker.loop import closure_twist, forward
 
         fr = forward(lk, asm.conf.take(np.array([k])))
         assert np.abs(closure_twist(fr.closure_R, fr.closure_p)).max() < 1e-10 * max(
@@ -216,7 +216,7 @@ def test_a_closed_form_reports_its_build_as_it_goes(family, monkeypatch):
     assert all(a[0] <= b[0] and a[1] <= b[1] for a, b in zip(calls, calls[1:], strict=False))
     assert all(0 <= d <= t for d, t in calls)
     # on a terminal, with no callback, a long sweep shows the bar (rich, on stderr)
-    import screwkit.kinematics.generic_motion as gm
+    import screwkit.kinematics.tracker.generic_motion as gm
 
     monkeypatch.setattr(gm, "PROGRESS_SAMPLES", 100)
     monkeypatch.setattr("sys.stderr.isatty", lambda: True, raising=False)
@@ -229,7 +229,7 @@ def test_a_closed_form_reports_its_build_as_it_goes(family, monkeypatch):
 
 
 def test_build_progress_counts_only_modes_built():
-    from screwkit.kinematics.mode_frames import _built, build_progress, expect_modes
+    from screwkit.kinematics.tracker.mode_frames import _built, build_progress, expect_modes
 
     calls = []
     with build_progress(lambda d, t: calls.append((d, t)), 10):
@@ -248,7 +248,7 @@ def test_build_progress_counts_only_modes_built():
 def test_a_layout_reused_for_other_dimensions_reads_their_link_transforms():
     # a layout caches its linkage's link transforms for the hot paths; reused for a loop with
     # the same joints and other dimensions (a synthesis trial), it must not apply the old ones
-    from screwkit.kinematics.loop import Configuration, forward, layout
+    from screwkit.kinematics.tracker.loop import Configuration, forward, layout
 
     a = rsrc(2, 4.5, 3, 3, 3, 1, deg(18), deg(60))
     b = rsrc(2.5, 4.0, 3, 3.5, 3, 1, deg(18), deg(60))

@@ -4,8 +4,8 @@ universal joints close, and their rates are derivatives of their positions."""
 import numpy as np
 import pytest
 
-from screwkit.kinematics.generic_motion import generic_motion as motion
-from screwkit.kinematics.loop import closure_twist, forward
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
+from screwkit.kinematics.tracker.loop import closure_twist, forward
 from screwkit.model import Joint, Linkage
 
 deg = np.radians

@@ -4,8 +4,8 @@ import numpy as np
 from typer.testing import CliRunner
 
 from screwkit.cli.main import app
-from screwkit.kinematics.generic_motion import generic_motion as motion
-from screwkit.kinematics.loop_mobility import linkage_mobility
+from screwkit.kinematics.analysis.loop_mobility import linkage_mobility
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
 from screwkit.model import Joint, Linkage
 from screwkit.model.families import fourbar, rsrc, rssr
 

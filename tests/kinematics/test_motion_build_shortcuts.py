@@ -6,9 +6,9 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from screwkit.kinematics.loop import closure_twist, rotation_matrix
-from screwkit.kinematics.mode_frames import closure_residual
-from screwkit.kinematics.rates import SINGULAR_RTOL, _sigma_ratio
+from screwkit.kinematics.tracker.loop import closure_twist, rotation_matrix
+from screwkit.kinematics.tracker.mode_frames import closure_residual
+from screwkit.kinematics.tracker.rates import SINGULAR_RTOL, _sigma_ratio
 
 
 def _jacobians(rng, n, k, m, weakest):

@@ -18,11 +18,11 @@ import os
 import numpy as np
 import pytest
 
-from screwkit.kinematics.generic_motion import generic_motion
-from screwkit.kinematics.loop import forward, layout
 from screwkit.kinematics.motion import AssemblyError, Motion
-from screwkit.kinematics.rates import rate_equations
 from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.kinematics.tracker.generic_motion import generic_motion
+from screwkit.kinematics.tracker.loop import forward, layout
+from screwkit.kinematics.tracker.rates import rate_equations
 from screwkit.model.families import fourbar, rccc, rsrc, rssr
 
 MECHANISMS = int(os.environ.get("SCREWKIT_PROPERTY_MECHANISMS", "1000"))

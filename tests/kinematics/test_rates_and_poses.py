@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from screwkit.kinematics.loop import forward, layout, lie_bracket
 from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.kinematics.tracker.loop import forward, layout, lie_bracket
 from screwkit.model import Joint, Linkage
 from screwkit.model.families import cssp, fourbar, rccc, rsrc, rssr
 

@@ -9,8 +9,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from screwkit.kinematics.quartic import real_quartic_roots, real_roots_of_trig_quadratic
-from screwkit.kinematics.rsrc import (
+from screwkit.kinematics.closed_forms.quartic import (
+    real_quartic_roots,
+    real_roots_of_trig_quadratic,
+)
+from screwkit.kinematics.closed_forms.rsrc import (
     RSRCDimensions,
     RSRCPositions,
     dwell_order,

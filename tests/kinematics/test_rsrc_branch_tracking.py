@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from screwkit.kinematics.rsrc import (
+from screwkit.kinematics.closed_forms.rsrc import (
     RSRCDimensions,
     RSRCPositions,
     branches,

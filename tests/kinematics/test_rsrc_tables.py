@@ -77,7 +77,7 @@ def test_excluded_cells_are_really_off() -> None:
 
     import numpy as np
 
-    from screwkit.kinematics.rsrc import rsrc_positions
+    from screwkit.kinematics.closed_forms.rsrc import rsrc_positions
 
     dims, _ = tables.table_dimensions("IX", meta)
     phi = rsrc_positions(dims, np.radians([0.0])).phi0[0, 1]

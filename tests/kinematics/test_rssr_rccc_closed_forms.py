@@ -1,4 +1,4 @@
-"""The RSSR and RCCC closed forms (kinematics/rssr.py, kinematics/rccc.py) against the generic
+"""The RSSR and RCCC closed forms (kinematics/closed_forms/rssr.py, kinematics/closed_forms/rccc.py) against the generic
 solver, the loop closure and their own derivatives."""
 
 from pathlib import Path
@@ -9,12 +9,12 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.loop import forward, layout
-from screwkit.kinematics.rates import rate_equations
-from screwkit.kinematics.rccc import rccc_applies
+from screwkit.kinematics.closed_forms.rccc import rccc_applies
+from screwkit.kinematics.closed_forms.rssr import RSSRDimensions, rssr_motion
 from screwkit.kinematics.registry import family_of
-from screwkit.kinematics.rssr import RSSRDimensions, rssr_motion
 from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.kinematics.tracker.loop import forward, layout
+from screwkit.kinematics.tracker.rates import rate_equations
 from screwkit.model.families import rccc, rssr
 
 deg = np.radians

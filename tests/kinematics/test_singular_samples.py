@@ -7,12 +7,12 @@ import pytest
 
 from screwkit.dual import Dual, ScrewMatrix
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.closed_form_motion import rsrc_dimensions
-from screwkit.kinematics.generic_motion import generic_motion
-from screwkit.kinematics.loop import forward, layout
-from screwkit.kinematics.rates import rate_equations
-from screwkit.kinematics.rsrc import rsrc_motion
+from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
+from screwkit.kinematics.closed_forms.rsrc import rsrc_motion
 from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.kinematics.tracker.generic_motion import generic_motion
+from screwkit.kinematics.tracker.loop import forward, layout
+from screwkit.kinematics.tracker.rates import rate_equations
 from screwkit.model import Joint, Linkage
 from screwkit.model.families import fourbar
 from screwkit.model.linkage import Link

@@ -13,7 +13,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.generic_motion import generic_motion as motion
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion
 from screwkit.model.joints import Joint
 from screwkit.model.linkage import Linkage
 from screwkit.pipeline import Pipeline

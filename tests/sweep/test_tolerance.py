@@ -14,10 +14,10 @@ import pytest
 from sweep_helpers import EXAMPLES, runner
 
 from screwkit.cli.main import app
-from screwkit.kinematics.loop import layout
-from screwkit.kinematics.sensitivity import constants_derivative, joint_sensitivities
-from screwkit.kinematics.solve import newton
+from screwkit.kinematics.analysis.sensitivity import constants_derivative, joint_sensitivities
 from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.kinematics.tracker.loop import layout
+from screwkit.kinematics.tracker.solve import newton
 from screwkit.model import families
 from screwkit.model.joints import Joint
 from screwkit.model.linkage import Linkage

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
+from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, rsrc_positions
 from screwkit.synthesis.problem import RSRCSynthesisProblem
 from screwkit.synthesis.targets import ScrewTarget, data_function
 

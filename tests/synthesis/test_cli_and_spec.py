@@ -90,7 +90,7 @@ def test_spec_validation_messages(tmp_path: Path) -> None:
 def test_overlay_recovers_an_exact_mechanism() -> None:
     # a delta0 = 0 mechanism generates psi at 7 points; the overlay with its own d1, d2, theta01
     # must find its output crank again (the circles then meet exactly)
-    from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
+    from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, rsrc_positions
 
     d = math.radians
     dims = RSRCDimensions(2.0, 3.0, 2.5, 3.2, 1.1, 0.0, 0.0, d(60))

@@ -21,7 +21,7 @@ from screwkit.io.synthesis_table import (
     overlay_problem_from_spec,
     problem_from_spec,
 )
-from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
+from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, rsrc_motion, rsrc_positions
 from screwkit.synthesis.overlay import (
     OverlayDwell,
     ellipse_curvature_radius,

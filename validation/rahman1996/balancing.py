@@ -27,7 +27,7 @@ from screwkit.balancing import balance, point_mass_variables
 from screwkit.balancing.measures import MEASURES
 from screwkit.io.balancing_table import balancing_table
 from screwkit.io.spec import load_spec
-from screwkit.kinematics.cssp_motion import cssp_mode_motion
+from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
 from screwkit.pipeline import balance_from_spec
 
 HERE = Path(__file__).resolve().parent

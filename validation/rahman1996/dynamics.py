@@ -5,7 +5,7 @@ Run ``python validation/rahman1996/dynamics.py`` to print the report, ``--write`
 
 * **screwkit**: the example of examples/rahman_cssp.toml (a1 = 2 in, a2 = 8 in, a4 = 1 in,
   s1 = 0.4 in, α4 = 250°, 3000 rpm, masses and inertias of §5.2), exact closed-form kinematics
-  through ``screwkit.kinematics.cssp_motion.cssp_mode_motion`` and ``screwkit.dynamics
+  through ``screwkit.kinematics.closed_forms.cssp_motion.cssp_mode_motion`` and ``screwkit.dynamics
   .inverse_dynamics``, in SI, printed in lbf and lbf·in at the boundary (pint).
 * **program**: ``seed_program_reenactment.py`` (next to this file), the seed's FORTRAN dynamics
   with its bugs; each bug can be switched off alone to measure what it does to each table.
@@ -36,9 +36,9 @@ import seed_program_reenactment as seed  # noqa: E402
 from screwkit.dynamics import Dynamics, inverse_dynamics  # noqa: E402
 from screwkit.dynamics.checks import check_link_masses  # noqa: E402
 from screwkit.io.spec import load_spec  # noqa: E402
-from screwkit.kinematics.cssp_motion import cssp_mode_motion  # noqa: E402
-from screwkit.kinematics.generic_motion import generic_motion as motion  # noqa: E402
+from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion  # noqa: E402
 from screwkit.kinematics.motion import ModeMotion  # noqa: E402
+from screwkit.kinematics.tracker.generic_motion import generic_motion as motion  # noqa: E402
 from screwkit.model.linkage import Linkage  # noqa: E402
 
 UREG = pint.UnitRegistry()

@@ -109,7 +109,7 @@ def rotate_back(R: Rotation, v: Vec) -> Vec:
 def rows(a: Array, finite: list[bool] | None = None) -> list[Scalar]:
     """The components of an (n, k…) block as k (n,) rows, rows that are zero throughout the
     block as 0.0. Component-major input (each component contiguous over the samples, as
-    :func:`screwkit.kinematics.cssp_motion.cssp_mode_motion` stores it) gives views; other
+    :func:`screwkit.kinematics.closed_forms.cssp_motion.cssp_mode_motion` stores it) gives views; other
     layouts are copied once, transposed (the fast paths read each row several times).
     With a ``finite`` list, appends whether every entry of the block is finite (a NaN or an
     infinity makes a sample's sum non-finite; a false alarm from overflow only costs the

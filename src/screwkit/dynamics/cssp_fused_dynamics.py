@@ -6,7 +6,7 @@ Two entry points share one kernel (:func:`cssp_rows_block`):
 * :func:`cssp_mode_block` — what :func:`screwkit.dynamics.inverse_dynamics` runs on each block
   of any CSSP ModeMotion (from the closed form or from the generic solver);
 * :func:`cssp_inverse_dynamics` — kinematics and dynamics fused: each block's link motion comes
-  straight from the closed form (:func:`screwkit.kinematics.cssp_motion.cssp_block_rows`),
+  straight from the closed form (:func:`screwkit.kinematics.closed_forms.cssp_motion.cssp_block_rows`),
   so the (N, …) ModeMotion arrays are never built. Same results as
   ``inverse_dynamics(linkage, cssp_mode_motion(linkage, …))`` to round-off.
 """
@@ -33,8 +33,12 @@ from screwkit.dynamics.loop_statics import statics_structure
 from screwkit.dynamics.result import Array, Dynamics
 from screwkit.dynamics.sample_blocks import BLOCK_SAMPLES, Outputs, Setup, as_dynamics, blocks
 from screwkit.dynamics.screws import freedom_screws
-from screwkit.kinematics.cssp import SEED_ROOT
-from screwkit.kinematics.cssp_motion import cssp_block_rows, cssp_mode_motion, cssp_sweep
+from screwkit.kinematics.closed_forms.cssp import SEED_ROOT
+from screwkit.kinematics.closed_forms.cssp_motion import (
+    cssp_block_rows,
+    cssp_mode_motion,
+    cssp_sweep,
+)
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import MassProperties
@@ -149,7 +153,7 @@ def cssp_inverse_dynamics(
     ModeMotion: memory is the loads, joint centres and inputs (≈ 400 bytes per sample) plus
     one block.
 
-    Arguments as :func:`screwkit.kinematics.cssp_motion.cssp_mode_motion` (crank angle and its
+    Arguments as :func:`screwkit.kinematics.closed_forms.cssp_motion.cssp_mode_motion` (crank angle and its
     rates, assembly ``mode``, driven crank offset) and
     :func:`screwkit.dynamics.inverse_dynamics` (gravity, moment point, external loads).
     Samples where the CSSP does not assemble raise ``CSSPAssemblyError`` unless

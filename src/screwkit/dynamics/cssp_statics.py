@@ -33,7 +33,7 @@ import numpy as np
 
 from screwkit.dynamics import component_arrays as soa
 from screwkit.dynamics.component_arrays import Array, Vec
-from screwkit.kinematics.cssp_motion import NotACSSPError, cssp_dimensions
+from screwkit.kinematics.closed_forms.cssp_motion import NotACSSPError, cssp_dimensions
 from screwkit.model.linkage import Linkage
 
 _KINDS = (("R", "C"), ("S",), ("S",), ("P",))
@@ -60,7 +60,7 @@ class CSSPBlockLoads:
 
 def cssp_statics_for(linkage: Linkage) -> CSSPStatics | None:
     """The closed form applies to a CSSP built by :func:`screwkit.model.families.cssp` (joints
-    R|C, S, S, P; :func:`~screwkit.kinematics.cssp_motion.cssp_dimensions` accepts it) whose
+    R|C, S, S, P; :func:`~screwkit.kinematics.closed_forms.cssp_motion.cssp_dimensions` accepts it) whose
     driven freedoms are exactly the crank joint's; ``None`` otherwise (the generic solve is
     used)."""
     try:

@@ -2,7 +2,7 @@
 
 The reaction of a joint does no work along the joint's freedoms except the actuator effort, so
 the statics of the loop needs one unit screw per freedom (Bagci 1969 eqs. 3.19–3.26, the skew
-operators of the joints carried to the base). :func:`screwkit.kinematics.loop.forward` computes
+operators of the joints carried to the base). :func:`screwkit.kinematics.tracker.loop.forward` computes
 them in the ground frame; here they are rebuilt in the world frame from the joint centres and
 axes already stored on the mode (no second pass round the loop):
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from screwkit.exchange.samples import Array, ExportError, ExportSamples, assembled_runs
 from screwkit.io.units import UnitError, unit_factor
-from screwkit.kinematics.coupler_curves import CouplerPoint, coupler_point_path
+from screwkit.kinematics.analysis.coupler_curves import CouplerPoint, coupler_point_path
 from screwkit.kinematics.motion import Motion
 from screwkit.report.scene import link_polylines
 

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.exchange.samples import Array, ExportError, assembled_runs
-from screwkit.kinematics.coupler_curves import CouplerPoint, coupler_point_path
+from screwkit.kinematics.analysis.coupler_curves import CouplerPoint, coupler_point_path
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.report.scene import link_polylines
 

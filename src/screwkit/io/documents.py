@@ -9,9 +9,9 @@ from typing import Any
 import numpy as np
 
 from screwkit.dynamics import Dynamics
-from screwkit.kinematics.coupler_curves import CouplerPoint, coupler_point_path
+from screwkit.kinematics.analysis.coupler_curves import CouplerPoint, coupler_point_path
+from screwkit.kinematics.analysis.transmission import Transmission
 from screwkit.kinematics.motion import Motion
-from screwkit.kinematics.transmission import Transmission
 from screwkit.synthesis.config import SynthesisRun
 
 TRANSMISSION_DEFINITION = (

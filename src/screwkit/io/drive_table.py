@@ -24,7 +24,7 @@ from pydantic import (
 
 from screwkit.io.errors import SpecError
 from screwkit.io.validation import validation_lines
-from screwkit.kinematics.rates import spin_links
+from screwkit.kinematics.tracker.rates import spin_links
 
 Value = StrictFloat | StrictInt | StrictStr
 MOTOR_KINDS = ("none", "constant", "linear", "table")

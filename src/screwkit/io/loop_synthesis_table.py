@@ -15,8 +15,8 @@ from screwkit.io.synthesis_table import (
     key_error,
     parse_synthesis,
 )
-from screwkit.kinematics.loop import layout
 from screwkit.kinematics.registry import default_outputs, family_of, output_freedom
+from screwkit.kinematics.tracker.loop import layout
 from screwkit.model.geometry import LoopGeometry, hartenberg_denavit_geometry
 from screwkit.model.joints import Joint
 from screwkit.model.linkage import Linkage

@@ -39,8 +39,8 @@ if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
     from screwkit.io.display_units import DisplayUnits
     from screwkit.io.drive_table import DriveConfig
-    from screwkit.kinematics.coupler_curves import CouplerPoint
-    from screwkit.kinematics.limit_positions import LimitsConfig
+    from screwkit.kinematics.analysis.coupler_curves import CouplerPoint
+    from screwkit.kinematics.analysis.limit_positions import LimitsConfig
     from screwkit.synthesis.config import SynthesisConfig
 
 Value = StrictFloat | StrictInt | StrictStr  # strict: a TOML true is not the number 1
@@ -132,14 +132,14 @@ class Spec:
     ``dimensions`` (SI), ``inputs`` (N,) input samples (rad or m), ``speed`` and
     ``acceleration`` of the input, ``mode`` (the assembly mode dynamics and balancing use),
     ``gravity_magnitude``, ``gravity_direction``, ``coupler_points`` (every
-    :class:`~screwkit.kinematics.coupler_curves.CouplerPoint` of ``[coupler_point]`` and
+    :class:`~screwkit.kinematics.analysis.coupler_curves.CouplerPoint` of ``[coupler_point]`` and
     ``[[coupler_points]]``), ``coupler_point`` (the ``[coupler_point]`` table's (f, g, h), m);
     the property ``linkage`` is the mechanism model (a :class:`~screwkit.model.Linkage`, built
     once at load); ``balancing``, ``synthesis`` and ``limits`` are the ``[balancing]``,
     ``[synthesis]`` and ``[limits]`` tables as typed configs
     (:class:`~screwkit.balancing.config.BalancingConfig`,
     :class:`~screwkit.synthesis.config.SynthesisConfig`,
-    :class:`~screwkit.kinematics.limit_positions.LimitsConfig`), or ``None``; ``drive`` the
+    :class:`~screwkit.kinematics.analysis.limit_positions.LimitsConfig`), or ``None``; ``drive`` the
     ``[drive]`` table of ``screwkit simulate`` (:class:`~screwkit.io.drive_table.DriveConfig`),
     or ``None``.
     """
@@ -200,7 +200,7 @@ class Spec:
     # --- helpers ---------------------------------------------------------------------------
     def _coupler_points(self) -> list[CouplerPoint]:
         """``[coupler_point]`` and ``[[coupler_points]]`` as coupler points of the linkage."""
-        from screwkit.kinematics.coupler_curves import coupler_point
+        from screwkit.kinematics.analysis.coupler_curves import coupler_point
         from screwkit.kinematics.registry import coupler_link_index
 
         tables = [("coupler_point", self.raw.coupler_point, "coupler point")] if (
@@ -232,7 +232,7 @@ class Spec:
     def _limits(self) -> LimitsConfig | None:
         """``[limits]`` as a :class:`LimitsConfig`, checked against the loop (the output names
         a variable it has; the closed form is there when asked for)."""
-        from screwkit.kinematics.limit_positions import LimitsConfig, check_limits_config
+        from screwkit.kinematics.analysis.limit_positions import LimitsConfig, check_limits_config
 
         t = self.raw.limits
         if t is None:
@@ -427,7 +427,7 @@ class Spec:
     def jobs(self) -> list[str]:
         """The jobs this spec asks for, each checked at load against what its family offers
         (the registry's capabilities): what ``screwkit demo`` runs on it."""
-        from screwkit.kinematics.limit_positions import uses_closed_form
+        from screwkit.kinematics.analysis.limit_positions import uses_closed_form
 
         out = ["analyze" + (f" ({len(self.coupler_points)} coupler point(s))"
                             if self.coupler_points else ""), "mobility"]

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.errors import InputError, InputTypeError, UnknownNameError
-from screwkit.kinematics.loop import Array, Configuration
+from screwkit.kinematics.tracker.loop import Array, Configuration
 from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 

@@ -25,9 +25,9 @@ from screwkit.errors import InputTypeError
 from screwkit.tables import Column, ResultTable, stack_tables
 
 if TYPE_CHECKING:
-    from screwkit.kinematics.coupler_curves import CouplerPoint
+    from screwkit.kinematics.analysis.coupler_curves import CouplerPoint
+    from screwkit.kinematics.analysis.transmission import Transmission
     from screwkit.kinematics.motion import ModeMotion, Motion
-    from screwkit.kinematics.transmission import Transmission
 
 _TRANSLATION_SEED = re.compile(r"[sS]\d*")
 
@@ -86,7 +86,7 @@ def motion_table(motion: Motion, coupler_point: Sequence[float] | None = None,
     """Every mode of ``motion`` one under the other (module docstring); ``coupler_point``
     (f, g, h) in the body frame of moving link ``coupler_link`` adds its world path, as does
     each of ``coupler_points``; ``transmission`` adds the transmission quality."""
-    from screwkit.kinematics.coupler_curves import CouplerPoint, coupler_point_path
+    from screwkit.kinematics.analysis.coupler_curves import CouplerPoint, coupler_point_path
 
     input_kind = variable_kind(motion.input_names[0])
     x = motion.input_values

@@ -2,8 +2,8 @@
 
 A :class:`Family` maps a family name to its dimensions (with their quantity kinds), its
 constructor (:mod:`screwkit.model.families`), its closed-form solver if it has one
-(:mod:`screwkit.kinematics.closed_form_motion`), the seed's variable names read off any mode
-(:mod:`screwkit.kinematics.seed_names`), a parameter sketch and the capabilities screwkit offers
+(:mod:`screwkit.kinematics.closed_forms.closed_form_motion`), the seed's variable names read off any mode
+(:mod:`screwkit.kinematics.closed_forms.seed_names`), a parameter sketch and the capabilities screwkit offers
 for it. Nothing else in the package compares family strings: code asks the registry
 (``family_of(linkage).closed_form``, ``require(linkage, "limits")``).
 
@@ -19,9 +19,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from screwkit.errors import CapabilityError, InputError, UnknownNameError
-from screwkit.kinematics import seed_names
-from screwkit.kinematics.loop import Array
+from screwkit.kinematics.closed_forms import seed_names
 from screwkit.kinematics.motion import ModeMotion, Motion
+from screwkit.kinematics.tracker.loop import Array
 from screwkit.model import families as constructors
 from screwkit.model import geometry as geometries
 from screwkit.model.geometry import LoopGeometry
@@ -111,38 +111,38 @@ class Family:
 
 
 def _rsrc_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
-    from screwkit.kinematics.closed_form_motion import rsrc_closed_motion
+    from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_closed_motion
 
     return rsrc_closed_motion(linkage, X, Xd, Xdd)
 
 
 def _cssp_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
-    from screwkit.kinematics.closed_form_motion import cssp_closed_motion
+    from screwkit.kinematics.closed_forms.closed_form_motion import cssp_closed_motion
 
     return cssp_closed_motion(linkage, X, Xd, Xdd)
 
 
 def _rssr_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
-    from screwkit.kinematics.closed_form_motion import rssr_closed_motion
+    from screwkit.kinematics.closed_forms.closed_form_motion import rssr_closed_motion
 
     return rssr_closed_motion(linkage, X, Xd, Xdd)
 
 
 def _rccc_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
-    from screwkit.kinematics.closed_form_motion import rccc_closed_motion
+    from screwkit.kinematics.closed_forms.closed_form_motion import rccc_closed_motion
 
     return rccc_closed_motion(linkage, X, Xd, Xdd)
 
 
 def _is_rccc(linkage: Linkage) -> bool:
-    from screwkit.kinematics.rccc import rccc_applies
+    from screwkit.kinematics.closed_forms.rccc import rccc_applies
 
     return rccc_applies(linkage)
 
 
 def _rsrc_limits(linkage: Linkage, dwell_tolerance: float, max_order: int,
                  at: list[float] | None) -> Any:
-    from screwkit.kinematics.closed_limits import rsrc_limit_positions
+    from screwkit.kinematics.closed_forms.closed_limits import rsrc_limit_positions
 
     return rsrc_limit_positions(linkage, dwell_tolerance, max_order, at)
 

@@ -11,11 +11,11 @@ from numpy.typing import ArrayLike
 
 from screwkit.budget import check_memory, check_time
 from screwkit.errors import CapabilityError, InputError, expect_number
-from screwkit.kinematics.generic_motion import Progress, generic_motion, progress_reporter
-from screwkit.kinematics.loop import Array
-from screwkit.kinematics.mode_frames import build_progress
 from screwkit.kinematics.motion import ModeMotion, Motion, as_input_array, per_sample
 from screwkit.kinematics.registry import family_of, seed_variables
+from screwkit.kinematics.tracker.generic_motion import Progress, generic_motion, progress_reporter
+from screwkit.kinematics.tracker.loop import Array
+from screwkit.kinematics.tracker.mode_frames import build_progress
 from screwkit.model.linkage import Linkage
 
 METHODS = ("auto", "closed", "generic")

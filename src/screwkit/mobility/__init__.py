@@ -4,7 +4,7 @@
 formula mobility (Malytcheff, Kutzbach, Kolchin; Bagci 1969 App. B) next to the rank of its
 loop-closure screw Jacobian at the first input where it assembles, and names the redundant
 constraints and passive motions by joint (a
-:class:`~screwkit.kinematics.loop_mobility.LinkageMobility`; SI units, radians).
+:class:`~screwkit.kinematics.analysis.loop_mobility.LinkageMobility`; SI units, radians).
 
 * :mod:`~screwkit.mobility.pairs` — pair catalogue (class, freedoms, names).
 * :mod:`~screwkit.mobility.general_constraints` — Bagci's m(M_R1 M_R2 M_R3, M_T1 M_T2 M_T3).
@@ -93,10 +93,10 @@ class _CallableMobility(types.ModuleType):
     """``screwkit.mobility`` is both this package and the front-door verb
     ``screwkit.mobility(linkage)``: whichever way it is reached (``sk.mobility``,
     ``import screwkit.mobility``), it is the same object, and calling it runs
-    :func:`screwkit.kinematics.loop_mobility.mobility`."""
+    :func:`screwkit.kinematics.analysis.loop_mobility.mobility`."""
 
     def __call__(self, linkage: Any, inputs: Any = None) -> Any:
-        from screwkit.kinematics.loop_mobility import mobility
+        from screwkit.kinematics.analysis.loop_mobility import mobility
 
         return mobility(linkage, inputs)
 

@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 
 from screwkit.io.spec import spec_from_data
-from screwkit.kinematics.loop import Array, Configuration, layout
 from screwkit.kinematics.motion import ModeMotion
-from screwkit.kinematics.solve import newton
+from screwkit.kinematics.tracker.loop import Array, Configuration, layout
+from screwkit.kinematics.tracker.solve import newton
 from screwkit.sweep.engine import Engine, batch_size, batches
 from screwkit.sweep.keys import SpecKey, with_values
 from screwkit.sweep.tolerance import FirstOrder, Tolerance

@@ -1,6 +1,6 @@
 """Tolerance analysis of a spec (docs/sweeps.md, "Tolerance analysis"): the first-order
 sensitivity of every output variable over the cycle to every toleranced value, exact from the
-loop's screw Jacobian (:mod:`screwkit.kinematics.sensitivity`), and the stack-ups
+loop's screw Jacobian (:mod:`screwkit.kinematics.analysis.sensitivity`), and the stack-ups
 
     worst case  Δy_wc  = Σ_k |∂y/∂x_k| t_k
     statistical Δy_rss = √(Σ_k (∂y/∂x_k t_k)²)
@@ -22,14 +22,14 @@ import numpy as np
 from screwkit.errors import InputError
 from screwkit.io.quantity import QuantitySyntaxError, parse_quantity
 from screwkit.io.spec import Spec, spec_from_data
-from screwkit.kinematics.loop import Array
-from screwkit.kinematics.motion import ModeMotion
-from screwkit.kinematics.sensitivity import (
+from screwkit.kinematics.analysis.sensitivity import (
     SensitivityError,
     constants_derivative,
     joint_sensitivities,
     seed_aliases,
 )
+from screwkit.kinematics.motion import ModeMotion
+from screwkit.kinematics.tracker.loop import Array
 from screwkit.model.linkage import Linkage
 from screwkit.pipeline import Pipeline
 from screwkit.sweep.keys import SpecKey, SpecKeyError, spec_key, unit_of, with_values

@@ -34,7 +34,8 @@ from numpy.typing import NDArray
 
 from screwkit.dual.spatial import vee, wrap_angle
 from screwkit.errors import InputError
-from screwkit.kinematics.loop import (
+from screwkit.kinematics.registry import output_freedom
+from screwkit.kinematics.tracker.loop import (
     Array,
     Configuration,
     LoopFrames,
@@ -42,8 +43,7 @@ from screwkit.kinematics.loop import (
     forward,
     layout,
 )
-from screwkit.kinematics.loop_jets import close_loop
-from screwkit.kinematics.registry import output_freedom
+from screwkit.kinematics.tracker.loop_jets import close_loop
 from screwkit.model.geometry import LoopGeometry
 from screwkit.model.linkage import Linkage, LinkageError
 from screwkit.synthesis.residuals import Evaluation, NotAssembled
@@ -133,7 +133,7 @@ def closure_sensitivities(linkage: Linkage, fr: LoopFrames, geometry: Callable[
         names: tuple[str, ...]) -> Array:
     """(N, 6, len(names)) ξ_u: the twist (ground frame, (ω; v) with v at the ground origin) by
     which the loop closure moves per unit of each dimension ``names`` at closed configurations
-    whose frames are ``fr`` (:func:`~screwkit.kinematics.loop.forward`; module docstring)."""
+    whose frames are ``fr`` (:func:`~screwkit.kinematics.tracker.loop.forward`; module docstring)."""
     N = fr.screws.shape[0]
     out = np.zeros((N, 6, len(names)))
     base = geometry(dims)

@@ -14,8 +14,8 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.loop import forward
-from screwkit.kinematics.transmission import transmission
+from screwkit.kinematics.analysis.transmission import transmission
+from screwkit.kinematics.tracker.loop import forward
 from screwkit.messages import shown, shown_range
 from screwkit.synthesis.loop_route import LoopResidualModel, LoopSynthesisProblem
 from screwkit.synthesis.residuals import Evaluation, NotAssembled

@@ -41,7 +41,7 @@ from scipy.optimize import least_squares
 
 from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
-from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
+from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, rsrc_positions
 from screwkit.messages import shown, shown_range
 
 __all__ = [

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
-from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
+from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, rsrc_positions
 from screwkit.messages import shown
 from screwkit.synthesis.overlay import (
     OverlayCircle,

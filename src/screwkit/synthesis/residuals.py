@@ -28,8 +28,8 @@ from numpy.typing import NDArray
 
 from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
-from screwkit.kinematics.rsrc import RSRCDimensions, rsrc_positions
-from screwkit.kinematics.rsrc.loop_equation import RSRCDimensionArrays, loop_equation
+from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, rsrc_positions
+from screwkit.kinematics.closed_forms.rsrc.loop_equation import RSRCDimensionArrays, loop_equation
 from screwkit.synthesis.problem import RSRCSynthesisProblem
 
 __all__ = [

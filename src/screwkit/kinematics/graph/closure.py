@@ -8,7 +8,7 @@ screw of freedom f in the world (Bagci 1969 eqs. 3.19–3.26 generalised to a lo
 of the stacked screw Jacobian, six per loop.
 
 Screws are 6-vectors (ω; v), v the velocity of the point at the world origin (as
-kinematics/loop.py). A configuration is a :class:`~screwkit.kinematics.loop.Configuration`:
+kinematics/tracker/loop.py). A configuration is a :class:`~screwkit.kinematics.tracker.loop.Configuration`:
 scalar freedoms in joint order and one rotation per spherical joint (body increments).
 """
 
@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual.spatial import cross
-from screwkit.kinematics.loop import (
+from screwkit.kinematics.tracker.loop import (
     Configuration,
     closure_error,
     closure_twist,

@@ -3,7 +3,7 @@ through their centres without moving anything else. The minimum-norm rates leave
 spin in (the norm is the joints', not the rod's); here the idle part of the rates is chosen so
 that every such rod's angular velocity and acceleration have no component along its axis
 (ω·u = 0 and then α·u = 0, since u̇ = ω × u), as single loops hold theirs
-(kinematics/idle_spin.py). Loads that do no work along a spin (a centre of mass on the axis, an
+(kinematics/tracker/idle_spin.py). Loads that do no work along a spin (a centre of mass on the axis, an
 inertia symmetric about it) are then carried exactly.
 """
 

@@ -14,12 +14,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.errors import CapabilityError, UnknownNameError
+from screwkit.kinematics.analysis.limit_results import LimitPosition, LimitPositions
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout
 from screwkit.kinematics.graph.motion import MechanismMotion
 from screwkit.kinematics.graph.newton import accelerations, linearise, rates
 from screwkit.kinematics.graph.track import reach
-from screwkit.kinematics.limit_results import LimitPosition, LimitPositions
-from screwkit.kinematics.loop import Configuration
+from screwkit.kinematics.tracker.loop import Configuration
 
 Array = NDArray[np.float64]
 

@@ -34,8 +34,8 @@ from screwkit.kinematics.graph.newton import (
     scaled_residual,
 )
 from screwkit.kinematics.graph.track import follow_drawn_mode
-from screwkit.kinematics.loop import Configuration, rotation_vector
 from screwkit.kinematics.motion import AssemblyError, ModeMotion
+from screwkit.kinematics.tracker.loop import Configuration, rotation_vector
 from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]

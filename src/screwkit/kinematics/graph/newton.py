@@ -26,7 +26,11 @@ from screwkit.kinematics.graph.closure import (
     loop_bias,
     loop_jacobian,
 )
-from screwkit.kinematics.loop import Configuration, apply_increment, configuration_difference
+from screwkit.kinematics.tracker.loop import (
+    Configuration,
+    apply_increment,
+    configuration_difference,
+)
 from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]

@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphLayout
 from screwkit.kinematics.graph.newton import linearise
-from screwkit.kinematics.loop import Configuration
+from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]

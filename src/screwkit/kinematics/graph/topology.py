@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout
 from screwkit.kinematics.graph.newton import RANK_CUTOFF, linearise
-from screwkit.kinematics.loop import Configuration
+from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]

@@ -30,7 +30,7 @@ from screwkit.kinematics.graph.newton import (
     rates,
     row_scale,
 )
-from screwkit.kinematics.loop import Configuration
+from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]

@@ -1,0 +1,1 @@
+"""What is computed on a solved motion: coupler curves, transmission, limit positions and dwells, sensitivities, loop mobility (docs/architecture.md)."""

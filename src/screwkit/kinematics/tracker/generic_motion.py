@@ -1,0 +1,576 @@
+"""The generic loop solver: every assembly mode of any single loop over an input sweep.
+
+Assembly modes are continuous branches (``../shared/DESIGN.md``), found by continuation
+(:mod:`screwkit.kinematics.tracker.continuation`), not by a root search at every sample:
+
+1. a global root search (:func:`~screwkit.kinematics.tracker.solve.find_assemblies`, Newton from many
+   random starts) runs at the first sample and, as a safety net with half as many starts, at
+   a coarse stride of *anchor* samples (every :data:`ANCHOR_SPAN` rad of input, or that
+   fraction of the length scale for a sliding input);
+2. every root not on a known branch seeds a new branch, which is followed forwards and
+   backwards to where it ends (so a mode born after the first sample is found over all of its
+   life, not from the anchor that found it);
+3. where a branch ends between two samples (the corrector says it dies: a limit position or
+   dead centre) the root search runs again at both samples, since a branch may be born where
+   another dies, and Newton looks for the root the branch meets at the fold along the passive
+   Jacobian's null direction (:func:`_seed_fold_partners`);
+4. a continuum of closed configurations at one input (a motion left free with the input
+   fixed) is one degenerate set, seeded once (:mod:`screwkit.kinematics.tracker.degenerate`), and
+   branches that turn out to be the same (found from two anchors) are merged.
+
+Rates, accelerations, link frames and singular samples then follow from the loop's rate
+equations (:mod:`screwkit.kinematics.tracker.mode_frames`).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics.motion import (
+    AssemblyError,
+    Motion,
+    as_input_array,
+    format_inputs,
+    per_sample,
+)
+from screwkit.kinematics.tracker.continuation import Tracker
+from screwkit.kinematics.tracker.degenerate import seeds_off_continua
+from screwkit.kinematics.tracker.loop import (
+    Array,
+    Configuration,
+    Layout,
+    apply_increment,
+    forward,
+    layout,
+)
+from screwkit.kinematics.tracker.mode_frames import (
+    build_progress,
+    expect_modes,
+    mode_from_configuration,
+)
+from screwkit.kinematics.tracker.rates import rate_equations
+from screwkit.kinematics.tracker.solve import (
+    Assemblies,
+    assemblies_from,
+    find_assemblies,
+    set_inputs,
+    signature,
+)
+from screwkit.kinematics.tracker.tracks import Track
+from screwkit.model.linkage import Linkage
+
+#: input movement between two anchor samples of the safety-net root search (rad; × the length
+#: scale for a sliding input)
+ANCHOR_SPAN = np.radians(15.0)
+#: a sweep at least this long shows a progress bar on a terminal (when no callback is given)
+PROGRESS_SAMPLES = 50_000
+#: ... or a solve estimated (solve_motion.motion_seconds) to take this long, seconds
+PROGRESS_SECONDS = 1.0
+#: how far (signature units) two overlapping tracks may move between the samples where they
+#: are compared first (:func:`_same_samples`)
+MERGE_MOVE = 0.25
+SAME_ROOT = 1e-6  # signature distance (length-scale units) of two copies of one configuration
+
+Progress = Callable[[int, int], None]
+
+
+def anchor_samples(linkage: Linkage, X: Array) -> NDArray[np.intp]:
+    """The first and last samples and every sample where the inputs have moved another
+    :data:`ANCHOR_SPAN` since the previous anchor (measured along the sweep)."""
+    N = X.shape[0]
+    if N == 1:
+        return np.array([0])
+    L = linkage.length_scale
+    scale = np.array([1.0 / L if n.endswith(".s") else 1.0 for n in linkage.inputs])
+    span = np.concatenate([[0.0], np.cumsum(np.max(np.abs(np.diff(X, axis=0)) * scale, axis=1))])
+    marks = np.searchsorted(span, np.arange(0.0, span[-1], ANCHOR_SPAN))
+    return np.unique(np.concatenate([[0], marks, [N - 1]]).clip(0, N - 1))
+
+
+@contextmanager
+def progress_reporter(progress: Progress | bool | None, N: int,
+                      label: str = "following assembly modes",
+                      seconds: float = 0.0) -> Iterator[Progress | None]:
+    """The progress callback to use: the caller's, none, or a rich bar (``label``) on stderr
+    for a sweep of :data:`PROGRESS_SAMPLES` samples or more, or estimated to take
+    :data:`PROGRESS_SECONDS` or more (``seconds``), on a terminal."""
+    if callable(progress):
+        yield progress
+        return
+    long = N >= PROGRESS_SAMPLES or seconds >= PROGRESS_SECONDS
+    if progress is False or (progress is None and (not long or not sys.stderr.isatty())):
+        yield None
+        return
+    from rich.console import Console
+    from rich.progress import Progress as Bar
+
+    with Bar(console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task(label, total=N)
+
+        def update(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        yield update
+
+
+def generic_motion(
+    linkage: Linkage,
+    input_values: Array | list[float],
+    input_rates: Array | list[float] | float = 1.0,
+    input_accelerations: Array | list[float] | float = 0.0,
+    starts: int = 48,
+    seed: int = 0,
+    progress: Progress | bool | None = None,
+) -> Motion:
+    """Positions, velocities and accelerations of every freedom and link over an input sweep,
+    in every assembly mode (generic solver; works for any single loop; module docstring).
+
+    ``starts`` random starts per root search and their ``seed``; ``progress`` a callback
+    ``(samples done, samples to do)`` (the samples followed, then each mode's build counting
+    every sample; ``done`` never decreases and ends equal to the total, which is revised as
+    modes are found and merged), ``False`` for none, or ``None``: a progress bar on stderr
+    for a sweep of 50 000 samples or more on a terminal."""
+    lay = layout(linkage)
+    X = as_input_array(linkage, input_values, "input values")
+    N = X.shape[0]
+    Xd = per_sample(linkage, input_rates, "input rates", X)
+    Xdd = per_sample(linkage, input_accelerations, "input accelerations", X)
+    with progress_reporter(progress, N) as report:
+        reached = [0]
+
+        def tracking(done: int, total: int) -> None:
+            reached[0] = max(reached[0], done)
+            if report is not None:
+                report(done, total)
+
+        tracks = all_branches(linkage, lay, X, starts, seed,
+                               tracking if report is not None else None)
+        if not tracks:
+            raise closes_nowhere(linkage, X)
+
+        def building(done: int, total: int) -> None:  # after the samples followed
+            if report is not None:
+                report(reached[0] + done, reached[0] + total)
+
+        modes = []
+        with build_progress(building if report is not None else None, N):
+            expect_modes(len(tracks))
+            for tr in tracks:
+                modes.append(mode_from_configuration(linkage, lay, tr.configuration(),
+                                                     tr.mask.copy(), X, Xd, Xdd,
+                                                     _events(linkage, X, tr)))
+    modes = [replace(md, index=k, label=f"branch {k}") for k, md in enumerate(modes)]
+    return Motion(linkage, X, Xd, Xdd, tuple(modes), method="generic",
+                  solver="generic loop solver: continuation along the input (second-order "
+                         "predictor, Newton corrector) from root searches at the first sample, "
+                         "at anchors and where branches end (docs/kinematics.md)")
+
+
+def closes_nowhere(linkage: Linkage, X: Array) -> AssemblyError:
+    """The error of a sweep where the generic solver finds no closed configuration at all."""
+    return AssemblyError(
+        f"{linkage.name}: the loop does not close at any of the {X.shape[0]} inputs "
+        f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
+        "check the dimensions")
+
+
+def _events(linkage: Linkage, X: Array, tr: Track) -> list[str]:
+    """Where a branch starts and stops assembling, from its mask."""
+    m = tr.mask
+    events = []
+    for k in np.nonzero(m[1:] & ~m[:-1])[0] + 1:
+        events.append(f"starts assembling at input {format_inputs(linkage, X[k])} (limit "
+                      f"position or dead centre after {format_inputs(linkage, X[k - 1])})")
+    for k in np.nonzero(m[:-1] & ~m[1:])[0]:
+        events.append(f"stops assembling after input {format_inputs(linkage, X[k])} (limit "
+                      f"position or dead centre before {format_inputs(linkage, X[k + 1])})")
+    return events
+
+
+def _signatures(linkage: Linkage, lay: Layout, tr: Track, samples: NDArray[np.intp]) -> Array:
+    conf = Configuration(tr.scalars[samples], tr.spherical[samples])
+    return signature(linkage, conf, lay)
+
+
+def _new_seeds(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray[np.intp],
+               asm: Assemblies, first_only: bool = False,
+               ) -> list[tuple[int, int, Configuration]]:
+    """The roots of a root search at ``samples`` that are on no known branch, per row of the
+    search (its index, its sample and the roots); of
+    the roots on a continuum (a motion free with the input fixed) one, and none where a known
+    branch is on a continuum already (:mod:`screwkit.kinematics.tracker.degenerate`)."""
+    K = asm.found.shape[1]
+    known = [(tr, tr.mask[samples]) for tr in tracker.tracks]
+    known_sig = [_signatures(linkage, lay, tr, samples[m]) if m.any() else None
+                 for tr, m in known]
+    out = []
+    for r, s in enumerate(samples.tolist()):
+        found = np.nonzero(asm.found[r])[0]
+        if found.size == 0:
+            continue
+        sig, radius = asm.signature[r][found], asm.radius[r][found]
+        new = np.ones(found.size, dtype=bool)
+        here = []
+        for (tr, m), ks in zip(known, known_sig, strict=True):
+            if ks is not None and m[r]:
+                own = ks[int(np.sum(m[:r]))]
+                new &= np.max(np.abs(sig - own), axis=1) >= np.maximum(radius, SAME_ROOT)
+                here.append(tr)
+        if not new.any():
+            continue
+        conf = asm.conf.take(r * K + found[new])
+        seen = Configuration(np.stack([tr.scalars[s] for tr in here]),
+                             np.stack([tr.spherical[s] for tr in here])) if here \
+            else conf.take(np.array([], dtype=int))
+        keep = seeds_off_continua(linkage, lay, seen, conf)
+        if keep.any():
+            out.append((r, s, conf.take(np.nonzero(keep)[0])))
+            if first_only:
+                break
+    return out
+
+
+def _root_search(linkage: Linkage, X: Array, samples: NDArray[np.intp], starts: int,
+                 seed: int) -> tuple[NDArray[np.intp], Assemblies]:
+    """Every root at ``samples`` by Newton from random starts, in one vectorised search:
+    ``starts`` at the first sample of the sweep, half as many at the others (the safety net:
+    there the known branches are found again by most starts, and a branch missed at one
+    sample is found at the next). Returns the sample of each row of the search and the
+    search."""
+    half = max(starts // 2, 8)
+    lead = int(samples[0] == 0) * max(starts // half - 1, 0)  # extra copies of sample 0
+    rows = np.concatenate([np.zeros(lead, dtype=np.intp), samples])
+    return rows, find_assemblies(linkage, X[rows], starts=half, seed=seed)
+
+
+def _seed_from(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray[np.intp],
+               X: Array, starts: int, seed: int) -> bool:
+    """Root search at ``samples`` (vectorised over them); then, in the order of the samples,
+    follow the roots on no known branch at the first sample that has some, and look again at
+    the later samples — so a branch found at one sample is not seeded again at the next. True
+    if any root was new."""
+    if samples.size == 0:
+        return False
+    samples, asm = _root_search(linkage, X, samples, starts, seed)
+    return _seed_from_search(linkage, lay, tracker, samples, asm)
+
+
+def _seed_from_search(linkage: Linkage, lay: Layout, tracker: Tracker,
+                      samples: NDArray[np.intp], asm: Assemblies) -> bool:
+    """Follow the roots of a search (row r at ``samples[r]``) that are on no known branch, in
+    the order of the rows, looking again after each (:func:`_seed_from`)."""
+    K = asm.found.shape[1]
+    remaining = np.nonzero(asm.found.any(axis=1))[0]
+    found_new = False
+    while remaining.size:
+        rows = (remaining[:, None] * K + np.arange(K)).ravel()
+        sub = Assemblies(asm.conf.take(rows), asm.found[remaining], asm.signature[remaining],
+                         asm.radius[remaining])
+        seeds = _new_seeds(linkage, lay, tracker, samples[remaining], sub, first_only=True)
+        if not seeds:
+            break
+        row, sample, conf = seeds[0]
+        tracker.follow(tracker.add_seeds(sample, conf))
+        found_new = True
+        remaining = remaining[row + 1:]
+    return found_new
+
+
+def all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int,
+                  report: Progress | None, rates: tuple[Array, Array] | None = None,
+                  ) -> list[Track]:
+    """Every branch over the sweep (module docstring); with the inputs' ``rates`` and
+    accelerations, each track also carries the rates the tracker found on the way
+    (:class:`~screwkit.kinematics.tracker.continuation.TrackRates`)."""
+    N = X.shape[0]
+    done = [0]
+
+    def count(n: int) -> None:
+        done[0] += n
+        if report is not None:
+            report(done[0], N * max(1, len(tracker.tracks)))
+
+    tracker = Tracker(linkage, lay, X, count if report is not None else None, rates)
+    _seed_from(linkage, lay, tracker, anchor_samples(linkage, X), X, starts, seed)
+    searched: set[int] = set()
+    partnered: set[tuple[int, int]] = set()
+    for round_ in range(4):  # births where branches die; rarely more than one round
+        ends: set[int] = set()
+        for tr in tracker.tracks:
+            for k, _ in tr.stops:
+                ends.update((k, k + 1))
+            for k, _ in tr.starts:
+                ends.update((k - 1, k))
+        todo = np.array(sorted(s for s in ends - searched if 0 <= s < N), dtype=np.intp)
+        searched |= set(todo.tolist())
+        found = _seed_from(linkage, lay, tracker, todo, X, starts, seed + 1 + round_)
+        if not (_seed_fold_partners(linkage, lay, tracker, X, partnered) or found):
+            break
+    tracks = _attach_turning_points(linkage, lay, _merge_duplicates(linkage, lay, tracker.tracks))
+    tracks = _attach_lone_ends(linkage, lay, tracks)
+    _pair_ends(linkage, lay, tracks)
+    return sorted(tracks, key=lambda tr: _order_key(linkage, lay, tr))
+
+
+#: steps (scaled freedoms) along the passive Jacobian's null direction from a branch's last
+#: sample before a fold, where Newton looks for the root it meets there
+PARTNER_STEPS = (1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3, 1.0, 3.0)
+
+
+def _seed_fold_partners(linkage: Linkage, lay: Layout, tracker: Tracker, X: Array,
+                        done: set[tuple[int, int]]) -> bool:
+    """Where a branch ends between two samples (a fold: it turns back in the input), the root it
+    meets there lies next to its last sample, along the passive Jacobian's null direction:
+    Newton from steps ±PARTNER_STEPS along it at that sample looks for it, and a root on no
+    known branch seeds one. (Random starts can miss a root whose basin is small — an island of
+    two modes that lives over a short stretch of input.) ``done`` holds the (track, sample)
+    ends already looked at; True if any root was new."""
+    ends = [(i, k) for i, tr in enumerate(tracker.tracks)
+            for k in [k for k, _ in tr.stops] + [k for k, _ in tr.starts]
+            if (i, k) not in done and tr.mask[k]]
+    done.update(ends)
+    if not ends:
+        return False
+    samples = np.array([k for _, k in ends], dtype=np.intp)
+    base = Configuration(np.stack([tracker.tracks[i].scalars[k] for i, k in ends]),
+                         np.stack([tracker.tracks[i].spherical[k] for i, k in ends]))
+    eq = rate_equations(linkage, lay, forward(linkage, base, lay))
+    k_rows, m_p = eq.passive.shape[1:]
+    if m_p == 0 or m_p > k_rows:
+        return False
+    null = np.linalg.svd(eq.passive)[2][:, -1, :]  # (B, m_p) scaled passive freedoms
+    steps = np.array([s * d for s in PARTNER_STEPS for d in (1.0, -1.0)])
+    per = len(steps)
+    delta = np.zeros((len(ends) * per, len(lay.names)))
+    delta[:, eq.p_idx] = (np.repeat(null, per, axis=0) * np.tile(steps, len(ends))[:, None]
+                          * eq.cols[eq.p_idx])
+    starts = set_inputs(apply_increment(base.take(np.repeat(np.arange(len(ends)), per)), delta,
+                                        lay), lay, linkage.inputs, np.repeat(X[samples], per,
+                                                                             axis=0))
+    order = np.argsort(samples, kind="stable")
+    asm = assemblies_from(linkage, starts.take(
+        (order[:, None] * per + np.arange(per)).ravel()), per)
+    return _seed_from_search(linkage, lay, tracker, samples[order], asm)
+
+
+def _pair_ends(linkage: Linkage, lay: Layout, tracks: list[Track]) -> None:
+    """Where two branches are born (or die) at the same sample next to a fold, their two
+    roots there are close and the searches may hand each branch the other's: swap them when
+    that makes both continuous with the neighbouring sample (the closed forms' pairing). Each
+    mode then starts on its own branch, so the rates and the idle spin carried along it start
+    right."""
+    for step in (1, -1):  # births continue to k + 1, deaths come from k − 1
+        for a_i, a in enumerate(tracks):
+            for b in tracks[a_i + 1:]:
+                both = a.mask & b.mask
+                held = np.pad(a.mask | b.mask, 1)  # False beyond the sweep
+                nxt = np.roll(np.pad(both, 1), -step)[1:-1]
+                prev = np.roll(held, step)[1:-1]
+                for kk in np.nonzero(both & nxt & ~prev)[0].tolist():
+                    k, n = int(kk), int(kk) + step
+                    sa, sb = _signatures(linkage, lay, a, np.array([k, n]))
+                    ta, tb = _signatures(linkage, lay, b, np.array([k, n]))
+                    kept = np.linalg.norm(sa - sb) + np.linalg.norm(ta - tb)
+                    swapped = np.linalg.norm(sa - tb) + np.linalg.norm(ta - sb)
+                    if swapped < kept:
+                        held_a = (a.scalars[k].copy(), a.spherical[k].copy())
+                        a.set_sample(k, b.scalars[k], b.spherical[k])
+                        b.set_sample(k, *held_a)
+
+
+def _merge_duplicates(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
+    """Tracks that are the same configuration wherever both hold are one branch; a track that
+    shares another's configuration at some samples only has jumped onto it there (near a fold
+    both branches are close) and loses those samples. (Two branches that cross share one
+    singular configuration; that sample is kept by both.)"""
+    out: list[Track] = []
+    for tr in tracks:
+        for kept in out:
+            both = np.nonzero(kept.mask & tr.mask)[0]
+            if both.size == 0:
+                continue
+            same = _same_samples(linkage, lay, kept, tr, both)
+            if same.all():
+                extra = tr.mask & ~kept.mask
+                kept.scalars[extra] = tr.scalars[extra]
+                kept.spherical[extra] = tr.spherical[extra]
+                kept.mask |= tr.mask
+                if kept.rates is not None and tr.rates is not None:
+                    for name in ("qd", "qdd", "singular", "known"):
+                        getattr(kept.rates, name)[extra] = getattr(tr.rates, name)[extra]
+                break
+            if same.sum() > 1:
+                tr.mask[both[same]] = False
+        else:
+            if tr.mask.any():
+                out.append(tr)
+    return out
+
+
+def _same_samples(linkage: Linkage, lay: Layout, a: Track, b: Track,
+                  both: NDArray[np.intp]) -> NDArray[np.bool_]:
+    """Which of the samples ``both`` (held by tracks ``a`` and ``b``) are the same
+    configuration in the two (signature distance below 1e-5). The signatures are compared first
+    at samples chosen so that between two of them the two tracks' signatures together move at
+    most :data:`MERGE_MOVE` (:func:`_signature_moves`, a bound from their joint variables'
+    steps; both sides of a gap are chosen too); in between, the tracks can meet only where the
+    distance at either end is not more than that move — and only there is every sample
+    compared."""
+    n = both.size
+    steps = _signature_moves(linkage, lay, a, both) + _signature_moves(linkage, lay, b, both)
+    gap = ~np.isfinite(steps)
+    moved = np.concatenate([[0.0], np.cumsum(np.where(gap, 0.0, steps))])
+    bucket = np.floor(moved / MERGE_MOVE)
+    chosen = np.zeros(n, dtype=bool)
+    chosen[[0, -1]] = True
+    chosen[1:] |= bucket[1:] != bucket[:-1]
+    chosen[:-1] |= bucket[1:] != bucket[:-1]
+    chosen[:-1] |= gap
+    chosen[1:] |= gap
+    pick = np.nonzero(chosen)[0]
+    sa, sb = _signatures(linkage, lay, a, both[pick]), _signatures(linkage, lay, b, both[pick])
+    d = np.max(np.abs(sa - sb), axis=1)
+    same = np.zeros(n, dtype=bool)
+    same[pick] = d < 1e-5
+    if pick.size == n:
+        return same
+    span = moved[pick[1:]] - moved[pick[:-1]]
+    contiguous = ~np.array([gap[i:j].any() for i, j in zip(pick[:-1], pick[1:], strict=True)]) \
+        if gap.any() else np.ones(pick.size - 1, dtype=bool)
+    apart = contiguous & (np.maximum(d[:-1], d[1:]) > span + 1e-5)
+    look = np.zeros(n, dtype=bool)
+    for j in np.nonzero(~apart)[0]:
+        look[pick[j] + 1:pick[j + 1]] = True
+    if look.any():
+        idx = both[look]
+        same[look] = np.max(np.abs(_signatures(linkage, lay, a, idx)
+                                   - _signatures(linkage, lay, b, idx)), axis=1) < 1e-5
+    return same
+
+
+def _signature_moves(linkage: Linkage, lay: Layout, tr: Track,
+                     samples: NDArray[np.intp]) -> Array:
+    """An upper bound (n − 1,) of how far the track's signature (max norm) moves between
+    consecutive ``samples``: every freedom's step times how far it can move a joint centre or
+    axis — a turn by δ moves a point at most δ times its distance from the axis, which is at most
+    the loop's whole length (links, offsets, and the largest slide of every P, C and H joint
+    over the samples; divided by the length scale), and an axis by δ; a slide moves points by
+    its length. A ball joint's turn is bounded by
+    the difference of its rotation matrices' first two columns: |ΔR e₀|² + |ΔR e₁|² =
+    4 sin²(θ/2)(2 − n₀² − n₁²) ≥ 4 sin²(θ/2) for a turn θ about n, so θ ≤ (π/2)·√(that)."""
+    L = linkage.length_scale
+    lo, hi = int(samples[0]), int(samples[-1]) + 1  # steps between neighbours, by slices
+    q = tr.scalars[lo:hi]
+    held = q[samples - lo]  # the slides' extent over the samples held (not the NaN between)
+    # every length along the chain: links, offsets, and the largest slide of each P, C and H
+    # joint over these samples (a point's distance from an earlier axis includes them)
+    reach = sum(float(np.linalg.norm(t)) for t in lay.link_translations)
+    for i, joint in enumerate(linkage.joints):
+        if joint.kind == "H":  # its slide is offset + pitch θ, and a turn also moves by pitch
+            c = lay.scalar_col[lay.joint_of.index(i)]
+            reach += float(np.max(np.abs(joint.offset + joint.pitch * held[:, c]))) \
+                + abs(joint.pitch)
+        elif joint.kind != "P":  # a P joint's offset is an angle
+            reach += abs(joint.offset)
+    for f, c in enumerate(lay.scalar_col):
+        if lay.is_translation[f]:
+            reach += float(np.max(np.abs(held[:, c])))
+    lever = max(1.0, reach / L)
+    dq = np.abs(q[1:] - q[:-1])
+    turn = ~np.array([lay.is_translation[f] for f in range(len(lay.names))
+                      if lay.scalar_col[f] >= 0], dtype=bool)
+    dq[:, turn] = np.abs(np.pi - np.mod(np.pi - dq[:, turn], 2 * np.pi))
+    dq[:, ~turn] /= L
+    steps = dq.sum(axis=1)
+    if lay.n_spherical:
+        cols = tr.spherical[lo:hi, :, :, :2]
+        d = cols[1:] - cols[:-1]
+        steps += 0.5 * np.pi * np.sqrt(np.einsum("nsij,nsij->ns", d, d)).sum(axis=1)
+    # between samples that are not neighbours (a gap) the bound is not known: infinite
+    out = np.full(len(samples) - 1, np.inf)
+    near = np.diff(samples) == 1
+    out[near] = steps[samples[:-1][near] - lo]
+    return np.asarray(lever * out)
+
+
+def _attach_turning_points(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
+    """A one-sample track at a singular configuration next to where other branches end is
+    the turning point where they meet (a sample exactly at a dead centre, found by the root
+    search there): it becomes the last sample of each of those branches, as the closed forms
+    report it."""
+    out = []
+    for tr in tracks:
+        held = np.nonzero(tr.mask)[0]
+        if held.size != 1:
+            out.append(tr)
+            continue
+        s = int(held[0])
+        ends = [o for o in tracks if o is not tr and not o.mask[s] and (
+            (s > 0 and o.mask[s - 1]) or (s + 1 < len(o.mask) and o.mask[s + 1]))]
+        conf = Configuration(tr.scalars[held], tr.spherical[held])
+        singular = rate_equations(linkage, lay, forward(linkage, conf, lay)).rank_deficient[0]
+        if not ends or not singular:
+            out.append(tr)
+            continue
+        for o in ends:
+            o.set_sample(s, tr.scalars[s], tr.spherical[s])
+    return out
+
+
+def _attach_lone_ends(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
+    """One-sample tracks at a sample s next to where as many branches start (or stop)
+    assembling, at s + 1 (or s − 1), are those branches' first (or last) samples: next to a
+    fold the continuation may stop a sample short of where the branches still assemble, and
+    the root search then finds that sample's roots alone. Each root goes to one branch,
+    paired by continuity (the least total distance to the branches' neighbouring
+    configurations, as :func:`_pair_ends`), and only within ten times the branch's own
+    step there. Attached, a branch's run — and an S–S rod's pose carried along it from the run's
+    first sample — is the closed forms'."""
+    from itertools import permutations
+
+    lone = [tr for tr in tracks if int(tr.mask.sum()) == 1]
+    if not lone:
+        return tracks
+    N = len(tracks[0].mask)
+    attached: list[Track] = []
+    for s in sorted({int(np.argmax(tr.mask)) for tr in lone}):
+        roots = [tr for tr in lone if tr.mask[s] and not any(tr is a for a in attached)]
+        for n in (s + 1, s - 1):
+            far = n + (n - s)
+            if not roots or not 0 <= far < N:
+                continue
+            ends = [o for o in tracks if int(o.mask.sum()) > 1 and o.mask[n] and o.mask[far]
+                    and not o.mask[s]]
+            if len(ends) != len(roots) or len(roots) > 4:
+                continue
+            mine = np.stack([_signatures(linkage, lay, tr, np.array([s]))[0] for tr in roots])
+            near = np.stack([_signatures(linkage, lay, o, np.array([n, far])) for o in ends])
+            gap = np.linalg.norm(mine[:, None, :] - near[None, :, 0, :], axis=-1)
+            step = np.linalg.norm(near[:, 0] - near[:, 1], axis=-1)
+            best = min(permutations(range(len(ends))),
+                       key=lambda perm: sum(gap[i, j] for i, j in enumerate(perm)))
+            if not all(gap[i, j] <= 10.0 * step[j] + SAME_ROOT for i, j in enumerate(best)):
+                continue
+            for i, j in enumerate(best):
+                o, tr = ends[j], roots[i]
+                o.set_sample(s, tr.scalars[s], tr.spherical[s])
+                attached.append(tr)
+            roots = []
+    return [tr for tr in tracks if not any(tr is a for a in attached)]
+
+
+def _order_key(linkage: Linkage, lay: Layout, tr: Track) -> tuple[float, ...]:
+    """A documented, deterministic mode order: by the first sample where the mode assembles,
+    then by its configuration there (joint centres and axes), not by the random starts."""
+    first = int(np.argmax(tr.mask))
+    sig = _signatures(linkage, lay, tr, np.array([first]))[0]
+    return (float(first), *np.round(sig, 9).tolist())
+
+
+__all__ = ["ANCHOR_SPAN", "all_branches", "closes_nowhere", "anchor_samples", "generic_motion", "progress_reporter"]
