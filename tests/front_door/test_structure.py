@@ -11,7 +11,7 @@ SRC = Path(__file__).resolve().parents[2] / "src" / "screwkit"
 
 #: layer rank of each top-level package/module; a module may import ranks ≤ its own
 RANK = {"errors": 0, "constants": 0, "budget": 0, "tables": 0, "messages": 0, "dual": 1,
-        "model": 2, "kinematics": 3, "mobility": 3,
+        "algebraic": 1, "model": 2, "kinematics": 3, "mobility": 3,
         "dynamics": 4, "balancing": 5, "synthesis": 5, "io": 6, "pipeline": 7, "report": 7,
         "sweep": 7, "simulation": 7, "exchange": 7, "studio": 8, "cli": 8, "__init__": 9}
 
