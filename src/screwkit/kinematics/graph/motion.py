@@ -11,7 +11,7 @@ bodies. Per mode the fields are those of a single loop's :class:`ModeMotion` wit
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,6 +33,7 @@ from screwkit.kinematics.graph.newton import (
     rates,
     scaled_residual,
 )
+from screwkit.kinematics.graph.subchains import Decomposition, decompose
 from screwkit.kinematics.graph.track import follow_drawn_mode
 from screwkit.kinematics.motion import AssemblyError, ModeMotion
 from screwkit.kinematics.tracker.loop import Configuration, rotation_vector
@@ -169,16 +170,29 @@ def check_cost(mech: Mechanism, samples: int) -> None:
 
 def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | None = 1.0,
                     accelerations: ArrayLike | None = 0.0,
-                    progress: Callable[[int, int], None] | None = None) -> MechanismMotion:
+                    progress: Callable[[int, int], None] | None = None,
+                    every_mode: bool = False) -> MechanismMotion:
     """The drawn mode of ``mech`` over ``inputs`` (N rows, one value per input, measured from
     the drawing; SI), with input ``rates`` and ``accelerations`` (a scalar, one per input or
-    one per sample and input)."""
+    one per sample and input).
+
+    A mechanism that decomposes into closed-form sub-chains (graph/subchains.py: driven joints
+    and planar dyads) is solved by their closed forms (graph/dyads.py), and with
+    ``every_mode`` every other assembly mode follows the drawn one (graph/closed_modes.py);
+    any other mechanism by continuation of the drawn mode (graph/track.py; ``every_mode``
+    then has nothing more to add: the motion's notes say so)."""
     X = input_rows(mech, inputs)
     N, n_in = X.shape
     check_cost(mech, N)
     Xd = _per_sample(rates, N, n_in, "rates")
     Xdd = _per_sample(accelerations, N, n_in, "accelerations")
     lay = graph_layout(mech)
+    dec = decompose(mech)
+    if dec.complete and lay.n_spherical == 0:
+        motion = _closed_form_motion(mech, lay, dec, X, Xd, Xdd, every_mode)
+        if callable(progress):
+            progress(N, N)
+        return motion
     followed = follow_drawn_mode(mech, lay, X, progress)
     if not followed.mask.any():
         raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
@@ -192,7 +206,86 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
             if k + 1 < N else ""
         events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[k])}{nxt}")
     mode = _with_events(mode, events)
-    return MechanismMotion(mech, X, Xd, Xdd, (mode,))
+    notes = (("every mode: only the drawn mode is found for this mechanism: "
+              + "; ".join(dec.describe(mech)[-1:])),) if every_mode else ()
+    return MechanismMotion(mech, X, Xd, Xdd, (mode,), notes=notes)
+
+
+CLOSED_FORM_SOLVER = ("closed-form sub-chains (driven joints and planar dyads, every branch), "
+                      "rates and accelerations from the stacked loop closure")
+
+
+def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
+                        Xd: Array, Xdd: Array, every: bool) -> MechanismMotion:
+    """The drawn mode (and with ``every`` every other mode that assembles somewhere) from the
+    closed forms (graph/closed_modes.py)."""
+    from screwkit.kinematics.graph.closed_modes import (
+        branch_combinations,
+        drawn_start,
+        every_mode,
+        mode_configuration,
+        mode_label,
+    )
+    from screwkit.kinematics.graph.dyads import place
+
+    N = X.shape[0]
+    signs = branch_combinations(dec)
+    if every:
+        pl = every_mode(mech, lay, dec, X).placement
+    else:
+        signs = signs[:1]
+        pl = place(mech, lay, dec, X, np.repeat(signs, N, axis=0))
+    M = signs.shape[0]
+    ok = pl.assembles.reshape(M, N)
+    R = pl.R.reshape(M, N, *pl.R.shape[1:])
+    p = pl.p.reshape(M, N, *pl.p.shape[1:])
+    start = drawn_start(mech, lay, dec, X[0])
+    if start is None or not ok[0, 0]:
+        raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
+                            f"first input row {_fmt(mech, lay, X[0])}: the mechanism stops "
+                            "assembling before it")
+    stop = int(np.argmin(ok[0])) if not ok[0].all() else N
+    drawn = np.zeros(N, dtype=bool)
+    drawn[:stop] = True
+    conf = mode_configuration(mech, lay, R[0], p[0], X, drawn, start)
+    mode = build_mode(mech, lay, conf, drawn, X, Xd, Xdd)
+    events = _fold_events(mech, lay, dec, X, signs[0], ok[0], after=stop)
+    if stop < N:
+        events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[stop - 1])} (a "
+                         f"limit position or dead centre before {_fmt(mech, lay, X[stop])})")
+    modes = [replace(_with_events(mode, [*events, *mode.events]), label="drawn")]
+    for m in range(1, M):
+        if not ok[m].any():
+            continue
+        conf = mode_configuration(mech, lay, R[m], p[m], X, ok[m])
+        md = build_mode(mech, lay, conf, ok[m], X, Xd, Xdd)
+        events = _fold_events(mech, lay, dec, X, signs[m], ok[m], after=0)
+        modes.append(replace(_with_events(md, [*events, *md.events]),
+                             label=f"branches {mode_label(mech, dec, signs[m])}",
+                             index=len(modes)))
+    notes = (f"{M} branch combination(s) of {len(dec.dyads)} dyad(s); {len(modes)} assemble "
+             "over these inputs",) if every else ()
+    return MechanismMotion(mech, X, Xd, Xdd, tuple(modes), method="graph (closed forms)",
+                           solver=CLOSED_FORM_SOLVER, notes=notes)
+
+
+def _fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
+                 signs: Array, ok: NDArray[np.bool_], after: int) -> list[str]:
+    """A mode's births and deaths at folds from sample ``after`` on, each located between
+    samples (graph/closed_modes.py's ``fold_inputs``)."""
+    from screwkit.kinematics.graph.closed_modes import fold_inputs
+
+    events = []
+    for k in np.nonzero(ok[:-1] != ok[1:])[0]:
+        if k + 1 < after:
+            continue
+        x, d = fold_inputs(mech, lay, dec, X, signs, int(k))
+        dyad = dec.dyads[d]
+        names = "–".join(mech.joints[i].name for i in dyad.joints)
+        what = "dies" if ok[k] else "is born"
+        events.append(f"{what} at {_fmt(mech, lay, x)}: the {dyad.kind} dyad {names} folds "
+                      "(its links in line)")
+    return events
 
 
 def _with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:

@@ -1,0 +1,148 @@
+"""Every assembly mode of a mechanism that decomposes into closed-form sub-chains
+(graph/subchains.py, graph/dyads.py).
+
+A mode is one combination of dyad branches σ (one ±1 per two-branch dyad): 2^D modes for D such
+dyads. Each is a continuous branch over the inputs wherever every discriminant of its dyads is
+positive; it is born or dies where one crosses zero (a fold: that dyad's links in line), which
+is located between the two samples around it by bisection along the segment joining their
+inputs (:func:`fold_inputs`). The drawn mode is the combination of the drawing's branches; as
+with the tracker (graph/track.py) it is followed from the drawing and stops at its first fold.
+Rates and accelerations come from the closure Jacobian (graph/motion.py's ``build_mode``).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.graph.dyads import Placement, configuration, place
+from screwkit.kinematics.graph.subchains import Decomposition
+from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.model.mechanism import Mechanism
+
+Array = NDArray[np.float64]
+
+#: bisection steps locating a fold between two samples (2⁻⁶⁰ of their input step)
+FOLD_STEPS = 60
+#: the largest input step (rad, or this fraction of the length scale for a slide) on the path
+#: from the drawing to the first sample, where turning angles are counted
+APPROACH_STEP = 0.05
+
+
+@dataclass(frozen=True)
+class EveryMode:
+    """The poses of every mode: ``signs[k]`` the branch of each dyad (M, D) and
+    ``placement`` over the M·N samples, mode-major; ``drawn`` the drawn mode's index."""
+
+    signs: Array
+    placement: Placement
+    drawn: int
+
+    @property
+    def count(self) -> int:
+        return int(self.signs.shape[0])
+
+    def assembles(self, N: int) -> NDArray[np.bool_]:
+        """(M, N) where each mode assembles."""
+        return self.placement.assembles.reshape(self.count, N)
+
+
+def branch_combinations(dec: Decomposition) -> Array:
+    """Every combination of dyad branches (M, D): ±1 for each two-branch dyad (the drawn
+    sign first), +1 for a one-branch dyad; the drawing's combination is row 0."""
+    choices = [(d.drawn_branch, -d.drawn_branch) if d.branches == 2 else (1,)
+               for d in dec.dyads]
+    return np.array(list(itertools.product(*choices)), dtype=float).reshape(-1, len(choices))
+
+
+def every_mode(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array) -> EveryMode:
+    """The body poses of every mode at every input row, in one batched evaluation."""
+    signs = branch_combinations(dec)
+    M, N = signs.shape[0], X.shape[0]
+    placement = place(mech, lay, dec, np.tile(X, (M, 1)), np.repeat(signs, N, axis=0))
+    return EveryMode(signs, placement, 0)
+
+
+def mode_configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Array,
+                       mask: NDArray[np.bool_], start: Array | None = None) -> Configuration:
+    """Joint variables of one mode (N samples): the inputs as given, every angle counted
+    continuously along each run of samples where the mode assembles (``start``: the angles
+    at the run's first sample, when known from the drawing)."""
+    conf = configuration(mech, lay, np.where(mask[:, None, None, None], R, np.eye(3)),
+                         np.where(mask[:, None, None], p, 0.0))
+    q = conf.scalars
+    turning = [lay.scalar_col[f] for f in range(lay.m)
+               if not lay.is_translation[f] and lay.scalar_col[f] >= 0]
+    for a, b in _runs(mask):
+        run = q[a:b, turning]
+        if a == 0 and start is not None:
+            run = np.vstack([start[None, turning], run])
+            q[a:b, turning] = np.unwrap(run, axis=0)[1:]
+        else:
+            q[a:b, turning] = np.unwrap(run, axis=0)
+    q[~mask] = 0.0
+    for k, f in enumerate(lay.inputs):
+        q[:, lay.scalar_col[f]] = X[:, k]
+    return conf
+
+
+def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """The [start, stop) index ranges where ``mask`` holds."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(zip(np.nonzero(edges == 1)[0].tolist(), np.nonzero(edges == -1)[0].tolist(),
+                    strict=True))
+
+
+def drawn_start(mech: Mechanism, lay: GraphLayout, dec: Decomposition, x0: Array
+                ) -> Array | None:
+    """The drawn mode's joint angles at the first input row ``x0``, counted from the drawing
+    (every angle 0) along the straight input path; None where the mode folds before it."""
+    scale = np.array([lay.length if lay.is_translation[f] else 1.0 for f in lay.inputs])
+    steps = max(1, int(np.ceil(float(np.max(np.abs(x0) / scale)) / APPROACH_STEP)))
+    path = np.linspace(0.0, 1.0, steps + 1)[:, None] * x0[None, :]
+    signs = branch_combinations(dec)[:1]
+    pl = place(mech, lay, dec, path, np.repeat(signs, path.shape[0], axis=0))
+    if not pl.assembles.all():
+        return None
+    conf = mode_configuration(mech, lay, pl.R, pl.p, path, pl.assembles,
+                              np.zeros(lay.n_scalar))
+    return np.asarray(conf.scalars[-1])
+
+
+def fold_inputs(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
+                signs: Array, k: int) -> tuple[Array, int]:
+    """Where the mode of branches ``signs`` (D,) is born or dies between samples k and k+1
+    (exactly one of them assembles): the input row at the fold, by bisection on the segment
+    X[k] → X[k+1], and the index of the dyad whose discriminant crosses zero there."""
+    lo, hi = 0.0, 1.0
+    ok_lo = bool(place(mech, lay, dec, X[k:k + 1], signs[None, :]).assembles[0])
+    for _ in range(FOLD_STEPS):
+        mid = 0.5 * (lo + hi)
+        x = X[k] + mid * (X[k + 1] - X[k])
+        if bool(place(mech, lay, dec, x[None, :], signs[None, :]).assembles[0]) == ok_lo:
+            lo = mid
+        else:
+            hi = mid
+    bad = hi if ok_lo else lo
+    x_bad = X[k] + bad * (X[k + 1] - X[k])
+    disc = place(mech, lay, dec, x_bad[None, :], signs[None, :]).discriminant[0]
+    folding = int(np.nanargmin(np.where(np.isnan(disc), -np.inf, disc)))
+    return X[k] + 0.5 * (lo + hi) * (X[k + 1] - X[k]), folding
+
+
+def mode_label(mech: Mechanism, dec: Decomposition, signs: Array) -> str:
+    """The branch of each two-branch dyad, e.g. ``"A–B–OB +, E–G–F −"`` (+: the drawing's)."""
+    parts = []
+    for d, s in zip(dec.dyads, signs, strict=True):
+        if d.branches == 2:
+            names = "–".join(mech.joints[k].name for k in d.joints)
+            parts.append(f"{names} {'+' if s == d.drawn_branch else '−'}")
+    return ", ".join(parts)
+
+
+def with_label(mode: object, label: str, index: int) -> object:
+    return replace(mode, label=label, index=index)  # type: ignore[type-var]

@@ -1,0 +1,251 @@
+"""The order in which a mechanism's bodies become placed from the ground and the inputs, by
+sub-chains that have closed forms (Assur-group decomposition; Mruthyunjaya 2003, Mechanism and
+Machine Theory 38(9), for the planar groups).
+
+Two kinds of step place bodies:
+
+- a **driven** body: joined to a placed body by a joint whose every freedom is an input (an R or
+  P joint): its pose is the placed body's times the joint motion;
+- a **planar dyad**: two unplaced bodies b1 and b2 joined to each other by joint J3 and each to a
+  placed body (b1 to p1 by J1, b2 to p2 by J2), with nothing else joining them to a placed body.
+  J1, J3 and J2 are R or P joints, none driven, forming RRR, RRP (or PRR), RPR or PRP; "planar"
+  means every R axis parallel to one normal n and every P direction perpendicular to it (within
+  :data:`ANGLE_TOL`, radians: a tilt ε moves points by ε·L on a mechanism of size L), and both
+  placed bodies moving in planes normal to n (the ground, or bodies placed by planar steps with
+  the same n). A spatial mechanism drawn planar is planar.
+
+What is left (a Stephenson III triad, a platform, a spatial loop) is reported as needing the
+homotopy; the graph tracker (graph/track.py) keeps handling those. The closed forms of the steps
+are in graph/dyads.py.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.model.mechanism import GROUND, Mechanism
+
+Array = NDArray[np.float64]
+
+#: axes closer than this to parallel (or P directions to perpendicular), in radians, count as
+#: parallel: relative to the length scale, a tilt this small moves points by 1e-9 of it
+ANGLE_TOL = 1e-9
+#: a dyad link shorter than this fraction of the length scale has no direction to solve for
+SHORT_LINK = 1e-9
+
+#: dyad kinds after orienting so that a single P sits at J2 (RRP) or J3 (RPR)
+DYAD_KINDS = ("RRR", "RRP", "RPR", "PRP")
+
+
+@dataclass(frozen=True)
+class Driven:
+    """A body placed by a driven joint from an already placed body."""
+
+    joint: int
+    parent: str
+    body: str
+
+    def describe(self, mech: Mechanism) -> str:
+        return f"{self.body!r} driven by {mech.joints[self.joint].name}"
+
+
+@dataclass(frozen=True)
+class Dyad:
+    """Two bodies placed together: ``bodies = (b1, b2)``, ``joints = (J1, J3, J2)`` (J1 joins
+    p1–b1, J3 b1–b2, J2 b2–p2), ``placed = (p1, p2)``, the kind read along J1 J3 J2, and the
+    plane normal ``normal``. ``drawn_branch`` is the branch sign of the drawing (+1 or −1; +1
+    for a PRP, which has one solution)."""
+
+    kind: str
+    bodies: tuple[str, str]
+    joints: tuple[int, int, int]
+    placed: tuple[str, str]
+    normal: Array
+    drawn_branch: int
+
+    @property
+    def branches(self) -> int:
+        return 1 if self.kind == "PRP" else 2
+
+    def describe(self, mech: Mechanism) -> str:
+        names = "–".join(mech.joints[k].name for k in self.joints)
+        return f"{self.kind} dyad {names} placing {self.bodies[0]!r} and {self.bodies[1]!r}"
+
+
+Step = Driven | Dyad
+
+
+@dataclass(frozen=True)
+class Decomposition:
+    """The steps in placing order; the bodies and joints no step places or uses."""
+
+    steps: tuple[Step, ...]
+    unplaced: tuple[str, ...]
+    unused_joints: tuple[int, ...]
+
+    @property
+    def complete(self) -> bool:
+        """Every body is placed and every joint is used by a step (a joint left over would
+        be a further constraint the closed forms do not see)."""
+        return not self.unplaced and not self.unused_joints
+
+    @property
+    def dyads(self) -> tuple[Dyad, ...]:
+        return tuple(s for s in self.steps if isinstance(s, Dyad))
+
+    @property
+    def mode_count(self) -> int:
+        """Branch combinations: 2 per two-branch dyad."""
+        return int(2 ** sum(d.branches == 2 for d in self.dyads))
+
+    def describe(self, mech: Mechanism) -> list[str]:
+        lines = [s.describe(mech) for s in self.steps]
+        if self.unplaced:
+            lines.append("needs the homotopy (no closed-form sub-chain places them): bodies "
+                         + ", ".join(repr(b) for b in self.unplaced))
+        elif self.unused_joints:
+            lines.append("needs the homotopy: joints "
+                         + ", ".join(mech.joints[k].name for k in self.unused_joints)
+                         + " constrain bodies the closed forms already placed")
+        return lines
+
+
+def _parallel(u: Array, v: Array) -> bool:
+    return float(np.linalg.norm(np.cross(u, v))) <= ANGLE_TOL
+
+
+def _perpendicular(u: Array, v: Array) -> bool:
+    return abs(float(u @ v)) <= ANGLE_TOL
+
+
+def _normals(mech: Mechanism) -> list[Array]:
+    """Candidate plane normals: the distinct R axis directions (up to sign)."""
+    out: list[Array] = []
+    for j in mech.joints:
+        if j.kind == "R" and not any(_parallel(j.axis, n) for n in out):
+            out.append(j.axis)
+    return out
+
+
+def _planar_in(mech: Mechanism, k: int, normals: list[Array]) -> set[int]:
+    """Indices of the normals joint ``k`` keeps motion planar about (R ∥ n, P ⊥ n)."""
+    j = mech.joints[k]
+    if j.kind == "R":
+        return {i for i, n in enumerate(normals) if _parallel(j.axis, n)}
+    if j.kind == "P":
+        return {i for i, n in enumerate(normals) if _perpendicular(j.axis, n)}
+    return set()
+
+
+def decompose(mech: Mechanism) -> Decomposition:
+    """Place bodies from the ground by driven joints and planar dyads until none applies
+    (module docstring)."""
+    normals = _normals(mech)
+    planes: dict[str, set[int]] = {GROUND: set(range(len(normals)))}  # placed body -> normals
+    used: set[int] = set()
+    steps: list[Step] = []
+    inputs = {f.split(".")[0] for f in mech.inputs}
+    driven = {k for k, j in enumerate(mech.joints) if j.kind in "RP" and j.name in inputs}
+    progress = True
+    while progress:
+        progress = False
+        for k, j in enumerate(mech.joints):
+            a, b = j.bodies
+            if k in driven and k not in used and (a in planes) != (b in planes):
+                parent, body = (a, b) if a in planes else (b, a)
+                steps.append(Driven(k, parent, body))
+                planes[body] = planes[parent] & _planar_in(mech, k, normals)
+                used.add(k)
+                progress = True
+        dyad = _find_dyad(mech, planes, used, driven, normals)
+        if dyad is not None:
+            steps.append(dyad)
+            used.update(dyad.joints)
+            n_index = next(i for i, n in enumerate(normals) if _parallel(n, dyad.normal))
+            for body in dyad.bodies:
+                planes[body] = {n_index}
+            progress = True
+    unplaced = tuple(b for b in mech.body_names if b not in planes)
+    unused = tuple(k for k in range(len(mech.joints)) if k not in used)
+    return Decomposition(tuple(steps), unplaced, unused)
+
+
+def _find_dyad(mech: Mechanism, planes: dict[str, set[int]], used: set[int], driven: set[int],
+               normals: list[Array]) -> Dyad | None:
+    """The first planar dyad on the placed bodies, or None."""
+    for k3, j3 in enumerate(mech.joints):
+        b1, b2 = j3.bodies
+        if k3 in used or k3 in driven or b1 in planes or b2 in planes or j3.kind not in "RP":
+            continue
+        first = _attachments(mech, b1, planes, used)
+        second = _attachments(mech, b2, planes, used)
+        if len(first) != 1 or len(second) != 1:
+            continue
+        k1, k2 = first[0], second[0]
+        if k1 in driven or k2 in driven:
+            continue
+        kinds = "".join(mech.joints[k].kind for k in (k1, k3, k2))
+        if kinds == "PRR":  # orient so the P is J2
+            b1, b2, k1, k2 = b2, b1, k2, k1
+            kinds = "RRP"
+        if kinds not in DYAD_KINDS:
+            continue
+        p1 = _other(mech, k1, b1)
+        p2 = _other(mech, k2, b2)
+        common = planes[p1] & planes[p2]
+        for k in (k1, k3, k2):
+            common &= _planar_in(mech, k, normals)
+        if not common:
+            continue
+        n = normals[min(common)]
+        branch = drawn_branch(mech, kinds, (k1, k3, k2), n)
+        if branch is None:
+            continue
+        return Dyad(kinds, (b1, b2), (k1, k3, k2), (p1, p2), n, branch)
+    return None
+
+
+def _attachments(mech: Mechanism, body: str, planes: dict[str, set[int]], used: set[int]
+                 ) -> list[int]:
+    """Unused joints from ``body`` to an already placed body."""
+    return [k for k, j in enumerate(mech.joints)
+            if k not in used and body in j.bodies and _other(mech, k, body) in planes]
+
+
+def _other(mech: Mechanism, k: int, body: str) -> str:
+    a, b = mech.joints[k].bodies
+    return b if a == body else a
+
+
+def _in_plane(v: Array, n: Array) -> Array:
+    return v - (v @ n) * n
+
+
+def drawn_branch(mech: Mechanism, kind: str, joints: tuple[int, int, int], n: Array
+                 ) -> int | None:
+    """The branch sign of the drawing (graph/dyads.py's conventions), or None where the
+    dyad is degenerate in the drawing (a link of no length, or parallel slides)."""
+    L = mech.length_scale
+    j1, j3, j2 = (mech.joints[k] for k in joints)
+    if kind == "RRR":
+        w0 = _in_plane(j2.at - j1.at, n)
+        r1 = _in_plane(j3.at - j1.at, n)
+        r2 = _in_plane(j3.at - j2.at, n)
+        if min(np.linalg.norm(w0), np.linalg.norm(r1), np.linalg.norm(r2)) <= SHORT_LINK * L:
+            return None
+        return 1 if float(n @ np.cross(w0, r1)) >= 0.0 else -1
+    if kind == "RRP":
+        r1 = _in_plane(j3.at - j1.at, n)
+        if np.linalg.norm(r1) <= SHORT_LINK * L:
+            return None
+        return 1 if float(r1 @ j2.axis) >= 0.0 else -1
+    if kind == "RPR":
+        w0 = _in_plane(j2.at - j1.at, n)
+        return 1 if float(w0 @ j3.axis) >= 0.0 else -1
+    # PRP: one solution where the two slides cross
+    if abs(float(n @ np.cross(j1.axis, j2.axis))) <= ANGLE_TOL:
+        return None
+    return 1
