@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphLayout
-from screwkit.kinematics.graph.dyads import Placement, configuration, place
+from screwkit.kinematics.graph.dyads import Placement, configuration, place, place_every
 from screwkit.kinematics.graph.subchains import Decomposition
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
@@ -61,10 +61,7 @@ def branch_combinations(dec: Decomposition) -> Array:
 
 def every_mode(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array) -> EveryMode:
     """The body poses of every mode at every input row, in one batched evaluation."""
-    signs = branch_combinations(dec)
-    M, N = signs.shape[0], X.shape[0]
-    placement = place(mech, lay, dec, np.tile(X, (M, 1)), np.repeat(signs, N, axis=0))
-    return EveryMode(signs, placement, 0)
+    return EveryMode(branch_combinations(dec), place_every(mech, lay, dec, X), 0)
 
 
 def mode_configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Array,
@@ -114,24 +111,24 @@ def drawn_start(mech: Mechanism, lay: GraphLayout, dec: Decomposition, x0: Array
 
 
 def fold_inputs(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
-                signs: Array, k: int) -> tuple[Array, int]:
-    """Where the mode of branches ``signs`` (D,) is born or dies between samples k and k+1
-    (exactly one of them assembles): the input row at the fold, by bisection on the segment
-    X[k] → X[k+1], and the index of the dyad whose discriminant crosses zero there."""
-    lo, hi = 0.0, 1.0
-    ok_lo = bool(place(mech, lay, dec, X[k:k + 1], signs[None, :]).assembles[0])
+                signs: Array, k: NDArray[np.intp]) -> tuple[Array, NDArray[np.intp]]:
+    """Where the modes of branches ``signs`` (T, D) are born or die between samples k and
+    k+1 (T,; exactly one of the two assembles): the input rows at the folds (T, n_in), by
+    bisection on each segment X[k] → X[k+1] (all at once), and the index of the dyad whose
+    discriminant crosses zero there (T,)."""
+    T = k.shape[0]
+    x0, x1 = X[k], X[k + 1]
+    lo, hi = np.zeros(T), np.ones(T)
+    ok_lo = place(mech, lay, dec, x0, signs).assembles
     for _ in range(FOLD_STEPS):
         mid = 0.5 * (lo + hi)
-        x = X[k] + mid * (X[k + 1] - X[k])
-        if bool(place(mech, lay, dec, x[None, :], signs[None, :]).assembles[0]) == ok_lo:
-            lo = mid
-        else:
-            hi = mid
-    bad = hi if ok_lo else lo
-    x_bad = X[k] + bad * (X[k + 1] - X[k])
-    disc = place(mech, lay, dec, x_bad[None, :], signs[None, :]).discriminant[0]
-    folding = int(np.nanargmin(np.where(np.isnan(disc), -np.inf, disc)))
-    return X[k] + 0.5 * (lo + hi) * (X[k + 1] - X[k]), folding
+        same = place(mech, lay, dec, x0 + mid[:, None] * (x1 - x0), signs).assembles == ok_lo
+        lo = np.where(same, mid, lo)
+        hi = np.where(same, hi, mid)
+    bad = np.where(ok_lo, hi, lo)
+    disc = place(mech, lay, dec, x0 + bad[:, None] * (x1 - x0), signs).discriminant
+    folding = np.argmin(np.where(np.isnan(disc), -np.inf, disc), axis=1)
+    return x0 + (0.5 * (lo + hi))[:, None] * (x1 - x0), folding
 
 
 def mode_label(mech: Mechanism, dec: Decomposition, signs: Array) -> str:

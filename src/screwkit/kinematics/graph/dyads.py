@@ -52,47 +52,119 @@ class Placement:
 
 def rotation_about(n: Array, angle: Array) -> Array:
     """Rotations (K, 3, 3) by ``angle`` (K,) about the unit axis n (Rodrigues)."""
-    K = np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]])
-    s, c = np.sin(angle), np.cos(angle)
-    return (np.eye(3) + np.multiply.outer(s, K) + np.multiply.outer(1.0 - c, K @ K))
+    return _rotation_cs(n, np.cos(angle), np.sin(angle))
+
+
+def _rotation_cs(n: Array, c: Array, s: Array) -> Array:
+    """Rodrigues' rotation about n from the angle's cosine and sine (K,): c I + s [n]× +
+    (1 − c) n nᵀ."""
+    nn = np.outer(n, n)
+    out = np.multiply.outer(c, np.eye(3) - nn)
+    out += np.multiply.outer(s, np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]],
+                                          [-n[1], n[0], 0.0]]))
+    out += nn
+    return out
 
 
 def _turn(n: Array, v0: Array, v: Array) -> Array:
     """The rotation about n taking the in-plane part of v0 (3,) to that of v (K, 3)."""
     v0 = v0 - (v0 @ n) * n
-    v = v - np.outer(v @ n, n)
-    angle = np.arctan2(np.cross(v0, v) @ n, v @ v0)
-    return rotation_about(n, angle)
-
-
-def _world(R: Array, p: Array, b: int, x0: Array) -> Array:
-    return R[:, b] @ x0 + p[:, b]
+    cross = np.cross(v0, n)  # sin = n·(v0 × v) = v·(n × v0)
+    c, s = v @ v0, -(v @ cross)
+    size = np.hypot(c, s)
+    return _rotation_cs(n, c / size, s / size)
 
 
 def place(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array, signs: Array
           ) -> Placement:
     """Every body's pose at inputs ``X`` (K, n_in) on the branches ``signs`` (K, D), one ±1
     per dyad of ``dec`` in order (module docstring)."""
-    K = X.shape[0]
-    B = len(mech.bodies) + 1
-    R = np.full((K, B, 3, 3), np.nan)
-    p = np.full((K, B, 3), np.nan)
-    g = lay.body_of[GROUND]
-    R[:, g] = np.eye(3)
-    p[:, g] = 0.0
-    disc = np.empty((K, len(dec.dyads)))
+    poses: dict[str, Pose] = {GROUND: _ground(X.shape[0])}
+    disc = np.empty((X.shape[0], len(dec.dyads)))
     d = 0
     for step in dec.steps:
         if isinstance(step, Driven):
-            _driven(mech, lay, step, X, R, p)
+            poses[step.body] = _driven(mech, lay, step, X, poses[step.parent])
         else:
-            disc[:, d] = _dyad(mech, lay, step, signs[:, d], R, p)
+            b1, b2, disc[:, d] = _dyad(mech, step, signs[:, d], poses[step.placed[0]],
+                                       poses[step.placed[1]])
+            poses[step.bodies[0]], poses[step.bodies[1]] = b1, b2
             d += 1
-    return Placement(R, p, disc)
+    return _gathered(mech, lay, poses, disc)
 
 
-def _driven(mech: Mechanism, lay: GraphLayout, step: Driven, X: Array, R: Array, p: Array
-            ) -> None:
+def place_every(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array) -> Placement:
+    """Every body's pose in every combination of dyad branches at every input row: M·N
+    samples, mode-major, in graph/closed_modes.py's ``branch_combinations`` order (the first
+    dyad's branch varies slowest, the drawing's branch first). Each dyad is solved once per
+    combination of the branches before it: a body's pose is shared by the modes that differ
+    only in later dyads."""
+    N = X.shape[0]
+    poses: dict[str, Pose] = {GROUND: _ground(N)}
+    count: dict[str, int] = {GROUND: 1}  # how many branch prefixes a body's pose covers
+    discs: list[tuple[Array, int]] = []
+    m = 1
+    for step in dec.steps:
+        if isinstance(step, Driven):
+            c = count[step.parent]
+            poses[step.body] = _driven(mech, lay, step, np.tile(X, (c, 1)), poses[step.parent])
+            count[step.body] = c
+            continue
+        m_new = m * step.branches
+        branch = [step.drawn_branch, -step.drawn_branch][:step.branches]
+        sigma = np.repeat(np.tile(np.array(branch, dtype=float), m), N)
+        ends = [_widened(poses[b], count[b], m, N) for b in step.placed]
+        if step.branches == 2:  # every prefix on both branches
+            ends = [_widened(e, m, m_new, N) for e in ends]
+        b1, b2, dsc = _dyad(mech, step, sigma, ends[0], ends[1])
+        poses[step.bodies[0]], poses[step.bodies[1]] = b1, b2
+        count[step.bodies[0]] = count[step.bodies[1]] = m_new
+        discs.append((dsc, m_new))
+        m = m_new
+    disc = np.empty((m * N, len(discs)))
+    for d, (dsc, have) in enumerate(discs):
+        disc[:, d] = np.repeat(dsc.reshape(have, N), m // have, axis=0).reshape(-1)
+    return _gathered(mech, lay, poses, disc, count, N)
+
+
+Pose = tuple[Array, Array]
+
+
+def _ground(K: int) -> Pose:
+    return np.broadcast_to(np.eye(3), (K, 3, 3)), np.zeros((K, 3))
+
+
+def _widened(pose: Pose, have: int, want: int, N: int) -> Pose:
+    """A pose over ``have`` branch prefixes (have·N samples) repeated to ``want`` prefixes
+    (a multiple of ``have``: each prefix followed by every branch of the dyads after it)."""
+    if have == want:
+        return pose
+    r = want // have
+    R, p = pose
+    return (np.repeat(R.reshape(have, N, 3, 3), r, axis=0).reshape(want * N, 3, 3),
+            np.repeat(p.reshape(have, N, 3), r, axis=0).reshape(want * N, 3))
+
+
+def _gathered(mech: Mechanism, lay: GraphLayout, poses: dict[str, Pose], disc: Array,
+              count: dict[str, int] | None = None, N: int = 0) -> Placement:
+    """The poses in graph/closure.py's layout (K, B+1, …), written body by body (a body
+    over fewer branch prefixes than K/N repeated to all: :func:`place_every`)."""
+    K = disc.shape[0]
+    B = len(mech.bodies) + 1
+    R = np.empty((B, K, 3, 3))  # body-major: each body's write is contiguous
+    p = np.empty((B, K, 3))
+    for name, (Rb, pb) in poses.items():
+        b = lay.body_of[name]
+        have = 1 if count is None else count[name]
+        if count is None or have * N == K:
+            R[b], p[b] = Rb, pb
+        else:
+            R[b].reshape(have, -1, N, 3, 3)[:] = Rb.reshape(have, 1, -1, 3, 3)
+            p[b].reshape(have, -1, N, 3)[:] = pb.reshape(have, 1, -1, 3)
+    return Placement(R.transpose(1, 0, 2, 3), p.transpose(1, 0, 2), disc)
+
+
+def _driven(mech: Mechanism, lay: GraphLayout, step: Driven, X: Array, parent: Pose) -> Pose:
     j = mech.joints[step.joint]
     x = X[:, lay.inputs.index(lay.first_freedom[step.joint])]
     if j.kind == "R":
@@ -101,25 +173,27 @@ def _driven(mech: Mechanism, lay: GraphLayout, step: Driven, X: Array, R: Array,
     else:
         Mr = np.broadcast_to(np.eye(3), (x.shape[0], 3, 3))
         Mp = x[:, None] * j.axis
-    a, b = lay.body_of[step.parent], lay.body_of[step.body]
     if j.bodies[0] != step.parent:  # the joint runs from the body to its parent: M⁻¹
         Mr = np.swapaxes(Mr, -1, -2)
         Mp = -np.einsum("nij,nj->ni", Mr, Mp)
-    R[:, b] = R[:, a] @ Mr
-    p[:, b] = np.einsum("nij,nj->ni", R[:, a], Mp) + p[:, a]
+    Ra, pa = parent
+    return Ra @ Mr, np.einsum("nij,nj->ni", Ra, Mp) + pa
 
 
-def _dyad(mech: Mechanism, lay: GraphLayout, dy: Dyad, sigma: Array, R: Array, p: Array
-          ) -> Array:
-    """Place the dyad's two bodies in ``R``, ``p``; its discriminant over L² (K,)."""
+def _world(pose: Pose, x0: Array) -> Array:
+    return pose[0] @ x0 + pose[1]
+
+
+def _dyad(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose
+          ) -> tuple[Pose, Pose, Array]:
+    """The poses of the dyad's two bodies from those of the placed bodies it joins (p1, p2)
+    on branches ``sigma`` (K,), and its discriminant over L² (K,)."""
     j1, j3, j2 = (mech.joints[k] for k in dy.joints)
-    p1, p2 = (lay.body_of[b] for b in dy.placed)
-    b1, b2 = (lay.body_of[b] for b in dy.bodies)
     n = dy.normal
     L2 = mech.length_scale ** 2
     with np.errstate(invalid="ignore", divide="ignore"):
         if dy.kind == "RRR":
-            A, C = _world(R, p, p1, j1.at), _world(R, p, p2, j2.at)
+            A, C = _world(first, j1.at), _world(second, j2.at)
             w = C - A
             w -= np.outer(w @ n, n)
             dist = np.linalg.norm(w, axis=1)
@@ -128,15 +202,14 @@ def _dyad(mech: Mechanism, lay: GraphLayout, dy: Dyad, sigma: Array, R: Array, p
             r2 = _sq(j3.at - j2.at, n)
             a = (dist ** 2 + r1 - r2) / (2.0 * dist)
             h2 = r1 - a ** 2
-            Bp = A + a[:, None] * e + (sigma * np.sqrt(h2))[:, None] * np.cross(n, e)
-            Bw = Bp + ((j3.at - j1.at) @ n) * n  # B keeps its drawn height along n
-            _rotating(R, p, b1, n, j3.at - j1.at, Bw - A, A, j1.at)
-            _rotating(R, p, b2, n, j3.at - j2.at, Bw - C, C, j2.at)
-            return np.asarray(np.where(dist > 0.0, h2 / L2, np.nan))
+            Bw = A + a[:, None] * e + (sigma * np.sqrt(h2))[:, None] * np.cross(n, e)
+            return (_rotating(n, j3.at - j1.at, Bw - A, A, j1.at),
+                    _rotating(n, j3.at - j2.at, Bw - C, C, j2.at),
+                    np.asarray(np.where(dist > 0.0, h2 / L2, np.nan)))
         if dy.kind == "RRP":
-            A = _world(R, p, p1, j1.at)
-            Q = _world(R, p, p2, j3.at)
-            dirn = R[:, p2] @ j2.axis
+            A = _world(first, j1.at)
+            Q = _world(second, j3.at)
+            dirn = second[0] @ j2.axis
             q = Q - A
             along = np.einsum("ki,ki->k", q, dirn)
             perp = q - along[:, None] * dirn
@@ -144,32 +217,25 @@ def _dyad(mech: Mechanism, lay: GraphLayout, dy: Dyad, sigma: Array, R: Array, p
             disc = _sq(j3.at - j1.at, n) - np.einsum("ki,ki->k", perp, perp)
             t = -along + sigma * np.sqrt(disc)
             Bw = Q + t[:, None] * dirn
-            _rotating(R, p, b1, n, j3.at - j1.at, Bw - A, A, j1.at)
-            R[:, b2] = R[:, p2]
-            p[:, b2] = Bw - R[:, p2] @ j3.at
-            return np.asarray(disc / L2)
+            return (_rotating(n, j3.at - j1.at, Bw - A, A, j1.at),
+                    (second[0], Bw - second[0] @ j3.at), np.asarray(disc / L2))
         if dy.kind == "RPR":
-            A, C = _world(R, p, p1, j1.at), _world(R, p, p2, j2.at)
+            A, C = _world(first, j1.at), _world(second, j2.at)
             w0 = j2.at - j1.at
             uw = float(j3.axis @ w0)
-            disc = uw ** 2 - _sq(w0, n) + np.einsum("ki,ki->k", C - A, C - A) - ((C - A) @ n) ** 2
+            w = C - A
+            disc = uw ** 2 - _sq(w0, n) + np.einsum("ki,ki->k", w, w) - (w @ n) ** 2
             t = -uw + sigma * np.sqrt(disc)
             slid = w0[None, :] + t[:, None] * j3.axis
-            Rb = _turn_each(n, slid, C - A)
-            R[:, b1] = Rb
-            p[:, b1] = A - Rb @ j1.at
-            R[:, b2] = Rb
-            p[:, b2] = C - Rb @ j2.at
-            return np.asarray(disc / L2)
-        # PRP
-        Q1, Q2 = _world(R, p, p1, j3.at), _world(R, p, p2, j3.at)
-        d1, d2 = R[:, p1] @ j1.axis, R[:, p2] @ j2.axis
+            Rb = _turn_each(n, slid, w)
+            return (Rb, A - Rb @ j1.at), (Rb, C - Rb @ j2.at), np.asarray(disc / L2)
+        # PRP: line–line
+        Q1, Q2 = _world(first, j3.at), _world(second, j3.at)
+        d1, d2 = first[0] @ j1.axis, second[0] @ j2.axis
         s = (np.cross(Q2 - Q1, d2) @ n) / (np.cross(d1, d2) @ n)
         Bw = Q1 + s[:, None] * d1
-        for b, par in ((b1, p1), (b2, p2)):
-            R[:, b] = R[:, par]
-            p[:, b] = Bw - R[:, par] @ j3.at
-        return np.asarray(np.where(np.isfinite(s), 1.0, np.nan))
+        return ((first[0], Bw - first[0] @ j3.at), (second[0], Bw - second[0] @ j3.at),
+                np.asarray(np.where(np.isfinite(s), 1.0, np.nan)))
 
 
 def _sq(v: Array, n: Array) -> float:
@@ -178,21 +244,20 @@ def _sq(v: Array, n: Array) -> float:
     return float(v @ v)
 
 
-def _rotating(R: Array, p: Array, b: int, n: Array, link0: Array, link: Array, pivot: Array,
-              pivot0: Array) -> None:
-    """Body ``b`` turned about n so its drawn link (pivot0 → …) lies along ``link``, with its
-    pivot at ``pivot``."""
+def _rotating(n: Array, link0: Array, link: Array, pivot: Array, pivot0: Array) -> Pose:
+    """A body turned about n so its drawn link (from pivot0) lies along ``link`` (K, 3), with
+    its pivot at ``pivot``."""
     Rb = _turn(n, link0, link)
-    R[:, b] = Rb
-    p[:, b] = pivot - Rb @ pivot0
+    return Rb, pivot - Rb @ pivot0
 
 
 def _turn_each(n: Array, v0: Array, v: Array) -> Array:
     """As :func:`_turn` with one drawn vector per sample (K, 3)."""
     v0 = v0 - np.outer(v0 @ n, n)
-    v = v - np.outer(v @ n, n)
-    angle = np.arctan2(np.cross(v0, v) @ n, np.einsum("ki,ki->k", v, v0))
-    return rotation_about(n, angle)
+    c = np.einsum("ki,ki->k", v, v0)
+    s = np.cross(v0, v) @ n
+    size = np.hypot(c, s)
+    return _rotation_cs(n, c / size, s / size)
 
 
 def joint_values(mech: Mechanism, lay: GraphLayout, R: Array, p: Array) -> Array:

@@ -249,17 +249,16 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     drawn[:stop] = True
     conf = mode_configuration(mech, lay, R[0], p[0], X, drawn, start)
     mode = build_mode(mech, lay, conf, drawn, X, Xd, Xdd)
-    events = _fold_events(mech, lay, dec, X, signs[0], ok[0], after=stop)
+    events = _fold_events(mech, lay, dec, X, signs[:1], ok[:1], after=stop)[0]
     if stop < N:
         events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[stop - 1])} (a "
                          f"limit position or dead centre before {_fmt(mech, lay, X[stop])})")
     modes = [replace(_with_events(mode, [*events, *mode.events]), label="drawn")]
-    for m in range(1, M):
-        if not ok[m].any():
-            continue
+    others = [m for m in range(1, M) if ok[m].any()]
+    folds = _fold_events(mech, lay, dec, X, signs[others], ok[others])
+    for m, events in zip(others, folds, strict=True):
         conf = mode_configuration(mech, lay, R[m], p[m], X, ok[m])
         md = build_mode(mech, lay, conf, ok[m], X, Xd, Xdd)
-        events = _fold_events(mech, lay, dec, X, signs[m], ok[m], after=0)
         modes.append(replace(_with_events(md, [*events, *md.events]),
                              label=f"branches {mode_label(mech, dec, signs[m])}",
                              index=len(modes)))
@@ -270,21 +269,25 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
 
 
 def _fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
-                 signs: Array, ok: NDArray[np.bool_], after: int) -> list[str]:
-    """A mode's births and deaths at folds from sample ``after`` on, each located between
-    samples (graph/closed_modes.py's ``fold_inputs``)."""
+                 signs: Array, ok: NDArray[np.bool_], after: int = 0) -> list[list[str]]:
+    """Each mode's (rows of ``signs`` (M', D) and ``ok`` (M', N)) births and deaths at folds
+    from sample ``after`` on, each located between samples (graph/closed_modes.py's
+    ``fold_inputs``, all at once)."""
     from screwkit.kinematics.graph.closed_modes import fold_inputs
 
-    events = []
-    for k in np.nonzero(ok[:-1] != ok[1:])[0]:
-        if k + 1 < after:
-            continue
-        x, d = fold_inputs(mech, lay, dec, X, signs, int(k))
-        dyad = dec.dyads[d]
+    change = ok[:, :-1] != ok[:, 1:]
+    change[:, :max(after - 1, 0)] = False
+    mode, k = np.nonzero(change)
+    events: list[list[str]] = [[] for _ in range(ok.shape[0])]
+    if k.size == 0:
+        return events
+    x, folding = fold_inputs(mech, lay, dec, X, signs[mode], k)
+    for m, kk, xx, d in zip(mode, k, x, folding, strict=True):
+        dyad = dec.dyads[int(d)]
         names = "–".join(mech.joints[i].name for i in dyad.joints)
-        what = "dies" if ok[k] else "is born"
-        events.append(f"{what} at {_fmt(mech, lay, x)}: the {dyad.kind} dyad {names} folds "
-                      "(its links in line)")
+        what = "dies" if ok[m, kk] else "is born"
+        events[int(m)].append(f"{what} at {_fmt(mech, lay, xx)}: the {dyad.kind} dyad {names} "
+                              "folds (its links in line)")
     return events
 
 
