@@ -9,14 +9,16 @@ from typing import Any
 import numpy as np
 
 
-def solved(spec: Any) -> Any:
-    """The drawn mode over the spec's inputs, with a progress bar on long runs."""
+def solved(spec: Any, every_mode: bool = False) -> Any:
+    """The drawn mode (and with ``every_mode`` every mode the closed-form sub-chains find)
+    over the spec's inputs, with a progress bar on long runs."""
     from screwkit.cli.progress import progress_bar
     from screwkit.kinematics.graph import solve_mechanism
 
     with progress_bar("following the drawn mode", spec.inputs.shape[0]) as report:
         return solve_mechanism(spec.mechanism, spec.inputs, rates=spec.speed,
-                               accelerations=spec.acceleration, progress=report)
+                               accelerations=spec.acceleration, progress=report,
+                               every_mode=every_mode)
 
 
 def graph_mobility(spec: Any) -> dict[str, Any]:
@@ -44,7 +46,7 @@ def analyze_graph(spec: Any, out: Any, plot: Path | None) -> None:
     from screwkit.cli.common import guard
     from screwkit.io.mechanism_documents import mechanism_document, mechanism_table
 
-    motion = guard(lambda: solved(spec))
+    motion = guard(lambda: solved(spec, every_mode=True))
     du = out.units_for(spec.units)
     if plot is not None:  # the loops' picture of every variable and point path fits a graph
         from screwkit.report.plots import plot_analysis
@@ -66,6 +68,8 @@ def _show(spec: Any, motion: Any, units: Any, full: bool) -> None:
 
     prose(f"[bold]{escape(spec.describe(units))}[/]")
     prose(f"method: {motion.method}; {units.describe()}")
+    for note in motion.notes:
+        prose(f"[yellow]note:[/] {escape(note)}")
     table = mechanism_table(motion)
     mech = spec.mechanism
     for md in motion.modes:
@@ -76,9 +80,10 @@ def _show(spec: Any, motion: Any, units: Any, full: bool) -> None:
             names += [n, f"{n}_dot"]
         for p in list(md.points)[:2]:
             names += [f"{p}_{a}" for a in "xyz"]
-        cols, values = table_columns(table, [n for n in names if n in table.names], units)
-        print_long_table(console, f"assembly mode {md.index} (drawn)", cols, values,
-                         full)
+        t = table.where(table.column("mode").values == md.index)
+        cols, values = table_columns(t, [n for n in names if n in t.names], units)
+        print_long_table(console, f"assembly mode {md.index} ({md.label or 'drawn'})", cols,
+                         values, full)
         hidden = len(md.variables) - len(shown) - len(mech.inputs)
         if hidden > 0:
             prose(f"  • {len(shown)} of {len(shown) + hidden} variables shown; every "

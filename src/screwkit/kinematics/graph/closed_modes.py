@@ -13,7 +13,7 @@ Rates and accelerations come from the closure Jacobian (graph/motion.py's ``buil
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -140,6 +140,3 @@ def mode_label(mech: Mechanism, dec: Decomposition, signs: Array) -> str:
             parts.append(f"{names} {'+' if s == d.drawn_branch else '−'}")
     return ", ".join(parts)
 
-
-def with_label(mode: object, label: str, index: int) -> object:
-    return replace(mode, label=label, index=index)  # type: ignore[type-var]
