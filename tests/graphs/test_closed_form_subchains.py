@@ -1,0 +1,246 @@
+"""Closed-form sub-chains (issue 27; kinematics/graph/subchains.py, dyads.py, closed_modes.py)
+checked against independent routes: the stacked loop closure (every mode closes), the graph
+tracker (the drawn mode equals its motion; the tracker started from each closed-form mode stays
+on it), the mode count of a Watt six-bar, and a four-bar's fold against brentq on the
+distance law."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+from scipy.spatial.transform import Rotation
+
+import screwkit as sk
+from screwkit.kinematics.graph import solve_mechanism
+from screwkit.kinematics.graph.closed_modes import every_mode
+from screwkit.kinematics.graph.closure import graph_forward, graph_layout, loop_residuals
+from screwkit.kinematics.graph.motion import build_mode
+from screwkit.kinematics.graph.subchains import decompose
+from screwkit.kinematics.graph.track import follow_drawn_mode, reach
+from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.model.mechanism import Body, BodyPoint, Mechanism, MechanismJoint
+
+MECHANISMS = Path(__file__).parents[2] / "examples" / "mechanisms"
+Z = np.array([0.0, 0.0, 1.0])
+
+
+def joint(name: str, kind: str, a: str, b: str, at: object, axis: object = Z) -> MechanismJoint:
+    return MechanismJoint(name, kind, (a, b), np.asarray(at, float), np.asarray(axis, float))
+
+
+def _residual(mech: Mechanism, conf: Configuration) -> float:
+    """The largest loop closure twist (rad, and length over the length scale)."""
+    lay = graph_layout(mech)
+    fr = graph_forward(mech, lay, conf)
+    res = loop_residuals(mech, lay, conf, fr.R, fr.p)
+    scale = np.array([1, 1, 1, *(3 * [1 / mech.length_scale])])
+    return float(np.max(np.abs(res * scale))) if res.size else 0.0
+
+
+def test_bundled_examples_decompose_or_say_what_needs_the_homotopy() -> None:
+    expect = {"fourbar_graph": 2, "watt_sixbar": 4, "jansen_leg": 8}
+    for path in sorted(MECHANISMS.glob("*.toml")):
+        mech = sk.load_spec(path).mechanism
+        dec = decompose(mech)
+        if path.stem in expect:
+            assert dec.complete and dec.mode_count == expect[path.stem], path.stem
+            assert all(d.kind == "RRR" for d in dec.dyads)
+        else:
+            assert not dec.complete, path.stem
+            assert "needs the homotopy" in dec.describe(mech)[-1]
+    st = decompose(sk.load_spec(MECHANISMS / "stephenson3_sixbar.toml").mechanism)
+    assert set(st.unplaced) == {"rod", "coupler", "link_k", "link_r"}  # the triad
+
+
+@pytest.mark.parametrize("name", ["fourbar_graph", "watt_sixbar", "jansen_leg"])
+def test_drawn_mode_equals_the_tracker_and_every_mode_closes(name: str) -> None:
+    spec = sk.load_spec(MECHANISMS / f"{name}.toml")
+    mech = spec.mechanism
+    X = spec.inputs
+    motion = solve_mechanism(mech, X, rates=spec.speed, every_mode=True)
+    assert motion.method == "graph (closed forms)"
+    lay = graph_layout(mech)
+    followed = follow_drawn_mode(mech, lay, X)
+    ones, zeros = np.full_like(X, spec.speed), np.zeros_like(X)
+    tracked = build_mode(mech, lay, followed.conf, followed.mask, X, ones, zeros)
+    drawn = motion.modes[0]
+    assert np.array_equal(drawn.assembles, tracked.assembles)
+    ok = tracked.assembles
+    assert np.max(np.abs(drawn.conf.scalars - followed.conf.scalars)[ok]) <= 1e-10
+    for table in ("variables", "velocities", "accelerations", "points"):
+        for key, value in getattr(tracked, table).items():
+            got = getattr(drawn, table)[key]
+            assert np.max(np.abs(got - value)[ok]) <= 1e-9 * max(1.0, np.max(np.abs(value))), key
+    assert np.max(np.abs(drawn.link_origin - tracked.link_origin)[ok]) <= 1e-10 * mech.length_scale
+    for md in motion.modes:
+        idx = np.nonzero(md.assembles)[0]
+        assert idx.size and _residual(mech, md.conf.take(idx)) <= 1e-10
+        assert np.all(np.isnan(md.link_origin[~md.assembles]))
+    # the modes are told apart: no two coincide at a sample where both assemble
+    for a in range(len(motion.modes)):
+        for b in range(a):
+            both = motion.modes[a].assembles & motion.modes[b].assembles
+            d = np.abs(motion.modes[a].link_origin - motion.modes[b].link_origin)[both]
+            assert np.all(np.max(d.reshape(both.sum(), -1), axis=1) > 1e-6 * mech.length_scale)
+
+
+def test_watt_sixbar_has_four_modes_and_the_folds_of_the_second_dyad() -> None:
+    spec = sk.load_spec(MECHANISMS / "watt_sixbar.toml")
+    mech = spec.mechanism
+    theta = np.radians(np.arange(0.0, 360.0, 0.5))
+    motion = solve_mechanism(mech, theta, every_mode=True)
+    labels = [md.label for md in motion.modes]
+    assert labels == ["drawn", "branches A–B–OB +, E–G–F −", "branches A–B–OB −, E–G–F +",
+                      "branches A–B–OB −, E–G–F −"]
+    assert [int(md.assembles.sum()) for md in motion.modes[:2]] == [720, 720]
+    # the four-bar's other branch folds the E–G–F dyad: modes 2 and 3 die and are born there,
+    # at the same inputs (the two branches of that dyad meet at its fold)
+    e2, e3 = motion.modes[2].events, motion.modes[3].events
+    assert len(e2) == 2 and [e.split(":")[0] for e in e2] == [e.split(":")[0] for e in e3]
+    assert e2[0].startswith("dies at OA.theta = ") and "E–G–F folds" in e2[0]
+    assert e2[1].startswith("is born at OA.theta = ")
+    # the batched every-mode poses agree on where each mode assembles
+    lay = graph_layout(mech)
+    em = every_mode(mech, lay, decompose(mech), theta[:, None])
+    assert em.count == 4 and em.assembles(theta.size).sum(axis=1).tolist()[:2] == [720, 720]
+
+
+def _fourbar(a: float, b: float, c: float, d: float) -> Mechanism:
+    """A four-bar (crank a at O, coupler b, rocker c pivoted at (d, 0)) drawn at crank 90°."""
+    A = np.array([0.0, a, 0.0])
+    D = np.array([d, 0.0, 0.0])
+    e = D - A
+    f = np.linalg.norm(e)
+    along = (f ** 2 + b ** 2 - c ** 2) / (2 * f)
+    B = A + along * e / f + np.sqrt(b ** 2 - along ** 2) * np.array([-e[1], e[0], 0.0]) / f
+    return Mechanism("4R", (Body("crank"), Body("coupler"), Body("rocker")),
+                     (joint("O", "R", "ground", "crank", [0, 0, 0]),
+                      joint("A", "R", "crank", "coupler", A),
+                      joint("B", "R", "coupler", "rocker", B),
+                      joint("D", "R", "rocker", "ground", D)), ("O.theta",),
+                     (BodyPoint("P", "coupler", B),))
+
+
+def test_a_fold_is_reported_where_brentq_finds_the_distance_law_root() -> None:
+    a, b, c, d = 2.0, 2.5, 1.5, 3.0  # non-Grashof: the crank stops where |A − D| = b + c
+    mech = _fourbar(a, b, c, d)
+    theta = np.radians(np.arange(-90.0, 181.0, 1.0))  # from the drawing (crank at 90°)
+    motion = solve_mechanism(mech, theta, every_mode=True)
+
+    def reach_gap(t: float) -> float:  # crank angle t measured from the drawing
+        phi = np.pi / 2 + t
+        return float(np.hypot(a * np.cos(phi) - d, a * np.sin(phi))) - (b + c)
+
+    drawn = motion.modes[0]
+    stop = int(np.argmin(drawn.assembles))
+    assert stop > 0 and not drawn.assembles[stop:].any()
+    root = brentq(reach_gap, theta[stop - 1], theta[stop], xtol=1e-14)
+    assert drawn.events[0].startswith(f"stops assembling after input O.theta = "
+                                      f"{np.degrees(theta[stop - 1]):.6g} deg")
+    fold = next(e for e in drawn.events if e.startswith("dies at"))
+    assert f"O.theta = {np.degrees(root):.6g} deg" in fold, (fold, np.degrees(root))
+    # the same fold to 1e-12 rad from the library's bisection
+    from screwkit.kinematics.graph.closed_modes import branch_combinations, fold_inputs
+
+    lay = graph_layout(mech)
+    dec = decompose(mech)
+    x, dyad = fold_inputs(mech, lay, dec, theta[:, None], branch_combinations(dec)[:1],
+                          np.array([stop - 1]))
+    assert abs(x[0, 0] - root) <= 1e-12 and dyad[0] == 0
+    # the other branch meets it there: it dies at the same input
+    other = motion.modes[1]
+    assert any(f"O.theta = {np.degrees(root):.6g} deg" in e for e in other.events)
+
+
+def _random_dyad_graph(rng: np.random.Generator, kind: str) -> Mechanism:
+    """A crank and one random dyad of ``kind`` on it and the ground, then an RRR dyad on the
+    dyad's bodies and the ground: every drawing closes (all freedoms 0)."""
+    pt = lambda: np.append(rng.uniform(-1.0, 1.0, 2), 0.0)  # noqa: E731
+    u = lambda: np.append(np.array([np.cos(t := rng.uniform(0, np.pi)), np.sin(t)]), 0.0)  # noqa: E731
+    A, B, C, E, F, G = (pt() for _ in range(6))
+    A = 0.3 * A / max(np.linalg.norm(A), 1e-3)  # a short crank: the dyads assemble often
+    j = [joint("O", "R", "ground", "crank", [0, 0, 0])]
+    if kind == "RRR":
+        j += [joint("A", "R", "crank", "b1", A), joint("B", "R", "b1", "b2", B),
+              joint("C", "R", "b2", "ground", C)]
+    elif kind == "RRP":
+        j += [joint("A", "R", "crank", "b1", A), joint("B", "R", "b1", "b2", B),
+              joint("C", "P", "b2", "ground", C, u())]
+    elif kind == "RPR":
+        j += [joint("A", "R", "crank", "b1", A), joint("B", "P", "b1", "b2", B, u()),
+              joint("C", "R", "b2", "ground", C)]
+    else:  # PRP: a slot in the crank, a slider on the ground
+        j += [joint("A", "P", "crank", "b1", A, u()), joint("B", "R", "b1", "b2", B),
+              joint("C", "P", "b2", "ground", C, u())]
+    j += [joint("E", "R", "b1", "b3", E), joint("G", "R", "b3", "b4", G),
+          joint("F", "R", "b4", "ground", F)]
+    bodies = tuple(Body(n) for n in ("crank", "b1", "b2", "b3", "b4"))
+    return Mechanism(f"random {kind}", bodies, tuple(j), ("O.theta",))
+
+
+@pytest.mark.parametrize("kind", ["RRR", "RRP", "RPR", "PRP"])
+def test_random_dyad_graphs_every_mode_closes_and_the_tracker_stays_on_it(kind: str) -> None:
+    rng = np.random.default_rng(27 + "RRR RRP RPR PRP".split().index(kind))
+    theta = np.radians(np.arange(0.0, 360.0, 2.0))
+    checked = 0
+    for _ in range(6):
+        mech = _random_dyad_graph(rng, kind)
+        dec = decompose(mech)
+        assert dec.complete and [d.kind for d in dec.dyads] == [kind, "RRR"]
+        assert dec.mode_count == (2 if kind == "PRP" else 4)
+        motion = solve_mechanism(mech, theta, every_mode=True)
+        lay = graph_layout(mech)
+        em = every_mode(mech, lay, dec, theta[:, None])
+        margin = np.min(em.placement.discriminant, axis=1).reshape(em.count, theta.size)
+        for md in motion.modes:
+            idx = np.nonzero(md.assembles)[0]
+            assert _residual(mech, md.conf.take(idx)) <= 1e-10
+            # the tracker started on this mode, where it is furthest from a fold, follows it
+            # over the next samples of its run
+            nb = len(mech.bodies)
+            origins = em.placement.p.reshape(em.count, theta.size, -1, 3)[:, idx, :nb]
+            m = int(np.argmin(np.max(np.abs(origins - md.link_origin[idx]), axis=(1, 2, 3))))
+            k = int(idx[np.argmax(margin[m, idx])])
+            for step in range(1, 6):
+                if k + step >= theta.size or not md.assembles[k + step]:
+                    break
+                got = reach(mech, lay, md.conf.take(slice(k + step - 1, k + step)),
+                            theta[k + step - 1:k + step], theta[k + step:k + step + 1])
+                assert got is not None
+                diff = np.abs(got.scalars[0] - md.conf.scalars[k + step])
+                assert np.max(diff) <= 1e-8, (kind, md.label, step, diff)
+                checked += 1
+    assert checked >= 20
+
+
+def test_a_planar_mechanism_drawn_tilted_in_space_is_still_planar() -> None:
+    mech = sk.load_spec(MECHANISMS / "watt_sixbar.toml").mechanism
+    rot = Rotation.from_rotvec([0.4, -0.7, 0.2]).as_matrix()
+    tilted = Mechanism("tilted Watt", mech.bodies,
+                       tuple(joint(j.name, j.kind, *j.bodies, rot @ j.at + [0.01, 0.02, 0.03],
+                                   rot @ j.axis) for j in mech.joints), mech.inputs)
+    dec = decompose(tilted)
+    assert dec.complete and np.allclose(np.abs(dec.dyads[0].normal), np.abs(rot @ Z))
+    theta = np.radians(np.arange(0.0, 360.0, 3.0))
+    a = solve_mechanism(mech, theta, every_mode=True)
+    b = solve_mechanism(tilted, theta, every_mode=True)
+    assert len(a.modes) == len(b.modes) == 4
+    for ma, mb in zip(a.modes, b.modes, strict=True):
+        assert np.array_equal(ma.assembles, mb.assembles)
+        ok = ma.assembles
+        assert np.max(np.abs(ma.conf.scalars - mb.conf.scalars)[ok]) <= 1e-10
+
+
+def test_an_axis_tilted_off_parallel_falls_back_to_the_tracker() -> None:
+    mech = sk.load_spec(MECHANISMS / "fourbar_graph.toml").mechanism
+    joints = list(mech.joints)
+    j = joints[2]
+    joints[2] = joint(j.name, j.kind, *j.bodies, j.at, j.axis + [1e-6, 0.0, 0.0])
+    bent = Mechanism("bent", mech.bodies, tuple(joints), mech.inputs)
+    assert not decompose(bent).complete
+    motion = solve_mechanism(bent, [0.0], every_mode=True)
+    assert motion.method == "graph" and len(motion.modes) == 1
+    assert motion.notes and "only the drawn mode" in motion.notes[0]
