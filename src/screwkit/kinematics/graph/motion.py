@@ -1,6 +1,9 @@
 """The motion of any mechanism over its inputs: :func:`solve_mechanism` → :class:`MechanismMotion`.
 
-The drawn assembly mode is followed along the inputs (graph/track.py); then, at every sample and
+A mechanism built of closed-form sub-chains (driven joints and planar dyads, graph/subchains.py)
+gets its drawn mode, and on request every mode, from their closed forms (graph/dyads.py,
+graph/closed_modes.py); any other has its drawn assembly mode followed along the inputs
+(graph/track.py). Then, for each mode, at every sample and
 all at once, the body poses, the freedoms' rates and accelerations from the stacked screw
 Jacobian (graph/newton.py: J_p q̇_p = −J_in ẋ, J_p q̈_p = −J_in ẍ − bias), every body's twist and
 acceleration (graph/closure.py), joint centres and axes, and the paths of the points carried by
