@@ -244,3 +244,29 @@ def test_an_axis_tilted_off_parallel_falls_back_to_the_tracker() -> None:
     motion = solve_mechanism(bent, [0.0], every_mode=True)
     assert motion.method == "graph" and len(motion.modes) == 1
     assert motion.notes and "only the drawn mode" in motion.notes[0]
+
+
+def test_a_slider_driven_slider_crank_matches_the_tracker() -> None:
+    """A driven P joint places its body; the RRR dyad on it gives both modes."""
+    mech = Mechanism("slider-driven", (Body("slider"), Body("rod"), Body("crank")),
+                     (joint("S", "P", "ground", "slider", [2.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+                      joint("B", "R", "slider", "rod", [2.0, 0.0, 0.0]),
+                      joint("A", "R", "rod", "crank", [0.6, 0.8, 0.0]),
+                      joint("O", "R", "crank", "ground", [0.0, 0.0, 0.0])), ("S.s",))
+    dec = decompose(mech)
+    assert dec.complete and [d.kind for d in dec.dyads] == ["RRR"]
+    s = np.linspace(-0.6, 0.9, 61)
+    motion = solve_mechanism(mech, s, every_mode=True)
+    lay = graph_layout(mech)
+    followed = follow_drawn_mode(mech, lay, s[:, None])
+    ok = followed.mask
+    assert np.array_equal(motion.modes[0].assembles, ok)
+    assert np.max(np.abs(motion.modes[0].conf.scalars - followed.conf.scalars)[ok]) <= 1e-10
+    # the crank angle by the cosine rule in the triangle O–A–B (OA = 1, AB = √2.6, OB = 2 + s)
+    crank = motion.variable("O.theta", 0)[ok]
+    B = 2.0 + s[ok]
+    phi = np.arccos((1.0 + B ** 2 - 2.6) / (2.0 * B))  # A above the x axis, as drawn
+    drawn = np.arctan2(0.8, 0.6)
+    assert np.max(np.abs(-crank - (phi - drawn))) <= 1e-10  # O turns the ground on the crank
+    for md in motion.modes:
+        assert _residual(mech, md.conf.take(np.nonzero(md.assembles)[0])) <= 1e-10

@@ -234,6 +234,7 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     N = X.shape[0]
     signs = branch_combinations(dec)
     if every:
+        check_cost(mech, N * signs.shape[0])  # 2^D modes: each costs a drawn mode's time
         pl = every_mode(mech, lay, dec, X).placement
     else:
         signs = signs[:1]

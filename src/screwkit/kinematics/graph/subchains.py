@@ -149,6 +149,10 @@ def decompose(mech: Mechanism) -> Decomposition:
     steps: list[Step] = []
     inputs = {f.split(".")[0] for f in mech.inputs}
     driven = {k for k, j in enumerate(mech.joints) if j.kind in "RP" and j.name in inputs}
+    joints_of: dict[str, list[int]] = {GROUND: [], **{b: [] for b in mech.body_names}}
+    for k, j in enumerate(mech.joints):
+        joints_of[j.bodies[0]].append(k)
+        joints_of[j.bodies[1]].append(k)
     progress = True
     while progress:
         progress = False
@@ -160,7 +164,7 @@ def decompose(mech: Mechanism) -> Decomposition:
                 planes[body] = planes[parent] & _planar_in(mech, k, normals)
                 used.add(k)
                 progress = True
-        dyad = _find_dyad(mech, planes, used, driven, normals)
+        dyad = _find_dyad(mech, planes, used, driven, normals, joints_of)
         if dyad is not None:
             steps.append(dyad)
             used.update(dyad.joints)
@@ -174,14 +178,14 @@ def decompose(mech: Mechanism) -> Decomposition:
 
 
 def _find_dyad(mech: Mechanism, planes: dict[str, set[int]], used: set[int], driven: set[int],
-               normals: list[Array]) -> Dyad | None:
+               normals: list[Array], joints_of: dict[str, list[int]]) -> Dyad | None:
     """The first planar dyad on the placed bodies, or None."""
     for k3, j3 in enumerate(mech.joints):
         b1, b2 = j3.bodies
         if k3 in used or k3 in driven or b1 in planes or b2 in planes or j3.kind not in "RP":
             continue
-        first = _attachments(mech, b1, planes, used)
-        second = _attachments(mech, b2, planes, used)
+        first = _attachments(mech, b1, planes, used, joints_of)
+        second = _attachments(mech, b2, planes, used, joints_of)
         if len(first) != 1 or len(second) != 1:
             continue
         k1, k2 = first[0], second[0]
@@ -208,11 +212,10 @@ def _find_dyad(mech: Mechanism, planes: dict[str, set[int]], used: set[int], dri
     return None
 
 
-def _attachments(mech: Mechanism, body: str, planes: dict[str, set[int]], used: set[int]
-                 ) -> list[int]:
+def _attachments(mech: Mechanism, body: str, planes: dict[str, set[int]], used: set[int],
+                 joints_of: dict[str, list[int]]) -> list[int]:
     """Unused joints from ``body`` to an already placed body."""
-    return [k for k, j in enumerate(mech.joints)
-            if k not in used and body in j.bodies and _other(mech, k, body) in planes]
+    return [k for k in joints_of[body] if k not in used and _other(mech, k, body) in planes]
 
 
 def _other(mech: Mechanism, k: int, body: str) -> str:
@@ -227,7 +230,8 @@ def _in_plane(v: Array, n: Array) -> Array:
 def drawn_branch(mech: Mechanism, kind: str, joints: tuple[int, int, int], n: Array
                  ) -> int | None:
     """The branch sign of the drawing (graph/dyads.py's conventions), or None where the
-    dyad is degenerate in the drawing (a link of no length, or parallel slides)."""
+    dyad is degenerate in the drawing (a link of no length, parallel slides) or drawn on a
+    fold (its links in line: the two branches meet there)."""
     L = mech.length_scale
     j1, j3, j2 = (mech.joints[k] for k in joints)
     if kind == "RRR":
@@ -236,16 +240,18 @@ def drawn_branch(mech: Mechanism, kind: str, joints: tuple[int, int, int], n: Ar
         r2 = _in_plane(j3.at - j2.at, n)
         if min(np.linalg.norm(w0), np.linalg.norm(r1), np.linalg.norm(r2)) <= SHORT_LINK * L:
             return None
-        return 1 if float(n @ np.cross(w0, r1)) >= 0.0 else -1
-    if kind == "RRP":
+        side = float(n @ np.cross(w0, r1)) / float(np.linalg.norm(w0))  # B's height over A–C
+    elif kind == "RRP":
         r1 = _in_plane(j3.at - j1.at, n)
         if np.linalg.norm(r1) <= SHORT_LINK * L:
             return None
-        return 1 if float(r1 @ j2.axis) >= 0.0 else -1
-    if kind == "RPR":
-        w0 = _in_plane(j2.at - j1.at, n)
-        return 1 if float(w0 @ j3.axis) >= 0.0 else -1
-    # PRP: one solution where the two slides cross
-    if abs(float(n @ np.cross(j1.axis, j2.axis))) <= ANGLE_TOL:
+        side = float(r1 @ j2.axis)
+    elif kind == "RPR":
+        side = float(_in_plane(j2.at - j1.at, n) @ j3.axis)
+    else:  # PRP: one solution where the two slides cross
+        return None if abs(float(n @ np.cross(j1.axis, j2.axis))) <= ANGLE_TOL else 1
+    # a drawing on a fold (the dyad's links in line) belongs to neither branch: the tracker
+    # decides there
+    if abs(side) <= SHORT_LINK * L:
         return None
-    return 1
+    return 1 if side > 0.0 else -1
