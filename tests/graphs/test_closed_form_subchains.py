@@ -17,6 +17,7 @@ import screwkit as sk
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closed_modes import every_mode
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout, loop_residuals
+from screwkit.kinematics.graph.from_loop import mechanism_from_loop
 from screwkit.kinematics.graph.motion import build_mode
 from screwkit.kinematics.graph.subchains import decompose
 from screwkit.kinematics.graph.track import follow_drawn_mode, reach
@@ -270,3 +271,31 @@ def test_a_slider_driven_slider_crank_matches_the_tracker() -> None:
     assert np.max(np.abs(-crank - (phi - drawn))) <= 1e-10  # O turns the ground on the crank
     for md in motion.modes:
         assert _residual(mech, md.conf.take(np.nonzero(md.assembles)[0])) <= 1e-10
+
+
+def test_an_rssr_as_a_graph_is_an_rss_leg_with_both_modes_of_the_closed_form() -> None:
+    """The RSSR family's closed form (both assembly modes) against the graph's RSS leg."""
+    lk = sk.rssr(1.0, 3.0, 2.0, 2.5, 1.0, 0.3)
+    x = np.radians(np.arange(0.0, 360.0, 3.0))
+    loop = sk.solve_motion(lk, x)
+    assert len(loop.modes) == 2
+    mech = mechanism_from_loop(loop, 0, 0)
+    dec = decompose(mech)
+    assert dec.complete and [d.kind for d in dec.dyads] == ["RSS"]
+    graph = solve_mechanism(mech, x - x[0], every_mode=True)
+    assert len(graph.modes) == 2
+    L = mech.length_scale
+    for gm in graph.modes:
+        # the loop mode with the same joint centres where both assemble
+        misses = []
+        for md in loop.modes:
+            both = gm.assembles & md.assembles
+            misses.append(np.max(np.abs(gm.joint_centres[both] - md.joint_centres[both]))
+                          if both.any() else np.inf)
+        assert min(misses) <= 1e-10 * L, misses
+        best = loop.modes[int(np.argmin(misses))]
+        assert np.array_equal(gm.assembles, best.assembles)
+        assert _residual(mech, gm.conf.take(np.nonzero(gm.assembles)[0])) <= 1e-10
+    centres = [gm.joint_centres for gm in graph.modes]
+    both = graph.modes[0].assembles & graph.modes[1].assembles
+    assert np.max(np.abs(centres[0] - centres[1])[both]) > 1e-3 * L  # two distinct modes

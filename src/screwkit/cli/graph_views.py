@@ -82,8 +82,11 @@ def _show(spec: Any, motion: Any, units: Any, full: bool) -> None:
             names += [f"{p}_{a}" for a in "xyz"]
         t = table.where(table.column("mode").values == md.index)
         cols, values = table_columns(t, [n for n in names if n in t.names], units)
-        print_long_table(console, f"assembly mode {md.index} ({md.label or 'drawn'})", cols,
-                         values, full)
+        drawn = not md.label or md.label == "drawn"
+        if not drawn:  # the branches on a line of their own: a long label would widen the title
+            prose(f"assembly mode {md.index}: {escape(md.label)}")
+        print_long_table(console, f"assembly mode {md.index}{' (drawn)' if drawn else ''}",
+                         cols, values, full)
         hidden = len(md.variables) - len(shown) - len(mech.inputs)
         if hidden > 0:
             prose(f"  • {len(shown)} of {len(shown) + hidden} variables shown; every "

@@ -188,6 +188,10 @@ def _dyad(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose
           ) -> tuple[Pose, Pose, Array]:
     """The poses of the dyad's two bodies from those of the placed bodies it joins (p1, p2)
     on branches ``sigma`` (K,), and its discriminant over L² (K,)."""
+    if dy.kind == "RSS":
+        from screwkit.kinematics.graph.legs import rss_leg
+
+        return rss_leg(mech, dy.joints, sigma, first, second)
     j1, j3, j2 = (mech.joints[k] for k in dy.joints)
     n = dy.normal
     L2 = mech.length_scale ** 2
@@ -266,6 +270,8 @@ def joint_values(mech: Mechanism, lay: GraphLayout, R: Array, p: Array) -> Array
     a P joint's slide s = u·R_aᵀ(p_b − p_a). Angles are principal values (−π, π]."""
     out = np.zeros((R.shape[0], lay.n_scalar))
     for i, j in enumerate(mech.joints):
+        if j.kind == "S":
+            continue
         a, b = (lay.body_of[x] for x in j.bodies)
         col = lay.scalar_col[lay.first_freedom[i]]
         Ra = R[:, a]
@@ -281,5 +287,10 @@ def joint_values(mech: Mechanism, lay: GraphLayout, R: Array, p: Array) -> Array
 
 
 def configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array) -> Configuration:
-    """The configuration of closed-form poses (only R and P joints take part in them)."""
-    return Configuration(joint_values(mech, lay, R, p), np.zeros((R.shape[0], 0, 3, 3)))
+    """The configuration of closed-form poses: R and P joints' values (:func:`joint_values`),
+    an S joint's relative rotation R_aᵀR_b (its M_j, graph/closure.py)."""
+    balls = np.empty((R.shape[0], lay.n_spherical, 3, 3))
+    for i, k in lay.spherical_of_joint.items():
+        a, b = (lay.body_of[x] for x in mech.joints[i].bodies)
+        balls[:, k] = np.swapaxes(R[:, a], -1, -2) @ R[:, b]
+    return Configuration(joint_values(mech, lay, R, p), balls)

@@ -191,7 +191,7 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     Xdd = _per_sample(accelerations, N, n_in, "accelerations")
     lay = graph_layout(mech)
     dec = decompose(mech)
-    if dec.complete and lay.n_spherical == 0:
+    if dec.complete:
         motion = _closed_form_motion(mech, lay, dec, X, Xd, Xdd, every_mode)
         if callable(progress):
             progress(N, N)
@@ -253,7 +253,7 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     drawn[:stop] = True
     conf = mode_configuration(mech, lay, R[0], p[0], X, drawn, start)
     mode = build_mode(mech, lay, conf, drawn, X, Xd, Xdd)
-    events = _fold_events(mech, lay, dec, X, signs[:1], ok[:1], after=stop)[0]
+    events = _fold_events(mech, lay, dec, X, signs[:1], ok[:1], after=stop)[0][:1]
     if stop < N:
         events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[stop - 1])} (a "
                          f"limit position or dead centre before {_fmt(mech, lay, X[stop])})")
@@ -290,8 +290,8 @@ def _fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array
         dyad = dec.dyads[int(d)]
         names = "–".join(mech.joints[i].name for i in dyad.joints)
         what = "dies" if ok[m, kk] else "is born"
-        events[int(m)].append(f"{what} at {_fmt(mech, lay, xx)}: the {dyad.kind} dyad {names} "
-                              "folds (its links in line)")
+        events[int(m)].append(f"{what} at {_fmt(mech, lay, xx)}: the {dyad.kind} {dyad.word} "
+                              f"{names} folds (its two branches meet)")
     return events
 
 

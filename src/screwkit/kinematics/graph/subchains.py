@@ -14,6 +14,10 @@ Two kinds of step place bodies:
   placed bodies moving in planes normal to n (the ground, or bodies placed by planar steps with
   the same n). A spatial mechanism drawn planar is planar.
 
+- a **spatial RSS leg**: a body joined to a placed body by one R joint only and, by a ball, to
+  a rod whose other ball is on a placed body (the rod held by those two balls alone): the body's
+  angle from the rod's length, two branches (graph/legs.py).
+
 What is left (a Stephenson III triad, a platform, a spatial loop) is reported as needing the
 homotopy; the graph tracker (graph/track.py) keeps handling those. The closed forms of the steps
 are in graph/dyads.py.
@@ -36,7 +40,8 @@ ANGLE_TOL = 1e-9
 #: a dyad link shorter than this fraction of the length scale has no direction to solve for
 SHORT_LINK = 1e-9
 
-#: dyad kinds after orienting so that a single P sits at J2 (RRP) or J3 (RPR)
+#: planar dyad kinds after orienting so that a single P sits at J2 (RRP) or J3 (RPR); "RSS"
+#: is the spatial leg (graph/legs.py), held in the same record
 DYAD_KINDS = ("RRR", "RRP", "RPR", "PRP")
 
 
@@ -70,9 +75,14 @@ class Dyad:
     def branches(self) -> int:
         return 1 if self.kind == "PRP" else 2
 
+    @property
+    def word(self) -> str:
+        return "leg" if self.kind == "RSS" else "dyad"
+
     def describe(self, mech: Mechanism) -> str:
         names = "–".join(mech.joints[k].name for k in self.joints)
-        return f"{self.kind} dyad {names} placing {self.bodies[0]!r} and {self.bodies[1]!r}"
+        return (f"{self.kind} {self.word} {names} placing {self.bodies[0]!r} and "
+                f"{self.bodies[1]!r}")
 
 
 Step = Driven | Dyad
@@ -165,12 +175,14 @@ def decompose(mech: Mechanism) -> Decomposition:
                 used.add(k)
                 progress = True
         dyad = _find_dyad(mech, planes, used, driven, normals, joints_of)
+        if dyad is None:
+            dyad = _find_leg(mech, planes, used, driven, joints_of)
         if dyad is not None:
             steps.append(dyad)
             used.update(dyad.joints)
             n_index = next(i for i, n in enumerate(normals) if _parallel(n, dyad.normal))
             for body in dyad.bodies:
-                planes[body] = {n_index}
+                planes[body] = {n_index} if dyad.kind != "RSS" else set()
             progress = True
     unplaced = tuple(b for b in mech.body_names if b not in planes)
     unused = tuple(k for k in range(len(mech.joints)) if k not in used)
@@ -209,6 +221,34 @@ def _find_dyad(mech: Mechanism, planes: dict[str, set[int]], used: set[int], dri
         if branch is None:
             continue
         return Dyad(kinds, (b1, b2), (k1, k3, k2), (p1, p2), n, branch)
+    return None
+
+
+def _find_leg(mech: Mechanism, planes: dict[str, set[int]], used: set[int], driven: set[int],
+              joints_of: dict[str, list[int]]) -> Dyad | None:
+    """The first RSS leg on the placed bodies (graph/legs.py), or None: a body b joined to a
+    placed body by one passive R joint only and to a rod by a ball, the rod held by that ball
+    and one ball on a placed body, and by nothing else."""
+    from screwkit.kinematics.graph.legs import drawn_leg_branch
+
+    for rod in mech.body_names:
+        own = joints_of[rod]
+        if rod in planes or len(own) != 2 or any(mech.joints[k].kind != "S" for k in own):
+            continue
+        for kc, kb in (own, own[::-1]):
+            body = _other(mech, kc, rod)
+            if body in planes or _other(mech, kb, rod) not in planes:
+                continue
+            hold = _attachments(mech, body, planes, used, joints_of)
+            if len(hold) != 1 or mech.joints[hold[0]].kind != "R" or hold[0] in driven:
+                continue
+            joints = (hold[0], kc, kb)
+            branch = drawn_leg_branch(mech, joints)
+            if branch is None:
+                continue
+            return Dyad("RSS", (body, rod), joints,
+                        (_other(mech, hold[0], body), _other(mech, kb, rod)),
+                        mech.joints[hold[0]].axis, branch)
     return None
 
 

@@ -1,0 +1,97 @@
+"""The closed form of a spatial RSS leg (graph/subchains.py): a body b turning on an R joint
+(point c, axis u) of a placed body p1 and carrying the ball C of a rod whose other ball B sits
+on a placed body; the rod is held by those two balls alone.
+
+In p1's frame (the drawing's coordinates), with v = C0 − c split along u (v∥) and across it
+(v⟂), the ball on b is C(φ) = c + v∥ + cos φ v⟂ + sin φ (u × v⟂), and the rod's length
+l = |C0 − B0| holds when (d = c + v∥ − B, B in p1's frame)
+
+    P cos φ + Q sin φ = S,  P = 2 d·v⟂,  Q = 2 d·(u × v⟂),  S = l² − |d|² − |v⟂|²,
+
+so φ = atan2(Q, P) + σ arccos(S/ρ), ρ = √(P² + Q²): two branches σ = ±1, continuous while the
+discriminant ρ² − S² stays positive (it folds where the rod's line meets the circle of C
+tangentially). The rod's rotation is the least rotation taking its drawn direction C0 − B0 to
+C − B: its spin about its own axis is idle (nothing drives it; graph/idle.py holds its rate
+at zero), so any choice is a pose of the mechanism, and this one is defined at every sample
+without a path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.model.mechanism import Mechanism
+
+Array = NDArray[np.float64]
+Pose = tuple[Array, Array]
+
+
+def leg_terms(mech: Mechanism, joints: tuple[int, int, int], B: Array
+              ) -> tuple[Array, Array, Array]:
+    """P, Q, S of the leg's equation for the far ball at ``B`` (K, 3) in p1's frame."""
+    jr, jc, _ = (mech.joints[k] for k in joints)
+    u, c = jr.axis, jr.at
+    v = jc.at - c
+    v_par = (v @ u) * u
+    v_perp = v - v_par
+    length2 = float(np.sum((jc.at - mech.joints[joints[2]].at) ** 2))
+    d = (c + v_par)[None, :] - B
+    P = 2.0 * d @ v_perp
+    Q = 2.0 * d @ np.cross(u, v_perp)
+    S = length2 - np.einsum("ki,ki->k", d, d) - float(v_perp @ v_perp)
+    return P, Q, S
+
+
+def drawn_leg_branch(mech: Mechanism, joints: tuple[int, int, int]) -> int | None:
+    """The branch of the drawing (φ = 0 is a root), None where it is drawn on its fold or
+    the equation is degenerate (the ball on the axis, or the far ball's distance to the
+    circle not changing with φ)."""
+    P, Q, S = leg_terms(mech, joints, mech.joints[joints[2]].at[None, :])
+    L = mech.length_scale
+    rho = float(np.hypot(P[0], Q[0]))
+    if rho <= 1e-9 * L ** 2:
+        return None
+    alpha = float(np.arctan2(Q[0], P[0]))
+    if abs(alpha) <= 1e-9:  # φ = 0 is a double root: the fold
+        return None
+    return -1 if alpha > 0.0 else 1
+
+
+def rss_leg(mech: Mechanism, joints: tuple[int, int, int], sigma: Array, first: Pose,
+            second: Pose) -> tuple[Pose, Pose, Array]:
+    """Poses of the turning body and the rod from the placed bodies' poses (``first`` holds
+    the R joint, ``second`` the far ball), on branches ``sigma`` (K,); the discriminant
+    (ρ² − S²)/L⁴ (K,). The body turns by φ about (c, u) relative to p1 whichever way the
+    joint is declared (the joint variable's sign follows from the poses)."""
+    from screwkit.kinematics.graph.dyads import rotation_about
+
+    jr, jc, jb = (mech.joints[k] for k in joints)
+    R1, p1 = first
+    B_world = second[0] @ jb.at + second[1]
+    B = np.einsum("kji,kj->ki", R1, B_world - p1)  # in p1's frame
+    P, Q, S = leg_terms(mech, joints, B)
+    disc = P ** 2 + Q ** 2 - S ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        phi = np.arctan2(Q, P) + sigma * np.arccos(np.clip(S / np.hypot(P, Q), -1.0, 1.0))
+    phi = np.where(disc >= 0.0, phi, np.nan)
+    M = rotation_about(jr.axis, phi)
+    Rb = R1 @ M
+    pb = np.einsum("kij,kj->ki", R1, jr.at - M @ jr.at) + p1
+    C = Rb @ jc.at + pb
+    rod = _least_rotation(jc.at - jb.at, C - B_world)
+    return (Rb, pb), (rod, B_world - rod @ jb.at), disc / mech.length_scale ** 4
+
+
+def _least_rotation(a0: Array, a: Array) -> Array:
+    """The rotation (K, 3, 3) of least angle taking the direction a0 (3,) to a (K, 3):
+    I + [w]× + [w]×²/(1 + c), w = â0 × â, c = â0·â (NaN where they are opposite)."""
+    e0 = a0 / np.linalg.norm(a0)
+    e = a / np.linalg.norm(a, axis=1)[:, None]
+    w = np.cross(e0, e)
+    c = e @ e0
+    K = np.zeros((a.shape[0], 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = w[:, 2], -w[:, 1], w[:, 0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.asarray(np.eye(3) + K + (K @ K) / (1.0 + c)[:, None, None])
