@@ -299,3 +299,19 @@ def test_an_rssr_as_a_graph_is_an_rss_leg_with_both_modes_of_the_closed_form() -
     centres = [gm.joint_centres for gm in graph.modes]
     both = graph.modes[0].assembles & graph.modes[1].assembles
     assert np.max(np.abs(centres[0] - centres[1])[both]) > 1e-3 * L  # two distinct modes
+
+
+def test_every_mode_of_too_many_dyads_is_refused_up_front() -> None:
+    """2^D modes: a chain of 40 RRR dyads asks for 2^40 of them."""
+    joints = [joint("O", "R", "ground", "b0", [0, 0, 0])]
+    bodies = [Body("b0")]
+    for k in range(40):
+        a, b, prev = f"a{k}", f"c{k}", f"b{k}" if k == 0 else f"c{k - 1}"
+        bodies += [Body(a), Body(b)]
+        joints += [joint(f"A{k}", "R", prev, a, [k + 1.0, 0.5, 0]),
+                   joint(f"B{k}", "R", a, b, [k + 1.5, 1.0, 0]),
+                   joint(f"C{k}", "R", b, "ground", [k + 2.0, 0.0, 0])]
+    mech = Mechanism("forty dyads", tuple(bodies), tuple(joints), ("O.theta",))
+    assert decompose(mech).mode_count == 2 ** 40
+    with pytest.raises(sk.ScrewkitError, match="time limit"):
+        solve_mechanism(mech, [0.0, 0.01], every_mode=True)

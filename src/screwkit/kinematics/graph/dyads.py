@@ -47,7 +47,10 @@ class Placement:
 
     @property
     def assembles(self) -> NDArray[np.bool_]:
-        return np.asarray(np.all(self.discriminant >= 0.0, axis=1))
+        """Every discriminant non-negative (and every pose finite: an RSS leg's rod turned
+        exactly end for end has no least rotation)."""
+        return np.asarray(np.all(self.discriminant >= 0.0, axis=1)
+                          & np.all(np.isfinite(self.p), axis=(1, 2)))
 
 
 def rotation_about(n: Array, angle: Array) -> Array:

@@ -232,9 +232,10 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     from screwkit.kinematics.graph.dyads import place
 
     N = X.shape[0]
+    if every:  # 2^D modes, each costing a drawn mode's time: refused up front when too many
+        check_cost(mech, N * dec.mode_count)
     signs = branch_combinations(dec)
     if every:
-        check_cost(mech, N * signs.shape[0])  # 2^D modes: each costs a drawn mode's time
         pl = every_mode(mech, lay, dec, X).placement
     else:
         signs = signs[:1]
