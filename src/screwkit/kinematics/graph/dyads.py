@@ -69,6 +69,15 @@ def _rotation_cs(n: Array, c: Array, s: Array) -> Array:
     return out
 
 
+def rotation_each(u: Array, angle: Array) -> Array:
+    """Rotations (K, 3, 3) by ``angle`` (K,) about unit axes ``u`` (K, 3) (Rodrigues)."""
+    K = np.zeros((u.shape[0], 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -u[:, 2], u[:, 1], -u[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = u[:, 2], -u[:, 1], u[:, 0]
+    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    return np.asarray(np.eye(3) + s * K + (1.0 - c) * (K @ K))
+
+
 def _turn(n: Array, v0: Array, v: Array) -> Array:
     """The rotation about n taking the in-plane part of v0 (3,) to that of v (K, 3)."""
     v0 = v0 - (v0 @ n) * n
@@ -195,6 +204,10 @@ def _dyad(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose
         from screwkit.kinematics.graph.legs import rss_leg
 
         return rss_leg(mech, dy.joints, sigma, first, second)
+    if dy.kind == "SS":
+        from screwkit.kinematics.graph.legs import spin_hold
+
+        return spin_hold(mech, dy.joints, dy.normal, sigma, first, second)
     j1, j3, j2 = (mech.joints[k] for k in dy.joints)
     n = dy.normal
     L2 = mech.length_scale ** 2

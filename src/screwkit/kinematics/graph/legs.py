@@ -27,35 +27,81 @@ Array = NDArray[np.float64]
 Pose = tuple[Array, Array]
 
 
+def circle_sphere(c: Array, u: Array, v: Array, B: Array, length2: float
+                  ) -> tuple[Array, Array, Array]:
+    """P, Q, S of P cos φ + Q sin φ = S: the point c + v turned by φ about the line (c, u)
+    keeps the squared distance ``length2`` from B (c, u, v, B (K, 3) or (3,))."""
+    v_par = np.sum(v * u, axis=-1)[..., None] * u
+    v_perp = v - v_par
+    d = c + v_par - B
+    P = 2.0 * np.sum(d * v_perp, axis=-1)
+    Q = 2.0 * np.sum(d * np.cross(u, v_perp), axis=-1)
+    S = length2 - np.sum(d * d, axis=-1) - np.sum(v_perp * v_perp, axis=-1)
+    return P, Q, S
+
+
 def leg_terms(mech: Mechanism, joints: tuple[int, int, int], B: Array
               ) -> tuple[Array, Array, Array]:
     """P, Q, S of the leg's equation for the far ball at ``B`` (K, 3) in p1's frame."""
-    jr, jc, _ = (mech.joints[k] for k in joints)
-    u, c = jr.axis, jr.at
-    v = jc.at - c
-    v_par = (v @ u) * u
-    v_perp = v - v_par
-    length2 = float(np.sum((jc.at - mech.joints[joints[2]].at) ** 2))
-    d = (c + v_par)[None, :] - B
-    P = 2.0 * d @ v_perp
-    Q = 2.0 * d @ np.cross(u, v_perp)
-    S = length2 - np.einsum("ki,ki->k", d, d) - float(v_perp @ v_perp)
-    return P, Q, S
+    jr, jc, jb = (mech.joints[k] for k in joints)
+    return circle_sphere(jr.at, jr.axis, jc.at - jr.at, B,
+                         float(np.sum((jc.at - jb.at) ** 2)))
+
+
+def _drawn_root_branch(P: Array, Q: Array, L: float) -> int | None:
+    """The branch σ whose root atan2(Q, P) + σ arccos(S/ρ) is φ = 0 (the drawing), None on a
+    fold or a degenerate equation."""
+    rho = float(np.hypot(P, Q))
+    if rho <= 1e-9 * L ** 2:
+        return None
+    alpha = float(np.arctan2(Q, P))
+    if abs(alpha) <= 1e-9:  # φ = 0 is a double root: the fold
+        return None
+    return -1 if alpha > 0.0 else 1
 
 
 def drawn_leg_branch(mech: Mechanism, joints: tuple[int, int, int]) -> int | None:
     """The branch of the drawing (φ = 0 is a root), None where it is drawn on its fold or
     the equation is degenerate (the ball on the axis, or the far ball's distance to the
     circle not changing with φ)."""
-    P, Q, S = leg_terms(mech, joints, mech.joints[joints[2]].at[None, :])
-    L = mech.length_scale
-    rho = float(np.hypot(P[0], Q[0]))
-    if rho <= 1e-9 * L ** 2:
-        return None
-    alpha = float(np.arctan2(Q[0], P[0]))
-    if abs(alpha) <= 1e-9:  # φ = 0 is a double root: the fold
-        return None
-    return -1 if alpha > 0.0 else 1
+    P, Q, _ = leg_terms(mech, joints, mech.joints[joints[2]].at)
+    return _drawn_root_branch(P, Q, mech.length_scale)
+
+
+def drawn_spin_branch(mech: Mechanism, joints: tuple[int, int, int], axis: Array
+                      ) -> int | None:
+    """As :func:`drawn_leg_branch` for the spin of a body about the line through its ball
+    joints[0] along ``axis``, held by the S–S rod joints[1]–joints[2]."""
+    jl, jt, ja = (mech.joints[k] for k in joints)
+    P, Q, _ = circle_sphere(jl.at, axis, jt.at - jl.at, ja.at,
+                            float(np.sum((jt.at - ja.at) ** 2)))
+    return _drawn_root_branch(P, Q, mech.length_scale)
+
+
+def spin_hold(mech: Mechanism, joints: tuple[int, int, int], axis: Array, sigma: Array,
+              body: Pose, anchor: Pose) -> tuple[Pose, Pose, Array]:
+    """The body (provisionally placed with its first two balls right) turned by ψ about the
+    line through its ball joints[0] along its drawn ``axis`` until the S–S rod joints[1]–
+    joints[2] (anchored on ``anchor``) fits, on branches ``sigma``; the rod by its least
+    rotation; the discriminant (ρ² − S²)/L⁴."""
+    from screwkit.kinematics.graph.dyads import rotation_each
+
+    jl, jt, ja = (mech.joints[k] for k in joints)
+    R, p = body
+    c = R @ jl.at + p
+    u = R @ axis
+    T = R @ jt.at + p
+    G = anchor[0] @ ja.at + anchor[1]
+    P, Q, S = circle_sphere(c, u, T - c, G, float(np.sum((jt.at - ja.at) ** 2)))
+    disc = P ** 2 + Q ** 2 - S ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        psi = np.arctan2(Q, P) + sigma * np.arccos(np.clip(S / np.hypot(P, Q), -1.0, 1.0))
+    psi = np.where(disc >= 0.0, psi, np.nan)
+    turn = rotation_each(u, psi)
+    Rb = turn @ R
+    pb = c + np.einsum("kij,kj->ki", turn, p - c)
+    rod = _least_rotation(jt.at - ja.at, Rb @ jt.at + pb - G)
+    return (Rb, pb), (rod, G - rod @ ja.at), disc / mech.length_scale ** 4
 
 
 def rss_leg(mech: Mechanism, joints: tuple[int, int, int], sigma: Array, first: Pose,

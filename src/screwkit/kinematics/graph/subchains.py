@@ -16,7 +16,9 @@ Two kinds of step place bodies:
 
 - a **spatial RSS leg**: a body joined to a placed body by one R joint only and, by a ball, to
   a rod whose other ball is on a placed body (the rod held by those two balls alone): the body's
-  angle from the rod's length, two branches (graph/legs.py).
+  angle from the rod's length, two branches (graph/legs.py); the "rod" may be a body with a third
+  ball on an S–S rod anchored on a placed body (a suspension upright and its tie rod): an "SS"
+  step then turns it about its first two balls until the tie rod fits, two branches.
 
 What is left (a Stephenson III triad, a platform, a spatial loop) is reported as needing the
 homotopy; the graph tracker (graph/track.py) keeps handling those. The closed forms of the steps
@@ -77,7 +79,7 @@ class Dyad:
 
     @property
     def word(self) -> str:
-        return "leg" if self.kind == "RSS" else "dyad"
+        return {"RSS": "leg", "SS": "rod"}.get(self.kind, "dyad")
 
     def describe(self, mech: Mechanism) -> str:
         names = "–".join(mech.joints[k].name for k in self.joints)
@@ -175,14 +177,14 @@ def decompose(mech: Mechanism) -> Decomposition:
                 used.add(k)
                 progress = True
         dyad = _find_dyad(mech, planes, used, driven, normals, joints_of)
-        if dyad is None:
-            dyad = _find_leg(mech, planes, used, driven, joints_of)
-        if dyad is not None:
-            steps.append(dyad)
-            used.update(dyad.joints)
-            n_index = next(i for i, n in enumerate(normals) if _parallel(n, dyad.normal))
-            for body in dyad.bodies:
-                planes[body] = {n_index} if dyad.kind != "RSS" else set()
+        found = (dyad,) if dyad is not None else _find_legs(mech, planes, used, driven,
+                                                            joints_of)
+        for step in found:
+            steps.append(step)
+            used.update(step.joints)
+            planar = {i for i, n in enumerate(normals) if _parallel(n, step.normal)}
+            for body in step.bodies:
+                planes[body] = planar if step.kind in DYAD_KINDS else set()
             progress = True
     unplaced = tuple(b for b in mech.body_names if b not in planes)
     unused = tuple(k for k in range(len(mech.joints)) if k not in used)
@@ -224,20 +226,32 @@ def _find_dyad(mech: Mechanism, planes: dict[str, set[int]], used: set[int], dri
     return None
 
 
-def _find_leg(mech: Mechanism, planes: dict[str, set[int]], used: set[int], driven: set[int],
-              joints_of: dict[str, list[int]]) -> Dyad | None:
-    """The first RSS leg on the placed bodies (graph/legs.py), or None: a body b joined to a
-    placed body by one passive R joint only and to a rod by a ball, the rod held by that ball
-    and one ball on a placed body, and by nothing else."""
+def _find_legs(mech: Mechanism, planes: dict[str, set[int]], used: set[int],
+               driven: set[int], joints_of: dict[str, list[int]]) -> tuple[Dyad, ...]:
+    """The first RSS leg on the placed bodies (graph/legs.py), or (): a body b joined to a
+    placed body by one passive R joint only and by a ball to a rod, the rod held by that ball
+    and one ball on a placed body, and by nothing else. The rod may instead be a body held by
+    a third ball to an S–S rod whose other ball is on a placed body (a suspension's upright
+    with its tie rod): then a second step fixes its spin about its first two balls."""
     from screwkit.kinematics.graph.legs import drawn_leg_branch
 
     for rod in mech.body_names:
         own = joints_of[rod]
-        if rod in planes or len(own) != 2 or any(mech.joints[k].kind != "S" for k in own):
+        if rod in planes or len(own) not in (2, 3) or any(mech.joints[k].kind != "S"
+                                                          for k in own):
             continue
-        for kc, kb in (own, own[::-1]):
+        for kc in own:
             body = _other(mech, kc, rod)
-            if body in planes or _other(mech, kb, rod) not in planes:
+            rest = [k for k in own if k != kc]
+            anchored = [k for k in rest if _other(mech, k, rod) in planes]
+            if body in planes or len(anchored) != 1:
+                continue
+            kb = anchored[0]
+            tie = [k for k in rest if k != kb]
+            axis = mech.joints[kc].at - mech.joints[kb].at
+            axis = axis / max(float(np.linalg.norm(axis)), 1e-300)
+            spin = _spin_step(mech, planes, joints_of, rod, kb, tie[0], axis) if tie else None
+            if tie and spin is None:
                 continue
             hold = _attachments(mech, body, planes, used, joints_of)
             if len(hold) != 1 or mech.joints[hold[0]].kind != "R" or hold[0] in driven:
@@ -246,10 +260,32 @@ def _find_leg(mech: Mechanism, planes: dict[str, set[int]], used: set[int], driv
             branch = drawn_leg_branch(mech, joints)
             if branch is None:
                 continue
-            return Dyad("RSS", (body, rod), joints,
-                        (_other(mech, hold[0], body), _other(mech, kb, rod)),
-                        mech.joints[hold[0]].axis, branch)
-    return None
+            leg = Dyad("RSS", (body, rod), joints,
+                       (_other(mech, hold[0], body), _other(mech, kb, rod)),
+                       mech.joints[hold[0]].axis, branch)
+            return (leg,) if spin is None else (leg, spin)
+    return ()
+
+
+def _spin_step(mech: Mechanism, planes: dict[str, set[int]], joints_of: dict[str, list[int]],
+               body: str, kb: int, kt: int, axis: Array) -> Dyad | None:
+    """The step fixing ``body``'s spin about the line through its ball ``kb`` along ``axis``
+    (drawn; towards its other ball) by the S–S rod on its ball ``kt`` (graph/legs.py), or
+    None where that is not the shape (or it is drawn on its fold)."""
+    from screwkit.kinematics.graph.legs import drawn_spin_branch
+
+    tie = _other(mech, kt, body)
+    own = joints_of[tie]
+    if tie in planes or len(own) != 2 or any(mech.joints[k].kind != "S" for k in own):
+        return None
+    kti = own[0] if own[1] == kt else own[1]
+    anchor = _other(mech, kti, tie)
+    if anchor not in planes:
+        return None
+    branch = drawn_spin_branch(mech, (kb, kt, kti), axis)
+    if branch is None:
+        return None
+    return Dyad("SS", (body, tie), (kb, kt, kti), (body, anchor), axis, branch)
 
 
 def _attachments(mech: Mechanism, body: str, planes: dict[str, set[int]], used: set[int],
