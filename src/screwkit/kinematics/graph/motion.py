@@ -1,10 +1,10 @@
 """The motion of any mechanism over its inputs: :func:`solve_mechanism` → :class:`MechanismMotion`.
 
-A mechanism built of closed-form sub-chains (driven joints and planar dyads, graph/subchains.py)
-gets its drawn mode, and on request every mode, from their closed forms (graph/dyads.py,
-graph/closed_modes.py); any other has its drawn assembly mode followed along the inputs
-(graph/track.py). Then, for each mode, at every sample and
-all at once, the body poses, the freedoms' rates and accelerations from the stacked screw
+A mechanism built of closed-form sub-chains (driven joints, planar dyads and RSS legs,
+graph/subchains.py) gets its drawn mode, and on request every mode, from their closed forms
+(graph/dyads.py, graph/legs.py, graph/closed_modes.py); any other has its drawn assembly mode
+followed along the inputs (graph/track.py). Then, for each mode, at every sample and all at
+once, the body poses, the freedoms' rates and accelerations from the stacked screw
 Jacobian (graph/newton.py: J_p q̇_p = −J_in ẋ, J_p q̈_p = −J_in ẍ − bias), every body's twist and
 acceleration (graph/closure.py), joint centres and axes, and the paths of the points carried by
 bodies. Per mode the fields are those of a single loop's :class:`ModeMotion` with "link" read as
@@ -179,8 +179,8 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     the drawing; SI), with input ``rates`` and ``accelerations`` (a scalar, one per input or
     one per sample and input).
 
-    A mechanism that decomposes into closed-form sub-chains (graph/subchains.py: driven joints
-    and planar dyads) is solved by their closed forms (graph/dyads.py), and with
+    A mechanism that decomposes into closed-form sub-chains (graph/subchains.py: driven joints,
+    planar dyads, RSS legs) is solved by their closed forms (graph/dyads.py, legs.py), and with
     ``every_mode`` every other assembly mode follows the drawn one (graph/closed_modes.py);
     any other mechanism by continuation of the drawn mode (graph/track.py; ``every_mode``
     then has nothing more to add: the motion's notes say so)."""
@@ -214,8 +214,8 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     return MechanismMotion(mech, X, Xd, Xdd, (mode,), notes=notes)
 
 
-CLOSED_FORM_SOLVER = ("closed-form sub-chains (driven joints and planar dyads, every branch), "
-                      "rates and accelerations from the stacked loop closure")
+CLOSED_FORM_SOLVER = ("closed-form sub-chains (driven joints, planar dyads, RSS legs; every "
+                      "branch), rates and accelerations from the stacked loop closure")
 
 
 def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
