@@ -327,3 +327,24 @@ def test_every_mode_of_too_many_dyads_is_refused_up_front() -> None:
     assert decompose(mech).mode_count == 2 ** 40
     with pytest.raises(sk.ScrewkitError, match="time limit"):
         solve_mechanism(mech, [0.0, 0.01], every_mode=True)
+
+
+def test_a_five_bar_driven_by_two_cranks_by_rows_matches_the_tracker() -> None:
+    """Two inputs (rows of values): both cranks driven, one RRR dyad between them."""
+    mech = Mechanism("five-bar", tuple(Body(n) for n in ("left", "right", "l2", "r2")),
+                     (joint("O1", "R", "ground", "left", [0, 0, 0]),
+                      joint("O2", "R", "right", "ground", [2.0, 0, 0]),
+                      joint("A", "R", "left", "l2", [0.3, 0.9, 0]),
+                      joint("B", "R", "right", "r2", [2.2, 1.0, 0]),
+                      joint("C", "R", "l2", "r2", [1.1, 2.2, 0])), ("O1.theta", "O2.theta"),
+                     (BodyPoint("tool", "l2", np.array([1.1, 2.2, 0.0])),))
+    t = np.linspace(0.0, 1.0, 41)
+    rows = np.stack([0.6 * np.sin(2 * np.pi * t), 0.4 * (1 - np.cos(2 * np.pi * t))], axis=1)
+    motion = solve_mechanism(mech, rows, every_mode=True)
+    assert motion.method == "graph (closed forms)" and len(motion.modes) == 2
+    lay = graph_layout(mech)
+    followed = follow_drawn_mode(mech, lay, rows)
+    assert followed.mask.all() and motion.modes[0].assembles.all()
+    assert np.max(np.abs(motion.modes[0].conf.scalars - followed.conf.scalars)) <= 1e-10
+    for md in motion.modes:
+        assert _residual(mech, md.conf.take(np.nonzero(md.assembles)[0])) <= 1e-10
