@@ -115,6 +115,8 @@ def test_watt_sixbar_has_four_modes_and_the_folds_of_the_second_dyad() -> None:
     assert len(e2) == 2 and [e.split(":")[0] for e in e2] == [e.split(":")[0] for e in e3]
     assert e2[0].startswith("dies at OA.theta = ") and "E–G–F folds" in e2[0]
     assert e2[1].startswith("is born at OA.theta = ")
+    # modes 2 and 3 meet at those folds: one circuit; the others are circuits of their own
+    assert motion.notes[1].endswith(": {0}, {1}, {2, 3}")
     # the batched every-mode poses agree on where each mode assembles
     lay = graph_layout(mech)
     em = every_mode(mech, lay, decompose(mech), theta[:, None])
@@ -163,9 +165,10 @@ def test_a_fold_is_reported_where_brentq_finds_the_distance_law_root() -> None:
     x, dyad = fold_inputs(mech, lay, dec, theta[:, None], branch_combinations(dec)[:1],
                           np.array([stop - 1]))
     assert abs(x[0, 0] - root) <= 1e-12 and dyad[0] == 0
-    # the other branch meets it there: it dies at the same input
+    # the other branch meets it there: it dies at the same input, one circuit with it
     other = motion.modes[1]
     assert any(f"O.theta = {np.degrees(root):.6g} deg" in e for e in other.events)
+    assert motion.notes[1].endswith(": {0, 1}")
 
 
 def _random_dyad_graph(rng: np.random.Generator, kind: str) -> Mechanism:

@@ -254,38 +254,43 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     drawn[:stop] = True
     conf = mode_configuration(mech, lay, R[0], p[0], X, drawn, start)
     mode = build_mode(mech, lay, conf, drawn, X, Xd, Xdd)
-    events = _fold_events(mech, lay, dec, X, signs[:1], ok[:1], after=stop)[0][:1]
+    rows = [0] + [m for m in range(1, M) if ok[m].any()]
+    folds, joins = _fold_events(mech, lay, dec, X, signs[rows], ok[rows])
+    events = folds[0][:1]  # the drawn mode ends at its first fold
     if stop < N:
         events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[stop - 1])} (a "
                          f"limit position or dead centre before {_fmt(mech, lay, X[stop])})")
     modes = [replace(_with_events(mode, [*events, *mode.events]), label="drawn")]
-    others = [m for m in range(1, M) if ok[m].any()]
-    folds = _fold_events(mech, lay, dec, X, signs[others], ok[others])
-    for m, events in zip(others, folds, strict=True):
+    for m, events in zip(rows[1:], folds[1:], strict=True):
         conf = mode_configuration(mech, lay, R[m], p[m], X, ok[m])
         md = build_mode(mech, lay, conf, ok[m], X, Xd, Xdd)
         modes.append(replace(_with_events(md, [*events, *md.events]),
                              label=f"branches {mode_label(mech, dec, signs[m])}",
                              index=len(modes)))
-    notes = (f"{M} branch combination(s) of {len(dec.dyads)} dyad(s); {len(modes)} assemble "
-             "over these inputs",) if every else ()
+    notes: tuple[str, ...] = ()
+    if every:
+        notes = (f"{M} branch combination(s) of {len(dec.dyads)} sub-chain(s); {len(modes)} "
+                 "assemble over these inputs",
+                 "circuits (modes that meet at a fold, where the input must turn back to go "
+                 "on): " + ", ".join("{" + ", ".join(map(str, c)) + "}"
+                                     for c in _circuits(signs[rows], joins)))
+
     return MechanismMotion(mech, X, Xd, Xdd, tuple(modes), method="graph (closed forms)",
                            solver=CLOSED_FORM_SOLVER, notes=notes)
 
 
 def _fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
-                 signs: Array, ok: NDArray[np.bool_], after: int = 0) -> list[list[str]]:
-    """Each mode's (rows of ``signs`` (M', D) and ``ok`` (M', N)) births and deaths at folds
-    from sample ``after`` on, each located between samples (graph/closed_modes.py's
-    ``fold_inputs``, all at once)."""
+                 signs: Array, ok: NDArray[np.bool_]
+                 ) -> tuple[list[list[str]], list[tuple[int, int]]]:
+    """Each mode's (rows of ``signs`` (M', D) and ``ok`` (M', N)) births and deaths at folds,
+    each located between samples (graph/closed_modes.py's ``fold_inputs``, all at once), and
+    every fold as (row, index of the folding sub-chain)."""
     from screwkit.kinematics.graph.closed_modes import fold_inputs
 
-    change = ok[:, :-1] != ok[:, 1:]
-    change[:, :max(after - 1, 0)] = False
-    mode, k = np.nonzero(change)
+    mode, k = np.nonzero(ok[:, :-1] != ok[:, 1:])
     events: list[list[str]] = [[] for _ in range(ok.shape[0])]
     if k.size == 0:
-        return events
+        return events, []
     x, folding = fold_inputs(mech, lay, dec, X, signs[mode], k)
     for m, kk, xx, d in zip(mode, k, x, folding, strict=True):
         dyad = dec.dyads[int(d)]
@@ -293,7 +298,29 @@ def _fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array
         what = "dies" if ok[m, kk] else "is born"
         events[int(m)].append(f"{what} at {_fmt(mech, lay, xx)}: the {dyad.kind} {dyad.word} "
                               f"{names} folds (its two branches meet)")
-    return events
+    return events, [(int(m), int(d)) for m, d in zip(mode, folding, strict=True)]
+
+
+def _circuits(signs: Array, joins: list[tuple[int, int]]) -> list[list[int]]:
+    """The modes (rows of ``signs``) grouped into circuits: at a fold of sub-chain d a mode
+    meets the mode whose branches differ in d alone (the same configuration there)."""
+    group = list(range(signs.shape[0]))
+
+    def root(i: int) -> int:
+        while group[i] != i:
+            i = group[i]
+        return i
+
+    for m, d in joins:
+        other = signs[m].copy()
+        other[d] = -other[d]
+        match = np.nonzero(np.all(signs == other, axis=1))[0]
+        if match.size:
+            group[root(int(match[0]))] = root(m)
+    out: dict[int, list[int]] = {}
+    for i in range(signs.shape[0]):
+        out.setdefault(root(i), []).append(i)
+    return sorted(out.values())
 
 
 def _with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:
