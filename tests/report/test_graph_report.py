@@ -124,7 +124,8 @@ def test_report_of_a_graph_spec_is_written_atomically(tmp_path: Path,
     assert r.exit_code == 0, r.output
     page = out.read_text(encoding="utf-8")
     assert page.startswith("<!doctype html>") and "screwkitViewer" in page
-    assert "181 frames, 1 assembly mode(s)" in r.output
+    # every mode: the four-bar's RRR dyad and the slider's RRP dyad, 2 × 2 branches
+    assert "181 frames, 4 assembly mode(s)" in r.output
     assert (tmp_path / "v.png").stat().st_size > 0
     assert not list(tmp_path.glob(".*"))  # no temporary file left behind
     out.write_text("old", encoding="utf-8")

@@ -141,6 +141,8 @@ def joint_gap(mech: Mechanism, mode: Any) -> float:
 def _mode_entry(mech: Mechanism, md: Any) -> dict[str, Any]:
     ok = np.asarray(md.assembles, dtype=bool)
     label = f"mode {md.index} (the drawn mode)" if md.index == 0 else f"mode {md.index}"
+    if md.index != 0 and getattr(md, "label", ""):  # a closed-form mode: its branches
+        label += f" ({md.label})"
     if not ok.all():
         label += f" (assembles at {int(ok.sum())} of {ok.size})"
     ends, second = joint_ends(mech, md)
