@@ -351,3 +351,55 @@ def test_a_five_bar_driven_by_two_cranks_by_rows_matches_the_tracker() -> None:
     assert np.max(np.abs(motion.modes[0].conf.scalars - followed.conf.scalars)) <= 1e-10
     for md in motion.modes:
         assert _residual(mech, md.conf.take(np.nonzero(md.assembles)[0])) <= 1e-10
+
+
+def _random_rssr(rng: np.random.Generator) -> Mechanism:
+    """A spatial RSSR: random axes and ball centres (every drawing closes)."""
+    ax = lambda: rng.normal(size=3)  # noqa: E731
+    O, Ac, Bc, D = (rng.uniform(-1.0, 1.0, 3) for _ in range(4))
+    Ac = O + 0.3 * (Ac - O) / np.linalg.norm(Ac - O)  # a short crank
+    return Mechanism("random RSSR", (Body("crank"), Body("rod"), Body("rocker")),
+                     (joint("O", "R", "ground", "crank", O, ax()),
+                      joint("A", "S", "crank", "rod", Ac),
+                      joint("B", "S", "rod", "rocker", Bc),
+                      joint("D", "R", "rocker", "ground", D, ax())), ("O.theta",))
+
+
+def _random_wishbone(rng: np.random.Generator) -> Mechanism:
+    """The bundled double wishbone with every hardpoint moved by up to 5 % of its size."""
+    mech = sk.load_spec(MECHANISMS / "double_wishbone.toml").mechanism
+    L = mech.length_scale
+    joints = tuple(joint(j.name, j.kind, *j.bodies, j.at + rng.uniform(-0.05, 0.05, 3) * L,
+                         j.axis) for j in mech.joints)
+    return Mechanism("random wishbone", mech.bodies, joints, mech.inputs)
+
+
+@pytest.mark.parametrize("shape", ["RSSR", "wishbone"])
+def test_random_spatial_legs_every_mode_closes_and_the_tracker_stays_on_it(shape: str) -> None:
+    rng = np.random.default_rng(2027 if shape == "RSSR" else 2028)
+    build, kinds = {"RSSR": (_random_rssr, ["RSS"]),
+                    "wishbone": (_random_wishbone, ["RSS", "SS"])}[shape]
+    checked = 0
+    for _ in range(8):
+        mech = build(rng)
+        dec = decompose(mech)
+        assert dec.complete and [d.kind for d in dec.dyads] == kinds
+        L = mech.length_scale
+        x = np.linspace(0.0, 1.0, 41) if shape == "RSSR" else np.linspace(0.0, 0.04, 41) / L
+        motion = solve_mechanism(mech, x, every_mode=True)
+        lay = graph_layout(mech)
+        for md in motion.modes:
+            idx = np.nonzero(md.assembles)[0]
+            assert _residual(mech, md.conf.take(idx)) <= 1e-10
+            k = int(idx[idx.size // 2])
+            for step in range(1, 4):
+                if k + step >= x.size or not md.assembles[k + step]:
+                    break
+                got = reach(mech, lay, md.conf.take(slice(k + step - 1, k + step)),
+                            x[k + step - 1:k + step], x[k + step:k + step + 1])
+                if got is None:
+                    continue  # the tracker cannot step here (next to a fold or singular)
+                centres = graph_forward(mech, lay, got).centres[0]
+                assert np.max(np.abs(centres - md.joint_centres[k + step])) <= 1e-8 * L
+                checked += 1
+    assert checked >= 20
