@@ -365,6 +365,18 @@ def _random_rssr(rng: np.random.Generator) -> Mechanism:
                       joint("D", "R", "rocker", "ground", D, ax())), ("O.theta",))
 
 
+def _random_rssp(rng: np.random.Generator) -> Mechanism:
+    """A spatial RSSP: a crank driving a slider on a random rail through an S–S rod."""
+    ax = lambda: rng.normal(size=3)  # noqa: E731
+    O, Ac, Bc = (rng.uniform(-1.0, 1.0, 3) for _ in range(3))
+    Ac = O + 0.3 * (Ac - O) / np.linalg.norm(Ac - O)
+    return Mechanism("random RSSP", (Body("crank"), Body("rod"), Body("slider")),
+                     (joint("O", "R", "ground", "crank", O, ax()),
+                      joint("A", "S", "crank", "rod", Ac),
+                      joint("B", "S", "rod", "slider", Bc),
+                      joint("P", "P", "slider", "ground", Bc, ax())), ("O.theta",))
+
+
 def _random_wishbone(rng: np.random.Generator) -> Mechanism:
     """The bundled double wishbone with every hardpoint moved by up to 5 % of its size."""
     mech = sk.load_spec(MECHANISMS / "double_wishbone.toml").mechanism
@@ -374,10 +386,10 @@ def _random_wishbone(rng: np.random.Generator) -> Mechanism:
     return Mechanism("random wishbone", mech.bodies, joints, mech.inputs)
 
 
-@pytest.mark.parametrize("shape", ["RSSR", "wishbone"])
+@pytest.mark.parametrize("shape", ["RSSR", "RSSP", "wishbone"])
 def test_random_spatial_legs_every_mode_closes_and_the_tracker_stays_on_it(shape: str) -> None:
-    rng = np.random.default_rng(2027 if shape == "RSSR" else 2028)
-    build, kinds = {"RSSR": (_random_rssr, ["RSS"]),
+    rng = np.random.default_rng({"RSSR": 2027, "RSSP": 2029, "wishbone": 2028}[shape])
+    build, kinds = {"RSSR": (_random_rssr, ["RSS"]), "RSSP": (_random_rssp, ["PSS"]),
                     "wishbone": (_random_wishbone, ["RSS", "SS"])}[shape]
     checked = 0
     for _ in range(8):
@@ -385,7 +397,7 @@ def test_random_spatial_legs_every_mode_closes_and_the_tracker_stays_on_it(shape
         dec = decompose(mech)
         assert dec.complete and [d.kind for d in dec.dyads] == kinds
         L = mech.length_scale
-        x = np.linspace(0.0, 1.0, 41) if shape == "RSSR" else np.linspace(0.0, 0.04, 41) / L
+        x = np.linspace(0.0, 0.04, 41) / L if shape == "wishbone" else np.linspace(0.0, 1.0, 41)
         motion = solve_mechanism(mech, x, every_mode=True)
         lay = graph_layout(mech)
         for md in motion.modes:

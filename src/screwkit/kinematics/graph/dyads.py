@@ -204,6 +204,10 @@ def _dyad(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose
         from screwkit.kinematics.graph.legs import rss_leg
 
         return rss_leg(mech, dy.joints, sigma, first, second)
+    if dy.kind == "PSS":
+        from screwkit.kinematics.graph.legs import pss_leg
+
+        return pss_leg(mech, dy.joints, sigma, first, second)
     if dy.kind == "SS":
         from screwkit.kinematics.graph.legs import spin_hold
 

@@ -1,4 +1,4 @@
-"""The closed form of a spatial RSS leg (graph/subchains.py): a body b turning on an R joint
+"""The closed forms of spatial legs (graph/subchains.py). An RSS leg: a body b turning on an R joint
 (point c, axis u) of a placed body p1 and carrying the ball C of a rod whose other ball B sits
 on a placed body; the rod is held by those two balls alone.
 
@@ -13,7 +13,8 @@ discriminant ρ² − S² stays positive (it folds where the rod's line meets th
 tangentially). The rod's rotation is the least rotation taking its drawn direction C0 − B0 to
 C − B: its spin about its own axis is idle (nothing drives it; graph/idle.py holds its rate
 at zero), so any choice is a pose of the mechanism, and this one is defined at every sample
-without a path.
+without a path. A PSS leg is the same with the body sliding on a P joint (a quadratic in the
+slide); an SS step turns a body about the line through two of its balls until a tie rod fits.
 """
 
 from __future__ import annotations
@@ -66,6 +67,35 @@ def drawn_leg_branch(mech: Mechanism, joints: tuple[int, int, int]) -> int | Non
     circle not changing with φ)."""
     P, Q, _ = leg_terms(mech, joints, mech.joints[joints[2]].at)
     return _drawn_root_branch(P, Q, mech.length_scale)
+
+
+def drawn_slide_branch(mech: Mechanism, joints: tuple[int, int, int]) -> int | None:
+    """The branch of a PSS leg's drawing (s = 0 is a root of s² + 2s (u·d) + |d|² − l² = 0,
+    d = C0 − B0; the other root is −2 u·d), None on its fold (u·d = 0)."""
+    jp, jc, jb = (mech.joints[k] for k in joints)
+    ud = float(jp.axis @ (jc.at - jb.at))
+    if abs(ud) <= 1e-9 * mech.length_scale:
+        return None
+    return 1 if ud > 0.0 else -1
+
+
+def pss_leg(mech: Mechanism, joints: tuple[int, int, int], sigma: Array, first: Pose,
+            second: Pose) -> tuple[Pose, Pose, Array]:
+    """A PSS leg: the body slides by s along the P joint's u (in p1's frame) until its ball
+    C0 + s u is the rod's length l from the far ball B: s = −u·d + σ √((u·d)² − |d|² + l²),
+    d = C0 − B; the rod by its least rotation; the discriminant over L²."""
+    jp, jc, jb = (mech.joints[k] for k in joints)
+    R1, p1 = first
+    B_world = second[0] @ jb.at + second[1]
+    d = jc.at - np.einsum("kji,kj->ki", R1, B_world - p1)
+    ud = d @ jp.axis
+    disc = ud ** 2 - np.einsum("ki,ki->k", d, d) + float(np.sum((jc.at - jb.at) ** 2))
+    with np.errstate(invalid="ignore"):
+        slide = -ud + sigma * np.sqrt(disc)
+    Rb = R1
+    pb = p1 + np.einsum("kij,kj->ki", R1, slide[:, None] * jp.axis)
+    rod = _least_rotation(jc.at - jb.at, Rb @ jc.at + pb - B_world)
+    return (Rb, pb), (rod, B_world - rod @ jb.at), disc / mech.length_scale ** 2
 
 
 def drawn_spin_branch(mech: Mechanism, joints: tuple[int, int, int], axis: Array

@@ -16,7 +16,8 @@ Two kinds of step place bodies:
 
 - a **spatial RSS leg**: a body joined to a placed body by one R joint only and, by a ball, to
   a rod whose other ball is on a placed body (the rod held by those two balls alone): the body's
-  angle from the rod's length, two branches (graph/legs.py); the "rod" may be a body with a third
+  angle from the rod's length, two branches (graph/legs.py); a PSS leg the same on a P joint;
+  the "rod" may be a body with a third
   ball on an S–S rod anchored on a placed body (a suspension upright and its tie rod): an "SS"
   step then turns it about its first two balls until the tie rod fits, two branches.
 
@@ -79,7 +80,7 @@ class Dyad:
 
     @property
     def word(self) -> str:
-        return {"RSS": "leg", "SS": "rod"}.get(self.kind, "dyad")
+        return {"RSS": "leg", "PSS": "leg", "SS": "rod"}.get(self.kind, "dyad")
 
     def describe(self, mech: Mechanism) -> str:
         names = "–".join(mech.joints[k].name for k in self.joints)
@@ -228,12 +229,12 @@ def _find_dyad(mech: Mechanism, planes: dict[str, set[int]], used: set[int], dri
 
 def _find_legs(mech: Mechanism, planes: dict[str, set[int]], used: set[int],
                driven: set[int], joints_of: dict[str, list[int]]) -> tuple[Dyad, ...]:
-    """The first RSS leg on the placed bodies (graph/legs.py), or (): a body b joined to a
-    placed body by one passive R joint only and by a ball to a rod, the rod held by that ball
+    """The first RSS (or PSS) leg on the placed bodies (graph/legs.py), or (): a body b joined
+    to a placed body by one passive R (or P) joint only and by a ball to a rod, the rod held by that ball
     and one ball on a placed body, and by nothing else. The rod may instead be a body held by
     a third ball to an S–S rod whose other ball is on a placed body (a suspension's upright
     with its tie rod): then a second step fixes its spin about its first two balls."""
-    from screwkit.kinematics.graph.legs import drawn_leg_branch
+    from screwkit.kinematics.graph.legs import drawn_leg_branch, drawn_slide_branch
 
     for rod in mech.body_names:
         own = joints_of[rod]
@@ -254,13 +255,14 @@ def _find_legs(mech: Mechanism, planes: dict[str, set[int]], used: set[int],
             if tie and spin is None:
                 continue
             hold = _attachments(mech, body, planes, used, joints_of)
-            if len(hold) != 1 or mech.joints[hold[0]].kind != "R" or hold[0] in driven:
+            if len(hold) != 1 or mech.joints[hold[0]].kind not in "RP" or hold[0] in driven:
                 continue
             joints = (hold[0], kc, kb)
-            branch = drawn_leg_branch(mech, joints)
+            kind = mech.joints[hold[0]].kind + "SS"
+            branch = (drawn_leg_branch if kind == "RSS" else drawn_slide_branch)(mech, joints)
             if branch is None:
                 continue
-            leg = Dyad("RSS", (body, rod), joints,
+            leg = Dyad(kind, (body, rod), joints,
                        (_other(mech, hold[0], body), _other(mech, kb, rod)),
                        mech.joints[hold[0]].axis, branch)
             return (leg,) if spin is None else (leg, spin)
