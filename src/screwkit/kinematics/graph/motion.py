@@ -214,7 +214,7 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     return MechanismMotion(mech, X, Xd, Xdd, (mode,), notes=notes)
 
 
-CLOSED_FORM_SOLVER = ("closed-form sub-chains (driven joints, planar dyads, RSS legs; every "
+CLOSED_FORM_SOLVER = ("closed-form sub-chains (driven joints, planar dyads, spatial legs; every "
                       "branch), rates and accelerations from the stacked loop closure")
 
 

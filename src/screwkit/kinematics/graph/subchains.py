@@ -154,8 +154,8 @@ def _planar_in(mech: Mechanism, k: int, normals: list[Array]) -> set[int]:
 
 
 def decompose(mech: Mechanism) -> Decomposition:
-    """Place bodies from the ground by driven joints and planar dyads until none applies
-    (module docstring)."""
+    """Place bodies from the ground by driven joints, planar dyads and spatial legs until
+    none applies (module docstring)."""
     normals = _normals(mech)
     planes: dict[str, set[int]] = {GROUND: set(range(len(normals)))}  # placed body -> normals
     used: set[int] = set()
