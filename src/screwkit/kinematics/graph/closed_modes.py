@@ -59,6 +59,12 @@ def branch_combinations(dec: Decomposition) -> Array:
     return np.array(list(itertools.product(*choices)), dtype=float).reshape(-1, len(choices))
 
 
+def drawn_combination(dec: Decomposition) -> Array:
+    """The drawing's branch of every sub-chain (1, D): row 0 of :func:`branch_combinations`,
+    without listing the others."""
+    return np.array([[float(d.drawn_branch) for d in dec.dyads]]).reshape(1, len(dec.dyads))
+
+
 def every_mode(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array) -> EveryMode:
     """The body poses of every mode at every input row, in one batched evaluation."""
     return EveryMode(branch_combinations(dec), place_every(mech, lay, dec, X), 0)
@@ -101,7 +107,7 @@ def drawn_start(mech: Mechanism, lay: GraphLayout, dec: Decomposition, x0: Array
     scale = np.array([lay.length if lay.is_translation[f] else 1.0 for f in lay.inputs])
     steps = max(1, int(np.ceil(float(np.max(np.abs(x0) / scale)) / APPROACH_STEP)))
     path = np.linspace(0.0, 1.0, steps + 1)[:, None] * x0[None, :]
-    signs = branch_combinations(dec)[:1]
+    signs = drawn_combination(dec)
     pl = place(mech, lay, dec, path, np.repeat(signs, path.shape[0], axis=0))
     if not pl.assembles.all():
         return None

@@ -222,8 +222,10 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
                         Xd: Array, Xdd: Array, every: bool) -> MechanismMotion:
     """The drawn mode (and with ``every`` every other mode that assembles somewhere) from the
     closed forms (graph/closed_modes.py)."""
+    from screwkit.budget import ResourceLimitError
     from screwkit.kinematics.graph.closed_modes import (
         branch_combinations,
+        drawn_combination,
         drawn_start,
         every_mode,
         mode_configuration,
@@ -232,13 +234,19 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     from screwkit.kinematics.graph.dyads import place
 
     N = X.shape[0]
-    if every:  # 2^D modes, each costing a drawn mode's time: refused up front when too many
-        check_cost(mech, N * dec.mode_count)
-    signs = branch_combinations(dec)
+    skipped = ""
+    if every:  # 2^D modes, each costing a drawn mode's time: only the drawn one when too many
+        try:
+            check_cost(mech, N * dec.mode_count)
+        except ResourceLimitError as err:
+            every, skipped = False, (f"every mode: only the drawn mode is solved; the "
+                                     f"{dec.mode_count} branch combinations would be over a "
+                                     f"limit ({err})")
     if every:
+        signs = branch_combinations(dec)
         pl = every_mode(mech, lay, dec, X).placement
     else:
-        signs = signs[:1]
+        signs = drawn_combination(dec)
         pl = place(mech, lay, dec, X, np.repeat(signs, N, axis=0))
     M = signs.shape[0]
     ok = pl.assembles.reshape(M, N)
@@ -267,7 +275,7 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
         modes.append(replace(_with_events(md, [*events, *md.events]),
                              label=f"branches {mode_label(mech, dec, signs[m])}",
                              index=len(modes)))
-    notes: tuple[str, ...] = ()
+    notes: tuple[str, ...] = (skipped,) if skipped else ()
     if every:
         notes = (f"{M} branch combination(s) of {len(dec.dyads)} sub-chain(s); {len(modes)} "
                  "assemble over these inputs",
