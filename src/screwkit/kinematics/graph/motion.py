@@ -76,7 +76,8 @@ class MechanismMotion:
 
     @property
     def input_names(self) -> tuple[str, ...]:
-        return self.mechanism.inputs
+        """The joint inputs, then the driven body freedoms (the columns of ``inputs``)."""
+        return self.mechanism.driven_names
 
     @property
     def samples(self) -> int:
@@ -130,17 +131,19 @@ def _per_sample(values: ArrayLike | None, N: int, n_in: int, name: str) -> Array
 
 
 def input_rows(mech: Mechanism, inputs: ArrayLike) -> Array:
-    """Input values as (N, n_in) rows, checked (one column per input of ``mech``)."""
+    """Input values as (N, n_in) rows, checked (one column per joint input and driven body
+    freedom of ``mech``)."""
     try:
         X = np.asarray(inputs, dtype=float)
     except (TypeError, ValueError):
         raise InputError(f"inputs must be numbers; got {inputs!r}") from None
-    n_in = len(mech.inputs)
+    names = mech.driven_names
+    n_in = len(names)
     if X.ndim == 1 and n_in == 1:
         X = X[:, None]
     if X.ndim != 2 or X.shape[1] != n_in or X.shape[0] == 0:
         raise InputError(f"{mech.name}: inputs must be rows of {n_in} value(s) "
-                         f"({', '.join(mech.inputs)}); got shape {np.shape(X)}")
+                         f"({', '.join(names)}); got shape {np.shape(X)}")
     if not np.all(np.isfinite(X)):
         raise InputError(f"{mech.name}: inputs must be finite numbers (a NaN or inf was given)")
     return X
@@ -172,7 +175,10 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
                     progress: Callable[[int, int], None] | None = None) -> MechanismMotion:
     """The drawn mode of ``mech`` over ``inputs`` (N rows, one value per input, measured from
     the drawing; SI), with input ``rates`` and ``accelerations`` (a scalar, one per input or
-    one per sample and input)."""
+    one per sample and input). The inputs are the joint inputs, then the driven body freedoms
+    (``mech.driven_names``; graph/drives.py)."""
+    if mech.drives:
+        return _solve_driven(mech, inputs, rates, accelerations, progress)
     X = input_rows(mech, inputs)
     N, n_in = X.shape
     check_cost(mech, N)
@@ -193,6 +199,28 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
         events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[k])}{nxt}")
     mode = _with_events(mode, events)
     return MechanismMotion(mech, X, Xd, Xdd, (mode,))
+
+
+def _solve_driven(mech: Mechanism, inputs: ArrayLike, rates_: ArrayLike | None,
+                  accelerations_: ArrayLike | None,
+                  progress: Callable[[int, int], None] | None) -> MechanismMotion:
+    """A mechanism with driven body freedoms: solved with its virtual chains (graph/drives.py),
+    which are then removed from the result."""
+    from screwkit.kinematics.graph.drives import augmented, rename_virtual, restricted_mode
+    from screwkit.kinematics.graph.topology import mechanism_topology
+
+    X = input_rows(mech, inputs)
+    topology = mechanism_topology(mech)
+    if not topology.as_dict()["drives"]:
+        raise InputError(f"{mech.name}: {topology.verdict}")
+    try:
+        whole = solve_mechanism(augmented(mech), X, rates=rates_,
+                                accelerations=accelerations_, progress=progress)
+    except AssemblyError as exc:
+        raise AssemblyError(rename_virtual(mech, str(exc))) from None
+    modes = tuple(restricted_mode(mech, md) for md in whole.modes)
+    return MechanismMotion(mech, whole.inputs, whole.input_rates, whole.input_accelerations,
+                           modes, notes=whole.notes)  # type: ignore[arg-type]
 
 
 def _with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:
