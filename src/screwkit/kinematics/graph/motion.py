@@ -187,9 +187,14 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     lay = graph_layout(mech)
     followed = follow_drawn_mode(mech, lay, X, progress)
     if not followed.mask.any():
+        where = ""
+        if followed.reached is not None:
+            where = (f", on the straight way from the drawing (every input 0) after "
+                     f"{_fmt(mech, lay, followed.reached)}: the inputs that assemble end there "
+                     "(a limit of the workspace, or a dead centre)")
         raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
                             f"first input row {_fmt(mech, lay, X[0])}: the mechanism stops "
-                            "assembling before it")
+                            f"assembling before it{where}")
     mode = build_mode(mech, lay, followed.conf, followed.mask, X, Xd, Xdd, followed.frames)
     events = list(mode.events)
     if followed.stopped_after is not None and followed.stopped_after >= 0:
