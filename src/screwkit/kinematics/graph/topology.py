@@ -223,7 +223,8 @@ def _driven_verdict(mech: Mechanism, mobility: int, idle: list[str]) -> tuple[li
     if whole.free or "conflict" in whole.verdict:
         return free or ["(a freedom)"], (
             f"the driven freedoms do not fix the mechanism: {given}, as many as its mobility "
-            f"{effective}, but some repeat what others fix"
+            f"{effective}, but they leave a freedom free (a driven coordinate that cannot "
+            "change here, or two that fix the same motion)"
             + (f"; free with these held: {', '.join(free)}" if free else "")
             + "; drive other freedoms (or draw it away from a singular configuration)")
     return [], (f"the driven freedom(s) drive the mechanism: mobility {effective}"
