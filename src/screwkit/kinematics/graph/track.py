@@ -155,9 +155,9 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
     sph = np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy()
     mask = np.zeros(N, dtype=bool)
     if np.any(X[0] != 0.0):
-        reached, last = _approach(mech, lay, at, X[0])
+        reached, furthest = _approach(mech, lay, at, X[0])
         if reached is None:
-            return Followed(Configuration(scal, sph), mask, -1, reached=last)
+            return Followed(Configuration(scal, sph), mask, -1, reached=furthest)
         at = reached
         scal[0], sph[0], mask[0] = at.conf.scalars[0], at.conf.spherical[0], True
         k = 1
