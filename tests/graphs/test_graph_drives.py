@@ -214,3 +214,31 @@ def test_a_pose_out_of_reach_says_where_the_workspace_ends() -> None:
     md = solve_mechanism(spec.mechanism, np.linspace(0.0, 0.5, 26)[:, None]).modes[0]
     assert md.assembles[:15].all() and not md.assembles[15:].any()
     assert md.events[0].startswith("stops assembling after input upright.z = 0.28 m")
+
+
+def _spec_text(name: str, old: str, new: str) -> str:
+    text = (EXAMPLES / f"{name}.toml").read_text(encoding="utf-8")
+    assert old in text
+    return text.replace(old, new, 1)
+
+
+@pytest.mark.parametrize(("name", "old", "new", "message"), [
+    ("double_wishbone_travel", 'name = "U"\n', 'name = "U"\nactuated = true\n',
+     r"2 actuated freedom\(s\) \(L.theta, U.theta\) for 1 driven body freedom"),
+    ("double_wishbone", 'name = "U"\n', 'name = "U"\nactuated = true\n',
+     r"actuated = true is for mechanisms driven by body freedoms"),
+    ("double_wishbone_travel", 'speed = "50 mm/s"', 'speed = ["50 mm/s", "1 deg/s"]',
+     r"give one speed for every driven freedom \(1: upright.z\)"),
+    ("double_wishbone_travel", 'point = "wheel_centre"\nfreedom = "z"',
+     'body = "tie_rod"\nfreedom = "roll"', r"'tie_rod' is a rod between two balls"),
+    ("double_wishbone_travel", 'point = "wheel_centre"\nfreedom = "z"',
+     'body = "upright"\nfreedom = "z"', r"give at = \[x, y, z\]"),
+    ("stewart_platform_pose", 'speed = ["5 mm/s", "0 mm/s", "10 mm/s",',
+     'speed = ["5 mm/s", "0 deg/s", "10 mm/s",', r"motion.speed\[1\]"),
+])
+def test_spec_errors_of_drives_and_motors(tmp_path: Path, name: str, old: str, new: str,
+                                          message: str) -> None:
+    path = tmp_path / "spec.toml"
+    path.write_text(_spec_text(name, old, new), encoding="utf-8")
+    with pytest.raises(ScrewkitError, match=message):
+        sk.load_spec(path)

@@ -247,6 +247,14 @@ class Mechanism:
                         f"{joints[0].name!r} and {joints[1].name!r}, off their line: the rod's "
                         "spin about that line is idle, so the point has no defined path; put it "
                         "on the line, or join the rod by a U joint at one end")
+            for d in self.drives:
+                off = d.at - a - ((d.at - a) @ u) * u
+                if d.body == b and (not d.is_translation
+                                    or float(np.linalg.norm(off)) > 1e-9 * self.length_scale):
+                    raise MechanismError(
+                        f"drive {d.name!r}: {b!r} is a rod between two balls, whose spin is idle; "
+                        "drive a body the joints hold fully (or the travel of a point on the "
+                        "rod's line)")
             for o in self.outputs:
                 if isinstance(o, BodyAngle) and o.body == b:
                     raise MechanismError(
