@@ -242,3 +242,22 @@ def test_spec_errors_of_drives_and_motors(tmp_path: Path, name: str, old: str, n
     path.write_text(_spec_text(name, old, new), encoding="utf-8")
     with pytest.raises(ScrewkitError, match=message):
         sk.load_spec(path)
+
+
+def test_dynamics_command_reports_the_leg_forces_of_a_pose_driven_platform() -> None:
+    import json
+
+    from typer.testing import CliRunner
+
+    from screwkit.cli.main import app
+
+    path = EXAMPLES / "stewart_platform_pose.toml"
+    r = CliRunner().invoke(app, ["dynamics", str(path), "--gravity", "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.output)
+    assert doc["inputs"] == LEGS and set(doc["efforts"]) == set(LEGS)
+    spec = sk.load_spec(path)
+    motion = solve_mechanism(spec.mechanism, spec.inputs, rates=spec.speed)
+    dyn = graph_inverse_dynamics(motion, gravity=spec.gravity_vector)
+    np.testing.assert_allclose(doc["efforts"]["P3.s"], dyn.efforts[:, 2], rtol=1e-12)
+    assert len(doc["input"]) == 41 and len(doc["input"][0]) == 6
