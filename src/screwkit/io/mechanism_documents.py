@@ -76,8 +76,9 @@ def _body_of(motion: MechanismMotion, point: str) -> str:
 
 
 def mechanism_table(motion: MechanismMotion) -> ResultTable:
-    """One row per sample and mode: the inputs, every freedom with its rates, the closure
-    residual and every point's path (``<point>_x|y|z``)."""
+    """One row per sample and mode: the inputs, every freedom with its rates, every driven body
+    freedom (``<body>.<freedom>``) with its rates, the closure residual and every point's path
+    (``<point>_x|y|z``)."""
     mech = motion.mechanism
     tables = []
     for md in motion.modes:
@@ -85,6 +86,16 @@ def mechanism_table(motion: MechanismMotion) -> ResultTable:
         cols = mode_columns(md, motion.inputs[:, 0], kinds[0])
         for k in range(1, len(kinds)):
             cols.insert(2 + k - 1, Column(f"input_{k + 1}", kinds[k], motion.inputs[:, k]))
+        for k, d in enumerate(mech.drives, start=len(mech.inputs)):
+            # a driven body freedom by its name, with its (given) rate and acceleration
+            rate = "angular_velocity" if d.kind == "angle" else "velocity"
+            acc = "angular_acceleration" if d.kind == "angle" else "acceleration"
+            bad = ~np.asarray(md.assembles)
+            cols += [Column(d.name, d.kind, np.where(bad, np.nan, motion.inputs[:, k])),
+                     Column(f"{d.name}_dot", rate, np.where(bad, np.nan,
+                                                           motion.input_rates[:, k])),
+                     Column(f"{d.name}_ddot", acc, np.where(bad, np.nan,
+                                                           motion.input_accelerations[:, k]))]
         for o in mech.outputs:
             rate = "angular_velocity" if o.kind == "angle" else "velocity"
             acc = "angular_acceleration" if o.kind == "angle" else "acceleration"
