@@ -163,6 +163,12 @@ def test_wheel_travel_drive_equals_the_arm_driven_suspension() -> None:
     np.testing.assert_allclose(ref.points["wheel_centre"], wheel, atol=1e-12)
     np.testing.assert_allclose(ref.link_angular_acceleration, md.link_angular_acceleration,
                                atol=1e-9 * np.abs(ref.link_angular_acceleration).max())
+    from screwkit.io.mechanism_documents import mechanism_table
+
+    table = mechanism_table(motion)  # the drive is a column of its own, with its kind
+    col = table.column("upright.z_dot")
+    assert col.kind == "velocity" and np.allclose(col.values, travel.speed[0])
+    assert np.array_equal(table.column("upright.z").values, travel.inputs[:, 0])
     dyn = graph_inverse_dynamics(motion, gravity=G)
     dref = graph_inverse_dynamics(ref_motion, gravity=G)
     assert dyn.input_names == ("L.theta",)
