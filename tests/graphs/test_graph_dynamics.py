@@ -163,7 +163,8 @@ def test_dynamics_command_on_a_graph_spec() -> None:
 
 
 @pytest.mark.parametrize("name", ["watt_sixbar", "stephenson3_sixbar", "jansen_leg",
-                                  "double_wishbone", "stewart_platform", "delta_robot"])
+                                  "double_wishbone", "stewart_platform", "delta_robot",
+                                  "stewart_platform_pose", "double_wishbone_travel"])
 def test_every_bundled_example_has_a_dynamics_spec(name: str) -> None:
     """Every graph example but the bare four-bar carries mass properties, and its loads balance
     (the rods' masses are symmetric about their axes, so their idle spins carry nothing)."""

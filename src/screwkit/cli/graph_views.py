@@ -73,9 +73,10 @@ def _show(spec: Any, motion: Any, units: Any, full: bool) -> None:
     table = mechanism_table(motion)
     mech = spec.mechanism
     for md in motion.modes:
-        names = ["input"] + [f"input_{k + 1}" for k in range(1, len(mech.inputs))]
+        names = ["input"] + [f"input_{k + 1}" for k in range(1, len(mech.driven_names))]
         outs = [o.name for o in mech.outputs][:4]
-        shown = [n for n in md.variables if n not in mech.inputs][:max(0, 3 - len(outs))]
+        order = [*mech.actuated, *(n for n in md.variables if n not in mech.actuated)]
+        shown = [n for n in order if n not in mech.inputs][:max(0, 3 - len(outs))]
         for n in outs + shown:
             names += [n, f"{n}_dot"]
         for p in list(md.points)[:2]:
@@ -111,11 +112,11 @@ def dynamics_table(spec: Any, dyn: Any) -> Any:
 
     mech = spec.mechanism
     cols = []
-    for k, name in enumerate(mech.inputs):
-        kind = "length" if name.endswith(".s") else "angle"
+    for k, slide in enumerate(mech.driven_is_translation()):
+        kind = "length" if slide else "angle"
         cols.append(Column("input" if k == 0 else f"input_{k + 1}", kind, spec.inputs[:, k]))
     cols.append(Column("assembles", "flag", dyn.ok))
-    for k, name in enumerate(mech.inputs):
+    for k, name in enumerate(dyn.input_names):
         cols.append(Column(f"effort_{name}", "force" if name.endswith(".s") else "moment",
                            dyn.efforts[:, k]))
     for what, kind, arr in (("shaking_force", "force", dyn.shaking_force),
@@ -178,7 +179,7 @@ def _show_dynamics(spec: Any, dyn: Any, summary: dict[str, dict[str, Any]], unit
 
     prose(f"[bold]{escape(spec.describe(units))}[/]")
     prose("gravity on" if gravity else "gravity off (add it with --gravity)")
-    kind0 = "length" if spec.mechanism.inputs[0].endswith(".s") else "angle"
+    kind0 = "length" if spec.mechanism.driven_is_translation()[0] else "angle"
     names = list(summary)
     cols = [TextColumn("load", names, "left"),
             TextColumn("unit", [units.label(summary[n]["kind"]) for n in names], "left"),

@@ -22,7 +22,7 @@ from screwkit.dynamics.inertia import inertia_wrench_regressor, inertia_wrenches
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
 from screwkit.kinematics.graph.motion import MechanismMotion
 from screwkit.model.mass import MassProperties
-from screwkit.model.mechanism import GROUND
+from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]
 
@@ -31,8 +31,9 @@ Array = NDArray[np.float64]
 class GraphDynamics:
     """Loads of one mode of a mechanism over its samples (SI, world frame).
 
-    ``efforts`` (N, n_in): each input's effort (torque of an R, force of a P), what the driving
-    body exerts on the driven one along the freedom; ``reaction_force``/``reaction_moment``
+    ``efforts`` (N, n_e): the effort (torque of an R, force of a P) of each freedom in
+    ``input_names`` — the joint inputs, then the actuated freedoms of a body-driven mechanism —
+    what the driving body exerts on the driven one along the freedom; ``reaction_force``/``reaction_moment``
     (N, J, 3): the wrench each joint's first body exerts on its second, moment about the joint
     centre; ``shaking_force``/``shaking_moment`` (N, 3): what the moving bodies exert on the
     ground, moment about the world origin; ``ok`` where the mode assembles and is regular;
@@ -80,6 +81,18 @@ def body_masses(motion: MechanismMotion) -> list[MassProperties]:
     return [b.mass for b in mech.bodies if b.mass is not None]
 
 
+def effort_names(mech: Mechanism) -> tuple[str, ...]:
+    """The freedoms whose efforts hold the mechanism: its joint inputs, then the actuated
+    freedoms of a mechanism driven by body freedoms (one per drive; model/mechanism_drives.py)."""
+    if mech.drives and len(mech.actuated) != len(mech.drives):
+        raise DynamicsInputError(
+            f"{mech.name}: loads of a mechanism driven by {len(mech.drives)} body freedom(s) "
+            f"({', '.join(d.name for d in mech.drives)}) need as many actuated joint freedoms, "
+            "the motors whose efforts hold it on that path; mark actuated = true on them (e.g. "
+            "a Stewart platform's six leg slides)")
+    return (*mech.inputs, *mech.actuated)
+
+
 def _statics(motion: MechanismMotion, mode: int, loads: Array) -> tuple[GraphStatics, Any]:
     mech = motion.mechanism
     md = motion.mode(mode)
@@ -87,9 +100,11 @@ def _statics(motion: MechanismMotion, mode: int, loads: Array) -> tuple[GraphSta
     if not ok.any():
         raise DynamicsInputError(f"{mech.name}: mode {mode} assembles (regularly) at no sample")
     lay = graph_layout(mech)
+    driven = [lay.names.index(n) for n in effort_names(mech)]
+    passive = [f for f in range(lay.m) if f not in driven]
     fr = graph_forward(mech, lay, md.conf.take(np.nonzero(ok)[0]))
-    st = solve_graph_statics(mech, fr.screws, fr.centres, loads[ok], list(lay.passive),
-                             list(lay.inputs), lay.joint_of, lay.length)
+    st = solve_graph_statics(mech, fr.screws, fr.centres, loads[ok], passive, driven,
+                             lay.joint_of, lay.length)
     return st, (ok, fr)
 
 
@@ -116,18 +131,18 @@ def graph_inverse_dynamics(motion: MechanismMotion, mode: int = 0,
             shaking += W[:, j]
         elif a == GROUND:
             shaking -= W[:, j]
-    efforts = np.full((N, len(mech.inputs)), np.nan)
+    efforts = np.full((N, len(effort_names(mech))), np.nan)
     efforts[ok] = st.efforts[..., 0]
     residual = np.full(N, np.nan)
     residual[ok] = st.residual[:, 0]
-    return GraphDynamics(mech.inputs, tuple(j.name for j in mech.joints), efforts, force,
+    return GraphDynamics(effort_names(mech), tuple(j.name for j in mech.joints), efforts, force,
                          moment, shaking[:, :3], shaking[:, 3:], ok, st.indeterminate,
                          st.indeterminate_joints, residual, g)
 
 
 def graph_regressor(motion: MechanismMotion, mode: int = 0, gravity: ArrayLike | None = None
                     ) -> Array:
-    """The efforts' regressor (N, n_in, 10·B): efforts = Y·π with π the bodies' inertial
+    """The efforts' regressor (N, n_e, 10·B): efforts = Y·π with π the bodies' inertial
     parameters (``MassProperties.inertial_parameters``, about the body-frame origin, which is the
     world origin of the drawing) stacked body by body; NaN where the mode is not regular."""
     mech = motion.mechanism
@@ -139,6 +154,6 @@ def graph_regressor(motion: MechanismMotion, mode: int = 0, gravity: ArrayLike |
     for b in range(B):
         loads[:, b, :, 10 * b:10 * b + 10] = Y[:, b]
     st, (ok, _) = _statics(motion, mode, loads)
-    out = np.full((N, len(mech.inputs), 10 * B), np.nan)
+    out = np.full((N, len(effort_names(mech)), 10 * B), np.nan)
     out[ok] = st.efforts
     return out

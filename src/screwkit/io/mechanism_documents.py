@@ -11,7 +11,7 @@ import numpy as np
 
 from screwkit.kinematics.graph.motion import MechanismMotion
 from screwkit.kinematics.graph.topology import MechanismTopology
-from screwkit.kinematics.motion_table import mode_columns, variable_kind
+from screwkit.kinematics.motion_table import mode_columns
 from screwkit.tables import Column, ResultTable, stack_tables
 
 
@@ -51,8 +51,8 @@ def mechanism_document(motion: MechanismMotion, topology: MechanismTopology | No
         "mechanism": mech.name,
         "family": "graph",
         "units": {"length": "m", "angle": "rad", "time": "s"},
-        "input_names": list(mech.inputs),
-        "input_name": mech.inputs[0],
+        "input_names": list(motion.input_names),
+        "input_name": motion.input_names[0],
         "input": motion.inputs[:, 0] if motion.inputs.shape[1] == 1 else motion.inputs,
         "input_speed": motion.input_rates[0].tolist(),
         "input_acceleration": motion.input_accelerations[0].tolist(),
@@ -62,6 +62,10 @@ def mechanism_document(motion: MechanismMotion, topology: MechanismTopology | No
         "loops": mech.loop_joint_names(),
         "modes": modes,
     }
+    if mech.drives:
+        doc["drives"] = [{"name": d.name, "body": d.body, "freedom": d.freedom,
+                          "at": d.at.tolist()} for d in mech.drives]
+        doc["actuated"] = list(mech.actuated)
     if topology is not None:
         doc["topology"] = topology.as_dict()
     return doc
@@ -72,16 +76,26 @@ def _body_of(motion: MechanismMotion, point: str) -> str:
 
 
 def mechanism_table(motion: MechanismMotion) -> ResultTable:
-    """One row per sample and mode: the inputs, every freedom with its rates, the closure
-    residual and every point's path (``<point>_x|y|z``)."""
+    """One row per sample and mode: the inputs, every freedom with its rates, every driven body
+    freedom (``<body>.<freedom>``) with its rates, the closure residual and every point's path
+    (``<point>_x|y|z``)."""
     mech = motion.mechanism
     tables = []
     for md in motion.modes:
-        kind0 = variable_kind(mech.inputs[0])
-        cols = mode_columns(md, motion.inputs[:, 0], kind0)
-        for k, name in enumerate(mech.inputs[1:], start=1):
-            cols.insert(2 + k - 1, Column(f"input_{k + 1}", variable_kind(name),
-                                          motion.inputs[:, k]))
+        kinds = ["length" if t else "angle" for t in mech.driven_is_translation()]
+        cols = mode_columns(md, motion.inputs[:, 0], kinds[0])
+        for k in range(1, len(kinds)):
+            cols.insert(2 + k - 1, Column(f"input_{k + 1}", kinds[k], motion.inputs[:, k]))
+        for k, d in enumerate(mech.drives, start=len(mech.inputs)):
+            # a driven body freedom by its name, with its (given) rate and acceleration
+            rate = "angular_velocity" if d.kind == "angle" else "velocity"
+            acc = "angular_acceleration" if d.kind == "angle" else "acceleration"
+            bad = ~np.asarray(md.assembles)
+            cols += [Column(d.name, d.kind, np.where(bad, np.nan, motion.inputs[:, k])),
+                     Column(f"{d.name}_dot", rate, np.where(bad, np.nan,
+                                                           motion.input_rates[:, k])),
+                     Column(f"{d.name}_ddot", acc, np.where(bad, np.nan,
+                                                           motion.input_accelerations[:, k]))]
         for o in mech.outputs:
             rate = "angular_velocity" if o.kind == "angle" else "velocity"
             acc = "angular_acceleration" if o.kind == "angle" else "acceleration"

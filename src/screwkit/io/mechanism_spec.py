@@ -38,6 +38,7 @@ from screwkit.model.mechanism import (
     Mechanism,
     MechanismJoint,
 )
+from screwkit.model.mechanism_drives import DRIVE_FREEDOMS, BodyDrive
 from screwkit.model.mechanism_outputs import BodyAngle, Output, PointTravel
 
 Value = StrictFloat | StrictInt | StrictStr
@@ -70,6 +71,7 @@ class GraphJointTable(_Strict):
     axis2: list[Value] | None = Field(None, min_length=3, max_length=3)
     pitch: Value = 0.0
     input: StrictBool | StrictStr = False
+    actuated: StrictBool | StrictStr = False
 
 
 class PointTable(_Strict):
@@ -87,13 +89,20 @@ class OutputTable(_Strict):
     along: list[StrictFloat | StrictInt] | None = Field(None, min_length=3, max_length=3)
 
 
+class DriveTable(_Strict):
+    body: StrictStr | None = None
+    freedom: Literal["x", "y", "z", "roll", "pitch", "yaw"]
+    at: list[Value] | None = Field(None, min_length=3, max_length=3)
+    point: StrictStr | None = None
+
+
 class GraphMotionTable(_Strict):
     start: Value = 0.0
     stop: Value | None = None
     step: Value | None = None
     rows: list[list[Value]] | None = Field(None, max_length=100_000)
-    speed: Value = 1.0
-    acceleration: Value = 0.0
+    speed: Value | list[Value] = 1.0
+    acceleration: Value | list[Value] = 0.0
 
 
 class GraphSpecFile(_Strict):
@@ -103,6 +112,7 @@ class GraphSpecFile(_Strict):
     joints: list[GraphJointTable] = Field(max_length=MAX_JOINTS + 1)
     points: list[PointTable] = Field(default_factory=list, max_length=1000)
     outputs: list[OutputTable] = Field(default_factory=list, max_length=100)
+    drives: list[DriveTable] = Field(default_factory=list, max_length=100)
     motion: GraphMotionTable = Field(default_factory=GraphMotionTable)  # type: ignore[arg-type]
     gravity: Value | None = None
     gravity_direction: list[StrictFloat | StrictInt] = Field(
@@ -141,13 +151,14 @@ class GraphSpec:
         self.mode = 0
         self.mechanism = self._mechanism()
         self.inputs = self._inputs()
-        kinds = [self._input_kind(k) for k in range(len(self.mechanism.inputs))]
+        kinds = [self._input_kind(k) for k in range(len(self.mechanism.driven_names))]
         rate = {"angle": "angular_velocity", "length": "velocity"}
         accel = {"angle": "angular_acceleration", "length": "acceleration"}
-        self.speed = np.array([self.quantity(raw.motion.speed, rate[k], "motion.speed")
-                               for k in kinds])
-        self.acceleration = np.array([self.quantity(raw.motion.acceleration, accel[k],
-                                                    "motion.acceleration") for k in kinds])
+        self.speed = np.array([self.quantity(v, rate[k], f"motion.speed{at}") for k, v, at
+                               in self._per_input(raw.motion.speed, kinds, "speed")])
+        self.acceleration = np.array([self.quantity(v, accel[k], f"motion.acceleration{at}")
+                                      for k, v, at in self._per_input(
+                                          raw.motion.acceleration, kinds, "acceleration")])
         g = 9.80665 if raw.gravity is None else self.quantity(raw.gravity, "acceleration",
                                                               "gravity")
         d = np.asarray(raw.gravity_direction, dtype=float)
@@ -157,16 +168,29 @@ class GraphSpec:
         from screwkit.kinematics.graph.topology import mechanism_topology
 
         self.topology = mechanism_topology(self.mechanism)
+        if self.mechanism.drives and not self.topology.as_dict()["drives"]:
+            self._fail("drives", self.topology.verdict)
         if self.topology.free or "conflict" in self.topology.verdict:
             self._fail("joints", f"{self.topology.verdict} (mark input = true on as many "
                                  "joints as the mechanism has freedoms)")
+
+    def _per_input(self, value: Any, kinds: list[str], key: str) -> list[tuple[str, Any, str]]:
+        """A rate for every input: one value for all, or a list of one per input."""
+        if not isinstance(value, list):
+            return [(k, value, "") for k in kinds]
+        if len(value) != len(kinds):
+            self._fail(f"motion.{key}", f"give one {key} for every driven freedom "
+                       f"({len(kinds)}: {', '.join(self.mechanism.driven_names)}) or one for "
+                       f"all; got {len(value)}")
+        return [(k, v, f"[{i}]") for i, (k, v) in enumerate(zip(kinds, value, strict=True))]
 
     def describe(self, units: DisplayUnits | None = None) -> str:
         """One line: what the spec describes."""
         t = self.topology
         n = self.inputs.shape[0]
         return (f"{self.path}: {self.name}: {t.bodies} bodies, {t.joints} joints, "
-                f"{len(t.loops)} loop(s); input {', '.join(self.mechanism.inputs)}, {n} samples")
+                f"{len(t.loops)} loop(s); input {', '.join(self.mechanism.driven_names)}, "
+                f"{n} samples")
 
     def jobs(self) -> list[str]:
         return ["analyze", "mobility"]
@@ -238,12 +262,25 @@ class GraphSpec:
             inputs.extend(self._joint_inputs(j, key))
         points = [BodyPoint(p.name, p.body, self._vector(p.at, "length", f"points.{k}.at"))
                   for k, p in enumerate(raw.points)]
-        if not inputs:
-            self._fail("joints", "no joint is driven: mark the driven joint with input = true")
+        drives = [self._drive(d, k, points) for k, d in enumerate(raw.drives)]
+        if not inputs and not drives:
+            self._fail("joints", "nothing is driven: mark the driven joint with input = true, "
+                                 "or drive a body's pose with [[drives]]")
+        actuated = [f for k, j in enumerate(raw.joints)
+                    for f in self._joint_inputs(j, f"joints.{k}", "actuated")]
+        if drives and len(actuated) not in (0, len(drives)):
+            self._fail("joints", f"{len(actuated)} actuated freedom(s) "
+                       f"({', '.join(actuated)}) for {len(drives)} driven body freedom(s) in "
+                       "[[drives]]: mark actuated = true on one joint freedom per driven body "
+                       "freedom (the motors whose efforts the loads report)")
+        if actuated and not drives:
+            self._fail("joints", "actuated = true is for mechanisms driven by body freedoms "
+                                 "([[drives]]); a joint input is actuated already")
         outputs = tuple(self._output(o, k) for k, o in enumerate(raw.outputs))
         try:
             return Mechanism(self.name, tuple(bodies), tuple(joints), tuple(inputs),
-                             tuple(points), outputs=outputs)
+                             tuple(points), outputs=outputs, drives=tuple(drives),
+                             actuated=tuple(actuated))
         except ScrewkitError as exc:
             raise SpecError(f"{self.path}: {exc}") from None
 
@@ -262,26 +299,50 @@ class GraphSpec:
         assert o.point is not None and o.along is not None
         return PointTravel(o.name, o.point, self._direction(list(o.along), f"{key}.along"))
 
-    def _joint_inputs(self, j: GraphJointTable, key: str) -> list[str]:
+    def _drive(self, d: DriveTable, k: int, points: list[BodyPoint]) -> BodyDrive:
+        key = f"drives.{k}"
+        at = None if d.at is None else self._vector(d.at, "length", f"{key}.at")
+        body = d.body
+        if d.point is not None:
+            found = [p for p in points if p.name == d.point]
+            if not found:
+                self._fail(f"{key}.point", f"no point {d.point!r}; the points are "
+                           f"{[p.name for p in points]}")
+            if at is not None or (body is not None and body != found[0].body):
+                self._fail(key, f"point {d.point!r} is on {found[0].body!r}: give the point "
+                                "alone (its body is known), or body and at")
+            body, at = found[0].body, found[0].at
+        if body is None:
+            self._fail(f"{key}.body", "say which body's freedom is driven: body = \"<name>\"")
+        assert body is not None
+        if at is None and DRIVE_FREEDOMS[d.freedom]:
+            self._fail(key, f"the travel {d.freedom!r} of {body!r} is measured at a point: "
+                            "give at = [x, y, z] (where it is drawn) or point = \"<name>\"")
+        return BodyDrive(f"{body}.{d.freedom}", body, d.freedom,
+                         np.zeros(3) if at is None else at)
+
+    def _joint_inputs(self, j: GraphJointTable, key: str, what: str = "input") -> list[str]:
         from screwkit.model.joints import JOINT_FREEDOMS
 
-        if j.input is False:
+        value = j.input if what == "input" else j.actuated
+        if value is False:
             return []
         freedoms = JOINT_FREEDOMS[j.kind]
+        verb = "driven" if what == "input" else "actuated"
         if j.kind == "S":
-            self._fail(f"{key}.input", f"joint {j.name!r} is spherical: its freedoms cannot be "
-                                       "driven; drive an R, P, C, H or U joint")
-        if j.input is True:
+            self._fail(f"{key}.{what}", f"joint {j.name!r} is spherical: its freedoms cannot be "
+                                        f"{verb}; use an R, P, C, H or U joint")
+        if value is True:
             if len(freedoms) > 1:
-                self._fail(f"{key}.input", f"joint {j.name!r} ({j.kind}) has freedoms "
-                                           f"{list(freedoms)}: say which is driven, e.g. "
-                                           f"input = {freedoms[0]!r}")
+                self._fail(f"{key}.{what}", f"joint {j.name!r} ({j.kind}) has freedoms "
+                                            f"{list(freedoms)}: say which is {verb}, e.g. "
+                                            f"{what} = {freedoms[0]!r}")
             return [f"{j.name}.{freedoms[0]}"]
-        names = [x.strip() for x in str(j.input).split(",")]
+        names = [x.strip() for x in str(value).split(",")]
         for n in names:
             if n not in freedoms:
-                self._fail(f"{key}.input", f"joint {j.name!r} ({j.kind}) has no freedom {n!r}; "
-                                           f"its freedoms are {list(freedoms)}")
+                self._fail(f"{key}.{what}", f"joint {j.name!r} ({j.kind}) has no freedom "
+                                            f"{n!r}; its freedoms are {list(freedoms)}")
         return [f"{j.name}.{n}" for n in names]
 
     def _mass(self, b: BodyTable, k: int) -> MassProperties | None:
@@ -310,12 +371,12 @@ class GraphSpec:
         raise AssertionError  # unreachable
 
     def _input_kind(self, k: int) -> str:
-        name = self.mechanism.inputs[k]
-        return "length" if name.endswith(".s") else "angle"
+        return "length" if self.mechanism.driven_is_translation()[k] else "angle"
 
     def _inputs(self) -> np.ndarray:
         m = self.raw.motion
-        n_in = len(self.mechanism.inputs)
+        names = self.mechanism.driven_names
+        n_in = len(names)
         kinds = [self._input_kind(k) for k in range(n_in)]
         if m.rows is not None:
             if m.stop is not None or m.step is not None:
@@ -324,7 +385,7 @@ class GraphSpec:
             for r, row in enumerate(m.rows):
                 if len(row) != n_in:
                     self._fail(f"motion.rows.{r}", f"each row gives one value per input "
-                               f"({n_in}: {', '.join(self.mechanism.inputs)}); got {len(row)}")
+                               f"({n_in}: {', '.join(names)}); got {len(row)}")
                 rows.append([self.coordinate(v, kinds[c], f"motion.rows.{r}")
                              for c, v in enumerate(row)])
             if not rows:
@@ -332,7 +393,7 @@ class GraphSpec:
             return np.array(rows, dtype=float)
         if n_in != 1:
             self._fail("motion", f"the mechanism has {n_in} inputs "
-                                 f"({', '.join(self.mechanism.inputs)}): give their values as "
+                                 f"({', '.join(names)}): give their values as "
                                  "rows = [[...], ...], one value per input")
         if m.stop is None or m.step is None:
             self._fail("motion", "give start, stop and step (measured from the drawing)")

@@ -38,6 +38,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.errors import InputError, UnknownNameError
 from screwkit.model.joints import JOINT_DESCRIPTIONS, JOINT_FREEDOMS
 from screwkit.model.mass import MassProperties
+from screwkit.model.mechanism_drives import DRIVE_FREEDOMS, BodyDrive
 from screwkit.model.mechanism_outputs import BodyAngle, Output, PointTravel
 
 Array = NDArray[np.float64]
@@ -176,6 +177,10 @@ class Mechanism:
     length_scale: float = field(default=0.0)
     #: named outputs (body angles, point travels), reported beside the joint variables
     outputs: tuple[Output, ...] = ()
+    #: driven body freedoms (model/mechanism_drives.py), after the joint inputs
+    drives: tuple[BodyDrive, ...] = ()
+    #: the freedoms whose efforts hold a body-driven mechanism (one per drive), for loads
+    actuated: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if len(self.bodies) > MAX_BODIES or len(self.joints) > MAX_JOINTS:
@@ -195,6 +200,7 @@ class Mechanism:
                                        f"{self.name!r}; bodies are {sorted(known)}")
         self._check_inputs()
         self._check_outputs(known)
+        self._check_drives(known)
         if not self.length_scale:
             pts = np.array([j.at for j in self.joints])
             spread = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
@@ -241,6 +247,14 @@ class Mechanism:
                         f"{joints[0].name!r} and {joints[1].name!r}, off their line: the rod's "
                         "spin about that line is idle, so the point has no defined path; put it "
                         "on the line, or join the rod by a U joint at one end")
+            for d in self.drives:
+                off = d.at - a - ((d.at - a) @ u) * u
+                if d.body == b and (not d.is_translation
+                                    or float(np.linalg.norm(off)) > 1e-9 * self.length_scale):
+                    raise MechanismError(
+                        f"drive {d.name!r}: {b!r} is a rod between two balls, whose spin is idle; "
+                        "drive a body the joints hold fully (or the travel of a point on the "
+                        "rod's line)")
             for o in self.outputs:
                 if isinstance(o, BodyAngle) and o.body == b:
                     raise MechanismError(
@@ -290,6 +304,53 @@ class Mechanism:
                         f"there is no joint {joint!r}")
                 raise MechanismError(f"input {inp!r} is not a freedom of {self.name!r} ({hint})")
 
+    def _check_drives(self, known: set[str]) -> None:
+        taken = set(self.freedom_names) | {p.name for p in self.points} | {
+            o.name for o in self.outputs}
+        points: dict[str, Array] = {}
+        object.__setattr__(self, "drives", tuple(
+            replace(d, at=point3(d.at, f"drive {d.name!r}: 'at'")) for d in self.drives))
+        for d in self.drives:
+            where = f"drive {d.name!r}"
+            if d.freedom not in DRIVE_FREEDOMS:
+                raise MechanismError(f"{where}: unknown freedom {d.freedom!r}; a body's driven "
+                                     f"freedom is one of {', '.join(DRIVE_FREEDOMS)}")
+            if d.body == GROUND or d.body not in known:
+                raise UnknownNameError(f"{where}: {d.body!r} is not a moving body of "
+                                       f"{self.name!r}; bodies are {list(self.body_names)}")
+            if d.name in taken:
+                raise MechanismError(f"{where}: the body's {d.freedom} is driven twice, or the "
+                                     "name is taken by a freedom, point or output")
+            taken.add(d.name)
+            if d.is_translation:
+                if d.body in points and np.any(points[d.body] != d.at):
+                    raise MechanismError(f"{where}: the travels of one body are measured at "
+                                         "one point; give every x, y, z drive of "
+                                         f"{d.body!r} the same point")
+                points[d.body] = d.at
+        if len(set(self.actuated)) != len(self.actuated):
+            raise MechanismError(f"mechanism {self.name!r}: a freedom is actuated twice: "
+                                 f"{list(self.actuated)}")
+        freedoms = self.freedom_names
+        balls = {j.name for j in self.joints if j.kind == "S"}
+        for a in self.actuated:
+            joint = a.split(".")[0]
+            if joint in balls or a not in freedoms:
+                own = [f for f in freedoms if f.split(".")[0] == joint]
+                hint = (f"joint {joint!r} has {own}" if own else f"there is no joint {joint!r}")
+                if joint in balls:
+                    hint = "a ball joint has no freedom a motor can drive"
+                raise MechanismError(f"actuated freedom {a!r} is not a motorised freedom of "
+                                     f"{self.name!r} ({hint})")
+            if a in self.inputs:
+                raise MechanismError(f"actuated freedom {a!r} is also an input: an input is "
+                                     "actuated already; remove one of the two")
+        if self.actuated and len(self.actuated) != len(self.drives):
+            raise MechanismError(
+                f"mechanism {self.name!r}: {len(self.actuated)} actuated freedom(s) "
+                f"({', '.join(self.actuated)}) for {len(self.drives)} driven body freedom(s); "
+                f"the loads need one actuated joint freedom per driven body freedom")
+
     # --- derived data ----------------------------------------------------------------------
     @property
     def body_names(self) -> tuple[str, ...]:
@@ -298,6 +359,17 @@ class Mechanism:
     @property
     def freedom_names(self) -> list[str]:
         return [f for j in self.joints for f in j.freedom_names()]
+
+    @property
+    def driven_names(self) -> tuple[str, ...]:
+        """The joint inputs, then the driven body freedoms: the columns of the input rows."""
+        return (*self.inputs, *(d.name for d in self.drives))
+
+    def driven_is_translation(self) -> list[bool]:
+        """Per driven name: whether it is a length (a slide, a body's travel)."""
+        slides = {j.name for j in self.joints if j.kind == "P"}
+        out = [x.endswith(".s") or x.split(".")[0] in slides for x in self.inputs]
+        return out + [d.is_translation for d in self.drives]
 
     @property
     def passive_names(self) -> list[str]:
@@ -384,12 +456,13 @@ class Mechanism:
     def with_bodies(self, bodies: Sequence[Body]) -> Mechanism:
         """A copy with other body data (e.g. mass properties)."""
         return Mechanism(self.name, tuple(bodies), self.joints, self.inputs, self.points,
-                         self.length_scale, self.outputs)
+                         self.length_scale, self.outputs, self.drives, self.actuated)
 
-    def with_inputs(self, inputs: Sequence[str]) -> Mechanism:
-        """A copy driven by other freedoms (the same drawing)."""
+    def with_inputs(self, inputs: Sequence[str], drives: Sequence[BodyDrive] = (),
+                    actuated: Sequence[str] = ()) -> Mechanism:
+        """A copy driven by other joint freedoms and body freedoms (the same drawing)."""
         return Mechanism(self.name, self.bodies, self.joints, tuple(inputs), self.points,
-                         self.length_scale, self.outputs)
+                         self.length_scale, self.outputs, tuple(drives), tuple(actuated))
 
 
 def _unique(kind: str, names: list[str], mechanism: str) -> None:

@@ -188,7 +188,7 @@ def _text(mech: Mechanism, motion: Any, modes: list[dict[str, Any]], units: dict
     ]
     joints = ", ".join(f"{j.name} ({j.kind}: {j.bodies[0]}–{j.bodies[1]})" for j in mech.joints)
     solver = [f"{motion.solver} ({motion.method}; screwkit.kinematics.graph).",
-              f"Joints: {joints}; inputs {', '.join(mech.inputs)}."]
+              f"Joints: {joints}; inputs {', '.join(mech.driven_names)}."]
     validation = []
     for m, md in zip(modes, motion.modes, strict=True):
         ok = np.asarray(m["assembles"], dtype=bool)
@@ -227,14 +227,14 @@ def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str 
     if not modes:
         raise InputError(f"{mech.name}: the motion has no assembly mode to show")
     x = np.asarray(motion.inputs, dtype=float)[:, 0]
-    input_name = mech.inputs[0]
-    kind = "length" if input_name.endswith(".s") else "angle"
+    input_name = mech.driven_names[0]
+    kind = "length" if mech.driven_is_translation()[0] else "angle"
     entries = [_mode_entry(mech, md) for md in modes]
     every = np.concatenate([e["link_points"].reshape(-1, 3) for e in entries])
     extent = float(np.nanmax(np.abs(every))) if np.isfinite(every).any() else 1.0
     units = display_length((getattr(spec, "units", None) or {}).get("length"), extent)
     plots, groups = kinematic_plots(modes, x, input_name, kind, units, (input_name,))
-    if len(mech.inputs) > 1:
+    if len(mech.driven_names) > 1:
         groups[0]["note"] += (f" Every variable is plotted against the first input, "
                               f"{input_name}; the other inputs are plotted too.")
     if topology is None:
@@ -258,7 +258,8 @@ def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str 
         "input": {"name": input_name, "kind": kind, "values": x,
                   "periodic": is_full_turn(x, kind)},
         "joints": [{"name": j.name, "kind": j.kind, "pitch": float(j.pitch),
-                    "input": any(i.split(".")[0] == j.name for i in mech.inputs)}
+                    "input": any(i.split(".")[0] == j.name
+                                 for i in (*mech.inputs, *mech.actuated))}
                    for j in mech.joints],
         "links": links,
         "loops": loop_entries(mech),

@@ -129,7 +129,7 @@ def graph_svg(mechanism: Any, motion: Any, title: str = "") -> str:
         pts = centres[frame, idx + idx[:1]] if len(idx) > 2 else centres[frame, idx]
         parts.append(f"<path d='{_path(pts, fit)}' fill='none' stroke='#2f4f6f' "
                      "stroke-width='2.2' stroke-linejoin='round'/>")
-    inputs = {name.split(".")[0] for name in mechanism.inputs}
+    inputs = {name.split(".")[0] for name in (*mechanism.inputs, *mechanism.actuated)}
     scale, ox, oy = fit
     for j, joint in enumerate(mechanism.joints):
         x, y = centres[frame, j]

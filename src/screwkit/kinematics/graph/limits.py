@@ -43,6 +43,10 @@ def graph_limit_positions(motion: MechanismMotion, output: str | None = None,
     """Every limit of ``output`` (a scalar joint freedom; default: every passive R, P, C, H
     freedom) over the motion's input sweep, on ``mode``."""
     mech = motion.mechanism
+    if mech.drives:
+        raise CapabilityError(f"{mech.name}: limit positions are found along one joint input; "
+                              "this mechanism is driven by body freedoms "
+                              f"({', '.join(mech.driven_names)}): drive a joint instead")
     if len(mech.inputs) != 1:
         raise CapabilityError(f"{mech.name}: limit positions need one input; this mechanism "
                               f"has {len(mech.inputs)} ({', '.join(mech.inputs)})")

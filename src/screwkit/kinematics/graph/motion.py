@@ -80,7 +80,8 @@ class MechanismMotion:
 
     @property
     def input_names(self) -> tuple[str, ...]:
-        return self.mechanism.inputs
+        """The joint inputs, then the driven body freedoms (the columns of ``inputs``)."""
+        return self.mechanism.driven_names
 
     @property
     def samples(self) -> int:
@@ -134,17 +135,19 @@ def _per_sample(values: ArrayLike | None, N: int, n_in: int, name: str) -> Array
 
 
 def input_rows(mech: Mechanism, inputs: ArrayLike) -> Array:
-    """Input values as (N, n_in) rows, checked (one column per input of ``mech``)."""
+    """Input values as (N, n_in) rows, checked (one column per joint input and driven body
+    freedom of ``mech``)."""
     try:
         X = np.asarray(inputs, dtype=float)
     except (TypeError, ValueError):
         raise InputError(f"inputs must be numbers; got {inputs!r}") from None
-    n_in = len(mech.inputs)
+    names = mech.driven_names
+    n_in = len(names)
     if X.ndim == 1 and n_in == 1:
         X = X[:, None]
     if X.ndim != 2 or X.shape[1] != n_in or X.shape[0] == 0:
         raise InputError(f"{mech.name}: inputs must be rows of {n_in} value(s) "
-                         f"({', '.join(mech.inputs)}); got shape {np.shape(X)}")
+                         f"({', '.join(names)}); got shape {np.shape(X)}")
     if not np.all(np.isfinite(X)):
         raise InputError(f"{mech.name}: inputs must be finite numbers (a NaN or inf was given)")
     return X
@@ -177,13 +180,16 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
                     every_mode: bool = False) -> MechanismMotion:
     """The drawn mode of ``mech`` over ``inputs`` (N rows, one value per input, measured from
     the drawing; SI), with input ``rates`` and ``accelerations`` (a scalar, one per input or
-    one per sample and input).
+    one per sample and input). The inputs are the joint inputs, then the driven body freedoms
+    (``mech.driven_names``; graph/drives.py).
 
     A mechanism that decomposes into closed-form sub-chains (graph/subchains.py: driven joints,
     planar dyads, RSS legs) is solved by their closed forms (graph/dyads.py, legs.py), and with
     ``every_mode`` every other assembly mode follows the drawn one (graph/closed_modes.py);
     any other mechanism by continuation of the drawn mode (graph/track.py; ``every_mode``
     then has nothing more to add: the motion's notes say so)."""
+    if mech.drives:
+        return _solve_driven(mech, inputs, rates, accelerations, progress, every_mode)
     X = input_rows(mech, inputs)
     N, n_in = X.shape
     check_cost(mech, N)
@@ -198,9 +204,14 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
         return motion
     followed = follow_drawn_mode(mech, lay, X, progress)
     if not followed.mask.any():
+        where = ""
+        if followed.reached is not None:
+            where = (f", on the straight way from the drawing (every input 0) after "
+                     f"{_fmt(mech, lay, followed.reached)}: the inputs that assemble end there "
+                     "(a limit of the workspace, or a dead centre)")
         raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
                             f"first input row {_fmt(mech, lay, X[0])}: the mechanism stops "
-                            "assembling before it")
+                            f"assembling before it{where}")
     mode = build_mode(mech, lay, followed.conf, followed.mask, X, Xd, Xdd, followed.frames)
     events = list(mode.events)
     if followed.stopped_after is not None and followed.stopped_after >= 0:
@@ -329,6 +340,31 @@ def _circuits(signs: Array, joins: list[tuple[int, int]]) -> list[list[int]]:
     for i in range(signs.shape[0]):
         out.setdefault(root(i), []).append(i)
     return sorted(out.values())
+
+
+def _solve_driven(mech: Mechanism, inputs: ArrayLike, rates_: ArrayLike | None,
+                  accelerations_: ArrayLike | None,
+                  progress: Callable[[int, int], None] | None,
+                  every_mode: bool = False) -> MechanismMotion:
+    """A mechanism with driven body freedoms: solved with its virtual chains (graph/drives.py),
+    which are then removed from the result."""
+    from screwkit.kinematics.graph.drives import augmented, rename_virtual, restricted_mode
+    from screwkit.kinematics.graph.topology import mechanism_topology
+
+    X = input_rows(mech, inputs)
+    topology = mechanism_topology(mech)
+    if not topology.as_dict()["drives"]:
+        raise InputError(f"{mech.name}: {topology.verdict}")
+    try:
+        whole = solve_mechanism(augmented(mech), X, rates=rates_,
+                                accelerations=accelerations_, progress=progress,
+                                every_mode=every_mode)
+    except AssemblyError as exc:
+        raise AssemblyError(rename_virtual(mech, str(exc))) from None
+    modes = tuple(restricted_mode(mech, md) for md in whole.modes)
+    return MechanismMotion(mech, whole.inputs, whole.input_rates, whole.input_accelerations,
+                           modes, method=whole.method, solver=whole.solver,
+                           notes=whole.notes)  # type: ignore[arg-type]
 
 
 def _with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:

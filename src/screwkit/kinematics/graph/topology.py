@@ -111,10 +111,13 @@ def mechanism_topology(mech: Mechanism, samples: Configuration | None = None
     grubler = 6 * len(mech.bodies) - sum(6 - len(j.freedoms) for j in mech.joints)
     redundant = _redundant_rows(mech, J, rank)
     idle, free = _null_freedoms(mech, lay, lin)
-    verdict = _verdict(mech, lay, J, m - rank, idle, free)
+    if mech.drives:
+        free, verdict = _driven_verdict(mech, m - rank, idle)
+    else:
+        verdict = _verdict(mech, lay, J, m - rank, idle, free)
     return MechanismTopology(mech.name, len(mech.bodies), len(mech.joints),
                              mech.loop_joint_names(), grubler, m, rank, m - rank, ranks,
-                             redundant, idle, free, list(mech.inputs), verdict)
+                             redundant, idle, free, list(mech.driven_names), verdict)
 
 
 def _redundant_rows(mech: Mechanism, J: Array, rank: int) -> list[str]:
@@ -193,6 +196,39 @@ def _rods(mech: Mechanism) -> list[tuple[str, str, str]]:
         if len(joints) == 2 and all(j.kind == "S" for j in joints):
             out.append((b, joints[0].name, joints[1].name))
     return out
+
+
+def _driven_verdict(mech: Mechanism, mobility: int, idle: list[str]) -> tuple[list[str], str]:
+    """Free freedoms and the verdict of a mechanism with driven body freedoms: first the count
+    (joint inputs + body drives = mobility, idle freedoms aside), then whether they fix it,
+    from the mechanism with its drives' virtual chains (graph/drives.py)."""
+    from screwkit.kinematics.graph.drives import augmented, rename_virtual
+
+    effective = mobility - len(idle)
+    names = mech.driven_names
+    given = (f"{len(names)} driven freedom(s) ({len(mech.inputs)} joint input(s), "
+             f"{len(mech.drives)} body freedom(s): {', '.join(names)})")
+    whole = mechanism_topology(augmented(mech))
+    free = [rename_virtual(mech, f) for f in whole.free]
+    if len(names) > effective:
+        return free, (f"the driven freedoms conflict: {given} for a mechanism of mobility "
+                      f"{effective} (idle freedoms aside), which needs {effective}; remove "
+                      f"{len(names) - effective} (a [[drives]] entry or an input = true)")
+    if len(names) < effective:
+        return free or ["(a freedom)"], (
+            f"too few driven freedoms: {given} for a mechanism of mobility {effective} (idle "
+            f"freedoms aside), which needs {effective}; add {effective - len(names)} (a "
+            "[[drives]] entry or an input = true)"
+            + (f"; free with these held: {', '.join(free)}" if free else ""))
+    if whole.free or "conflict" in whole.verdict:
+        return free or ["(a freedom)"], (
+            f"the driven freedoms do not fix the mechanism: {given}, as many as its mobility "
+            f"{effective}, but they leave a freedom free (a driven coordinate that cannot "
+            "change here, or two that fix the same motion)"
+            + (f"; free with these held: {', '.join(free)}" if free else "")
+            + "; drive other freedoms (or draw it away from a singular configuration)")
+    return [], (f"the driven freedom(s) drive the mechanism: mobility {effective}"
+                + (f" + {len(idle)} idle" if idle else "") + f", {len(names)} driven")
 
 
 def _verdict(mech: Mechanism, lay: GraphLayout, J: Array, mobility: int, idle: list[str],

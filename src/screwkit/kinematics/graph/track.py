@@ -139,6 +139,9 @@ class Followed:
     #: the body poses, screws, joint centres and axes at every sample reached (the corrector's
     #: last evaluation, at the closed configuration), for the motion build to reuse
     frames: GraphFrames | None = None
+    #: where the first sample is not reached: the last input on the straight way there from
+    #: the drawing that assembles (the drawing, 0, if no step does)
+    reached: Array | None = None
 
 
 def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
@@ -152,9 +155,9 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
     sph = np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy()
     mask = np.zeros(N, dtype=bool)
     if np.any(X[0] != 0.0):
-        reached = _approach(mech, lay, at, X[0])
+        reached, furthest = _approach(mech, lay, at, X[0])
         if reached is None:
-            return Followed(Configuration(scal, sph), mask, -1)
+            return Followed(Configuration(scal, sph), mask, -1, reached=furthest)
         at = reached
         scal[0], sph[0], mask[0] = at.conf.scalars[0], at.conf.spherical[0], True
         k = 1
@@ -211,9 +214,11 @@ def _store(store: GraphFrames, k: int, frames: GraphFrames, count: int) -> None:
         a[k:k + n] = b[:n]
 
 
-def _approach(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array) -> _Point | None:
+def _approach(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array
+              ) -> tuple[_Point | None, Array]:
     """From the drawing to the first sample in steps of at most ~3° (or 5 % of the length
-    scale) of input travel."""
+    scale) of input travel; where it fails, None and the last input reached (to a twentieth
+    of a step, by bisection)."""
     span = np.abs(x - at.x) / np.where(np.array([lay.is_translation[f] for f in lay.inputs]),
                                        0.05 * lay.length, 0.05)
     steps = max(1, int(np.ceil(span.max())))
@@ -225,9 +230,22 @@ def _approach(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array) -> _Point
             continue
         reached = _split_step(mech, lay, at, target, 1)
         if reached is None:
-            return None
+            return None, _furthest(mech, lay, at, target)
         at = reached
-    return at
+    return at, x
+
+
+def _furthest(mech: Mechanism, lay: GraphLayout, at: _Point, target: Array) -> Array:
+    """The furthest input towards ``target`` reached from ``at`` (bisection, 5 halvings)."""
+    good, bad = at.x, target
+    for _ in range(5):
+        mid = 0.5 * (good + bad)
+        end = _split_step(mech, lay, at, mid, 1)
+        if end is None:
+            bad = mid
+        else:
+            at, good = end, mid
+    return np.asarray(good, dtype=float)
 
 
 def reach(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from: Array, x_to: Array
