@@ -179,7 +179,8 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     Xd = _per_sample(rates, N, n_in, "rates")
     Xdd = _per_sample(accelerations, N, n_in, "accelerations")
     lay = graph_layout(mech)
-    followed = follow_drawn_mode(mech, lay, X, progress)
+    start = reassemble_drawing(mech, lay) if misfits(mech) else None
+    followed = follow_drawn_mode(mech, lay, X, progress, start)
     if not followed.mask.any():
         raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
                             f"first input row {_fmt(mech, lay, X[0])}: the mechanism stops "
@@ -193,6 +194,36 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
         events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[k])}{nxt}")
     mode = _with_events(mode, events)
     return MechanismMotion(mech, X, Xd, Xdd, (mode,))
+
+
+def misfits(mech: Mechanism) -> bool:
+    """Whether any joint of ``mech`` is made off its drawing (a ``seat_offset``), so that the
+    drawing does not close."""
+    return any(j.seat_offset is not None for j in mech.joints)
+
+
+#: Newton iterations allowed to re-assemble a drawing whose parts are made off it
+REASSEMBLE_ITERATIONS = 30
+
+
+def reassemble_drawing(mech: Mechanism, lay: GraphLayout) -> Configuration:
+    """The assembly nearest the drawing of a mechanism whose parts are made off it
+    (``seat_offset``): the inputs held at the drawing (0), the passive freedoms closed by
+    Newton's method on the stacked closure (graph/newton.py) from the drawn configuration.
+    An AssemblyError where it does not converge (the misfits are too large to assemble)."""
+    from screwkit.kinematics.graph.closure import zero_configuration
+    from screwkit.kinematics.graph.newton import CLOSURE_TOL, newton
+
+    X0 = np.zeros((1, len(mech.inputs)))
+    conf, err, _ = newton(mech, lay, zero_configuration(lay), X0,
+                          max_iter=REASSEMBLE_ITERATIONS)
+    if not err[0] <= 10 * CLOSURE_TOL:
+        raise AssemblyError(f"{mech.name}: with its parts made off the drawing (seat offsets of "
+                            f"{', '.join(j.name for j in mech.joints if j.seat_offset is not None)}"
+                            f") the mechanism does not re-assemble near the drawing (closure "
+                            f"residual {err[0]:.3g} after {REASSEMBLE_ITERATIONS} Newton steps); "
+                            "use smaller offsets")
+    return conf
 
 
 def _with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:
