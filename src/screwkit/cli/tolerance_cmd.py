@@ -23,10 +23,6 @@ from screwkit.cli.sweep_cmd import (
 )
 
 
-def _is_angle(freedom: str) -> bool:
-    return not freedom.endswith(".s")
-
-
 def _kind(angle: bool) -> str:
     return "angle" if angle else "length"
 
@@ -44,7 +40,7 @@ def _tables(doc: dict[str, Any], description: str, units: Any, input_is_angle: b
         t.add_column(col, justify="right")
     input_kind = _kind(input_is_angle)
     for row in doc["summary"]:
-        angle = _is_angle(doc["outputs"][row["output"]]["joint_freedom"])
+        angle = doc["outputs"][row["output"]]["kind"] == "angle"
         t.add_row(row["output"], _show(units, row["max_worst_case"], angle),
                   _show(units, row["max_rss"], angle),
                   f"{units.show(input_kind, row['at_input']):.4g} {units.pretty(input_kind)}",
@@ -86,7 +82,7 @@ def _plot(doc: dict[str, Any], path: Path, inputs: list[Path], units: Any,
     x = np.asarray(doc["input"], dtype=float) * units.show(input_kind, 1.0)
     for ax, name in zip(axes[:, 0], outs, strict=True):
         o = doc["outputs"][name]
-        kind = _kind(_is_angle(o["joint_freedom"]))
+        kind = o["kind"]
         scale = units.show(kind, 1.0)
         wc, rss = np.asarray(o["worst_case"]) * scale, np.asarray(o["rss"]) * scale
         ax.fill_between(x, -wc, wc, color="tab:orange", alpha=0.25, label="worst case")
@@ -104,6 +100,21 @@ def _plot(doc: dict[str, Any], path: Path, inputs: list[Path], units: Any,
     with atomic_path(path, inputs, "--plot") as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
     plt.close(fig)
+
+
+def _graph_first_order(spec: Any, tolerances: Any, n: int, seed: int) -> tuple[Any, Any]:
+    """The first-order result of a graph spec's hardpoint tolerances and its Monte Carlo run
+    (:mod:`screwkit.sweep.graph_tolerance`)."""
+    from screwkit.cli.graph_views import solved
+    from screwkit.sweep.graph_tolerance import graph_first_order, run_graph_monte_carlo
+
+    mode = solved(spec).modes[0]
+    fo = graph_first_order(spec, tolerances, mode)
+
+    def run(engine: Any, update: Any) -> Any:
+        return run_graph_monte_carlo(engine, spec, tolerances, mode, fo, n, seed, update)
+
+    return fo, run
 
 
 def register(app: typer.Typer) -> None:
@@ -133,16 +144,21 @@ def register(app: typer.Typer) -> None:
                               formats=("json",), units=units, unit=unit)
         data, s = guard(lambda: read_spec_tables(spec))
         tolerances = guard(lambda: make_tolerances(data, s, tol))
-        pipe = Pipeline(s)
-        fo = guard(lambda: first_order(data, s, str(spec), tolerances, pipe))
+        if getattr(s, "family", None) == "graph":  # hardpoints of a mechanism graph
+            fo, run = guard(lambda: _graph_first_order(s, tolerances, monte_carlo, seed))
+        else:
+            pipe = Pipeline(s)
+            fo = guard(lambda: first_order(data, s, str(spec), tolerances, pipe))
+
+            def run(engine: Any, update: Any) -> Any:
+                return run_monte_carlo(engine, data, str(spec), tolerances, pipe.mode(), fo,
+                                       monte_carlo, seed, update)
         mc = None
         if monte_carlo:
             try:
                 with progress_bar("Monte Carlo") as update, \
                         engine_for(scheduler, workers, "Monte Carlo sample") as engine:
-                    deviations = guard(lambda: run_monte_carlo(
-                        engine, data, str(spec), tolerances, pipe.mode(), fo, monte_carlo,
-                        seed, update))
+                    deviations = guard(lambda: run(engine, update))
             except KeyboardInterrupt as exc:
                 stopped(exc, "nothing written")
             mc = compare(fo, tolerances, deviations, seed)
