@@ -38,7 +38,7 @@ def _motion_kind(field: str, angle: bool) -> str | None:
 
 def valid_keys(data: dict[str, Any]) -> list[str]:
     """The keys of this graph spec, in the forms accepted (for error messages)."""
-    out = []
+    out: list[str] = []
     for table, fields in (("joints", ("at[0..2]", "axis[0..2]", "axis2[0..2]", "pitch")),
                           ("points", ("at[0..2]",)),
                           ("bodies", ("mass", "com[0..2]", "inertia[0..2][0..2]"))):

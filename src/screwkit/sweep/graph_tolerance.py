@@ -197,7 +197,7 @@ class GraphMonteCarloTask:
     scalars: Array
     spherical: Array
     inputs: Array
-    index: Array
+    index: np.ndarray
     samples: int
     outputs: tuple[str, ...]
     nominal_outputs: Array  # (outputs, n_ok)

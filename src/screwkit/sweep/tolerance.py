@@ -98,7 +98,7 @@ def make_tolerances(data: dict[str, Any], spec: Spec, texts: list[str]) -> list[
     if not texts:
         raise ToleranceError("give at least one --tol KEY=±T (e.g. --tol d2=±0.05mm)")
     out = []
-    expanded = []
+    expanded: list[tuple[str, float, str | None, str]] = []
     for text in texts:
         name, t, unit = parse_tolerance(text)
         if getattr(spec, "family", None) == "graph":  # joints.*.at: every hardpoint coordinate
