@@ -240,3 +240,17 @@ def test_tolerance_command_on_a_graph_spec(tmp_path):
                             "--monte-carlo", "0"], env={"COLUMNS": "80"})
     assert r.exit_code == 0, r.output
     assert "camber" in r.output and "joints.UB.at[2]" in r.output
+
+
+def test_the_headline_numbers_of_docs_sweeps():
+    """docs/sweeps.md, "Tolerances on a graph": ±0.5 mm on every hardpoint coordinate."""
+    spec, tols, mode = _wishbone_tolerances(["joints.*.at=±0.5mm", "points.*.at=±0.5mm"])
+    fo = graph_first_order(spec, tols, mode)
+    deg = np.degrees
+    got = {o: (np.nanmax(fo.worst_case[o]), np.nanmax(fo.rss[o])) for o in fo.outputs}
+    assert deg(got["camber"][0]) == pytest.approx(0.430, abs=5e-4)
+    assert deg(got["camber"][1]) == pytest.approx(0.171, abs=5e-4)
+    assert deg(got["toe"][0]) == pytest.approx(0.987, abs=5e-4)
+    assert deg(got["toe"][1]) == pytest.approx(0.393, abs=5e-4)
+    assert got["track_change"][0] * 1e3 == pytest.approx(2.52, abs=5e-3)
+    assert got["track_change"][1] * 1e3 == pytest.approx(1.11, abs=5e-3)

@@ -123,7 +123,7 @@ def register(app: typer.Typer) -> None:
     @app.command()
     def tolerance(
         spec: Annotated[Path, typer.Argument(help="Spec file (TOML): the nominal design.")],
-        tol: Annotated[list[str], typer.Option("--tol", help="KEY=±T: a tolerance (±3σ) on a spec value, with a unit or in the spec's units (d2=±0.05mm, delta0=+-0.1deg, joints[1].length=±0.01). Repeatable.")],
+        tol: Annotated[list[str], typer.Option("--tol", help="KEY=±T: a tolerance (±3σ) on a spec value, with a unit or in the spec's units (d2=±0.05mm, delta0=+-0.1deg, joints[1].length=±0.01; on a graph spec a hardpoint: joints.UB.at[2]=±0.5mm, joints.*.at=±0.5mm). Repeatable.")],
         monte_carlo: Annotated[int, typer.Option("--monte-carlo", min=0, max=1_000_000, help="Monte Carlo designs checking the first-order result on the sweep engine (0: none).")] = 1000,
         seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the Monte Carlo draw.")] = 0,
         as_json: JsonOpt = False,
