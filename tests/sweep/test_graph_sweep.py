@@ -240,6 +240,10 @@ def test_tolerance_command_on_a_graph_spec(tmp_path):
                             "--monte-carlo", "0"], env={"COLUMNS": "80"})
     assert r.exit_code == 0, r.output
     assert "camber" in r.output and "joints.UB.at[2]" in r.output
+    # without --tol: the spec's [tolerances] table (every hardpoint ±0.5 mm)
+    r = runner.invoke(app, ["tolerance", str(spec), "--monte-carlo", "0", "--json"])
+    assert r.exit_code == 0, r.output
+    assert len(json.loads(r.stdout)["tolerances"]) == 24
 
 
 def test_the_headline_numbers_of_docs_sweeps():

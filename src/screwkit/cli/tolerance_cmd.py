@@ -123,7 +123,7 @@ def register(app: typer.Typer) -> None:
     @app.command()
     def tolerance(
         spec: Annotated[Path, typer.Argument(help="Spec file (TOML): the nominal design.")],
-        tol: Annotated[list[str], typer.Option("--tol", help="KEY=±T: a tolerance (±3σ) on a spec value, with a unit or in the spec's units (d2=±0.05mm, delta0=+-0.1deg, joints[1].length=±0.01; on a graph spec a hardpoint: joints.UB.at[2]=±0.5mm, joints.*.at=±0.5mm). Repeatable.")],
+        tol: Annotated[list[str] | None, typer.Option("--tol", help="KEY=±T: a tolerance (±3σ) on a spec value, with a unit or in the spec's units (d2=±0.05mm, delta0=+-0.1deg, joints[1].length=±0.01; on a graph spec a hardpoint: joints.UB.at[2]=±0.5mm, joints.*.at=±0.5mm). Repeatable; without any, the spec's [tolerances] table.")] = None,
         monte_carlo: Annotated[int, typer.Option("--monte-carlo", min=0, max=1_000_000, help="Monte Carlo designs checking the first-order result on the sweep engine (0: none).")] = 1000,
         seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the Monte Carlo draw.")] = 0,
         as_json: JsonOpt = False,
@@ -138,12 +138,17 @@ def register(app: typer.Typer) -> None:
         from screwkit.pipeline import Pipeline
         from screwkit.sweep.monte_carlo import compare, run_monte_carlo
         from screwkit.sweep.run import read_spec_tables
-        from screwkit.sweep.tolerance import first_order, make_tolerances, tolerance_document
+        from screwkit.sweep.tolerance import (
+            first_order,
+            make_tolerances,
+            tolerance_document,
+            tolerance_texts,
+        )
 
         out = Outputs.prepare([spec], as_json=as_json, output=output, files={"--plot": plot},
                               formats=("json",), units=units, unit=unit)
         data, s = guard(lambda: read_spec_tables(spec))
-        tolerances = guard(lambda: make_tolerances(data, s, tol))
+        tolerances = guard(lambda: make_tolerances(data, s, tolerance_texts(data, tol)))
         if getattr(s, "family", None) == "graph":  # hardpoints of a mechanism graph
             fo, run = guard(lambda: _graph_first_order(s, tolerances, monte_carlo, seed))
         else:

@@ -93,10 +93,20 @@ def _nominal_number(data: dict[str, Any], spec: Spec, key: SpecKey) -> float:
     return si / to_si(1.0, key.kind, key.unit)
 
 
+def tolerance_texts(data: dict[str, Any], given: list[str] | None) -> list[str]:
+    """The ``--tol`` options, or without any the spec's ``[tolerances]`` table (``KEY =
+    "±T"`` per line) as the same ``KEY=±T`` texts."""
+    if given:
+        return list(given)
+    table = data.get("tolerances") or {}
+    return [f"{key}={value}" for key, value in table.items()]
+
+
 def make_tolerances(data: dict[str, Any], spec: Spec, texts: list[str]) -> list[Tolerance]:
     """The ``--tol`` options as :class:`Tolerance` values (units checked, keys resolved)."""
     if not texts:
-        raise ToleranceError("give at least one --tol KEY=±T (e.g. --tol d2=±0.05mm)")
+        raise ToleranceError("give at least one --tol KEY=±T (e.g. --tol d2=±0.05mm), or a "
+                             "[tolerances] table in the spec")
     out = []
     expanded: list[tuple[str, float, str | None, str]] = []
     for text in texts:
