@@ -136,15 +136,25 @@ def output_values(mech: Mechanism, lay: GraphLayout, conf: Configuration, nomina
     return out
 
 
+#: a misfit the passive freedoms take up leaves J_p ∂q_p/∂δ + ∂r/∂δ below this fraction of ∂r/∂δ
+ABSORBED = 1e-6
+
+
 def _passive_derivative(mech: Mechanism, lay: GraphLayout, conf: Configuration, lin: Any,
-                        plus: Mechanism, minus: Mechanism, h: float) -> Array:
-    """∂q/∂δ (N, m) per unit δ: J_p ∂q_p/∂δ = −∂r/∂δ (module docstring)."""
+                        plus: Mechanism, minus: Mechanism, h: float) -> tuple[Array, float]:
+    """∂q/∂δ (N, m) per unit δ: J_p ∂q_p/∂δ = −∂r/∂δ (module docstring), and the largest
+    relative part of ∂r/∂δ that no motion of the passive freedoms takes up (0 where the
+    mechanism assembles with the misfit; not 0 where it is overconstrained against it)."""
     rp = scaled_residual(plus, lay, graph_forward(plus, lay, conf))
     rm = scaled_residual(minus, lay, graph_forward(minus, lay, conf))
+    dr = (rp - rm) / (2 * h)
+    x = lin.solve(dr)
+    miss = np.linalg.norm(np.einsum("nij,nj->ni", lin.Jp, x) - dr, axis=1)
+    size = np.linalg.norm(dr, axis=1)
     passive = list(lay.passive)
     dq = np.zeros((conf.size, lay.m))
-    dq[:, passive] = -lin.solve((rp - rm) / (2 * h)) * column_scale(lay)[passive]
-    return dq
+    dq[:, passive] = -x * column_scale(lay)[passive]
+    return dq, float(np.max(miss / np.maximum(size, 1e-300), initial=0.0))
 
 
 def graph_first_order(spec: Any, tolerances: list[Tolerance], mode: Any) -> FirstOrder:
@@ -169,7 +179,13 @@ def graph_first_order(spec: Any, tolerances: list[Tolerance], mode: Any) -> Firs
         e = np.zeros(k)
         e[i] = h
         plus, minus = made_off(mech, pts, e), made_off(mech, pts, -e)
-        dq = _passive_derivative(mech, lay, conf, lin, plus, minus, h)
+        dq, stuck = _passive_derivative(mech, lay, conf, lin, plus, minus, h)
+        if stuck > ABSORBED:
+            raise ToleranceError(
+                f"--tol {t.key.text}: {mech.name} cannot take this misfit up by moving (it is "
+                "overconstrained in that direction: its loops have redundant constraints, "
+                "docs/mechanisms.md), so a part made off so only assembles by straining; leave "
+                "this coordinate out (e.g. a planar mechanism's out-of-plane coordinate)")
         yp = output_values(plus, lay, increment(conf, h * dq, lay), mech)
         ym = output_values(minus, lay, increment(conf, -h * dq, lay), mech)
         for o in kinds:
