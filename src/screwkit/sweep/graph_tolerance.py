@@ -168,6 +168,10 @@ def graph_first_order(spec: Any, tolerances: list[Tolerance], mode: Any) -> Firs
     conf = mode.conf.take(idx)
     lin = linearise(mech, lay, conf)
     kinds = output_names(mech, lay)
+    if not kinds:
+        raise ToleranceError(f"{spec.path}: {mech.name} has no named outputs and no scalar "
+                             "joint freedom besides its inputs to analyse: name them in "
+                             "[[outputs]] (a body's angle, a point's travel; docs/mechanisms.md)")
     N = ok.size
     nominal = {o: np.full(N, np.nan) for o in kinds}
     for o, v in output_values(mech, lay, conf, mech).items():
@@ -196,7 +200,7 @@ def graph_first_order(spec: Any, tolerances: list[Tolerance], mode: Any) -> Firs
     worst = {o: np.sum([np.abs(s[x]) * tol_of[x] for x in s], axis=0) for o, s in sens.items()}
     rss = {o: np.sqrt(np.sum([(s[x] * tol_of[x]) ** 2 for x in s], axis=0))
            for o, s in sens.items()}
-    x = spec.inputs[:, 0] if spec.inputs.shape[1] == 1 else np.arange(N, dtype=float)
+    x = spec.inputs[:, 0]  # the first input's value labels a sample (several inputs: rows)
     return FirstOrder(np.asarray(x, dtype=float), list(kinds), nominal, sens, worst, rss,
                       {o: (o, 1.0) for o in kinds}, kinds)
 
