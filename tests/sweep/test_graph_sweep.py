@@ -258,3 +258,15 @@ def test_the_headline_numbers_of_docs_sweeps():
     assert deg(got["toe"][1]) == pytest.approx(0.393, abs=5e-4)
     assert got["track_change"][0] * 1e3 == pytest.approx(2.52, abs=5e-3)
     assert got["track_change"][1] * 1e3 == pytest.approx(1.11, abs=5e-3)
+
+
+def test_graph_monte_carlo_on_the_embedded_cluster_equals_the_in_process_run(tmp_path):
+    spec, tols, mode = _wishbone_tolerances(["joints.UB.at=±0.5mm", "points.*.at=±0.5mm"],
+                                            _small_wishbone(tmp_path, "5"))
+    fo = graph_first_order(spec, tols, mode)
+    runs = []
+    for workers in (0, 2):
+        with start_engine(EngineConfig(workers=workers)) as engine:
+            runs.append(run_graph_monte_carlo(engine, spec, tols, mode, fo, 40, 3))
+    assert np.isfinite(runs[0]).all()
+    assert np.array_equal(runs[0], runs[1])
