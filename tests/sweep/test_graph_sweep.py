@@ -270,3 +270,18 @@ def test_graph_monte_carlo_on_the_embedded_cluster_equals_the_in_process_run(tmp
             runs.append(run_graph_monte_carlo(engine, spec, tols, mode, fo, 40, 3))
     assert np.isfinite(runs[0]).all()
     assert np.array_equal(runs[0], runs[1])
+
+
+def test_a_loop_spec_reads_its_tolerances_table_and_tol_replaces_it(tmp_path):
+    from screwkit.sweep.tolerance import tolerance_texts
+
+    data = read_toml(EXAMPLES / "bagci_fig7_rsrc.toml")
+    data["tolerances"] = {"d2": "±0.01 in", "delta0": "+-0.1 deg"}
+    path = tmp_path / "rsrc.toml"
+    path.write_text(toml_text(data), encoding="utf-8")
+    data, spec = read_spec_tables(path)
+    tols = make_tolerances(data, spec, tolerance_texts(data, None))
+    assert [(t.key.text, t.tolerance) for t in tols] == [("dimensions.d2", 0.01),
+                                                         ("dimensions.delta0", 0.1)]
+    tols = make_tolerances(data, spec, tolerance_texts(data, ["e=±0.1mm"]))
+    assert [t.key.text for t in tols] == ["dimensions.e"]
