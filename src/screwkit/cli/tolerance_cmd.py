@@ -23,10 +23,6 @@ from screwkit.cli.sweep_cmd import (
 )
 
 
-def _is_angle(freedom: str) -> bool:
-    return not freedom.endswith(".s")
-
-
 def _kind(angle: bool) -> str:
     return "angle" if angle else "length"
 
@@ -44,7 +40,7 @@ def _tables(doc: dict[str, Any], description: str, units: Any, input_is_angle: b
         t.add_column(col, justify="right")
     input_kind = _kind(input_is_angle)
     for row in doc["summary"]:
-        angle = _is_angle(doc["outputs"][row["output"]]["joint_freedom"])
+        angle = doc["outputs"][row["output"]]["kind"] == "angle"
         t.add_row(row["output"], _show(units, row["max_worst_case"], angle),
                   _show(units, row["max_rss"], angle),
                   f"{units.show(input_kind, row['at_input']):.4g} {units.pretty(input_kind)}",
@@ -86,7 +82,7 @@ def _plot(doc: dict[str, Any], path: Path, inputs: list[Path], units: Any,
     x = np.asarray(doc["input"], dtype=float) * units.show(input_kind, 1.0)
     for ax, name in zip(axes[:, 0], outs, strict=True):
         o = doc["outputs"][name]
-        kind = _kind(_is_angle(o["joint_freedom"]))
+        kind = o["kind"]
         scale = units.show(kind, 1.0)
         wc, rss = np.asarray(o["worst_case"]) * scale, np.asarray(o["rss"]) * scale
         ax.fill_between(x, -wc, wc, color="tab:orange", alpha=0.25, label="worst case")
@@ -106,13 +102,28 @@ def _plot(doc: dict[str, Any], path: Path, inputs: list[Path], units: Any,
     plt.close(fig)
 
 
+def _graph_first_order(spec: Any, tolerances: Any, n: int, seed: int) -> tuple[Any, Any]:
+    """The first-order result of a graph spec's hardpoint tolerances and its Monte Carlo run
+    (:mod:`screwkit.sweep.graph_tolerance`)."""
+    from screwkit.cli.graph_views import solved
+    from screwkit.sweep.graph_tolerance import graph_first_order, run_graph_monte_carlo
+
+    mode = solved(spec).modes[0]
+    fo = graph_first_order(spec, tolerances, mode)
+
+    def run(engine: Any, update: Any) -> Any:
+        return run_graph_monte_carlo(engine, spec, tolerances, mode, fo, n, seed, update)
+
+    return fo, run
+
+
 def register(app: typer.Typer) -> None:
     """Add the ``tolerance`` command to ``app``."""
 
     @app.command()
     def tolerance(
         spec: Annotated[Path, typer.Argument(help="Spec file (TOML): the nominal design.")],
-        tol: Annotated[list[str], typer.Option("--tol", help="KEY=±T: a tolerance (±3σ) on a spec value, with a unit or in the spec's units (d2=±0.05mm, delta0=+-0.1deg, joints[1].length=±0.01). Repeatable.")],
+        tol: Annotated[list[str] | None, typer.Option("--tol", help="KEY=±T: a tolerance (±3σ) on a spec value, with a unit or in the spec's units (d2=±0.05mm, delta0=+-0.1deg, joints[1].length=±0.01; on a graph spec a hardpoint: joints.UB.at[2]=±0.5mm, joints.*.at=±0.5mm). Repeatable; without any, the spec's [tolerances] table.")] = None,
         monte_carlo: Annotated[int, typer.Option("--monte-carlo", min=0, max=1_000_000, help="Monte Carlo designs checking the first-order result on the sweep engine (0: none).")] = 1000,
         seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the Monte Carlo draw.")] = 0,
         as_json: JsonOpt = False,
@@ -127,22 +138,32 @@ def register(app: typer.Typer) -> None:
         from screwkit.pipeline import Pipeline
         from screwkit.sweep.monte_carlo import compare, run_monte_carlo
         from screwkit.sweep.run import read_spec_tables
-        from screwkit.sweep.tolerance import first_order, make_tolerances, tolerance_document
+        from screwkit.sweep.tolerance import (
+            first_order,
+            make_tolerances,
+            tolerance_document,
+            tolerance_texts,
+        )
 
         out = Outputs.prepare([spec], as_json=as_json, output=output, files={"--plot": plot},
                               formats=("json",), units=units, unit=unit)
         data, s = guard(lambda: read_spec_tables(spec))
-        tolerances = guard(lambda: make_tolerances(data, s, tol))
-        pipe = Pipeline(s)
-        fo = guard(lambda: first_order(data, s, str(spec), tolerances, pipe))
+        tolerances = guard(lambda: make_tolerances(data, s, tolerance_texts(data, tol)))
+        if getattr(s, "family", None) == "graph":  # hardpoints of a mechanism graph
+            fo, run = guard(lambda: _graph_first_order(s, tolerances, monte_carlo, seed))
+        else:
+            pipe = Pipeline(s)
+            fo = guard(lambda: first_order(data, s, str(spec), tolerances, pipe))
+
+            def run(engine: Any, update: Any) -> Any:
+                return run_monte_carlo(engine, data, str(spec), tolerances, pipe.mode(), fo,
+                                       monte_carlo, seed, update)
         mc = None
         if monte_carlo:
             try:
                 with progress_bar("Monte Carlo") as update, \
                         engine_for(scheduler, workers, "Monte Carlo sample") as engine:
-                    deviations = guard(lambda: run_monte_carlo(
-                        engine, data, str(spec), tolerances, pipe.mode(), fo, monte_carlo,
-                        seed, update))
+                    deviations = guard(lambda: run(engine, update))
             except KeyboardInterrupt as exc:
                 stopped(exc, "nothing written")
             mc = compare(fo, tolerances, deviations, seed)

@@ -117,6 +117,7 @@ class GraphSpecFile(_Strict):
     gravity: Value | None = None
     gravity_direction: list[StrictFloat | StrictInt] = Field(
         default_factory=lambda: [0.0, 0.0, -1.0])
+    tolerances: dict[str, StrictStr] | None = None  # read by `screwkit tolerance`
 
 
 def is_graph_spec(data: dict[str, Any]) -> bool:

@@ -123,6 +123,7 @@ class SpecFile(_Strict):
     balancing: dict[str, Any] | None = None
     synthesis: dict[str, Any] | None = None
     drive: dict[str, Any] | None = None
+    tolerances: dict[str, StrictStr] | None = None  # read by `screwkit tolerance`
 
 
 class Spec:

@@ -71,7 +71,13 @@ class MechanismJoint:
 
     ``at`` is its point (a U or S joint's centre), ``axis`` its unit axis (a P joint's slide
     direction; a U joint's first axis, fixed in ``bodies[0]``), ``axis2`` a U joint's second
-    axis (fixed in ``bodies[1]``), ``pitch`` an H joint's lead per radian (m/rad)."""
+    axis (fixed in ``bodies[1]``), ``pitch`` an H joint's lead per radian (m/rad).
+
+    ``seat_offset`` (default none) models a part made off its drawing: the joint's point is
+    ``at`` in ``bodies[0]`` but ``at − seat_offset`` in ``bodies[1]``, so T_second =
+    T_first · M_j(q) · Trans(seat_offset) and the drawing no longer closes; the mechanism is
+    then re-assembled near it by Newton's method (kinematics/graph/motion.py, docs/sweeps.md
+    "Tolerances on a graph")."""
 
     name: str
     kind: str
@@ -80,9 +86,13 @@ class MechanismJoint:
     axis: Array
     axis2: Array | None = None
     pitch: float = 0.0
+    seat_offset: Array | None = None
 
     def __post_init__(self) -> None:
         where = f"joint {self.name!r}"
+        if self.seat_offset is not None:
+            object.__setattr__(self, "seat_offset",
+                               point3(self.seat_offset, f"{where}: 'seat_offset'"))
         object.__setattr__(self, "at", point3(self.at, f"{where}: 'at'"))
         object.__setattr__(self, "axis", unit_vector(self.axis, f"{where}: 'axis'"))
         if self.axis2 is not None:

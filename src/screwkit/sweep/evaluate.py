@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.io.mechanism_spec import is_graph_spec
 from screwkit.io.spec import spec_from_data
 from screwkit.pipeline import Pipeline
 from screwkit.sweep.jobs import JOB_ROWS, JobOptions, Row, assembly_columns
@@ -48,6 +49,18 @@ def evaluate_design(task: SweepTask, values: np.ndarray) -> Row:
     row: Row = {"status": STATUS_OK, "reason": None}
     try:
         with np.errstate(over="raise", divide="raise", invalid="raise"):
+            if is_graph_spec(task.data):  # a mechanism graph, re-drawn (sweep/graph_jobs.py)
+                from screwkit.io.mechanism_spec import graph_spec_from_data
+                from screwkit.sweep.graph_jobs import graph_row
+
+                graph = graph_spec_from_data(with_values(task.data, overrides), task.path)
+                try:
+                    row.update(graph_row(graph, task.job, task.options))
+                except ValueError:
+                    row.update({"modes": 0, "assembles": False, "assembling_samples": 0,
+                                "where": "nowhere"})
+                    raise
+                return row
             spec = spec_from_data(with_values(task.data, overrides), task.path)
             pipe = Pipeline(spec, method=task.options.method)
             try:

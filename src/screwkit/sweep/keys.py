@@ -184,10 +184,11 @@ class SpecKey:
     kind: str | None
     unit: str | None
     written_unit: bool  # the value is written with its unit ("4.6 in"), not as a bare number
+    label: str | None = None  # the name by names of a graph spec's key (joints.LB.at[0])
 
     @property
     def text(self) -> str:
-        return key_text(self.path)
+        return self.label if self.label is not None else key_text(self.path)
 
     @property
     def column(self) -> str:
@@ -206,24 +207,30 @@ class SpecKey:
 def spec_key(data: dict[str, Any], spec: Spec, text: str, given_unit: str | None) -> SpecKey:
     """The :class:`SpecKey` of ``text``; ``given_unit`` is the unit the user wrote with the
     numbers (checked against the key's kind), else the spec's unit for the key is used."""
-    path = resolve_key(data, spec, text)
-    kind = key_kind(spec, path)
-    name = key_text(path)
+    label = None
+    if getattr(spec, "family", None) == "graph":  # io.mechanism_spec.GraphSpec
+        from screwkit.sweep.graph_keys import graph_key
+
+        path, kind, label = graph_key(data, spec.input_is_angle, text)
+    else:
+        path = resolve_key(data, spec, text)
+        kind = key_kind(spec, path)
+    name = label or key_text(path)
     if kind == "integer":
         if given_unit:
             raise SpecKeyError(f"{name} is a whole number (an index); give it without a unit")
-        return SpecKey(path, kind, None, False)
+        return SpecKey(path, kind, None, False, label)
     if given_unit is not None:
         if kind is not None:
             try:
                 check_unit(given_unit, kind)
             except UnitError as exc:
                 raise SpecKeyError(f"{name}: {exc}") from None
-        return SpecKey(path, kind, given_unit, True)
+        return SpecKey(path, kind, given_unit, True, label)
     written = unit_of(get_value(data, path))
     if written is not None:
-        return SpecKey(path, kind, written, True)
+        return SpecKey(path, kind, written, True, label)
     if kind is None:
-        return SpecKey(path, None, None, False)
+        return SpecKey(path, None, None, False, label)
     default = spec.units.get(kind)
-    return SpecKey(path, kind, default or SI_SYMBOL[kind] or None, False)
+    return SpecKey(path, kind, default or SI_SYMBOL[kind] or None, False, label)

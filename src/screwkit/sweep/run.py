@@ -40,12 +40,10 @@ def read_spec_tables(path: Path) -> tuple[dict[str, Any], Spec]:
         data = read_toml(path)
     except SpecFileError as exc:
         raise SpecError(str(exc)) from None
-    from screwkit.io.mechanism_spec import is_graph_spec
+    from screwkit.io.mechanism_spec import graph_spec_from_data, is_graph_spec
 
     if is_graph_spec(data):
-        raise SpecError(f"{path}: sweeps and tolerance analysis do not take a mechanism graph "
-                        "(bodies and joints) yet; graphs work with validate, analyze, mobility, "
-                        "limits, report and dynamics (docs/mechanisms.md)")
+        return data, graph_spec_from_data(data, path)  # type: ignore[return-value]
     return data, spec_from_data(data, path)
 
 
@@ -82,6 +80,11 @@ class SweepDefinition:
 def check_job_on_spec(spec: Spec, job: str) -> None:
     """Refuse, before any design runs, a job the spec cannot have (every row would fail)."""
     check_job(job)
+    if getattr(spec, "family", None) == "graph":  # io.mechanism_spec.GraphSpec
+        from screwkit.sweep.graph_jobs import check_graph_job
+
+        check_graph_job(spec, job)
+        return
     require(spec.linkage, job)
     if job == "dynamics" and any(link.mass is None for link in spec.linkage.links):
         raise SpecError(f"{spec.path}: --job dynamics needs mass properties for every link "

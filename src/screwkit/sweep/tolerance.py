@@ -93,13 +93,31 @@ def _nominal_number(data: dict[str, Any], spec: Spec, key: SpecKey) -> float:
     return si / to_si(1.0, key.kind, key.unit)
 
 
+def tolerance_texts(data: dict[str, Any], given: list[str] | None) -> list[str]:
+    """The ``--tol`` options, or without any the spec's ``[tolerances]`` table (``KEY =
+    "±T"`` per line) as the same ``KEY=±T`` texts."""
+    if given:
+        return list(given)
+    table = data.get("tolerances") or {}
+    return [f"{key}={value}" for key, value in table.items()]
+
+
 def make_tolerances(data: dict[str, Any], spec: Spec, texts: list[str]) -> list[Tolerance]:
     """The ``--tol`` options as :class:`Tolerance` values (units checked, keys resolved)."""
     if not texts:
-        raise ToleranceError("give at least one --tol KEY=±T (e.g. --tol d2=±0.05mm)")
+        raise ToleranceError("give at least one --tol KEY=±T (e.g. --tol d2=±0.05mm), or a "
+                             "[tolerances] table in the spec")
     out = []
+    expanded: list[tuple[str, float, str | None, str]] = []
     for text in texts:
         name, t, unit = parse_tolerance(text)
+        if getattr(spec, "family", None) == "graph":  # joints.*.at: every hardpoint coordinate
+            from screwkit.sweep.graph_tolerance import expand_keys
+
+            expanded.extend((k, t, unit, text) for k in expand_keys(data, name))
+        else:
+            expanded.append((name, t, unit, text))
+    for name, t, unit, text in expanded:
         try:
             key = spec_key(data, spec, name, None)
         except SpecKeyError as exc:
@@ -135,6 +153,13 @@ class FirstOrder:
     worst_case: dict[str, Array]
     rss: dict[str, Array]
     freedom_of: dict[str, tuple[str, float]]  # output → (joint freedom, sign)
+    kinds: dict[str, str] | None = None  # output → "angle"/"length" (a graph's named outputs)
+
+    def kind(self, output: str) -> str:
+        """``"angle"`` or ``"length"``: the output's kind."""
+        if self.kinds is not None:
+            return self.kinds[output]
+        return "length" if self.freedom_of[output][0].endswith(".s") else "angle"
 
 
 def output_names(linkage: Linkage, mode: ModeMotion, sens: dict[str, Array]) -> dict[str, tuple[str, float]]:
@@ -210,7 +235,8 @@ def tolerance_document(spec_path: Path, spec: Spec, tolerances: list[Tolerance],
         "tolerances": [{"key": t.key.text, "unit": t.key.unit, "nominal": t.nominal,
                         "tolerance": t.tolerance} for t in tolerances],
         "input": fo.inputs,
-        "outputs": {o: {"joint_freedom": fo.freedom_of[o][0], "nominal": fo.nominal[o],
+        "outputs": {o: {"joint_freedom": fo.freedom_of[o][0], "kind": fo.kind(o),
+                        "nominal": fo.nominal[o],
                         "sensitivity": fo.sensitivity[o], "worst_case": fo.worst_case[o],
                         "rss": fo.rss[o]} for o in fo.outputs},
         "summary": summary_rows(fo, tolerances),

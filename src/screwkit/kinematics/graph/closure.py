@@ -86,7 +86,8 @@ def _axis_rotation(u: Array, th: Array) -> Array:
 
 def joint_motion(mech: Mechanism, lay: GraphLayout, conf: Configuration, i: int
                  ) -> tuple[Array, Array]:
-    """M_j(q) (R (N, 3, 3), p (N, 3)) of joint ``i`` in drawn world coordinates."""
+    """M_j(q) (R (N, 3, 3), p (N, 3)) of joint ``i`` in drawn world coordinates (times
+    Trans(seat_offset) for a joint made off its drawing, model/mechanism.py)."""
     j = mech.joints[i]
     N = conf.size
     f0 = lay.first_freedom[i]
@@ -95,7 +96,10 @@ def joint_motion(mech: Mechanism, lay: GraphLayout, conf: Configuration, i: int
         R = conf.spherical[:, lay.spherical_of_joint[i]]
     elif j.kind == "P":
         s = conf.scalars[:, lay.scalar_col[f0]]
-        return np.broadcast_to(np.eye(3), (N, 3, 3)), s[:, None] * u
+        slide = s[:, None] * u
+        if j.seat_offset is not None:
+            slide = slide + j.seat_offset
+        return np.broadcast_to(np.eye(3), (N, 3, 3)), slide
     elif j.kind == "U":
         assert j.axis2 is not None
         R = (_axis_rotation(u, conf.scalars[:, lay.scalar_col[f0]])
@@ -108,6 +112,8 @@ def joint_motion(mech: Mechanism, lay: GraphLayout, conf: Configuration, i: int
         p = p + conf.scalars[:, lay.scalar_col[f0 + 1], None] * u
     elif j.kind == "H":
         p = p + (j.pitch * conf.scalars[:, lay.scalar_col[f0]])[:, None] * u
+    if j.seat_offset is not None:  # M_j(q) · Trans(δ): the second body's seat is off by δ
+        p = p + R @ j.seat_offset
     return R, p
 
 

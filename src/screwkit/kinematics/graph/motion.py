@@ -197,12 +197,13 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     Xdd = _per_sample(accelerations, N, n_in, "accelerations")
     lay = graph_layout(mech)
     dec = decompose(mech)
-    if dec.complete:
+    if dec.complete and not misfits(mech):  # seat offsets (tolerances): re-assembled below
         motion = _closed_form_motion(mech, lay, dec, X, Xd, Xdd, every_mode)
         if callable(progress):
             progress(N, N)
         return motion
-    followed = follow_drawn_mode(mech, lay, X, progress)
+    start = reassemble_drawing(mech, lay) if misfits(mech) else None
+    followed = follow_drawn_mode(mech, lay, X, progress, start)
     if not followed.mask.any():
         where = ""
         if followed.reached is not None:
@@ -365,6 +366,36 @@ def _solve_driven(mech: Mechanism, inputs: ArrayLike, rates_: ArrayLike | None,
     return MechanismMotion(mech, whole.inputs, whole.input_rates, whole.input_accelerations,
                            modes, method=whole.method, solver=whole.solver,
                            notes=whole.notes)  # type: ignore[arg-type]
+
+
+def misfits(mech: Mechanism) -> bool:
+    """Whether any joint of ``mech`` is made off its drawing (a ``seat_offset``), so that the
+    drawing does not close."""
+    return any(j.seat_offset is not None for j in mech.joints)
+
+
+#: Newton iterations allowed to re-assemble a drawing whose parts are made off it
+REASSEMBLE_ITERATIONS = 30
+
+
+def reassemble_drawing(mech: Mechanism, lay: GraphLayout) -> Configuration:
+    """The assembly nearest the drawing of a mechanism whose parts are made off it
+    (``seat_offset``): the inputs held at the drawing (0), the passive freedoms closed by
+    Newton's method on the stacked closure (graph/newton.py) from the drawn configuration.
+    An AssemblyError where it does not converge (the misfits are too large to assemble)."""
+    from screwkit.kinematics.graph.closure import zero_configuration
+    from screwkit.kinematics.graph.newton import CLOSURE_TOL, newton
+
+    X0 = np.zeros((1, len(mech.inputs)))
+    conf, err, _ = newton(mech, lay, zero_configuration(lay), X0,
+                          max_iter=REASSEMBLE_ITERATIONS)
+    if not err[0] <= 10 * CLOSURE_TOL:
+        raise AssemblyError(f"{mech.name}: with its parts made off the drawing (seat offsets of "
+                            f"{', '.join(j.name for j in mech.joints if j.seat_offset is not None)}"
+                            f") the mechanism does not re-assemble near the drawing (closure "
+                            f"residual {err[0]:.3g} after {REASSEMBLE_ITERATIONS} Newton steps); "
+                            "use smaller offsets")
+    return conf
 
 
 def _with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:

@@ -145,11 +145,13 @@ class Followed:
 
 
 def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
-                      progress: object = None) -> Followed:
-    """Follow the drawn configuration (inputs 0) to ``X[0]`` and along every row of ``X``."""
+                      progress: object = None, start: Configuration | None = None) -> Followed:
+    """Follow the drawn configuration (inputs 0) to ``X[0]`` and along every row of ``X``;
+    ``start`` replaces the drawing (one closed sample at inputs 0: a mechanism re-assembled
+    near its drawing, motion.reassemble_drawing)."""
     N, n_in = X.shape
-    conf0 = Configuration(np.zeros((1, lay.n_scalar)),
-                          np.broadcast_to(np.eye(3), (1, lay.n_spherical, 3, 3)).copy())
+    conf0 = start if start is not None else Configuration(
+        np.zeros((1, lay.n_scalar)), np.broadcast_to(np.eye(3), (1, lay.n_spherical, 3, 3)).copy())
     at = _Point(conf0, np.zeros(n_in), linearise(mech, lay, conf0, exact=False))
     scal = np.zeros((N, lay.n_scalar))  # samples it does not reach keep the drawing (finite)
     sph = np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy()
@@ -162,7 +164,7 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
         scal[0], sph[0], mask[0] = at.conf.scalars[0], at.conf.spherical[0], True
         k = 1
     else:
-        scal[0], sph[0], mask[0] = 0.0, np.eye(3), True
+        scal[0], sph[0], mask[0] = conf0.scalars[0], conf0.spherical[0], True
         k = 1
     frames = _frame_store(at.lin.frames, N)
     _store(frames, 0, at.lin.frames, 0)
