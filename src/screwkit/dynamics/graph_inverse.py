@@ -52,6 +52,16 @@ class GraphDynamics:
     residual: Array
     gravity: Array
 
+    @property
+    def gravity_on(self) -> bool:
+        """Whether the loads include gravity (a non-zero ``gravity`` vector)."""
+        return bool(np.any(self.gravity != 0))
+
+    @property
+    def relative_residual(self) -> Array:
+        """``residual`` (already relative to the loads), as single loops name it."""
+        return self.residual
+
     def as_dict(self) -> dict[str, Any]:
         return {"inputs": list(self.input_names),
                 "efforts": {n: self.efforts[:, k] for k, n in enumerate(self.input_names)},

@@ -45,6 +45,10 @@ class GraphStatics:
     residual: Array
     indeterminate: int
     indeterminate_joints: list[str]
+    #: (N, R, K) the scaled equations' residual A·y − b itself and the rank of A: loads along
+    #: idle freedoms leave R − rank consistency conditions (dynamics/graph_regressor.py)
+    equation_residual: Array
+    rank: int
 
 
 def _system(mech: Mechanism, screws: Array, centres: Array, passive: list[int],
@@ -113,7 +117,7 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
         S = screws[:, :, f]
         efforts[:, k] = (np.einsum("nk,nkl->nl", S[:, :3], wrench[:, j, 3:])
                          + np.einsum("nk,nkl->nl", S[:, 3:], wrench[:, j, :3]))
-    return GraphStatics(wrench, efforts, residual, indeterminate, named)
+    return GraphStatics(wrench, efforts, residual, indeterminate, named, res, rank)
 
 
 def _null_joints(mech: Mechanism, null: Array) -> list[str]:
