@@ -97,6 +97,22 @@ def graph_dynamics(spec: Any, gravity: bool) -> Any:
     return graph_inverse_dynamics(solved(spec), 0, spec.gravity_vector if gravity else None)
 
 
+def graph_balance(spec: Any, motion: Any, progress: Any = None) -> Any:
+    """The spec's ``[balancing]`` run on a graph spec's drawn mode (``motion``, from
+    :func:`solved`; docs/balancing.md, "Mechanism graphs"); ``progress(done, total)`` follows
+    a Pareto sweep."""
+    from screwkit.balancing.errors import BalancingError
+    from screwkit.balancing.graph import balance_mechanism
+
+    if spec.balancing is None:
+        raise BalancingError(f"{spec.path}: no [balancing] table; see docs/balancing.md")
+    try:
+        return balance_mechanism(motion, 0, spec.balancing, speed=float(spec.speed[0]),
+                                 gravity=spec.gravity_vector, progress=progress)
+    except BalancingError as exc:
+        raise BalancingError(f"{spec.path}: {exc}") from None
+
+
 def dynamics_table(spec: Any, dyn: Any) -> Any:
     """One row per sample: the inputs, every effort, the shaking loads, every reaction."""
     from screwkit.tables import Column, ResultTable

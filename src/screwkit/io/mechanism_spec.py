@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from pydantic import (
@@ -39,6 +39,9 @@ from screwkit.model.mechanism import (
     MechanismJoint,
 )
 from screwkit.model.mechanism_outputs import BodyAngle, Output, PointTravel
+
+if TYPE_CHECKING:
+    from screwkit.balancing.config import BalancingConfig
 
 Value = StrictFloat | StrictInt | StrictStr
 MAX_ROWS = 10_000_000
@@ -107,6 +110,7 @@ class GraphSpecFile(_Strict):
     gravity: Value | None = None
     gravity_direction: list[StrictFloat | StrictInt] = Field(
         default_factory=lambda: [0.0, 0.0, -1.0])
+    balancing: dict[str, Any] | None = None
 
 
 def is_graph_spec(data: dict[str, Any]) -> bool:
@@ -160,6 +164,11 @@ class GraphSpec:
         if self.topology.free or "conflict" in self.topology.verdict:
             self._fail("joints", f"{self.topology.verdict} (mark input = true on as many "
                                  "joints as the mechanism has freedoms)")
+        self.balancing: BalancingConfig | None = None
+        if raw.balancing is not None:  # the form single loops use, bodies for links
+            from screwkit.io.balancing_table import balancing_config
+
+            self.balancing = balancing_config(self)
 
     def describe(self, units: DisplayUnits | None = None) -> str:
         """One line: what the spec describes."""
@@ -169,7 +178,12 @@ class GraphSpec:
                 f"{len(t.loops)} loop(s); input {', '.join(self.mechanism.inputs)}, {n} samples")
 
     def jobs(self) -> list[str]:
-        return ["analyze", "mobility"]
+        out = ["analyze", "mobility"]
+        if all(b.mass is not None for b in self.mechanism.bodies):
+            out.append("dynamics")
+        if self.balancing is not None:
+            out.append("balance")
+        return out
 
     # --- helpers ---------------------------------------------------------------------------
     def _fail(self, key: str, message: str) -> None:
