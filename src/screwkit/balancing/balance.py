@@ -76,7 +76,7 @@ def prepare(
     reg = regressor(linkage, mode, gravity=gravity, inputs=inputs)
     norm = normalisation or default_normalisation(linkage, mode, speed)
     rows = load_rows(linkage, mode, reg, norm)
-    _check_idle_spin(linkage, mode, reg, variables)
+    check_idle_spin(linkage, mode, reg, variables)
     extra = consistency_constraints(reg, variables)
     x_in = (np.asarray(inputs, dtype=float).reshape(mode.assembles.shape[0], -1)[:, 0]
             if inputs is not None else mode.variables[linkage.inputs[0]])
@@ -115,7 +115,7 @@ def _rod_description(linkage: Linkage, mode: ModeMotion, k: int) -> str:
             "of its ball centres)")
 
 
-def _check_idle_spin(linkage: Subject, mode: ModeMotion, reg: Regressor | GraphRegressor,
+def check_idle_spin(linkage: Subject, mode: ModeMotion, reg: Regressor | GraphRegressor,
                      variables: DesignVariables) -> None:
     """The original design must already balance the idle spin of every S–S rod (docs/dynamics.md:
     an S–S rod must be axisymmetric about the line of its ball centres, CoM on that line, for

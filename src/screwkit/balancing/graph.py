@@ -18,7 +18,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.balancing.balance import BalancingSetup, _check_idle_spin, solve_setup
+from screwkit.balancing.balance import BalancingSetup, check_idle_spin, solve_setup
 from screwkit.balancing.config import BalancingConfig, run_config
 from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.measures import Normalisation, default_normalisation, load_rows
@@ -66,7 +66,7 @@ def prepare_graph(motion: MechanismMotion, mode: int, blocks: Sequence[VariableB
     w = graph_speed(motion) if speed is None else speed
     norm = normalisation or default_normalisation(mech, md, w)
     rows = load_rows(mech, md, reg, norm)
-    _check_idle_spin(mech, md, reg, variables)
+    check_idle_spin(mech, md, reg, variables)
     extra = consistency_constraints(reg, variables)
     x_in = np.asarray(motion.inputs, dtype=float)[:, 0]
     return BalancingSetup(mech, md, reg, rows, variables, extra, x_in)

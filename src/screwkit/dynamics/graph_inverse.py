@@ -90,7 +90,10 @@ def body_masses(motion: MechanismMotion) -> list[MassProperties]:
     return [b.mass for b in mech.bodies if b.mass is not None]
 
 
-def _statics(motion: MechanismMotion, mode: int, loads: Array) -> tuple[GraphStatics, Any]:
+def statics_of_mode(motion: MechanismMotion, mode: int, loads: Array
+                    ) -> tuple[GraphStatics, Any]:
+    """The joint wrenches and efforts for body loads ``loads`` (N, B, 6, K) at the regular
+    samples of ``mode``, with (the regular-sample mask, the graph frames there)."""
     mech = motion.mechanism
     md = motion.mode(mode)
     ok = np.asarray(md.assembles & ~md.singular)
@@ -111,7 +114,7 @@ def graph_inverse_dynamics(motion: MechanismMotion, mode: int = 0,
     masses = body_masses(motion)
     md = motion.mode(mode)
     loads = np.nan_to_num(inertia_wrenches(masses, md, g, np.zeros(3)))[..., None]
-    st, (ok, fr) = _statics(motion, mode, loads)
+    st, (ok, fr) = statics_of_mode(motion, mode, loads)
     N, J = md.samples, len(mech.joints)
     W = np.full((N, J, 6), np.nan)
     W[ok] = st.wrenches[..., 0]
@@ -148,7 +151,7 @@ def graph_regressor(motion: MechanismMotion, mode: int = 0, gravity: ArrayLike |
     loads = np.zeros((N, B, 6, 10 * B))
     for b in range(B):
         loads[:, b, :, 10 * b:10 * b + 10] = Y[:, b]
-    st, (ok, _) = _statics(motion, mode, loads)
+    st, (ok, _) = statics_of_mode(motion, mode, loads)
     out = np.full((N, len(mech.inputs), 10 * B), np.nan)
     out[ok] = st.efforts
     return out

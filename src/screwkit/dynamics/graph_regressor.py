@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dynamics.checks import DynamicsInputError, check_vector3
-from screwkit.dynamics.graph_inverse import GraphDynamics, _statics
+from screwkit.dynamics.graph_inverse import GraphDynamics, statics_of_mode
 from screwkit.dynamics.inertia import inertia_wrench_regressor
 from screwkit.dynamics.inverse import INERTIAL_PARAMETER_NAMES
 from screwkit.dynamics.result import Indeterminacy
@@ -97,7 +97,7 @@ def graph_load_regressor(motion: MechanismMotion, mode: int = 0,
     loads = np.zeros((N, B, 6, P))
     for b in range(B):
         loads[:, b, :, N_INERTIAL_PARAMETERS * b:N_INERTIAL_PARAMETERS * (b + 1)] = Y[:, b]
-    st, (_, fr) = _statics(motion, mode, loads)
+    st, (_, fr) = statics_of_mode(motion, mode, loads)
     W = st.wrenches  # (N, J, 6, P), moment about the origin
     c = fr.centres  # (N, J, 3)
     force = W[:, :, :3]
