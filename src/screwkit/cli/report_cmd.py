@@ -61,7 +61,7 @@ def register(app: typer.Typer) -> None:
             from screwkit.cli.graph_views import solved
             from screwkit.report.graph_scene import graph_spec_scene
 
-            scene = _guard(lambda: graph_spec_scene(s, solved(s)))
+            scene = _guard(lambda: graph_spec_scene(s, solved(s), gravity=gravity))
         else:
             scene = _guard(lambda: spec_scene(s, gravity=gravity))
         if plots:
