@@ -255,6 +255,15 @@ def demo_graph_example(f: Path, output_dir: Path, files: list[Path], plots: bool
         sf = doc["summary"]["shaking force"]
         summary.append((f"shaking force RMS / peak, gravity on ({du.label('force')})",
                         f"{du.show('force', sf['rms']):.6g} / {du.show('force', sf['peak']):.6g}"))
+    if spec.balancing is not None:
+        from screwkit.io.documents import balance_document
+
+        bal = balance_document(guard(lambda: graph_balance(spec, motion)))
+        write(output_dir / f"{f.stem}.balance.json", bal)
+        jobs.append("balance")
+        g = bal["measures"]
+        summary.append(("balancing objective G before → after",
+                        f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
     if reports:
         from screwkit.report.spec_report import write_spec_report
 

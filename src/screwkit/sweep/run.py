@@ -45,7 +45,7 @@ def read_spec_tables(path: Path) -> tuple[dict[str, Any], Spec]:
     if is_graph_spec(data):
         raise SpecError(f"{path}: sweeps and tolerance analysis do not take a mechanism graph "
                         "(bodies and joints) yet; graphs work with validate, analyze, mobility, "
-                        "limits, report and dynamics (docs/mechanisms.md)")
+                        "limits, report, dynamics and balance (docs/mechanisms.md)")
     return data, spec_from_data(data, path)
 
 
