@@ -237,3 +237,25 @@ def test_graph_balancing_bad_input() -> None:
     blocks = [counterweight_variables(bare, "crank", "cw", mass_max=1.0, at=[0, 0, 0])]
     with pytest.raises(BalancingError, match="'link_eg' has none"):
         balance_mechanism(dataclasses.replace(motion, mechanism=bare), 0, blocks, {"F": 1.0})
+
+
+def test_spec_bound_table_on_a_graph(tmp_path: Path) -> None:
+    """[balancing.bound.ellipsoids.<body>] in drawing coordinates: the SDP runs on the graph;
+    an ellipsoid that does not hold the body is refused at load, naming the body."""
+    text = EXAMPLE.read_text(encoding="utf-8")
+    good = tmp_path / "bound.toml"
+    good.write_text(text + "\n[balancing.bound.ellipsoids.coupler]\n"
+                    "centre = [45.256277, 34.969036, 0.0]\nsemi_axes = [60, 60, 10]\n",
+                    encoding="utf-8")
+    spec = sk.load_spec(good)
+    motion = solve_mechanism(spec.mechanism, spec.inputs, rates=spec.speed)
+    res = balance_mechanism(motion, 0, spec.balancing)
+    bound = res.redistribution_bound
+    assert bound is not None
+    assert bound.measures_after["G"] < bound.measures_before["G"]
+    assert bound.measures_before["G"] == pytest.approx(res.measures_before["G"], rel=1e-12)
+    bad = tmp_path / "bad.toml"
+    bad.write_text(good.read_text(encoding="utf-8").replace("[60, 60, 10]", "[6, 6, 1]"),
+                   encoding="utf-8")
+    with pytest.raises(BalancingError, match="the body 'coupler' as it is does not lie inside"):
+        sk.load_spec(bad)

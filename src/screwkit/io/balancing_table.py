@@ -212,10 +212,12 @@ def _check_ellipsoid(spec: Any, key: str, link: str, centre: list[float],
         raise BalancingConfigError(f"{spec.path}: [balancing.{key}] {exc}") from None
     pi = mass.inertial_parameters()
     if row @ pi < -1e-9 * pi[0]:
+        word = part_word(subject)
+        frame = "the drawing's axes" if word == "body" else "the link's body frame"
         raise BalancingConfigError(
-            f"{spec.path}: [balancing.{key}] the link {link!r} as it is does not lie inside "
-            "this ellipsoid (centre and semi-axes in the link's body frame, in the spec's "
-            "length unit); enlarge it or move its centre to the link's centre of mass")
+            f"{spec.path}: [balancing.{key}] the {word} {link!r} as it is does not lie inside "
+            f"this ellipsoid (centre and semi-axes in {frame}, in the spec's length unit); "
+            f"enlarge it or move its centre to the {word}'s centre of mass")
 
 
 def balancing_config(spec: Any) -> BalancingConfig:
