@@ -138,6 +138,11 @@ def test_fourbar_graph_equals_single_loop_balancing() -> None:
         mech, b, f"cw_{b}", mass_max=5.0, at=R0[idx[b]] @ p + p0[idx[b]])
         for b, p in at.items()], weights)
     np.testing.assert_allclose(r2.after, r1.after, rtol=1e-9, atol=1e-12)
+    # the front door takes a solved mechanism too
+    r3 = balance(graph, 0, [counterweight_variables(
+        mech, b, f"cw_{b}", mass_max=5.0, at=R0[idx[b]] @ p + p0[idx[b]])
+        for b, p in at.items()], weights)
+    np.testing.assert_array_equal(r3.after, r2.after)
     for k in ("F", "T", "T0", "R", "G"):  # M: round-off on both sides (planar, z axes)
         assert abs(r2.measures_before[k] - r1.measures_before[k]) <= 1e-9 * r1.measures_before[k]
         assert abs(r2.measures_after[k] - r1.measures_after[k]) <= 1e-9 * r1.measures_after[k]
@@ -230,6 +235,8 @@ def test_balance_command_on_a_graph_spec(tmp_path: Path) -> None:
 
 def test_graph_balancing_bad_input() -> None:
     spec, motion = _sixbar()
+    with pytest.raises(BalancingError, match="give the mode as an index"):
+        balance(motion, motion.mode(0), [], {"F": 1.0})
     with pytest.raises(BalancingError, match="no moving body named 'crnk'"):
         counterweight_variables(spec.mechanism, "crnk", "cw", mass_max=1.0, at=[0, 0, 0])
     bare = dataclasses.replace(spec.mechanism, bodies=tuple(

@@ -45,6 +45,7 @@ from screwkit.model.mechanism import Mechanism
 
 if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
+    from screwkit.kinematics.graph.motion import MechanismMotion
 
 
 @dataclass(frozen=True, eq=False)
@@ -254,7 +255,7 @@ def _check_arguments(linkage: object, mode: object, blocks: object, weights: obj
 
 
 def balance(
-    linkage: Linkage | Motion,
+    linkage: Linkage | Motion | MechanismMotion,
     mode: ModeMotion | int,
     blocks: Sequence[VariableBlock] | BalancingConfig,
     weights: Mapping[str, float] | None = None,
@@ -269,7 +270,9 @@ def balance(
     moment, bearing forces and moments and input torque over the cycle (a convex QP).
 
     ``balance(motion, k, blocks, weights)`` balances mode ``k`` of a solved
-    :class:`~screwkit.kinematics.motion.Motion` (speed ω from its input rates);
+    :class:`~screwkit.kinematics.motion.Motion` (speed ω from its input rates), or of a solved
+    mechanism graph (``sk.solve_mechanism``; :func:`screwkit.balancing.graph.balance_mechanism`,
+    blocks naming bodies);
     ``balance(linkage, mode_motion, blocks, weights, speed=ω)`` one mode's
     :class:`~screwkit.kinematics.motion.ModeMotion` of ``linkage``.
 
@@ -281,7 +284,16 @@ def balance(
     gravitational acceleration vector (m/s²), or none.
     """
     from screwkit.balancing.config import BalancingConfig, balance_with_config
+    from screwkit.kinematics.graph.motion import MechanismMotion
 
+    if isinstance(linkage, MechanismMotion):  # a mechanism graph (balancing/graph.py)
+        from screwkit.balancing.graph import balance_mechanism
+
+        if isinstance(mode, bool) or not isinstance(mode, int | np.integer):
+            raise BalancingError(f"balance: with a solved mechanism, give the mode as an index "
+                                 f"(0, the drawn mode); got {mode!r}")
+        return balance_mechanism(linkage, int(mode), blocks, weights, speed=speed,
+                                 gravity=gravity, normalisation=normalisation)
     _check_arguments(linkage, mode, blocks, weights, BalancingConfig, speed)
     if isinstance(linkage, Motion):
         motion = linkage
