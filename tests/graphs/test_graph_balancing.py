@@ -217,8 +217,11 @@ def test_balance_command_on_a_graph_spec(tmp_path: Path) -> None:
     from screwkit.cli.main import app
 
     out = tmp_path / "b.json"
-    r = CliRunner().invoke(app, ["balance", str(EXAMPLE), "-o", str(out)])
+    r = CliRunner().invoke(app, ["balance", str(EXAMPLE), "-o", str(out), "--plots",
+                                 str(tmp_path / "plots")], env={"MPLBACKEND": "Agg"})
     assert r.exit_code == 0, r.output
+    # a sweep of two measures (F, T0) draws its front as a plain scatter
+    assert (tmp_path / "plots" / "balance_pareto.png").read_bytes()[:4] == b"\x89PNG"
     doc = json.loads(out.read_text())
     assert doc["variables"]["names"] == ["cw_crank.mass", "cw_rocker.mass"]
     assert doc["variables"]["links"] == ["crank", "rocker"]
