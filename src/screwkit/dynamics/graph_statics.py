@@ -98,7 +98,9 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
     U, s, Vt = np.linalg.svd(A, full_matrices=False)
     keep = s > RANK_RTOL * np.maximum(s[:, :1], 1e-300)
     inv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
-    y = np.einsum("nji,nj,nkj,nkl->nil", Vt, inv, U, rhs)
+    # y = V·diag(1/s)·Uᵀ·rhs as two batched products (one einsum over all five indices costs
+    # O(J²·R·K) per sample, which the regressor's K = 10·B right-hand sides make slow)
+    y = np.swapaxes(Vt, 1, 2) @ (inv[..., None] * (np.swapaxes(U, 1, 2) @ rhs))
     rank = int(np.median(keep.sum(axis=1)))
     indeterminate = 6 * J - rank
     named = _null_joints(mech, np.linalg.svd(A[0])[2][rank:]) if indeterminate else []
@@ -108,7 +110,7 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
     wrench[:, :, 3:] = length * wrench[:, :, 3:] + np.cross(c[:, :, None, :],
                                                                wrench[:, :, :3].swapaxes(2, 3)
                                                                ).swapaxes(2, 3)
-    res = np.einsum("nij,njk->nik", A, y) - rhs
+    res = A @ y - rhs
     size = np.linalg.norm(rhs, axis=1) + 1e-300
     residual = np.linalg.norm(res, axis=1) / size
     efforts = np.empty((N, len(inputs), K))
