@@ -67,9 +67,10 @@ class Pipeline:
                  units: UnitChoice | None = None) -> None:
         if getattr(spec, "family", None) == "graph":  # io.mechanism_spec.GraphSpec
             raise SpecError(f"{spec.path}: a mechanism graph (bodies and joints): validate, "
-                            "analyze, mobility, limits, report, dynamics, sweep and tolerance "
-                            "work on it so far; balancing, synthesis and simulation of graphs "
-                            "are not there yet (docs/mechanisms.md)")
+                            "analyze, mobility, limits, report, dynamics, sweep, tolerance and "
+                            "balance work on it (screwkit.balancing.graph.balance_mechanism from "
+                            "Python); synthesis and simulation of graphs are not there yet "
+                            "(docs/mechanisms.md)")
         expect_instance(spec, Spec, "Pipeline: spec", "a Spec (sk.load_spec(path))")
         if method not in ("auto", "closed", "generic"):
             raise InputError(f"Pipeline: method must be 'auto', 'closed' or 'generic'; got "

@@ -26,25 +26,36 @@ from screwkit.balancing.problem import (
     solve_balancing,
 )
 from screwkit.balancing.result import BalanceResult
-from screwkit.balancing.variables import DesignVariables, VariableBlock, assemble
+from screwkit.balancing.variables import (
+    DesignVariables,
+    Subject,
+    VariableBlock,
+    assemble,
+    moving_parts,
+)
 from screwkit.dynamics import Dynamics, Regressor, regressor
+from screwkit.dynamics.graph_inverse import GraphDynamics
+from screwkit.dynamics.graph_regressor import GraphRegressor
 from screwkit.errors import expect_instance, expect_number
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
+from screwkit.model.mechanism import Mechanism
 
 if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
+    from screwkit.kinematics.graph.motion import MechanismMotion
 
 
 @dataclass(frozen=True, eq=False)
 class BalancingSetup:
-    """Everything that does not depend on the weights (reused by a Pareto sweep)."""
+    """Everything that does not depend on the weights (reused by a Pareto sweep); ``linkage``
+    is a single loop's Linkage or a graph's Mechanism (balancing/graph.py builds that setup)."""
 
-    linkage: Linkage
+    linkage: Subject
     mode: ModeMotion
-    regressor: Regressor
+    regressor: Regressor | GraphRegressor
     rows: LoadRows
     variables: DesignVariables
     extra_constraints: list  # type: ignore[type-arg]
@@ -66,7 +77,7 @@ def prepare(
     reg = regressor(linkage, mode, gravity=gravity, inputs=inputs)
     norm = normalisation or default_normalisation(linkage, mode, speed)
     rows = load_rows(linkage, mode, reg, norm)
-    _check_idle_spin(linkage, mode, reg, variables)
+    check_idle_spin(linkage, mode, reg, variables)
     extra = consistency_constraints(reg, variables)
     x_in = (np.asarray(inputs, dtype=float).reshape(mode.assembles.shape[0], -1)[:, 0]
             if inputs is not None else mode.variables[linkage.inputs[0]])
@@ -105,7 +116,7 @@ def _rod_description(linkage: Linkage, mode: ModeMotion, k: int) -> str:
             "of its ball centres)")
 
 
-def _check_idle_spin(linkage: Linkage, mode: ModeMotion, reg: Regressor,
+def check_idle_spin(linkage: Subject, mode: ModeMotion, reg: Regressor | GraphRegressor,
                      variables: DesignVariables) -> None:
     """The original design must already balance the idle spin of every S–S rod (docs/dynamics.md:
     an S–S rod must be axisymmetric about the line of its ball centres, CoM on that line, for
@@ -117,8 +128,9 @@ def _check_idle_spin(linkage: Linkage, mode: ModeMotion, reg: Regressor,
     worst = float(np.max(dyn.relative_residual, initial=0.0))
     if worst <= IDLE_RESIDUAL_RTOL:
         return
-    rods = [_rod_description(linkage, mode, k) for k in _ss_links(linkage)
-            if linkage.links[k].mass is not None]
+    rods = ([] if isinstance(linkage, Mechanism) else
+            [_rod_description(linkage, mode, k) for k in _ss_links(linkage)
+             if linkage.links[k].mass is not None])
     raise BalancingError(
         f"{'; '.join(rods) or 'an S-S link'}: the original design loads the idle spin of the "
         f"rod about the line of its ball centres (residual up to {worst:.3g} of the largest "
@@ -143,22 +155,24 @@ def check_free_counterweights(blocks: Sequence[VariableBlock], weights: Mapping[
         )
 
 
-def _link_masses(linkage: Linkage, pi: np.ndarray) -> dict[str, float]:
-    return {lk.name: float(pi[N_INERTIAL_PARAMETERS * k]) for k, lk in enumerate(linkage.links)}
+def _link_masses(linkage: Subject, pi: np.ndarray) -> dict[str, float]:
+    return {lk.name: float(pi[N_INERTIAL_PARAMETERS * k])
+            for k, lk in enumerate(moving_parts(linkage))}
 
 
-def _mass_properties(linkage: Linkage, pi: np.ndarray) -> dict[str, MassProperties]:
+def _mass_properties(linkage: Subject, pi: np.ndarray) -> dict[str, MassProperties]:
     return {lk.name: MassProperties.from_inertial_parameters(
         pi[N_INERTIAL_PARAMETERS * k: N_INERTIAL_PARAMETERS * (k + 1)])
-        for k, lk in enumerate(linkage.links)}
+        for k, lk in enumerate(moving_parts(linkage))}
 
 
-def _sample_loads(setup: BalancingSetup, dyn: Dynamics, pi: np.ndarray,
+def _sample_loads(setup: BalancingSetup, dyn: Dynamics | GraphDynamics, pi: np.ndarray,
                   weights: Mapping[str, float]) -> dict[str, np.ndarray]:
     sq = setup.rows.per_sample(pi)
     norm = setup.rows.normalisation
     F0 = norm.force
-    efforts = list(dyn.efforts.values())
+    efforts = (list(dyn.efforts.T) if isinstance(dyn, GraphDynamics)
+               else list(dyn.efforts.values()))
     return {
         "G": sum((weights[k] * sq[k] for k in MEASURES), start=np.zeros(setup.rows.samples)),
         "shaking_force": np.linalg.norm(dyn.shaking_force, axis=-1),
@@ -241,7 +255,7 @@ def _check_arguments(linkage: object, mode: object, blocks: object, weights: obj
 
 
 def balance(
-    linkage: Linkage | Motion,
+    linkage: Linkage | Motion | MechanismMotion,
     mode: ModeMotion | int,
     blocks: Sequence[VariableBlock] | BalancingConfig,
     weights: Mapping[str, float] | None = None,
@@ -256,7 +270,9 @@ def balance(
     moment, bearing forces and moments and input torque over the cycle (a convex QP).
 
     ``balance(motion, k, blocks, weights)`` balances mode ``k`` of a solved
-    :class:`~screwkit.kinematics.motion.Motion` (speed ω from its input rates);
+    :class:`~screwkit.kinematics.motion.Motion` (speed ω from its input rates), or of a solved
+    mechanism graph (``sk.solve_mechanism``; :func:`screwkit.balancing.graph.balance_mechanism`,
+    blocks naming bodies);
     ``balance(linkage, mode_motion, blocks, weights, speed=ω)`` one mode's
     :class:`~screwkit.kinematics.motion.ModeMotion` of ``linkage``.
 
@@ -268,7 +284,16 @@ def balance(
     gravitational acceleration vector (m/s²), or none.
     """
     from screwkit.balancing.config import BalancingConfig, balance_with_config
+    from screwkit.kinematics.graph.motion import MechanismMotion
 
+    if isinstance(linkage, MechanismMotion):  # a mechanism graph (balancing/graph.py)
+        from screwkit.balancing.graph import balance_mechanism
+
+        if isinstance(mode, bool) or not isinstance(mode, int | np.integer):
+            raise BalancingError(f"balance: with a solved mechanism, give the mode as an index "
+                                 f"(0, the drawn mode); got {mode!r}")
+        return balance_mechanism(linkage, int(mode), blocks, weights, speed=speed,
+                                 gravity=gravity, normalisation=normalisation)
     _check_arguments(linkage, mode, blocks, weights, BalancingConfig, speed)
     if isinstance(linkage, Motion):
         motion = linkage

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from screwkit.balancing.balance import prepare, solve_setup
+from screwkit.balancing.balance import BalancingSetup, prepare, solve_setup
 from screwkit.balancing.measures import default_normalisation
 from screwkit.balancing.result import BalanceResult
 from screwkit.balancing.variables import VariableBlock
@@ -63,6 +63,13 @@ def balance_with_config(linkage: Linkage, mode: ModeMotion, config: BalancingCon
     g = gravity if config.gravity else None
     setup = prepare(linkage, mode, list(config.blocks), speed=speed, gravity=g,
                     normalisation=norm, inputs=inputs)
+    return run_config(setup, config, progress)
+
+
+def run_config(setup: BalancingSetup, config: BalancingConfig,
+               progress: Callable[[int, int], None] | None = None) -> BalanceResult:
+    """The QP of ``config``'s weights on a prepared setup (a loop's or a graph's), then the SDP
+    bound and the Pareto sweep when asked for."""
     result = solve_setup(setup, config.weights)
     if config.bound is not None:
         from screwkit.balancing.sdp import redistribution_bound

@@ -25,8 +25,10 @@ from numpy.typing import NDArray
 
 from screwkit.balancing.errors import BalancingError
 from screwkit.dynamics import Regressor
+from screwkit.dynamics.graph_regressor import GraphRegressor
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.model.linkage import Linkage
+from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]
 
@@ -61,7 +63,7 @@ class Normalisation:
 
 
 def default_normalisation(
-    linkage: Linkage,
+    linkage: Linkage | Mechanism,
     mode: ModeMotion,
     speed: float,
     *,
@@ -70,13 +72,19 @@ def default_normalisation(
     bearing_length: float | None = None,
 ) -> Normalisation:
     """Seed defaults: the first moving link's mass and length (distance between its two joint
-    centres, e.g. the crank a₁), the input speed ω; bearing length defaults to that length."""
+    centres, e.g. the crank a₁), the input speed ω; bearing length defaults to that length.
+    On a mechanism graph, the body the first input drives and the distance from the input
+    joint's centre to the centre of that body's next joint (the crank of a six-bar)."""
+    if isinstance(linkage, Mechanism):
+        mass, length = _graph_defaults(linkage, mode, mass, length)
     if mass is None:
+        assert isinstance(linkage, Linkage)
         first = linkage.links[0].mass
         if first is None:
             raise BalancingError(f"link {linkage.links[0].name!r} has no mass properties")
         mass = first.mass
     if length is None:
+        assert isinstance(linkage, Linkage)
         d = np.linalg.norm(mode.joint_centres[:, 1] - mode.joint_centres[:, 0], axis=-1)
         length = float(np.nanmean(d))
         if not np.isfinite(length) or length <= 0.0:
@@ -92,6 +100,30 @@ def default_normalisation(
         if not (np.isfinite(val) and val > 0):
             raise BalancingError(f"[balancing.normalisation] {key} must be > 0; got {val!r}")
     return Normalisation(float(mass), float(length), abs(float(speed)), float(bearing_length))
+
+
+def _graph_defaults(mech: Mechanism, mode: ModeMotion, mass: float | None,
+                    length: float | None) -> tuple[float, float]:
+    """Mass and length of the body the first input drives (see default_normalisation)."""
+    names = [j.name for j in mech.joints]
+    j0 = names.index(mech.inputs[0].rsplit(".", 1)[0])
+    a, b = mech.joints[j0].bodies
+    body = b if b != GROUND else a
+    if mass is None:
+        props = next(x.mass for x in mech.bodies if x.name == body)
+        if props is None:
+            raise BalancingError(f"body {body!r} has no mass properties (give mass, com and "
+                                 "inertia in its [[bodies]] entry)")
+        mass = props.mass
+    if length is None:
+        other = [k for k, j in enumerate(mech.joints) if k != j0 and body in j.bodies]
+        length = float("nan")
+        if other:
+            d = mode.joint_centres[:, other[0]] - mode.joint_centres[:, j0]
+            length = float(np.nanmean(np.linalg.norm(d, axis=-1)))
+        if not np.isfinite(length) or length <= 0.0:
+            length = mech.length_scale
+    return float(mass), float(length)
 
 
 @dataclass(frozen=True)
@@ -117,9 +149,12 @@ class LoadRows:
 
 
 def load_rows(
-    linkage: Linkage, mode: ModeMotion, reg: Regressor, norm: Normalisation
+    linkage: Linkage | Mechanism, mode: ModeMotion, reg: Regressor | GraphRegressor,
+    norm: Normalisation
 ) -> LoadRows:
-    """The five measures' load rows from a regressor (see module docstring)."""
+    """The five measures' load rows from a regressor (see module docstring); a graph's
+    (:class:`~screwkit.dynamics.graph_regressor.GraphRegressor`) has the same fields, joints
+    and inputs by name."""
     F0 = norm.force
     ell = norm.length
     const = reg.constant

@@ -27,6 +27,7 @@ from screwkit.balancing.optimal_set import canonical_basis as canonical_basis  #
 from screwkit.balancing.qp import QPSolution, solve_qp
 from screwkit.balancing.variables import DesignVariables, LinearConstraint
 from screwkit.dynamics import Regressor
+from screwkit.dynamics.graph_regressor import GraphRegressor
 
 Array = NDArray[np.float64]
 
@@ -94,7 +95,8 @@ def quadratic_objective(rows: LoadRows, variables: DesignVariables,
     return QuadraticObjective(parts, w)
 
 
-def consistency_constraints(reg: Regressor, variables: DesignVariables) -> list[LinearConstraint]:
+def consistency_constraints(reg: Regressor | GraphRegressor, variables: DesignVariables
+                            ) -> list[LinearConstraint]:
     """Equalities that keep the idle-freedom residual zero (docs/dynamics.md): an S–S rod whose
     axial spin is idle must stay axisymmetric about the line of its ball centres, otherwise its
     joints would have to carry a moment they cannot. For Rahman's rod this ties the two

@@ -14,6 +14,7 @@ from screwkit.balancing.measures import MEASURE_TITLES, MEASURES, Normalisation
 from screwkit.balancing.problem import NonUniqueDirection, QuadraticObjective
 from screwkit.balancing.variables import DesignVariables
 from screwkit.dynamics import Dynamics
+from screwkit.dynamics.graph_inverse import GraphDynamics
 from screwkit.model.mass import MassProperties
 
 if TYPE_CHECKING:  # the SDP bound and the Pareto sweep are built on top of BalanceResult
@@ -66,8 +67,8 @@ class BalanceResult:
     active_constraints: list[str]
     multipliers: dict[str, float]
     normalisation: Normalisation
-    dynamics_before: Dynamics
-    dynamics_after: Dynamics
+    dynamics_before: Dynamics | GraphDynamics  # GraphDynamics for a mechanism graph
+    dynamics_after: Dynamics | GraphDynamics
     notes: list[str]
     #: the bound over every physically consistent redistribution (SDP), when asked for
     redistribution_bound: RedistributionBound | None = None

@@ -21,7 +21,13 @@ from screwkit.balancing.errors import BalancingError, SolverError
 from screwkit.balancing.measures import MEASURES
 from screwkit.balancing.problem import check_weights, consistency_constraints, quadratic_objective
 from screwkit.balancing.qp import load_clarabel
-from screwkit.balancing.variables import DesignVariables, LinearConstraint, VariableBlock
+from screwkit.balancing.variables import (
+    DesignVariables,
+    LinearConstraint,
+    VariableBlock,
+    moving_parts,
+    part_word,
+)
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 
 Array = NDArray[np.float64]
@@ -84,13 +90,14 @@ def redistribution_bound(
 
     clarabel = load_clarabel()
     w = check_weights(weights)
-    lk = setup.linkage
-    names = [link.name for link in lk.links]
+    parts = moving_parts(setup.linkage)
+    names = [link.name for link in parts]
     unknown = sorted(set(ellipsoids) - set(names))
     if unknown or not ellipsoids:
-        raise BalancingError(f"ellipsoids must name moving links {names}; got {list(ellipsoids)}")
+        raise BalancingError(f"ellipsoids must name moving {part_word(setup.linkage)}s {names}; "
+                             f"got {list(ellipsoids)}")
     P = N_INERTIAL_PARAMETERS * len(names)
-    pi0 = np.concatenate([link.mass.inertial_parameters() for link in lk.links
+    pi0 = np.concatenate([link.mass.inertial_parameters() for link in parts
                           if link.mass is not None])
     blocks = []
     for link in ellipsoids:

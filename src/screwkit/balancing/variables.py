@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,6 +34,7 @@ from screwkit.model.mass import (
     N_INERTIAL_PARAMETERS,
     equivalent_point_masses,
 )
+from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]
 
@@ -107,16 +109,35 @@ class DesignVariables:
         return np.asarray(pi)
 
 
-def _link_index(linkage: Linkage, link: str) -> int:
-    expect_instance(linkage, Linkage, "linkage", "a screwkit Linkage (load_spec(...).linkage)")
-    names = [lk.name for lk in linkage.links]
+#: what balancing works on: a single loop (its moving links) or a mechanism graph (its bodies)
+Subject = Linkage | Mechanism
+
+
+def moving_parts(subject: Subject) -> tuple[Any, ...]:
+    """The moving links of a loop or the moving bodies of a graph, in parameter order (each has
+    ``name`` and ``mass``); a graph's body frame is the drawing's frame."""
+    expect_instance(subject, Linkage | Mechanism, "linkage",
+                    "a screwkit Linkage (load_spec(...).linkage) or a Mechanism "
+                    "(load_spec(...).mechanism)")
+    return tuple(subject.links) if isinstance(subject, Linkage) else tuple(subject.bodies)
+
+
+def part_word(subject: Subject) -> str:
+    """"link" for a loop, "body" for a graph (for messages)."""
+    return "body" if isinstance(subject, Mechanism) else "link"
+
+
+def _link_index(linkage: Subject, link: str) -> int:
+    names = [lk.name for lk in moving_parts(linkage)]
     if link not in names:
-        raise BalancingError(f"no moving link named {link!r}; the links are {names}")
+        word = part_word(linkage)
+        raise BalancingError(f"no moving {word} named {link!r}; the "
+                             f"{'bodies' if word == 'body' else 'links'} are {names}")
     return names.index(link)
 
 
 def point_mass_variables(
-    linkage: Linkage,
+    linkage: Subject,
     link: str,
     *,
     split: Sequence[float] | None = None,
@@ -137,11 +158,11 @@ def point_mass_variables(
     ``variables`` — the subset that varies (the others keep their original mass).
     """
     idx = _link_index(linkage, link)
-    props = linkage.links[idx].mass
+    props = moving_parts(linkage)[idx].mass
     if props is None:
-        raise BalancingError(
-            f"link {link!r} has no mass properties; add [links.{link}] (mass, com, inertia)"
-        )
+        where = ("mass, com and inertia in its [[bodies]] entry" if part_word(linkage) == "body"
+                 else f"[links.{link}] (mass, com, inertia)")
+        raise BalancingError(f"{part_word(linkage)} {link!r} has no mass properties; add {where}")
     fractions = np.full(4, 0.25) if split is None else np.asarray(split, dtype=float)
     if fractions.shape != (4,) or np.any(fractions < 0) or abs(fractions.sum() - 1.0) > 1e-9:
         raise BalancingError(
@@ -168,7 +189,7 @@ def point_mass_variables(
         )
     masses = fractions * props.mass
     model = equivalent_point_masses(props, masses)
-    P = N_INERTIAL_PARAMETERS * len(linkage.links)
+    P = N_INERTIAL_PARAMETERS * len(moving_parts(linkage))
     columns = np.zeros((P, 4))
     rows = slice(N_INERTIAL_PARAMETERS * idx, N_INERTIAL_PARAMETERS * (idx + 1))
     for k in range(4):
@@ -214,7 +235,7 @@ def _group(label: str) -> int:
 
 
 def counterweight_variables(
-    linkage: Linkage,
+    linkage: Subject,
     link: str,
     name: str,
     *,
@@ -238,7 +259,7 @@ def counterweight_variables(
         )
     if (at is None) == (box is None):
         raise BalancingError(f"counterweight {name!r}: give exactly one of at= or box=")
-    P = N_INERTIAL_PARAMETERS * len(linkage.links)
+    P = N_INERTIAL_PARAMETERS * len(moving_parts(linkage))
     rows = slice(N_INERTIAL_PARAMETERS * idx, N_INERTIAL_PARAMETERS * (idx + 1))
     if at is not None:
         p = np.asarray(at, dtype=float)
@@ -281,17 +302,22 @@ def counterweight_variables(
     return VariableBlock(names, link, col, np.zeros(4), size, tuple(cons), kind="free_counterweight")
 
 
-def assemble(linkage: Linkage, blocks: Sequence[VariableBlock]) -> DesignVariables:
+def assemble(linkage: Subject, blocks: Sequence[VariableBlock]) -> DesignVariables:
     """Stack variable blocks into one :class:`DesignVariables` (π_fixed = the links' own
     parameters minus what the point-mass blocks replace)."""
     if not blocks:
         raise BalancingError("no design variables: list at least one link under "
                              "[balancing.links] or one [[balancing.counterweights]]")
-    missing = [lk.name for lk in linkage.links if lk.mass is None]
+    parts = moving_parts(linkage)
+    missing = [lk.name for lk in parts if lk.mass is None]
     if missing:
-        raise BalancingError(f"balancing needs mass properties for every link; missing: {missing}")
-    pi = np.concatenate([lk.mass.inertial_parameters() for lk in linkage.links
-                         if lk.mass is not None])
+        word = part_word(linkage)
+        where = ("give mass, com and inertia in its [[bodies]] entry" if word == "body"
+                 else "add its [links.<name>] table")
+        raise BalancingError(f"balancing needs mass properties for every moving {word}; "
+                             f"{', '.join(repr(m) for m in missing)} "
+                             f"{'has' if len(missing) == 1 else 'have'} none ({where})")
+    pi = np.concatenate([lk.mass.inertial_parameters() for lk in parts if lk.mass is not None])
     seen: set[str] = set()
     for b in blocks:
         if b.replaces is not None:

@@ -80,8 +80,9 @@ def show_balance(spec: Any, res: Any, doc: dict[str, Any], units: Any,
         TextColumn("bound", [f"at {bounds[n]}" if n in bounds else "" for n in res.names],
                    "left")])
     links = list(res.link_mass_before)
-    print_columns(console, f"link masses [{units.label('mass')}]", [
-        TextColumn("link", links, "left"),
+    word = "body" if getattr(spec, "family", None) == "graph" else "link"
+    print_columns(console, f"{word} masses [{units.label('mass')}]", [
+        TextColumn(word, links, "left"),
         TextColumn("before", [number(units.show("mass", res.link_mass_before[k]))
                               for k in links]),
         TextColumn("after", [number(units.show("mass", res.link_mass_after[k])) for k in links]),
@@ -126,7 +127,7 @@ def register(app: typer.Typer) -> None:
         plots: Annotated[Path | None, typer.Option("--plots", help="Write PNG plots of each load over the cycle (display units) into this folder (needs matplotlib).")] = None,
     ) -> None:
         """Choose the links' point masses (and counterweights) that minimise the weighted load measures over the cycle; print the before/after summary."""
-        from screwkit.cli.common import guard, loop_only
+        from screwkit.cli.common import guard
         from screwkit.cli.outputs import Outputs
         from screwkit.cli.progress import progress_bar
         from screwkit.io.balance_tables import write_balance_tables
@@ -137,12 +138,22 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full,
                               folders={"--tables": tables, "--plots": plots})
-        s = loop_only(guard(lambda: load_spec(spec)), "balance")
+        s = guard(lambda: load_spec(spec))
+        graph = getattr(s, "family", None) == "graph"
+        if graph:
+            from screwkit.cli.graph_views import graph_balance, solved
+
+            if s.balancing is None:
+                guard(lambda: graph_balance(s, None))  # the "no [balancing] table" sentence
+            motion = guard(lambda: solved(s))
         du = out.units_for(s.units)
         pareto = s.balancing.pareto if s.balancing is not None else None
         total = None if pareto is None else pareto_size(pareto)
         with progress_bar("Pareto sweep", total, enabled=pareto is not None) as advance:
-            res = guard(lambda: Pipeline(s, units=du).balance(progress=advance))
+            if graph:
+                res = guard(lambda: graph_balance(s, motion, advance))
+            else:
+                res = guard(lambda: Pipeline(s, units=du).balance(progress=advance))
         doc = balance_document(res)
         written: list[str] = []
         if tables is not None:

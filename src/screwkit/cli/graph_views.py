@@ -106,6 +106,22 @@ def graph_dynamics(spec: Any, gravity: bool) -> Any:
     return graph_inverse_dynamics(solved(spec), 0, spec.gravity_vector if gravity else None)
 
 
+def graph_balance(spec: Any, motion: Any, progress: Any = None) -> Any:
+    """The spec's ``[balancing]`` run on a graph spec's drawn mode (``motion``, from
+    :func:`solved`; docs/balancing.md, "Mechanism graphs"); ``progress(done, total)`` follows
+    a Pareto sweep."""
+    from screwkit.balancing.errors import BalancingError
+    from screwkit.balancing.graph import balance_mechanism
+
+    if spec.balancing is None:
+        raise BalancingError(f"{spec.path}: no [balancing] table; see docs/balancing.md")
+    try:
+        return balance_mechanism(motion, 0, spec.balancing, speed=float(spec.speed[0]),
+                                 gravity=spec.gravity_vector, progress=progress)
+    except BalancingError as exc:
+        raise BalancingError(f"{spec.path}: {exc}") from None
+
+
 def dynamics_table(spec: Any, dyn: Any) -> Any:
     """One row per sample: the inputs, every effort, the shaking loads, every reaction."""
     from screwkit.tables import Column, ResultTable
@@ -248,6 +264,15 @@ def demo_graph_example(f: Path, output_dir: Path, files: list[Path], plots: bool
         sf = doc["summary"]["shaking force"]
         summary.append((f"shaking force RMS / peak, gravity on ({du.label('force')})",
                         f"{du.show('force', sf['rms']):.6g} / {du.show('force', sf['peak']):.6g}"))
+    if spec.balancing is not None:
+        from screwkit.io.documents import balance_document
+
+        bal = balance_document(guard(lambda: graph_balance(spec, motion)))
+        write(output_dir / f"{f.stem}.balance.json", bal)
+        jobs.append("balance")
+        g = bal["measures"]
+        summary.append(("balancing objective G before → after",
+                        f"{g['before']['G']:.6g} → {g['after']['G']:.6g}"))
     if reports:
         from screwkit.report.spec_report import write_spec_report
 

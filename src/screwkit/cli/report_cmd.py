@@ -61,7 +61,8 @@ def register(app: typer.Typer) -> None:
             from screwkit.cli.graph_views import solved
             from screwkit.report.graph_scene import graph_spec_scene
 
-            scene = _guard(lambda: graph_spec_scene(s, solved(s, every_mode=True)))
+            scene = _guard(lambda: graph_spec_scene(s, solved(s, every_mode=True),
+                                                    gravity=gravity))
         else:
             scene = _guard(lambda: spec_scene(s, gravity=gravity))
         if plots:

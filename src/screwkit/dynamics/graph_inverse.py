@@ -53,6 +53,16 @@ class GraphDynamics:
     residual: Array
     gravity: Array
 
+    @property
+    def gravity_on(self) -> bool:
+        """Whether the loads include gravity (a non-zero ``gravity`` vector)."""
+        return bool(np.any(self.gravity != 0))
+
+    @property
+    def relative_residual(self) -> Array:
+        """``residual`` (already relative to the loads), as single loops name it."""
+        return self.residual
+
     def as_dict(self) -> dict[str, Any]:
         return {"inputs": list(self.input_names),
                 "efforts": {n: self.efforts[:, k] for k, n in enumerate(self.input_names)},
@@ -93,7 +103,10 @@ def effort_names(mech: Mechanism) -> tuple[str, ...]:
     return (*mech.inputs, *mech.actuated)
 
 
-def _statics(motion: MechanismMotion, mode: int, loads: Array) -> tuple[GraphStatics, Any]:
+def statics_of_mode(motion: MechanismMotion, mode: int, loads: Array
+                    ) -> tuple[GraphStatics, Any]:
+    """The joint wrenches and efforts for body loads ``loads`` (N, B, 6, K) at the regular
+    samples of ``mode``, with (the regular-sample mask, the graph frames there)."""
     mech = motion.mechanism
     md = motion.mode(mode)
     ok = np.asarray(md.assembles & ~md.singular)
@@ -116,7 +129,7 @@ def graph_inverse_dynamics(motion: MechanismMotion, mode: int = 0,
     masses = body_masses(motion)
     md = motion.mode(mode)
     loads = np.nan_to_num(inertia_wrenches(masses, md, g, np.zeros(3)))[..., None]
-    st, (ok, fr) = _statics(motion, mode, loads)
+    st, (ok, fr) = statics_of_mode(motion, mode, loads)
     N, J = md.samples, len(mech.joints)
     W = np.full((N, J, 6), np.nan)
     W[ok] = st.wrenches[..., 0]
@@ -153,7 +166,7 @@ def graph_regressor(motion: MechanismMotion, mode: int = 0, gravity: ArrayLike |
     loads = np.zeros((N, B, 6, 10 * B))
     for b in range(B):
         loads[:, b, :, 10 * b:10 * b + 10] = Y[:, b]
-    st, (ok, _) = _statics(motion, mode, loads)
+    st, (ok, _) = statics_of_mode(motion, mode, loads)
     out = np.full((N, len(effort_names(mech)), 10 * B), np.nan)
     out[ok] = st.efforts
     return out

@@ -45,6 +45,10 @@ class GraphStatics:
     residual: Array
     indeterminate: int
     indeterminate_joints: list[str]
+    #: (N, R, K) the scaled equations' residual A·y − b itself and the rank of A: loads along
+    #: idle freedoms leave R − rank consistency conditions (dynamics/graph_regressor.py)
+    equation_residual: Array
+    rank: int
 
 
 def _system(mech: Mechanism, screws: Array, centres: Array, passive: list[int],
@@ -94,7 +98,9 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
     U, s, Vt = np.linalg.svd(A, full_matrices=False)
     keep = s > RANK_RTOL * np.maximum(s[:, :1], 1e-300)
     inv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
-    y = np.einsum("nji,nj,nkj,nkl->nil", Vt, inv, U, rhs)
+    # y = V·diag(1/s)·Uᵀ·rhs as two batched products (one einsum over all five indices costs
+    # O(J²·R·K) per sample, which the regressor's K = 10·B right-hand sides make slow)
+    y = np.swapaxes(Vt, 1, 2) @ (inv[..., None] * (np.swapaxes(U, 1, 2) @ rhs))
     rank = int(np.median(keep.sum(axis=1)))
     indeterminate = 6 * J - rank
     named = _null_joints(mech, np.linalg.svd(A[0])[2][rank:]) if indeterminate else []
@@ -104,7 +110,7 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
     wrench[:, :, 3:] = length * wrench[:, :, 3:] + np.cross(c[:, :, None, :],
                                                                wrench[:, :, :3].swapaxes(2, 3)
                                                                ).swapaxes(2, 3)
-    res = np.einsum("nij,njk->nik", A, y) - rhs
+    res = A @ y - rhs
     size = np.linalg.norm(rhs, axis=1) + 1e-300
     residual = np.linalg.norm(res, axis=1) / size
     efforts = np.empty((N, len(inputs), K))
@@ -113,7 +119,7 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
         S = screws[:, :, f]
         efforts[:, k] = (np.einsum("nk,nkl->nl", S[:, :3], wrench[:, j, 3:])
                          + np.einsum("nk,nkl->nl", S[:, 3:], wrench[:, j, :3]))
-    return GraphStatics(wrench, efforts, residual, indeterminate, named)
+    return GraphStatics(wrench, efforts, residual, indeterminate, named, res, rank)
 
 
 def _null_joints(mech: Mechanism, null: Array) -> list[str]:

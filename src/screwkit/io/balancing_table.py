@@ -21,6 +21,8 @@ from screwkit.balancing.variables import (
     POINT_MASS_NAMES,
     VariableBlock,
     counterweight_variables,
+    moving_parts,
+    part_word,
     point_mass_variables,
 )
 from screwkit.io.errors import SpecError
@@ -109,18 +111,26 @@ def balancing_table(spec: Any) -> BalancingTable:
         raise BalancingConfigError("\n".join(lines)) from exc
 
 
+def _subject(spec: Any) -> Any:
+    """What the table's names refer to: a loop's Linkage (links) or a graph's Mechanism
+    (bodies; ``[balancing.links.<body>]`` and a counterweight's ``link`` name a body)."""
+    return spec.mechanism if getattr(spec, "family", None) == "graph" else spec.linkage
+
+
 def _si(spec: Any, value: Any, kind: str, key: str) -> float:
     return float(spec.quantity(value, kind, f"balancing.{key}"))
 
 
 def _link_blocks(spec: Any, table: BalancingTable) -> list[VariableBlock]:
-    lk = spec.linkage
-    names = [link.name for link in lk.links]
+    lk = _subject(spec)
+    names = [link.name for link in moving_parts(lk)]
     blocks: list[VariableBlock] = []
     for link, t in table.links.items():
         if link not in names:
-            raise BalancingConfigError(f"{spec.path}: [balancing.links.{link}] no moving link "
-                                       f"named {link!r}; the links are {names}")
+            word = part_word(lk)
+            raise BalancingConfigError(f"{spec.path}: [balancing.links.{link}] no moving {word} "
+                                       f"named {link!r}; the "
+                                       f"{'bodies' if word == 'body' else 'links'} are {names}")
         if not t.variables:
             raise BalancingConfigError(f"{spec.path}: [balancing.links.{link}] has no variables; "
                                        f"list some of {list(POINT_MASS_NAMES)} or remove the table")
@@ -135,7 +145,7 @@ def _link_blocks(spec: Any, table: BalancingTable) -> list[VariableBlock]:
 
 
 def _counterweight_blocks(spec: Any, table: BalancingTable) -> list[VariableBlock]:
-    lk = spec.linkage
+    lk = _subject(spec)
     blocks: list[VariableBlock] = []
     for k, cw in enumerate(table.counterweights):
         key = f"counterweights[{k}]"
@@ -187,10 +197,12 @@ def _check_ellipsoid(spec: Any, key: str, link: str, centre: list[float],
                      semi_axes: list[float]) -> None:
     """The bound keeps the link inside its ellipsoid, so the link as it is must be inside it
     (checked at load: `validate` reports it)."""
-    links = {lk.name: lk for lk in spec.linkage.links}
+    subject = _subject(spec)
+    links = {lk.name: lk for lk in moving_parts(subject)}
     if link not in links:
-        raise BalancingConfigError(f"{spec.path}: [balancing.{key}] no link {link!r}; the links "
-                                   f"are {list(links)}")
+        word = part_word(subject)
+        raise BalancingConfigError(f"{spec.path}: [balancing.{key}] no {word} {link!r}; the "
+                                   f"{'bodies' if word == 'body' else 'links'} are {list(links)}")
     mass = links[link].mass
     if mass is None:
         return  # named by the dynamics' own check
@@ -200,10 +212,12 @@ def _check_ellipsoid(spec: Any, key: str, link: str, centre: list[float],
         raise BalancingConfigError(f"{spec.path}: [balancing.{key}] {exc}") from None
     pi = mass.inertial_parameters()
     if row @ pi < -1e-9 * pi[0]:
+        word = part_word(subject)
+        frame = "the drawing's axes" if word == "body" else "the link's body frame"
         raise BalancingConfigError(
-            f"{spec.path}: [balancing.{key}] the link {link!r} as it is does not lie inside "
-            "this ellipsoid (centre and semi-axes in the link's body frame, in the spec's "
-            "length unit); enlarge it or move its centre to the link's centre of mass")
+            f"{spec.path}: [balancing.{key}] the {word} {link!r} as it is does not lie inside "
+            f"this ellipsoid (centre and semi-axes in {frame}, in the spec's length unit); "
+            f"enlarge it or move its centre to the {word}'s centre of mass")
 
 
 def balancing_config(spec: Any) -> BalancingConfig:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from pydantic import (
@@ -40,6 +40,9 @@ from screwkit.model.mechanism import (
 )
 from screwkit.model.mechanism_drives import DRIVE_FREEDOMS, BodyDrive
 from screwkit.model.mechanism_outputs import BodyAngle, Output, PointTravel
+
+if TYPE_CHECKING:
+    from screwkit.balancing.config import BalancingConfig
 
 Value = StrictFloat | StrictInt | StrictStr
 MAX_ROWS = 10_000_000
@@ -118,6 +121,7 @@ class GraphSpecFile(_Strict):
     gravity_direction: list[StrictFloat | StrictInt] = Field(
         default_factory=lambda: [0.0, 0.0, -1.0])
     tolerances: dict[str, StrictStr] | None = None  # read by `screwkit tolerance`
+    balancing: dict[str, Any] | None = None
 
 
 def is_graph_spec(data: dict[str, Any]) -> bool:
@@ -174,6 +178,11 @@ class GraphSpec:
         if self.topology.free or "conflict" in self.topology.verdict:
             self._fail("joints", f"{self.topology.verdict} (mark input = true on as many "
                                  "joints as the mechanism has freedoms)")
+        self.balancing: BalancingConfig | None = None
+        if raw.balancing is not None:  # the form single loops use, bodies for links
+            from screwkit.io.balancing_table import balancing_config
+
+            self.balancing = balancing_config(self)
 
     def _per_input(self, value: Any, kinds: list[str], key: str) -> list[tuple[str, Any, str]]:
         """A rate for every input: one value for all, or a list of one per input."""
@@ -194,7 +203,12 @@ class GraphSpec:
                 f"{n} samples")
 
     def jobs(self) -> list[str]:
-        return ["analyze", "mobility"]
+        out = ["analyze", "mobility"]
+        if all(b.mass is not None for b in self.mechanism.bodies):
+            out.append("dynamics")
+        if self.balancing is not None:
+            out.append("balance")
+        return out
 
     # --- helpers ---------------------------------------------------------------------------
     def _fail(self, key: str, message: str) -> None:

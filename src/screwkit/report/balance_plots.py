@@ -62,17 +62,27 @@ def write_plots(result: BalanceResult, folder: str | Path, units: Any = None) ->
     return paths
 
 
-def write_pareto_plot(front: Any, path: str | Path, x: str = "F", y: str = "T",
-                      colour: str = "T0") -> str:
+def write_pareto_plot(front: Any, path: str | Path, x: str | None = None, y: str | None = None,
+                      colour: str | None = None) -> str:
     """Scatter of a :class:`~screwkit.balancing.pareto.ParetoFront`: measure ``x`` against ``y``,
-    coloured by ``colour`` (non-dominated points filled)."""
+    coloured by ``colour`` (non-dominated points outlined). By default the swept measures in
+    order: the first two on the axes, the third (if any) as the colour — a sweep of F and T0
+    alone is a plain scatter."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     vals = front.measures
-    cols = {k: i for i, k in enumerate(front.names)}
-    sc = ax.scatter(vals[:, cols[x]], vals[:, cols[y]], c=vals[:, cols[colour]],
-                    edgecolors=np.where(front.efficient, "k", "none"))
-    fig.colorbar(sc, ax=ax, label=colour)
+    names = list(front.names)
+    x = x or names[0]
+    y = y or names[1]
+    colour = colour or (names[2] if len(names) > 2 else None)
+    cols = {k: i for i, k in enumerate(names)}
+    edges = np.where(front.efficient, "k", "none")
+    if colour is not None:
+        sc = ax.scatter(vals[:, cols[x]], vals[:, cols[y]], c=vals[:, cols[colour]],
+                        edgecolors=edges)
+        fig.colorbar(sc, ax=ax, label=colour)
+    else:
+        ax.scatter(vals[:, cols[x]], vals[:, cols[y]], edgecolors=edges)
     ax.set_xlabel(x)
     ax.set_ylabel(y)
     ax.set_title("balancing trade-off (outlined: non-dominated)")

@@ -213,11 +213,15 @@ def _text(mech: Mechanism, motion: Any, modes: list[dict[str, Any]], units: dict
 
 
 def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str | None = None,
-                         topology: list[str] | None = None) -> dict[str, Any]:
+                         topology: list[str] | None = None,
+                         loads: tuple[dict[str, Any], dict[str, Any]] | None = None,
+                         balance_doc: dict[str, Any] | None = None) -> dict[str, Any]:
     """The scene of a solved mechanism (``solve_mechanism``): ``spec_or_mechanism`` is a graph
     spec (``load_spec``; gives the name, source, units and topology) or a bare
     :class:`~screwkit.model.mechanism.Mechanism`. ``topology``: the summary lines (default:
-    the spec's, else ``mechanism_topology`` at the drawing)."""
+    the spec's, else ``mechanism_topology`` at the drawing). ``loads``: the drawn mode's
+    dynamics document and load arrows (report/graph_loads.py); ``balance_doc``: a balancing
+    result's document (before/after plots)."""
     mech = getattr(spec_or_mechanism, "mechanism", spec_or_mechanism)
     spec = spec_or_mechanism if spec_or_mechanism is not mech else None
     if not isinstance(mech, Mechanism):
@@ -237,6 +241,8 @@ def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str 
     if len(mech.driven_names) > 1:
         groups[0]["note"] += (f" Every variable is plotted against the first input, "
                               f"{input_name}; the other inputs are plotted too.")
+    if loads is not None or balance_doc is not None:
+        _add_load_plots(spec, entries, plots, groups, (x, input_name, kind), loads, balance_doc)
     if topology is None:
         if spec is not None and getattr(spec, "topology", None) is not None:
             topology = list(spec.topology.summary())
@@ -274,13 +280,58 @@ def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str 
     return out
 
 
-def graph_spec_scene(spec: Any, motion: Any = None) -> dict[str, Any]:
+def _add_load_plots(spec: Any, entries: list[dict[str, Any]], plots: list[dict[str, Any]],
+                    groups: list[dict[str, Any]], axis: tuple[Any, str, str],
+                    loads: tuple[dict[str, Any], dict[str, Any]] | None,
+                    balance_doc: dict[str, Any] | None) -> None:
+    """The drawn mode's load arrows, the dynamics plots (every input's effort among them) and
+    the balancing plots, in the spec's display units."""
+    from screwkit.report.scene_plots import balancing_plots, dynamics_plots
+
+    x, input_name, kind = axis
+    du = spec.display_units() if spec is not None else None
+    if loads is not None:
+        doc, arrows = loads
+        entries[0]["arrows"] = arrows
+        p, g = dynamics_plots(doc, 0, x, input_name, kind, du)
+        g[0]["note"] = g[0]["note"].replace(
+            "A reaction is the force on the distal link by the proximal link; the shaking "
+            "force is what the moving links exert on the ground.",
+            "A reaction is the force by the joint's first body on its second (between = "
+            "[first, second]); the shaking force is what the moving bodies exert on the ground, "
+            "its moment about the world origin; a body's inertia force (with its weight when "
+            "gravity is on) is drawn at its centre of mass.")
+        plots += p
+        groups += g
+    if balance_doc is not None:
+        p, g = balancing_plots(balance_doc, 0, x, input_name, kind, du)
+        plots += p
+        groups += g
+
+
+def graph_spec_scene(spec: Any, motion: Any = None, *, gravity: bool = False) -> dict[str, Any]:
     """The scene of a graph spec (``load_spec`` of a ``[[joints]]`` spec): its drawn mode over
-    its inputs (solved here unless ``motion`` is given) and the text of the spec file."""
+    its inputs (solved here unless ``motion`` is given) and the text of the spec file; with
+    mass properties on every body, the loads of the drawn mode (gravity along the spec's
+    direction if ``gravity``), and the spec's ``[balancing]`` run when it has one."""
     if motion is None:
         from screwkit.kinematics.graph import solve_mechanism
 
         motion = solve_mechanism(spec.mechanism, spec.inputs, rates=spec.speed,
                                  accelerations=spec.acceleration)
     text = Path(spec.path).read_text(encoding="utf-8") if Path(spec.path).is_file() else None
-    return scene_from_mechanism(spec, motion, spec_text=text)
+    loads = balance_doc = None
+    if all(b.mass is not None for b in spec.mechanism.bodies):
+        from screwkit.dynamics.graph_inverse import graph_inverse_dynamics
+        from screwkit.report.graph_loads import graph_dynamics_document, graph_load_arrows
+
+        dyn = graph_inverse_dynamics(motion, 0, spec.gravity_vector if gravity else None)
+        doc = graph_dynamics_document(dyn)
+        loads = (doc, graph_load_arrows(motion, 0, doc))
+    if getattr(spec, "balancing", None) is not None:
+        from screwkit.balancing.graph import balance_mechanism
+
+        balance_doc = balance_mechanism(motion, 0, spec.balancing, speed=float(spec.speed[0]),
+                                        gravity=spec.gravity_vector).as_dict()
+    return scene_from_mechanism(spec, motion, spec_text=text, loads=loads,
+                                balance_doc=balance_doc)

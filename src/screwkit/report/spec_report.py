@@ -40,14 +40,16 @@ def spec_scene(spec: Spec | Pipeline | GraphSpec, *, gravity: bool = False,
     mode's motion and, when the spec has them, the dynamics of ``[motion] mode`` (masses),
     balancing (``[balancing]``) and synthesis (``[synthesis]``) — computed here unless their
     documents are given. A graph spec (``[[joints]]``, docs/mechanisms.md) gives the scene of
-    its drawn mode (:func:`screwkit.report.graph_scene.graph_spec_scene`; kinematics only)."""
+    its drawn mode (:func:`screwkit.report.graph_scene.graph_spec_scene`: its loads when every
+    body has masses, gravity as asked, and its ``[balancing]`` run; the documents are not
+    taken)."""
     from screwkit.io.documents import synthesis_document
     from screwkit.report.scene import scene_from_motion
 
     if isinstance(spec, GraphSpec):
         from screwkit.report.graph_scene import graph_spec_scene
 
-        return graph_spec_scene(spec)
+        return graph_spec_scene(spec, gravity=gravity)
 
     pipe = spec if isinstance(spec, Pipeline) else Pipeline(spec)
     s = pipe.spec
@@ -144,7 +146,7 @@ def write_spec_report(spec: Spec | Pipeline | GraphSpec, path: str | Path, **doc
                       ) -> dict[str, Any]:
     """Write the HTML report of a loaded spec (or pipeline, or graph spec) to ``path``
     atomically; returns its scene. ``docs``: ``gravity``, ``dynamics_doc``, ``balance_doc``,
-    ``synthesis_doc`` (ignored for a graph spec)."""
+    ``synthesis_doc`` (for a graph spec only ``gravity`` is used)."""
     from screwkit.io.results import write_atomic
     from screwkit.report.viewer import render_report_html
 
