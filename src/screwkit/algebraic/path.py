@@ -122,8 +122,7 @@ def circle(radius: Real) -> Curve:
 def _solve(J: Complex, b: Complex) -> Complex:
     with np.errstate(all="ignore"):
         try:
-            solution: Complex = np.linalg.solve(J, b[..., None])[..., 0]
-            return solution
+            return np.linalg.solve(J, b[..., None])[..., 0].astype(complex, copy=False)
         except np.linalg.LinAlgError:
             out = np.full_like(b, np.nan)
             ok = np.isfinite(np.linalg.cond(J))
