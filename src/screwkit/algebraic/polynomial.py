@@ -180,6 +180,24 @@ class PolynomialSystem:
         return PolynomialSystem((name, *self.variables), self.parameters, self.eq, self.coef,
                                 sym, pw, self.starts, self.degrees)
 
+    def coefficients_at(self, p: Complex) -> tuple[NDArray[np.intp], NDArray[np.intp], Complex]:
+        """The system as polynomials in x alone at the parameters p (B, k) or (k,): the
+        equation (G,) and exponent vector (G, n) of each distinct monomial in x, and its
+        coefficient (B, G), the sum over the terms with that monomial of coef·Π p^pw."""
+        p = np.atleast_2d(np.asarray(p, dtype=complex))
+        unknown = self.sym < self.n
+        exps = np.zeros((len(self.eq), self.n), dtype=np.intp)
+        rows = np.nonzero(unknown)
+        np.add.at(exps, (rows[0], self.sym[rows]), self.pw[rows])
+        keys, group = np.unique(np.column_stack([self.eq, exps]), axis=0, return_inverse=True)
+        z = np.concatenate([np.ones((len(p), self.n), dtype=complex), p], axis=1)
+        values = self.coef * np.prod(self._power_table(z)[:, self.sym, self.pw], axis=2)
+        out = np.zeros((len(p), len(keys)), dtype=complex)
+        order = np.argsort(group.reshape(-1), kind="stable")
+        heads = np.flatnonzero(np.r_[True, np.diff(group.reshape(-1)[order]) != 0])
+        out[:] = np.add.reduceat(values[:, order], heads, axis=1)
+        return keys[:, 0].astype(np.intp), keys[:, 1:].astype(np.intp), out
+
     def _power_table(self, z: Complex) -> Complex:
         top = int(self.pw.max(initial=0))
         table = np.empty((*z.shape, top + 1), dtype=complex)

@@ -101,10 +101,11 @@ def _check(system: PolynomialSystem, p_start: Complex, p_target: Complex,
             x)
 
 
-def same_points(points: Complex, groups: NDArray[np.intp], tolerance: float,
-                seed: int = 0) -> NDArray[np.intp]:
-    """A cluster label per point: points of one group within ``tolerance``·(1 + ‖·‖∞) of each
-    other (transitively) share a label, the smallest index among them.
+def same_points(points: Complex, groups: NDArray[np.intp], tolerance: float, seed: int = 0,
+                absolute: NDArray[np.float64] | None = None) -> NDArray[np.intp]:
+    """A cluster label per point: points i, j of one group with ‖x_i − x_j‖₂ ≤
+    tolerance·(1 + max ‖x‖∞) + absolute_i + absolute_j (transitively) share a label, the
+    smallest index among them.
 
     Candidates are found by sorting each group along a random projection and comparing
     neighbours a few places apart, so it costs O(P log P), not O(P²)."""
@@ -115,16 +116,19 @@ def same_points(points: Complex, groups: NDArray[np.intp], tolerance: float,
     rng = np.random.default_rng(seed)
     direction = rng.standard_normal(points.shape[1]) + 1j * rng.standard_normal(points.shape[1])
     finite = np.asarray(np.isfinite(points).all(axis=1), dtype=bool)
-    key = np.where(finite, (points @ direction).real if points.shape[1] else 0.0, np.inf)
+    safe = np.where(finite[:, None], points, 0.0)
+    key = np.where(finite, (safe @ direction).real, np.inf)
+    extra = np.zeros(P) if absolute is None else np.nan_to_num(absolute, nan=0.0, posinf=0.0)
     order = np.lexsort((key, groups))
     pairs: list[tuple[int, int]] = []
-    width = np.abs(direction).sum()
+    width = np.linalg.norm(direction)
     for shift in range(1, min(P, 8)):
         i, j = order[:-shift], order[shift:]
-        scale = 1.0 + np.maximum(np.abs(points[i]).max(axis=1), np.abs(points[j]).max(axis=1))
+        scale = 1.0 + np.maximum(np.abs(safe[i]).max(axis=1), np.abs(safe[j]).max(axis=1))
+        reach = tolerance * scale + extra[i] + extra[j]
         close = (groups[i] == groups[j]) & finite[i] & finite[j]
-        close &= np.abs(key[i] - key[j]) <= tolerance * scale * width
-        close &= np.abs(points[i] - points[j]).max(axis=1) <= tolerance * scale
+        close &= np.abs(key[i] - key[j]) <= reach * width
+        close &= np.linalg.norm(safe[i] - safe[j], axis=1) <= reach
         pairs.extend(zip(i[close].tolist(), j[close].tolist(), strict=True))
     for first, second in pairs:  # union–find over the (few) close pairs
         a, b = first, second
