@@ -134,35 +134,62 @@ class PolynomialSystem:
     def evaluate(self, x: Complex, p: Complex,
                  want_jp: bool = True) -> tuple[Complex, Complex, Complex | None]:
         """F (B, N), ∂F/∂x (B, N, n) and ∂F/∂p (B, N, k) (None unless ``want_jp``) at the
-        points x (B, n) with parameters p (B, k) or (k,).
+        points x (B, n) with parameters p (B, k) or (k,)."""
+        dims = self.n + self.k if want_jp else self.n
+        F, J, _ = self._evaluate_columns(self._columns(x, p), dims, None)
+        return F.T, J[:, :, : self.n], (J[:, :, self.n:] if want_jp else None)
 
-        One table of powers z^0..z^D per point, one gather per factor, and one segmented sum
-        for F and one for all the Jacobian entries (the derivative of a term by the symbol of
-        factor f is its coefficient times pw_f·z_f^(pw_f−1) times the other factors)."""
+    def evaluate_directional(self, x: Complex, p: Complex,
+                             dp: Complex | None) -> tuple[Complex, Complex, Complex | None]:
+        """F (B, N), ∂F/∂x (B, N, n) and, when ``dp`` (B, k) is given, the derivative of F
+        along the parameter direction dp, (∂F/∂p)·dp (B, N), without forming ∂F/∂p: what a
+        parameter homotopy needs at each step."""
+        F, J, Fdp = self._evaluate_columns(self._columns(x, p), self.n, dp)
+        return F.T, J, (None if Fdp is None else Fdp.T)
+
+    def _columns(self, x: Complex, p: Complex) -> Complex:
+        """The symbols as rows, the batch along the rows: z (n + k, B)."""
         x = np.asarray(x, dtype=complex)
         B = x.shape[0]
-        p = np.broadcast_to(np.asarray(p, dtype=complex), (B, self.k))
-        z = np.concatenate([x, p], axis=1)
-        table = self._power_table(z)  # (B, S, D+1)
-        powers = table[:, self.sym, self.pw]  # (B, T, f)
-        F = self._reduce(self.coef * np.prod(powers, axis=2))
-        dims = self.n + self.k if want_jp else self.n
-        J = np.zeros((B, self.size * dims), dtype=complex)
-        order, heads, targets, slot, term = self._jacobian_plan(dims)
-        if len(order):
-            lower = table[:, self.sym, np.maximum(self.pw - 1, 0)]  # (B, T, f)
-            width = self.sym.shape[1]
-            parts = []
-            for f in range(width):
-                others = [powers[:, :, g] for g in range(width) if g != f]
-                value = lower[:, :, f] * (self.coef * self.pw[:, f])
-                for o in others:
-                    value = value * o
-                parts.append(value)
-            derivative = np.stack(parts, axis=2)[:, term, slot]  # (B, M) entries
-            J[:, targets] = np.add.reduceat(derivative[:, order], heads, axis=1)
-        J3 = J.reshape(B, self.size, dims)
-        return F, J3[:, :, : self.n], (J3[:, :, self.n:] if want_jp else None)
+        z = np.empty((self.n + self.k, B), dtype=complex)
+        z[: self.n] = x.T
+        z[self.n:] = np.broadcast_to(np.asarray(p, dtype=complex), (B, self.k)).T
+        return z
+
+    def _evaluate_columns(self, z: Complex, dims: int, dp: Complex | None
+                          ) -> tuple[Complex, Complex, Complex | None]:
+        """The core, laid out symbol-major so that every gather moves whole rows of B
+        values: a table of powers z^0..z^D (D+1, S, B), the factors of each term (T, f, B),
+        F by a segmented sum over terms, and every Jacobian entry (the derivative of a term by
+        the symbol of factor f is coef·pw_f·z_f^(pw_f−1) times the other factors) by one
+        segmented sum over the (term, factor) entries sorted by target cell."""
+        B = z.shape[1]
+        table = self._power_table(z)
+        powers = table[self.pw, self.sym]  # (T, f, B)
+        F = self._reduce(self.coef[:, None] * np.prod(powers, axis=1))
+        width = self.sym.shape[1]
+        parts = np.empty((width, len(self.eq), B), dtype=complex)
+        lower = np.maximum(self.pw - 1, 0)
+        for f in range(width):
+            value = table[lower[:, f], self.sym[:, f]] * (self.coef * self.pw[:, f])[:, None]
+            for g in range(width):
+                if g != f:
+                    value *= powers[:, g]
+            parts[f] = value
+        J = np.zeros((self.size * dims, B), dtype=complex)
+        heads, targets, slot, term = self._jacobian_plan(dims)
+        if len(slot):
+            J[targets] = np.add.reduceat(parts[slot, term], heads, axis=0)
+        J3 = J.reshape(self.size, dims, B).transpose(2, 0, 1)
+        if dp is None:
+            return F, J3, None
+        dpT = np.broadcast_to(np.asarray(dp, dtype=complex), (B, self.k)).T
+        term_p, slot_p, eq_p, heads_p = self._direction_plan()
+        Fdp = np.zeros((self.size, B), dtype=complex)
+        if len(term_p):
+            weighted = parts[slot_p, term_p] * dpT[self.sym[term_p, slot_p] - self.n]
+            Fdp[eq_p[heads_p]] = np.add.reduceat(weighted, heads_p, axis=0)
+        return F, J3, Fdp
 
     def homogenized(self) -> PolynomialSystem:
         """The system in n+1 homogeneous unknowns (h, x·h): each term of equation i times
@@ -190,8 +217,9 @@ class PolynomialSystem:
         rows = np.nonzero(unknown)
         np.add.at(exps, (rows[0], self.sym[rows]), self.pw[rows])
         keys, group = np.unique(np.column_stack([self.eq, exps]), axis=0, return_inverse=True)
-        z = np.concatenate([np.ones((len(p), self.n), dtype=complex), p], axis=1)
-        values = self.coef * np.prod(self._power_table(z)[:, self.sym, self.pw], axis=2)
+        z = self._columns(np.ones((len(p), self.n), dtype=complex), p)
+        values = (self.coef[:, None] * np.prod(self._power_table(z)[self.pw, self.sym],
+                                               axis=1)).T
         out = np.zeros((len(p), len(keys)), dtype=complex)
         order = np.argsort(group.reshape(-1), kind="stable")
         heads = np.flatnonzero(np.r_[True, np.diff(group.reshape(-1)[order]) != 0])
@@ -199,17 +227,18 @@ class PolynomialSystem:
         return keys[:, 0].astype(np.intp), keys[:, 1:].astype(np.intp), out
 
     def _power_table(self, z: Complex) -> Complex:
+        """z^0..z^D (D+1, S, B) for z (S, B)."""
         top = int(self.pw.max(initial=0))
-        table = np.empty((*z.shape, top + 1), dtype=complex)
-        table[..., 0] = 1.0
+        table = np.empty((top + 1, *z.shape), dtype=complex)
+        table[0] = 1.0
         for d in range(1, top + 1):
-            table[..., d] = table[..., d - 1] * z
+            table[d] = table[d - 1] * z
         return table
 
     def _jacobian_plan(self, dims: int) -> tuple[NDArray[np.intp], ...]:
-        """For the Jacobian's nonzero (term, factor) entries: their order sorted by target
-        cell eq·dims + symbol, the head of each run of one target, the distinct targets, and
-        each entry's factor slot and term."""
+        """For the Jacobian's nonzero (term, factor) entries sorted by target cell
+        eq·dims + symbol: the head of each run of one target, the distinct targets, and each
+        entry's factor slot and term."""
         cache = self.__dict__.setdefault("_plans", {})
         if dims not in cache:
             term, slot = np.nonzero((self.pw > 0) & (self.sym < dims))
@@ -217,14 +246,28 @@ class PolynomialSystem:
             order = np.argsort(cell, kind="stable")
             cell = cell[order]
             heads = np.flatnonzero(np.r_[True, cell[1:] != cell[:-1]]) if len(cell) else cell
-            cache[dims] = (order, heads, cell[heads], slot, term)
+            cache[dims] = (heads, cell[heads], slot[order], term[order])
         return cache[dims]  # type: ignore[no-any-return]
 
+    def _direction_plan(self) -> tuple[NDArray[np.intp], ...]:
+        """The (term, factor) entries whose symbol is a parameter, sorted by equation, and
+        the head of each equation's run."""
+        cache = self.__dict__.setdefault("_plans", {})
+        if "direction" not in cache:
+            term, slot = np.nonzero((self.pw > 0) & (self.sym >= self.n))
+            eq = self.eq[term]  # nonzero walks terms in order, so eq is already sorted
+            heads = np.flatnonzero(np.r_[True, eq[1:] != eq[:-1]]) if len(eq) else eq
+            cache["direction"] = (term, slot, eq, heads)
+        return cache["direction"]  # type: ignore[no-any-return]
+
     def _reduce(self, values: Complex) -> Complex:
-        out = np.add.reduceat(values, self.starts, axis=1) if values.shape[1] else values
-        empty = np.diff(np.append(self.starts, values.shape[1])) == 0
+        """Per-equation sums of the term values (T, B) → (N, B)."""
+        if not values.shape[0]:
+            return np.zeros((self.size, values.shape[1]), dtype=complex)
+        out = np.add.reduceat(values, self.starts, axis=0)
+        empty = np.diff(np.append(self.starts, values.shape[0])) == 0
         if empty.any():
-            out[:, empty] = 0.0
+            out[empty] = 0.0
         return out
 
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from enum import IntEnum
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.endgame import cauchy_endgame
 from screwkit.algebraic.path import Homotopy, TrackOptions, line, newton, track
@@ -80,8 +80,8 @@ class TrackResult:
         return {s.name.lower(): int((self.status == s).sum()) for s in PathStatus}
 
 
-def _check(system: PolynomialSystem, p_start: Complex, p_target: Complex,
-           x_start: Complex) -> tuple[Complex, Complex, Complex]:
+def _check(system: PolynomialSystem, p_start: ArrayLike, p_target: ArrayLike,
+           x_start: ArrayLike) -> tuple[Complex, Complex, Complex]:
     x = np.asarray(x_start, dtype=complex)
     if x.ndim != 2 or x.shape[1] != system.n:
         raise InputError(f"x_start must have shape (paths, {system.n}) for the unknowns "
@@ -199,8 +199,8 @@ def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArra
             "steps": steps}
 
 
-def track_parameter_homotopy(system: PolynomialSystem, p_start: Complex, p_target: Complex,
-                             x_start: Complex,
+def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
+                             p_target: ArrayLike, x_start: ArrayLike,
                              options: TrackOptions | None = None) -> TrackResult:
     """Track the start solutions ``x_start`` (P, n) of F(x; p_start) = 0 to F(x; p_target) = 0
     along p(s) = (1 − s)·p_start + s·p_target (Sommese & Wampler 2005, ch. 7).
