@@ -42,8 +42,10 @@ class TrackOptions:
     max_step: float = 0.2
     min_step: float = 1e-13
     max_steps: int = 2000
-    predictor_tolerance: float = 1e-5
-    corrector_tolerance: float = 1e-9
+    predictor_tolerance: float = 1e-3
+    corrector_tolerance: float = 1e-7
+    #: the second Newton correction must be at most this fraction of the first
+    contraction: float = 0.1
     #: the endgame starts on the circle |1 − σ| = endgame_radius and shrinks it by 4 a level
     endgame_radius: float = 0.05
     endgame_levels: int = 5
@@ -187,8 +189,10 @@ def track(hom: Homotopy, curve: Curve, y0: Complex, rows: Index, tau0: Real, tau
             scale = 1.0 + np.abs(ya).max(axis=1)
             first, second = sizes[0] / scale, sizes[1] / scale
             tol_c = options.corrector_tolerance
+            # Newton must contract fast (quadratic convergence from the predicted point, the
+            # guard against converging onto a neighbouring path) and end within tol_c
             accept = ((first <= options.predictor_tolerance) & (second <= tol_c)
-                      & ((second <= 0.25 * first) | (first <= tol_c)))
+                      & ((second <= options.contraction * first) | (first <= tol_c)))
             accept &= np.isfinite(yc).all(axis=1)
             # the first correction is the RK4 predictor's error, O(h^5): aim the next step at
             # 0.8× the tolerance, growing at most 2× and shrinking at least 2×
