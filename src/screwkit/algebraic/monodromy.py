@@ -6,8 +6,8 @@ a permutation, and for an irreducible solution variety the loops' permutations a
 transitively, so random loops reach every solution (Duff, Hill, Jensen, Lee, Leykin &
 Sommars, "Solving polynomial systems via homotopy continuation and monodromy", IMA J. Numer.
 Anal. 39(3), 2019). Each loop here is a random triangle p0 → p1 → p2 → p0 through two fresh
-random complex parameter points, with all the solutions known so far tracked around it at once
-(one batched call of the tracker per edge).
+random complex parameter points; a few such loops run together, every solution known so far
+tracked around each of them in one batched call of the tracker per edge.
 
 The stopping rule is the paper's heuristic: stop when a given expected count is reached, or
 after ``stale_loops`` loops in a row that found nothing new. Without an expected count the
@@ -31,9 +31,12 @@ from screwkit.errors import InputError
 class MonodromyOptions:
     """``stale_loops``: loops in a row without a new solution before stopping;
     ``expected``: stop as soon as this many are known; ``max_loops``: a hard cap;
+    ``parallel_loops``: loops run together (the stale count grows by a whole batch);
     ``seed`` for the random loop points."""
 
-    stale_loops: int = 5
+    stale_loops: int = 6
+    #: loops (random triangles) tracked together in one batch
+    parallel_loops: int = 3
     expected: int | None = None
     max_loops: int = 200
     seed: int = 0
@@ -53,22 +56,28 @@ class MonodromyStats:
     failed_paths: int
 
 
-def _loop(system: PolynomialSystem, p0: Complex, x: Complex, rng: np.random.Generator,
-          options: TrackOptions) -> tuple[Complex, int, int]:
-    """Track x (m, n) around p0 → p1 → p2 → p0; the regular end points, paths and failures."""
+def _loops(system: PolynomialSystem, p0: Complex, x: Complex, count: int,
+           rng: np.random.Generator, options: TrackOptions) -> tuple[Complex, int, int]:
+    """Track x (m, n) around ``count`` random triangles p0 → p1 → p2 → p0 at once (one
+    batched call per edge); the regular end points, the paths tracked and those that failed."""
+    m = len(x)
     scale = max(1.0, float(np.abs(p0).max(initial=0.0)))
-    corners = [p0] + [scale * (rng.standard_normal(system.k)
-                               + 1j * rng.standard_normal(system.k)) for _ in range(2)] + [p0]
+    shape = (count, system.k)
+    p1, p2 = (scale * (rng.standard_normal(shape) + 1j * rng.standard_normal(shape))
+              for _ in range(2))
+    corners = [np.tile(p0, (count, 1)), p1, p2, np.tile(p0, (count, 1))]
+    loop = np.repeat(np.arange(count), m)
+    points = np.tile(x, (count, 1))
     tracked = failed = 0
     for a, b in zip(corners[:-1], corners[1:], strict=True):
-        result = track_parameter_homotopy(system, a, b, x, options)
+        result = track_parameter_homotopy(system, a[loop], b[loop], points, options)
         ok = result.status == PathStatus.REGULAR
-        tracked += len(x)
+        tracked += len(points)
         failed += int((~ok).sum())
-        x = result.x[ok]
-        if not len(x):
+        points, loop = result.x[ok], loop[ok]
+        if not len(points):
             break
-    return x, tracked, failed
+    return points, tracked, failed
 
 
 def monodromy_solve(system: PolynomialSystem, p0: Complex, x0: Complex,
@@ -105,11 +114,12 @@ def monodromy_solve(system: PolynomialSystem, p0: Complex, x0: Complex,
         if stale >= options.stale_loops:
             stopped = "stabilised"
             break
-        ends, used, lost = _loop(system, p0, known, rng, options.track)
-        loops, tracked, failed = loops + 1, tracked + used, failed + lost
+        batch = min(options.parallel_loops, options.max_loops - loops)
+        ends, used, lost = _loops(system, p0, known, batch, rng, options.track)
+        loops, tracked, failed = loops + batch, tracked + used, failed + lost
         merged = np.concatenate([known, ends])
         label = same_points(merged, np.zeros(len(merged), dtype=np.intp), 1e-8)
         new = merged[(label == np.arange(len(merged))) & (np.arange(len(merged)) >= len(known))]
-        stale = 0 if len(new) else stale + 1
+        stale = 0 if len(new) else stale + batch
         known = np.concatenate([known, new])
     return p0, known, MonodromyStats(len(known), loops, stopped, tracked, failed)

@@ -58,7 +58,9 @@ class TrackResult:
     number from the endgame (1 for paths that did not need it); ``multiplicity`` (P,) the number
     of paths of the same instance ending at the same point (1 for a regular end); ``steps`` (P,)
     predictor–corrector steps taken; ``retracked`` (P,) paths tracked again after a suspected
-    jump; ``instance`` (P,) the index of each path's target among the distinct targets."""
+    jump; ``instance`` (P,) the index of each path's homotopy (its pair p_start, p_target)
+    among the distinct pairs: paths of one instance are one homotopy, whose regular ends must
+    differ."""
 
     x: Complex
     y: Complex
@@ -217,7 +219,7 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
     patch = ((rng.standard_normal(system.n + 1) + 1j * rng.standard_normal(system.n + 1))
              / 2).astype(complex)
     hom = Homotopy(hsys, patch, ps, pt - ps)
-    _, instance = np.unique(pt, axis=0, return_inverse=True)
+    _, instance = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_inverse=True)
     instance = instance.reshape(-1).astype(np.intp)
     rows = np.arange(P)
     out = _run(system, hom, x, rows, options)
