@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from numbers import Number
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +26,8 @@ from numpy.typing import NDArray
 from screwkit.errors import InputError
 
 Complex = NDArray[np.complex128]
+#: points evaluated together (see PolynomialSystem._blocks)
+BLOCK = 64
 Monomial = tuple[tuple[int, int], ...]  # ((symbol index, power > 0), ...) sorted by index
 
 
@@ -136,7 +139,7 @@ class PolynomialSystem:
         """F (B, N), ∂F/∂x (B, N, n) and ∂F/∂p (B, N, k) (None unless ``want_jp``) at the
         points x (B, n) with parameters p (B, k) or (k,)."""
         dims = self.n + self.k if want_jp else self.n
-        F, J, _ = self._evaluate_columns(self._columns(x, p), dims, None)
+        F, J, _ = self._blocks(self._columns(x, p), dims, None)
         return F.T, J[:, :, : self.n], (J[:, :, self.n:] if want_jp else None)
 
     def evaluate_directional(self, x: Complex, p: Complex,
@@ -144,8 +147,30 @@ class PolynomialSystem:
         """F (B, N), ∂F/∂x (B, N, n) and, when ``dp`` (B, k) is given, the derivative of F
         along the parameter direction dp, (∂F/∂p)·dp (B, N), without forming ∂F/∂p: what a
         parameter homotopy needs at each step."""
-        F, J, Fdp = self._evaluate_columns(self._columns(x, p), self.n, dp)
+        F, J, Fdp = self._blocks(self._columns(x, p), self.n, dp)
         return F.T, J, (None if Fdp is None else Fdp.T)
+
+    def _blocks(self, z: Complex, dims: int, dp: Complex | None
+                ) -> tuple[Complex, Complex, Complex | None]:
+        """:meth:`_evaluate_columns` over blocks of BLOCK points: the temporaries of a block
+        stay small enough to live in cache and to skip the page faults that fresh large
+        allocations cost (measured: 6× faster per point at 64 than at 128 and more)."""
+        B = z.shape[1]
+        if B <= BLOCK:
+            return self._evaluate_columns(z, dims, dp)
+        dpB = None if dp is None else np.broadcast_to(np.asarray(dp, dtype=complex),
+                                                      (B, self.k))
+        F = np.empty((self.size, B), dtype=complex)
+        J = np.empty((B, self.size, dims), dtype=complex)
+        Fdp = None if dp is None else np.empty((self.size, B), dtype=complex)
+        for start in range(0, B, BLOCK):
+            cut = slice(start, start + BLOCK)
+            f, j, fdp = self._evaluate_columns(z[:, cut], dims, None if dpB is None
+                                               else dpB[cut])
+            F[:, cut], J[cut] = f, j
+            if Fdp is not None and fdp is not None:
+                Fdp[:, cut] = fdp
+        return F, J, Fdp
 
     def _columns(self, x: Complex, p: Complex) -> Complex:
         """The symbols as rows, the batch along the rows: z (n + k, B)."""
@@ -159,37 +184,40 @@ class PolynomialSystem:
     def _evaluate_columns(self, z: Complex, dims: int, dp: Complex | None
                           ) -> tuple[Complex, Complex, Complex | None]:
         """The core, laid out symbol-major so that every gather moves whole rows of B
-        values: a table of powers z^0..z^D (D+1, S, B), the factors of each term (T, f, B),
-        F by a segmented sum over terms, and every Jacobian entry (the derivative of a term by
-        the symbol of factor f is coef·pw_f·z_f^(pw_f−1) times the other factors) by one
-        segmented sum over the (term, factor) entries sorted by target cell."""
+        values: a table of powers z^0..z^D (D+1, S, B); the factors of each term (T, f, B)
+        and their prefix and suffix products; F as a sparse sum of the terms; each Jacobian
+        entry (the derivative of a term by the symbol of factor f is
+        coef·pw_f·z_f^(pw_f−1) times the prefix before f and the suffix after it) as a sparse
+        sum of those (term, factor) entries into their cells (scipy.sparse CSR products, which
+        beat numpy's segmented sums several times over)."""
         B = z.shape[1]
         table = self._power_table(z)
         powers = table[self.pw, self.sym]  # (T, f, B)
-        F = self._reduce(self.coef[:, None] * np.prod(powers, axis=1))
         width = self.sym.shape[1]
-        parts = np.empty((width, len(self.eq), B), dtype=complex)
-        lower = np.maximum(self.pw - 1, 0)
+        prefix = np.empty((width + 1, len(self.eq), B), dtype=complex)
+        suffix = np.empty_like(prefix)
+        prefix[0] = 1.0
+        suffix[width] = 1.0
         for f in range(width):
-            value = table[lower[:, f], self.sym[:, f]] * (self.coef * self.pw[:, f])[:, None]
-            for g in range(width):
-                if g != f:
-                    value *= powers[:, g]
-            parts[f] = value
-        J = np.zeros((self.size * dims, B), dtype=complex)
-        heads, targets, slot, term = self._jacobian_plan(dims)
-        if len(slot):
-            J[targets] = np.add.reduceat(parts[slot, term], heads, axis=0)
+            prefix[f + 1] = prefix[f] * powers[:, f]
+            suffix[width - 1 - f] = suffix[width - f] * powers[:, width - 1 - f]
+        plan = self._plan(dims)
+        F = np.asarray(plan["F"] @ (self.coef[:, None] * prefix[width]))
+
+        def entries(term: NDArray[np.intp], slot: NDArray[np.intp]) -> Complex:
+            lower = np.maximum(self.pw[term, slot] - 1, 0)
+            scale = (self.coef[term] * self.pw[term, slot])[:, None]
+            return (table[lower, self.sym[term, slot]] * prefix[slot, term]
+                    * suffix[slot + 1, term] * scale)
+
+        J = np.asarray(plan["J"] @ entries(plan["term"], plan["slot"]))
         J3 = J.reshape(self.size, dims, B).transpose(2, 0, 1)
         if dp is None:
             return F, J3, None
         dpT = np.broadcast_to(np.asarray(dp, dtype=complex), (B, self.k)).T
-        term_p, slot_p, eq_p, heads_p = self._direction_plan()
-        Fdp = np.zeros((self.size, B), dtype=complex)
-        if len(term_p):
-            weighted = parts[slot_p, term_p] * dpT[self.sym[term_p, slot_p] - self.n]
-            Fdp[eq_p[heads_p]] = np.add.reduceat(weighted, heads_p, axis=0)
-        return F, J3, Fdp
+        term_p, slot_p = plan["term_p"], plan["slot_p"]
+        weighted = entries(term_p, slot_p) * dpT[self.sym[term_p, slot_p] - self.n]
+        return F, J3, np.asarray(plan["P"] @ weighted)
 
     def homogenized(self) -> PolynomialSystem:
         """The system in n+1 homogeneous unknowns (h, x·h): each term of equation i times
@@ -235,40 +263,29 @@ class PolynomialSystem:
             table[d] = table[d - 1] * z
         return table
 
-    def _jacobian_plan(self, dims: int) -> tuple[NDArray[np.intp], ...]:
-        """For the Jacobian's nonzero (term, factor) entries sorted by target cell
-        eq·dims + symbol: the head of each run of one target, the distinct targets, and each
-        entry's factor slot and term."""
+    def _plan(self, dims: int) -> dict[str, Any]:
+        """The sparse sums of one evaluation (cached per ``dims``): terms into equations
+        ("F", N×T); the nonzero (term, factor) entries with symbol < dims into the Jacobian
+        cells eq·dims + symbol ("J", N·dims×M, with their "term" and "slot"); and the entries
+        with a parameter symbol into equations ("P", with "term_p", "slot_p")."""
+        from scipy import sparse
+
         cache = self.__dict__.setdefault("_plans", {})
         if dims not in cache:
+            T, N = len(self.eq), self.size
             term, slot = np.nonzero((self.pw > 0) & (self.sym < dims))
             cell = self.eq[term] * dims + self.sym[term, slot]
-            order = np.argsort(cell, kind="stable")
-            cell = cell[order]
-            heads = np.flatnonzero(np.r_[True, cell[1:] != cell[:-1]]) if len(cell) else cell
-            cache[dims] = (heads, cell[heads], slot[order], term[order])
+            term_p, slot_p = np.nonzero((self.pw > 0) & (self.sym >= self.n))
+
+            def matrix(rows: NDArray[np.intp], cols: int, shape0: int) -> Any:
+                ones = np.ones(len(rows), dtype=complex)
+                return sparse.csr_matrix((ones, (rows, np.arange(cols))), shape=(shape0, cols))
+
+            cache[dims] = {"F": matrix(self.eq, T, N), "J": matrix(cell, len(term), N * dims),
+                           "term": term, "slot": slot,
+                           "P": matrix(self.eq[term_p], len(term_p), N),
+                           "term_p": term_p, "slot_p": slot_p}
         return cache[dims]  # type: ignore[no-any-return]
-
-    def _direction_plan(self) -> tuple[NDArray[np.intp], ...]:
-        """The (term, factor) entries whose symbol is a parameter, sorted by equation, and
-        the head of each equation's run."""
-        cache = self.__dict__.setdefault("_plans", {})
-        if "direction" not in cache:
-            term, slot = np.nonzero((self.pw > 0) & (self.sym >= self.n))
-            eq = self.eq[term]  # nonzero walks terms in order, so eq is already sorted
-            heads = np.flatnonzero(np.r_[True, eq[1:] != eq[:-1]]) if len(eq) else eq
-            cache["direction"] = (term, slot, eq, heads)
-        return cache["direction"]  # type: ignore[no-any-return]
-
-    def _reduce(self, values: Complex) -> Complex:
-        """Per-equation sums of the term values (T, B) → (N, B)."""
-        if not values.shape[0]:
-            return np.zeros((self.size, values.shape[1]), dtype=complex)
-        out = np.add.reduceat(values, self.starts, axis=0)
-        empty = np.diff(np.append(self.starts, values.shape[0])) == 0
-        if empty.any():
-            out[empty] = 0.0
-        return out
 
 
 def compile_system(equations: Sequence[Poly], variables: Sequence[str],
