@@ -85,11 +85,16 @@ class Homotopy:
     p_start: Complex  # (P, k)
     direction: Complex  # (P, k)
 
-    def parts(self, y: Complex, rows: Index, sigma: Complex,
+    def restricted(self, rows: Index) -> Homotopy:
+        """The homotopy of the paths ``rows`` only (their parameters gathered once)."""
+        return Homotopy(self.system, self.patch, self.p_start[rows], self.direction[rows])
+
+    def parts(self, y: Complex, rows: Index | None, sigma: Complex,
               dsigma: Complex | None = None) -> tuple[Complex, Complex, Complex | None]:
-        """H (B, n+1), ∂H/∂y (B, n+1, n+1) and, when ``dsigma`` is given, ∂H/∂τ (B, n+1)."""
-        d = self.direction[rows]
-        p = self.p_start[rows] + sigma[:, None] * d
+        """H (B, n+1), ∂H/∂y (B, n+1, n+1) and, when ``dsigma`` is given, ∂H/∂τ (B, n+1), for
+        the paths ``rows`` (None: every path of this homotopy, in order)."""
+        d = self.direction if rows is None else self.direction[rows]
+        p = (self.p_start if rows is None else self.p_start[rows]) + sigma[:, None] * d
         F, Jy, Fd = self.system.evaluate_directional(y, p, None if dsigma is None else d)
         B, m = y.shape
         H = np.empty((B, m), dtype=complex)
@@ -140,8 +145,9 @@ def _solve(J: Complex, b: Complex) -> Complex:
 
 
 def _velocity(hom: Homotopy, curve: Curve, y: Complex, rows: Index, tau: Real) -> Complex:
+    """dy/dτ of the paths of ``hom`` (restricted to ``rows``, which the curve still needs)."""
     sigma, dsigma = curve(tau, rows)
-    _, J, Ht = hom.parts(y, rows, sigma, dsigma)
+    _, J, Ht = hom.parts(y, None, sigma, dsigma)
     assert Ht is not None
     return -_solve(J, Ht)
 
@@ -156,7 +162,7 @@ def _rk4(hom: Homotopy, curve: Curve, y: Complex, rows: Index, tau: Real,
     return y + hc / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
-def newton(hom: Homotopy, y: Complex, rows: Index, sigma: Complex,
+def newton(hom: Homotopy, y: Complex, rows: Index | None, sigma: Complex,
            iterations: int) -> tuple[Complex, list[Real]]:
     """``iterations`` Newton corrections at fixed σ; the ∞-norm of each correction."""
     sizes = []
@@ -188,10 +194,11 @@ def track(hom: Homotopy, curve: Curve, y0: Complex, rows: Index, tau0: Real, tau
         hs = np.minimum(h[a], left)
         last = hs >= left
         ya = y[a]
+        sub = hom.restricted(rows[a])
         with np.errstate(all="ignore"):
-            yp = _rk4(hom, curve, ya, rows[a], tau[a], hs)
+            yp = _rk4(sub, curve, ya, rows[a], tau[a], hs)
             sigma, _ = curve(tau[a] + hs, rows[a])
-            yc, sizes = newton(hom, yp, rows[a], sigma, 2)
+            yc, sizes = newton(sub, yp, None, sigma, 2)
             scale = 1.0 + np.abs(ya).max(axis=1)
             first, second = sizes[0] / scale, sizes[1] / scale
             tol_c = options.corrector_tolerance
