@@ -87,3 +87,17 @@ def test_too_many_paths_are_refused_naming_the_bezout_number():
     system = compile_system([v * v - 1 for v in xs], [f"x{i}" for i in range(13)])
     with pytest.raises(InputError, match="8192 paths"):
         solve_total_degree(system, np.zeros(0))
+
+
+def test_a_point_of_multiplicity_four_takes_all_four_paths():
+    # (x − 1)² = 0, (y + 2)² = 0: one solution of multiplicity 4 (two double roots); the
+    # start system's paths meet exactly singular Jacobians on the way, which must not crash
+    x, y = Poly.variable(0), Poly.variable(1)
+    system = compile_system([(x - 1) ** 2, (y + 2) ** 2], ["x", "y"])
+    result = solve_total_degree(system, np.zeros(0))
+    assert (result.status == PathStatus.SINGULAR).all()
+    assert (result.multiplicity == 4).all() and (result.winding == 2).all()
+    assert np.abs(result.x - np.array([1.0, -2.0])).max() < 1e-8
+    # two concentric circles never meet: all four paths go to infinity
+    circles = compile_system([x * x + y * y - 1, x * x + y * y - 4], ["x", "y"])
+    assert solve_total_degree(circles, np.zeros(0)).counts()["at_infinity"] == 4

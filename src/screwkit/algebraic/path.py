@@ -139,11 +139,13 @@ def _solve(J: Complex, b: Complex) -> Complex:
     with np.errstate(all="ignore"):
         try:
             out = np.linalg.solve(J, rhs).astype(complex, copy=False)
-        except np.linalg.LinAlgError:
+        except np.linalg.LinAlgError:  # rare: one matrix at a time, NaN for the singular
             out = np.full_like(rhs, np.nan)
-            ok = np.isfinite(np.linalg.cond(J))
-            if ok.any():
-                out[ok] = np.linalg.solve(J[ok], rhs[ok])
+            for i in range(len(J)):
+                try:
+                    out[i] = np.linalg.solve(J[i], rhs[i])
+                except np.linalg.LinAlgError:
+                    pass
     return out[..., 0] if column else out
 
 
