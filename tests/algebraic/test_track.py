@@ -69,6 +69,17 @@ def test_double_root_is_singular_with_multiplicity_two():
     assert _matches(result.x[~singular, 0], np.array([2.0, -1 + 1j, -1 - 1j]), 1e-10)
 
 
+def test_triple_root_has_multiplicity_and_winding_three():
+    system = univariate(5)
+    c0, roots0 = univariate_start(5, seed=0)
+    target = np.poly([1.0, 1.0, 1.0, 2.0, -3.0])[::-1][:5].real
+    result = track_parameter_homotopy(system, c0, target, roots0)
+    singular = result.status == PathStatus.SINGULAR
+    assert singular.sum() == 3
+    assert (result.multiplicity[singular] == 3).all() and (result.winding[singular] == 3).all()
+    assert np.abs(result.x[singular, 0] - 1.0).max() < 1e-8
+
+
 def test_a_root_going_to_infinity_is_reported_at_infinity():
     # a·x² + b·x + c with a → 0: one root stays finite (−c/b), the other diverges
     x, a, b, c = (Poly.variable(i) for i in range(4))
