@@ -20,10 +20,11 @@ polynomial systems", ACM TOMS 38(4), 2012, §1–2):
 
 **What this certifies, honestly.** The quantities are computed in double precision, not in
 exact rational or interval arithmetic as alphaCertified does. β and γ are inflated by stated
-rounding margins (the evaluation error of f bounded by 8·(terms + degree)·u·Σ|terms|, and the
-linear solves' relative error by 10·n·κ·u, u the unit round-off, κ the condition number), so a
-certificate here is a floating-point α-test with a rounding allowance: strong evidence, and
-rigorous under the assumption that those margins bound the rounding, but not a computer proof.
+rounding margins (the evaluation error of f bounded by 8·(terms + degree + factors)·u·Σ|terms|,
+and the linear solves' relative error by 10·n·κ·u, u the unit round-off, κ the condition
+number); the rounding of Df(x) itself and of the norm computations is not bounded separately.
+So a certificate here is a floating-point α-test with a rounding allowance: strong evidence,
+rigorous under the assumption that those margins cover the rounding, but not a computer proof.
 """
 
 from __future__ import annotations
