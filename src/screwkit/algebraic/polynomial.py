@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from numbers import Number
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +26,8 @@ from numpy.typing import NDArray
 from screwkit.errors import InputError
 
 Complex = NDArray[np.complex128]
+#: points evaluated together (see PolynomialSystem._blocks)
+BLOCK = 64
 Monomial = tuple[tuple[int, int], ...]  # ((symbol index, power > 0), ...) sorted by index
 
 
@@ -135,33 +138,154 @@ class PolynomialSystem:
                  want_jp: bool = True) -> tuple[Complex, Complex, Complex | None]:
         """F (B, N), ∂F/∂x (B, N, n) and ∂F/∂p (B, N, k) (None unless ``want_jp``) at the
         points x (B, n) with parameters p (B, k) or (k,)."""
-        x = np.asarray(x, dtype=complex)
-        p = np.broadcast_to(np.asarray(p, dtype=complex), (x.shape[0], self.k))
-        z = np.concatenate([x, p], axis=1)
-        F = self._reduce(self._terms(z))
         dims = self.n + self.k if want_jp else self.n
-        J = np.empty((x.shape[0], self.size, dims), dtype=complex)
-        for i in range(dims):
-            J[:, :, i] = self._reduce(self._derivative_terms(z, i))
-        return F, J[:, :, : self.n], (J[:, :, self.n:] if want_jp else None)
+        F, J, _ = self._blocks(self._columns(x, p), dims, None)
+        return F.T, J[:, :, : self.n], (J[:, :, self.n:] if want_jp else None)
 
-    def _terms(self, z: Complex) -> Complex:
-        factors = z[:, self.sym] ** self.pw  # (B, T, f); power 0 gives 1
-        return self.coef * np.prod(factors, axis=2)
+    def evaluate_directional(self, x: Complex, p: Complex,
+                             dp: Complex | None) -> tuple[Complex, Complex, Complex | None]:
+        """F (B, N), ∂F/∂x (B, N, n) and, when ``dp`` (B, k) is given, the derivative of F
+        along the parameter direction dp, (∂F/∂p)·dp (B, N), without forming ∂F/∂p: what a
+        parameter homotopy needs at each step."""
+        F, J, Fdp = self._blocks(self._columns(x, p), self.n, dp)
+        return F.T, J, (None if Fdp is None else Fdp.T)
 
-    def _derivative_terms(self, z: Complex, i: int) -> Complex:
-        hit = self.sym == i
-        power = np.where(hit, self.pw, 0).sum(axis=1)  # (T,)
-        pw = self.pw - hit.astype(np.intp)
-        factors = z[:, self.sym] ** np.maximum(pw, 0)
-        return (self.coef * power) * np.prod(factors, axis=2)
+    def _blocks(self, z: Complex, dims: int, dp: Complex | None
+                ) -> tuple[Complex, Complex, Complex | None]:
+        """:meth:`_evaluate_columns` over blocks of BLOCK points: the temporaries of a block
+        stay small enough to live in cache and to skip the page faults that fresh large
+        allocations cost (measured: 6× faster per point at 64 than at 128 and more)."""
+        B = z.shape[1]
+        if B <= BLOCK:
+            return self._evaluate_columns(z, dims, dp)
+        dpB = None if dp is None else np.broadcast_to(np.asarray(dp, dtype=complex),
+                                                      (B, self.k))
+        F = np.empty((self.size, B), dtype=complex)
+        J = np.empty((B, self.size, dims), dtype=complex)
+        Fdp = None if dp is None else np.empty((self.size, B), dtype=complex)
+        for start in range(0, B, BLOCK):
+            cut = slice(start, start + BLOCK)
+            f, j, fdp = self._evaluate_columns(z[:, cut], dims, None if dpB is None
+                                               else dpB[cut])
+            F[:, cut], J[cut] = f, j
+            if Fdp is not None and fdp is not None:
+                Fdp[:, cut] = fdp
+        return F, J, Fdp
 
-    def _reduce(self, values: Complex) -> Complex:
-        out = np.add.reduceat(values, self.starts, axis=1) if values.shape[1] else values
-        empty = np.diff(np.append(self.starts, values.shape[1])) == 0
-        if empty.any():
-            out[:, empty] = 0.0
-        return out
+    def _columns(self, x: Complex, p: Complex) -> Complex:
+        """The symbols as rows, the batch along the rows: z (n + k, B)."""
+        x = np.asarray(x, dtype=complex)
+        B = x.shape[0]
+        z = np.empty((self.n + self.k, B), dtype=complex)
+        z[: self.n] = x.T
+        z[self.n:] = np.broadcast_to(np.asarray(p, dtype=complex), (B, self.k)).T
+        return z
+
+    def _evaluate_columns(self, z: Complex, dims: int, dp: Complex | None
+                          ) -> tuple[Complex, Complex, Complex | None]:
+        """The core, laid out symbol-major so that every gather moves whole rows of B
+        values: a table of powers z^0..z^D (D+1, S, B); the factors of each term (T, f, B)
+        and their prefix and suffix products; F as a sparse sum of the terms; each Jacobian
+        entry (the derivative of a term by the symbol of factor f is
+        coef·pw_f·z_f^(pw_f−1) times the prefix before f and the suffix after it) as a sparse
+        sum of those (term, factor) entries into their cells (scipy.sparse CSR products, which
+        beat numpy's segmented sums several times over)."""
+        B = z.shape[1]
+        table = self._power_table(z)
+        powers = table[self.pw, self.sym]  # (T, f, B)
+        width = self.sym.shape[1]
+        prefix = np.empty((width + 1, len(self.eq), B), dtype=complex)
+        suffix = np.empty_like(prefix)
+        prefix[0] = 1.0
+        suffix[width] = 1.0
+        for f in range(width):
+            prefix[f + 1] = prefix[f] * powers[:, f]
+            suffix[width - 1 - f] = suffix[width - f] * powers[:, width - 1 - f]
+        plan = self._plan(dims)
+        F = np.asarray(plan["F"] @ (self.coef[:, None] * prefix[width]))
+
+        def entries(term: NDArray[np.intp], slot: NDArray[np.intp]) -> Complex:
+            lower = np.maximum(self.pw[term, slot] - 1, 0)
+            scale = (self.coef[term] * self.pw[term, slot])[:, None]
+            return (table[lower, self.sym[term, slot]] * prefix[slot, term]
+                    * suffix[slot + 1, term] * scale)
+
+        J = np.asarray(plan["J"] @ entries(plan["term"], plan["slot"]))
+        J3 = J.reshape(self.size, dims, B).transpose(2, 0, 1)
+        if dp is None:
+            return F, J3, None
+        dpT = np.broadcast_to(np.asarray(dp, dtype=complex), (B, self.k)).T
+        term_p, slot_p = plan["term_p"], plan["slot_p"]
+        weighted = entries(term_p, slot_p) * dpT[self.sym[term_p, slot_p] - self.n]
+        return F, J3, np.asarray(plan["P"] @ weighted)
+
+    def homogenized(self) -> PolynomialSystem:
+        """The system in n+1 homogeneous unknowns (h, x·h): each term of equation i times
+        h^(d_i − its degree), so F_i^h(h, y) = h^(d_i)·F_i(y/h) (Sommese & Wampler 2005,
+        §3.2). The new unknown ``h`` comes first; parameters are unchanged and N = n
+        equations remain (a patch equation closes the system)."""
+        unknown = self.sym < self.n
+        term_degree = np.where(unknown, self.pw, 0).sum(axis=1)
+        lift = np.asarray(self.degrees, dtype=np.intp)[self.eq] - term_degree
+        sym = np.concatenate([self.sym + 1, np.zeros((len(self.eq), 1), dtype=np.intp)], axis=1)
+        pw = np.concatenate([self.pw, lift[:, None]], axis=1)
+        name = "h"
+        while name in self.variables or name in self.parameters:
+            name += "_"
+        return PolynomialSystem((name, *self.variables), self.parameters, self.eq, self.coef,
+                                sym, pw, self.starts, self.degrees)
+
+    def coefficients_at(self, p: Complex) -> tuple[NDArray[np.intp], NDArray[np.intp], Complex]:
+        """The system as polynomials in x alone at the parameters p (B, k) or (k,): the
+        equation (G,) and exponent vector (G, n) of each distinct monomial in x, and its
+        coefficient (B, G), the sum over the terms with that monomial of coef·Π p^pw."""
+        p = np.atleast_2d(np.asarray(p, dtype=complex))
+        unknown = self.sym < self.n
+        exps = np.zeros((len(self.eq), self.n), dtype=np.intp)
+        rows = np.nonzero(unknown)
+        np.add.at(exps, (rows[0], self.sym[rows]), self.pw[rows])
+        keys, group = np.unique(np.column_stack([self.eq, exps]), axis=0, return_inverse=True)
+        z = self._columns(np.ones((len(p), self.n), dtype=complex), p)
+        values = (self.coef[:, None] * np.prod(self._power_table(z)[self.pw, self.sym],
+                                               axis=1)).T
+        out = np.zeros((len(p), len(keys)), dtype=complex)
+        order = np.argsort(group.reshape(-1), kind="stable")
+        heads = np.flatnonzero(np.r_[True, np.diff(group.reshape(-1)[order]) != 0])
+        out[:] = np.add.reduceat(values[:, order], heads, axis=1)
+        return keys[:, 0].astype(np.intp), keys[:, 1:].astype(np.intp), out
+
+    def _power_table(self, z: Complex) -> Complex:
+        """z^0..z^D (D+1, S, B) for z (S, B)."""
+        top = int(self.pw.max(initial=0))
+        table = np.empty((top + 1, *z.shape), dtype=complex)
+        table[0] = 1.0
+        for d in range(1, top + 1):
+            table[d] = table[d - 1] * z
+        return table
+
+    def _plan(self, dims: int) -> dict[str, Any]:
+        """The sparse sums of one evaluation (cached per ``dims``): terms into equations
+        ("F", N×T); the nonzero (term, factor) entries with symbol < dims into the Jacobian
+        cells eq·dims + symbol ("J", N·dims×M, with their "term" and "slot"); and the entries
+        with a parameter symbol into equations ("P", with "term_p", "slot_p")."""
+        from scipy import sparse
+
+        cache = self.__dict__.setdefault("_plans", {})
+        if dims not in cache:
+            T, N = len(self.eq), self.size
+            term, slot = np.nonzero((self.pw > 0) & (self.sym < dims))
+            cell = self.eq[term] * dims + self.sym[term, slot]
+            term_p, slot_p = np.nonzero((self.pw > 0) & (self.sym >= self.n))
+
+            def matrix(rows: NDArray[np.intp], cols: int, shape0: int) -> Any:
+                ones = np.ones(len(rows), dtype=complex)
+                return sparse.csr_matrix((ones, (rows, np.arange(cols))), shape=(shape0, cols))
+
+            cache[dims] = {"F": matrix(self.eq, T, N), "J": matrix(cell, len(term), N * dims),
+                           "term": term, "slot": slot,
+                           "P": matrix(self.eq[term_p], len(term_p), N),
+                           "term_p": term_p, "slot_p": slot_p}
+        return cache[dims]  # type: ignore[no-any-return]
 
 
 def compile_system(equations: Sequence[Poly], variables: Sequence[str],
