@@ -32,7 +32,12 @@ def register(app: typer.Typer) -> None:
         from screwkit.simulation.spec_run import spec_gravity
 
         check_paths([spec], {"--output": output})
-        s = loop_only(guard(lambda: load_spec(spec)), "export-mjcf")
+        s = guard(lambda: load_spec(spec))
+        if getattr(s, "family", None) == "graph":
+            from screwkit.cli.graph_simulate import export_graph_mjcf
+
+            return export_graph_mjcf(s, output, spec, gravity, timestep)
+        s = loop_only(s, "export-mjcf")
         with_gravity = export_gravity(s) if gravity is None else gravity
         flywheel = s.drive.flywheel if s.drive else 0.0
         text = guard(lambda: mjcf_model(s.linkage, start=float(s.inputs[0]), mode=s.mode,

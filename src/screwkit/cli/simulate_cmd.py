@@ -111,7 +111,13 @@ def register(app: typer.Typer) -> None:
             lambda: to_si(flywheel, "inertia", "kg*m**2"))
         from screwkit.messages import message_units
 
-        s = loop_only(guard(lambda: load_spec(spec)), "simulate")
+        s = guard(lambda: load_spec(spec))
+        if getattr(s, "family", None) == "graph":
+            from screwkit.cli.graph_simulate import simulate_graph_cli
+
+            return simulate_graph_cli(s, out, flywheel=fw, fluctuation=fluctuation,
+                                      cycles=cycles, plot=plot)
+        s = loop_only(s, "simulate")
         du = out.units_for(s.units)
         with message_units(du):
             run = guard(lambda: simulate_spec(s, fluctuation=fluctuation, cycles=cycles,

@@ -107,6 +107,7 @@ class GraphSpecFile(_Strict):
     gravity: Value | None = None
     gravity_direction: list[StrictFloat | StrictInt] = Field(
         default_factory=lambda: [0.0, 0.0, -1.0])
+    drive: dict[str, Any] | None = None  # checked by io/graph_drive.py when simulating
 
 
 def is_graph_spec(data: dict[str, Any]) -> bool:

@@ -83,6 +83,9 @@ def checked_graph_friction(mech: Mechanism, friction: Sequence[JointFriction]
     coefficient needs a joint that turns (not P), a translation one a joint that slides (P or
     C); coefficients are ≥ 0."""
     names = {j.name: j for j in mech.joints}
+    from screwkit.kinematics.graph.idle import rods
+
+    rod_balls = {mech.joints[k].name: body for body, a, b in rods(mech) for k in (a, b)}
     merged: dict[str, JointFriction] = {}
     for f in friction:
         j = names.get(f.joint)
@@ -92,6 +95,12 @@ def checked_graph_friction(mech: Mechanism, friction: Sequence[JointFriction]
         if not (f.rotation >= 0 and f.translation >= 0):
             raise SimulationError(f"{mech.name}: joint {f.joint!r}: friction coefficients are "
                                   ">= 0")
+        if f.rotation and f.joint in rod_balls:
+            raise SimulationError(
+                f"{mech.name}: joint {f.joint!r} is a ball joint of the rod "
+                f"{rod_balls[f.joint]!r}, which lies between two ball joints: its spin about "
+                "its own axis is idle and held at zero, so friction there, which would drive "
+                "that spin, is not modelled; put friction on the other joints")
         if f.rotation and j.kind == "P":
             raise SimulationError(f"{mech.name}: joint {f.joint!r} is a P joint, it does not "
                                   "turn: give it translation friction only")
@@ -151,6 +160,22 @@ class GraphEquationOfMotion:
         self.rank = expected_rank(mech, self.layout)
         self._idle = self.rank < len(self.layout.passive)
         self._conf = zero_configuration(self.layout)
+
+    def start_at(self, x: ArrayLike) -> None:
+        """Start the closures from the drawn mode followed to inputs ``x`` (n,) (the graph
+        tracker, :func:`~screwkit.kinematics.graph.motion.solve_mechanism`), so that a run
+        starting away from the drawing stays in the drawn assembly mode."""
+        from screwkit.kinematics.graph.motion import solve_mechanism
+
+        X = np.asarray(x, dtype=float).reshape(1, -1)
+        if np.all(X == 0.0):
+            self._conf = zero_configuration(self.layout)
+            return
+        md = solve_mechanism(self.mechanism, X, rates=0.0, accelerations=0.0).mode(0)
+        if not md.assembles[0]:
+            raise SimulationError(f"{self.mechanism.name}: the drawn mode does not assemble at "
+                                  f"the start inputs {self._shown(X[0])}")
+        self._conf = md.conf.take(np.array([0]))
 
     # --- kinematics --------------------------------------------------------------------
     def close(self, x: ArrayLike) -> GraphState:

@@ -93,6 +93,7 @@ def simulate_graph(eom: GraphEquationOfMotion, *, duration: float, samples: int 
     x0, v0 = x0 * np.ones(n), v0 * np.ones(n)
     _check(eom, duration, samples, x0, v0)
     times = np.linspace(0.0, float(duration), int(samples))
+    eom.start_at(x0)
 
     def rhs(t: float, y: Array) -> Array:
         T = eom.terms(y[:n], y[n:2 * n])
