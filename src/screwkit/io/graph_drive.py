@@ -134,6 +134,11 @@ def graph_drive_config(spec: Any) -> GraphDriveConfig:
             _fail(spec, f'motors."{name}"', f"{name!r} is a slide: motors drive rotating "
                                             "inputs (a force motor is not offered yet)")
         motors.append(MotorConfig() if table is None else _motor(spec, table))
+    freedoms = [f for j in spec.mechanism.joints for f in j.freedom_names()]
+    missing = sorted(set(t.motors) - set(freedoms))
+    if missing:
+        _fail(spec, "motors", f"a motor on {missing}: no such freedom in {spec.name!r}; motors "
+                              f"drive its inputs {inputs}")
     unknown = sorted(set(t.motors) - set(inputs))
     if unknown:
         _fail(spec, "motors", f"a motor on {unknown}, which {'is' if len(unknown) == 1 else 'are'}"
