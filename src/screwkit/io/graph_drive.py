@@ -19,11 +19,20 @@ The run starts at the first ``[motion]`` row (measured from the drawing)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr
-from pydantic import ValidationError
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+)
 
 from screwkit.io.drive_table import (
     DriveConfigError,
@@ -32,7 +41,7 @@ from screwkit.io.drive_table import (
     MotorConfig,
     MotorTable,
     Value,
-    _motor,
+    motor_config,
 )
 from screwkit.io.validation import validation_lines
 
@@ -70,17 +79,18 @@ def _fail(spec: Any, key: str, message: str) -> None:
     raise DriveConfigError(f"{spec.path}: [drive.{key}] {message}")
 
 
-def _per_input(spec: Any, value: Any, kind: str, key: str) -> tuple[float, ...]:
-    """One SI value per input from a single value or an ``{input = value}`` table."""
+def _per_input(spec: Any, value: Any, kind: Callable[[str], str], key: str
+               ) -> tuple[float, ...]:
+    """One SI value per input from a single value or an ``{input = value}`` table;
+    ``kind(input)`` is the quantity kind of that input's value."""
     inputs = list(spec.mechanism.inputs)
     if not isinstance(value, dict):
-        return tuple(spec.quantity(value, kind(name) if callable(kind) else kind, f"drive.{key}")
-                     for name in inputs)
+        return tuple(spec.quantity(value, kind(name), f"drive.{key}") for name in inputs)
     unknown = sorted(set(value) - set(inputs))
     if unknown:
         _fail(spec, key, f"{unknown} are not inputs of {spec.name!r}; the inputs are {inputs}")
-    return tuple(spec.quantity(value.get(name, 0.0), kind(name) if callable(kind) else kind,
-                               f"drive.{key}.{name}") for name in inputs)
+    return tuple(spec.quantity(value.get(name, 0.0), kind(name), f"drive.{key}.{name}")
+                 for name in inputs)
 
 
 def _friction(spec: Any, table: dict[str, Any] | None) -> tuple[JointFriction, ...]:
@@ -133,7 +143,7 @@ def graph_drive_config(spec: Any) -> GraphDriveConfig:
         if table is not None and name.endswith(".s") and table.kind != "none":
             _fail(spec, f'motors."{name}"', f"{name!r} is a slide: motors drive rotating "
                                             "inputs (a force motor is not offered yet)")
-        motors.append(MotorConfig() if table is None else _motor(spec, table))
+        motors.append(MotorConfig() if table is None else motor_config(spec, table))
     freedoms = [f for j in spec.mechanism.joints for f in j.freedom_names()]
     missing = sorted(set(t.motors) - set(freedoms))
     if missing:

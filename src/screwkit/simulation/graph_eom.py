@@ -49,7 +49,13 @@ from screwkit.kinematics.graph.closure import (
     graph_layout,
     zero_configuration,
 )
-from screwkit.kinematics.graph.newton import Linearised, accelerations, newton, rates
+from screwkit.kinematics.graph.newton import (
+    Linearised,
+    accelerations,
+    increment,
+    newton,
+    rates,
+)
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mass import MassProperties
 from screwkit.model.mechanism import Mechanism
@@ -160,6 +166,7 @@ class GraphEquationOfMotion:
         self.rank = expected_rank(mech, self.layout)
         self._idle = self.rank < len(self.layout.passive)
         self._conf = zero_configuration(self.layout)
+        self._last: tuple[Array, Array] | None = None  # inputs and G of the last closure
 
     def start_at(self, x: ArrayLike) -> None:
         """Start the closures from the drawn mode followed to inputs ``x`` (n,) (the graph
@@ -168,6 +175,7 @@ class GraphEquationOfMotion:
         from screwkit.kinematics.graph.motion import solve_mechanism
 
         X = np.asarray(x, dtype=float).reshape(1, -1)
+        self._last = None
         if np.all(X == 0.0):
             self._conf = zero_configuration(self.layout)
             return
@@ -183,7 +191,11 @@ class GraphEquationOfMotion:
         one, and the partial rates G."""
         mech, lay = self.mechanism, self.layout
         X = np.asarray(x, dtype=float).reshape(1, -1)
-        conf, err, lin = newton(mech, lay, self._conf, X, max_iter=20)
+        start = self._conf
+        if self._last is not None:  # first-order predictor along the last partial rates
+            x_last, G_last = self._last
+            start = increment(start, (G_last @ (X[0] - x_last))[None], lay)
+        conf, err, lin = newton(mech, lay, start, X, max_iter=20)
         if not err[0] <= CLOSURE_LIMIT:
             raise SimulationError(
                 f"{mech.name}: the loops do not close at inputs {self._shown(X[0])} (scaled "
@@ -201,6 +213,7 @@ class GraphEquationOfMotion:
 
                 qd = hold_rod_spin(mech, lay, lin, qd)
             G[:, k] = qd[0]
+        self._last = (X[0].copy(), G)
         return GraphState(conf, lin, G, float(err[0]), ratio)
 
     def _shown(self, x: Array) -> str:

@@ -41,7 +41,7 @@ from numpy.typing import ArrayLike
 from screwkit.io.drive_table import JointFriction
 from screwkit.model.mechanism import GROUND, Mechanism
 from screwkit.simulation.graph_eom import Array, checked_graph_friction, graph_masses
-from screwkit.simulation.mjcf import DEFAULT_SOLIMP, DEFAULT_SOLREF, DEFAULT_TIMESTEP, _f
+from screwkit.simulation.mjcf import DEFAULT_SOLIMP, DEFAULT_SOLREF, DEFAULT_TIMESTEP, xml_numbers
 from screwkit.simulation.reduced import SimulationError
 
 
@@ -90,7 +90,7 @@ def _joint_lines(mech: Mechanism, k: int, reversed_: bool, indent: str,
     rot, slide = damping.get(j.name, (0.0, 0.0))
     if j.kind == "S":
         return [f'{indent}<joint name={quoteattr(j.name + "_ball")} type="ball" '
-                f'pos="{_f(j.at)}" limited="false" damping="{rot!r}"/>']
+                f'pos="{xml_numbers(j.at)}" limited="false" damping="{rot!r}"/>']
     items: list[tuple[str, str, Array]] = []
     if j.kind == "U":
         assert j.axis2 is not None
@@ -106,8 +106,8 @@ def _joint_lines(mech: Mechanism, k: int, reversed_: bool, indent: str,
     for f, tag, u in items:
         name = f"{j.name}_{f}"
         c = slide if tag == "slide" else rot
-        lines.append(f'{indent}<joint name={quoteattr(name)} type="{tag}" pos="{_f(j.at)}" '
-                     f'axis="{_f(u)}" limited="false" damping="{c!r}" '
+        lines.append(f'{indent}<joint name={quoteattr(name)} type="{tag}" pos="{xml_numbers(j.at)}" '
+                     f'axis="{xml_numbers(u)}" limited="false" damping="{c!r}" '
                      f'armature="{armature.get(name, 0.0)!r}"/>')
     return lines
 
@@ -121,15 +121,15 @@ def _body_lines(mech: Mechanism, body: str, children: dict[str, list[tuple[int, 
     assert mp is not None
     I = mp.inertia
     lines = [f'{indent}<body name={quoteattr(body)} pos="0 0 0" quat="1 0 0 0">',
-             f'{indent}  <inertial pos="{_f(mp.com)}" mass="{mp.mass:.17g}" fullinertia="'
-             f'{_f([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>']
+             f'{indent}  <inertial pos="{xml_numbers(mp.com)}" mass="{mp.mass:.17g}" fullinertia="'
+             f'{xml_numbers([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>']
     reversed_ = mech.joints[joint].bodies[1] != body  # the tree reaches body as the first
     lines += _joint_lines(mech, joint, reversed_, indent + "  ", damping, armature)
     points = [j.at for j in mech.joints if body in j.bodies]
     points += [p.at for p in mech.points if p.body == body]
     for p in points[1:]:
         if np.linalg.norm(p - points[0]) > 1e-9 * mech.length_scale:
-            lines.append(f'{indent}  <geom type="capsule" fromto="{_f(points[0])} {_f(p)}" '
+            lines.append(f'{indent}  <geom type="capsule" fromto="{xml_numbers(points[0])} {xml_numbers(p)}" '
                          f'size="{0.02 * mech.length_scale:.6g}" mass="0" contype="0" '
                          'conaffinity="0"/>')
     for k, child in children.get(body, []):
@@ -139,7 +139,7 @@ def _body_lines(mech: Mechanism, body: str, children: dict[str, list[tuple[int, 
 
 def _equality_lines(mech: Mechanism, solref: tuple[float, ...], solimp: tuple[float, ...]
                     ) -> list[str]:
-    soft = f'solref="{_f(np.array(solref))}" solimp="{_f(np.array(solimp))}"'
+    soft = f'solref="{xml_numbers(np.array(solref))}" solimp="{xml_numbers(np.array(solimp))}"'
     lines = []
     for k in mech.topology.chords:
         j = mech.joints[k]
@@ -153,7 +153,7 @@ def _equality_lines(mech: Mechanism, solref: tuple[float, ...], solimp: tuple[fl
         name2 = "world" if b == GROUND else b
         for n, p in enumerate(points):
             lines.append(f'    <connect name={quoteattr(f"cut_{j.name}_{n}")} '
-                         f'body1={quoteattr(a)} body2={quoteattr(name2)} anchor="{_f(p)}" '
+                         f'body1={quoteattr(a)} body2={quoteattr(name2)} anchor="{xml_numbers(p)}" '
                          f'{soft}/>')
     return lines
 
@@ -191,7 +191,7 @@ def graph_mjcf_model(mech: Mechanism, *, gravity: ArrayLike | None = None,
              f"at the joints {', '.join(lay.chords)} -->",
              '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
              f'  <option timestep="{timestep:.17g}" integrator="{integrator}" '
-             f'gravity="{_f(g)}">',
+             f'gravity="{xml_numbers(g)}">',
              '    <flag contact="disable"/>',
              "  </option>",
              "  <worldbody>"]

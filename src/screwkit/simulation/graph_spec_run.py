@@ -80,5 +80,5 @@ def graph_simulation_table(sim: GraphSimulation) -> ResultTable:
              Column("potential_energy", "energy", sim.potential_energy),
              Column("motor_work", "energy", sim.motor_work),
              Column("friction_work", "energy", sim.friction_work),
-             Column("closure_residual", "dimensionless", np.asarray(sim.closure_residual))]
+             Column("closure_residual", "ratio", np.asarray(sim.closure_residual))]
     return ResultTable(tuple(cols), "simulation of a mechanism graph: one row per sample")
