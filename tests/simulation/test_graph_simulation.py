@@ -256,3 +256,30 @@ def test_export_refuses_friction_at_a_cut_joint(watt):
     chord = watt.mechanism.joints[watt.mechanism.topology.chords[0]].name
     with pytest.raises(SimulationError, match="cannot damp"):
         graph_mjcf_model(watt.mechanism, friction=[JointFriction(chord, 1e-3)])
+
+
+@pytest.mark.parametrize(("name", "start"), [("double_wishbone", -0.17), ("watt_sixbar", 0.9)])
+def test_export_keyframe_at_the_start_is_assembled_and_moves_as_screwkit(name, start):
+    """The keyframe ``start`` is the drawn mode followed to the start inputs: MuJoCo's
+    constraints hold there, its input joint is at the start, and released under gravity from it
+    MuJoCo's input angle follows screwkit's run from the same start (as the cross-check does
+    from the drawing)."""
+    spec = graph_spec(name)
+    mech = spec.mechanism
+    dt = 1e-5
+    xml = graph_mjcf_model(mech, gravity=spec.gravity_vector, timestep=dt,
+                           solref=(20 * dt, 1.0), start=[start])
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    mujoco.mj_forward(m, d)
+    assert np.max(np.abs(d.efc_pos[: d.nefc])) < 1e-12
+    jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, mech.inputs[0].replace(".", "_"))
+    adr = int(m.jnt_qposadr[jid])
+    assert d.qpos[adr] == pytest.approx(start, abs=1e-14)
+    for _ in range(2000):  # 0.02 s
+        mujoco.mj_step(m, d)
+    eom = GraphEquationOfMotion(mech, gravity=spec.gravity_vector)
+    run = simulate_graph(eom, duration=2000 * dt, samples=2, initial_inputs=[start])
+    assert abs(run.inputs[-1, 0] - start) > 1e-4  # it moved
+    assert d.qpos[adr] == pytest.approx(run.inputs[-1, 0], abs=1e-8)

@@ -71,9 +71,10 @@ def export_graph_mjcf(s: Any, output: Path, spec_path: Path, gravity: bool | Non
     text = guard(lambda: graph_mjcf_model(
         s.mechanism, gravity=s.gravity_vector if with_gravity else None, timestep=timestep,
         solref=(20 * timestep, 1.0), friction=drive.friction if drive else (),
-        flywheel=drive.flywheel if drive else None))
+        flywheel=drive.flywheel if drive else None, start=s.inputs[0]))
     guard(lambda: write_atomic(output, text, [spec_path], "--output"))
     g = (f"gravity {float(np.linalg.norm(s.gravity_vector)):.6g} m/s²" if with_gravity
          else "no gravity")
-    console.print(f"wrote {escape(str(output))} (the drawn configuration; a motor on each input; "
-                  f"{g})", highlight=False)
+    console.print(f"wrote {escape(str(output))} (the drawn configuration, keyframe 'start' at "
+                  f"the first {escape('[motion]')} row; a motor on each input; {g})",
+                  highlight=False)

@@ -12,7 +12,8 @@ becomes the body tree and every chord — the joint that closes a loop — an eq
   cannot act across the cut, so neither is used;
 * P, C, U and H chords are not exported (a clear error names the joint).
 
-The model is written in the drawn configuration: every body frame is the world frame of the
+The model is written in the drawn configuration (and, given a ``start``, with a keyframe
+``start`` at the drawn mode followed to those inputs): every body frame is the world frame of the
 drawing (as in the spec), so ``qpos0`` is the drawing and closes every loop, a joint's ``pos``
 and ``axis`` are its drawn point and axis, and a body's ``<inertial pos="com"
 fullinertia="…">`` are its spec mass properties unchanged. Tree joints: R → ``hinge``,
@@ -37,8 +38,11 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.spatial.transform import Rotation
 
 from screwkit.io.drive_table import JointFriction
+from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import GROUND, Mechanism
 from screwkit.simulation.graph_eom import Array, checked_graph_friction, graph_masses
 from screwkit.simulation.mjcf import DEFAULT_SOLIMP, DEFAULT_SOLREF, DEFAULT_TIMESTEP, xml_numbers
@@ -158,15 +162,58 @@ def _equality_lines(mech: Mechanism, solref: tuple[float, ...], solimp: tuple[fl
     return lines
 
 
+def _joint_qpos(mech: Mechanism, lay: GraphLayout, conf: Configuration, k: int,
+                reversed_: bool) -> list[float]:
+    """MuJoCo's ``qpos`` entries of tree joint ``k`` at ``conf`` (in the order
+    :func:`_joint_lines` writes them): a hinge's or slide's value is the freedom's (the axis is
+    reversed with the tree), a ball's quaternion (w, x, y, z) is its rotation (transposed where
+    the tree runs backwards)."""
+    j = mech.joints[k]
+    f0 = lay.first_freedom[k]
+    if j.kind == "S":
+        R = conf.spherical[0, lay.spherical_of_joint[k]]
+        x, y, z, w = Rotation.from_matrix(R.T if reversed_ else R).as_quat()
+        return [float(w), float(x), float(y), float(z)]
+    values = [float(conf.scalars[0, lay.scalar_col[f0 + n]]) for n in range(len(j.freedoms))]
+    return values[::-1] if j.kind == "U" and reversed_ else values
+
+
+def _start_qpos(mech: Mechanism, children: dict[str, list[tuple[int, str]]],
+                start: ArrayLike) -> list[float]:
+    """``qpos`` of the drawn mode followed to inputs ``start`` (the graph tracker), bodies in
+    the depth-first order the XML lists them."""
+    from screwkit.kinematics.graph.closure import graph_layout
+    from screwkit.kinematics.graph.motion import solve_mechanism
+
+    X = np.asarray(start, dtype=float).reshape(1, -1)
+    md = solve_mechanism(mech, X, rates=0.0, accelerations=0.0).mode(0)
+    if not md.assembles[0]:
+        raise SimulationError(f"{mech.name}: the drawn mode does not assemble at the start "
+                              f"inputs {X[0].tolist()}")
+    lay = graph_layout(mech)
+    out: list[float] = []
+
+    def visit(parent: str) -> None:
+        for k, child in children.get(parent, []):
+            out.extend(_joint_qpos(mech, lay, md.conf, k, mech.joints[k].bodies[1] != child))
+            visit(child)
+
+    visit(GROUND)
+    return out
+
+
 def graph_mjcf_model(mech: Mechanism, *, gravity: ArrayLike | None = None,
                      timestep: float = DEFAULT_TIMESTEP, integrator: str = "RK4",
                      solref: tuple[float, ...] = DEFAULT_SOLREF,
                      solimp: tuple[float, ...] = DEFAULT_SOLIMP,
                      friction: Sequence[JointFriction] = (),
-                     flywheel: ArrayLike | None = None) -> str:
+                     flywheel: ArrayLike | None = None, start: ArrayLike | None = None
+                     ) -> str:
     """The MJCF text of ``mech`` in its drawn configuration (module docstring). SI units;
     ``gravity`` (m/s², world) zero if omitted; ``friction`` the joints' viscous damping;
-    ``flywheel`` (one per input, or one for all) the input freedoms' armature."""
+    ``flywheel`` (one per input, or one for all) the input freedoms' armature; ``start`` (one
+    value per input, from the drawing) adds a keyframe ``start`` whose ``qpos`` is the drawn
+    mode there (``mj_resetDataKeyframe``)."""
     graph_masses(mech)
     lay = graph_mjcf_layout(mech)
     n = len(mech.inputs)
@@ -198,7 +245,12 @@ def graph_mjcf_model(mech: Mechanism, *, gravity: ArrayLike | None = None,
     for k, child in children.get(GROUND, []):
         lines += _body_lines(mech, child, children, 0, damping, armature, k)
     lines += ["  </worldbody>", "  <equality>", *_equality_lines(mech, solref, solimp),
-              "  </equality>", "  <actuator>"]
+              "  </equality>"]
+    if start is not None:
+        qpos = _start_qpos(mech, children, start)
+        lines += ["  <keyframe>", f'    <key name="start" qpos="{xml_numbers(qpos)}"/>',
+                  "  </keyframe>"]
+    lines += ["  <actuator>"]
     for name in mech.inputs:
         lines.append(f'    <motor name={quoteattr(name)} joint={quoteattr(lay.dofs[name])} '
                      'gear="1"/>')
