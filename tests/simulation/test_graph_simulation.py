@@ -56,24 +56,32 @@ def wishbone():  # type: ignore[no-untyped-def]
     return graph_spec("double_wishbone")
 
 
-@pytest.mark.parametrize("name", ["watt_sixbar", "double_wishbone"])
-def test_equations_of_motion_give_the_inverse_dynamics_efforts(name):
-    """M ẍ + h − Q_g is the input effort the graph inverse dynamics finds from the joint
-    reactions (dynamics/graph_statics.py) at the same inputs, rates and accelerations."""
+@pytest.mark.parametrize(("name", "step"), [("watt_sixbar", 0.05), ("double_wishbone", 0.05),
+                                           ("delta_robot", 0.05), ("stewart_platform", 0.002)])
+def test_equations_of_motion_give_the_inverse_dynamics_efforts(name, step):
+    """M ẍ + h − Q_g is every input's effort the graph inverse dynamics finds from the joint
+    reactions (dynamics/graph_statics.py) at the same inputs, rates and accelerations: one
+    crank, the suspension's rod spin held still, the Delta robot's three cranks with six idle
+    rods, the Stewart platform's six slides."""
     spec = graph_spec(name)
+    n = len(spec.mechanism.inputs)
     eom = GraphEquationOfMotion(spec.mechanism, gravity=spec.gravity_vector)
     rng = np.random.default_rng(7)
-    X = np.array([[0.0], [0.05], [0.1], [0.15], [0.2]])
-    for x in X[1:]:
-        xd, xdd = rng.normal(size=1) * 3, rng.normal(size=1) * 10
-        T = eom.terms(x, xd)
+    direction = rng.uniform(0.5, 1.0, n)
+    X = np.outer(np.arange(5) * step, direction)
+    for k in range(1, 5):
+        xd, xdd = rng.normal(size=n) * 3 * step / 0.05, rng.normal(size=n) * 10 * step / 0.05
+        T = eom.terms(X[k], xd)
         expected = T["mass_matrix"] @ xdd + T["velocity_terms"] - T["gravity"]
-        path = X[X[:, 0] <= x[0] + 1e-12]
-        motion = solve_mechanism(spec.mechanism, path, rates=xd, accelerations=xdd)
+        motion = solve_mechanism(spec.mechanism, X[: k + 1], rates=xd, accelerations=xdd)
         dyn = graph_inverse_dynamics(motion, gravity=spec.gravity_vector)
         np.testing.assert_allclose(expected, dyn.efforts[-1], rtol=1e-9,
-                                   atol=1e-12 * np.max(np.abs(T["gravity"])))
+                                   atol=1e-10 * np.max(np.abs(expected)))
         assert T["residual"] < 1e-12
+        # M is symmetric positive definite
+        M = T["mass_matrix"]
+        np.testing.assert_allclose(M, M.T, rtol=1e-12, atol=1e-15 * np.max(np.abs(M)))
+        assert np.min(np.linalg.eigvalsh(M)) > 0
 
 
 def test_energy_is_conserved_and_the_loops_stay_closed(watt, wishbone):
@@ -88,6 +96,26 @@ def test_energy_is_conserved_and_the_loops_stay_closed(watt, wishbone):
         assert np.ptp(run.inputs[:, 0]) > 0.05  # it moved: gravity did work
         E = run.kinetic_energy + run.potential_energy
         assert np.max(np.abs(E - E[0])) < 1e-9 * np.max(run.kinetic_energy)
+
+
+def test_several_motors_and_slides_balance_the_energy():
+    """The Delta robot's three cranks, each with its own motor law and flywheel, and the
+    Stewart platform's six slides falling under gravity: E(t) − E(0) = W_motor, closure kept."""
+    delta = graph_spec("delta_robot")
+    motors = [MotorConfig("constant", torque=0.5), MotorConfig("constant", torque=-0.2),
+              MotorConfig("linear", stall_torque=0.4, no_load_speed=20.0)]
+    eom = GraphEquationOfMotion(delta.mechanism, motors=motors, flywheel=[1e-3, 2e-3, 0.0],
+                                gravity=delta.gravity_vector)
+    run = simulate_graph(eom, duration=0.05, samples=6, rtol=1e-11)
+    assert run.status == "completed" and run.energy_error < 1e-9
+    assert np.max(run.closure_residual) < 1e-12
+    assert len(set(np.round(run.inputs[-1], 6))) == 3  # three different motions
+    stewart = graph_spec("stewart_platform")
+    eom = GraphEquationOfMotion(stewart.mechanism, gravity=stewart.gravity_vector)
+    run = simulate_graph(eom, duration=0.03, samples=4, rtol=1e-11)
+    assert run.status == "completed" and run.energy_error < 1e-9
+    assert np.all(run.inputs[-1] < 0)  # the legs shorten: the platform falls
+    assert np.max(run.closure_residual) < 1e-12
 
 
 def test_motor_and_friction_work_balance_the_energy(watt):
