@@ -127,6 +127,8 @@ def graph_drive_config(spec: Any) -> GraphDriveConfig:
     """The ``[drive]`` table of a loaded graph spec as a typed, SI :class:`GraphDriveConfig`;
     a :class:`~screwkit.io.drive_table.DriveConfigError` naming the file and key otherwise."""
     raw = spec.raw.drive
+    if getattr(spec, "drive", None) is not None:
+        return spec.drive  # type: ignore[no-any-return]
     if raw is None:
         raise DriveConfigError(f"{spec.path}: no [drive] table; add one to simulate (duration, "
                                "motors, flywheel, friction; docs/simulation.md, \"Graphs\")")

@@ -161,6 +161,12 @@ class GraphSpec:
         if self.topology.free or "conflict" in self.topology.verdict:
             self._fail("joints", f"{self.topology.verdict} (mark input = true on as many "
                                  "joints as the mechanism has freedoms)")
+        from screwkit.io.graph_drive import GraphDriveConfig, graph_drive_config
+
+        #: the ``[drive]`` table of ``screwkit simulate`` (io/graph_drive.py), checked here so
+        #: that ``validate`` reports what ``simulate`` would refuse
+        self.drive: GraphDriveConfig | None = (graph_drive_config(self) if raw.drive is not None
+                                               else None)
 
     def describe(self, units: DisplayUnits | None = None) -> str:
         """One line: what the spec describes."""
