@@ -311,3 +311,21 @@ def test_export_keyframe_at_the_start_is_assembled_and_moves_as_screwkit(name, s
     run = simulate_graph(eom, duration=2000 * dt, samples=2, initial_inputs=[start])
     assert abs(run.inputs[-1, 0] - start) > 1e-4  # it moved
     assert d.qpos[adr] == pytest.approx(run.inputs[-1, 0], abs=1e-8)
+
+
+def test_the_simulate_example_is_the_watt_six_bar(watt):
+    """watt_sixbar_simulate.toml is watt_sixbar.toml plus its [drive] table: the same bodies,
+    masses, joints and motion, so the Watt example's kinematics and loads tests cover it."""
+    driven = graph_spec("watt_sixbar_simulate")
+    a, b = watt.mechanism, driven.mechanism
+    assert [x.name for x in a.bodies] == [x.name for x in b.bodies]
+    for x, y in zip(a.bodies, b.bodies, strict=True):
+        assert x.mass.mass == y.mass.mass
+        assert np.array_equal(x.mass.com, y.mass.com)
+        assert np.array_equal(x.mass.inertia, y.mass.inertia)
+    for x, y in zip(a.joints, b.joints, strict=True):
+        assert (x.name, x.kind, x.bodies) == (y.name, y.kind, y.bodies)
+        assert np.array_equal(x.at, y.at) and np.array_equal(x.axis, y.axis)
+    assert np.array_equal(watt.inputs, driven.inputs) and a.inputs == b.inputs
+    assert watt.drive is None and driven.drive is not None
+    assert driven.drive.motors[0].kind == "linear" and driven.drive.gravity
