@@ -1,7 +1,7 @@
 """Cross-check of screwkit's forward dynamics of mechanism graphs against MuJoCo.
 
-For the Watt six-bar (under gravity, then under gravity with a constant motor torque on the
-crank) and the double-wishbone suspension (under gravity, released from rest in the drawing):
+For the Watt six-bar (under gravity; with a constant motor torque on the crank; with viscous
+friction in its tree joints) and the double-wishbone suspension (under gravity, released from rest in the drawing):
 
 1. ``screwkit export-mjcf`` writes the graph as a MuJoCo model: the spanning tree as the body
    tree, the loops closed by ``connect`` constraints at the chord joints
@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT / "src"))
 
 import mujoco  # noqa: E402
 
-from screwkit.io.drive_table import MotorConfig  # noqa: E402
+from screwkit.io.drive_table import JointFriction, MotorConfig  # noqa: E402
 from screwkit.io.mechanism_spec import GraphSpec, graph_spec_from_data  # noqa: E402
 from screwkit.simulation.graph_eom import GraphEquationOfMotion  # noqa: E402
 from screwkit.simulation.graph_mjcf import graph_mjcf_layout, graph_mjcf_model  # noqa: E402
@@ -49,8 +49,10 @@ SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 #: MuJoCo's own step error (its angle at the step minus at half the step, measured) plus
 #: FLOOR (rad), round-off and the screwkit integrator's tolerance
 FLOOR = 1e-8
-#: (example, motor torque on the first input in N·m, duration in s)
-CASES = (("watt_sixbar", 0.0, 0.3), ("watt_sixbar", 0.05, 0.2), ("double_wishbone", 0.0, 0.2))
+#: (example, motor torque on the first input in N·m, duration in s, viscous friction in every
+#: tree R joint in N·m·s/rad — MuJoCo's joint damping; a cut joint cannot be damped there)
+CASES = (("watt_sixbar", 0.0, 0.3, 0.0), ("watt_sixbar", 0.05, 0.2, 0.0),
+         ("watt_sixbar", 0.0, 0.3, 1e-3), ("double_wishbone", 0.0, 0.2, 0.0))
 SAMPLES = 21  # sample spacing a whole number of MuJoCo (half) steps
 
 
@@ -66,10 +68,19 @@ class MujocoRun:
     violation: float  # largest |efc_pos| of the equality rows (m)
 
 
-def mujoco_run(spec: GraphSpec, torque: float, duration: float, dt: float) -> MujocoRun:
+def friction_for(spec: GraphSpec, c: float) -> tuple[JointFriction, ...]:
+    """Viscous friction ``c`` in every R joint of the spanning tree (not at a cut)."""
+    mech = spec.mechanism
+    cut = {mech.joints[k].name for k in mech.topology.chords}
+    return tuple(JointFriction(j.name, c) for j in mech.joints
+                 if c and j.kind == "R" and j.name not in cut)
+
+
+def mujoco_run(spec: GraphSpec, torque: float, duration: float, dt: float,
+               friction: tuple[JointFriction, ...] = ()) -> MujocoRun:
     mech = spec.mechanism
     xml = graph_mjcf_model(mech, gravity=spec.gravity_vector, timestep=dt,
-                           solref=(SOLREF_STEPS * dt, 1.0), solimp=SOLIMP)
+                           solref=(SOLREF_STEPS * dt, 1.0), solimp=SOLIMP, friction=friction)
     m = mujoco.MjModel.from_xml_string(xml)
     d = mujoco.MjData(m)
     jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT,
@@ -91,22 +102,24 @@ def mujoco_run(spec: GraphSpec, torque: float, duration: float, dt: float) -> Mu
     return MujocoRun(np.array(angle), violation)
 
 
-def screwkit_run(spec: GraphSpec, torque: float, duration: float) -> tuple[np.ndarray, float,
-                                                                             float]:
+def screwkit_run(spec: GraphSpec, torque: float, duration: float,
+                 friction: tuple[JointFriction, ...] = ()) -> tuple[np.ndarray, float, float]:
     mech = spec.mechanism
     motors = [MotorConfig("constant", torque=torque) if torque else MotorConfig()]
     motors += [MotorConfig()] * (len(mech.inputs) - 1)
-    eom = GraphEquationOfMotion(mech, motors=motors, gravity=spec.gravity_vector)
+    eom = GraphEquationOfMotion(mech, motors=motors, gravity=spec.gravity_vector,
+                                friction=friction)
     run = simulate_graph(eom, duration=duration, samples=SAMPLES, rtol=1e-10)
     assert run.status == "completed", run.message
     return run.inputs[:, 0], run.energy_error, float(np.max(run.closure_residual))
 
 
-def check(name: str, torque: float, duration: float) -> dict[str, float]:
+def check(name: str, torque: float, duration: float, c: float = 0.0) -> dict[str, float]:
     spec = load(name)
-    sk_angle, energy, closure = screwkit_run(spec, torque, duration)
-    coarse = mujoco_run(spec, torque, duration, TIMESTEP)
-    fine = mujoco_run(spec, torque, duration, TIMESTEP / 2)
+    friction = friction_for(spec, c)
+    sk_angle, energy, closure = screwkit_run(spec, torque, duration, friction)
+    coarse = mujoco_run(spec, torque, duration, TIMESTEP, friction)
+    fine = mujoco_run(spec, torque, duration, TIMESTEP / 2, friction)
     return {"difference": float(np.max(np.abs(coarse.angle - sk_angle))),
             "MuJoCo step error": float(np.max(np.abs(coarse.angle - fine.angle))),
             "difference (half step)": float(np.max(np.abs(fine.angle - sk_angle))),
@@ -134,20 +147,20 @@ def main() -> int:
              f"constraints solref = ({SOLREF_STEPS:g}·timestep, 1), solimp = {SOLIMP}; gravity "
              "as the spec (9.80665 m/s²); input angle compared at "
              f"{SAMPLES} equal times.", "",
-             "| example | motor torque (N·m) | duration (s) | input travel (rad) | max |Δθ| "
+             "| example | motor torque (N·m) | friction (N·m·s/rad) | duration (s) | input travel (rad) | max |Δθ| "
              "(rad) | max |Δθ|, half step | MuJoCo constraint violation (m) | violation / L | "
              "screwkit energy error | screwkit closure | bound: 2 × MuJoCo step error + "
              f"{FLOOR:g} |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for name, torque, duration in CASES:
-        r = check(name, torque, duration)
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, torque, duration, c in CASES:
+        r = check(name, torque, duration, c)
         bound = 2.0 * r["MuJoCo step error"] + FLOOR
         ok = (r["difference (half step)"] <= bound
               and r["difference (half step)"] <= r["difference"] + FLOOR)
         if not ok:
             failed.append(f"{name} (torque {torque}): |Δθ| {r['difference']:.3g}, half step "
                           f"{r['difference (half step)']:.3g}")
-        lines.append(f"| {name} | {torque:g} | {duration:g} | {r['travel']:.4g} | "
+        lines.append(f"| {name} | {torque:g} | {c:g} | {duration:g} | {r['travel']:.4g} | "
                      f"{r['difference']:.2e} | {r['difference (half step)']:.2e} | "
                      f"{r['violation']:.2e} | {r['violation / L']:.2e} | "
                      f"{r['energy error']:.1e} | {r['closure']:.1e} | {bound:.2e}"
