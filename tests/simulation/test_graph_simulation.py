@@ -203,7 +203,8 @@ def test_friction_on_an_idle_rod_ball_is_refused(wishbone):
 
 
 def test_simulate_cli_on_the_example(tmp_path):
-    """The bundled graph simulate example runs (shortened by its copy), writes JSON and CSV."""
+    """The bundled graph simulate example runs (shortened by its copy), writes JSON, CSV and
+    the plots; --cycles, for a loop's crank cycles, is refused."""
     text = (EXAMPLES / "mechanisms" / "watt_sixbar_simulate.toml").read_text(encoding="utf-8")
     assert 'duration = "1 s"' in text
     spec = tmp_path / "w.toml"
@@ -219,6 +220,9 @@ def test_simulate_cli_on_the_example(tmp_path):
     assert r.exit_code == 0, r.output
     head = (tmp_path / "s.csv").read_text(encoding="utf-8").splitlines()[0]
     assert "OA.theta" in head and "closure_residual" in head
+    r = runner.invoke(app, ["simulate", str(spec), "--plot", str(tmp_path / "s.png"), "--json"])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "s.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     r = runner.invoke(app, ["simulate", str(spec), "--cycles", "2"])
     assert r.exit_code == 2 and "[drive] duration" in r.output
 

@@ -18,7 +18,7 @@ def simulate_graph_cli(s: Any, out: Any, *, flywheel: float | None, fluctuation:
     from screwkit.messages import message_units
     from screwkit.simulation.graph_spec_run import graph_simulation_table, simulate_graph_spec
 
-    for flag, value in (("--fluctuation", fluctuation), ("--cycles", cycles), ("--plot", plot)):
+    for flag, value in (("--fluctuation", fluctuation), ("--cycles", cycles)):
         if value is not None:
             user_error(f"{s.path}: {flag} is for a single loop's crank cycles; a mechanism graph "
                        "is simulated for [drive] duration (docs/simulation.md, \"Graphs\")")
@@ -26,6 +26,11 @@ def simulate_graph_cli(s: Any, out: Any, *, flywheel: float | None, fluctuation:
     with message_units(du):
         run = guard(lambda: simulate_graph_spec(s, flywheel=flywheel))
     doc = guard(lambda: run.as_dict())
+    if plot is not None:
+        from screwkit.report.simulation_plots import write_graph_simulation_png
+
+        guard(lambda: write_graph_simulation_png(doc, plot))
+        out.note_written(plot)
     out.deliver(document=lambda: doc, table=lambda: graph_simulation_table(run.simulation),
                 show=lambda: _show(s, run.simulation, du), units=du)
 
