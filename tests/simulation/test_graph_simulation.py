@@ -333,3 +333,13 @@ def test_the_simulate_example_is_the_watt_six_bar(watt):
     assert np.array_equal(watt.inputs, driven.inputs) and a.inputs == b.inputs
     assert watt.drive is None and driven.drive is not None
     assert driven.drive.motors[0].kind == "linear" and driven.drive.gravity
+
+
+def test_a_jump_of_the_closure_is_refused(watt):
+    """A closure far from the predictor (an input step of 2.5 rad at once) is refused rather
+    than risk landing on another assembly branch; small steps pass."""
+    eom = GraphEquationOfMotion(watt.mechanism)
+    for x in np.linspace(0.0, 0.5, 11):
+        eom.terms([x], [0.0])
+    with pytest.raises(SimulationError, match="assembly branch"):
+        eom.terms([2.5], [0.0])

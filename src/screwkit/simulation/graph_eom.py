@@ -52,6 +52,8 @@ from screwkit.kinematics.graph.closure import (
 from screwkit.kinematics.graph.newton import (
     Linearised,
     accelerations,
+    column_scale,
+    difference,
     increment,
     newton,
     rates,
@@ -67,6 +69,12 @@ Array = NDArray[np.float64]
 #: scaled closure residual a state must reach (the graph Newton's own target is 1e-13; this
 #: leaves room for round-off on large mechanisms and is the bound the runs report against)
 CLOSURE_LIMIT = 1e-10
+#: near a limit (this fraction) a large Newton correction is the limit's doing, reported so
+NEAR_SINGULAR = 1e-2
+#: largest Newton correction (rad, or the mechanism's length scale) accepted after the
+#: first-order predictor: its error is second order in the input step, so a larger one means
+#: a step too long to be sure the closure stayed on its assembly branch (refused, not guessed)
+BRANCH_JUMP = 0.05
 #: a state whose passive block's smallest kept singular value falls below this fraction of the
 #: largest is at a dead centre or limit position: the input coordinates stop describing it
 SINGULAR_RATIO = 1e-6
@@ -200,9 +208,18 @@ class GraphEquationOfMotion:
             raise SimulationError(
                 f"{mech.name}: the loops do not close at inputs {self._shown(X[0])} (scaled "
                 f"residual {err[0]:.3g}): the motion has left the assembled range")
-        self._conf = conf
         s = lin.sigma[0]
         ratio = float(s[self.rank - 1] / s[0]) if self.rank and s.size else 1.0
+        correction = difference(conf, start, lay) / column_scale(lay)
+        if self._last is not None and float(np.max(np.abs(correction))) > BRANCH_JUMP:
+            if ratio < NEAR_SINGULAR:  # the passive rates grow without bound at a limit
+                raise self._singular_error(X[0])
+            raise SimulationError(
+                f"{mech.name}: closing the loops at inputs {self._shown(X[0])} moved the "
+                f"passive freedoms by {float(np.max(np.abs(correction))):.3g} (rad, or length "
+                "scales) from the predicted configuration, too far to be sure it stayed on its "
+                "assembly branch; integrate with a smaller rtol (smaller steps)")
+        self._conf = conf
         G = np.empty((lay.m, self.inputs))
         for k in range(self.inputs):
             e = np.zeros((1, self.inputs))
@@ -215,6 +232,12 @@ class GraphEquationOfMotion:
             G[:, k] = qd[0]
         self._last = (X[0].copy(), G)
         return GraphState(conf, lin, G, float(err[0]), ratio)
+
+    def _singular_error(self, x: Array) -> SimulationError:
+        return SimulationError(
+            f"{self.mechanism.name}: the motion reaches a dead centre or limit position at "
+            f"inputs {self._shown(x)}, where the inputs stop describing it (the equations of "
+            "motion in the input coordinates are singular there)")
 
     def _shown(self, x: Array) -> str:
         lay = self.layout
@@ -248,10 +271,7 @@ class GraphEquationOfMotion:
         xd = np.asarray(xd, dtype=float)
         st = self.close(x)
         if st.singular_ratio < SINGULAR_RATIO:
-            raise SimulationError(
-                f"{mech.name}: the motion reaches a dead centre or limit position at inputs "
-                f"{self._shown(np.asarray(x, dtype=float))}, where the inputs stop describing "
-                "it (the equations of motion in the input coordinates are singular there)")
+            raise self._singular_error(np.asarray(x, dtype=float))
         c, I_w = self._body_frames(st)
         w_k, v_k = self._partials(st, c)
         m = self.mass
