@@ -19,7 +19,8 @@ HERE = Path(__file__).resolve().parent
 EXAMPLES = HERE.parent / "examples" / "mechanisms"
 MARKERS = {"R": "o", "P": "s", "C": "D", "H": "h", "U": "^", "S": "*"}
 #: examples drawn flat (seen along z): the planar ones
-PLANAR = {"fourbar_graph", "watt_sixbar", "watt_sixbar_balance", "stephenson3_sixbar",
+PLANAR = {"fourbar_graph", "watt_sixbar", "watt_sixbar_balance", "watt_sixbar_simulate",
+          "stephenson3_sixbar",
           "jansen_leg"}
 
 

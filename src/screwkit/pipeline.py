@@ -66,11 +66,12 @@ class Pipeline:
                  progress: Callable[[int, int], None] | bool | None = None,
                  units: UnitChoice | None = None) -> None:
         if getattr(spec, "family", None) == "graph":  # io.mechanism_spec.GraphSpec
-            raise SpecError(f"{spec.path}: a mechanism graph (bodies and joints): validate, "
-                            "analyze, mobility, limits, report, dynamics, sweep, tolerance and "
-                            "balance work on it (screwkit.balancing.graph.balance_mechanism from "
-                            "Python); synthesis and simulation of graphs are not there yet "
-                            "(docs/mechanisms.md)")
+            raise SpecError(f"{spec.path}: a mechanism graph (bodies and joints) is not run by "
+                            "a Pipeline: from Python use screwkit.kinematics.graph.motion."
+                            "solve_mechanism and screwkit.balancing.graph.balance_mechanism; the "
+                            "CLI's validate, analyze, mobility, limits, report, dynamics, sweep, "
+                            "tolerance, balance, simulate and export-mjcf take it; synthesis of "
+                            "graphs is not there yet (docs/mechanisms.md)")
         expect_instance(spec, Spec, "Pipeline: spec", "a Spec (sk.load_spec(path))")
         if method not in ("auto", "closed", "generic"):
             raise InputError(f"Pipeline: method must be 'auto', 'closed' or 'generic'; got "

@@ -22,7 +22,7 @@ def register(app: typer.Typer) -> None:
         gravity: Annotated[bool | None, typer.Option("--gravity/--no-gravity", help="Include the spec's gravity (its gravity, default 9.80665 m/s², along gravity_direction) or leave it out. Default: as screwkit simulate has it ([drive] gravity); on for a spec without [drive].", show_default=False)] = None,
         timestep: Annotated[float, typer.Option("--timestep", help="MuJoCo time step (s); the equality constraints' time constant is 20 steps.", min=1e-9, max=1.0)] = 1e-5,
     ) -> None:
-        """Write a MuJoCo model (MJCF) of the spec's loop at its [motion] start, in its [motion] mode, with its [drive] flywheel (the input's armature), friction and gravity: the model screwkit simulate integrates, less the motor law and the load."""
+        """Write a MuJoCo model (MJCF) of the spec's loop at its [motion] start, in its [motion] mode, with its [drive] flywheel (the input's armature), friction and gravity: the model screwkit simulate integrates, less the motor law and the load. A mechanism graph: its spanning tree as the body tree, its loops closed by connect constraints at the cut joints, a motor per input, a keyframe 'start' at its first [motion] row."""
         from rich.markup import escape
 
         from screwkit.cli.common import check_paths, console, guard, loop_only
@@ -32,7 +32,12 @@ def register(app: typer.Typer) -> None:
         from screwkit.simulation.spec_run import spec_gravity
 
         check_paths([spec], {"--output": output})
-        s = loop_only(guard(lambda: load_spec(spec)), "export-mjcf")
+        s = guard(lambda: load_spec(spec))
+        if getattr(s, "family", None) == "graph":
+            from screwkit.cli.graph_simulate import export_graph_mjcf
+
+            return export_graph_mjcf(s, output, spec, gravity, timestep)
+        s = loop_only(s, "export-mjcf")
         with_gravity = export_gravity(s) if gravity is None else gravity
         flywheel = s.drive.flywheel if s.drive else 0.0
         text = guard(lambda: mjcf_model(s.linkage, start=float(s.inputs[0]), mode=s.mode,

@@ -95,7 +95,7 @@ def register(app: typer.Typer) -> None:
         cycles: Annotated[int | None, typer.Option("--cycles", help="Cycles to simulate (default: [drive] cycles).", min=1, max=100000)] = None,
         flywheel: Annotated[str | None, typer.Option("--flywheel", help="Flywheel inertia on the input shaft, e.g. \"0.02 kg*m^2\" (overrides [drive] flywheel).")] = None,
     ) -> None:
-        """Forward dynamics of the machine: motor, flywheel and load of the [drive] table; speed fluctuation, motor torque, energy per cycle and every load; --fluctuation sizes the flywheel."""
+        """Forward dynamics of the machine: motor, flywheel and load of the [drive] table; speed fluctuation, motor torque, energy per cycle and every load; --fluctuation sizes the flywheel. A mechanism graph: a motor per input, flywheel and friction over [drive] duration, the loops closed at every step (docs/simulation.md, "Graphs")."""
         from screwkit.cli.common import guard, loop_only, user_error
         from screwkit.cli.outputs import Outputs
         from screwkit.io.spec import load_spec
@@ -111,7 +111,13 @@ def register(app: typer.Typer) -> None:
             lambda: to_si(flywheel, "inertia", "kg*m**2"))
         from screwkit.messages import message_units
 
-        s = loop_only(guard(lambda: load_spec(spec)), "simulate")
+        s = guard(lambda: load_spec(spec))
+        if getattr(s, "family", None) == "graph":
+            from screwkit.cli.graph_simulate import simulate_graph_cli
+
+            return simulate_graph_cli(s, out, flywheel=fw, fluctuation=fluctuation,
+                                      cycles=cycles, plot=plot)
+        s = loop_only(s, "simulate")
         du = out.units_for(s.units)
         with message_units(du):
             run = guard(lambda: simulate_spec(s, fluctuation=fluctuation, cycles=cycles,

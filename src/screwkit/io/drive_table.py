@@ -149,7 +149,7 @@ def _fail(spec: Any, key: str, message: str) -> None:
     raise DriveConfigError(f"{spec.path}: [drive.{key}] {message}")
 
 
-def _motor(spec: Any, t: MotorTable) -> MotorConfig:
+def motor_config(spec: Any, t: MotorTable) -> MotorConfig:
     need = {"constant": ("torque",), "linear": ("stall_torque", "no_load_speed"),
             "table": ("speeds", "torques"), "none": ()}[t.kind]
     given = {k for k in ("torque", "stall_torque", "no_load_speed", "speeds", "torques")
@@ -312,7 +312,7 @@ def drive_config(spec: Any) -> DriveConfig:
     max_time = None if t.max_time is None else _si(spec, t.max_time, "time", "max_time")
     if max_time is not None and not max_time > 0:
         _fail(spec, "max_time", f"must be positive; got {t.max_time!r}")
-    return DriveConfig(motor=_motor(spec, t.motor), load=_load(spec, t.load), flywheel=flywheel,
+    return DriveConfig(motor=motor_config(spec, t.motor), load=_load(spec, t.load), flywheel=flywheel,
                        initial_speed=speed, cycles=t.cycles,
                        samples_per_cycle=t.samples_per_cycle, rtol=t.rtol, atol=t.atol,
                        gravity=t.gravity, max_time=max_time,

@@ -122,6 +122,7 @@ class GraphSpecFile(_Strict):
         default_factory=lambda: [0.0, 0.0, -1.0])
     tolerances: dict[str, StrictStr] | None = None  # read by `screwkit tolerance`
     balancing: dict[str, Any] | None = None
+    drive: dict[str, Any] | None = None  # checked by io/graph_drive.py when simulating
 
 
 def is_graph_spec(data: dict[str, Any]) -> bool:
@@ -193,6 +194,12 @@ class GraphSpec:
                        f"({len(kinds)}: {', '.join(self.mechanism.driven_names)}) or one for "
                        f"all; got {len(value)}")
         return [(k, v, f"[{i}]") for i, (k, v) in enumerate(zip(kinds, value, strict=True))]
+        from screwkit.io.graph_drive import GraphDriveConfig, graph_drive_config
+
+        #: the ``[drive]`` table of ``screwkit simulate`` (io/graph_drive.py), checked here so
+        #: that ``validate`` reports what ``simulate`` would refuse
+        self.drive: GraphDriveConfig | None = (graph_drive_config(self) if raw.drive is not None
+                                               else None)
 
     def describe(self, units: DisplayUnits | None = None) -> str:
         """One line: what the spec describes."""

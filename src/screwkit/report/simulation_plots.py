@@ -1,4 +1,4 @@
-"""Plots of a simulation (``screwkit simulate``): speed against the input angle (one curve per
+"""Plots of a simulation (``screwkit simulate``; a graph's: :func:`graph_simulation_plots`): speed against the input angle (one curve per
 cycle) and against time, the motor torque and the shaft torque into the loop against time, and
 the coefficient of speed fluctuation per cycle — as report-scene plots (the viewer's plot
 dictionaries, :mod:`screwkit.report.scene`) and as one matplotlib PNG (``--plot``)."""
@@ -76,6 +76,13 @@ def simulation_scene_plots(doc: dict[str, Any], mode: int | None = None
 def write_simulation_png(doc: dict[str, Any], path: str | Path) -> None:
     """Speed against angle and time, torques against time and C_s per cycle in one PNG (or
     SVG/PDF, by the suffix); needs matplotlib (the ``plot`` extra)."""
+    plots, _ = simulation_scene_plots(doc)
+    plots_png(plots, f"{doc['name']}: simulation", path)
+
+
+def plots_png(plots: list[dict[str, Any]], title: str, path: str | Path) -> None:
+    """Four scene plots (``_plot`` dictionaries) in a 2 × 2 figure written to ``path``
+    (PNG, SVG or PDF by the suffix); needs matplotlib."""
     try:
         import matplotlib
 
@@ -86,7 +93,6 @@ def write_simulation_png(doc: dict[str, Any], path: str | Path) -> None:
     from screwkit.io.outputs import atomic_path
     from screwkit.report.plots import tidy_axes
 
-    plots, _ = simulation_scene_plots(doc)
     fig, axes = plt.subplots(2, 2, figsize=(11, 7.5))
     for ax, p in zip(axes.ravel(), plots, strict=True):
         for s in p["series"]:
@@ -100,9 +106,54 @@ def write_simulation_png(doc: dict[str, Any], path: str | Path) -> None:
         ax.grid(alpha=0.3)
         if len(p["series"]) <= 6:
             ax.legend(fontsize=7)
-    fig.suptitle(f"{doc['name']}: simulation", fontsize=11)
+    fig.suptitle(title, fontsize=11)
     tidy_axes(fig)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png", dpi=110)
     plt.close(fig)
+
+
+def graph_simulation_plots(doc: dict[str, Any]) -> list[dict[str, Any]]:
+    """Four plots of a graph run (``GraphSpecSimulation.as_dict``): every input and every input
+    rate against time (degrees for rotating inputs, metres for slides), every input's motor and
+    friction effort, and the energy account (kinetic, potential from the start, the motors'
+    and the friction's work, and the balance E − E₀ − W, which is zero up to the integrator's
+    tolerance)."""
+    t = np.asarray(doc["time"], dtype=float)
+    inputs = doc["inputs"]
+
+    def scale(name: str) -> float:
+        return 1.0 if name.endswith(".s") else DEG
+
+    def unit(rate: bool) -> str:
+        kinds = {n.endswith(".s") for n in inputs}
+        base = "deg or m" if len(kinds) == 2 else ("m" if kinds == {True} else "deg")
+        return f"{base}/s" if rate else base
+
+    values = [_series(n, t, np.asarray(v["value"], dtype=float) * scale(n))
+              for n, v in inputs.items()]
+    rates = [_series(n, t, np.asarray(v["rate"], dtype=float) * scale(n))
+             for n, v in inputs.items()]
+    efforts = [_series(f"{n} {part}", t, v[part]) for n, v in inputs.items()
+               for part in ("motor", "friction") if np.any(np.asarray(v[part]))]
+    kinetic = np.asarray(doc["kinetic_energy"], dtype=float)
+    potential = np.asarray(doc["potential_energy"], dtype=float)
+    works = np.asarray(doc["motor_work"], dtype=float) + np.asarray(doc["friction_work"])
+    energy = [_series("kinetic", t, kinetic), _series("potential (from the start)", t,
+                                                       potential - potential[0]),
+              _series("motor work", t, doc["motor_work"]),
+              _series("friction work", t, doc["friction_work"]),
+              _series("E − E₀ − W", t, kinetic + potential - kinetic[0] - potential[0] - works)]
+    return jsonable([
+        _plot("gsim-inputs", "inputs against time", "time (s)", unit(False), values),
+        _plot("gsim-rates", "input rates against time", "time (s)", unit(True), rates),
+        _plot("gsim-efforts", "motor and friction efforts on the inputs", "time (s)",
+              "N·m (N on a slide)", efforts or [_series("none", t, np.zeros_like(t))]),
+        _plot("gsim-energy", "energy account", "time (s)", "J", energy)])
+
+
+def write_graph_simulation_png(doc: dict[str, Any], path: str | Path) -> None:
+    """The four plots of :func:`graph_simulation_plots` in one PNG (or SVG/PDF)."""
+    plots_png(graph_simulation_plots(doc), f"{doc['name']}: simulation", path)
+

@@ -100,7 +100,7 @@ def loop_layout(linkage: Linkage) -> MjcfLayout:
                       dofs=dofs, spin_links=spin)
 
 
-def _f(x: Any) -> str:
+def xml_numbers(x: Any) -> str:
     return " ".join(f"{v:.17g}" for v in np.atleast_1d(np.asarray(x, dtype=float)))
 
 
@@ -127,9 +127,9 @@ def _joint_xml(linkage: Linkage, k: int, layout: MjcfLayout, centre: Array, axis
     tags = {"R": ("hinge",), "P": ("slide",), "C": ("hinge", "slide"), "S": ("ball",)}[j.kind]
     rotation, translation = damping.get(j.name, (0.0, 0.0))
     for name, tag in zip(layout.dofs[j.name], tags, strict=True):
-        extra = "" if tag == "ball" else f' axis="{_f(axis)}"'
+        extra = "" if tag == "ball" else f' axis="{xml_numbers(axis)}"'
         c = translation if tag == "slide" else rotation
-        lines.append(f'{indent}<joint name={quoteattr(name)} type="{tag}" pos="{_f(centre)}"'
+        lines.append(f'{indent}<joint name={quoteattr(name)} type="{tag}" pos="{xml_numbers(centre)}"'
                      f'{extra} limited="false" damping="{float(c)!r}" '
                      f'armature="{float(armature.get(name, 0.0))!r}"/>')
     return lines
@@ -152,13 +152,13 @@ def _body_xml(linkage: Linkage, md: ModeMotion, link: int, joint: int, parent: i
     I = mp.inertia
     centre = R.T @ (md.joint_centres[0, joint] - o)
     axis = R.T @ md.joint_axes[0, joint]
-    lines = [f'{indent}<body name={quoteattr(lk.name)} pos="{_f(pos)}" quat="{_f(_quat(rot))}">',
-             f'{indent}  <inertial pos="{_f(mp.com)}" mass="{mp.mass:.17g}" fullinertia="'
-             f'{_f([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>']
+    lines = [f'{indent}<body name={quoteattr(lk.name)} pos="{xml_numbers(pos)}" quat="{xml_numbers(_quat(rot))}">',
+             f'{indent}  <inertial pos="{xml_numbers(mp.com)}" mass="{mp.mass:.17g}" fullinertia="'
+             f'{xml_numbers([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>']
     lines += _joint_xml(linkage, joint, layout, centre, axis, indent + "  ", damping, armature)
     ends = [R.T @ (md.joint_centres[0, k] - o) for k in (link, link + 1)]
     if np.linalg.norm(ends[1] - ends[0]) > 1e-9:
-        lines.append(f'{indent}  <geom type="capsule" fromto="{_f(ends[0])} {_f(ends[1])}" '
+        lines.append(f'{indent}  <geom type="capsule" fromto="{xml_numbers(ends[0])} {xml_numbers(ends[1])}" '
                      f'size="{0.02 * linkage.length_scale:.6g}" mass="0" contype="0" '
                      'conaffinity="0"/>')
     return lines
@@ -190,10 +190,10 @@ def _equality(linkage: Linkage, md: ModeMotion, layout: MjcfLayout, solref: tupl
         arm = 0.1 * linkage.length_scale
         points = [centre + arm * u, centre - arm * u]
     name2 = linkage.links[body2].name if body2 < len(linkage.links) else "world"
-    soft = f'solref="{_f(np.array(solref))}" solimp="{_f(np.array(solimp))}"'
+    soft = f'solref="{xml_numbers(np.array(solref))}" solimp="{xml_numbers(np.array(solimp))}"'
     return [f'    <connect name="cut_{linkage.joints[c].name}_{k}" '
             f'body1={quoteattr(linkage.links[body1].name)} '
-            f'body2={quoteattr(name2)} anchor="{_f(R.T @ (p - o))}" {soft}/>'
+            f'body2={quoteattr(name2)} anchor="{xml_numbers(R.T @ (p - o))}" {soft}/>'
             for k, p in enumerate(points)]
 
 
@@ -235,7 +235,7 @@ def mjcf_model(linkage: Linkage, *, start: float = 0.0, mode: int = 0,
              f"{linkage.joints[layout.cut].name!r} and closed by equality constraints -->",
              '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
              f'  <option timestep="{timestep:.17g}" integrator="{integrator}" '
-             f'gravity="{_f(g)}">',
+             f'gravity="{xml_numbers(g)}">',
              '    <flag contact="disable"/>',
              "  </option>",
              "  <worldbody>"]

@@ -1,0 +1,85 @@
+"""``screwkit simulate`` and ``screwkit export-mjcf`` on a mechanism graph (docs/simulation.md,
+"Graphs"): the terminal view of a graph run, and the MuJoCo export of a graph spec."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from screwkit.cli.common import prose
+
+
+def simulate_graph_cli(s: Any, out: Any, *, flywheel: float | None, fluctuation: float | None,
+                       cycles: int | None, plot: Path | None) -> None:
+    """Run a graph spec's ``[drive]`` and deliver it (JSON, CSV, terminal)."""
+    from screwkit.cli.common import guard, user_error
+    from screwkit.messages import message_units
+    from screwkit.simulation.graph_spec_run import graph_simulation_table, simulate_graph_spec
+
+    for flag, value in (("--fluctuation", fluctuation), ("--cycles", cycles)):
+        if value is not None:
+            user_error(f"{s.path}: {flag} is for a single loop's crank cycles; a mechanism graph "
+                       "is simulated for [drive] duration (docs/simulation.md, \"Graphs\")")
+    du = out.units_for(s.units)
+    with message_units(du):
+        run = guard(lambda: simulate_graph_spec(s, flywheel=flywheel))
+    doc = guard(lambda: run.as_dict())
+    if plot is not None:
+        from screwkit.report.simulation_plots import write_graph_simulation_png
+
+        guard(lambda: write_graph_simulation_png(doc, plot))
+        out.note_written(plot)
+    out.deliver(document=lambda: doc, table=lambda: graph_simulation_table(run.simulation),
+                show=lambda: _show(s, run.simulation, du), units=du)
+
+
+def _show(s: Any, sim: Any, units: Any) -> None:
+    from rich.markup import escape
+
+    from screwkit.cli.common import console
+    from screwkit.cli.formatting import TextColumn, number, print_columns
+
+    prose(f"[bold]{escape(s.describe(units))}[/]")
+    prose(f"{escape(sim.message)} ({sim.status}); {sim.time.size} samples; energy balance "
+          f"error {sim.energy_error:.2g}; largest closure residual "
+          f"{float(np.max(sim.closure_residual)):.2g}")
+    rows = np.unique(np.linspace(0, sim.time.size - 1, min(sim.time.size, 11)).astype(int))
+    cols = [TextColumn(f"t\n[{units.pretty('time')}]",
+                       [number(units.show("time", sim.time[i])) for i in rows])]
+    for k, name in enumerate(sim.input_names):
+        kind, rate = (("length", "velocity") if name.endswith(".s")
+                      else ("angle", "angular_velocity"))
+        cols.append(TextColumn(f"{name}\n[{units.pretty(kind)}]",
+                               [number(units.show(kind, sim.inputs[i, k])) for i in rows]))
+        cols.append(TextColumn(f"rate\n[{units.pretty(rate)}]",
+                               [number(units.show(rate, sim.rates[i, k])) for i in rows]))
+    energy = sim.kinetic_energy + sim.potential_energy - sim.potential_energy[0]
+    cols.append(TextColumn(f"T + V\n[{units.pretty('energy')}]",
+                           [number(units.show("energy", energy[i])) for i in rows]))
+    print_columns(console, "the run (every input, and the energy)", cols)
+
+
+def export_graph_mjcf(s: Any, output: Path, spec_path: Path, gravity: bool | None,
+                      timestep: float) -> None:
+    """Write a graph spec as a MuJoCo model (simulation/graph_mjcf.py)."""
+    from rich.markup import escape
+
+    from screwkit.cli.common import console, guard
+    from screwkit.io.graph_drive import graph_drive_config
+    from screwkit.io.results import write_atomic
+    from screwkit.simulation.graph_mjcf import graph_mjcf_model
+
+    drive = guard(lambda: graph_drive_config(s)) if s.raw.drive is not None else None
+    with_gravity = (drive.gravity if drive is not None else True) if gravity is None else gravity
+    text = guard(lambda: graph_mjcf_model(
+        s.mechanism, gravity=s.gravity_vector if with_gravity else None, timestep=timestep,
+        solref=(20 * timestep, 1.0), friction=drive.friction if drive else (),
+        flywheel=drive.flywheel if drive else None, start=s.inputs[0]))
+    guard(lambda: write_atomic(output, text, [spec_path], "--output"))
+    g = (f"gravity {float(np.linalg.norm(s.gravity_vector)):.6g} m/s²" if with_gravity
+         else "no gravity")
+    console.print(f"wrote {escape(str(output))} (the drawn configuration, keyframe 'start' at "
+                  f"the first {escape('[motion]')} row; a motor on each input; {g})",
+                  highlight=False)

@@ -1,0 +1,84 @@
+"""``screwkit simulate`` and ``export-mjcf`` on a mechanism-graph spec: its ``[drive]`` table
+(io/graph_drive.py), its first ``[motion]`` row as the start, its gravity
+(docs/simulation.md, "Graphs"). The CLI calls these and formats what they return."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from screwkit.io.graph_drive import GraphDriveConfig, graph_drive_config
+from screwkit.simulation.graph_eom import GraphEquationOfMotion
+from screwkit.simulation.graph_run import GraphSimulation, simulate_graph
+from screwkit.tables import Column, ResultTable
+
+
+@dataclass(frozen=True, eq=False)
+class GraphSpecSimulation:
+    """A graph spec's run: the ``simulation`` with the ``drive`` it used."""
+
+    spec: Any
+    drive: GraphDriveConfig
+    simulation: GraphSimulation
+
+    def as_dict(self) -> dict[str, Any]:
+        d = self.drive
+        return {"name": self.spec.name, "spec": self.spec.path,
+                "drive": {"duration": d.duration, "samples": d.samples,
+                          "initial_rates": dict(zip(self.spec.mechanism.inputs,
+                                                    d.initial_rates, strict=True)),
+                          "flywheel": dict(zip(self.spec.mechanism.inputs, d.flywheel,
+                                               strict=True)),
+                          "motors": {n: vars(m) for n, m in
+                                     zip(self.spec.mechanism.inputs, d.motors, strict=True)},
+                          "friction": {f.joint: {"rotation": f.rotation,
+                                                 "translation": f.translation}
+                                       for f in d.friction},
+                          "gravity": d.gravity, "rtol": d.rtol, "atol": d.atol},
+                **self.simulation.as_dict()}
+
+
+def graph_spec_equation_of_motion(spec: Any, drive: GraphDriveConfig | None = None,
+                                  flywheel: float | None = None) -> GraphEquationOfMotion:
+    """The equations of motion of a graph spec with its ``[drive]`` (``flywheel`` overrides
+    the table's on every input)."""
+    d = drive if drive is not None else graph_drive_config(spec)
+    return GraphEquationOfMotion(
+        spec.mechanism, motors=d.motors,
+        flywheel=d.flywheel if flywheel is None else flywheel, friction=d.friction,
+        gravity=spec.gravity_vector if d.gravity else None)
+
+
+def simulate_graph_spec(spec: Any, *, duration: float | None = None,
+                        flywheel: float | None = None) -> GraphSpecSimulation:
+    """Run a graph spec's ``[drive]`` from its first ``[motion]`` row for ``duration`` (default
+    the table's) seconds."""
+    d = graph_drive_config(spec)
+    eom = graph_spec_equation_of_motion(spec, d, flywheel)
+    run = simulate_graph(eom, duration=duration or d.duration, samples=d.samples,
+                         initial_inputs=spec.inputs[0], initial_rates=d.initial_rates,
+                         rtol=d.rtol, atol=d.atol)
+    return GraphSpecSimulation(spec, d, run)
+
+
+def graph_simulation_table(sim: GraphSimulation) -> ResultTable:
+    """The samples as a table (``screwkit simulate --csv``): time, every input's value, rate,
+    acceleration, motor and friction effort, the energies and works, the closure residual."""
+    cols = [Column("time", "time", sim.time)]
+    for k, name in enumerate(sim.input_names):
+        slide = name.endswith(".s")
+        kinds = (("length", "velocity", "acceleration", "force") if slide else
+                 ("angle", "angular_velocity", "angular_acceleration", "moment"))
+        cols += [Column(name, kinds[0], sim.inputs[:, k]),
+                 Column(f"{name}.rate", kinds[1], sim.rates[:, k]),
+                 Column(f"{name}.acceleration", kinds[2], sim.accelerations[:, k]),
+                 Column(f"{name}.motor", kinds[3], sim.motor[:, k]),
+                 Column(f"{name}.friction", kinds[3], sim.friction[:, k])]
+    cols += [Column("kinetic_energy", "energy", sim.kinetic_energy),
+             Column("potential_energy", "energy", sim.potential_energy),
+             Column("motor_work", "energy", sim.motor_work),
+             Column("friction_work", "energy", sim.friction_work),
+             Column("closure_residual", "ratio", np.asarray(sim.closure_residual))]
+    return ResultTable(tuple(cols), "simulation of a mechanism graph: one row per sample")
