@@ -43,7 +43,8 @@ def _residual(mech: Mechanism, conf: Configuration) -> float:
 
 
 def test_bundled_examples_decompose_or_say_what_needs_the_homotopy() -> None:
-    expect = {"fourbar_graph": 2, "watt_sixbar": 4, "watt_sixbar_balance": 4, "jansen_leg": 8,
+    expect = {"fourbar_graph": 2, "watt_sixbar": 4, "watt_sixbar_balance": 4,
+              "watt_sixbar_simulate": 4, "jansen_leg": 8,
               "double_wishbone": 4}
     for path in sorted(MECHANISMS.glob("*.toml")):
         mech = sk.load_spec(path).mechanism

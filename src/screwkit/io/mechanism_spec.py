@@ -185,6 +185,13 @@ class GraphSpec:
 
             self.balancing = balancing_config(self)
 
+        from screwkit.io.graph_drive import GraphDriveConfig, graph_drive_config
+
+        #: the ``[drive]`` table of ``screwkit simulate`` (io/graph_drive.py), checked here so
+        #: that ``validate`` reports what ``simulate`` would refuse
+        self.drive: GraphDriveConfig | None = (graph_drive_config(self) if raw.drive is not None
+                                               else None)
+
     def _per_input(self, value: Any, kinds: list[str], key: str) -> list[tuple[str, Any, str]]:
         """A rate for every input: one value for all, or a list of one per input."""
         if not isinstance(value, list):
@@ -194,12 +201,6 @@ class GraphSpec:
                        f"({len(kinds)}: {', '.join(self.mechanism.driven_names)}) or one for "
                        f"all; got {len(value)}")
         return [(k, v, f"[{i}]") for i, (k, v) in enumerate(zip(kinds, value, strict=True))]
-        from screwkit.io.graph_drive import GraphDriveConfig, graph_drive_config
-
-        #: the ``[drive]`` table of ``screwkit simulate`` (io/graph_drive.py), checked here so
-        #: that ``validate`` reports what ``simulate`` would refuse
-        self.drive: GraphDriveConfig | None = (graph_drive_config(self) if raw.drive is not None
-                                               else None)
 
     def describe(self, units: DisplayUnits | None = None) -> str:
         """One line: what the spec describes."""
