@@ -364,8 +364,8 @@ def _solve_driven(mech: Mechanism, inputs: ArrayLike, rates_: ArrayLike | None,
         raise AssemblyError(rename_virtual(mech, str(exc))) from None
     modes = tuple(restricted_mode(mech, md) for md in whole.modes)
     return MechanismMotion(mech, whole.inputs, whole.input_rates, whole.input_accelerations,
-                           modes, method=whole.method, solver=whole.solver,
-                           notes=whole.notes)  # type: ignore[arg-type]
+                           modes,  # type: ignore[arg-type]
+                           method=whole.method, solver=whole.solver, notes=whole.notes)
 
 
 def misfits(mech: Mechanism) -> bool:
