@@ -23,9 +23,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.errors import InputError
@@ -93,7 +94,7 @@ def _normal_feet(link: PlacedLink) -> tuple[float, float, Array]:
     sa = ((dv @ link.u) - (dv @ link.v) * c) / (1.0 - c * c)
     sb = ((dv @ link.u) * c - (dv @ link.v)) / (1.0 - c * c)
     n = (link.b + sb * link.v) - (link.a + sa * link.u)
-    return sa, sb, n
+    return float(sa), float(sb), n
 
 
 def loop6r_parameters(links: list[PlacedLink]) -> Array:
@@ -114,7 +115,7 @@ def loop6r_parameters(links: list[PlacedLink]) -> Array:
     return np.concatenate([z1, z6, cos_a, k, d[1:5], g])
 
 
-def loop6r_axes(solution: Complex, params: Complex) -> Complex:
+def loop6r_axes(solution: ArrayLike, params: ArrayLike) -> NDArray[Any]:
     """All six axes (…, 6, 3) of solutions (…, 12) with their parameters (…, 23) or (23,)."""
     solution = np.asarray(solution)
     p = np.broadcast_to(params, solution.shape[:-1] + (len(PARAMETER_NAMES),))
@@ -122,10 +123,11 @@ def loop6r_axes(solution: Complex, params: Complex) -> Complex:
                            p[..., None, 3:6]], axis=-2)
 
 
-def loop6r_angles(axes: Array) -> Array:
+def loop6r_angles(axes: ArrayLike) -> Array:
     """Joint angles (…, 6) of real solutions' axes (…, 6, 3): θ_i from n_{i−1} to n_i about
     z_i, n_i ∥ z_i × z_{i+1} (defined up to one constant per joint, which the drawn
     configuration fixes)."""
+    axes = np.asarray(axes, dtype=float)
     w = np.cross(axes, np.roll(axes, -1, axis=-2))  # w_i = z_i × z_{i+1}
     w_prev = np.roll(w, 1, axis=-2)
     sin = np.einsum("...i,...i->...", np.cross(w_prev, w), axes)

@@ -107,7 +107,8 @@ def r_loop_instance(mech: Mechanism, input_values: ArrayLike = ()) -> RLoopInsta
         raise InputError(f"{mech.name}: {len(mech.inputs)} input values are needed "
                          f"({list(mech.inputs)}); got {values.shape[0]}")
     joint_index = {j.name: k for k, j in enumerate(mech.joints)}
-    fixed = {joint_index[name.split(".")[0]]: float(v) for name, v in zip(mech.inputs, values)}
+    fixed = {joint_index[name.split(".")[0]]: float(v)
+             for name, v in zip(mech.inputs, values, strict=True)}
     if order[-1] in fixed:  # walk the other way round, so the last joint is free
         order, axes = order[::-1], [-a for a in axes[::-1]]
         if order[-1] in fixed:

@@ -127,7 +127,7 @@ def study_from_pose(R: ArrayLike, t: ArrayLike) -> Complex:
     y = np.stack(quaternion_product(list(np.moveaxis(tq, -1, 0)),
                                     list(np.moveaxis(x, -1, 0))), -1) / 2
     z = np.concatenate([x, y], -1)
-    return z / (z[..., :4] @ _PATCH)[..., None]
+    return np.asarray(z / (z[..., :4] @ _PATCH)[..., None], dtype=complex)
 
 
 def pose_from_study(z: ArrayLike) -> tuple[Complex, Complex]:
