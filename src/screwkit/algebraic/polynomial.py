@@ -134,27 +134,91 @@ class PolynomialSystem:
     def evaluate(self, x: Complex, p: Complex,
                  want_jp: bool = True) -> tuple[Complex, Complex, Complex | None]:
         """F (B, N), ∂F/∂x (B, N, n) and ∂F/∂p (B, N, k) (None unless ``want_jp``) at the
-        points x (B, n) with parameters p (B, k) or (k,)."""
+        points x (B, n) with parameters p (B, k) or (k,).
+
+        One table of powers z^0..z^D per point, one gather per factor, and one segmented sum
+        for F and one for all the Jacobian entries (the derivative of a term by the symbol of
+        factor f is its coefficient times pw_f·z_f^(pw_f−1) times the other factors)."""
         x = np.asarray(x, dtype=complex)
-        p = np.broadcast_to(np.asarray(p, dtype=complex), (x.shape[0], self.k))
+        B = x.shape[0]
+        p = np.broadcast_to(np.asarray(p, dtype=complex), (B, self.k))
         z = np.concatenate([x, p], axis=1)
-        F = self._reduce(self._terms(z))
+        table = self._power_table(z)  # (B, S, D+1)
+        powers = table[:, self.sym, self.pw]  # (B, T, f)
+        F = self._reduce(self.coef * np.prod(powers, axis=2))
         dims = self.n + self.k if want_jp else self.n
-        J = np.empty((x.shape[0], self.size, dims), dtype=complex)
-        for i in range(dims):
-            J[:, :, i] = self._reduce(self._derivative_terms(z, i))
-        return F, J[:, :, : self.n], (J[:, :, self.n:] if want_jp else None)
+        J = np.zeros((B, self.size * dims), dtype=complex)
+        order, heads, targets, slot, term = self._jacobian_plan(dims)
+        if len(order):
+            lower = table[:, self.sym, np.maximum(self.pw - 1, 0)]  # (B, T, f)
+            width = self.sym.shape[1]
+            parts = []
+            for f in range(width):
+                others = [powers[:, :, g] for g in range(width) if g != f]
+                value = lower[:, :, f] * (self.coef * self.pw[:, f])
+                for o in others:
+                    value = value * o
+                parts.append(value)
+            derivative = np.stack(parts, axis=2)[:, term, slot]  # (B, M) entries
+            J[:, targets] = np.add.reduceat(derivative[:, order], heads, axis=1)
+        J3 = J.reshape(B, self.size, dims)
+        return F, J3[:, :, : self.n], (J3[:, :, self.n:] if want_jp else None)
 
-    def _terms(self, z: Complex) -> Complex:
-        factors = z[:, self.sym] ** self.pw  # (B, T, f); power 0 gives 1
-        return self.coef * np.prod(factors, axis=2)
+    def homogenized(self) -> PolynomialSystem:
+        """The system in n+1 homogeneous unknowns (h, x·h): each term of equation i times
+        h^(d_i − its degree), so F_i^h(h, y) = h^(d_i)·F_i(y/h) (Sommese & Wampler 2005,
+        §3.2). The new unknown ``h`` comes first; parameters are unchanged and N = n
+        equations remain (a patch equation closes the system)."""
+        unknown = self.sym < self.n
+        term_degree = np.where(unknown, self.pw, 0).sum(axis=1)
+        lift = np.asarray(self.degrees, dtype=np.intp)[self.eq] - term_degree
+        sym = np.concatenate([self.sym + 1, np.zeros((len(self.eq), 1), dtype=np.intp)], axis=1)
+        pw = np.concatenate([self.pw, lift[:, None]], axis=1)
+        name = "h"
+        while name in self.variables or name in self.parameters:
+            name += "_"
+        return PolynomialSystem((name, *self.variables), self.parameters, self.eq, self.coef,
+                                sym, pw, self.starts, self.degrees)
 
-    def _derivative_terms(self, z: Complex, i: int) -> Complex:
-        hit = self.sym == i
-        power = np.where(hit, self.pw, 0).sum(axis=1)  # (T,)
-        pw = self.pw - hit.astype(np.intp)
-        factors = z[:, self.sym] ** np.maximum(pw, 0)
-        return (self.coef * power) * np.prod(factors, axis=2)
+    def coefficients_at(self, p: Complex) -> tuple[NDArray[np.intp], NDArray[np.intp], Complex]:
+        """The system as polynomials in x alone at the parameters p (B, k) or (k,): the
+        equation (G,) and exponent vector (G, n) of each distinct monomial in x, and its
+        coefficient (B, G), the sum over the terms with that monomial of coef·Π p^pw."""
+        p = np.atleast_2d(np.asarray(p, dtype=complex))
+        unknown = self.sym < self.n
+        exps = np.zeros((len(self.eq), self.n), dtype=np.intp)
+        rows = np.nonzero(unknown)
+        np.add.at(exps, (rows[0], self.sym[rows]), self.pw[rows])
+        keys, group = np.unique(np.column_stack([self.eq, exps]), axis=0, return_inverse=True)
+        z = np.concatenate([np.ones((len(p), self.n), dtype=complex), p], axis=1)
+        values = self.coef * np.prod(self._power_table(z)[:, self.sym, self.pw], axis=2)
+        out = np.zeros((len(p), len(keys)), dtype=complex)
+        order = np.argsort(group.reshape(-1), kind="stable")
+        heads = np.flatnonzero(np.r_[True, np.diff(group.reshape(-1)[order]) != 0])
+        out[:] = np.add.reduceat(values[:, order], heads, axis=1)
+        return keys[:, 0].astype(np.intp), keys[:, 1:].astype(np.intp), out
+
+    def _power_table(self, z: Complex) -> Complex:
+        top = int(self.pw.max(initial=0))
+        table = np.empty((*z.shape, top + 1), dtype=complex)
+        table[..., 0] = 1.0
+        for d in range(1, top + 1):
+            table[..., d] = table[..., d - 1] * z
+        return table
+
+    def _jacobian_plan(self, dims: int) -> tuple[NDArray[np.intp], ...]:
+        """For the Jacobian's nonzero (term, factor) entries: their order sorted by target
+        cell eq·dims + symbol, the head of each run of one target, the distinct targets, and
+        each entry's factor slot and term."""
+        cache = self.__dict__.setdefault("_plans", {})
+        if dims not in cache:
+            term, slot = np.nonzero((self.pw > 0) & (self.sym < dims))
+            cell = self.eq[term] * dims + self.sym[term, slot]
+            order = np.argsort(cell, kind="stable")
+            cell = cell[order]
+            heads = np.flatnonzero(np.r_[True, cell[1:] != cell[:-1]]) if len(cell) else cell
+            cache[dims] = (order, heads, cell[heads], slot, term)
+        return cache[dims]  # type: ignore[no-any-return]
 
     def _reduce(self, values: Complex) -> Complex:
         out = np.add.reduceat(values, self.starts, axis=1) if values.shape[1] else values

@@ -1,0 +1,135 @@
+"""Smale's α-test: which approximate solutions provably converge to a true, distinct, real zero.
+
+For a square polynomial system f and a point x (Blum, Cucker, Shub & Smale, *Complexity and Real
+Computation*, 1998, ch. 8; Hauenstein & Sottile, "alphaCertified: certifying solutions to
+polynomial systems", ACM TOMS 38(4), 2012, §1–2):
+
+- β(f, x) = ‖Df(x)⁻¹ f(x)‖ (the Newton step), γ(f, x) = sup_{k≥2} ‖Df(x)⁻¹ D^k f(x)/k!‖^(1/(k−1)),
+  α = β·γ;
+- γ is bounded from the coefficients and degrees alone (Shub & Smale, the bound used by
+  alphaCertified): γ ≤ μ(f, x)·D^(3/2) / (2‖x‖₁), where ‖x‖₁ = √(1 + ‖x‖²), D = max d_i,
+  μ(f, x) = max(1, ‖f‖·‖Df(x)⁻¹·Δ(x)‖), Δ = diag(√d_i·‖x‖₁^(d_i − 1)), and ‖f‖ the
+  Bombieri–Weyl norm: ‖f_i‖² = Σ_α |c_α|²·α₀!α₁!…α_n!/d_i! with α₀ = d_i − |α|;
+- if α < α₀ = (13 − 3√17)/4 ≈ 0.157671, Newton's method from x converges quadratically to a
+  zero ξ with ‖x − ξ‖ ≤ 2β (x is a *certified approximate solution*);
+- two certified points x₁, x₂ belong to distinct zeros if ‖x₁ − x₂‖ > 2(β₁ + β₂);
+- for a real system (real coefficients at real parameters): if ‖x − x̄‖ > 4β the zero is not
+  real (ξ real would put both x and x̄ within 2β of it); if α < 0.03 and ‖x − x̄‖ < 1/(20γ), x̄
+  is an approximate solution with the same associated zero as x, whose conjugate it also is,
+  so ξ = ξ̄ is real (Hauenstein & Sottile 2012, the real-solution test).
+
+**What this certifies, honestly.** The quantities are computed in double precision, not in
+exact rational or interval arithmetic as alphaCertified does. β and γ are inflated by stated
+rounding margins (the evaluation error of f bounded by 8·(terms + degree)·u·Σ|terms|, and the
+linear solves' relative error by 10·n·κ·u, u the unit round-off, κ the condition number), so a
+certificate here is a floating-point α-test with a rounding allowance: strong evidence, and
+rigorous under the assumption that those margins bound the rounding, but not a computer proof.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import lgamma, sqrt
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.algebraic.polynomial import Complex, PolynomialSystem
+from screwkit.algebraic.track import same_points
+
+#: Smale's constant (13 − 3√17)/4
+ALPHA_0 = (13.0 - 3.0 * sqrt(17.0)) / 4.0
+#: α below which the real-solution and same-zero tests apply (Hauenstein & Sottile 2012)
+ALPHA_REAL = 0.03
+UNIT_ROUNDOFF = np.finfo(float).eps / 2
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """Per point (P,): ``certified`` (α < α₀), ``alpha``, ``beta``, ``gamma`` (the upper
+    bounds used), ``radius`` = 2β (a true zero lies within it, in the 2-norm), ``real``
+    (certified to be a real zero), ``not_real`` (certified non-real), ``newton`` the Newton
+    point x − Df⁻¹f (P, n)."""
+
+    certified: NDArray[np.bool_]
+    alpha: NDArray[np.float64]
+    beta: NDArray[np.float64]
+    gamma: NDArray[np.float64]
+    radius: NDArray[np.float64]
+    real: NDArray[np.bool_]
+    not_real: NDArray[np.bool_]
+    newton: Complex
+
+
+def bombieri_weyl_norm(system: PolynomialSystem, p: Complex) -> NDArray[np.float64]:
+    """‖f‖ (B,) of the system at each parameter vector of p (B, k)."""
+    eq, exps, coef = system.coefficients_at(p)
+    degree = np.asarray(system.degrees)[eq]
+    alpha0 = degree - exps.sum(axis=1)
+    log_fact = np.vectorize(lambda v: lgamma(v + 1.0))
+    log_weight = log_fact(alpha0) + log_fact(exps).sum(axis=1) - log_fact(degree)
+    if not len(eq):
+        return np.zeros(len(coef))
+    return np.sqrt((np.abs(coef) ** 2 * np.exp(log_weight)).sum(axis=1))
+
+
+def _evaluation_error(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[np.float64]:
+    """A bound on the rounding error of each F_i(x) (P, N): 8·(terms + degree)·u·Σ|terms|."""
+    absolute = _with_moduli(system)
+    F_abs, _, _ = absolute.evaluate(np.abs(x).astype(complex), np.abs(p).astype(complex),
+                                    want_jp=False)
+    terms = np.diff(np.append(system.starts, len(system.eq)))
+    factor = 8.0 * (terms + np.asarray(system.degrees) + system.sym.shape[1]) * UNIT_ROUNDOFF
+    return np.asarray(F_abs.real * factor, dtype=float)
+
+
+def _with_moduli(system: PolynomialSystem) -> PolynomialSystem:
+    """The system with every coefficient replaced by its modulus: at |x|, |p| it bounds the
+    sum of the moduli of the terms."""
+    from dataclasses import replace
+
+    return replace(system, coef=np.abs(system.coef).astype(complex))
+
+
+def certify(system: PolynomialSystem, x: Complex, p: Complex) -> Certificate:
+    """The α-test of the points x (P, n) for F(·; p) = 0, p (k,) or (P, k)."""
+    x = np.asarray(x, dtype=complex)
+    P, n = x.shape
+    p = np.broadcast_to(np.asarray(p, dtype=complex), (P, system.k))
+    F, J, _ = system.evaluate(x, p, want_jp=False)
+    err = _evaluation_error(system, x, p)
+    with np.errstate(all="ignore"):
+        finite = np.asarray(np.isfinite(J).all(axis=(1, 2)) & np.isfinite(F).all(axis=1),
+                            dtype=bool)
+        Jsafe = np.where(finite[:, None, None], J, np.eye(n))
+        s = np.linalg.svd(Jsafe, compute_uv=False)
+        kappa = s[:, 0] / s[:, -1]
+        solve_margin = 1.0 + 10.0 * n * kappa * UNIT_ROUNDOFF
+        step = np.linalg.solve(Jsafe, np.where(finite[:, None], F, 0.0)[..., None])[..., 0]
+        beta = (np.linalg.norm(step, axis=1) + np.linalg.norm(err, axis=1) / s[:, -1]) \
+            * solve_margin
+        d = np.asarray(system.degrees, dtype=float)
+        norm1 = np.sqrt(1.0 + np.linalg.norm(x, axis=1) ** 2)
+        delta = np.sqrt(d)[None, :] * norm1[:, None] ** (d - 1.0)[None, :]
+        scaled = np.linalg.solve(Jsafe, delta[:, :, None] * np.eye(n)[None])  # J⁻¹Δ
+        norm_scaled = np.linalg.norm(scaled, ord=2, axis=(1, 2)) * solve_margin
+        mu = np.maximum(1.0, bombieri_weyl_norm(system, p) * norm_scaled)
+        gamma = mu * d.max(initial=1.0) ** 1.5 / (2.0 * norm1)
+        alpha = beta * gamma
+        ok = finite & np.isfinite(alpha) & (s[:, -1] > 0)
+        certified = ok & (alpha < ALPHA_0)
+        gap = np.linalg.norm(x - x.conj(), axis=1)
+        real_system = bool(np.all(system.coef.imag == 0)) and np.all(p.imag == 0, axis=1)
+        real = certified & real_system & (alpha < ALPHA_REAL) & (gap < 1.0 / (20.0 * gamma))
+        not_real = certified & real_system & (gap > 4.0 * beta)
+    bad = ~ok
+    alpha[bad], beta[bad], gamma[bad] = np.inf, np.inf, np.inf
+    return Certificate(certified, alpha, beta, gamma, 2.0 * beta, real, not_real, x - step)
+
+
+def distinct(x: Complex, radius: NDArray[np.float64],
+             groups: NDArray[np.intp]) -> NDArray[np.intp]:
+    """A label per point: points of one group whose balls (‖x_i − x_j‖∞ ≤ radius_i + radius_j,
+    radius = 2β) overlap share the label of the first of them. Two certified points with
+    disjoint balls are proved to be distinct zeros; overlapping ones are counted once."""
+    return same_points(x, groups, 0.0, absolute=radius)

@@ -1,0 +1,265 @@
+"""Parameter homotopy: track known solutions at p_start to the solutions at p_target.
+
+:func:`track_parameter_homotopy` moves the parameters along the straight segment
+p(s) = (1 − s)·p_start + s·p_target, s ∈ [0, 1], and carries every start solution along
+(Sommese & Wampler, *The Numerical Solution of Systems of Polynomials*, 2005, ch. 7: with
+p_start generic and complex, the open segment misses the discriminant with probability one, so
+the paths are smooth until s = 1 and every isolated solution at p_target is the end of some
+path). All paths (and a batch of targets, one per path) run in one vectorised tracker
+(:mod:`.path`) on a random affine patch of the homogenised system, so a path going to infinity
+stays finite and is reported as at infinity.
+
+Each path first runs to s = 1 − r (r = ``endgame_radius``) and then to s = 1; an end point where
+the tracker arrives with a well-conditioned Jacobian is polished by Newton and is regular. The
+others (the step collapsed, or the Jacobian is ill-conditioned, or h ≈ 0) go through the Cauchy
+endgame (:mod:`.endgame`) from s = 1 − r, which gives their end point and winding number; they
+are then classified singular (with the number of paths that reach the same point as its
+multiplicity estimate), at infinity, or failed.
+
+Path jumping: two paths of one instance ending at the same regular solution cannot both be
+right (a regular solution is the end of exactly one path). Both are tracked again with 10×
+smaller steps; a pair that still coincides is marked failed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import IntEnum
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.algebraic.endgame import cauchy_endgame
+from screwkit.algebraic.path import Homotopy, TrackOptions, line, newton, track
+from screwkit.algebraic.polynomial import Complex, PolynomialSystem
+from screwkit.errors import InputError
+
+__all__ = ["PathStatus", "TrackOptions", "TrackResult", "track_parameter_homotopy",
+           "same_points"]
+
+
+class PathStatus(IntEnum):
+    """How a path ended."""
+
+    REGULAR = 0  # a nonsingular isolated solution, Newton-polished
+    SINGULAR = 1  # a singular end point (winding number > 1 or ill-conditioned Jacobian)
+    AT_INFINITY = 2  # the path diverged: h → 0 on the patch
+    FAILED = 3  # the tracker or the endgame did not finish, or a jump that did not resolve
+
+
+@dataclass(frozen=True)
+class TrackResult:
+    """The end of every path at s = 1.
+
+    ``x`` (P, n) are the affine end points (NaN for paths at infinity or failed), ``y`` (P, n+1)
+    the end points on the patch (h, h·x); ``status`` (P,) a :class:`PathStatus` code;
+    ``condition`` (P,) the 2-norm condition number of the patch Jacobian at the end point;
+    ``residual`` (P,) ‖F(x; p_target)‖∞ at finite end points; ``winding`` (P,) the cycle
+    number from the endgame (1 for paths that did not need it); ``multiplicity`` (P,) the number
+    of paths of the same instance ending at the same point (1 for a regular end); ``steps`` (P,)
+    predictor–corrector steps taken; ``retracked`` (P,) paths tracked again after a suspected
+    jump; ``instance`` (P,) the index of each path's target among the distinct targets."""
+
+    x: Complex
+    y: Complex
+    status: NDArray[np.int8]
+    condition: NDArray[np.float64]
+    residual: NDArray[np.float64]
+    winding: NDArray[np.int64]
+    multiplicity: NDArray[np.int64]
+    steps: NDArray[np.int64]
+    retracked: NDArray[np.bool_]
+    instance: NDArray[np.intp]
+
+    @property
+    def regular(self) -> NDArray[np.bool_]:
+        return self.status == PathStatus.REGULAR
+
+    def counts(self) -> dict[str, int]:
+        """The number of paths per status, by name."""
+        return {s.name.lower(): int((self.status == s).sum()) for s in PathStatus}
+
+
+def _check(system: PolynomialSystem, p_start: Complex, p_target: Complex,
+           x_start: Complex) -> tuple[Complex, Complex, Complex]:
+    x = np.asarray(x_start, dtype=complex)
+    if x.ndim != 2 or x.shape[1] != system.n:
+        raise InputError(f"x_start must have shape (paths, {system.n}) for the unknowns "
+                         f"{', '.join(system.variables)}; got shape {x.shape}")
+    P = x.shape[0]
+    ps, pt = (np.asarray(v, dtype=complex) for v in (p_start, p_target))
+    for name, v in (("p_start", ps), ("p_target", pt)):
+        if v.shape not in ((system.k,), (P, system.k)):
+            raise InputError(f"{name} must have shape ({system.k},) or ({P}, {system.k}) for "
+                             f"the parameters {', '.join(system.parameters) or '(none)'}; got "
+                             f"shape {v.shape}")
+        if not np.isfinite(v).all():
+            raise InputError(f"{name} must be finite")
+    if not np.isfinite(x).all():
+        raise InputError("x_start must be finite")
+    return (np.broadcast_to(ps, (P, system.k)).copy(), np.broadcast_to(pt, (P, system.k)).copy(),
+            x)
+
+
+def same_points(points: Complex, groups: NDArray[np.intp], tolerance: float, seed: int = 0,
+                absolute: NDArray[np.float64] | None = None) -> NDArray[np.intp]:
+    """A cluster label per point: points i, j of one group with ‖x_i − x_j‖₂ ≤
+    tolerance·(1 + max ‖x‖∞) + absolute_i + absolute_j (transitively) share a label, the
+    smallest index among them.
+
+    Candidates are found by sorting each group along a random projection and comparing
+    neighbours a few places apart, so it costs O(P log P), not O(P²)."""
+    P = len(points)
+    label = np.arange(P)
+    if P < 2:
+        return label
+    rng = np.random.default_rng(seed)
+    direction = rng.standard_normal(points.shape[1]) + 1j * rng.standard_normal(points.shape[1])
+    finite = np.asarray(np.isfinite(points).all(axis=1), dtype=bool)
+    safe = np.where(finite[:, None], points, 0.0)
+    key = np.where(finite, (safe @ direction).real, np.inf)
+    extra = np.zeros(P) if absolute is None else np.nan_to_num(absolute, nan=0.0, posinf=0.0)
+    order = np.lexsort((key, groups))
+    pairs: list[tuple[int, int]] = []
+    width = np.linalg.norm(direction)
+    for shift in range(1, min(P, 8)):
+        i, j = order[:-shift], order[shift:]
+        scale = 1.0 + np.maximum(np.abs(safe[i]).max(axis=1), np.abs(safe[j]).max(axis=1))
+        reach = tolerance * scale + extra[i] + extra[j]
+        close = (groups[i] == groups[j]) & finite[i] & finite[j]
+        close &= np.abs(key[i] - key[j]) <= reach * width
+        close &= np.linalg.norm(safe[i] - safe[j], axis=1) <= reach
+        pairs.extend(zip(i[close].tolist(), j[close].tolist(), strict=True))
+    for first, second in pairs:  # union–find over the (few) close pairs
+        a, b = first, second
+        while label[a] != a:
+            a = int(label[a])
+        while label[b] != b:
+            b = int(label[b])
+        label[max(a, b)] = min(a, b)
+    for point in range(P):
+        label[point] = label[label[point]]
+    return label
+
+
+def _polish(hom: Homotopy, y: Complex, rows: NDArray[np.intp],
+            options: TrackOptions) -> tuple[Complex, NDArray[np.bool_], NDArray[np.float64]]:
+    """Three Newton steps at s = 1; converged (last correction ≤ 1e-11 relative, contracting)
+    and the condition number there."""
+    one = np.ones(len(rows), dtype=complex)
+    with np.errstate(all="ignore"):
+        polished, sizes = newton(hom, y, rows, one, 3)
+        scale = 1.0 + np.abs(y).max(axis=1)
+        ok = (sizes[-1] <= 1e-11 * scale) & np.isfinite(polished).all(axis=1)
+        _, J, _ = hom.parts(polished, rows, one)
+        cond = np.where(np.isfinite(J).all(axis=(1, 2)),
+                        np.linalg.cond(np.where(np.isfinite(J), J, 0.0)), np.inf)
+    return polished, ok & (cond <= options.max_condition), cond
+
+
+def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArray[np.intp],
+         options: TrackOptions) -> dict[str, np.ndarray]:
+    """Track the paths ``rows`` from s = 0 to 1 and classify their ends."""
+    m = len(rows)
+    y0 = hom.to_patch(x_start)
+    near = 1.0 - options.endgame_radius
+    y_near, ok1, steps = track(hom, line, y0, rows, np.zeros(m), np.full(m, near), options)
+    y_end, ok2, used = track(hom, line, y_near, rows, np.full(m, near), np.ones(m), options)
+    steps = steps + used
+    status = np.full(m, PathStatus.FAILED, dtype=np.int8)
+    winding = np.ones(m, dtype=np.int64)
+    y_final = np.full_like(y0, np.nan)
+    cond = np.full(m, np.inf)
+    arrived = np.flatnonzero(ok1 & ok2)
+    polished, good, cond_a = _polish(hom, y_end[arrived], rows[arrived], options)
+    h = np.abs(polished[:, 0]) <= options.infinity_threshold * np.abs(polished).max(axis=1)
+    good &= ~h
+    status[arrived[good]] = PathStatus.REGULAR
+    y_final[arrived[good]] = polished[good]
+    cond[arrived] = cond_a
+    late = np.flatnonzero(ok1 & (status != PathStatus.REGULAR))
+    if late.size:
+        eg = cauchy_endgame(hom, y_near[late], rows[late], options)
+        steps[late] += eg.steps
+        winding[late] = eg.winding
+        estimate = eg.y
+        fin = np.isfinite(estimate).all(axis=1) & (eg.winding > 0)
+        y_final[late[fin]] = estimate[fin]
+        infinite = fin & (np.abs(estimate[:, 0])
+                          <= options.infinity_threshold * np.abs(estimate).max(axis=1))
+        status[late[infinite]] = PathStatus.AT_INFINITY
+        finite = np.flatnonzero(fin & ~infinite)
+        pol, good, cond_e = _polish(hom, estimate[finite], rows[late[finite]], options)
+        cond[late[finite]] = cond_e
+        regular = good & (eg.winding[finite] == 1)
+        status[late[finite[regular]]] = PathStatus.REGULAR
+        y_final[late[finite[regular]]] = pol[regular]
+        status[late[finite[~regular]]] = PathStatus.SINGULAR
+    return {"y": y_final, "status": status, "condition": cond, "winding": winding,
+            "steps": steps}
+
+
+def track_parameter_homotopy(system: PolynomialSystem, p_start: Complex, p_target: Complex,
+                             x_start: Complex,
+                             options: TrackOptions | None = None) -> TrackResult:
+    """Track the start solutions ``x_start`` (P, n) of F(x; p_start) = 0 to F(x; p_target) = 0
+    along p(s) = (1 − s)·p_start + s·p_target (Sommese & Wampler 2005, ch. 7).
+
+    ``p_start`` and ``p_target`` are (k,) or (P, k), one row per path, so a batch of many
+    instances times their start solutions is one call. ``p_start`` should be generic complex
+    (random complex parameters) for the paths to be smooth; the caller's start solutions must
+    solve F(x; p_start) = 0 to tracking accuracy. Returns a :class:`TrackResult`."""
+    options = options or TrackOptions()
+    ps, pt, x = _check(system, p_start, p_target, x_start)
+    P = x.shape[0]
+    hsys = system.homogenized()
+    rng = np.random.default_rng(options.seed)
+    patch = ((rng.standard_normal(system.n + 1) + 1j * rng.standard_normal(system.n + 1))
+             / 2).astype(complex)
+    hom = Homotopy(hsys, patch, ps, pt - ps)
+    _, instance = np.unique(pt, axis=0, return_inverse=True)
+    instance = instance.reshape(-1).astype(np.intp)
+    rows = np.arange(P)
+    out = _run(system, hom, x, rows, options)
+    retracked = np.zeros(P, dtype=bool)
+    jumped = _jumps(out["y"], out["status"], instance, options)
+    if jumped.size and options.retrack:
+        again = _run(system, hom, x[jumped], rows[jumped], options.tighter())
+        for key, value in again.items():
+            out[key][jumped] = value
+        retracked[jumped] = True
+        still = _jumps(out["y"], out["status"], instance, options)
+        out["status"][still] = PathStatus.FAILED
+    elif jumped.size:
+        out["status"][jumped] = PathStatus.FAILED
+    return _result(system, out, pt, instance, retracked, options)
+
+
+def _jumps(y: Complex, status: NDArray[np.int8], instance: NDArray[np.intp],
+           options: TrackOptions) -> NDArray[np.intp]:
+    """Regular end points shared by two or more paths of one instance."""
+    regular = np.flatnonzero(status == PathStatus.REGULAR)
+    label = same_points(y[regular], instance[regular], options.same_point_tolerance)
+    shared = np.bincount(label, minlength=len(regular))[label] > 1
+    return regular[shared]
+
+
+def _result(system: PolynomialSystem, out: dict[str, np.ndarray], p_target: Complex,
+            instance: NDArray[np.intp], retracked: NDArray[np.bool_],
+            options: TrackOptions) -> TrackResult:
+    y, status = out["y"], out["status"]
+    finite = (status == PathStatus.REGULAR) | (status == PathStatus.SINGULAR)
+    x = np.full((len(y), system.n), np.nan + 0j)
+    with np.errstate(all="ignore"):
+        x[finite] = y[finite, 1:] / y[finite, :1]
+    residual = np.full(len(y), np.nan)
+    if finite.any():
+        F, _, _ = system.evaluate(x[finite], p_target[finite], want_jp=False)
+        residual[finite] = np.abs(F).max(axis=1)
+    multiplicity = np.ones(len(y), dtype=np.int64)
+    singular = np.flatnonzero(status == PathStatus.SINGULAR)
+    if singular.size:
+        label = same_points(x[singular], instance[singular], 1e3 * options.same_point_tolerance)
+        multiplicity[singular] = np.bincount(label, minlength=len(singular))[label]
+    return TrackResult(x, y, status, out["condition"], residual, out["winding"], multiplicity,
+                       out["steps"], retracked, instance)
