@@ -73,22 +73,24 @@ def bombieri_weyl_norm(system: PolynomialSystem, p: Complex) -> NDArray[np.float
     return np.sqrt((np.abs(coef) ** 2 * np.exp(log_weight)).sum(axis=1))
 
 
-def _evaluation_error(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[np.float64]:
-    """A bound on the rounding error of each F_i(x) (P, N): 8·(terms + degree)·u·Σ|terms|."""
-    absolute = _with_moduli(system)
-    F_abs, _, _ = absolute.evaluate(np.abs(x).astype(complex), np.abs(p).astype(complex),
-                                    want_jp=False)
-    terms = np.diff(np.append(system.starts, len(system.eq)))
-    factor = 8.0 * (terms + np.asarray(system.degrees) + system.sym.shape[1]) * UNIT_ROUNDOFF
-    return np.asarray(F_abs.real * factor, dtype=float)
-
-
-def _with_moduli(system: PolynomialSystem) -> PolynomialSystem:
-    """The system with every coefficient replaced by its modulus: at |x|, |p| it bounds the
-    sum of the moduli of the terms."""
+def term_magnitude(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[np.float64]:
+    """Σ_t |c_t·x^α·p^β| per equation (P, N): the scale of each F_i(x), against which a
+    residual or a rounding error is measured."""
     from dataclasses import replace
 
-    return replace(system, coef=np.abs(system.coef).astype(complex))
+    moduli = replace(system, coef=np.abs(system.coef).astype(complex))
+    F_abs, _, _ = moduli.evaluate(np.abs(x).astype(complex), np.abs(p).astype(complex),
+                                  want_jp=False)
+    return np.asarray(F_abs.real, dtype=float)
+
+
+def _evaluation_error(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[np.float64]:
+    """A bound on the rounding error of each F_i(x) (P, N): 8·(terms + degree + factors)·u
+    times Σ|terms| (Higham, *Accuracy and Stability of Numerical Algorithms*, 2002, §3.1, for
+    sums and products, with a factor 2 to spare)."""
+    terms = np.diff(np.append(system.starts, len(system.eq)))
+    factor = 8.0 * (terms + np.asarray(system.degrees) + system.sym.shape[1]) * UNIT_ROUNDOFF
+    return term_magnitude(system, x, p) * factor
 
 
 def certify(system: PolynomialSystem, x: Complex, p: Complex) -> Certificate:

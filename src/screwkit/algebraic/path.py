@@ -42,8 +42,10 @@ class TrackOptions:
     max_step: float = 0.2
     min_step: float = 1e-13
     max_steps: int = 2000
-    predictor_tolerance: float = 1e-5
-    corrector_tolerance: float = 1e-9
+    predictor_tolerance: float = 1e-3
+    corrector_tolerance: float = 1e-7
+    #: the second Newton correction must be at most this fraction of the first
+    contraction: float = 0.1
     #: the endgame starts on the circle |1 − σ| = endgame_radius and shrinks it by 4 a level
     endgame_radius: float = 0.05
     endgame_levels: int = 5
@@ -82,7 +84,7 @@ class Homotopy:
         """H (B, n+1), ∂H/∂y (B, n+1, n+1) and, when ``dsigma`` is given, ∂H/∂τ (B, n+1)."""
         d = self.direction[rows]
         p = self.p_start[rows] + sigma[:, None] * d
-        F, Jy, Jp = self.system.evaluate(y, p, want_jp=dsigma is not None)
+        F, Jy, Fd = self.system.evaluate_directional(y, p, None if dsigma is None else d)
         B, m = y.shape
         H = np.empty((B, m), dtype=complex)
         H[:, :-1] = F
@@ -92,9 +94,9 @@ class Homotopy:
         J[:, -1] = self.patch
         if dsigma is None:
             return H, J, None
-        assert Jp is not None
+        assert Fd is not None and dsigma is not None
         Ht = np.zeros((B, m), dtype=complex)
-        Ht[:, :-1] = np.einsum("bij,bj->bi", Jp, d) * dsigma[:, None]
+        Ht[:, :-1] = Fd * dsigma[:, None]
         return H, J, Ht
 
     def to_patch(self, x: Complex) -> Complex:
@@ -187,17 +189,23 @@ def track(hom: Homotopy, curve: Curve, y0: Complex, rows: Index, tau0: Real, tau
             scale = 1.0 + np.abs(ya).max(axis=1)
             first, second = sizes[0] / scale, sizes[1] / scale
             tol_c = options.corrector_tolerance
+            # Newton must contract fast (quadratic convergence from the predicted point, the
+            # guard against converging onto a neighbouring path) and end within tol_c
             accept = ((first <= options.predictor_tolerance) & (second <= tol_c)
-                      & ((second <= 0.25 * first) | (first <= tol_c)))
+                      & ((second <= options.contraction * first) | (first <= tol_c)))
             accept &= np.isfinite(yc).all(axis=1)
-            growth = np.clip(0.8 * (options.predictor_tolerance / np.maximum(first, 1e-300))
-                             ** 0.2, 1.0, 2.0)
+            # the first correction is the RK4 predictor's error, O(h^5): aim the next step at
+            # 0.8× the tolerance, growing at most 2× and shrinking at least 2×
+            ratio = 0.8 * (options.predictor_tolerance / np.maximum(first, 1e-300)) ** 0.2
+            ratio = np.where(np.isfinite(ratio), ratio, 0.25)
         acc = a[accept]
         y[acc] = yc[accept]
         tau[acc] = np.where(last[accept], tau1[acc], tau[acc] + hs[accept])
         reached[acc[last[accept]]] = True
-        h[a] = np.where(accept, np.minimum(np.maximum(hs, h[a]) * growth, options.max_step),
-                        0.5 * hs)
+        h[a] = np.where(accept,
+                        np.minimum(np.maximum(hs, h[a]) * np.clip(ratio, 1.0, 2.0),
+                                   options.max_step),
+                        hs * np.clip(ratio, 0.25, 0.5))
         steps[a] += 1
         alive = ~reached[a] & (h[a] >= options.min_step * np.maximum(span[a], 1.0)) \
             & (steps[a] < options.max_steps)

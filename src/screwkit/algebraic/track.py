@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from enum import IntEnum
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.endgame import cauchy_endgame
 from screwkit.algebraic.path import Homotopy, TrackOptions, line, newton, track
@@ -58,7 +58,9 @@ class TrackResult:
     number from the endgame (1 for paths that did not need it); ``multiplicity`` (P,) the number
     of paths of the same instance ending at the same point (1 for a regular end); ``steps`` (P,)
     predictor–corrector steps taken; ``retracked`` (P,) paths tracked again after a suspected
-    jump; ``instance`` (P,) the index of each path's target among the distinct targets."""
+    jump; ``instance`` (P,) the index of each path's homotopy (its pair p_start, p_target)
+    among the distinct pairs: paths of one instance are one homotopy, whose regular ends must
+    differ."""
 
     x: Complex
     y: Complex
@@ -80,8 +82,8 @@ class TrackResult:
         return {s.name.lower(): int((self.status == s).sum()) for s in PathStatus}
 
 
-def _check(system: PolynomialSystem, p_start: Complex, p_target: Complex,
-           x_start: Complex) -> tuple[Complex, Complex, Complex]:
+def _check(system: PolynomialSystem, p_start: ArrayLike, p_target: ArrayLike,
+           x_start: ArrayLike) -> tuple[Complex, Complex, Complex]:
     x = np.asarray(x_start, dtype=complex)
     if x.ndim != 2 or x.shape[1] != system.n:
         raise InputError(f"x_start must have shape (paths, {system.n}) for the unknowns "
@@ -199,8 +201,8 @@ def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArra
             "steps": steps}
 
 
-def track_parameter_homotopy(system: PolynomialSystem, p_start: Complex, p_target: Complex,
-                             x_start: Complex,
+def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
+                             p_target: ArrayLike, x_start: ArrayLike,
                              options: TrackOptions | None = None) -> TrackResult:
     """Track the start solutions ``x_start`` (P, n) of F(x; p_start) = 0 to F(x; p_target) = 0
     along p(s) = (1 − s)·p_start + s·p_target (Sommese & Wampler 2005, ch. 7).
@@ -217,7 +219,7 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: Complex, p_targe
     patch = ((rng.standard_normal(system.n + 1) + 1j * rng.standard_normal(system.n + 1))
              / 2).astype(complex)
     hom = Homotopy(hsys, patch, ps, pt - ps)
-    _, instance = np.unique(pt, axis=0, return_inverse=True)
+    _, instance = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_inverse=True)
     instance = instance.reshape(-1).astype(np.intp)
     rows = np.arange(P)
     out = _run(system, hom, x, rows, options)

@@ -1,0 +1,103 @@
+"""The parameter-homotopy tracker: univariate targets against numpy.roots, a batch against
+one-at-a-time, a double root through the endgame, a path to infinity, path-jump handling and
+bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from homotopy_helpers import univariate, univariate_start
+from screwkit.algebraic.polynomial import Poly, compile_system
+from screwkit.algebraic.track import PathStatus, TrackOptions, track_parameter_homotopy
+from screwkit.errors import InputError
+
+
+def _matches(found: np.ndarray, expected: np.ndarray, tol: float) -> bool:
+    """Every expected root has a found one within tol (relative), one to one."""
+    found = list(found)
+    for root in expected:
+        gaps = [abs(f - root) for f in found]
+        best = int(np.argmin(gaps))
+        if gaps[best] > tol * (1 + abs(root)):
+            return False
+        found.pop(best)
+    return True
+
+
+@pytest.mark.parametrize("degree", [4, 5])
+def test_univariate_roots_match_numpy(degree):
+    system = univariate(degree)
+    c0, roots0 = univariate_start(degree, seed=degree)
+    rng = np.random.default_rng(10 + degree)
+    for _ in range(5):
+        target = rng.standard_normal(degree)
+        result = track_parameter_homotopy(system, c0, target, roots0)
+        assert result.counts()["regular"] == degree
+        assert np.nanmax(result.residual) < 1e-12
+        expected = np.roots(np.r_[1.0, target[::-1]])
+        assert _matches(result.x[:, 0], expected, 1e-10)
+
+
+def test_batch_of_targets_equals_one_at_a_time():
+    system = univariate(4)
+    c0, roots0 = univariate_start(4, seed=1)
+    targets = np.random.default_rng(2).standard_normal((6, 4))
+    batch = track_parameter_homotopy(system, c0, np.repeat(targets, 4, axis=0),
+                                     np.tile(roots0, (6, 1)))
+    groups = batch.instance.reshape(6, 4)
+    assert (groups == groups[:, :1]).all() and len(set(groups[:, 0])) == 6
+    for b, target in enumerate(targets):
+        alone = track_parameter_homotopy(system, c0, target, roots0)
+        assert np.abs(batch.x[4 * b: 4 * b + 4] - alone.x).max() < 1e-12
+        assert (batch.status[4 * b: 4 * b + 4] == alone.status).all()
+
+
+def test_double_root_is_singular_with_multiplicity_two():
+    system = univariate(5)
+    c0, roots0 = univariate_start(5, seed=0)
+    target = np.poly([1.0, 1.0, 2.0, -1 + 1j, -1 - 1j])[::-1][:5].real
+    result = track_parameter_homotopy(system, c0, target, roots0)
+    singular = result.status == PathStatus.SINGULAR
+    assert singular.sum() == 2
+    assert (result.multiplicity[singular] == 2).all() and (result.winding[singular] == 2).all()
+    assert np.abs(result.x[singular, 0] - 1.0).max() < 1e-8  # the Cauchy endgame's accuracy
+    assert _matches(result.x[~singular, 0], np.array([2.0, -1 + 1j, -1 - 1j]), 1e-10)
+
+
+def test_a_root_going_to_infinity_is_reported_at_infinity():
+    # a·x² + b·x + c with a → 0: one root stays finite (−c/b), the other diverges
+    x, a, b, c = (Poly.variable(i) for i in range(4))
+    system = compile_system([a * x * x + b * x + c], ["x"], ["a", "b", "c"])
+    p0 = np.array([1.0 + 0.5j, -0.3 + 1j, 0.7 - 0.2j])
+    roots0 = np.roots(p0)[:, None]
+    result = track_parameter_homotopy(system, p0, [0.0, 2.0, -3.0], roots0)
+    assert sorted(result.status.tolist()) == [PathStatus.REGULAR, PathStatus.AT_INFINITY]
+    assert abs(result.x[result.regular, 0][0] - 1.5) < 1e-12
+    assert np.isnan(result.x[result.status == PathStatus.AT_INFINITY]).all()
+
+
+def test_two_paths_on_one_regular_solution_are_retracked_then_failed():
+    # the same start solution twice: both paths end at one regular solution, which a correct
+    # tracking never gives; both are tracked again and, still together, marked failed
+    system = univariate(3)
+    c0, roots0 = univariate_start(3, seed=4)
+    starts = np.vstack([roots0, roots0[:1]])
+    result = track_parameter_homotopy(system, c0, [0.5, -1.0, 0.2], starts)
+    assert result.retracked.tolist() == [True, False, False, True]
+    assert result.status.tolist() == [PathStatus.FAILED, PathStatus.REGULAR,
+                                      PathStatus.REGULAR, PathStatus.FAILED]
+    off = track_parameter_homotopy(system, c0, [0.5, -1.0, 0.2], starts,
+                                   TrackOptions(retrack=False))
+    assert not off.retracked.any() and (off.status[[0, 3]] == PathStatus.FAILED).all()
+
+
+def test_bad_shapes_are_refused_with_the_expected_shape():
+    system = univariate(3)
+    c0, roots0 = univariate_start(3)
+    with pytest.raises(InputError, match=r"x_start must have shape \(paths, 1\)"):
+        track_parameter_homotopy(system, c0, c0, roots0[:, 0])
+    with pytest.raises(InputError, match=r"p_target must have shape \(3,\)"):
+        track_parameter_homotopy(system, c0, [1.0, 2.0], roots0)
+    with pytest.raises(InputError, match="p_start must be finite"):
+        track_parameter_homotopy(system, [np.nan, 0, 0], c0, roots0)
