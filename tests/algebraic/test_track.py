@@ -47,6 +47,10 @@ def test_batch_of_targets_equals_one_at_a_time():
                                      np.tile(roots0, (6, 1)))
     groups = batch.instance.reshape(6, 4)
     assert (groups == groups[:, :1]).all() and len(set(groups[:, 0])) == 6
+    chunked = track_parameter_homotopy(system, c0, np.repeat(targets, 4, axis=0),
+                                       np.tile(roots0, (6, 1)), TrackOptions(chunk=5))
+    assert np.abs(chunked.x - batch.x).max() < 1e-12
+    assert (chunked.steps == batch.steps).all()
     for b, target in enumerate(targets):
         alone = track_parameter_homotopy(system, c0, target, roots0)
         assert np.abs(batch.x[4 * b: 4 * b + 4] - alone.x).max() < 1e-12

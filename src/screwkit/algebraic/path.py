@@ -60,6 +60,8 @@ class TrackOptions:
     same_point_tolerance: float = 1e-7
     retrack: bool = True
     seed: int = 0
+    #: paths tracked together (larger batches run in chunks of this many)
+    chunk: int = 512
 
     def tighter(self) -> TrackOptions:
         """The options for a retrack after suspected path jumping: 10× smaller steps and

@@ -201,6 +201,18 @@ def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArra
             "steps": steps}
 
 
+def _run_in_chunks(system: PolynomialSystem, hom: Homotopy, x: Complex,
+                   rows: NDArray[np.intp], options: TrackOptions) -> dict[str, np.ndarray]:
+    """:func:`_run` over chunks of ``options.chunk`` paths: every array of a chunk stays
+    small enough for the cache (a batch of thousands of paths at once runs slower per path
+    than a few hundred, measured on the 6-quadric benchmark)."""
+    if len(rows) <= options.chunk:
+        return _run(system, hom, x, rows, options)
+    parts = [_run(system, hom, x[i: i + options.chunk], rows[i: i + options.chunk], options)
+             for i in range(0, len(rows), options.chunk)]
+    return {key: np.concatenate([part[key] for part in parts]) for key in parts[0]}
+
+
 def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
                              p_target: ArrayLike, x_start: ArrayLike,
                              options: TrackOptions | None = None) -> TrackResult:
@@ -222,11 +234,11 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
     _, instance = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_inverse=True)
     instance = instance.reshape(-1).astype(np.intp)
     rows = np.arange(P)
-    out = _run(system, hom, x, rows, options)
+    out = _run_in_chunks(system, hom, x, rows, options)
     retracked = np.zeros(P, dtype=bool)
     jumped = _jumps(out["y"], out["status"], instance, options)
     if jumped.size and options.retrack:
-        again = _run(system, hom, x[jumped], rows[jumped], options.tighter())
+        again = _run_in_chunks(system, hom, x[jumped], rows[jumped], options.tighter())
         for key, value in again.items():
             out[key][jumped] = value
         retracked[jumped] = True
