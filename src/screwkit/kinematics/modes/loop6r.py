@@ -29,7 +29,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
+from screwkit.algebraic.solve import StartSolutions
 from screwkit.errors import InputError
+from screwkit.kinematics.modes.starts import start_solutions
 
 Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
@@ -151,3 +153,9 @@ def random_loop6r(rng: np.random.Generator, count: int, complex_values: bool = F
           + np.einsum("ni,nij->nj", d, z[:, 1:5]))
     p = np.concatenate([z[:, 0], z[:, 5], cos_a, k, d, g], -1)
     return p, z[:, 1:5].reshape(count, 12)
+
+
+def loop6r_start() -> StartSolutions:
+    """The 16 start solutions at a random complex instance (monodromy; cached per process)."""
+    return start_solutions(loop6r_system(), lambda rng: random_loop6r(rng, 1, True),
+                           LOOP6R_GENERIC_COUNT)

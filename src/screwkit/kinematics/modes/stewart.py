@@ -11,7 +11,7 @@ length ‖R b_i + t − a_i‖² = L_i² times Δ is the quadric
     Δ(‖a_i‖² + ‖b_i‖² − L_i²) + 4 y·y + 4 b_i·vec(x̄ y) − 4 a_i·vec(y x̄) − 2 a_iᵀ R'(x) b_i = 0
 
 (y·y = ‖y x̄‖²/Δ and (R b)·t = b·Rᵀt with Rᵀt = 2 vec(x̄ y)/Δ). The unknowns are the eight
-Study coordinates on the affine patch r·x = 1 (r fixed random complex): the patch is on x only,
+Study coordinates on the affine patch r·x = 1 (r fixed random real): the patch is on x only,
 which keeps out the exceptional set x = 0, y·y = 0 that satisfies every leg equation. Equations:
 the Study quadric, the six legs, the patch (8 in 8). Parameters: the base points a_i (world),
 the platform points b_i (platform frame) and the squared lengths L_i² (42, all free: any complex
@@ -26,15 +26,19 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
+from screwkit.algebraic.solve import StartSolutions
 from screwkit.errors import InputError
+from screwkit.kinematics.modes.starts import start_solutions
 
 Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
 
 #: the generic number of complex solutions (Husty 1996; Wampler 1996)
 STEWART_GENERIC_COUNT = 40
-#: the affine patch r·x = 1 (fixed, so that one compiled system serves every instance)
-_PATCH = np.array([1.0, 1j]) @ np.random.default_rng(20260627).normal(size=(2, 4))
+#: the affine patch r·x = 1: fixed, so that one compiled system serves every instance, and real,
+#: so that a real pose has real Study coordinates (the solver's real and certified-real tests
+#: then apply to poses directly)
+_PATCH = np.random.default_rng(20260627).normal(size=4)
 STUDY_NAMES = ("x0", "x1", "x2", "x3", "y0", "y1", "y2", "y3")
 
 
@@ -167,3 +171,9 @@ def random_stewart(rng: np.random.Generator, count: int, complex_values: bool = 
     t = draw(count, 3) * 0.3 + np.array([0.0, 0.0, 1.5])
     z = study_from_pose(R, t)
     return stewart_parameters(A, B, leg_lengths(R, t, A, B)), z
+
+
+def stewart_start() -> StartSolutions:
+    """The 40 start solutions at a random complex instance (monodromy; cached per process)."""
+    return start_solutions(stewart_system(), lambda rng: random_stewart(rng, 1, True),
+                           STEWART_GENERIC_COUNT)
