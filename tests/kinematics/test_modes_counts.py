@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 import screwkit as sk
+from modes_helpers import random_r_loop
 from screwkit.algebraic.solve import Solutions, solve_all
 from screwkit.kinematics.graph.closure import graph_forward
 from screwkit.kinematics.modes.loop6r import loop6r_start, loop6r_system
@@ -29,7 +30,6 @@ from screwkit.kinematics.modes.stewart import (
     stewart_system,
 )
 from screwkit.model.mechanism import Mechanism, MechanismJoint
-from test_modes_formulations import random_r_loop
 
 INSTANCES = int(os.environ.get("SCREWKIT_MODES_INSTANCES", "200"))
 EXAMPLES = Path(__file__).parents[2] / "examples" / "mechanisms"

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import screwkit as sk
-from screwkit.algebraic.polynomial import PolynomialSystem
+from modes_helpers import check_jacobians, random_r_loop, relative_residual
 from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout, zero_configuration
 from screwkit.kinematics.graph.track import follow_drawn_mode
@@ -26,38 +26,9 @@ from screwkit.kinematics.modes.stewart import (
     stewart_system,
     study_from_pose,
 )
-from screwkit.model.mechanism import GROUND, Body, Mechanism, MechanismJoint
+from screwkit.model.mechanism import Mechanism
 
 EXAMPLES = Path(__file__).parents[2] / "examples" / "mechanisms"
-
-
-def relative_residual(system: PolynomialSystem, x: np.ndarray, p: np.ndarray) -> float:
-    """max |F| over the size of the terms it sums (|Jx|·|x| + |Jp|·|p|, Euler's bound for
-    the homogeneous parts), so that a root of a large instance is judged like a small one."""
-    F, Jx, Jp = system.evaluate(x, p)
-    assert Jp is not None
-    scale = (np.abs(Jx) @ np.abs(x)[..., None])[..., 0] + np.abs(
-        Jp @ np.broadcast_to(p, (x.shape[0], system.k))[..., None])[..., 0]
-    return float(np.max(np.abs(F) / (1.0 + scale)))
-
-
-def check_jacobians(system: PolynomialSystem, x: np.ndarray, p: np.ndarray) -> None:
-    """∂F/∂x and ∂F/∂p against central differences (the system is polynomial, so h = 1e-6
-    leaves an error of order h² times the third derivatives)."""
-    _, Jx, Jp = system.evaluate(x, p)
-    assert Jp is not None
-    h = 1e-6
-    for i in range(system.n):
-        e = np.zeros(system.n)
-        e[i] = h
-        d = (system.evaluate(x + e, p, False)[0] - system.evaluate(x - e, p, False)[0]) / (2 * h)
-        assert np.allclose(d, Jx[:, :, i], rtol=1e-6, atol=1e-6), f"∂F/∂{system.variables[i]}"
-    P = np.broadcast_to(p, (x.shape[0], system.k))
-    for i in range(system.k):
-        e = np.zeros(system.k)
-        e[i] = h
-        d = (system.evaluate(x, P + e, False)[0] - system.evaluate(x, P - e, False)[0]) / (2 * h)
-        assert np.allclose(d, Jp[:, :, i], rtol=1e-6, atol=1e-6), f"∂F/∂{system.parameters[i]}"
 
 
 # --- Stewart–Gough ---------------------------------------------------------------------------
@@ -107,18 +78,6 @@ def test_loop6r_system_vanishes_at_random_axes(complex_values: bool) -> None:
     assert (S.n, S.k) == (12, 23)
     assert relative_residual(S, x, p) <= 1e-12
     check_jacobians(S, x[:5], p[:5])
-
-
-def random_r_loop(rng: np.random.Generator, n: int, inputs: list[int]) -> Mechanism:
-    """A loop of n R joints on random lines, some joints' bodies listed against the walk."""
-    bodies = [Body(f"l{i}") for i in range(1, n)]
-    names = [GROUND, *(b.name for b in bodies), GROUND]
-    joints = []
-    for i in range(n):
-        a, b = (names[i], names[i + 1]) if rng.random() < 0.6 else (names[i + 1], names[i])
-        joints.append(MechanismJoint(f"j{i}", "R", (a, b), rng.normal(size=3),
-                                     rng.normal(size=3)))
-    return Mechanism("loop", tuple(bodies), tuple(joints), tuple(f"j{k}.theta" for k in inputs))
 
 
 def test_a_7r_loop_at_one_input_is_a_6r_instance_the_tracker_agrees_with() -> None:
