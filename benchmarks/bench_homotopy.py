@@ -84,12 +84,6 @@ def run() -> list[dict[str, Any]]:
     rng = np.random.default_rng(0)
     targets = rng.standard_normal((BATCH, system.k))
 
-    t0 = time.process_time()
-    solutions = solve_all(system, targets, start)
-    t_solve = time.process_time() - t0
-    complete = int(((solutions.found == 2**N) & (solutions.failed == 0)).sum())
-    certified = bool(solutions.certified.all())
-
     def alone() -> None:
         track_parameter_homotopy(system, start.p, targets[0], start.x)
 
@@ -98,6 +92,12 @@ def run() -> list[dict[str, Any]]:
                                  np.tile(start.x, (BATCH, 1)))
 
     t_alone, t_batch = _best(alone), _best(batch, repeats=1)
+    t0 = time.process_time()
+    solutions = solve_all(system, targets, start)
+    t_solve = time.process_time() - t0
+    complete = int(((solutions.found == 2**N) & (solutions.failed == 0)).sum())
+    certified = bool(solutions.certified.all())
+
     rate = BATCH * m / t_batch
     note = f"{complete}/{BATCH} instances with all {2**N}, all certified: {certified}"
     return [

@@ -1,6 +1,14 @@
 """Polynomial systems and the homotopy continuation that finds all their isolated solutions.
 
-This package knows nothing of mechanisms: :mod:`.polynomial` holds sparse polynomial systems with
-parameters, evaluated batched over many points; the formulations of mechanism closures as
-polynomial systems live in ``screwkit.kinematics``.
+This package knows nothing of mechanisms (docs/kinematics.md, "How every mode is found"):
+
+- :mod:`.polynomial`: sparse polynomial systems with parameters, evaluated batched;
+- :mod:`.track` (with :mod:`.path` and :mod:`.endgame`): the parameter homotopy
+  ``track_parameter_homotopy``, its Cauchy endgame and path-jump check;
+- :mod:`.total_degree`: ``solve_total_degree``, the first solve of a small system;
+- :mod:`.monodromy`: ``monodromy_solve``, every solution at a generic point from one;
+- :mod:`.certify`: Smale's α-test, real and distinct certificates;
+- :mod:`.solve`: ``solve_all`` from ``StartSolutions``.
+
+The formulations of mechanism closures as polynomial systems live in ``screwkit.kinematics``.
 """
