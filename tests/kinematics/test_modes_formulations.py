@@ -154,3 +154,34 @@ def test_planar_refuses_a_spatial_mechanism_and_a_free_one() -> None:
     free = Mechanism(mech.name, mech.bodies, mech.joints, ())
     with pytest.raises(InputError, match="square only"):
         planar_formulation(free)
+
+
+# --- RSSR, RSRC, RCCC at one input -----------------------------------------------------------
+
+@pytest.mark.parametrize("family", ["RSSR", "RSRC", "RCCC"])
+def test_loop_systems_vanish_at_the_closed_form_configuration(family: str) -> None:
+    """The loop drawn where its closed form puts it: the drawing (output 0, slide 0) is a
+    root at input 0, and the Jacobians match central differences there."""
+    from screwkit.kinematics.graph.from_loop import mechanism_from_loop
+    from screwkit.kinematics.modes.rccc import rccc_loop
+    from screwkit.kinematics.modes.rod_loops import rod_loop
+    from screwkit.kinematics.solve_motion import solve_motion
+    from screwkit.model.families import rccc, rsrc, rssr
+
+    lk = {"RSSR": rssr(1.0, 3.0, 2.0, 2.5, 1.0, 0.7, 0.2),
+          "RSRC": rsrc(1.0, 4.0, 2.5, 3.0, 1.0, 0.2, 0.1, 0.8),
+          "RCCC": rccc((1.0, 3.0, 2.5, 3.0), (0.3, 0.2, -0.4, 0.5))}[family]
+    motion = solve_motion(lk, np.linspace(0.0, 2 * np.pi, 24, endpoint=False), method="closed")
+    sample = int(np.argmax(motion.mode(0).assembles))
+    mech = mechanism_from_loop(motion, 0, sample)
+    if family == "RCCC":
+        form = rccc_loop(mech)
+        c3 = next(j for j in mech.joints if j.name == "C3")
+        x = np.r_[c3.axis, np.cross(c3.at, c3.axis)][None]
+        x = x * (1 if form._line(2)[1] @ c3.axis > 0 else -1)
+    else:
+        form = rod_loop(mech)
+        x = np.array([[1.0, 0.0, 0.0][: form.system.n]])
+    p = form.parameters([0.0]).astype(complex)
+    assert relative_residual(form.system, x.astype(complex), p) <= 1e-12
+    check_jacobians(form.system, x.astype(complex) + 0.1j, p)

@@ -69,7 +69,7 @@ def rsrc_system() -> PolynomialSystem:
                           ("mu0", "mu1", "mu2", "mu3", "nu0", "nu1", "nu2", "nu3"))
 
 
-def _walk(mech: Mechanism, kinds: str) -> list[tuple[int, bool]]:
+def walk_loop(mech: Mechanism, kinds: str) -> list[tuple[int, bool]]:
     """The loop's joints from the driven ground joint, each with whether the walk runs from
     its first body to its second."""
     name = f"{kinds[0]}{kinds[1:]}"
@@ -231,8 +231,8 @@ def rod_loop(mech: Mechanism) -> RodLoop:
     """The RSSR or RSRC system of ``mech`` (a single loop driven at a ground R joint)."""
     kinds = "".join(sorted(j.kind for j in mech.joints))
     if kinds == "RRSS":
-        return RodLoop(mech, "RSSR", tuple(_walk(mech, "RSSR")), rssr_system())
+        return RodLoop(mech, "RSSR", tuple(walk_loop(mech, "RSSR")), rssr_system())
     if kinds == "CRRS":
-        return RodLoop(mech, "RSRC", tuple(_walk(mech, "RSRC")), rsrc_system())
+        return RodLoop(mech, "RSRC", tuple(walk_loop(mech, "RSRC")), rsrc_system())
     raise InputError(f"{mech.name}: joints {[j.kind for j in mech.joints]} are neither an RSSR "
                      "nor an RSRC loop")
