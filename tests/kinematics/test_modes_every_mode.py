@@ -64,3 +64,44 @@ def test_a_mechanism_no_formulation_takes_is_refused_by_name() -> None:
     mech = sk.load_spec(EXAMPLES / "double_wishbone.toml").mechanism
     with pytest.raises(CapabilityError, match="no polynomial formulation takes"):
         every_mode(mech, np.zeros((1, len(mech.inputs))))
+
+
+def test_every_pose_of_the_stewart_example_holds_the_tracked_one() -> None:
+    """The bundled UPS platform (symmetric, so not generic: fewer than 40 finite poses, some
+    paths end singular or fail, and the solver says so): the pose the graph tracker reaches is
+    among the real poses, and every real pose has the six leg lengths (an independent check:
+    from the pose, not from the polynomial system)."""
+    from screwkit.algebraic.solve import solve_all
+    from screwkit.kinematics.graph.closure import graph_forward
+    from screwkit.kinematics.modes.stewart import (
+        pose_from_study,
+        stewart_from_mechanism,
+        stewart_start,
+        stewart_system,
+    )
+
+    mech = sk.load_spec(EXAMPLES / "stewart_platform.toml").mechanism
+    rig = stewart_from_mechanism(mech)
+    X = np.array([[0.0] * 6, [0.004, -0.003, 0.002, 0.005, -0.001, 0.003]])
+    lay = graph_layout(mech)
+    followed = follow_drawn_mode(mech, lay, X)
+    assert followed.mask.all()
+    frames = graph_forward(mech, lay, followed.conf)
+    body = lay.body_of[rig.platform]
+    p = rig.parameters(X)
+    sol = solve_all(stewart_system(), p, stewart_start())
+    assert np.all(sol.found <= 40)
+    for b in range(len(X)):
+        R, t = pose_from_study(sol.x[(sol.instance == b) & sol.real].real)
+        gap = np.abs(R - frames.R[b, body]).max(axis=(1, 2)) + np.abs(t - frames.p[b, body]).max(1)
+        assert gap.min() <= 1e-9
+        legs = np.einsum("nij,kj->nki", R, rig.top) + t[:, None] - rig.base
+        L = np.sqrt(p[b, 36:])
+        assert np.abs(np.linalg.norm(legs, axis=2) - L).max() <= 1e-10 * max(L)
+
+
+def test_a_mechanism_that_is_not_a_stewart_platform_is_refused() -> None:
+    from screwkit.kinematics.modes.stewart import stewart_from_mechanism
+
+    with pytest.raises(CapabilityError, match="not a 6-6 Stewart"):
+        stewart_from_mechanism(sk.load_spec(EXAMPLES / "watt_sixbar.toml").mechanism)

@@ -20,6 +20,7 @@ values are an instance). The generic count is 40 (Husty 1996; Wampler 1996; Ragh
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
@@ -27,8 +28,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.algebraic.solve import StartSolutions
-from screwkit.errors import InputError
+from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.modes.starts import start_solutions
+from screwkit.model.mechanism import GROUND, Mechanism, MechanismJoint
 
 Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
@@ -177,3 +179,61 @@ def stewart_start() -> StartSolutions:
     """The 40 start solutions at a random complex instance (monodromy; cached per process)."""
     return start_solutions(stewart_system(), lambda rng: random_stewart(rng, 1, True),
                            STEWART_GENERIC_COUNT)
+
+
+@dataclass(frozen=True)
+class StewartMechanism:
+    """A 6-6 platform drawn as a :class:`Mechanism`: six legs from the ground to one platform
+    body, each a driven P joint between two bodies, the lower one jointed to the ground at a
+    (U or S) centre a_i, the upper one to the platform at an S centre b_i. The platform's
+    frame is the world's in the drawing, so b_i are the platform points as drawn; a leg's
+    length at slide s is ‖b_i − a_i + s u_i‖ (u_i the slide axis, in the lower body)."""
+
+    mechanism: Mechanism
+    platform: str
+    base: Array
+    top: Array
+    slide_axes: Array
+    input_columns: tuple[int, ...]
+
+    def parameters(self, input_values: ArrayLike) -> Array:
+        """Parameters (N, 42) at rows of input values (N, n_inputs) (metres from the drawing)."""
+        X = np.atleast_2d(np.asarray(input_values, dtype=float))
+        d = (self.top - self.base)[None] + X[:, self.input_columns, None] * self.slide_axes[None]
+        N = X.shape[0]
+        return stewart_parameters(np.broadcast_to(self.base, (N, 6, 3)),
+                                  np.broadcast_to(self.top, (N, 6, 3)),
+                                  np.linalg.norm(d, axis=2)).real
+
+
+def _beyond(mech: Mechanism, joint: MechanismJoint, body: str, kinds: str
+            ) -> tuple[str, Array] | None:
+    """The body across ``body``'s only other joint (of one of ``kinds``) and that joint's
+    centre, or None."""
+    near = [j for j in mech.joints if body in j.bodies and j is not joint]
+    if len(near) != 1 or near[0].kind not in kinds:
+        return None
+    return (near[0].bodies[1] if near[0].bodies[0] == body else near[0].bodies[0], near[0].at)
+
+
+def stewart_from_mechanism(mech: Mechanism) -> StewartMechanism:
+    """Recognise the six legs of a Stewart–Gough platform in ``mech`` (class docstring)."""
+    legs = []
+    for col, name in enumerate(mech.inputs):
+        k = next(i for i, j in enumerate(mech.joints) if j.name == name.split(".")[0])
+        joint = mech.joints[k]
+        if joint.kind != "P":
+            continue
+        lower, upper = joint.bodies
+        down, up = _beyond(mech, joint, lower, "US"), _beyond(mech, joint, upper, "S")
+        if down is None or up is None or down[0] != GROUND:
+            continue
+        legs.append((col, up[0], down[1], up[1], joint.axis))
+    platforms = {leg[1] for leg in legs}
+    if len(legs) != 6 or len(platforms) != 1 or len(mech.bodies) != 13:
+        raise CapabilityError(f"{mech.name}: not a 6-6 Stewart–Gough platform (six legs, each "
+                              "a driven P joint between a body jointed to the ground by a U or "
+                              "S joint and one jointed to the platform by an S joint)")
+    return StewartMechanism(mech, platforms.pop(), np.array([leg[2] for leg in legs]),
+                            np.array([leg[3] for leg in legs]), np.array([leg[4] for leg in legs]),
+                            tuple(leg[0] for leg in legs))
