@@ -12,7 +12,7 @@ n_{i−1} and n_i along z_i. The loop closes when
 (the loop equation of Duffy, *Analysis of Mechanisms and Robot Manipulators*, 1980, ch. 2; the
 same as the Σ(a_i x_i + d_i z_i) = 0 of a Denavit–Hartenberg chain). The unknowns are the moving
 axes z_2..z_5 (12), the equations z_i·z_i = 1 (4), the five link angles and the closure (3):
-the formulation of Sommese & Wampler 2005, §9.4 (after Tsai & Morgan 1985 and Wampler & Morgan
+the formulation of the 6R case study in Sommese & Wampler 2005, ch. 9 (after Tsai & Morgan 1985 and Wampler & Morgan
 1991), whose generic count is 16. Once the axes are known every joint angle follows: θ_i is the
 angle from n_{i−1} to n_i about z_i, so the cos/sin of every joint are rational in the solution
 and no spurious solution is added. The parameters (z_1, z_6, cos α_1..5, k_1..5, d_2..5, g: 23)

@@ -9,12 +9,13 @@ unknown, and each remaining body with joints P_1, P_2, …, P_k gives
                                                   rotation-and-scale of the drawing, a complex
                                                   number acting on (x, y))
 
-(the distance equations of Wampler, Morgan & Sommese 1992, "Complete solution of the nine-point
-path synthesis problem for four-bar linkages", and of Wampler 2001, "Solving the kinematics of
-planar mechanisms by Dixon determinant and a complex-plane formulation"). The system is square
+(a body's rigidity as a complex rotation-and-scale, the complex-plane view of Wampler 2001,
+"Solving the kinematics of planar mechanisms by Dixon determinant and a complex-plane
+formulation", written here in Cartesian coordinates). The system is square
 exactly when the mechanism has no freedom left at fixed inputs. The linear rigid-body equations
 keep a ternary body from being mirrored, so every solution is an assembly: a 4R gives 2, a
-Stephenson III six-bar driven at its crank 6 (Wampler 2001). Every parameter (the placed joints,
+Stephenson III six-bar driven at its crank 6 (a triad; checked by the total-degree
+homotopy, tests/kinematics/test_modes_counts.py). Every parameter (the placed joints,
 the squared distances and the complex ratios M) is free, so the real instances are generic
 members of the family.
 """

@@ -5,7 +5,7 @@ known; what is unknown is the line of C3, as its unit direction z and moment m (
 coordinates: m = c × z for a point c on it). Link 2 keeps the angle and the distance between
 the C2 and C3 lines, link 3 between C3 and C4: for two lines (z_a, m_a), (z_b, m_b) the cosine
 z_a·z_b and the mutual moment z_a·m_b + z_b·m_a = −d sin α are invariant under rigid motion
-(Hunt, *Kinematic Geometry of Mechanisms*, 1978, §2.4). So
+(the mutual moment of two lines; Hunt, *Kinematic Geometry of Mechanisms*, 1978). So
 
     z·z = 1,  z·m = 0,  z₂·z = cos α₂,  z₄·z = cos α₃,
     z₂·m + m₂·z = μ₂,  z₄·m + m₄·z = μ₃
