@@ -136,3 +136,37 @@ def test_stephenson_iii_has_6_solutions_and_the_drawing_among_the_real_ones() ->
 
 def test_a_planar_fourbar_has_2_solutions() -> None:
     _planar_check("fourbar_graph", 2)
+
+
+def test_a_6r_arm_has_16_inverse_kinematics_solutions_and_the_pose_they_came_from() -> None:
+    """Random arms at random joint values q*: the target is their forward kinematics (product
+    of exponentials, arm_forward), every real solution's forward kinematics gives the target
+    back, and q* is among them."""
+    from screwkit.kinematics.modes.arm6r import arm6r_instance, arm_forward
+
+    rng = np.random.default_rng(14)
+    arms, insts, truth = [], [], []
+    for _ in range(INSTANCES):
+        C, U = rng.normal(size=(6, 3)), rng.normal(size=(6, 3))
+        U /= np.linalg.norm(U, axis=1)[:, None]
+        Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        home = (Q * np.sign(np.linalg.det(Q)), rng.normal(size=3))
+        q = rng.uniform(-np.pi, np.pi, 6)
+        target = arm_forward(C, U, home, q)
+        arms.append((C, U, home, target))
+        insts.append(arm6r_instance(C, U, home, target))
+        truth.append(q)
+    sol = solve_all(loop6r_system(), np.array([i.params for i in insts]), loop6r_start())
+    assert_count(sol.found, 16, "6R arm")
+    missing, worst = [], 0.0
+    for b, inst in enumerate(insts):
+        q = inst.joint_values(sol.x[(sol.instance == b) & sol.real])
+        gap = np.abs(np.mod(q - truth[b] + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+        if len(q) == 0 or gap.min() > 1e-8:
+            missing.append(b)
+        C, U, home, (Rt, pt) = arms[b]
+        for row in q:
+            R, p = arm_forward(C, U, home, row)
+            worst = max(worst, float(np.abs(R - Rt).max() + np.abs(p - pt).max()))
+    print(f"6R arm: the generating joint values not found for instances {missing}")
+    assert len(missing) <= 0.01 * INSTANCES and worst <= CLOSE

@@ -185,3 +185,19 @@ def test_loop_systems_vanish_at_the_closed_form_configuration(family: str) -> No
     p = form.parameters([0.0]).astype(complex)
     assert relative_residual(form.system, x.astype(complex), p) <= 1e-12
     check_jacobians(form.system, x.astype(complex) + 0.1j, p)
+
+
+def test_an_arm_at_home_is_a_root_that_decodes_to_zero() -> None:
+    from screwkit.kinematics.modes.arm6r import arm6r_instance
+
+    rng = np.random.default_rng(7)
+    C, U = rng.normal(size=(6, 3)), rng.normal(size=(6, 3))
+    U /= np.linalg.norm(U, axis=1)[:, None]
+    home = (np.eye(3), rng.normal(size=3))
+    inst = arm6r_instance(C, U, home, home)
+    x = U[1:5].reshape(1, 12)
+    assert relative_residual(loop6r_system(), x.astype(complex), inst.params.astype(complex)
+                             ) <= 1e-12
+    assert np.abs(inst.joint_values(x)).max() <= 1e-12
+    with pytest.raises(InputError, match="6 joint points"):
+        arm6r_instance(C[:5], U, home, home)
