@@ -1,0 +1,20 @@
+"""Mechanism closures written as polynomial systems F(x; p) = 0 (issue 27).
+
+Each formulation compiles one :class:`~screwkit.algebraic.polynomial.PolynomialSystem` per
+topology; the geometry (and, for loops at one input value, the input) are its parameters p, so one
+compiled system serves every instance of the topology and a parameter homotopy can move between
+instances (Sommese & Wampler 2005, ch. 7). Every formulation is chosen so that the physical
+instances are generic members of its parameter family (the parameters are free: any complex
+value is an instance with the same number of isolated solutions), which is what a parameter
+homotopy started at a random complex instance needs to find every solution.
+
+- :mod:`.stewart`: 6-6 Stewart–Gough forward kinematics in Study coordinates (40 solutions);
+- :mod:`.loop6r`: a 6R loop, the inverse kinematics of a 6R arm (:mod:`.arm6r`), a 7R loop at
+  one input (16);
+- :mod:`.planar`: planar R-joint mechanisms as graphs (distance equations; 4R: 2, Stephenson III: 6);
+- :mod:`.rod_loops`: the RSSR (2) and RSRC (4) loops at one input;
+- :mod:`.rccc`: the RCCC loop at one input, in Plücker coordinates (2);
+- :mod:`.r_loop`: a Mechanism's single R loop (6R, 7R at one input) as a 6R instance;
+- :mod:`.starts`: start solutions per topology; :mod:`.continuum`: a continuum told from
+  isolated roots at a singular end point.
+"""

@@ -1,0 +1,146 @@
+"""Every assembly mode of a mechanism at given input values, by the homotopy (issue 27).
+
+:func:`closure_formulation` picks the formulation of this package that fits the mechanism (a
+planar R-joint graph; a single loop of R joints with six free; an RSSR, RSRC or RCCC driven at
+a ground R joint) and :func:`every_mode` solves it for every row of inputs in one batched
+parameter homotopy from the topology's start solutions. Each real solution is turned into the
+graph tracker's :class:`Configuration` and kept only if the tracker's own closure
+(``graph_forward``, the exact SE(3) logarithm round every loop) is within
+:data:`CLOSURE_TOLERANCE` of the length scale: the check is independent of the polynomial
+system. A row whose paths end singular on a curve of solutions is reported as a continuum.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.algebraic.polynomial import PolynomialSystem
+from screwkit.algebraic.solve import solve_all
+from screwkit.algebraic.track import PathStatus
+from screwkit.errors import CapabilityError
+from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
+from screwkit.kinematics.modes.continuum import on_a_continuum
+from screwkit.kinematics.modes.loop6r import loop6r_start, loop6r_system
+from screwkit.kinematics.modes.planar import planar_formulation
+from screwkit.kinematics.modes.r_loop import r_loop_instance
+from screwkit.kinematics.modes.rccc import rccc_loop
+from screwkit.kinematics.modes.rod_loops import rod_loop
+from screwkit.kinematics.modes.starts import start_solutions
+from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.model.mechanism import Mechanism
+
+Array = NDArray[np.float64]
+#: a real solution is a mode when every loop closes to this, relative to the length scale
+CLOSURE_TOLERANCE = 1e-10
+
+
+class Formulation(Protocol):
+    """What :func:`every_mode` needs of a formulation."""
+
+    @property
+    def system(self) -> PolynomialSystem: ...
+
+    def parameters(self, input_values: ArrayLike) -> Array: ...
+
+    def configuration(self, solutions: ArrayLike, input_values: ArrayLike
+                      ) -> tuple[Configuration, GraphLayout]: ...
+
+
+@dataclass(frozen=True)
+class _RLoopFormulation:
+    """A single R loop as a formulation over rows of inputs (one 6R instance per row)."""
+
+    mechanism: Mechanism
+    system: PolynomialSystem
+
+    def parameters(self, input_values: ArrayLike) -> Array:
+        X = np.atleast_2d(np.asarray(input_values, dtype=float))
+        return np.array([r_loop_instance(self.mechanism, row).params for row in X])
+
+    def configuration(self, solutions: ArrayLike, input_values: ArrayLike
+                      ) -> tuple[Configuration, GraphLayout]:
+        row = np.atleast_1d(np.asarray(input_values, dtype=float)).reshape(-1)
+        return r_loop_instance(self.mechanism, row).configuration(solutions)
+
+
+def closure_formulation(mech: Mechanism) -> Formulation:
+    """The formulation of this package that takes ``mech``, or a ScrewkitError that says why
+    none does."""
+    helical = [j.name for j in mech.joints if j.kind == "H"]
+    if helical:
+        raise CapabilityError(
+            f"{mech.name}: joints {helical} are helical; an H joint's slide (pitch·θ) is not "
+            "polynomial in cos θ and sin θ, so its closure is not algebraic and the homotopy "
+            "cannot promise every mode: follow the mechanism with the graph tracker "
+            "(solve_mechanism) instead")
+    kinds = {j.kind for j in mech.joints}
+    parallel = all(np.linalg.norm(np.cross(j.axis, mech.joints[0].axis)) < 1e-9
+                   for j in mech.joints)
+    if kinds == {"R"} and parallel:
+        return planar_formulation(mech)
+    if kinds == {"R"} and len(mech.topology.loops) == 1:
+        return _RLoopFormulation(mech, loop6r_system())
+    single = len(mech.topology.loops) == 1 and len(mech.joints) == 4
+    if single and sorted(j.kind for j in mech.joints) in (["R", "R", "S", "S"],
+                                                          ["C", "R", "R", "S"]):
+        return rod_loop(mech)
+    if single and sorted(j.kind for j in mech.joints) == ["C", "C", "C", "R"]:
+        return rccc_loop(mech)
+    raise CapabilityError(
+        f"{mech.name}: no polynomial formulation takes this mechanism yet (joints "
+        f"{sorted(j.kind for j in mech.joints)}, {len(mech.topology.loops)} loops); there are "
+        "formulations for planar R-joint graphs, single R loops with six free joints, and "
+        "RSSR, RSRC and RCCC loops driven at a ground R joint")
+
+
+@dataclass(frozen=True)
+class MechanismModes:
+    """Every mode at each row of inputs (B): ``configurations[b]`` the real modes that close
+    (graph-tracker configurations), ``certified[b]`` whether each passed Smale's α-test,
+    ``found`` the distinct complex solutions per row, ``continuum`` rows whose singular end
+    points lie on a curve of solutions, ``generic_count`` and ``how_found`` from the start
+    solutions, ``worst_closure`` the largest loop residual of a kept mode."""
+
+    mechanism: Mechanism
+    inputs: Array
+    configurations: tuple[Configuration, ...]
+    certified: tuple[NDArray[np.bool_], ...]
+    found: NDArray[np.int64]
+    continuum: NDArray[np.bool_]
+    generic_count: int
+    how_found: str
+    worst_closure: float
+
+
+def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:
+    """Every real assembly mode of ``mech`` at each row of ``inputs`` (B, n_inputs), radians
+    and metres from the drawing (module docstring)."""
+    form = closure_formulation(mech)
+    X = np.atleast_2d(np.asarray(inputs, dtype=float)).reshape(-1, len(mech.inputs))
+    start = (loop6r_start() if isinstance(form, _RLoopFormulation)
+             else start_solutions(form.system))
+    p = form.parameters(X)  # (B, n_in); the one-input loops read it as (B,)
+    sol = solve_all(form.system, p, start)
+    confs, certs, continuum, worst = [], [], np.zeros(len(X), dtype=bool), 0.0
+    for b in range(len(X)):
+        rows = np.flatnonzero((sol.instance == b) & sol.real)
+        singular = np.flatnonzero((sol.instance == b) & (sol.status == PathStatus.SINGULAR))
+        if len(singular):
+            continuum[b] = bool(on_a_continuum(form.system, sol.x[singular], p[b]).any())
+        if len(rows) == 0:
+            confs.append(Configuration(np.zeros((0, 0)), np.zeros((0, 0, 3, 3))))
+            certs.append(np.zeros(0, dtype=bool))
+            continue
+        conf, lay = form.configuration(sol.x[rows], X[b])
+        residual = np.abs(graph_forward(mech, lay, conf).residual).max(axis=(1, 2))
+        keep = (residual <= CLOSURE_TOLERANCE * max(mech.length_scale, 1.0)) & (
+            sol.status[rows] == PathStatus.REGULAR)
+        worst = max(worst, float(residual[keep].max(initial=0.0)))
+        confs.append(conf.take(np.flatnonzero(keep)))
+        certs.append(sol.certified_real[rows][keep])
+    return MechanismModes(mech, X, tuple(confs), tuple(certs), sol.found, continuum,
+                          start.generic_count, start.how_found, worst)

@@ -1,0 +1,107 @@
+"""every_mode on mechanisms (issue 27): the graph tracker's drawn mode is among the homotopy's
+modes at every input row, every mode closes by the tracker's own closure, and what no
+formulation takes is refused with the reason (H joints are not algebraic)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import screwkit as sk
+from modes_helpers import random_r_loop
+from screwkit.errors import CapabilityError
+from screwkit.kinematics.graph.closure import graph_layout
+from screwkit.kinematics.graph.track import follow_drawn_mode
+from screwkit.kinematics.modes.every_mode import CLOSURE_TOLERANCE, every_mode
+from screwkit.model.mechanism import Mechanism, MechanismJoint
+
+EXAMPLES = Path(__file__).parents[2] / "examples" / "mechanisms"
+
+
+def wrapped(a: np.ndarray) -> np.ndarray:
+    return np.mod(a + np.pi, 2 * np.pi) - np.pi
+
+
+def assert_tracked_mode_among(mech: Mechanism, X: np.ndarray, modes: int | None) -> None:
+    result = every_mode(mech, X)
+    followed = follow_drawn_mode(mech, graph_layout(mech), X)
+    assert followed.mask.all()
+    assert result.worst_closure <= CLOSURE_TOLERANCE
+    for b in range(len(X)):
+        conf = result.configurations[b]
+        if modes is not None:
+            assert conf.size == modes and result.certified[b].all()
+        gap = np.abs(wrapped(conf.scalars - followed.conf.scalars[b])).max(axis=1)
+        assert gap.min() <= 1e-9, f"{mech.name}: the tracked mode is missing at row {b}"
+
+
+@pytest.mark.parametrize("name,modes", [("fourbar_graph", 2), ("stephenson3_sixbar", 2),
+                                        ("watt_sixbar", 4)])
+def test_the_tracked_mode_is_among_every_mode_of_the_planar_examples(name: str, modes: int
+                                                                     ) -> None:
+    mech = sk.load_spec(EXAMPLES / f"{name}.toml").mechanism
+    assert_tracked_mode_among(mech, np.array([[0.0], [0.5], [1.0]]), modes)
+
+
+def test_the_tracked_mode_is_among_every_mode_of_a_7r_loop() -> None:
+    mech = random_r_loop(np.random.default_rng(21), 7, [2])
+    assert_tracked_mode_among(mech, np.array([[0.0], [0.1], [0.2]]), None)
+
+
+def test_an_h_joint_is_refused_as_not_algebraic() -> None:
+    mech = sk.load_spec(EXAMPLES / "fourbar_graph.toml").mechanism
+    j = mech.joints[1]
+    joints = list(mech.joints)
+    joints[1] = MechanismJoint(j.name, "H", j.bodies, j.at, j.axis, pitch=0.01)
+    helical = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+    with pytest.raises(CapabilityError, match="not algebraic"):
+        every_mode(helical, [[0.0]])
+
+
+def test_a_mechanism_no_formulation_takes_is_refused_by_name() -> None:
+    mech = sk.load_spec(EXAMPLES / "double_wishbone.toml").mechanism
+    with pytest.raises(CapabilityError, match="no polynomial formulation takes"):
+        every_mode(mech, np.zeros((1, len(mech.inputs))))
+
+
+def test_every_pose_of_the_stewart_example_holds_the_tracked_one() -> None:
+    """The bundled UPS platform (symmetric, so not generic: fewer than 40 finite poses, some
+    paths end singular or fail, and the solver says so): the pose the graph tracker reaches is
+    among the real poses, and every real pose has the six leg lengths (an independent check:
+    from the pose, not from the polynomial system)."""
+    from screwkit.algebraic.solve import solve_all
+    from screwkit.kinematics.graph.closure import graph_forward
+    from screwkit.kinematics.modes.stewart import (
+        pose_from_study,
+        stewart_from_mechanism,
+        stewart_start,
+        stewart_system,
+    )
+
+    mech = sk.load_spec(EXAMPLES / "stewart_platform.toml").mechanism
+    rig = stewart_from_mechanism(mech)
+    X = np.array([[0.0] * 6, [0.004, -0.003, 0.002, 0.005, -0.001, 0.003]])
+    lay = graph_layout(mech)
+    followed = follow_drawn_mode(mech, lay, X)
+    assert followed.mask.all()
+    frames = graph_forward(mech, lay, followed.conf)
+    body = lay.body_of[rig.platform]
+    p = rig.parameters(X)
+    sol = solve_all(stewart_system(), p, stewart_start())
+    assert np.all(sol.found <= 40)
+    for b in range(len(X)):
+        R, t = pose_from_study(sol.x[(sol.instance == b) & sol.real].real)
+        gap = np.abs(R - frames.R[b, body]).max(axis=(1, 2)) + np.abs(t - frames.p[b, body]).max(1)
+        assert gap.min() <= 1e-9
+        legs = np.einsum("nij,kj->nki", R, rig.top) + t[:, None] - rig.base
+        L = np.sqrt(p[b, 36:])
+        assert np.abs(np.linalg.norm(legs, axis=2) - L).max() <= 1e-10 * max(L)
+
+
+def test_a_mechanism_that_is_not_a_stewart_platform_is_refused() -> None:
+    from screwkit.kinematics.modes.stewart import stewart_from_mechanism
+
+    with pytest.raises(CapabilityError, match="not a 6-6 Stewart"):
+        stewart_from_mechanism(sk.load_spec(EXAMPLES / "watt_sixbar.toml").mechanism)
