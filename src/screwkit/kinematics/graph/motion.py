@@ -221,9 +221,58 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
             if k + 1 < N else ""
         events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[k])}{nxt}")
     mode = _with_events(mode, events)
-    notes = (("every mode: only the drawn mode is found for this mechanism: "
-              + "; ".join(dec.describe(mech)[-1:])),) if every_mode else ()
-    return MechanismMotion(mech, X, Xd, Xdd, (mode,), notes=notes)
+    if every_mode:
+        modes, notes = _every_mode_along(mech, lay, dec, X, Xd, Xdd, mode, followed.conf)
+        method = "graph (homotopy at anchors, tracking between)" if len(notes) and \
+            notes[0].startswith("every mode along") else "graph"
+        return MechanismMotion(mech, X, Xd, Xdd, modes, method=method, notes=notes)
+    return MechanismMotion(mech, X, Xd, Xdd, (mode,))
+
+
+def _every_mode_along(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
+                      Xd: Array, Xdd: Array, drawn: MechanismMode, conf: Configuration
+                      ) -> tuple[tuple[MechanismMode, ...], tuple[str, ...]]:
+    """Every mode of a mechanism that does not decompose, where a polynomial formulation
+    takes it (kinematics/modes/along.py): the drawn mode first, then the others, labelled
+    "mode 2", "mode 3" …; only the drawn mode (a note says why) where none does."""
+    from screwkit.budget import ResourceLimitError
+    from screwkit.errors import CapabilityError
+    from screwkit.kinematics.modes.along import MATCH_TOLERANCE, modes_along, pose_vectors
+
+    only = "every mode: only the drawn mode is found for this mechanism: "
+    if misfits(mech):
+        return (drawn,), (only + "its parts are made off the drawing (seat offsets), which "
+                          "the polynomial formulations do not model",)
+    try:
+        along = modes_along(mech, lay, X, lambda x: _fmt(mech, lay, x))
+    except (CapabilityError, ResourceLimitError) as err:
+        return (drawn,), (only + "; ".join([*dec.describe(mech)[-1:], str(err)]),)
+    pd = pose_vectors(mech, lay, conf)
+    mine, other = None, []
+    for k, (c, m) in enumerate(zip(along.configurations, along.masks, strict=True)):
+        both = np.flatnonzero(m & drawn.assembles)
+        gap = np.abs(pose_vectors(mech, lay, c.take(both)) - pd[both]).max(axis=1) \
+            if both.size else np.zeros(0)
+        if mine is None and m[0] and drawn.assembles[0] and gap[0] <= MATCH_TOLERANCE:
+            mine = k
+            events = list(along.events[k])
+            if np.any(gap > MATCH_TOLERANCE):
+                events.append(f"the drawn mode parts from the anchored tracking at "
+                              f"{_fmt(mech, lay, X[both[int(np.argmax(gap > MATCH_TOLERANCE))]])}"
+                              ": a possible branch switch of the drawn mode's tracker")
+            drawn = _with_events(drawn, [*drawn.events, *events])
+        elif m.any():
+            other.append(k)
+    modes = [replace(drawn, label="drawn")]
+    for k in other:
+        md = build_mode(mech, lay, along.configurations[k], along.masks[k], X, Xd, Xdd)
+        modes.append(replace(_with_events(md, [*along.events[k], *md.events]),
+                             label=f"mode {len(modes) + 1}", index=len(modes)))
+    notes = list(along.notes)
+    if mine is None:
+        notes.append("the drawn mode is not among the modes the homotopy finds at the first "
+                     "input: check the drawing closes")
+    return tuple(modes), tuple(notes)
 
 
 CLOSED_FORM_SOLVER = ("closed-form sub-chains (driven joints, planar dyads, spatial legs; every "

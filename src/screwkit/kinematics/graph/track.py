@@ -145,18 +145,21 @@ class Followed:
 
 
 def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
-                      progress: object = None, start: Configuration | None = None) -> Followed:
+                      progress: object = None, start: Configuration | None = None,
+                      start_inputs: Array | None = None) -> Followed:
     """Follow the drawn configuration (inputs 0) to ``X[0]`` and along every row of ``X``;
-    ``start`` replaces the drawing (one closed sample at inputs 0: a mechanism re-assembled
-    near its drawing, motion.reassemble_drawing)."""
+    ``start`` replaces the drawing (one closed sample at inputs ``start_inputs``, 0 if not
+    given: a mechanism re-assembled near its drawing, motion.reassemble_drawing; a mode found
+    at an anchor, kinematics/modes/along.py)."""
     N, n_in = X.shape
     conf0 = start if start is not None else Configuration(
         np.zeros((1, lay.n_scalar)), np.broadcast_to(np.eye(3), (1, lay.n_spherical, 3, 3)).copy())
-    at = _Point(conf0, np.zeros(n_in), linearise(mech, lay, conf0, exact=False))
+    x0 = np.zeros(n_in) if start_inputs is None else np.asarray(start_inputs, dtype=float)
+    at = _Point(conf0, x0, linearise(mech, lay, conf0, exact=False))
     scal = np.zeros((N, lay.n_scalar))  # samples it does not reach keep the drawing (finite)
     sph = np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy()
     mask = np.zeros(N, dtype=bool)
-    if np.any(X[0] != 0.0):
+    if np.any(X[0] != x0):
         reached, furthest = _approach(mech, lay, at, X[0])
         if reached is None:
             return Followed(Configuration(scal, sph), mask, -1, reached=furthest)

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import PolynomialSystem
-from screwkit.algebraic.solve import solve_all
+from screwkit.algebraic.solve import StartSolutions, solve_all
 from screwkit.algebraic.track import PathStatus
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
@@ -116,13 +116,17 @@ class MechanismModes:
     worst_closure: float
 
 
+def formulation_start(form: Formulation) -> StartSolutions:
+    """The start solutions of ``form``'s topology (cached per topology, modes/starts.py)."""
+    return loop6r_start() if isinstance(form, _RLoopFormulation) else start_solutions(form.system)
+
+
 def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:
     """Every real assembly mode of ``mech`` at each row of ``inputs`` (B, n_inputs), radians
     and metres from the drawing (module docstring)."""
     form = closure_formulation(mech)
     X = np.atleast_2d(np.asarray(inputs, dtype=float)).reshape(-1, len(mech.inputs))
-    start = (loop6r_start() if isinstance(form, _RLoopFormulation)
-             else start_solutions(form.system))
+    start = formulation_start(form)
     p = form.parameters(X)  # (B, n_in); the one-input loops read it as (B,)
     sol = solve_all(form.system, p, start)
     confs, certs, continuum, worst = [], [], np.zeros(len(X), dtype=bool), 0.0

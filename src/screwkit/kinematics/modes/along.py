@@ -1,0 +1,292 @@
+"""Every assembly mode along a motion, for a mechanism that has a polynomial formulation but
+does not decompose into closed-form sub-chains (issue 27, "Along the motion").
+
+The homotopy (:func:`~screwkit.kinematics.modes.every_mode.every_mode`) solves the closure at
+*anchor* samples only (the first, the last and every K-th, K from the time budget); between two
+anchors each mode found at the first is followed sample by sample with the graph tracker
+(graph/track.py, whose own steps are checked against the rates by the trapezoid rule). Identities
+are kept by matching the tracked end to the next anchor's modes by body poses
+(:data:`MATCH_TOLERANCE`, relative to the length scale). A tracked end that meets no anchor mode,
+or two that meet the same one, is a path jump: the segment is tracked again with
+:data:`REFINE` sub-steps per sample, and where that still does not match uniquely the mode is cut
+at the anchor before (an event says so) rather than switched. An anchor mode that no tracked
+mode reaches is born in the segment: it is tracked backward to where it stops assembling, and
+the fold is located by bisection of that step (:func:`fold_between`, as graph/closed_modes.py
+does for dyads). A tracked mode that stops assembling dies there, located the same way.
+
+Guaranteed: every isolated real mode at every anchor (the homotopy's promise), continuity in
+between (the tracker's checks), no silent switch at an anchor. Not guaranteed: a mode born and
+dying between two anchors (an island shorter than the anchor spacing) is not seen.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
+from screwkit.kinematics.graph.track import follow_drawn_mode, reach
+from screwkit.kinematics.modes.every_mode import MechanismModes, every_mode
+from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.model.mechanism import Mechanism
+
+Array = NDArray[np.float64]
+
+#: a tracked configuration is an anchor's mode when every body pose agrees to this (rotation
+#: entries, and positions relative to the length scale)
+MATCH_TOLERANCE = 1e-6
+#: sub-steps per sample when a segment is tracked again after a suspected path jump
+REFINE = 8
+#: bisection steps locating a birth or death between two samples (2⁻³⁰ of the step)
+FOLD_STEPS = 30
+#: anchors are at most this many samples apart
+ANCHOR_SPACING = 8
+#: measured homotopy time per anchor and generic solution (rounded up; ~0.1 s per 6R instance)
+SECONDS_PER_ANCHOR_ROOT = 5e-3
+
+
+@dataclass
+class _Chain:
+    """One mode over the samples: joint variables, where it holds, its events, and at how
+    many anchors it was met and certified."""
+
+    scalars: Array
+    spherical: Array
+    mask: NDArray[np.bool_]
+    events: list[str] = field(default_factory=list)
+    anchors_met: int = 0
+    anchors_certified: int = 0
+
+    def conf_at(self, k: int) -> Configuration:
+        return Configuration(self.scalars[k:k + 1].copy(), self.spherical[k:k + 1].copy())
+
+    def put(self, idx: NDArray[np.intp], conf: Configuration) -> None:
+        self.scalars[idx] = conf.scalars
+        self.spherical[idx] = conf.spherical
+        self.mask[idx] = True
+
+
+@dataclass(frozen=True)
+class ModesAlong:
+    """Every mode found along the inputs: ``configurations[k]`` (N samples) where
+    ``masks[k]`` holds, with ``events[k]``; ``anchors`` the anchor samples; ``notes`` what was
+    found and how."""
+
+    configurations: tuple[Configuration, ...]
+    masks: tuple[NDArray[np.bool_], ...]
+    events: tuple[tuple[str, ...], ...]
+    anchors: NDArray[np.intp]
+    notes: tuple[str, ...]
+    solved: MechanismModes
+
+
+def anchor_samples(N: int, per_anchor: float) -> NDArray[np.intp]:
+    """The anchor samples: first, last and every K-th, K the smallest of
+    :data:`ANCHOR_SPACING` that keeps the anchors' estimated time (``per_anchor`` s each)
+    within half the time limit (screwkit.budget)."""
+    from screwkit.budget import check_time, time_limit
+
+    check_time(2 * per_anchor, "the homotopy at the first and last input",
+               "use a mechanism with fewer solutions or fewer inputs")
+    affordable = max(2, int(0.5 * time_limit() / max(per_anchor, 1e-9)))
+    K = max(ANCHOR_SPACING, int(np.ceil((N - 1) / max(affordable - 1, 1))))
+    return np.unique(np.concatenate([np.arange(0, N, K), [N - 1]])).astype(np.intp)
+
+
+def pose_vectors(mech: Mechanism, lay: GraphLayout, conf: Configuration) -> Array:
+    """Every body's pose as one row per sample (rotation entries, positions / length)."""
+    fr = graph_forward(mech, lay, conf)
+    n = conf.size
+    return np.concatenate([fr.R.reshape(n, -1), fr.p.reshape(n, -1) / lay.length], axis=1)
+
+
+def pose_distance(mech: Mechanism, lay: GraphLayout, a: Configuration, b: Configuration
+                  ) -> Array:
+    """(n_a, n_b) largest pose difference between configurations ``a`` and ``b``."""
+    if a.size == 0 or b.size == 0:
+        return np.zeros((a.size, b.size))
+    pa, pb = pose_vectors(mech, lay, a), pose_vectors(mech, lay, b)
+    return np.asarray(np.abs(pa[:, None, :] - pb[None, :, :]).max(axis=2))
+
+
+def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from: Array,
+                 x_to: Array) -> Array:
+    """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the way
+    to ``x_to`` (which it does not reach): bisection of the segment, :data:`FOLD_STEPS`
+    halvings, each half reached by continuation (graph/track.py ``reach``)."""
+    lo, hi = np.asarray(x_from, dtype=float), np.asarray(x_to, dtype=float)
+    for _ in range(FOLD_STEPS):
+        mid = 0.5 * (lo + hi)
+        got = reach(mech, lay, conf, lo, mid)
+        if got is None:
+            hi = mid
+        else:
+            lo, conf = mid, got
+    return np.asarray(0.5 * (lo + hi))
+
+
+def _track(mech: Mechanism, lay: GraphLayout, start: Configuration, x0: Array, X: Array,
+           refine: int = 1) -> tuple[Configuration, NDArray[np.bool_], int | None]:
+    """Follow the mode through ``start`` (at ``x0``) along the rows of ``X`` (with ``refine``
+    sub-steps per row): configurations, where reached, and the last row reached before it
+    stops (-1: not even the first; None: reached throughout)."""
+    if refine > 1:
+        t = np.arange(1, refine + 1) / refine
+        prev = np.vstack([x0[None, :], X[:-1]])
+        fine = (prev[:, None, :] + t[None, :, None] * (X - prev)[:, None, :]).reshape(-1,
+                                                                                     X.shape[1])
+        f = follow_drawn_mode(mech, lay, fine, start=start, start_inputs=x0)
+        take = np.arange(refine - 1, fine.shape[0], refine)
+        mask = f.mask[take]
+        stop = None if mask.all() else int(np.argmin(mask)) - 1
+        return f.conf.take(take), mask, stop
+    f = follow_drawn_mode(mech, lay, X, start=start, start_inputs=x0)
+    return f.conf, f.mask, f.stopped_after
+
+
+def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> ModesAlong:
+    """Every mode of ``mech`` over the input rows ``X`` (module docstring); ``fmt(x)`` writes
+    an input row for the events."""
+    from screwkit.kinematics.modes.every_mode import closure_formulation, formulation_start
+
+    write = fmt if callable(fmt) else str
+    N = X.shape[0]
+    form = closure_formulation(mech)
+    roots = formulation_start(form).generic_count
+    anchors = anchor_samples(N, SECONDS_PER_ANCHOR_ROOT * roots)
+    solved = every_mode(mech, X[anchors])
+    chains: list[_Chain] = []
+    active: dict[int, int] = {}  # mode index at the current anchor → chain
+    first = solved.configurations[0]
+    for m in range(first.size):
+        active[m] = _new_chain(chains, lay, N)
+        chains[active[m]].put(np.array([anchors[0]]), first.take(slice(m, m + 1)))
+        _met(chains[active[m]], solved, 0, m)
+    for i in range(len(anchors) - 1):
+        active = _segment(mech, lay, X, anchors, i, solved, chains, active, write)
+    return ModesAlong(tuple(Configuration(c.scalars, c.spherical) for c in chains),
+                      tuple(c.mask for c in chains),
+                      tuple(tuple(c.events) + (_certificate_event(c),) for c in chains),
+                      anchors, _notes(solved, anchors, len(chains)), solved)
+
+
+def _new_chain(chains: list[_Chain], lay: GraphLayout, N: int) -> int:
+    chains.append(_Chain(np.zeros((N, lay.n_scalar)),
+                         np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy(),
+                         np.zeros(N, dtype=bool)))
+    return len(chains) - 1
+
+
+def _met(chain: _Chain, solved: MechanismModes, i: int, m: int) -> None:
+    chain.anchors_met += 1
+    chain.anchors_certified += int(bool(solved.certified[i][m]))
+
+
+def _segment(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.intp], i: int,
+             solved: MechanismModes, chains: list[_Chain], active: dict[int, int],
+             write: object) -> dict[int, int]:
+    """Carry the modes of anchor i to anchor i + 1 (module docstring); the modes active at
+    anchor i + 1 (its mode index → chain)."""
+    fmt = write if callable(write) else str
+    A, B = int(anchors[i]), int(anchors[i + 1])
+    rows = np.arange(A + 1, B + 1)
+    there = solved.configurations[i + 1]
+    ends: dict[int, tuple[Configuration, NDArray[np.bool_], int | None]] = {}
+    for refine in (1, REFINE):
+        pending = [c for c in active.values() if c not in ends]
+        for c in pending:
+            ends[c] = _track(mech, lay, chains[c].conf_at(A), X[A], X[rows], refine)
+        claims = _claims(mech, lay, ends, there)
+        jumped = [c for c, j in claims.items() if j is None or
+                  sum(1 for k in claims.values() if k == j) > 1]
+        if not jumped:
+            break
+        for c in jumped:
+            del ends[c]
+    nxt: dict[int, int] = {}
+    for c, (conf, mask, stop) in ends.items():
+        chain = chains[c]
+        if stop is not None:  # stops assembling inside the segment: it dies there
+            reached = rows[mask]
+            chain.put(reached, conf.take(np.flatnonzero(mask)))
+            k = int(reached[-1]) if reached.size else A
+            at = fold_between(mech, lay, chain.conf_at(k), X[k], X[k + 1])
+            chain.events.append(f"dies at {fmt(at)}: it stops assembling there (a fold, located "
+                                "by bisection between samples)")
+            continue
+        j = claims[c]
+        chain.put(rows, conf)
+        if j is not None:
+            nxt[j] = c
+            _met(chain, solved, i + 1, j)
+    for c in jumped:  # still no unique match after refining: cut, never switch
+        chains[c].events.append(
+            f"cut after {fmt(X[A])}: tracked on to {fmt(X[B])} it does not land on exactly one "
+            "of the modes the homotopy finds there (a path jump), so the mode is not continued "
+            "past this anchor rather than switched")
+    for j in range(there.size):
+        if j not in nxt:
+            nxt[j] = _born(mech, lay, X, A, B, there.take(slice(j, j + 1)), chains, fmt)
+            _met(chains[nxt[j]], solved, i + 1, j)
+    return nxt
+
+
+def _claims(mech: Mechanism, lay: GraphLayout,
+            ends: dict[int, tuple[Configuration, NDArray[np.bool_], int | None]],
+            there: Configuration) -> dict[int, int | None]:
+    """The anchor mode each mode tracked through the segment lands on (None: on none)."""
+    out: dict[int, int | None] = {}
+    for c, (conf, _, stop) in ends.items():
+        if stop is not None:
+            continue
+        d = pose_distance(mech, lay, conf.take(slice(conf.size - 1, conf.size)), there)
+        close = np.flatnonzero(d[0] <= MATCH_TOLERANCE)
+        out[c] = int(close[0]) if close.size == 1 else None
+    return out
+
+
+def _born(mech: Mechanism, lay: GraphLayout, X: Array, A: int, B: int, conf: Configuration,
+          chains: list[_Chain], fmt: object) -> int:
+    """A mode found at anchor B that no mode tracked from anchor A reaches: tracked back to
+    where it is born (a fold, by bisection), or to A where a path jump cut a mode there."""
+    write = fmt if callable(fmt) else str
+    c = _new_chain(chains, lay, X.shape[0])
+    chain = chains[c]
+    chain.put(np.array([B]), conf)
+    back = np.arange(B - 1, A - 1, -1)
+    got, mask, stop = _track(mech, lay, conf, X[B], X[back])
+    chain.put(back[mask], got.take(np.flatnonzero(mask)))
+    if stop is None:
+        chain.events.append(f"starts at {write(X[A])}: tracked back from {write(X[B])} it does "
+                            "not continue a mode of this anchor (a path jump was refused there)")
+        return c
+    k = int(back[mask][-1]) if mask.any() else B
+    at = fold_between(mech, lay, chain.conf_at(k), X[k], X[k - 1])
+    chain.events.append(f"is born at {write(at)}: it starts assembling there (a fold, located "
+                        "by bisection between samples)")
+    return c
+
+
+def _certificate_event(chain: _Chain) -> str:
+    return (f"certified by Smale's α-test at {chain.anchors_certified} of the "
+            f"{chain.anchors_met} anchor(s) where the homotopy finds it")
+
+
+def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int) -> tuple[str, ...]:
+    real = sum(c.size for c in solved.configurations)
+    cert = sum(int(c.sum()) for c in solved.certified)
+    found = (f"{int(solved.found.min())}" if solved.found.min() == solved.found.max()
+             else f"{int(solved.found.min())}–{int(solved.found.max())}")
+    notes = [f"every mode along the motion: the homotopy at {len(anchors)} anchor input(s) "
+             f"(samples {', '.join(str(int(a)) for a in anchors[:6])}"
+             f"{' …' if len(anchors) > 6 else ''}) finds {found} distinct complex solution(s) "
+             f"per anchor, generic count {solved.generic_count} ({solved.how_found}); {real} "
+             f"real mode(s) over the anchors, {cert} certified by Smale's α-test; {count} "
+             "mode(s) tracked between anchors with jump checks (a mode born and dying between "
+             "two anchors is not seen)"]
+    if solved.continuum.any():
+        notes.append(f"at {int(solved.continuum.sum())} anchor(s) the solutions include a "
+                     "continuum (a curve of assemblies), whose points are not isolated modes")
+    return tuple(notes)
