@@ -108,12 +108,12 @@ def _wave(mech: Mechanism, lay: GraphLayout, at: _Point, X: Array
     return (int(bad[0]) if bad.size else X.shape[0]), conf, lin
 
 
-def _split_step(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array, depth: int
-                ) -> _Point | None:
+def _split_step(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array, depth: int,
+                smallest: float = SMALLEST_STEP) -> _Point | None:
     """Reach input ``x`` from ``at`` in 2, then 4 … sub-steps, halving where a sub-step fails
-    until it is :data:`SMALLEST_STEP` long; None where it cannot (a fold in between)."""
+    until it is ``smallest`` long; None where it cannot (a fold in between)."""
     scale = np.where(np.array([lay.is_translation[f] for f in lay.inputs]), lay.length, 1.0)
-    if depth > MAX_SPLIT_DEPTH or float(np.max(np.abs(x - at.x) / scale)) < SMALLEST_STEP:
+    if depth > MAX_SPLIT_DEPTH or float(np.max(np.abs(x - at.x) / scale)) < smallest:
         return None
     mid = 0.5 * (at.x + x)
     for target in (mid, x):
@@ -121,7 +121,7 @@ def _split_step(mech: Mechanism, lay: GraphLayout, at: _Point, x: Array, depth: 
         if count == 1:
             at = _Point(conf, target, lin)
             continue
-        reached = _split_step(mech, lay, at, target, depth + 1)
+        reached = _split_step(mech, lay, at, target, depth + 1, smallest)
         if reached is None:
             return None
         at = reached
@@ -253,14 +253,15 @@ def _furthest(mech: Mechanism, lay: GraphLayout, at: _Point, target: Array) -> A
     return np.asarray(good, dtype=float)
 
 
-def reach(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from: Array, x_to: Array
-          ) -> Configuration | None:
+def reach(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from: Array, x_to: Array,
+          smallest: float = SMALLEST_STEP) -> Configuration | None:
     """The configuration at inputs ``x_to`` on the branch through ``conf`` (one sample, closed
-    at ``x_from``), followed by continuation; None where the branch does not get there."""
+    at ``x_from``), followed by continuation in steps no shorter than ``smallest``; None where
+    the branch does not get there."""
     at = _Point(conf, np.asarray(x_from, dtype=float), linearise(mech, lay, conf, exact=False))
     x_to = np.asarray(x_to, dtype=float)
     count, reached, _ = _wave(mech, lay, at, x_to[None, :])
     if count == 1:
         return reached
-    end = _split_step(mech, lay, at, x_to, 1)
+    end = _split_step(mech, lay, at, x_to, 1, smallest)
     return None if end is None else end.conf

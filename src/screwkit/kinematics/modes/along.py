@@ -39,8 +39,10 @@ Array = NDArray[np.float64]
 MATCH_TOLERANCE = 1e-6
 #: sub-steps per sample when a segment is tracked again after a suspected path jump
 REFINE = 8
-#: bisection steps locating a birth or death between two samples (2⁻³⁰ of the step)
-FOLD_STEPS = 30
+#: bisection steps locating a birth or death between two samples (2⁻²⁶ of the step)
+FOLD_STEPS = 26
+#: a bisection step's continuation may split it down to this fraction of its length
+FOLD_SPLIT = 8
 #: anchors are at most this many samples apart
 ANCHOR_SPACING = 8
 #: measured homotopy time per anchor and generic solution (rounded up; ~0.1 s per 6R instance)
@@ -115,11 +117,14 @@ def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
                  x_to: Array) -> Array:
     """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the way
     to ``x_to`` (which it does not reach): bisection of the segment, :data:`FOLD_STEPS`
-    halvings, each half reached by continuation (graph/track.py ``reach``)."""
+    halvings, each half reached by continuation (graph/track.py ``reach``, in steps down to
+    1/:data:`FOLD_SPLIT` of the half)."""
     lo, hi = np.asarray(x_from, dtype=float), np.asarray(x_to, dtype=float)
+    scale = np.where(np.array([lay.is_translation[f] for f in lay.inputs]), lay.length, 1.0)
     for _ in range(FOLD_STEPS):
         mid = 0.5 * (lo + hi)
-        got = reach(mech, lay, conf, lo, mid)
+        got = reach(mech, lay, conf, lo, mid,
+                    max(float(np.max(np.abs(mid - lo) / scale)) / FOLD_SPLIT, 1e-12))
         if got is None:
             hi = mid
         else:
