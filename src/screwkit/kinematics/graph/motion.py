@@ -267,7 +267,8 @@ def _every_mode_along(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     for k in other:
         md = build_mode(mech, lay, along.configurations[k], along.masks[k], X, Xd, Xdd)
         modes.append(replace(_with_events(md, [*along.events[k], *md.events]),
-                             label=f"mode {len(modes) + 1}", index=len(modes)))
+                             label=f"mode {len(modes)} (homotopy at the anchors, tracked between)",
+                             index=len(modes)))
     notes = list(along.notes)
     if mine is None:
         notes.append("the drawn mode is not among the modes the homotopy finds at the first "
