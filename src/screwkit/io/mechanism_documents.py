@@ -48,6 +48,7 @@ def mechanism_document(motion: MechanismMotion, topology: MechanismTopology | No
     doc: dict[str, Any] = {
         "method": motion.method,
         "solver": motion.solver,
+        "notes": list(motion.notes),
         "mechanism": mech.name,
         "family": "graph",
         "units": {"length": "m", "angle": "rad", "time": "s"},
