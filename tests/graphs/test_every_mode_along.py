@@ -131,3 +131,41 @@ def test_without_a_formulation_only_the_drawn_mode_with_the_reason() -> None:
     m = solve_mechanism(mech, np.zeros((2, len(mech.inputs))), every_mode=True)
     assert len(m.modes) == 1
     assert "only the drawn mode" in m.notes[0] and "no polynomial formulation" in m.notes[0]
+
+
+def test_a_mode_that_meets_no_anchor_mode_is_cut_not_switched(
+        six_bar: Mechanism, monkeypatch: pytest.MonkeyPatch) -> None:
+    """With a match tolerance nothing can meet, every tracked end is a path jump: each mode
+    stops at its anchor with an event and the next anchor's modes start anew, so no mode runs
+    through an anchor it was not matched at."""
+    from screwkit.kinematics.modes import along
+
+    monkeypatch.setattr(along, "MATCH_TOLERANCE", -1.0)
+    lay = graph_layout(six_bar)
+    Xs = X[:9]  # one segment: anchors at samples 0 and 8
+    got = along.modes_along(six_bar, lay, Xs, str)
+    assert list(got.anchors) == [0, 8]
+    cut = [k for k, ev in enumerate(got.events) if any(e.startswith("cut after") for e in ev)]
+    fresh = [k for k, ev in enumerate(got.events) if any("path jump was refused" in e
+                                                           for e in ev)]
+    assert len(cut) == len(fresh) == 2
+    for k in cut:
+        assert got.masks[k].tolist() == [True] + [False] * 8
+    for k in fresh:
+        assert got.masks[k].all()  # tracked back from the last anchor to the first
+
+
+def test_analyze_lists_every_mode_with_its_certificate() -> None:
+    from typer.testing import CliRunner
+
+    from screwkit.cli.main import app
+
+    r = CliRunner().invoke(app, ["analyze", str(EXAMPLES / "stephenson3_sixbar.toml")])
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())  # however the terminal wraps it
+    assert "note: every mode along the motion: the homotopy at 46 anchor" in text
+    assert "generic count 6" in text and "certified by Smale's α-test" in text
+    for k in range(4):
+        assert f"assembly mode {k}" in text
+    assert text.count("is born at Q3.theta = 205.8") == 2
+    assert text.count("dies at Q3.theta = 280.3") == 2

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
+from screwkit.kinematics.graph.motion import check_cost
 from screwkit.kinematics.graph.track import follow_drawn_mode, reach
 from screwkit.kinematics.modes.every_mode import MechanismModes, every_mode
 from screwkit.kinematics.tracker.loop import Configuration
@@ -161,6 +162,7 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     form = closure_formulation(mech)
     roots = formulation_start(form).generic_count
     anchors = anchor_samples(N, SECONDS_PER_ANCHOR_ROOT * roots)
+    check_cost(mech, N * max(roots, 1))  # at most every generic solution tracked throughout
     solved = every_mode(mech, X[anchors])
     chains: list[_Chain] = []
     active: dict[int, int] = {}  # mode index at the current anchor → chain
