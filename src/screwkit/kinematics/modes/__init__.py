@@ -17,4 +17,6 @@ homotopy started at a random complex instance needs to find every solution.
 - :mod:`.r_loop`: a Mechanism's single R loop (6R, 7R at one input) as a 6R instance;
 - :mod:`.starts`: start solutions per topology; :mod:`.continuum`: a continuum told from
   isolated roots at a singular end point.
+- :mod:`.every_mode`: every real mode of a Mechanism at given inputs; :mod:`.along`: every mode
+  over a motion (the homotopy at anchor samples, the graph tracker between them).
 """
