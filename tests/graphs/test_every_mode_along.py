@@ -169,3 +169,13 @@ def test_analyze_lists_every_mode_with_its_certificate() -> None:
         assert f"assembly mode {k}" in text
     assert text.count("is born at Q3.theta = 205.8") == 2
     assert text.count("dies at Q3.theta = 280.3") == 2
+
+
+def test_the_two_modes_born_at_one_fold_are_one_circuit(motion: MechanismMotion) -> None:
+    """Modes 2 and 3 are born together and die together (the homotopy's real count changes
+    by two there, test above): they meet at both folds, so they are one circuit, and the two
+    modes that assemble throughout are circuits of their own."""
+    circuits = [n for n in motion.notes if n.startswith("circuits")]
+    assert circuits and circuits[0].endswith("{0}, {1}, {2, 3}")
+    assert all(not np.asarray(md.assembles).all() for md in motion.modes[2:])
+    assert all(np.asarray(md.assembles).all() for md in motion.modes[:2])

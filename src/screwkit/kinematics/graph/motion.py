@@ -208,72 +208,27 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
         where = ""
         if followed.reached is not None:
             where = (f", on the straight way from the drawing (every input 0) after "
-                     f"{_fmt(mech, lay, followed.reached)}: the inputs that assemble end there "
+                     f"{input_text(mech, lay, followed.reached)}: the inputs that assemble end there "
                      "(a limit of the workspace, or a dead centre)")
         raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
-                            f"first input row {_fmt(mech, lay, X[0])}: the mechanism stops "
+                            f"first input row {input_text(mech, lay, X[0])}: the mechanism stops "
                             f"assembling before it{where}")
     mode = build_mode(mech, lay, followed.conf, followed.mask, X, Xd, Xdd, followed.frames)
     events = list(mode.events)
     if followed.stopped_after is not None and followed.stopped_after >= 0:
         k = followed.stopped_after
-        nxt = f" (a limit position or dead centre before {_fmt(mech, lay, X[k + 1])})" \
+        nxt = f" (a limit position or dead centre before {input_text(mech, lay, X[k + 1])})" \
             if k + 1 < N else ""
-        events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[k])}{nxt}")
-    mode = _with_events(mode, events)
+        events.insert(0, f"stops assembling after input {input_text(mech, lay, X[k])}{nxt}")
+    mode = with_events(mode, events)
     if every_mode:
-        modes, notes = _every_mode_along(mech, lay, dec, X, Xd, Xdd, mode, followed.conf)
+        from screwkit.kinematics.modes.along import every_mode_motion
+
+        modes, notes = every_mode_motion(mech, lay, dec, X, Xd, Xdd, mode, followed.conf)
         method = "graph (homotopy at anchors, tracking between)" if len(notes) and \
             notes[0].startswith("every mode along") else "graph"
         return MechanismMotion(mech, X, Xd, Xdd, modes, method=method, notes=notes)
     return MechanismMotion(mech, X, Xd, Xdd, (mode,))
-
-
-def _every_mode_along(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
-                      Xd: Array, Xdd: Array, drawn: MechanismMode, conf: Configuration
-                      ) -> tuple[tuple[MechanismMode, ...], tuple[str, ...]]:
-    """Every mode of a mechanism that does not decompose, where a polynomial formulation
-    takes it (kinematics/modes/along.py): the drawn mode first, then the others, labelled
-    "mode 2", "mode 3" …; only the drawn mode (a note says why) where none does."""
-    from screwkit.budget import ResourceLimitError
-    from screwkit.errors import CapabilityError
-    from screwkit.kinematics.modes.along import MATCH_TOLERANCE, modes_along, pose_vectors
-
-    only = "every mode: only the drawn mode is found for this mechanism: "
-    if misfits(mech):
-        return (drawn,), (only + "its parts are made off the drawing (seat offsets), which "
-                          "the polynomial formulations do not model",)
-    try:
-        along = modes_along(mech, lay, X, lambda x: _fmt(mech, lay, x))
-    except (CapabilityError, ResourceLimitError) as err:
-        return (drawn,), (only + "; ".join([*dec.describe(mech)[-1:], str(err)]),)
-    pd = pose_vectors(mech, lay, conf)
-    mine, other = None, []
-    for k, (c, m) in enumerate(zip(along.configurations, along.masks, strict=True)):
-        both = np.flatnonzero(m & drawn.assembles)
-        gap = np.abs(pose_vectors(mech, lay, c.take(both)) - pd[both]).max(axis=1) \
-            if both.size else np.zeros(0)
-        if mine is None and m[0] and drawn.assembles[0] and gap[0] <= MATCH_TOLERANCE:
-            mine = k
-            events = list(along.events[k])
-            if np.any(gap > MATCH_TOLERANCE):
-                events.append(f"the drawn mode parts from the anchored tracking at "
-                              f"{_fmt(mech, lay, X[both[int(np.argmax(gap > MATCH_TOLERANCE))]])}"
-                              ": a possible branch switch of the drawn mode's tracker")
-            drawn = _with_events(drawn, [*drawn.events, *events])
-        elif m.any():
-            other.append(k)
-    modes = [replace(drawn, label="drawn")]
-    for k in other:
-        md = build_mode(mech, lay, along.configurations[k], along.masks[k], X, Xd, Xdd)
-        modes.append(replace(_with_events(md, [*along.events[k], *md.events]),
-                             label=f"mode {len(modes)} (homotopy at the anchors, tracked between)",
-                             index=len(modes)))
-    notes = list(along.notes)
-    if mine is None:
-        notes.append("the drawn mode is not among the modes the homotopy finds at the first "
-                     "input: check the drawing closes")
-    return tuple(modes), tuple(notes)
 
 
 CLOSED_FORM_SOLVER = ("closed-form sub-chains (driven joints, planar dyads, spatial legs; every "
@@ -317,7 +272,7 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     start = drawn_start(mech, lay, dec, X[0])
     if start is None or not ok[0, 0]:
         raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
-                            f"first input row {_fmt(mech, lay, X[0])}: the mechanism stops "
+                            f"first input row {input_text(mech, lay, X[0])}: the mechanism stops "
                             "assembling before it")
     stop = int(np.argmin(ok[0])) if not ok[0].all() else N
     drawn = np.zeros(N, dtype=bool)
@@ -328,13 +283,13 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     folds, joins = _fold_events(mech, lay, dec, X, signs[rows], ok[rows])
     events = folds[0][:1]  # the drawn mode ends at its first fold
     if stop < N:
-        events.insert(0, f"stops assembling after input {_fmt(mech, lay, X[stop - 1])} (a "
-                         f"limit position or dead centre before {_fmt(mech, lay, X[stop])})")
-    modes = [replace(_with_events(mode, [*events, *mode.events]), label="drawn")]
+        events.insert(0, f"stops assembling after input {input_text(mech, lay, X[stop - 1])} (a "
+                         f"limit position or dead centre before {input_text(mech, lay, X[stop])})")
+    modes = [replace(with_events(mode, [*events, *mode.events]), label="drawn")]
     for m, events in zip(rows[1:], folds[1:], strict=True):
         conf = mode_configuration(mech, lay, R[m], p[m], X, ok[m])
         md = build_mode(mech, lay, conf, ok[m], X, Xd, Xdd)
-        modes.append(replace(_with_events(md, [*events, *md.events]),
+        modes.append(replace(with_events(md, [*events, *md.events]),
                              label=f"branches {mode_label(mech, dec, signs[m])}",
                              index=len(modes)))
     notes: tuple[str, ...] = (skipped,) if skipped else ()
@@ -366,31 +321,39 @@ def _fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array
         dyad = dec.dyads[int(d)]
         names = "–".join(mech.joints[i].name for i in dyad.joints)
         what = "dies" if ok[m, kk] else "is born"
-        events[int(m)].append(f"{what} at {_fmt(mech, lay, xx)}: the {dyad.kind} {dyad.word} "
+        events[int(m)].append(f"{what} at {input_text(mech, lay, xx)}: the {dyad.kind} {dyad.word} "
                               f"{names} folds (its two branches meet)")
     return events, [(int(m), int(d)) for m, d in zip(mode, folding, strict=True)]
 
 
-def _circuits(signs: Array, joins: list[tuple[int, int]]) -> list[list[int]]:
-    """The modes (rows of ``signs``) grouped into circuits: at a fold of sub-chain d a mode
-    meets the mode whose branches differ in d alone (the same configuration there)."""
-    group = list(range(signs.shape[0]))
+def groups(n: int, joins: list[tuple[int, int]]) -> list[list[int]]:
+    """0 … n−1 grouped by the pairs ``joins`` (union–find)."""
+    group = list(range(n))
 
     def root(i: int) -> int:
         while group[i] != i:
             i = group[i]
         return i
 
+    for a, b in joins:
+        group[root(a)] = root(b)
+    out: dict[int, list[int]] = {}
+    for i in range(n):
+        out.setdefault(root(i), []).append(i)
+    return sorted(out.values())
+
+
+def _circuits(signs: Array, joins: list[tuple[int, int]]) -> list[list[int]]:
+    """The modes (rows of ``signs``) grouped into circuits: at a fold of sub-chain d a mode
+    meets the mode whose branches differ in d alone (the same configuration there)."""
+    pairs = []
     for m, d in joins:
         other = signs[m].copy()
         other[d] = -other[d]
         match = np.nonzero(np.all(signs == other, axis=1))[0]
         if match.size:
-            group[root(int(match[0]))] = root(m)
-    out: dict[int, list[int]] = {}
-    for i in range(signs.shape[0]):
-        out.setdefault(root(i), []).append(i)
-    return sorted(out.values())
+            pairs.append((int(match[0]), m))
+    return groups(signs.shape[0], pairs)
 
 
 def _solve_driven(mech: Mechanism, inputs: ArrayLike, rates_: ArrayLike | None,
@@ -448,13 +411,13 @@ def reassemble_drawing(mech: Mechanism, lay: GraphLayout) -> Configuration:
     return conf
 
 
-def _with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:
+def with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:
     fields = {k: getattr(mode, k) for k in mode.__dataclass_fields__}
     fields["events"] = events
     return MechanismMode(**fields)
 
 
-def _fmt(mech: Mechanism, lay: GraphLayout, x: Array) -> str:
+def input_text(mech: Mechanism, lay: GraphLayout, x: Array) -> str:
     parts = []
     for name, f, v in zip(mech.inputs, lay.inputs, x, strict=True):
         parts.append(f"{name} = {v:.6g} m" if lay.is_translation[f]
@@ -523,7 +486,7 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
 
         idx = np.nonzero(singular)[0]
         events = singular_events(mech, lay, conf, rank, idx,
-                                 {int(k): _fmt(mech, lay, X[k]) for k in idx})
+                                 {int(k): input_text(mech, lay, X[k]) for k in idx})
     return MechanismMode(mask, singular, conf, variables, velocities, accels,
                          link_rotation=frames[0], link_origin=frames[1],
                          link_angular_velocity=twists[0], link_origin_velocity=twists[1],

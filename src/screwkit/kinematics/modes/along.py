@@ -21,13 +21,22 @@ dying between two anchors (an island shorter than the anchor spacing) is not see
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
-from screwkit.kinematics.graph.motion import check_cost
+from screwkit.kinematics.graph.motion import (
+    MechanismMode,
+    build_mode,
+    check_cost,
+    groups,
+    input_text,
+    misfits,
+    with_events,
+)
+from screwkit.kinematics.graph.subchains import Decomposition
 from screwkit.kinematics.graph.track import follow_drawn_mode, reach
 from screwkit.kinematics.modes.every_mode import MechanismModes, every_mode
 from screwkit.kinematics.tracker.loop import Configuration
@@ -44,6 +53,10 @@ REFINE = 8
 FOLD_STEPS = 26
 #: a bisection step's continuation may split it down to this fraction of its length
 FOLD_SPLIT = 8
+#: two folds are one where their inputs agree to this (rad, or fraction of the length scale)
+SAME_FOLD = 1e-6
+#: ... and the two modes' body poses next to it to this
+FOLD_POSES = 1e-2
 #: anchors are at most this many samples apart
 ANCHOR_SPACING = 8
 #: measured homotopy time per anchor and generic solution (rounded up; ~0.1 s per 6R instance)
@@ -61,6 +74,8 @@ class _Chain:
     events: list[str] = field(default_factory=list)
     anchors_met: int = 0
     anchors_certified: int = 0
+    #: where it is born or dies: the input there and the configuration next to it
+    folds: list[tuple[Array, Configuration]] = field(default_factory=list)
 
     def conf_at(self, k: int) -> Configuration:
         return Configuration(self.scalars[k:k + 1].copy(), self.spherical[k:k + 1].copy())
@@ -75,7 +90,7 @@ class _Chain:
 class ModesAlong:
     """Every mode found along the inputs: ``configurations[k]`` (N samples) where
     ``masks[k]`` holds, with ``events[k]``; ``anchors`` the anchor samples; ``notes`` what was
-    found and how."""
+    found and how; ``meets`` the pairs of modes that meet at a fold (:func:`fold_meetings`)."""
 
     configurations: tuple[Configuration, ...]
     masks: tuple[NDArray[np.bool_], ...]
@@ -83,6 +98,7 @@ class ModesAlong:
     anchors: NDArray[np.intp]
     notes: tuple[str, ...]
     solved: MechanismModes
+    meets: tuple[tuple[int, int], ...] = ()
 
 
 def anchor_samples(N: int, per_anchor: float) -> NDArray[np.intp]:
@@ -115,11 +131,11 @@ def pose_distance(mech: Mechanism, lay: GraphLayout, a: Configuration, b: Config
 
 
 def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from: Array,
-                 x_to: Array) -> Array:
+                 x_to: Array) -> tuple[Array, Configuration]:
     """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the way
     to ``x_to`` (which it does not reach): bisection of the segment, :data:`FOLD_STEPS`
     halvings, each half reached by continuation (graph/track.py ``reach``, in steps down to
-    1/:data:`FOLD_SPLIT` of the half)."""
+    1/:data:`FOLD_SPLIT` of the half); the input there and the last configuration reached."""
     lo, hi = np.asarray(x_from, dtype=float), np.asarray(x_to, dtype=float)
     scale = np.where(np.array([lay.is_translation[f] for f in lay.inputs]), lay.length, 1.0)
     for _ in range(FOLD_STEPS):
@@ -130,7 +146,7 @@ def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
             hi = mid
         else:
             lo, conf = mid, got
-    return np.asarray(0.5 * (lo + hi))
+    return np.asarray(0.5 * (lo + hi)), conf
 
 
 def _track(mech: Mechanism, lay: GraphLayout, start: Configuration, x0: Array, X: Array,
@@ -176,7 +192,25 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     return ModesAlong(tuple(Configuration(c.scalars, c.spherical) for c in chains),
                       tuple(c.mask for c in chains),
                       tuple(tuple(c.events) + (_certificate_event(c),) for c in chains),
-                      anchors, _notes(solved, anchors, len(chains)), solved)
+                      anchors, _notes(solved, anchors, len(chains)), solved,
+                      fold_meetings(mech, lay, [c.folds for c in chains]))
+
+
+def fold_meetings(mech: Mechanism, lay: GraphLayout,
+                  folds: list[list[tuple[Array, Configuration]]]) -> tuple[tuple[int, int], ...]:
+    """The pairs of modes (indices into ``folds``) that meet at a fold: born or dying at the
+    same input (to :data:`SAME_FOLD` of a radian, or of the length scale) with body poses
+    there within :data:`FOLD_POSES` (at 2⁻²⁶ of a step from a fold, where two branches differ
+    by about the square root of that distance)."""
+    scale = np.where(np.array([lay.is_translation[f] for f in lay.inputs]), lay.length, 1.0)
+    flat = [(k, x, pose_vectors(mech, lay, c)[0]) for k, fs in enumerate(folds) for x, c in fs]
+    out = set()
+    for i, (a, xa, pa) in enumerate(flat):
+        for b, xb, pb in flat[i + 1:]:
+            if a != b and float(np.max(np.abs(xa - xb) / scale)) <= SAME_FOLD and \
+                    float(np.max(np.abs(pa - pb))) <= FOLD_POSES:
+                out.add((min(a, b), max(a, b)))
+    return tuple(sorted(out))
 
 
 def _new_chain(chains: list[_Chain], lay: GraphLayout, N: int) -> int:
@@ -219,7 +253,8 @@ def _segment(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.in
             reached = rows[mask]
             chain.put(reached, conf.take(np.flatnonzero(mask)))
             k = int(reached[-1]) if reached.size else A
-            at = fold_between(mech, lay, chain.conf_at(k), X[k], X[k + 1])
+            at, near = fold_between(mech, lay, chain.conf_at(k), X[k], X[k + 1])
+            chain.folds.append((at, near))
             chain.events.append(f"dies at {fmt(at)}: it stops assembling there (a fold, located "
                                 "by bisection between samples)")
             continue
@@ -270,7 +305,8 @@ def _born(mech: Mechanism, lay: GraphLayout, X: Array, A: int, B: int, conf: Con
                             "not continue a mode of this anchor (a path jump was refused there)")
         return c
     k = int(back[mask][-1]) if mask.any() else B
-    at = fold_between(mech, lay, chain.conf_at(k), X[k], X[k - 1])
+    at, near = fold_between(mech, lay, chain.conf_at(k), X[k], X[k - 1])
+    chain.folds.append((at, near))
     chain.events.append(f"is born at {write(at)}: it starts assembling there (a fold, located "
                         "by bisection between samples)")
     return c
@@ -297,3 +333,56 @@ def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int) -> tup
         notes.append(f"at {int(solved.continuum.sum())} anchor(s) the solutions include a "
                      "continuum (a curve of assemblies), whose points are not isolated modes")
     return tuple(notes)
+
+
+def every_mode_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
+                      Xd: Array, Xdd: Array, drawn: MechanismMode, conf: Configuration
+                      ) -> tuple[tuple[MechanismMode, ...], tuple[str, ...]]:
+    """Every mode of a mechanism that does not decompose (graph/motion.py's
+    ``solve_mechanism`` with ``every_mode``), where a polynomial formulation takes it: the
+    drawn mode ``drawn`` (its configurations ``conf``) first, then the others, labelled "mode
+    1 (…)", "mode 2 (…)" …, and the notes with the circuits; only the drawn mode (a note says
+    why) where no formulation takes it."""
+    from screwkit.budget import ResourceLimitError
+    from screwkit.errors import CapabilityError
+
+    only = "every mode: only the drawn mode is found for this mechanism: "
+    if misfits(mech):
+        return (drawn,), (only + "its parts are made off the drawing (seat offsets), which "
+                          "the polynomial formulations do not model",)
+    try:
+        along = modes_along(mech, lay, X, lambda x: input_text(mech, lay, x))
+    except (CapabilityError, ResourceLimitError) as err:
+        return (drawn,), (only + "; ".join([*dec.describe(mech)[-1:], str(err)]),)
+    pd = pose_vectors(mech, lay, conf)
+    mine, other = None, []
+    for k, (c, m) in enumerate(zip(along.configurations, along.masks, strict=True)):
+        both = np.flatnonzero(m & drawn.assembles)
+        gap = np.abs(pose_vectors(mech, lay, c.take(both)) - pd[both]).max(axis=1) \
+            if both.size else np.zeros(0)
+        if mine is None and m[0] and drawn.assembles[0] and gap[0] <= MATCH_TOLERANCE:
+            mine = k
+            events = list(along.events[k])
+            far = gap > MATCH_TOLERANCE
+            if np.any(far):
+                events.append(f"the drawn mode parts from the anchored tracking at "
+                              f"{input_text(mech, lay, X[both[int(np.argmax(far))]])}"
+                              ": a possible branch switch of the drawn mode's tracker")
+            drawn = with_events(drawn, [*drawn.events, *events])
+        elif m.any():
+            other.append(k)
+    modes = [replace(drawn, label="drawn")]
+    index = {k: i for i, k in enumerate([mine, *other]) if k is not None}
+    for k in other:
+        md = build_mode(mech, lay, along.configurations[k], along.masks[k], X, Xd, Xdd)
+        modes.append(replace(with_events(md, [*along.events[k], *md.events]),
+                             label=f"mode {len(modes)} (homotopy at anchors, tracked between)",
+                             index=len(modes)))
+    joins = [(index[a], index[b]) for a, b in along.meets if a in index and b in index]
+    notes = [*along.notes, "circuits (modes that meet at a fold, where the input must turn "
+             "back to go on): " + ", ".join("{" + ", ".join(map(str, c)) + "}"
+                                            for c in groups(len(modes), joins))]
+    if mine is None:
+        notes.append("the drawn mode is not among the modes the homotopy finds at the first "
+                     "input: check the drawing closes")
+    return tuple(modes), tuple(notes)
