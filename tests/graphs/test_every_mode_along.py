@@ -179,3 +179,13 @@ def test_the_two_modes_born_at_one_fold_are_one_circuit(motion: MechanismMotion)
     assert circuits and circuits[0].endswith("{0}, {1}, {2, 3}")
     assert all(not np.asarray(md.assembles).all() for md in motion.modes[2:])
     assert all(np.asarray(md.assembles).all() for md in motion.modes[:2])
+
+
+def test_a_birth_inside_one_long_step_is_located(six_bar: Mechanism) -> None:
+    """Two samples 23° apart, the fold 5° after the first: the born modes are tracked back
+    the whole way and the fold is still where the homotopy's count changes."""
+    m = solve_mechanism(six_bar, [[3.5], [3.9]], every_mode=True)
+    born = [float(re.match(r"is born at Q3\.theta = ([-\d.]+) deg", ev)[1])  # type: ignore[index]
+            for md in m.modes[2:] for ev in md.events if ev.startswith("is born")]
+    assert len(m.modes) == 4 and len(born) == 2
+    assert np.abs(np.radians(born) - _fine_fold(six_bar, 3.5, 3.9)).max() <= 1e-4

@@ -37,7 +37,7 @@ from screwkit.kinematics.graph.motion import (
     with_events,
 )
 from screwkit.kinematics.graph.subchains import Decomposition
-from screwkit.kinematics.graph.track import follow_drawn_mode, reach
+from screwkit.kinematics.graph.track import SMALLEST_STEP, follow_drawn_mode, reach
 from screwkit.kinematics.modes.every_mode import MechanismModes, every_mode
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
@@ -53,6 +53,9 @@ REFINE = 8
 FOLD_STEPS = 26
 #: a bisection step's continuation may split it down to this fraction of its length
 FOLD_SPLIT = 8
+#: ... once the half is this short (rad, or fraction of the length scale): a half wrongly
+#: refused then moves the fold by less than its length
+FINE_HALF = 1e-4
 #: two folds are one where their inputs agree to this (rad, or fraction of the length scale)
 SAME_FOLD = 1e-6
 #: ... and the two modes' body poses next to it to this
@@ -135,13 +138,17 @@ def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
     """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the way
     to ``x_to`` (which it does not reach): bisection of the segment, :data:`FOLD_STEPS`
     halvings, each half reached by continuation (graph/track.py ``reach``, in steps down to
+    the tracker's smallest while a half is longer than :data:`FINE_HALF`, then to
     1/:data:`FOLD_SPLIT` of the half); the input there and the last configuration reached."""
     lo, hi = np.asarray(x_from, dtype=float), np.asarray(x_to, dtype=float)
     scale = np.where(np.array([lay.is_translation[f] for f in lay.inputs]), lay.length, 1.0)
     for _ in range(FOLD_STEPS):
         mid = 0.5 * (lo + hi)
-        got = reach(mech, lay, conf, lo, mid,
-                    max(float(np.max(np.abs(mid - lo) / scale)) / FOLD_SPLIT, 1e-12))
+        h = float(np.max(np.abs(mid - lo) / scale))
+        # a half that ends just short of the fold needs steps as short as its distance to
+        # it: down to the tracker's smallest while the half is long, 1/FOLD_SPLIT of it after
+        got = reach(mech, lay, conf, lo, mid, SMALLEST_STEP if h > FINE_HALF
+                    else max(h / FOLD_SPLIT, 1e-12))
         if got is None:
             hi = mid
         else:
