@@ -119,6 +119,8 @@ def anchor_samples(N: int, per_anchor: float) -> NDArray[np.intp]:
 
 def pose_vectors(mech: Mechanism, lay: GraphLayout, conf: Configuration) -> Array:
     """Every body's pose as one row per sample (rotation entries, positions / length)."""
+    if conf.size == 0:  # (every_mode's empty rows have no columns either)
+        return np.zeros((0, 12 * (len(mech.bodies) + 1)))
     fr = graph_forward(mech, lay, conf)
     n = conf.size
     return np.concatenate([fr.R.reshape(n, -1), fr.p.reshape(n, -1) / lay.length], axis=1)
