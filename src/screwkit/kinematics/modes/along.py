@@ -198,10 +198,16 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
         _met(chains[active[m]], solved, 0, m)
     for i in range(len(anchors) - 1):
         active = _segment(mech, lay, X, anchors, i, solved, chains, active, write)
+    before = len(chains)
+    extra = _islands(mech, lay, X, anchors, chains, write)
+    notes = _notes(solved, anchors, len(chains))
+    if extra:
+        notes += (f"the homotopy also at the {extra} sample(s) next to a birth or death: "
+                  f"{len(chains) - before} mode(s) found there that reach no anchor (islands)",)
     return ModesAlong(tuple(Configuration(c.scalars, c.spherical) for c in chains),
                       tuple(c.mask for c in chains),
                       tuple(tuple(c.events) + (_certificate_event(c),) for c in chains),
-                      anchors, _notes(solved, anchors, len(chains)), solved,
+                      anchors, notes, solved,
                       fold_meetings(mech, lay, [c.folds for c in chains]))
 
 
@@ -220,6 +226,65 @@ def fold_meetings(mech: Mechanism, lay: GraphLayout,
                     float(np.max(np.abs(pa - pb))) <= FOLD_POSES:
                 out.add((min(a, b), max(a, b)))
     return tuple(sorted(out))
+
+
+def _islands(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.intp],
+             chains: list[_Chain], fmt: object) -> int:
+    """Modes that reach no anchor but meet a known mode at a fold (an island between two
+    anchors): the homotopy solved again at the samples on both sides of every birth and
+    death, each mode there on no known mode tracked both ways (:func:`_island`). The count of
+    samples solved."""
+    near: set[int] = set()
+    for c in chains:
+        for k in np.flatnonzero(c.mask[:-1] != c.mask[1:]).tolist():
+            near.update((k, k + 1))
+    rows = np.array(sorted(near - set(anchors.tolist())), dtype=np.intp)
+    if rows.size == 0:
+        return 0
+    solved = every_mode(mech, X[rows])
+    for r, n in enumerate(rows.tolist()):
+        there = solved.configurations[r]
+        for j in range(there.size):
+            conf = there.take(slice(j, j + 1))
+            known = [c for c in chains if c.mask[n]]
+            if known and pose_distance(mech, lay, conf, Configuration(
+                    np.stack([c.scalars[n] for c in known]),
+                    np.stack([c.spherical[n] for c in known]))).min() <= MATCH_TOLERANCE:
+                continue
+            _island(mech, lay, X, n, conf, anchors, chains, fmt,
+                    bool(solved.certified[r][j]))
+    return int(rows.size)
+
+
+def _island(mech: Mechanism, lay: GraphLayout, X: Array, n: int, conf: Configuration,
+            anchors: NDArray[np.intp], chains: list[_Chain], fmt: object, certified: bool
+            ) -> None:
+    """A mode found at sample ``n`` between anchors, tracked to where it is born and where it
+    dies (both located by bisection); dropped where it reaches an anchor (there it is a mode
+    already followed)."""
+    write = fmt if callable(fmt) else str
+    fwd = np.arange(n + 1, int(anchors[anchors > n].min()) + 1)
+    back = np.arange(n - 1, int(anchors[anchors < n].max()) - 1, -1)
+    gf, mf, sf = _track(mech, lay, conf, X[n], X[fwd])
+    gb, mb, sb = _track(mech, lay, conf, X[n], X[back])
+    if sf is None or sb is None:
+        return
+    chain = chains[_new_chain(chains, lay, X.shape[0])]
+    chain.anchors_met, chain.anchors_certified = 1, int(certified)
+    chain.put(np.array([n]), conf)
+    chain.put(fwd[mf], gf.take(np.flatnonzero(mf)))
+    chain.put(back[mb], gb.take(np.flatnonzero(mb)))
+    k = int(back[mb][-1]) if mb.any() else n
+    at, near = fold_between(mech, lay, chain.conf_at(k), X[k], X[k - 1])
+    chain.folds.append((at, near))
+    chain.events.append(f"is born at {write(at)}: it starts assembling there (a fold, located "
+                        "by bisection between samples)")
+    k = int(fwd[mf][-1]) if mf.any() else n
+    at, near = fold_between(mech, lay, chain.conf_at(k), X[k], X[k + 1])
+    chain.folds.append((at, near))
+    chain.events.append(f"dies at {write(at)}: it stops assembling there (a fold, located by "
+                        f"bisection between samples); found by the homotopy at {write(X[n])}, "
+                        "next to another mode's fold, between two anchors")
 
 
 def _new_chain(chains: list[_Chain], lay: GraphLayout, N: int) -> int:
