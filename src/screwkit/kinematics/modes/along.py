@@ -13,10 +13,13 @@ at the anchor before (an event says so) rather than switched. An anchor mode tha
 mode reaches is born in the segment: it is tracked backward to where it stops assembling, and
 the fold is located by bisection of that step (:func:`fold_between`, as graph/closed_modes.py
 does for dyads). A tracked mode that stops assembling dies there, located the same way.
+Then the homotopy is solved again at the samples on both sides of every birth and death: a
+mode there that no known mode holds (an island between two anchors that meets a known mode at
+a fold) is tracked both ways to its own birth and death (:func:`_islands`).
 
 Guaranteed: every isolated real mode at every anchor (the homotopy's promise), continuity in
-between (the tracker's checks), no silent switch at an anchor. Not guaranteed: a mode born and
-dying between two anchors (an island shorter than the anchor spacing) is not seen.
+between (the tracker's checks), no silent switch at an anchor. Not guaranteed: an island
+between two anchors that meets no known mode's fold next to a sample is not seen.
 """
 
 from __future__ import annotations
@@ -401,8 +404,8 @@ def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int) -> tup
              f"{' …' if len(anchors) > 6 else ''}) finds {found} distinct complex solution(s) "
              f"per anchor, generic count {solved.generic_count} ({solved.how_found}); {real} "
              f"real mode(s) over the anchors, {cert} certified by Smale's α-test; {count} "
-             "mode(s) tracked between anchors with jump checks (a mode born and dying between "
-             "two anchors is not seen)"]
+             "mode(s) tracked between anchors with jump checks (an island between two anchors "
+             "is found only where it meets a known mode at a fold)"]
     if solved.continuum.any():
         notes.append(f"at {int(solved.continuum.sum())} anchor(s) the solutions include a "
                      "continuum (a curve of assemblies), whose points are not isolated modes")
