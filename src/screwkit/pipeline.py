@@ -67,8 +67,8 @@ class Pipeline:
                  units: UnitChoice | None = None) -> None:
         if getattr(spec, "family", None) == "graph":  # io.mechanism_spec.GraphSpec
             raise SpecError(f"{spec.path}: a mechanism graph (bodies and joints): validate, "
-                            "analyze, mobility, limits, report, dynamics, sweep, tolerance and "
-                            "balance work on it (screwkit.balancing.graph.balance_mechanism from "
+                            "analyze, mobility, limits, report, dynamics, sweep, tolerance, "
+                            "balance and export work on it (screwkit.balancing.graph.balance_mechanism from "
                             "Python); synthesis and simulation of graphs are not there yet "
                             "(docs/mechanisms.md)")
         expect_instance(spec, Spec, "Pipeline: spec", "a Spec (sk.load_spec(path))")

@@ -188,7 +188,12 @@ def graph_export(spec: Any, fmt: str, at: Sequence[str] = (), *, mode: int | Non
         raise ExportError(f"{spec.name}: --at needs a graph with one input swept from start "
                           f"to stop; this one has {inputs.shape[1]} input(s) given as rows: "
                           "leave out --at (the skeleton is drawn at the first row)")
-    samples, labels = samples_for(spec, at)
+    if at:
+        samples, labels = samples_for(spec, at)
+    else:  # the spec's samples in their order (rows need not be sorted), skeleton at the first
+        N = len(inputs)
+        samples = ExportSamples(inputs[:, 0], np.arange(N), np.zeros(1, dtype=np.intp))
+        labels = samples_for(spec)[1] if inputs.shape[1] == 1 else ["row 1"]
     x = inputs if len(samples.inputs) == len(inputs) else samples.inputs[:, None]
     motion = solve_mechanism(spec.mechanism, x, rates=spec.speed,
                              accelerations=spec.acceleration, every_mode=True)
