@@ -11,8 +11,9 @@ Equations (Newton–Euler for every moving body b, B_b its applied inertia + wei
 with S·W = ω·m + v·f the reciprocal product of a unit freedom screw with the wrench (no work
 along a frictionless freedom; Bagci 1969 §3.4). A driven freedom's effort is τ_k = S_k·W_{j(k)}.
 
-A square system of full rank (a statically determinate mechanism, e.g. the Stewart platform) is
-solved by LU; any other per sample for the wrenches that minimise Σ_j |f_j|² + |m_cj/ℓ|², moments
+A system of full row or column rank is solved by LU (of A when square: a statically determinate
+mechanism such as the Stewart platform; else of A·Aᵀ, y = Aᵀz, or of AᵀA); any other, per
+sample, by the SVD. Either way the solution is the one of the wrenches that minimise Σ_j |f_j|² + |m_cj/ℓ|², moments
 taken about each joint's centre c_j and divided by the length scale ℓ (as single loops do,
 dynamics/loop_statics.py): the choice is independent of the reference point and of how the graph
 is cut. Its null space — self-stress that rigid joints can carry without any load, three per
@@ -98,7 +99,7 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
     rhs[:, :6 * B] = -(loads * rows[None, None, :, None]).reshape(N, 6 * B, K)
     s0, vt0 = np.linalg.svd(A[0])[1:]  # the first sample: is the system square, full rank?
     rank = int(np.sum(s0 > RANK_RTOL * max(float(s0[0]), 1e-300)))
-    if A.shape[1] == A.shape[2] == rank:  # statically determinate: LU
+    if rank in A.shape[1:]:  # full row or column rank: LU
         y = _lu_solve(A, rhs)
     else:
         y, ranks = _least_norm(A, rhs)
@@ -141,15 +142,27 @@ LU_RESIDUAL = 1e-10
 
 
 def _lu_solve(A: Array, rhs: Array) -> Array:
-    """A·y = rhs for square, full-rank A (a statically determinate mechanism: every joint
-    wrench fixed by the loads), by batched LU: the same solution as :func:`_least_norm` at a
-    fraction of the cost (about 25× for the Stewart platform's 108 × 108 system); a sample
-    where LU fails or leaves a residual above ``LU_RESIDUAL`` is solved by the SVD."""
+    """The least-norm least-squares solution of A·y = rhs for A of full row or column rank, by
+    batched LU: of A itself when it is square (a statically determinate mechanism: every joint
+    wrench fixed by the loads); of A·Aᵀ for full row rank (y = Aᵀz, in A's row space: the
+    least-norm solution); of AᵀA for full column rank (the unique least-squares solution; more
+    equations than unknowns where a rod's idle spin makes one depend on the others). The same
+    solution as :func:`_least_norm` at a fraction of the cost (about 25× for the Stewart
+    platform's 108 × 108 system, 8× for a four-bar); a sample where LU fails or leaves a
+    residual above ``LU_RESIDUAL`` (next to a singular configuration, or loads along an idle
+    freedom; the residual bounds y's error by 1/σ_min) is solved by the SVD."""
+    R, C = A.shape[1:]
+    At = np.swapaxes(A, 1, 2)
     try:
-        y = np.linalg.solve(A, rhs)
+        if R == C:
+            y = np.linalg.solve(A, rhs)
+        elif C > R:
+            y = At @ np.linalg.solve(A @ At, rhs)
+        else:
+            y = np.linalg.solve(At @ A, At @ rhs)
         bad = ~np.all(np.isfinite(y), axis=(1, 2))
     except np.linalg.LinAlgError:  # a singular sample: solve each one
-        y = np.zeros(A.shape[:1] + (A.shape[2], rhs.shape[2]))
+        y = np.zeros((A.shape[0], C, rhs.shape[2]))
         bad = np.ones(A.shape[0], dtype=bool)
     y[bad] = 0.0
     res = np.linalg.norm(A @ y - rhs, axis=1) / (np.linalg.norm(rhs, axis=1) + 1e-300)
