@@ -169,7 +169,7 @@ def _lu_solve(A: Array, rhs: Array) -> Array:
     bad |= np.any(res > LU_RESIDUAL, axis=1)
     if bad.any():
         y[bad] = _least_norm(A[bad], rhs[bad])[0]
-    return y
+    return np.asarray(y, dtype=np.float64)
 
 
 def _null_joints(mech: Mechanism, null: Array) -> list[str]:
