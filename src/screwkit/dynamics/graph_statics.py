@@ -34,6 +34,8 @@ from screwkit.model.mechanism import GROUND, Mechanism
 Array = NDArray[np.float64]
 
 RANK_RTOL = 1e-9
+#: samples whose equations are built and solved together (their dense systems stay in cache)
+CHUNK = 64
 
 
 @dataclass(frozen=True)
@@ -92,18 +94,30 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
     (N, B, 6, K): applied wrenches about the world origin, one column per load case."""
     N, _, _, K = loads.shape
     B, J = len(mech.bodies), len(mech.joints)
-    A = _system(mech, screws, centres, passive, joint_of, length)
     rows = np.ones(6)
     rows[3:] = 1.0 / length
-    rhs = np.zeros((N, A.shape[1], K))
-    rhs[:, :6 * B] = -(loads * rows[None, None, :, None]).reshape(N, 6 * B, K)
-    s0, vt0 = np.linalg.svd(A[0])[1:]  # the first sample: is the system square, full rank?
+    A0 = _system(mech, screws[:1], centres[:1], passive, joint_of, length)[0]
+    s0, vt0 = np.linalg.svd(A0)[1:]  # the first sample: is the system of full rank?
     rank = int(np.sum(s0 > RANK_RTOL * max(float(s0[0]), 1e-300)))
-    if rank in A.shape[1:]:  # full row or column rank: LU
-        y = _lu_solve(A, rhs)
-    else:
-        y, ranks = _least_norm(A, rhs)
-        rank = int(np.median(ranks))
+    fast = rank in A0.shape  # full row or column rank: LU
+    y = np.empty((N, 6 * J, K))
+    res = np.empty((N, A0.shape[0], K))
+    size = np.empty((N, K))
+    ranks = []
+    for a in range(0, N, CHUNK):  # a chunk's dense system stays in cache
+        sl = slice(a, min(a + CHUNK, N))
+        A = _system(mech, screws[sl], centres[sl], passive, joint_of, length)
+        rhs = np.zeros((A.shape[0], A.shape[1], K))
+        rhs[:, :6 * B] = -(loads[sl] * rows[None, None, :, None]).reshape(-1, 6 * B, K)
+        if fast:
+            y[sl], res[sl] = _lu_solve(A, rhs)
+        else:
+            y[sl], r = _least_norm(A, rhs)
+            ranks.append(r)
+            res[sl] = A @ y[sl] - rhs
+        size[sl] = np.linalg.norm(rhs, axis=1) + 1e-300
+    if not fast:
+        rank = int(np.median(np.concatenate(ranks)))
     indeterminate = 6 * J - rank
     named = _null_joints(mech, vt0[rank:]) if indeterminate else []
     # back to W_j about the origin
@@ -112,8 +126,6 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
     wrench[:, :, 3:] = length * wrench[:, :, 3:] + np.cross(c[:, :, None, :],
                                                                wrench[:, :, :3].swapaxes(2, 3)
                                                                ).swapaxes(2, 3)
-    res = A @ y - rhs
-    size = np.linalg.norm(rhs, axis=1) + 1e-300
     residual = np.linalg.norm(res, axis=1) / size
     efforts = np.empty((N, len(inputs), K))
     for k, f in enumerate(inputs):
@@ -141,7 +153,7 @@ def _least_norm(A: Array, rhs: Array) -> tuple[Array, NDArray[np.intp]]:
 LU_RESIDUAL = 1e-10
 
 
-def _lu_solve(A: Array, rhs: Array) -> Array:
+def _lu_solve(A: Array, rhs: Array) -> tuple[Array, Array]:
     """The least-norm least-squares solution of A·y = rhs for A of full row or column rank, by
     batched LU: of A itself when it is square (a statically determinate mechanism: every joint
     wrench fixed by the loads); of A·Aᵀ for full row rank (y = Aᵀz, in A's row space: the
@@ -150,7 +162,8 @@ def _lu_solve(A: Array, rhs: Array) -> Array:
     solution as :func:`_least_norm` at a fraction of the cost (about 25× for the Stewart
     platform's 108 × 108 system, 8× for a four-bar); a sample where LU fails or leaves a
     residual above ``LU_RESIDUAL`` (next to a singular configuration, or loads along an idle
-    freedom; the residual bounds y's error by 1/σ_min) is solved by the SVD."""
+    freedom; the residual bounds y's error by 1/σ_min) is solved by the SVD. Returns y and
+    A·y − rhs."""
     R, C = A.shape[1:]
     At = np.swapaxes(A, 1, 2)
     try:
@@ -165,11 +178,13 @@ def _lu_solve(A: Array, rhs: Array) -> Array:
         y = np.zeros((A.shape[0], C, rhs.shape[2]))
         bad = np.ones(A.shape[0], dtype=bool)
     y[bad] = 0.0
-    res = np.linalg.norm(A @ y - rhs, axis=1) / (np.linalg.norm(rhs, axis=1) + 1e-300)
-    bad |= np.any(res > LU_RESIDUAL, axis=1)
+    res = A @ y - rhs
+    rel = np.linalg.norm(res, axis=1) / (np.linalg.norm(rhs, axis=1) + 1e-300)
+    bad |= np.any(rel > LU_RESIDUAL, axis=1)
     if bad.any():
         y[bad] = _least_norm(A[bad], rhs[bad])[0]
-    return np.asarray(y, dtype=np.float64)
+        res[bad] = A[bad] @ y[bad] - rhs[bad]
+    return np.asarray(y, dtype=np.float64), np.asarray(res, dtype=np.float64)
 
 
 def _null_joints(mech: Mechanism, null: Array) -> list[str]:
