@@ -185,9 +185,11 @@ def graph_export(spec: Any, fmt: str, at: Sequence[str] = (), *, mode: int | Non
     inputs = np.asarray(spec.inputs, dtype=float)
     steps = np.diff(inputs[:, 0])
     if at and (inputs.shape[1] != 1 or not (np.all(steps > 0) or np.all(steps < 0))):
+        why = (f"this one has {inputs.shape[1]} inputs given as rows" if inputs.shape[1] != 1
+               else "this one's rows are not in increasing or decreasing order")
         raise ExportError(f"{spec.name}: --at needs a graph with one input swept from start "
-                          f"to stop; this one has {inputs.shape[1]} input(s) given as rows: "
-                          "leave out --at (the skeleton is drawn at the first row)")
+                          f"to stop; {why}: leave out --at (the skeleton is drawn at the first "
+                          "row)")
     if at:
         samples, labels = samples_for(spec, at)
     else:  # the spec's samples in their order (rows need not be sorted), skeleton at the first
