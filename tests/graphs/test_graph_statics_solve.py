@@ -35,3 +35,40 @@ def test_a_singular_sample_falls_back_to_the_svd() -> None:
     y, res = _lu_solve(A, rhs)
     np.testing.assert_allclose(y, _pinv_solution(A, rhs), atol=1e-9)
     assert np.abs(res).max() < 1e-9
+
+
+def test_the_spanning_tree_route_equals_the_full_system(monkeypatch) -> None:
+    """The Stewart platform (square, full rank) goes through the spanning tree
+    (graph_tree_statics.py); forcing every sample back to the full system (a residual
+    threshold no sample meets, so the full system's LU defers to its SVD too) gives the same
+    wrenches and efforts."""
+    from pathlib import Path
+
+    import screwkit as sk
+    import screwkit.dynamics.graph_statics as gs
+    from screwkit.dynamics.graph_inverse import graph_inverse_dynamics
+    from screwkit.kinematics.graph import solve_mechanism
+
+    spec = sk.load_spec(Path(__file__).resolve().parents[2] / "examples" / "mechanisms"
+                        / "stewart_platform_pose.toml")
+    motion = solve_mechanism(spec.mechanism, spec.inputs, rates=spec.speed,
+                             accelerations=np.linspace(-1.0, 1.0, 6))
+    calls: list[int] = []
+    dense = gs._dense
+
+    def counted(*args):  # type: ignore[no-untyped-def]
+        calls.append(len(args[7]))
+        return dense(*args)
+
+    monkeypatch.setattr(gs, "_dense", counted)
+    tree = graph_inverse_dynamics(motion, gravity=spec.gravity_vector)
+    assert calls == []  # no sample needed the full system
+    monkeypatch.setattr(gs, "LU_RESIDUAL", -1.0)  # every sample: the full system's SVD
+    full = graph_inverse_dynamics(motion, gravity=spec.gravity_vector)
+    assert calls == [int(tree.ok.sum())]
+    scale = np.abs(tree.reaction_force).max()
+    np.testing.assert_allclose(tree.reaction_force, full.reaction_force, atol=1e-11 * scale)
+    np.testing.assert_allclose(tree.reaction_moment, full.reaction_moment,
+                               atol=1e-11 * scale * spec.mechanism.length_scale)
+    np.testing.assert_allclose(tree.efforts, full.efforts, atol=1e-11 * scale)
+    assert np.nanmax(tree.residual) < 1e-12

@@ -11,9 +11,10 @@ Equations (Newton–Euler for every moving body b, B_b its applied inertia + wei
 with S·W = ω·m + v·f the reciprocal product of a unit freedom screw with the wrench (no work
 along a frictionless freedom; Bagci 1969 §3.4). A driven freedom's effort is τ_k = S_k·W_{j(k)}.
 
-A system of full row or column rank is solved by LU (of A when square: a statically determinate
-mechanism such as the Stewart platform; else of A·Aᵀ, y = Aᵀz, or of AᵀA); any other, per
-sample, by the SVD. Either way the solution is the one of the wrenches that minimise Σ_j |f_j|² + |m_cj/ℓ|², moments
+A square system of full rank (a statically determinate mechanism such as the Stewart platform)
+is solved through the spanning tree, the chords' wrenches the only unknowns
+(dynamics/graph_tree_statics.py); one of full row or column rank by LU (of A·Aᵀ, y = Aᵀz, or
+of AᵀA); any other, per sample, by the SVD. Either way the solution is the one of the wrenches that minimise Σ_j |f_j|² + |m_cj/ℓ|², moments
 taken about each joint's centre c_j and divided by the length scale ℓ (as single loops do,
 dynamics/loop_statics.py): the choice is independent of the reference point and of how the graph
 is cut. Its null space — self-stress that rigid joints can carry without any load, three per
@@ -29,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.dynamics.graph_tree_statics import tree_cut, tree_statics
 from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]
@@ -93,39 +95,26 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
     """Joint wrenches and efforts (module docstring) from the body loads ``loads``
     (N, B, 6, K): applied wrenches about the world origin, one column per load case."""
     N, _, _, K = loads.shape
-    B, J = len(mech.bodies), len(mech.joints)
-    rows = np.ones(6)
-    rows[3:] = 1.0 / length
+    J = len(mech.joints)
     A0 = _system(mech, screws[:1], centres[:1], passive, joint_of, length)[0]
     s0, vt0 = np.linalg.svd(A0)[1:]  # the first sample: is the system of full rank?
     rank = int(np.sum(s0 > RANK_RTOL * max(float(s0[0]), 1e-300)))
     fast = rank in A0.shape  # full row or column rank: LU
-    y = np.empty((N, 6 * J, K))
-    res = np.empty((N, A0.shape[0], K))
-    size = np.empty((N, K))
-    ranks = []
-    for a in range(0, N, CHUNK):  # a chunk's dense system stays in cache
-        sl = slice(a, min(a + CHUNK, N))
-        A = _system(mech, screws[sl], centres[sl], passive, joint_of, length)
-        rhs = np.zeros((A.shape[0], A.shape[1], K))
-        rhs[:, :6 * B] = -(loads[sl] * rows[None, None, :, None]).reshape(-1, 6 * B, K)
-        if fast:
-            y[sl], res[sl] = _lu_solve(A, rhs)
-        else:
-            y[sl], r = _least_norm(A, rhs)
-            ranks.append(r)
-            res[sl] = A @ y[sl] - rhs
-        size[sl] = np.linalg.norm(rhs, axis=1) + 1e-300
-    if not fast:
-        rank = int(np.median(np.concatenate(ranks)))
+    args = (mech, screws, centres, loads, passive, joint_of, length)
+    if fast and A0.shape[0] == A0.shape[1]:  # determinate: through the spanning tree
+        wrench, res, size = tree_statics(mech, tree_cut(mech), screws, loads, passive,
+                                         joint_of, length)
+        rel = np.linalg.norm(res, axis=1) / size
+        bad = ~np.all(np.isfinite(wrench), axis=(1, 2, 3)) | np.any(~(rel <= LU_RESIDUAL),
+                                                                     axis=1)
+        if bad.any():
+            wrench[bad], res[bad], size[bad], _ = _dense(*args, np.nonzero(bad)[0], fast)
+    else:
+        wrench, res, size, ranks = _dense(*args, np.arange(N), fast)
+        if not fast:
+            rank = int(np.median(ranks))
     indeterminate = 6 * J - rank
     named = _null_joints(mech, vt0[rank:]) if indeterminate else []
-    # back to W_j about the origin
-    wrench = y.reshape(N, J, 6, K).copy()
-    c = centres
-    wrench[:, :, 3:] = length * wrench[:, :, 3:] + np.cross(c[:, :, None, :],
-                                                               wrench[:, :, :3].swapaxes(2, 3)
-                                                               ).swapaxes(2, 3)
     residual = np.linalg.norm(res, axis=1) / size
     efforts = np.empty((N, len(inputs), K))
     for k, f in enumerate(inputs):
@@ -134,6 +123,38 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
         efforts[:, k] = (np.einsum("nk,nkl->nl", S[:, :3], wrench[:, j, 3:])
                          + np.einsum("nk,nkl->nl", S[:, 3:], wrench[:, j, :3]))
     return GraphStatics(wrench, efforts, residual, indeterminate, named, res, rank)
+
+
+def _dense(mech: Mechanism, screws: Array, centres: Array, loads: Array, passive: list[int],
+           joint_of: tuple[int, ...], length: float, samples: NDArray[np.intp], fast: bool
+           ) -> tuple[Array, Array, Array, NDArray[np.intp]]:
+    """The full system at ``samples``, built and solved a chunk at a time (LU when ``fast``,
+    else the SVD): wrenches about the origin (n, J, 6, K), the residual A·y − rhs, the norm of
+    rhs (n, K) and the rank of each sample's A (``fast``: its column count)."""
+    n, K, B, J = len(samples), loads.shape[3], len(mech.bodies), len(mech.joints)
+    rows = np.ones(6)
+    rows[3:] = 1.0 / length
+    y = np.empty((n, 6 * J, K))
+    res = np.empty((n, 6 * B + len(passive), K))
+    size = np.empty((n, K))
+    ranks = np.full(n, 6 * J, dtype=np.intp)
+    for a in range(0, n, CHUNK):  # a chunk's dense system stays in cache
+        sl, at = slice(a, min(a + CHUNK, n)), samples[a:a + CHUNK]
+        A = _system(mech, screws[at], centres[at], passive, joint_of, length)
+        rhs = np.zeros((A.shape[0], A.shape[1], K))
+        rhs[:, :6 * B] = -(loads[at] * rows[None, None, :, None]).reshape(-1, 6 * B, K)
+        if fast:
+            y[sl], res[sl] = _lu_solve(A, rhs)
+        else:
+            y[sl], ranks[sl] = _least_norm(A, rhs)
+            res[sl] = A @ y[sl] - rhs
+        size[sl] = np.linalg.norm(rhs, axis=1) + 1e-300
+    wrench = y.reshape(n, J, 6, K).copy()  # back to W_j about the origin
+    c = centres[samples]
+    wrench[:, :, 3:] = length * wrench[:, :, 3:] + np.cross(c[:, :, None, :],
+                                                               wrench[:, :, :3].swapaxes(2, 3)
+                                                               ).swapaxes(2, 3)
+    return wrench, res, size, ranks
 
 
 def _least_norm(A: Array, rhs: Array) -> tuple[Array, NDArray[np.intp]]:
