@@ -11,10 +11,11 @@ Equations (Newton–Euler for every moving body b, B_b its applied inertia + wei
 with S·W = ω·m + v·f the reciprocal product of a unit freedom screw with the wrench (no work
 along a frictionless freedom; Bagci 1969 §3.4). A driven freedom's effort is τ_k = S_k·W_{j(k)}.
 
-A square system of full rank (a statically determinate mechanism such as the Stewart platform)
-is solved through the spanning tree, the chords' wrenches the only unknowns
-(dynamics/graph_tree_statics.py); one of full row or column rank by LU (of A·Aᵀ, y = Aᵀz, or
-of AᵀA); any other, per sample, by the SVD. Either way the solution is the one of the wrenches that minimise Σ_j |f_j|² + |m_cj/ℓ|², moments
+A system of full column rank (a statically determinate mechanism such as the Stewart platform
+or an RSSR) is solved through the spanning tree, the chords' wrenches the only unknowns
+(dynamics/graph_tree_statics.py); one of full row rank by LU of A·Aᵀ (y = Aᵀz); any other,
+per sample, by the SVD (a sample the first two leave a residual at is solved again by the
+full system). Either way the solution is the one of the wrenches that minimise Σ_j |f_j|² + |m_cj/ℓ|², moments
 taken about each joint's centre c_j and divided by the length scale ℓ (as single loops do,
 dynamics/loop_statics.py): the choice is independent of the reference point and of how the graph
 is cut. Its null space — self-stress that rigid joints can carry without any load, three per
@@ -101,7 +102,7 @@ def solve_graph_statics(mech: Mechanism, screws: Array, centres: Array, loads: A
     rank = int(np.sum(s0 > RANK_RTOL * max(float(s0[0]), 1e-300)))
     fast = rank in A0.shape  # full row or column rank: LU
     args = (mech, screws, centres, loads, passive, joint_of, length)
-    if fast and A0.shape[0] == A0.shape[1]:  # determinate: through the spanning tree
+    if rank == A0.shape[1]:  # full column rank (determinate): through the spanning tree
         wrench, res, size = tree_statics(mech, tree_cut(mech), screws, loads, passive,
                                          joint_of, length)
         rel = np.linalg.norm(res, axis=1) / size

@@ -1,5 +1,6 @@
 """The joint wrenches of a statically determinate mechanism graph through its spanning tree: the
-route :mod:`screwkit.dynamics.graph_statics` takes when its system is square and of full rank.
+route :mod:`screwkit.dynamics.graph_statics` takes when its system has full column rank (one
+solution at most: square, or with more equations where a rod's idle spin adds one).
 
 Cut the graph along a spanning tree rooted at the ground (breadth first); the joints left out
 (the chords, one per independent loop) carry unknown wrenches W_c (about the world origin).
@@ -12,11 +13,14 @@ with s_t = +1 when the subtree's body is t's second body (−1: its first) and e
 0 when chord c's second / first / neither or both bodies lie in S_t (wrenches about one point
 add). Every passive freedom k of joint j then gives S_k·W_j = 0, linear in the chord wrenches:
 6·(number of chords) unknowns, as many equations as passive freedoms — the same count, because
-the full system is square (6B + m_p = 6J, J = B + chords). A square system of full rank has one
-solution, so this one is the full system's, found by an LU of a (6C × 6C) matrix instead of
-(6J × 6J): 30 × 30 against 108 × 108 for the Stewart platform. The residual of the full system
-(A·y − rhs, with the same row scaling) is rebuilt from the wrenches, so a sample where the LU
-is inaccurate is seen and solved again by the caller.
+the full system is square (6B + m_p = 6J, J = B + chords); more equations than unknowns when it
+is tall (solved by the normal equations). A system of full column rank has at most one
+solution, so where the full system is consistent this one is its solution, found by an LU of a
+(6C × 6C) matrix instead of (6J × 6J): 30 × 30 against 108 × 108 for the Stewart platform. The
+residual of the full system (A·y − rhs, with the same row scaling) is rebuilt from the
+wrenches, so a sample where the LU is inaccurate, or where the loads work along an idle
+freedom (no exact solution: the full system's least-squares one is wanted), is seen and solved
+again by the caller.
 """
 
 from __future__ import annotations
@@ -115,7 +119,11 @@ def tree_statics(mech: Mechanism, cut: TreeCut, screws: Array, loads: Array,
         r[:, row] = s * np.einsum("ni,nik->nk", Sr[:, :, f], below_loads[:, t])
     with np.errstate(all="ignore"):
         try:
-            x = np.linalg.solve(M, r)
+            if P == 6 * C:
+                x = np.linalg.solve(M, r)
+            else:  # more equations (an idle spin's): the normal equations, exact if consistent
+                Mt = np.swapaxes(M, 1, 2)
+                x = np.linalg.solve(Mt @ M, Mt @ r)
         except np.linalg.LinAlgError:  # a singular sample: the caller solves it again
             x = np.full((N, 6 * C, K), np.nan)
     chord_w = x.reshape(N, C, 6, K)
