@@ -70,7 +70,7 @@ class Pipeline:
                             "a Pipeline: from Python use screwkit.kinematics.graph.motion."
                             "solve_mechanism and screwkit.balancing.graph.balance_mechanism; the "
                             "CLI's validate, analyze, mobility, limits, report, dynamics, sweep, "
-                            "tolerance, balance, simulate and export-mjcf take it; synthesis of "
+                            "tolerance, balance, simulate, export-mjcf and export take it; synthesis of "
                             "graphs is not there yet (docs/mechanisms.md)")
         expect_instance(spec, Spec, "Pipeline: spec", "a Spec (sk.load_spec(path))")
         if method not in ("auto", "closed", "generic"):

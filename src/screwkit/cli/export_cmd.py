@@ -1,6 +1,7 @@
 """``screwkit export SPEC --format dxf|gltf|step -o FILE``: the spec's motion as a CAD exchange
-file — DXF coupler curves, joint paths and link skeletons in the spec's length unit, or the
-animated glTF (GLB) scene; STEP is refused with the reason (docs/exchange.md). Registered on the
+file — DXF coupler curves (a graph's point paths), joint paths and link (body) skeletons in
+the spec's length unit, or the animated glTF (GLB) scene, of a single loop or a mechanism
+graph; STEP is refused with the reason (docs/exchange.md). Registered on the
 main app by ``register(app)``."""
 
 from __future__ import annotations
@@ -28,8 +29,8 @@ def register(app: typer.Typer) -> None:
         """Write the spec's motion for CAD: DXF curves and skeletons, or an animated glTF scene."""
         from rich.markup import escape
 
-        from screwkit.cli.common import check_paths, console, err_console, guard, loop_only
-        from screwkit.exchange.export import check_suffix, export_format
+        from screwkit.cli.common import check_paths, console, err_console, guard
+        from screwkit.exchange.export import check_suffix, export_format, graph_export
         from screwkit.io.outputs import write_bytes_atomic
         from screwkit.io.spec import load_spec
         from screwkit.pipeline import Pipeline
@@ -38,10 +39,14 @@ def register(app: typer.Typer) -> None:
         kind = guard(lambda: export_format(fmt))  # refused before the spec is solved
         guard(lambda: check_suffix(kind, output))
         binary = output.suffix.lower() != ".gltf"  # a .gltf file is JSON, anything else GLB
-        s = loop_only(guard(lambda: load_spec(spec)), "export")
-        pipe = Pipeline(s, method=method)
-        result = guard(lambda: pipe.export(kind, at or (), mode=mode, splines=splines,
-                                           binary=binary, max_points=max_points))
+        s = guard(lambda: load_spec(spec))
+        if getattr(s, "family", None) == "graph":  # bodies and joints: solve_mechanism
+            result = guard(lambda: graph_export(s, kind, at or (), mode=mode, splines=splines,
+                                                binary=binary, max_points=max_points))
+        else:
+            pipe = Pipeline(s, method=method)
+            result = guard(lambda: pipe.export(kind, at or (), mode=mode, splines=splines,
+                                               binary=binary, max_points=max_points))
         guard(lambda: write_bytes_atomic(output, result.data, [spec], "--output"))
         for note in result.notes:
             err_console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)

@@ -1,13 +1,16 @@
 """Curves and the link skeleton to **DXF** (ezdxf, MIT; docs/exchange.md), in the spec's length
 unit with the drawing's ``$INSUNITS`` set to it, so a CAD program scales the drawing on import.
 
-One layer per curve and mode: ``mode<k> <point>`` for the path of each coupler point,
+One layer per curve and mode: ``mode<k> <point>`` for the path of each coupler point (of a
+loop) or ``[[points]]`` point (of a mechanism graph),
 ``mode<k> joint <name>`` for the path of each joint centre that moves, ``mode<k> skeleton at
-<input>`` for the links at an asked input. Curves are 3-D polylines (POLYLINE), or fit-point
+<input>`` for the links or bodies at an asked input. Curves are 3-D polylines (POLYLINE), or fit-point
 splines (SPLINE) with ``splines=True``; a curve is cut where its mode does not assemble, and a
-polyline over a full turn of the input is closed. The skeleton draws each link as the report
-does (:func:`screwkit.report.scene.link_polylines`): from where it leaves its joint, along the
-common normal, to the next joint's centre.
+polyline over a full turn of the input is closed. The skeleton draws each body as the report
+does (:mod:`screwkit.exchange.geometry`): a loop's link from where it leaves its joint, along
+the common normal, to the next joint's centre (:func:`screwkit.report.scene.link_polylines`);
+a graph's body as the polyline through its joints and points
+(:func:`screwkit.report.graph_scene.body_polylines`).
 """
 
 from __future__ import annotations
@@ -19,11 +22,9 @@ from typing import Any
 
 import numpy as np
 
+from screwkit.exchange.geometry import ExportGeometry
 from screwkit.exchange.samples import Array, ExportError, ExportSamples, assembled_runs
 from screwkit.io.units import UnitError, unit_factor
-from screwkit.kinematics.analysis.coupler_curves import CouplerPoint, coupler_point_path
-from screwkit.kinematics.motion import Motion
-from screwkit.report.scene import link_polylines
 
 #: DXF ``$INSUNITS`` codes by the metres in one unit (AutoCAD DXF reference, HEADER section)
 INSUNITS = ((0.0254, 1, "in"), (0.3048, 2, "ft"), (1609.344, 3, "mi"), (0.001, 4, "mm"),
@@ -92,24 +93,22 @@ def _moving(path: Array, scale: float) -> bool:
     return len(finite) > 1 and float(np.ptp(finite, axis=0).max()) > 1e-9 * scale
 
 
-def dxf_text(motion: Motion, samples: ExportSamples, *, points: Sequence[CouplerPoint],
-             modes: Sequence[int], unit: DxfUnit, at_labels: Sequence[str],
-             splines: bool = False, full_turn: bool = False,
+def dxf_text(geometry: ExportGeometry, samples: ExportSamples, *, unit: DxfUnit,
+             at_labels: Sequence[str], splines: bool = False, full_turn: bool = False,
              max_points: int = 5000) -> tuple[str, list[str]]:
-    """The DXF drawing (text, R2013) of ``motion`` and notes for the user.
+    """The DXF drawing (text, R2013) of every mode of ``geometry`` and notes for the user.
 
     ``samples`` says which samples are the sweep's (curves) and where the skeleton is drawn
-    (``samples.at``, labelled ``at_labels`` in the layer names); ``points`` the coupler points;
-    ``modes`` the assembly modes drawn; ``full_turn`` closes the curves of a mode that
-    assembles over a whole turn of the input. A curve over more than ``max_points`` samples
-    (0: no limit) goes through every k-th of them (and the ends of each piece), exact samples
-    all: ezdxf writes a 3-D polyline at about 14,000 vertices a second."""
+    (``samples.at``, labelled ``at_labels`` in the layer names); ``full_turn`` closes the
+    curves of a mode that assembles over a whole turn of the input. A curve over more than
+    ``max_points`` samples (0: no limit) goes through every k-th of them (and the ends of each
+    piece), exact samples all: ezdxf writes a 3-D polyline at about 14,000 vertices a
+    second."""
     import ezdxf
 
     doc = ezdxf.new("R2013", units=unit.code)
     doc.header["$MEASUREMENT"] = 0 if unit.code in (1, 2, 3, 8, 9, 10) else 1
     msp = doc.modelspace()
-    lk = motion.linkage
     notes: list[str] = []
     colour = 1
     n = len(samples.sweep)
@@ -126,20 +125,19 @@ def dxf_text(motion: Motion, samples: ExportSamples, *, points: Sequence[Coupler
             colour = colour % 254 + 1
         return name
 
-    for k in modes:
-        md = motion.mode(k)
-        scale = float(np.nanmax(np.abs(md.joint_centres))) if md.assembles.any() else 1.0
-        sweep = samples.sweep
-        for cp in points:
-            path = coupler_point_path(md, cp.point, cp.link)[sweep] / unit.metres
-            _add_curve(msp, path, layer(f"mode{k} {cp.name}"), splines=splines,
-                       closed=full_turn, stride=stride)
-        for j, joint in enumerate(lk.joints):
-            path = np.asarray(md.joint_centres[sweep, j]) / unit.metres
+    sweep = samples.sweep
+    for md in geometry.modes:
+        k = md.index
+        scale = md.scale() if md.assembles.any() else 1.0
+        for point, path in md.points.items():
+            _add_curve(msp, path[sweep] / unit.metres, layer(f"mode{k} {point}"),
+                       splines=splines, closed=full_turn, stride=stride)
+        for joint, path in md.joints.items():
+            path = path[sweep] / unit.metres
             if _moving(path, scale / unit.metres):
-                _add_curve(msp, path, layer(f"mode{k} joint {joint.name}"), splines=splines,
+                _add_curve(msp, path, layer(f"mode{k} joint {joint}"), splines=splines,
                            closed=full_turn, stride=stride)
-        skeleton = link_polylines(lk, md) / unit.metres
+        skeleton = md.skeleton / unit.metres
         tiny = 1e-12 * scale / unit.metres
         for i, label in zip(samples.at, at_labels, strict=True):
             if not md.assembles[i]:
@@ -147,11 +145,16 @@ def dxf_text(motion: Motion, samples: ExportSamples, *, points: Sequence[Coupler
                 continue
             name = layer(f"mode{k} skeleton at {label}")
             for poly in skeleton[i]:
-                keep = [0] + [m for m in (1, 2)
-                              if np.linalg.norm(poly[m] - poly[m - 1]) > tiny]
-                keep = keep if len(keep) > 1 else [0, 2]
-                msp.add_polyline3d([tuple(map(float, p)) for p in poly[keep]],
+                msp.add_polyline3d([tuple(map(float, p)) for p in poly[_kept(poly, tiny)]],
                                    dxfattribs={"layer": name})
     stream = io.StringIO()
     doc.write(stream)
     return stream.getvalue(), notes
+
+
+def _kept(poly: Array, tiny: float) -> list[int]:
+    """The vertices of a polyline that are not within ``tiny`` of the one before (padding and
+    zero-length segments dropped), at least its two ends."""
+    keep = [0] + [m for m in range(1, len(poly))
+                  if np.linalg.norm(poly[m] - poly[m - 1]) > tiny]
+    return keep if len(keep) > 1 else [0, len(poly) - 1]

@@ -2,12 +2,13 @@
 the spec's sweep, for Blender, three.js and CAD viewers.
 
 Layout: one root node turns screwkit's z-up world into glTF's y-up (a −90° turn about x, as
-Blender's exporter does); under it one node per link (moving links, then ``ground``) whose
-translation and rotation are the link's body frame (``ModeMotion.link_origin``,
-``link_rotation``; the ground stays in the world frame) and one node per coupler point holding
-its path as line strips. Each link's mesh is what the report draws of it
-(:func:`screwkit.report.scene.link_polylines`): cylinders along its polyline and a sphere at the
-centre of the joint it leads to, in the link's own frame. One animation ("mode k") has a
+Blender's exporter does); under it one node per link or body (moving ones, then ``ground``)
+whose translation and rotation are its body frame (``ModeMotion.link_origin``,
+``link_rotation``; the ground stays in the world frame) and one node per coupler point (a
+graph's ``[[points]]`` point) holding its path as line strips. Each body's mesh is what the
+report draws of it (:mod:`screwkit.exchange.geometry`): cylinders along its polyline and a
+sphere at its last vertex (a loop's link: the centre of the joint it leads to), in its own
+frame. One animation ("mode k") has a
 translation and a rotation channel per moving link at the samples where the mode assembles;
 keyframe times follow the spec's input speed (t = (x − x₀)/ẋ), or 24 frames per second when the
 speed is zero. Lengths are metres (the glTF unit); geometry is float32.
@@ -16,16 +17,13 @@ speed is zero. Lengths are metres (the glTF unit); geometry is float32.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.exchange.geometry import ExportGeometry, ModeGeometry
 from screwkit.exchange.samples import Array, ExportError, assembled_runs
-from screwkit.kinematics.analysis.coupler_curves import CouplerPoint, coupler_point_path
-from screwkit.kinematics.motion import ModeMotion, Motion
-from screwkit.report.scene import link_polylines
 
 #: z-up (screwkit) to y-up (glTF): −90° about x, as (x, y, z, w)
 Z_UP_TO_Y_UP = (-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))
@@ -72,7 +70,7 @@ def sphere(centre: Array, radius: float, rings: int = 8, sectors: int = 12
 
 
 def link_mesh(local: Array, radius: float) -> tuple[Array, NDArray[np.uint32]]:
-    """One link's mesh from its polyline ``local`` (3, 3) in its own frame: a cylinder per
+    """One body's mesh from its polyline ``local`` (P, 3) in its own frame: a cylinder per
     segment longer than round-off, a sphere at the end (the next joint's centre)."""
     parts = [sphere(local[-1], 2 * radius)]
     for a, b in zip(local[:-1], local[1:], strict=True):
@@ -135,35 +133,31 @@ def keyframe_times(x: Array, speed: float) -> Array:
     return np.arange(len(x)) / 24.0
 
 
-def _link_poses(linkage: Any, md: ModeMotion, frames: NDArray[np.intp]
-                ) -> tuple[Array, Array, Array]:
-    """Per link (moving, then ground): rotations (L+1, K, 3, 3), origins (L+1, K, 3) at the
-    keyframes, and its polyline (L+1, 3, 3) in its own frame (ground: the world)."""
-    pts = link_polylines(linkage, md)[frames]  # (K, n, 3, 3)
-    R = np.asarray(md.link_rotation)[frames]
-    o = np.asarray(md.link_origin)[frames]
-    eye = np.broadcast_to(np.eye(3), (len(frames), 1, 3, 3))
-    R_all = np.concatenate([R, eye], axis=1).transpose(1, 0, 2, 3)
-    o_all = np.concatenate([o, np.zeros((len(frames), 1, 3))], axis=1).transpose(1, 0, 2)
+def _body_poses(md: ModeGeometry, frames: NDArray[np.intp]) -> tuple[Array, Array, Array]:
+    """Per body (moving, then ground): rotations (B+1, K, 3, 3), origins (B+1, K, 3) at the
+    keyframes, and its polyline (B+1, P, 3) in its own frame (ground: the world)."""
+    pts = md.skeleton[frames]  # (K, B+1, P, 3)
+    R_all = md.rotations[frames].transpose(1, 0, 2, 3)
+    o_all = md.origins[frames].transpose(1, 0, 2)
     local = np.einsum("lji,lpj->lpi", R_all[:, 0], pts[0] - o_all[:, 0, None, :])
     return R_all, o_all, local
 
 
-def gltf_bytes(motion: Motion, mode: int, sweep: NDArray[np.intp], *, name: str,
-               points: Sequence[CouplerPoint], speed: float, binary: bool = True) -> bytes:
-    """The glTF file (module docstring) of assembly mode ``mode`` of ``motion`` over the samples
-    ``sweep``; ``speed`` is the input's rate (rad/s or m/s) that sets the keyframe times.
-    ``binary``: GLB; else glTF JSON with the buffer embedded as a data URI."""
+def gltf_bytes(geometry: ExportGeometry, sweep: NDArray[np.intp], *, name: str,
+               speed: float, binary: bool = True) -> bytes:
+    """The glTF file (module docstring) of the first mode of ``geometry`` over the samples
+    ``sweep``; ``speed`` is the first input's rate (rad/s or m/s) that sets the keyframe
+    times. ``binary``: GLB; else glTF JSON with the buffer embedded as a data URI."""
     import pygltflib as g
 
-    md = motion.mode(mode)
-    frames = np.asarray(sweep)[np.asarray(md.assembles)[sweep]]
+    md = geometry.modes[0]
+    mode = md.index
+    frames = np.asarray(sweep)[md.assembles[sweep]]
     if len(frames) == 0:
         raise ExportError(f"assembly mode {mode} does not assemble anywhere on the sweep; "
                           "choose another mode (--mode)")
-    lk = motion.linkage
-    R_all, o_all, local = _link_poses(lk, md, frames)
-    centres = np.asarray(md.joint_centres)[frames]
+    R_all, o_all, local = _body_poses(md, frames)
+    centres = np.stack(list(md.joints.values()), axis=1)[frames]
     size = float(np.linalg.norm(np.ptp(centres.reshape(-1, 3), axis=0))) or 1.0
     radius = 0.012 * size
     gltf = g.GLTF2(asset=g.Asset(generator="screwkit"), scene=0)
@@ -172,7 +166,7 @@ def gltf_bytes(motion: Motion, mode: int, sweep: NDArray[np.intp], *, name: str,
         baseColorFactor=c, metallicFactor=0.2, roughnessFactor=0.6))
         for n, c in (("link", [0.23, 0.45, 0.75, 1.0]), ("ground", [0.35, 0.35, 0.35, 1.0]),
                      ("path", [0.85, 0.3, 0.1, 1.0]))]
-    names = [link.name for link in lk.links] + ["ground"]
+    names = list(md.bodies)
     children = []
     for li, link_name in enumerate(names):
         verts, tris = link_mesh(local[li], radius)
@@ -185,18 +179,18 @@ def gltf_bytes(motion: Motion, mode: int, sweep: NDArray[np.intp], *, name: str,
         gltf.nodes.append(g.Node(name=link_name, mesh=len(gltf.meshes) - 1,
                                  translation=o_all[li, 0].tolist(), rotation=q.tolist()))
         children.append(len(gltf.nodes) - 1)
-    runs = assembled_runs(np.asarray(md.assembles)[sweep])
-    for cp in points:
-        path = coupler_point_path(md, cp.point, cp.link)[sweep]
+    runs = assembled_runs(md.assembles[sweep])
+    for point, whole in md.points.items():
+        path = whole[sweep]
         strips = [g.Primitive(attributes=g.Attributes(
             POSITION=buf.add(path[a:b], "VEC3", ARRAY_BUFFER, bounds=True)),
             mode=g.LINE_STRIP, material=2) for a, b in runs if b - a > 1]
         if not strips:
             continue
-        gltf.meshes.append(g.Mesh(name=cp.name, primitives=strips))
-        gltf.nodes.append(g.Node(name=f"path {cp.name}", mesh=len(gltf.meshes) - 1))
+        gltf.meshes.append(g.Mesh(name=point, primitives=strips))
+        gltf.nodes.append(g.Node(name=f"path {point}", mesh=len(gltf.meshes) - 1))
         children.append(len(gltf.nodes) - 1)
-    x = np.asarray(motion.input_values)[frames]
+    x = geometry.inputs[frames]
     times = buf.add(keyframe_times(x, speed), "SCALAR", bounds=True)
     samplers, channels = [], []
     for li in range(len(names) - 1):
@@ -208,7 +202,7 @@ def gltf_bytes(motion: Motion, mode: int, sweep: NDArray[np.intp], *, name: str,
             channels.append(g.AnimationChannel(sampler=len(samplers) - 1, target=g.AnimationChannelTarget(
                 node=children[li], path=target)))
     gltf.animations = [g.Animation(name=f"mode {mode}", samplers=samplers, channels=channels,
-                                   extras={"input_name": lk.inputs[0],
+                                   extras={"input_name": geometry.input_name,
                                            "inputs": x.tolist()})]
     gltf.nodes.append(g.Node(name=name, rotation=list(Z_UP_TO_Y_UP), children=children))
     gltf.scenes = [g.Scene(name=name, nodes=[len(gltf.nodes) - 1])]
