@@ -166,3 +166,25 @@ def test_units_and_refusals(tmp_path):
     with pytest.raises(ExportError, match="STEP has no unit for the spec's length unit 'yd'"):
         step_unit("yd")
     assert export_format("STEP") == "step"
+
+
+def test_missing_kernel_names_the_extra(monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "OCP" else real(name, *a))
+    with pytest.raises(ExportError, match=r"^STEP export needs cadquery-ocp-novtk: "
+                                          r"pip install 'screwkit\[step\]'$"):
+        export_format("step")
+
+
+def test_a_mode_that_does_not_assemble_at_the_input_is_refused():
+    from screwkit.exchange.step import step_export
+
+    spec = sk.load_spec(FIG7)
+    motion = sk.solve_motion(spec.linkage, np.radians([0.0, 10.0]), rates=1.0)
+    md = motion.mode(0)
+    md.assembles[1] = False  # as if the mode stopped assembling at the second input
+    with pytest.raises(ExportError, match="assembly mode 0 does not assemble at 10 deg"):
+        step_export(motion, 0, [1], ["10 deg"], spec_unit="in")
