@@ -102,7 +102,8 @@ def _has_end(cylinders: list[dict], p: np.ndarray, tol: float) -> bool:
 
 
 def _check_pose(parts: dict, spec: sk.Spec, md, sample: int, suffix: str = "") -> None:
-    """Each link's part ends (a cylinder's flat end) at the next joint's centre and carries its
+    """Each link's part ends (a cylinder's flat end) at the next joint's centre (a link whose
+    next joint is at its own joint's centre, the CSSP's slider, has no cylinder) and carries its
     joint's solid (a sphere for S, else a cylinder along the joint's axis) at its centre; radii
     are r and 2r, volumes πr²L and 4/3·πR³."""
     lk = spec.linkage
@@ -122,7 +123,11 @@ def _check_pose(parts: dict, spec: sk.Spec, md, sample: int, suffix: str = "") -
             else:
                 assert abs(s["volume"] - 4 / 3 * math.pi * s["radius"] ** 3) < 1e-9 * s["volume"]
         links = [s for s in _cylinders(solids) if abs(s["radius"] - r) < tol]
-        assert _has_end(links, centres[(k + 1) % len(names)], tol)  # reaches the next joint
+        after = centres[(k + 1) % len(names)]
+        if np.linalg.norm(after - centres[k]) > tol:  # a link with a length has cylinders
+            assert links
+        if links:  # ... and reaches the next joint's centre
+            assert _has_end(links, after, tol)
         joint = [s for s in solids if abs(s["radius"] - 2 * r) < tol]
         assert len(joint) == 1
         (j,) = joint
@@ -188,3 +193,25 @@ def test_a_mode_that_does_not_assemble_at_the_input_is_refused():
     md.assembles[1] = False  # as if the mode stopped assembling at the second input
     with pytest.raises(ExportError, match="assembly mode 0 does not assemble at 10 deg"):
         step_export(motion, 0, [1], ["10 deg"], spec_unit="in")
+
+
+@pytest.mark.parametrize("name", ["rahman_cssp.toml", "rccc_loop.toml"])
+def test_prismatic_and_cylindric_joints(tmp_path, name):
+    """A P joint (the CSSP's slider) and C joints (the RCCC) get their cylinders along their
+    axes, at the spec mode's first input."""
+    spec_path = EXAMPLES / name
+    out = _export(tmp_path, spec_path)
+    spec = sk.load_spec(spec_path)
+    motion = sk.solve_motion(spec.linkage, spec.inputs, rates=spec.speed)
+    _check_pose(_read(out), spec, motion.mode(spec.mode), 0)
+
+
+def test_a_spec_in_metres(tmp_path):
+    text = FIG7.read_text(encoding="utf-8").replace('length = "in"', 'length = "m"')
+    spec_path = tmp_path / "fig7_m.toml"
+    spec_path.write_text(text, encoding="utf-8")
+    out = _export(tmp_path, spec_path, "--at", "90")
+    assert "SI_UNIT($,.METRE.)" in out.read_text()
+    spec = sk.load_spec(spec_path)
+    motion = sk.solve_motion(spec.linkage, spec.inputs, rates=spec.speed)
+    _check_pose(_read(out), spec, motion.mode(spec.mode), 9)
