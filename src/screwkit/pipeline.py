@@ -252,9 +252,10 @@ class Pipeline:
     def export(self, fmt: str, at: Sequence[str] = (), *, mode: int | None = None,
                splines: bool = False, binary: bool = True, max_points: int = 5000) -> Any:
         """A CAD exchange file of the spec (:mod:`screwkit.exchange`, docs/exchange.md): DXF
-        curves and the skeleton at the ``at`` inputs (text in the spec's unit of the input), or
-        the animated glTF scene of ``mode`` (GLB, or glTF JSON if not ``binary``). Inputs off the sweep are solved with it, in one
-        solve; otherwise the pipeline's motion is used."""
+        curves and the skeleton at the ``at`` inputs (text in the spec's unit of the input),
+        the animated glTF scene of ``mode`` (GLB, or glTF JSON if not ``binary``), or STEP link
+        solids of ``mode`` at the ``at`` inputs (the ``[step]`` extra). Inputs off the sweep
+        are solved with it, in one solve; otherwise the pipeline's motion is used."""
         from screwkit.exchange.export import export_format, export_motion, samples_for
 
         kind = export_format(fmt)

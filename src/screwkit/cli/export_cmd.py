@@ -1,7 +1,8 @@
 """``screwkit export SPEC --format dxf|gltf|step -o FILE``: the spec's motion as a CAD exchange
 file — DXF coupler curves (a graph's point paths), joint paths and link (body) skeletons in
 the spec's length unit, or the animated glTF (GLB) scene, of a single loop or a mechanism
-graph; STEP is refused with the reason (docs/exchange.md). Registered on the
+graph, or STEP link solids of a single loop at chosen inputs (the ``[step]`` extra;
+docs/exchange.md). Registered on the
 main app by ``register(app)``."""
 
 from __future__ import annotations
@@ -18,15 +19,15 @@ def register(app: typer.Typer) -> None:
     @app.command("export")
     def export(
         spec: Annotated[Path, typer.Argument(help="Spec file (TOML).")],
-        fmt: Annotated[str, typer.Option("--format", "-f", help="dxf (coupler curves, joint paths and link skeletons as 3-D polylines, in the spec's length unit), gltf (the animated scene, metres: glTF JSON for an -o name ending in .gltf, binary GLB otherwise) or step (not available; says why).")],
-        output: Annotated[Path, typer.Option("--output", "-o", help="The file to write (atomically): .dxf for DXF, .glb or .gltf for glTF.")],
-        at: Annotated[list[str] | None, typer.Option("--at", help="DXF: draw the link skeleton at this input, in the spec's unit of the input (or with a unit: '45 deg'); repeatable; default the sweep's first input. Inputs between samples are solved with the sweep.")] = None,
-        mode: Annotated[int | None, typer.Option("--mode", help="Assembly mode: DXF draws every mode unless this is given; glTF animates this one (default: the spec's [motion] mode).", min=0)] = None,
+        fmt: Annotated[str, typer.Option("--format", "-f", help="dxf (coupler curves, joint paths and link skeletons as 3-D polylines, in the spec's length unit), gltf (the animated scene, metres: glTF JSON for an -o name ending in .gltf, binary GLB otherwise) or step (link solids at the --at inputs, in the spec's length unit; needs the [step] extra).")],
+        output: Annotated[Path, typer.Option("--output", "-o", help="The file to write (atomically): .dxf for DXF, .glb or .gltf for glTF, .step or .stp for STEP.")],
+        at: Annotated[list[str] | None, typer.Option("--at", help="DXF and STEP: draw the links at this input, in the spec's unit of the input (or with a unit: '45 deg'); repeatable; default the sweep's first input. Inputs between samples are solved with the sweep.")] = None,
+        mode: Annotated[int | None, typer.Option("--mode", help="Assembly mode: DXF draws every mode unless this is given; glTF and STEP show this one (default: the spec's [motion] mode).", min=0)] = None,
         splines: Annotated[bool, typer.Option("--splines", help="DXF: curves as fit-point splines instead of polylines.")] = False,
         max_points: Annotated[int, typer.Option("--max-points", help="DXF: a curve over more samples goes through every k-th of them (exact samples, about 14,000 vertices a second to write); 0 draws every sample.", min=0)] = 5000,
         method: Annotated[str, typer.Option("--method", help="auto, closed or generic (as for analyze).")] = "auto",
     ) -> None:
-        """Write the spec's motion for CAD: DXF curves and skeletons, or an animated glTF scene."""
+        """Write the spec's motion for CAD: DXF curves and skeletons, an animated glTF scene, or STEP link solids."""
         from rich.markup import escape
 
         from screwkit.cli.common import check_paths, console, err_console, guard

@@ -1,8 +1,8 @@
 """``screwkit export``'s computation: a solved motion of a spec (a single loop or a mechanism
 graph, through :mod:`screwkit.exchange.geometry`) to a CAD exchange file — DXF
 curves and skeleton (:mod:`screwkit.exchange.dxf`) or an animated glTF scene
-(:mod:`screwkit.exchange.gltf`); docs/exchange.md. STEP is refused with the reason
-(:data:`STEP_UNAVAILABLE`)."""
+(:mod:`screwkit.exchange.gltf`) or STEP link solids of a single loop at chosen inputs
+(:mod:`screwkit.exchange.step`, the ``[step]`` extra); docs/exchange.md."""
 
 from __future__ import annotations
 
@@ -18,12 +18,6 @@ from screwkit.io.units import UnitError, to_si, unit_factor
 from screwkit.kinematics.motion import Motion
 
 FORMATS = ("dxf", "gltf", "step")
-#: why ``--format step`` is refused (docs/exchange.md, "STEP")
-STEP_UNAVAILABLE = (
-    "STEP export is not available: writing STEP solids needs the OpenCASCADE kernel "
-    "(cadquery-ocp, a 67 MB download that installs to about 400 MB), which screwkit does not "
-    "ship; export --format gltf (link solids, animated) or --format dxf (curves and skeleton) "
-    "and convert in a CAD program")
 
 
 @dataclass(frozen=True)
@@ -35,30 +29,32 @@ class Export:
     notes: list[str] = field(default_factory=list)
 
 
-#: the library each format is written with (the ``[cad]`` extra)
-LIBRARIES = {"dxf": "ezdxf", "gltf": "pygltflib"}
+#: the module each format is written with and the extra that installs it
+LIBRARIES = {"dxf": ("ezdxf", "cad"), "gltf": ("pygltflib", "cad"),
+             "step": ("OCP", "step")}
+#: the package a user installs for each module
+PACKAGES = {"ezdxf": "ezdxf", "pygltflib": "pygltflib", "OCP": "cadquery-ocp-novtk"}
 
 
 def export_format(name: str) -> str:
     """The format ``name`` (``dxf``, ``gltf`` or its binary form's name ``glb``, ``step``)
-    checked before any work: an unknown one, STEP, or one whose library is not installed is an
-    :class:`ExportError`."""
+    checked before any work: an unknown one, or one whose library is not installed (naming the
+    extra that installs it) is an :class:`ExportError`."""
     import importlib.util
 
     fmt = str(name).strip().lower()
     fmt = "gltf" if fmt == "glb" else fmt
-    if fmt == "step":
-        raise ExportError(STEP_UNAVAILABLE)
     if fmt not in LIBRARIES:
-        raise ExportError(f"--format {name!r} is not an export format; choose dxf or gltf")
-    if importlib.util.find_spec(LIBRARIES[fmt]) is None:
-        raise ExportError(f"{fmt.upper()} export needs {LIBRARIES[fmt]}: "
-                          "pip install 'screwkit[cad]'")
+        raise ExportError(f"--format {name!r} is not an export format; choose dxf, gltf or step")
+    module, extra = LIBRARIES[fmt]
+    if importlib.util.find_spec(module) is None:
+        raise ExportError(f"{fmt.upper()} export needs {PACKAGES[module]}: "
+                          f"pip install 'screwkit[{extra}]'")
     return fmt
 
 
 #: the file name endings of each format
-SUFFIXES = {"dxf": (".dxf",), "gltf": (".glb", ".gltf")}
+SUFFIXES = {"dxf": (".dxf",), "gltf": (".glb", ".gltf"), "step": (".step", ".stp")}
 
 
 def check_suffix(fmt: str, path: Any) -> None:
@@ -110,6 +106,13 @@ def export_motion(spec: Any, motion: Motion, samples: ExportSamples, fmt: str, *
     (:func:`screwkit.exchange.dxf.dxf_text`)."""
     from screwkit.exchange.geometry import loop_geometry
 
+    if fmt == "step":  # link solids (exchange/step.py), of one mode at the --at inputs
+        from screwkit.exchange.step import step_export
+
+        k = spec.mode if mode is None else mode
+        data, notes = step_export(motion, motion.mode(k).index, list(samples.at), at_labels,
+                                  spec_unit=spec.units.get("length"))
+        return Export(data, fmt, notes)
     points = list(getattr(spec, "coupler_points", []))
     modes = _modes(spec, motion, fmt, mode)
     return write_geometry(spec, loop_geometry(motion, modes, points), samples, fmt,
@@ -162,7 +165,7 @@ def write_geometry(spec: Any, geometry: Any, samples: ExportSamples, fmt: str, *
         data = gltf_bytes(geometry, samples.sweep, name=str(spec.name), speed=speed,
                           binary=binary)
         return Export(data, fmt)
-    raise ExportError(f"--format {fmt!r} is not an export format; choose dxf or gltf")
+    raise ExportError(f"--format {fmt!r} is not an export format; choose dxf, gltf or step")
 
 
 def input_is_angle(spec: Any) -> bool:
@@ -182,6 +185,9 @@ def graph_export(spec: Any, fmt: str, at: Sequence[str] = (), *, mode: int | Non
     from screwkit.kinematics.graph import solve_mechanism
 
     kind = export_format(fmt)
+    if kind == "step":
+        raise ExportError(f"{spec.name}: STEP export takes single loops only so far; export a "
+                          "mechanism graph as --format gltf (animated bodies) or dxf")
     inputs = np.asarray(spec.inputs, dtype=float)
     steps = np.diff(inputs[:, 0])
     if at and (inputs.shape[1] != 1 or not (np.all(steps > 0) or np.all(steps < 0))):
