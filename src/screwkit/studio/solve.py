@@ -280,6 +280,11 @@ def assembling_values(design: Any, values: dict[str, float], mode: int, name: st
         try:
             spec = design.spec_with({**values, name: float(v)}, mode)
             every = max(1, len(spec.inputs) // SCAN_INPUTS)
+            if design.graph:
+                from screwkit.studio.graph import graph_closes
+
+                ok[k] = graph_closes(spec, every)
+                continue
             mot = solve_motion(spec.linkage, spec.inputs[::every], rates=spec.speed)
             ok[k] = any(np.asarray(md.assembles).any() for md in mot.modes)
         except (ScrewkitError, FloatingPointError, np.linalg.LinAlgError):
