@@ -23,10 +23,11 @@ from typing import Any
 import numpy as np
 
 from screwkit.errors import ScrewkitError
+from screwkit.studio.solve import json_series
 from screwkit.sweep.keys import SpecKey, spec_key
 
 #: a hardpoint slider spans ± this fraction of the diagonal of the hardpoints' bounding box
-HARDPOINT_HALF_RANGE = 0.1
+HARDPOINT_HALF_RANGE = 0.2
 
 
 def graph_keys(data: dict[str, Any], spec: Any) -> list[SpecKey]:
@@ -45,7 +46,7 @@ def graph_keys(data: dict[str, Any], spec: Any) -> list[SpecKey]:
 
 def graph_ranges(spec: Any, keys: list[SpecKey], values: list[float]
                  ) -> list[tuple[float, float]]:
-    """A hardpoint coordinate ± a tenth of the hardpoints' bounding-box diagonal; a mass from
+    """A hardpoint coordinate ± a fifth of the hardpoints' bounding-box diagonal; a mass from
     a tenth of its value to twice it."""
     from screwkit.io.units import to_si
 
@@ -102,12 +103,6 @@ class GraphRun:
             return None, str(exc)
 
 
-def _series(values: Any) -> list[float | None]:
-    from screwkit.studio.solve import _series as series
-
-    return series(values)
-
-
 def _outputs(run: GraphRun) -> list[tuple[str, str]]:
     """(name, kind) of what the page plots against the input: the named outputs, else the
     scalar joint freedoms that are not inputs (at most six)."""
@@ -131,13 +126,13 @@ def _paths(run: GraphRun, factor: float) -> dict[str, Any]:
     names = [j.name for j in run.spec.mechanism.joints]
     for md in run.motion.modes:
         if md.points:
-            out.append({n: [_series(np.asarray(p)[:, j] / factor) for j in range(3)]
+            out.append({n: [json_series(np.asarray(p)[:, j] / factor) for j in range(3)]
                         for n, p in md.points.items()})
             continue
         c = np.asarray(md.joint_centres, dtype=float)
         moving = [k for k in range(c.shape[1])
                   if np.nanmax(np.nanstd(c[:, k, :], axis=0), initial=0.0) > 1e-12]
-        out.append({names[k]: [_series(c[:, k, j] / factor) for j in range(3)] for k in moving})
+        out.append({names[k]: [json_series(c[:, k, j] / factor) for j in range(3)] for k in moving})
     return {"title": "point paths" if run.spec.mechanism.points else "joint-centre paths",
             "modes": out}
 
@@ -159,7 +154,7 @@ def _loads(dyn: Any, mode: int, units: Any) -> dict[str, Any]:
     curves, summary = {}, []
     for label, (k, v) in raw.items():
         shown = np.asarray(units.show(k, np.asarray(v, dtype=float)), dtype=float)
-        curves[label] = _series(shown)
+        curves[label] = json_series(shown)
         a = np.abs(shown[np.isfinite(shown)])
         summary.append([label, float(a.max()) if a.size else None,
                         float(np.sqrt(np.mean(a ** 2))) if a.size else None])
@@ -176,7 +171,7 @@ def solve_graph(run: GraphRun, *, numbers: bool = True, scene: bool = True) -> d
     outputs = _outputs(run)
     modes = [{"index": int(md.index), "label": _label(md),
               "assembles": [bool(v) for v in np.asarray(md.assembles)],
-              "outputs": {f"{n} [{units.label(k)}]": _series(units.show(
+              "outputs": {f"{n} [{units.label(k)}]": json_series(units.show(
                   k, np.asarray(_values(md, n), dtype=float))) for n, k in outputs}}
              for md in motion.modes]
     dyn, loads_note = run.dynamics()
@@ -184,7 +179,7 @@ def solve_graph(run: GraphRun, *, numbers: bool = True, scene: bool = True) -> d
     return {
         "ok": True, "method": motion.method, "mode": mode,
         "input": {"name": motion.input_names[0], "unit": units.label(x_kind),
-                  "values": _series(x_shown)},
+                  "values": json_series(x_shown)},
         "modes": modes, "paths": _paths(run, units.unit_of("length")[1]),
         "length_unit": units.label("length"),
         "transmission": None,

@@ -114,7 +114,7 @@ class Tab:
     def __post_init__(self) -> None:
         d = self.design
         self.state = DesignState(tuple(d.initial_values.items()), d.initial_mode)
-        self._solved: tuple[DesignState, Pipeline] | None = None
+        self._solved: tuple[DesignState, Any] | None = None
 
     def set(self, values: dict[str, float], mode: int | None) -> None:
         merged = {**self.state.as_dict, **values}
