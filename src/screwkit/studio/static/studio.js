@@ -1,7 +1,8 @@
 // screwkit studio page (docs/studio.md): dimension sliders and number boxes, the input slider
 // with play/pause, the mode picker, SVG plots, the numbers table; every change goes to the
 // server over the WebSocket and the answer is redrawn. The 3-D view is the report's viewer in
-// an iframe, reloaded with each new scene. window.studio exposes the state for tests.
+// an iframe; each new scene of the same mechanism is handed to it and drawn in place.
+// window.studio exposes the state for tests.
 'use strict';
 (function () {
   const boot = JSON.parse(document.getElementById('studio-boot').textContent);
@@ -287,9 +288,25 @@
   }
 
   // ---- the 3-D view (the report's viewer in an iframe) ---------------------------------
-  // the new scene loads in a second iframe on top of the shown one (transparent until its
-  // viewer is up), which then takes the id 'view': the picture never goes blank
+  // a scene of the same mechanism goes to the shown viewer, which replaces its frames in place
+  // (screwkitViewer.update); another one (the first, or a new topology) loads in a second
+  // iframe on top of the shown one (transparent until its viewer is up), which then takes the
+  // id 'view': the picture never goes blank
   function loadView(scene, t0) {
+    const shown = $('view');
+    const viewer = shown && !document.getElementById('view-next') && shown.contentWindow.screwkitViewer;
+    if (viewer && viewer.update && viewer.update(scene)) {
+      viewer.pause();
+      S.viewReady = true;
+      setFrame(S.frame);
+      viewer.renderNow();
+      S.viewUpdates = (S.viewUpdates || 0) + 1;
+      requestAnimationFrame(() => { // the frame that shows the new view (the curves are drawn)
+        S.viewLatencies.push(performance.now() - t0);
+        document.body.dataset.view = String(S.viewLatencies.length);
+      });
+      return;
+    }
     const old = document.getElementById('view-next');
     if (old) old.remove();
     const frame = el('iframe', { id: 'view-next', title: '3-D view', class: 'loading' });
