@@ -215,7 +215,8 @@ def _text(mech: Mechanism, motion: Any, modes: list[dict[str, Any]], units: dict
 def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str | None = None,
                          topology: list[str] | None = None,
                          loads: tuple[dict[str, Any], dict[str, Any]] | None = None,
-                         balance_doc: dict[str, Any] | None = None) -> dict[str, Any]:
+                         balance_doc: dict[str, Any] | None = None, packed: bool = False
+                         ) -> dict[str, Any]:
     """The scene of a solved mechanism (``solve_mechanism``): ``spec_or_mechanism`` is a graph
     spec (``load_spec``; gives the name, source, units and topology) or a bare
     :class:`~screwkit.model.mechanism.Mechanism`. ``topology``: the summary lines (default:
@@ -276,6 +277,10 @@ def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str 
         "plot_groups": groups,
         "text": _text(mech, motion, entries, units, kind, spec_text, topology),
     }
+    if packed:  # the large arrays straight to base64 (report/viewer.py), not through lists
+        from screwkit.report.viewer import pack_scene
+
+        scene = pack_scene(scene)
     out: dict[str, Any] = jsonable(scene)
     return out
 

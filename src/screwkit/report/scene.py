@@ -205,6 +205,7 @@ def scene_from_motion(
     notes: list[str] | None = None,
     linkage: Any = None,
     initial_mode: int | None = None,
+    packed: bool = False,
 ) -> dict[str, Any]:
     """Build the scene (module docstring) of a solved motion.
 
@@ -217,6 +218,8 @@ def scene_from_motion(
     accelerations) under the seed's names, plotted instead of the joint variables.
     ``linkage``: the loop the motion is of, when it is not the spec's (the synthesised one);
     ``initial_mode``: the mode shown first (default: the mode with dynamics, else 0).
+    ``packed``: the scene as the page gets it (:func:`~screwkit.report.viewer.pack_scene`: the
+    large arrays as base64 floats), packed from the arrays without the lists between.
     """
     spec_linkage = getattr(spec_or_linkage, "linkage", spec_or_linkage)
     spec = spec_or_linkage if spec_or_linkage is not spec_linkage else None
@@ -285,5 +288,9 @@ def scene_from_motion(
                               dynamics_mode=dyn_mode, balance_doc=balance_doc,
                               synthesis_doc=synthesis_doc),
     }
+    if packed:  # the large arrays straight to base64 (report/viewer.py), not through lists
+        from screwkit.report.viewer import pack_scene
+
+        scene = pack_scene(scene)
     out: dict[str, Any] = jsonable(scene)
     return out

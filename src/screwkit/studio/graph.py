@@ -250,7 +250,6 @@ def graph_scene(run: GraphRun, dyn: Any = None) -> dict[str, Any]:
     """The graph report's scene (:mod:`screwkit.report.graph_scene`) of every mode, with the
     load arrows of the shown mode, packed for the page's 3-D view (its plots left out)."""
     from screwkit.report.graph_scene import scene_from_mechanism
-    from screwkit.report.viewer import pack_scene
 
     loads = None
     if dyn is not None:
@@ -258,9 +257,8 @@ def graph_scene(run: GraphRun, dyn: Any = None) -> dict[str, Any]:
 
         doc = graph_dynamics_document(dyn)
         loads = (doc, graph_load_arrows(run.motion, run.shown_mode, doc))
-    scene = scene_from_mechanism(run.spec, run.motion, loads=loads)
-    scene["initial_mode"] = run.shown_mode
-    packed = pack_scene(scene)
+    packed = scene_from_mechanism(run.spec, run.motion, loads=loads, packed=True)
+    packed["initial_mode"] = run.shown_mode
     packed["plots"], packed["plot_groups"] = [], []
     return packed
 

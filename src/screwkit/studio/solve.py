@@ -24,7 +24,9 @@ from screwkit.pipeline import Pipeline
 def json_series(values: Any) -> list[float | None]:
     """An array as a JSON list, ``None`` where a value is missing (NaN or infinite)."""
     a = np.asarray(values, dtype=float).ravel()
-    return [float(v) if np.isfinite(v) else None for v in a]
+    out = a.astype(object)  # one vectorised step, not a Python test per sample
+    out[~np.isfinite(a)] = None
+    return list(out.tolist())
 
 
 def _floats(values: Any, width: int | None = None) -> np.ndarray:
@@ -188,11 +190,13 @@ def numbers_table(pipe: Pipeline) -> list[list[str]]:
     return rows
 
 
-def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None) -> dict[str, Any]:
+def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None, *, packed: bool = False
+                 ) -> dict[str, Any]:
     """The report's scene (:func:`~screwkit.report.scene.scene_from_motion`) of the pipeline's
     motion with the spec's coupler points as traces (their 3-D paths) and the loads of
     ``[motion] mode`` (``dyn_doc``, from :func:`dynamics_document`; None: no loads), as
-    :func:`~screwkit.report.spec_report.spec_scene` builds it. No balancing or synthesis: they are not redone on every change."""
+    :func:`~screwkit.report.spec_report.spec_scene` builds it. No balancing or synthesis: they
+    are not redone on every change. ``packed``: as the page gets it (report/viewer.py)."""
     from screwkit.report.scene import scene_from_motion
     from screwkit.report.spec_report import seed_tables
 
@@ -201,15 +205,13 @@ def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None) -> dict[str, An
                              dynamics_mode=None if dyn_doc is None else int(pipe.spec.mode),
                              seed_variables=[seed_tables(md) for md in mot.modes],
                              coupler_points={p.name: (p.link, p.point)
-                                             for p in pipe.spec.coupler_points})
+                                             for p in pipe.spec.coupler_points}, packed=packed)
 
 
 def packed_scene(pipe: Pipeline) -> dict[str, Any]:
     """The scene of :func:`design_scene` packed for the page's 3-D view (the report's plots
     left out: the page draws its own)."""
-    from screwkit.report.viewer import pack_scene
-
-    packed = pack_scene(design_scene(pipe, dynamics_document(pipe)[0]))
+    packed = design_scene(pipe, dynamics_document(pipe)[0], packed=True)
     packed["plots"], packed["plot_groups"] = [], []
     return packed
 

@@ -12,6 +12,7 @@
     state: null, result: null, frame: 0, mode: boot.mode, playing: false, seq: 0,
     inflight: null, pending: null, lastChange: 0, latencies: [], viewLatencies: [], errors: [],
     messages: [], viewReady: false,
+    phases: [], // per timed change: ms from the input event to the answer, the scene, the view
   };
   window.studio = S;
 
@@ -62,7 +63,8 @@
 
   function receive(msg) {
     const timed = S.inflight && msg.seq === S.inflight.seq ? S.inflight : null;
-    if (timed) S.inflight = null;
+    if (timed) { S.inflight = null; S.phases.push({ answer: performance.now() - timed.t0 }); }
+    if (msg.type === 'scene' && S.phases.length) S.phases[S.phases.length - 1].scene = performance.now() - S.stateT0;
     if (msg.type === 'state') showState(msg, timed);
     else if (msg.type === 'error') { S.errors.push(msg.message); say(msg.message, 'error'); }
     else if (msg.type === 'saved') say(`saved ${msg.path}`, 'ok');
@@ -295,14 +297,17 @@
   function loadView(scene, t0) {
     const shown = $('view');
     const viewer = shown && !document.getElementById('view-next') && shown.contentWindow.screwkitViewer;
+    const t1 = performance.now();
     if (viewer && viewer.update && viewer.update(scene)) {
       viewer.pause();
       S.viewReady = true;
       setFrame(S.frame);
       viewer.renderNow();
+      if (S.phases.length) S.phases[S.phases.length - 1].update = performance.now() - t1;
       S.viewUpdates = (S.viewUpdates || 0) + 1;
       requestAnimationFrame(() => { // the frame that shows the new view (the curves are drawn)
         S.viewLatencies.push(performance.now() - t0);
+        if (S.phases.length) S.phases[S.phases.length - 1].view = performance.now() - t0;
         document.body.dataset.view = String(S.viewLatencies.length);
       });
       return;
