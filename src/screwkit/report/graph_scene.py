@@ -44,6 +44,7 @@ from screwkit.model.mechanism import GROUND, Mechanism
 from screwkit.report.scene import SCENE_FORMAT, display_length, is_full_turn
 from screwkit.report.scene_plots import kinematic_plots
 from screwkit.report.scene_text import link_span_variation
+from screwkit.report.viewer import pack_scene
 
 Array = NDArray[np.float64]
 
@@ -277,11 +278,7 @@ def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str 
         "plot_groups": groups,
         "text": _text(mech, motion, entries, units, kind, spec_text, topology),
     }
-    if packed:  # the large arrays straight to base64 (report/viewer.py), not through lists
-        from screwkit.report.viewer import pack_scene
-
-        scene = pack_scene(scene)
-    out: dict[str, Any] = jsonable(scene)
+    out: dict[str, Any] = jsonable(pack_scene(scene) if packed else scene)
     return out
 
 

@@ -73,6 +73,7 @@ from screwkit.report.scene_plots import (
     synthesis_plots,
 )
 from screwkit.report.scene_text import text_sections
+from screwkit.report.viewer import pack_scene
 
 Array = NDArray[np.float64]
 SCENE_FORMAT = "screwkit-scene/1"
@@ -288,9 +289,5 @@ def scene_from_motion(
                               dynamics_mode=dyn_mode, balance_doc=balance_doc,
                               synthesis_doc=synthesis_doc),
     }
-    if packed:  # the large arrays straight to base64 (report/viewer.py), not through lists
-        from screwkit.report.viewer import pack_scene
-
-        scene = pack_scene(scene)
-    out: dict[str, Any] = jsonable(scene)
+    out: dict[str, Any] = jsonable(pack_scene(scene) if packed else scene)
     return out
