@@ -246,9 +246,9 @@ def graph_numbers(run: GraphRun) -> list[list[str]]:
     return rows
 
 
-def graph_scene(run: GraphRun, dyn: Any = None) -> dict[str, Any]:
-    """The graph report's scene (:mod:`screwkit.report.graph_scene`) of every mode, with the
-    load arrows of the shown mode, packed for the page's 3-D view (its plots left out)."""
+def _scene(run: GraphRun, dyn: Any, packed: bool) -> dict[str, Any]:
+    """The graph report's scene (:mod:`screwkit.report.graph_scene`) of every mode, showing
+    the picked one, with the load arrows of ``dyn`` (its loads; None: none)."""
     from screwkit.report.graph_scene import scene_from_mechanism
 
     loads = None
@@ -257,10 +257,27 @@ def graph_scene(run: GraphRun, dyn: Any = None) -> dict[str, Any]:
 
         doc = graph_dynamics_document(dyn)
         loads = (doc, graph_load_arrows(run.motion, run.shown_mode, doc))
-    packed = scene_from_mechanism(run.spec, run.motion, loads=loads, packed=True)
-    packed["initial_mode"] = run.shown_mode
+    scene = scene_from_mechanism(run.spec, run.motion, loads=loads, packed=packed)
+    scene["initial_mode"] = run.shown_mode
+    return scene
+
+
+def graph_scene(run: GraphRun, dyn: Any = None) -> dict[str, Any]:
+    """The scene of the design packed for the page's 3-D view (its plots left out: the page
+    draws its own)."""
+    packed = _scene(run, dyn, True)
     packed["plots"], packed["plot_groups"] = [], []
     return packed
+
+
+def graph_notebook(run: GraphRun) -> tuple[dict[str, Any], list[list[str]], list[str]]:
+    """What the notebook controls show of a graph design: the graph report's scene (every
+    mode, the loads of the shown mode), the numbers table and the assembly notes."""
+    units = run.spec.display_units()
+    kind = "angle" if run.spec.input_is_angle else "length"
+    x = np.asarray(units.show(kind, np.asarray(run.spec.inputs, dtype=float)[:, 0]))
+    return (_scene(run, run.dynamics()[0], False), graph_numbers(run),
+            [*_assembly(run.motion, x, units.label(kind)), *(str(n) for n in run.motion.notes)])
 
 
 def graph_closes(spec: Any, every: int) -> bool:
