@@ -194,3 +194,20 @@ def test_graph_spec_in_the_browser(open_studio: Any, served: Any, tmp_path: Path
     assert f"at = [5.0, 740.0, {value!r}]" in saved
     served.spec.write_text(original, encoding="utf-8")
     assert not page.errors
+
+
+def test_a_hardpoint_where_the_sweep_cannot_be_reached(tmp_path: Path) -> None:
+    """A sweep that leaves out the drawing (150 … 200 deg): a crank too long to reach it gives
+    the library's sentence and the crank lengths where the four-bar still closes."""
+    text = (MECHANISMS / "fourbar_graph.toml").read_text(encoding="utf-8")
+    assert "start = 0\n" in text and "stop = 360\n" in text
+    spec = tmp_path / "fourbar_part.toml"
+    spec.write_text(text.replace("start = 0\n", "start = 150\n").replace(
+        "stop = 360\n", "stop = 200\n"), encoding="utf-8")
+    tab = Tab(Design(spec))
+    assert tab.handle(json.dumps({"type": "state"}))["result"]["ok"]
+    r = tab.handle(json.dumps({"type": "set", "values": {"joints.B.at[0]": 19.0}}))["result"]
+    assert r["ok"] is False and "cannot be followed to the first input row" in r["error"]
+    assert r["where"].startswith("joints.B.at[0] closes the loop (somewhere over the input "
+                                 "sweep) at ")
+    assert "the other values held" in r["where"]
