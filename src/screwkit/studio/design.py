@@ -1,8 +1,10 @@
 """The design a studio edits: the spec file it was started with, the values of that spec a page
 may change (every dimension of a family, every length, twist, offset and pitch of a joint
-list, and ``[motion] mode``), and the spec with new values, loaded exactly as ``screwkit
-analyze`` loads a file (:func:`~screwkit.io.spec.spec_from_data`), so every number the studio
-shows is the number the CLI prints for a spec holding those values (docs/studio.md).
+list, and ``[motion] mode``; a graph spec's hardpoints and masses, :mod:`screwkit.studio.
+graph`), and the spec with new values, loaded exactly as ``screwkit analyze`` loads a file
+(:func:`~screwkit.io.spec.spec_from_data`, or :func:`~screwkit.io.mechanism_spec.
+graph_spec_from_data` for a graph), so every number the studio shows is the number the CLI
+prints for a spec holding those values (docs/studio.md).
 
 Values are held in the unit the spec writes them in (the unit written with the value, else the
 ``[units]`` default of its kind, else SI): a page shows and sends those numbers. Saving
