@@ -174,6 +174,17 @@ def test_graph_spec_in_the_browser(open_studio: Any, served: Any, tmp_path: Path
     design = served.studio.design
     text = design.text_with({**design.initial_values, LB_Z: value}, 0)
     assert_outputs_equal_analyze(r, analyze_json(text, tmp_path, "lb_150.toml"))
+    # a hardpoint where only two of the four modes assemble: the view in place shows two
+    to_z = page.page.locator(".dim[data-name='joints.TO.at[2]'] input[type=number]")
+    to_z.fill("135")
+    to_z.dispatch_event("change")
+    page.wait_drawn()
+    assert len(page.result()["modes"]) == 2
+    viewer = "document.getElementById('view').contentWindow.screwkitViewer"
+    assert page.evaluate(f"{viewer}.modeCount") == 2 and page.evaluate("window.studio.viewUpdates") >= 2
+    page.page.click("#undo")
+    page.wait_drawn()
+    assert len(page.result()["modes"]) == 4 and page.evaluate(f"{viewer}.modeCount") == 4
     # a bad value: the error on the page, and the server goes on
     box = page.page.locator(f".dim[data-name='{MASS}'] input[type=number]")
     box.fill("-5")
