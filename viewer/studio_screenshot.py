@@ -1,8 +1,11 @@
 """Make docs/studio.png: ``screwkit studio`` on examples/rssr_spatial.toml in headless Debian
-chromium (driven by Playwright, no downloaded browser), after one dimension was dragged.
+chromium (driven by Playwright, no downloaded browser), after one dimension was dragged; and
+docs/studio_graph.png, the double-wishbone graph spec after its lower ball joint was raised.
 Run from the repository root:
 
     .venv/bin/python viewer/studio_screenshot.py docs/studio.png
+    .venv/bin/python viewer/studio_screenshot.py docs/studio_graph.png \
+        examples/mechanisms/double_wishbone.toml 'joints.LB.at[2]' 150
 """
 
 from __future__ import annotations
@@ -20,8 +23,9 @@ READY = """() => { const s = window.studio; return s.inflight === null && !s.pen
   && +document.body.dataset.numbers > s.lastChange; }"""
 
 
-def main(out: str) -> None:
-    studio = new_studio("examples/rssr_spatial.toml")
+def main(out: str, spec: str = "examples/rssr_spatial.toml", name: str = "dimensions.d2",
+         value: str = "92") -> None:
+    studio = new_studio(spec)
     sock = bind("127.0.0.1", 0)
     server = make_server(studio)
     thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
@@ -35,7 +39,7 @@ def main(out: str) -> None:
             page = browser.new_page(viewport={"width": 1400, "height": 860})
             page.goto(url_of(sock, studio.token))
             page.wait_for_function(READY, timeout=60_000)
-            page.locator(".dim[data-name='dimensions.d2'] input[type=range]").fill("92")
+            page.locator(f".dim[data-name='{name}'] input[type=range]").fill(value)
             page.wait_for_function(READY, timeout=60_000)
             page.evaluate("window.studio.setFrame(7)")
             page.evaluate("document.getElementById('view').contentWindow.screwkitViewer"
@@ -50,4 +54,4 @@ def main(out: str) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "docs/studio.png")
+    main(*(sys.argv[1:] or ["docs/studio.png"]))

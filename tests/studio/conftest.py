@@ -70,6 +70,12 @@ def rssr_copy(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest.fixture(scope="module")
+def serve_spec() -> Any:
+    """:func:`serve`, for a test module that serves another spec (its own ``served``)."""
+    return serve
+
+
+@pytest.fixture(scope="module")
 def served(rssr_copy: Path) -> Iterator[Served]:
     yield from serve(rssr_copy, save_as=rssr_copy.with_name("rssr_exported.toml"))
 

@@ -67,16 +67,27 @@ def test_slider_redraws_with_the_numbers_of_analyze(open_studio: Any, served: An
 
 
 def test_latency_of_a_slider_move(open_studio: Any, served: Any) -> None:
-    """Input event → curves redrawn, and → 3-D view reloaded, at 360 samples (printed; the
-    bound only catches a page that hangs on a loaded two-core machine)."""
+    """Input event → curves redrawn, and → the frame where the 3-D view shows the new design
+    too (the page redrawn), at 360 samples (printed; the bound only catches a page that hangs
+    on a loaded two-core machine: the target lives in benchmarks/bench_studio.py). The view
+    takes each new scene in place (screwkitViewer.update), keeping its iframe and camera."""
     page = open_studio()
+    frame = page.evaluate("document.getElementById('view') !== null")
+    shown = page.page.locator("#view").element_handle()
+    joints = "document.getElementById('view').contentWindow.screwkitViewer.jointPositions(5)"
+    drawn = page.evaluate(joints)
     for k in range(8):
         move_slider(page, D2, 100 + 2 * k + 1)
+    page.page.wait_for_function("window.studio.viewLatencies.length >= 9", timeout=30_000)
     curves = page.evaluate("window.studio.latencies")[-8:]
     view = page.evaluate("window.studio.viewLatencies")[-8:]
     print(f"\nstudio latency at 360 samples: input to curves median {statistics.median(curves):.0f} "
-          f"ms (max {max(curves):.0f}); input to 3-D view median {statistics.median(view):.0f} ms")
-    assert statistics.median(curves) < 3000
+          f"ms (max {max(curves):.0f}); input to page redrawn (3-D view in place) median "
+          f"{statistics.median(view):.0f} ms")
+    assert frame and page.evaluate("el => el.isConnected && el.id === 'view'", shown)
+    assert page.evaluate("window.studio.viewUpdates") >= 8
+    assert page.evaluate(joints) != drawn  # the view in place draws the new design
+    assert statistics.median(view) < 5000
 
 
 def test_modes_play_and_undo(open_studio: Any) -> None:

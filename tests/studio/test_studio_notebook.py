@@ -52,3 +52,23 @@ def test_notebook_controls(tmp_path: Path) -> None:
     assert "# Mass properties" in path.read_text(encoding="utf-8")
     assert path.with_name(path.name + ".bak").read_text(encoding="utf-8") == (
         EXAMPLES / "rssr_spatial.toml").read_text(encoding="utf-8")
+
+
+def test_notebook_controls_on_a_graph_spec(tmp_path: Path) -> None:
+    """A graph spec's hardpoints drive the graph report in the output (every mode) and the
+    outputs' table, as the web page's graph answer has them."""
+    from screwkit.studio.graph import GraphRun, graph_numbers
+
+    spec = tmp_path / "double_wishbone.toml"
+    shutil.copy(EXAMPLES / "mechanisms" / "double_wishbone.toml", spec)
+    s = studio(spec)
+    first = s.view.value
+    assert first.startswith("<iframe srcdoc=") and '"family":"graph"' in html.unescape(first)
+    assert [v for _, v in s.mode.options] == [0, 1, 2, 3]
+    s.sliders["joints.LB.at[2]"].value = 150.0
+    assert s.tab.state.as_dict["joints.LB.at[2]"] == 150.0 and s.view.value != first
+    expected = graph_numbers(GraphRun(s.tab.design.spec_with(s.tab.state.as_dict, 0), 0))
+    assert expected[0][0] == "camber, mode 0"
+    assert all(html.escape(v) in s.numbers.value for _, v in expected)
+    s.mode.value = 2
+    assert '"initial_mode":2' in html.unescape(s.view.value)

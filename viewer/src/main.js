@@ -4,7 +4,8 @@
 // setMode(k), setView(name), jointPositions(i) (the joint centres drawn at frame i, metres),
 // and for a mechanism with loops: loopCount, loop, setLoop(k) (-1: all), fullJoints() (the
 // joints drawn in full, not faint).
-// plotAxes() (each plot's axis limits and tick labels).
+// plotAxes() (each plot's axis limits and tick labels), and update(scene) (show another
+// packed scene of the same mechanism in place, keeping the camera; false when it is not one).
 import { decode, value } from './data.js';
 import { MechanismView } from './view3d.js';
 import { buildPlots } from './plots.js';
@@ -29,6 +30,7 @@ class ViewerApp {
     this.cycleSeconds = Math.max(4, this.N / 30);
     this.buildLayout(viewRoot);
     this.view = new MechanismView(this.canvasBox, scene);
+    this.plotRoot = plotRoot;
     this.plots = buildPlots(plotRoot, scene, (i) => { this.pause(); this.setFrame(i); });
     this.setMode(scene.initial_mode || 0);
     document.body.dataset.frames = String(this.N);
@@ -56,7 +58,7 @@ class ViewerApp {
     }
     speed.addEventListener('change', () => { this.speed = +speed.value; });
     this.modeSelect = el('select', { 'aria-label': 'assembly mode' });
-    this.scene.modes.forEach((m, k) => this.modeSelect.appendChild(el('option', { value: String(k) }, m.label)));
+    this.fillModes();
     this.modeSelect.addEventListener('change', () => this.setMode(+this.modeSelect.value));
     bar.append(this.playButton, this.slider, el('span', { class: 'sk-label' }, 'speed'), speed);
     if (this.scene.modes.length > 1) bar.append(el('span', { class: 'sk-label' }, 'mode'), this.modeSelect);
@@ -99,6 +101,26 @@ class ViewerApp {
       if (e.key === 'ArrowRight') { this.pause(); this.setFrame((this.frame + 1) % this.N); }
       if (e.key === 'ArrowLeft') { this.pause(); this.setFrame((this.frame - 1 + this.N) % this.N); }
     });
+  }
+
+  fillModes() {
+    this.modeSelect.textContent = '';
+    this.scene.modes.forEach((m, k) => this.modeSelect.appendChild(el('option', { value: String(k) }, m.label)));
+  }
+
+  // Another scene of the same mechanism (a new design): its frames replace the shown ones in
+  // place (no new page, the camera stays); false, and nothing changed, when it draws another
+  // mechanism (other joints, links or samples).
+  update(scene) {
+    if (!this.view.sameShape(scene)) return false;
+    this.scene = scene;
+    this.view.update(scene);
+    this.fillModes();
+    for (const p of this.plots) if (p.chart) p.chart.destroy();
+    this.plotRoot.textContent = '';
+    this.plots = buildPlots(this.plotRoot, scene, (i) => { this.pause(); this.setFrame(i); });
+    this.setMode(Math.min(this.mode, scene.modes.length - 1));
+    return true;
   }
 
   inputText(i) {
@@ -224,6 +246,8 @@ class ViewerApp {
       fullJoints: () => app.view.fullJoints(),
       // each plot's axes as drawn: {plot id: {x: {min, max, labels}, y: {…}}}
       plotAxes: () => Object.fromEntries(app.plots.map((p) => [p.plot.id, p.axes()])),
+      // a packed scene (JSON text or its parsed object) of the same mechanism, shown in place
+      update: (packed) => app.update(decode(typeof packed === 'string' ? JSON.parse(packed) : packed)),
     };
   }
 }

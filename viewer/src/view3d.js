@@ -33,6 +33,16 @@ function fade(obj, factor) {
   });
 }
 
+// Free the geometries and materials of a group's children, then remove them.
+function clearGroup(group) {
+  group.traverse((o) => {
+    if (o === group) return;
+    if (o.geometry) o.geometry.dispose();
+    if (o.material) o.material.dispose();
+  });
+  group.clear();
+}
+
 function niceStep(x) {
   const p = Math.pow(10, Math.floor(Math.log10(x)));
   const m = x / p;
@@ -292,7 +302,7 @@ export class MechanismView {
     this.modeIndex = k;
     const mode = this.sceneData.modes[k];
     // traces: every joint centre and every extra point, split where the mode does not assemble
-    this.traceGroup.clear();
+    clearGroup(this.traceGroup);
     const N = this.sceneData.input.values.length;
     const closed = this.sceneData.input.periodic;
     const addTrace = (get, colour, opacity) => {
@@ -319,7 +329,7 @@ export class MechanismView {
     }
     // arrows: one per load, scaled together so that the largest force over the cycle is half
     // the mechanism's size
-    this.arrowGroup.clear();
+    clearGroup(this.arrowGroup);
     this.arrows = [];
     let fmax = 0;
     const names = Object.keys(mode.arrows || {});
@@ -408,6 +418,24 @@ export class MechanismView {
     }
     this.dirty = true;
     return ok;
+  }
+
+  // Whether `scene` draws the same mechanism (joints, links, link polylines, samples) as the
+  // shown one, so that update(scene) can replace its frames in place.
+  sameShape(scene) {
+    const a = this.sceneData, b = scene;
+    return a.joints.length === b.joints.length && a.links.length === b.links.length
+      && a.joints.every((j, k) => j.kind === b.joints[k].kind && j.input === b.joints[k].input)
+      && a.input.values.length === b.input.values.length && b.modes.length > 0
+      && b.modes.every((m) => m.link_points.shape[2] === a.modes[0].link_points.shape[2]);
+  }
+
+  // Take the frames of another scene of the same mechanism (sameShape) without rebuilding the
+  // view: the camera, the grid and the joint sizes stay; setMode then redraws the traces and
+  // arrows.
+  update(scene) {
+    this.sceneData = scene;
+    if (this.loopIndex >= (scene.loops || []).length) this.setLoop(-1);
   }
 
   // Draw the joints and links outside loop k faint (k = -1: every part in full).

@@ -44,6 +44,7 @@ from screwkit.model.mechanism import GROUND, Mechanism
 from screwkit.report.scene import SCENE_FORMAT, display_length, is_full_turn
 from screwkit.report.scene_plots import kinematic_plots
 from screwkit.report.scene_text import link_span_variation
+from screwkit.report.viewer import pack_scene
 
 Array = NDArray[np.float64]
 
@@ -215,7 +216,8 @@ def _text(mech: Mechanism, motion: Any, modes: list[dict[str, Any]], units: dict
 def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str | None = None,
                          topology: list[str] | None = None,
                          loads: tuple[dict[str, Any], dict[str, Any]] | None = None,
-                         balance_doc: dict[str, Any] | None = None) -> dict[str, Any]:
+                         balance_doc: dict[str, Any] | None = None, packed: bool = False
+                         ) -> dict[str, Any]:
     """The scene of a solved mechanism (``solve_mechanism``): ``spec_or_mechanism`` is a graph
     spec (``load_spec``; gives the name, source, units and topology) or a bare
     :class:`~screwkit.model.mechanism.Mechanism`. ``topology``: the summary lines (default:
@@ -276,7 +278,7 @@ def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str 
         "plot_groups": groups,
         "text": _text(mech, motion, entries, units, kind, spec_text, topology),
     }
-    out: dict[str, Any] = jsonable(scene)
+    out: dict[str, Any] = jsonable(pack_scene(scene) if packed else scene)
     return out
 
 

@@ -73,6 +73,7 @@ from screwkit.report.scene_plots import (
     synthesis_plots,
 )
 from screwkit.report.scene_text import text_sections
+from screwkit.report.viewer import pack_scene
 
 Array = NDArray[np.float64]
 SCENE_FORMAT = "screwkit-scene/1"
@@ -205,6 +206,7 @@ def scene_from_motion(
     notes: list[str] | None = None,
     linkage: Any = None,
     initial_mode: int | None = None,
+    packed: bool = False,
 ) -> dict[str, Any]:
     """Build the scene (module docstring) of a solved motion.
 
@@ -217,6 +219,8 @@ def scene_from_motion(
     accelerations) under the seed's names, plotted instead of the joint variables.
     ``linkage``: the loop the motion is of, when it is not the spec's (the synthesised one);
     ``initial_mode``: the mode shown first (default: the mode with dynamics, else 0).
+    ``packed``: the scene as the page gets it (:func:`~screwkit.report.viewer.pack_scene`: the
+    large arrays as base64 floats), packed from the arrays without the lists between.
     """
     spec_linkage = getattr(spec_or_linkage, "linkage", spec_or_linkage)
     spec = spec_or_linkage if spec_or_linkage is not spec_linkage else None
@@ -285,5 +289,5 @@ def scene_from_motion(
                               dynamics_mode=dyn_mode, balance_doc=balance_doc,
                               synthesis_doc=synthesis_doc),
     }
-    out: dict[str, Any] = jsonable(scene)
+    out: dict[str, Any] = jsonable(pack_scene(scene) if packed else scene)
     return out

@@ -85,8 +85,14 @@ def third_party_notices() -> str:
 
 def _pack(values: Any, dtype: str) -> dict[str, Any]:
     """An array (lists with ``None`` for missing values allowed) as base64 little-endian
-    floats; missing values become NaN."""
+    floats; missing values become NaN. An infinite value is refused as :func:`~screwkit.io.
+    results.jsonable` refuses it."""
     a = np.asarray(values, dtype=float)
+    if np.isinf(a).any():
+        from screwkit.io.results import NonFiniteResultError
+
+        raise NonFiniteResultError(f"an infinite value in an array of shape {list(a.shape)} of "
+                                   "the scene; strict JSON has no Infinity")
     raw = a.astype("<f8" if dtype == "f8" else "<f4").tobytes()
     return {"$b64": base64.b64encode(raw).decode("ascii"), "dtype": dtype, "shape": list(a.shape)}
 

@@ -1,8 +1,10 @@
 """The design a studio edits: the spec file it was started with, the values of that spec a page
 may change (every dimension of a family, every length, twist, offset and pitch of a joint
-list, and ``[motion] mode``), and the spec with new values, loaded exactly as ``screwkit
-analyze`` loads a file (:func:`~screwkit.io.spec.spec_from_data`), so every number the studio
-shows is the number the CLI prints for a spec holding those values (docs/studio.md).
+list, and ``[motion] mode``; a graph spec's hardpoints and masses, :mod:`screwkit.studio.
+graph`), and the spec with new values, loaded exactly as ``screwkit analyze`` loads a file
+(:func:`~screwkit.io.spec.spec_from_data`, or :func:`~screwkit.io.mechanism_spec.
+graph_spec_from_data` for a graph), so every number the studio shows is the number the CLI
+prints for a spec holding those values (docs/studio.md).
 
 Values are held in the unit the spec writes them in (the unit written with the value, else the
 ``[units]`` default of its kind, else SI): a page shows and sends those numbers. Saving
@@ -18,11 +20,10 @@ from pathlib import Path
 from typing import Any
 
 from screwkit.errors import InputError
-from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec, spec_from_data
 from screwkit.io.toml_file import read_toml
 from screwkit.kinematics.registry import family
-from screwkit.sweep.keys import SpecKey, get_value, key_text, spec_key, with_values
+from screwkit.sweep.keys import SpecKey, get_value, spec_key, with_values
 
 #: the fields of a ``[[joints]]`` entry a studio offers as dimensions (docs/spec-format.md)
 JOINT_FIELDS = ("length", "twist", "offset", "pitch")
@@ -47,7 +48,7 @@ class Dimension:
 
     @property
     def name(self) -> str:
-        return key_text(self.key.path)
+        return self.key.text
 
     def as_dict(self) -> dict[str, Any]:
         return {"name": self.name, "kind": self.key.kind, "unit": self.key.unit or "",
@@ -114,16 +115,30 @@ class Design:
         self.text = self.path.read_text(encoding="utf-8")
         from screwkit.io.mechanism_spec import is_graph_spec
 
-        if is_graph_spec(self.data):
-            raise SpecError(f"{self.path}: the studio designs single loops (a family or a joint "
-                            "list) so far; a mechanism graph works with screwkit report, analyze "
-                            "and dynamics (docs/mechanisms.md)")
-        self.spec = spec_from_data(self.data, self.path)
-        keys = editable_keys(self.data, self.spec)
-        values = [_number(self.data, self.spec, k) for k in keys]
+        #: a graph spec (studio/graph.py): its hardpoints and masses are its dimensions
+        self.graph = is_graph_spec(self.data)
+        self.spec = self.load_tables(self.data)
+        if self.graph:
+            from screwkit.studio.graph import graph_keys, graph_ranges
+
+            keys = graph_keys(self.data, self.spec)
+            values = [_number(self.data, self.spec, k) for k in keys]
+            ranges = graph_ranges(self.spec, keys, values)
+        else:
+            keys = editable_keys(self.data, self.spec)
+            values = [_number(self.data, self.spec, k) for k in keys]
+            ranges = _ranges(self.spec, keys, values)
         self.dimensions = [Dimension(k, v, lo, hi) for k, v, (lo, hi)
-                           in zip(keys, values, _ranges(self.spec, keys, values), strict=True)]
+                           in zip(keys, values, ranges, strict=True)]
         self.by_name = {d.name: d for d in self.dimensions}
+
+    def load_tables(self, data: dict[str, Any]) -> Any:
+        """The spec of these tables, validated as ``load_spec`` validates a file."""
+        if self.graph:
+            from screwkit.io.mechanism_spec import graph_spec_from_data
+
+            return graph_spec_from_data(data, self.path)
+        return spec_from_data(data, self.path)
 
     @property
     def initial_values(self) -> dict[str, float]:
@@ -153,15 +168,16 @@ class Design:
             d = self.by_name[name]
             if v != d.value:
                 out.append((d.key.path, d.key.toml_value(v)))
-        if mode != self.initial_mode:
+        if mode != self.initial_mode and not self.graph:  # a graph spec has no [motion] mode
             out.append((("motion", "mode"), int(mode)))
         return out
 
-    def spec_with(self, values: dict[str, float], mode: int) -> Spec:
+    def spec_with(self, values: dict[str, float], mode: int) -> Any:
         """The spec with these values (in their units) and ``[motion] mode``, validated as
-        ``screwkit analyze`` validates a file (a SpecError says what is wrong)."""
+        ``screwkit analyze`` validates a file (a SpecError says what is wrong); a graph spec
+        (a :class:`~screwkit.io.mechanism_spec.GraphSpec`) for a graph."""
         data = with_values(self.data, self.changes(values, mode))
-        return spec_from_data(data, self.path)
+        return self.load_tables(data)
 
     def text_with(self, values: dict[str, float], mode: int) -> str:
         """The spec file's text with these values, its comments and layout kept (tomlkit)."""

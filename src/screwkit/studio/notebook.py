@@ -123,19 +123,25 @@ class StudioWidget:
             self.buttons["redo"].disabled = not self.tab.future
             try:
                 pipe = self.tab.pipeline()
-                modes = [(md.label, md.index) for md in pipe.motion.modes]
+                modes = [(md.label or f"mode {md.index}", md.index) for md in pipe.motion.modes]
                 if state.mode >= len(modes):
                     modes.append((f"mode {state.mode} (none)", state.mode))
                 self.mode.options = modes
                 self.mode.value = state.mode
-                scene = design_scene(pipe, dynamics_document(pipe)[0])
-                units = pipe.spec.display_units()
-                kind = "angle" if pipe.spec.input_is_angle else "length"
-                x = units.show(kind, np.asarray(pipe.spec.inputs, dtype=float).reshape(
-                    len(pipe.spec.inputs), -1)[:, 0])
-                notes = assembly_notes(pipe, np.asarray(x), units.label(kind))
+                if self.tab.design.graph:  # a graph spec (studio/graph.py)
+                    from screwkit.studio.graph import graph_notebook
+
+                    scene, rows, notes = graph_notebook(pipe)
+                else:
+                    scene = design_scene(pipe, dynamics_document(pipe)[0])
+                    units = pipe.spec.display_units()
+                    kind = "angle" if pipe.spec.input_is_angle else "length"
+                    x = units.show(kind, np.asarray(pipe.spec.inputs, dtype=float).reshape(
+                        len(pipe.spec.inputs), -1)[:, 0])
+                    rows = numbers_table(pipe)
+                    notes = assembly_notes(pipe, np.asarray(x), units.label(kind))
                 self.view.value = report_iframe(scene, self.height)
-                self.numbers.value = _numbers_html(numbers_table(pipe), notes)
+                self.numbers.value = _numbers_html(rows, notes)
                 self.message.value = ""
             except AssemblyError as exc:
                 where = self.tab.where_it_closes()

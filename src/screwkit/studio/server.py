@@ -49,6 +49,15 @@ def finite(doc: Any) -> Any:
     return doc
 
 
+def to_json(doc: Any) -> str:
+    """The document as compact JSON, a NaN or infinity as ``null`` (:func:`finite`; a copy is
+    made only when the document holds one: the answers' series already say ``None``)."""
+    try:
+        return json.dumps(doc, separators=(",", ":"), allow_nan=False)
+    except ValueError:
+        return json.dumps(finite(doc), separators=(",", ":"))
+
+
 @dataclass
 class Studio:
     """What one studio process serves: the design, its token and the ``--save-as`` file."""
@@ -114,10 +123,10 @@ def create_app(studio: Studio) -> Any:
         follows) or None."""
         reply = guarded(lambda: tab.handle(text))
         solved = reply["type"] == "state" and bool(reply["result"].get("ok"))
-        return json.dumps(finite(reply), separators=(",", ":")), reply["seq"] if solved else None
+        return to_json(reply), reply["seq"] if solved else None
 
     def scene(tab: Tab, seq: int) -> str:
-        return json.dumps(finite(guarded(lambda: tab.scene(seq))), separators=(",", ":"))
+        return to_json(guarded(lambda: tab.scene(seq)))
 
     async def updates(ws: WebSocket) -> None:
         origin = ws.headers.get("origin")

@@ -114,7 +114,7 @@ class Tab:
     def __post_init__(self) -> None:
         d = self.design
         self.state = DesignState(tuple(d.initial_values.items()), d.initial_mode)
-        self._solved: tuple[DesignState, Pipeline] | None = None
+        self._solved: tuple[DesignState, Any] | None = None
 
     def set(self, values: dict[str, float], mode: int | None) -> None:
         merged = {**self.state.as_dict, **values}
@@ -132,21 +132,35 @@ class Tab:
             target.append(self.state)
             self.state = source.pop()
 
-    def pipeline(self) -> Pipeline:
-        """The pipeline of the current state (solved once per state)."""
+    def pipeline(self) -> Any:
+        """The pipeline of the current state (solved once per state); for a graph spec a
+        :class:`~screwkit.studio.graph.GraphRun`."""
         if self._solved is None or self._solved[0] != self.state:
-            self._solved = (self.state, Pipeline(self.design.spec_with(self.state.as_dict,
-                                                                       self.state.mode)))
+            spec = self.design.spec_with(self.state.as_dict, self.state.mode)
+            if self.design.graph:
+                from screwkit.studio.graph import GraphRun
+
+                self._solved = (self.state, GraphRun(spec, self.state.mode))
+            else:
+                self._solved = (self.state, Pipeline(spec))
         return self._solved[1]
+
+    def solved(self, *, numbers: bool, scene: bool) -> dict[str, Any]:
+        """The page's picture of the current state (studio/solve.py, studio/graph.py)."""
+        if self.design.graph:
+            from screwkit.studio.graph import solve_graph
+
+            return solve_graph(self.pipeline(), numbers=numbers, scene=scene)
+        from screwkit.studio.solve import solve_spec
+
+        return solve_spec(self.pipeline(), numbers=numbers, scene=scene)
 
     def answer(self, seq: int) -> dict[str, Any]:
         """The ``state`` answer: the values, the history flags and the solved design (without
         the numbers table, which a ``numbers`` message asks for)."""
-        from screwkit.studio.solve import solve_spec
-
         values, mode = self.state.as_dict, self.state.mode
         try:
-            result = solve_spec(self.pipeline(), numbers=False, scene=False)
+            result = self.solved(numbers=False, scene=False)
         except AssemblyError as exc:
             result = {"ok": False, "error": str(exc), "where": self.where_it_closes()}
         except ScrewkitError as exc:
@@ -174,6 +188,11 @@ class Tab:
     def scene(self, seq: int) -> dict[str, Any]:
         """The ``scene`` message: the 3-D scene of the current state (sent after its
         ``state``)."""
+        if self.design.graph:
+            from screwkit.studio.graph import graph_scene
+
+            run = self.pipeline()
+            return {"type": "scene", "seq": seq, "scene": graph_scene(run, run.dynamics()[0])}
         from screwkit.studio.solve import packed_scene
 
         return {"type": "scene", "seq": seq, "scene": packed_scene(self.pipeline())}
@@ -191,15 +210,23 @@ class Tab:
             elif msg.type in ("undo", "redo"):
                 self.step(msg.type == "undo")
             elif msg.type == "numbers":
-                from screwkit.studio.solve import numbers_table
-
-                return {"type": "numbers", "seq": seq, "numbers": numbers_table(self.pipeline())}
+                return {"type": "numbers", "seq": seq, "numbers": self.numbers()}
             elif msg.type == "save":
                 path = save_design(self.design, self.state.as_dict, self.state.mode)
                 return {"type": "saved", "seq": seq, "path": str(path)}
             return self.answer(seq)
         except ScrewkitError as exc:
             return {"type": "error", "seq": seq, "message": str(exc)}
+
+    def numbers(self) -> list[list[str]]:
+        """The numbers table of the current state."""
+        if self.design.graph:
+            from screwkit.studio.graph import graph_numbers
+
+            return graph_numbers(self.pipeline())
+        from screwkit.studio.solve import numbers_table
+
+        return numbers_table(self.pipeline())
 
     def export(self, what: str, seq: int) -> dict[str, Any]:
         from screwkit.studio.exports import export_csv, export_report
@@ -214,6 +241,15 @@ class Tab:
             return {"type": "download", "seq": seq, "name": f"{stem}_studio.toml",
                     "mime": "application/toml", "text": text}
         spec = self.design.spec_with(values, mode)
+        if self.design.graph:
+            from screwkit.studio.graph import GraphRun, graph_csv, graph_report
+
+            if what == "csv":
+                return {"type": "download", "seq": seq, "name": f"{stem}_studio.csv",
+                        "mime": "text/csv", "text": graph_csv(GraphRun(spec, mode))}
+            return {"type": "download", "seq": seq, "name": f"{stem}_studio.html",
+                    "mime": "text/html",
+                    "text": graph_report(spec, self.design.text_with(values, mode))}
         if what == "csv":
             return {"type": "download", "seq": seq, "name": f"{stem}_studio.csv",
                     "mime": "text/csv", "text": export_csv(spec)}
@@ -227,9 +263,8 @@ def write_spec(path: Path, text: str, design: Design) -> None:
     import tomlkit
 
     from screwkit.io.results import write_atomic
-    from screwkit.io.spec import spec_from_data
 
-    spec_from_data(tomlkit.parse(text).unwrap(), path)
+    design.load_tables(tomlkit.parse(text).unwrap())
     write_atomic(path, text)
 
 

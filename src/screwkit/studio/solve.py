@@ -21,10 +21,12 @@ from screwkit.kinematics.registry import default_outputs
 from screwkit.pipeline import Pipeline
 
 
-def _series(values: Any) -> list[float | None]:
+def json_series(values: Any) -> list[float | None]:
     """An array as a JSON list, ``None`` where a value is missing (NaN or infinite)."""
     a = np.asarray(values, dtype=float).ravel()
-    return [float(v) if np.isfinite(v) else None for v in a]
+    out = a.astype(object)  # one vectorised step, not a Python test per sample
+    out[~np.isfinite(a)] = None
+    return list(out.tolist())
 
 
 def _floats(values: Any, width: int | None = None) -> np.ndarray:
@@ -73,7 +75,7 @@ def _paths(pipe: Pipeline, factor: float) -> dict[str, Any]:
     if pipe.spec.coupler_points:
         curves = pipe.coupler_curves()
         return {"title": "coupler-point paths",
-                "modes": [{name: [_series(c[:, j] / factor) for j in range(3)]
+                "modes": [{name: [json_series(c[:, j] / factor) for j in range(3)]
                            for name, c in per.items()} for per in curves]}
     out = []
     names = [j.name for j in pipe.spec.linkage.joints]
@@ -81,7 +83,7 @@ def _paths(pipe: Pipeline, factor: float) -> dict[str, Any]:
         c = np.asarray(md.joint_centres, dtype=float)
         moving = [k for k in range(c.shape[1])
                   if np.nanmax(np.nanstd(c[:, k, :], axis=0), initial=0.0) > 1e-12]
-        out.append({names[k]: [_series(c[:, k, j] / factor) for j in range(3)] for k in moving})
+        out.append({names[k]: [json_series(c[:, k, j] / factor) for j in range(3)] for k in moving})
     return {"title": "joint-centre paths", "modes": out}
 
 
@@ -92,9 +94,9 @@ def _transmission(pipe: Pipeline, units: Any) -> tuple[list[dict[str, Any]] | No
         return None, str(exc)
     out = []
     for m in tr.modes:
-        entry: dict[str, Any] = {"index": {k: _series(v) for k, v in m.index.items()}}
+        entry: dict[str, Any] = {"index": {k: json_series(v) for k, v in m.index.items()}}
         if m.angle is not None:
-            entry["angle"] = _series(units.show("angle", np.asarray(m.angle, dtype=float)))
+            entry["angle"] = json_series(units.show("angle", np.asarray(m.angle, dtype=float)))
         out.append(entry)
     return out, None
 
@@ -123,12 +125,12 @@ def _loads(doc: dict[str, Any], mode: int, units: Any) -> dict[str, Any]:
     f, m = units.label("force"), units.label("moment")
     curves = {
         f"input effort {name} [{units.label(effort_kind)}]":
-            _series(units.show(effort_kind, _floats(doc["efforts"][name]))),
-        f"shaking force [{f}]": _series(units.show(
+            json_series(units.show(effort_kind, _floats(doc["efforts"][name]))),
+        f"shaking force [{f}]": json_series(units.show(
             "force", np.linalg.norm(_floats(doc["shaking_force"], 3), axis=1))),
-        f"shaking moment [{m}]": _series(units.show(
+        f"shaking moment [{m}]": json_series(units.show(
             "moment", np.linalg.norm(_floats(doc["shaking_moment"], 3), axis=1))),
-        f"largest joint reaction force [{f}]": _series(units.show("force", largest)),
+        f"largest joint reaction force [{f}]": json_series(units.show("force", largest)),
     }
     summary = []
     for key, stats in doc["summary"].items():
@@ -188,11 +190,13 @@ def numbers_table(pipe: Pipeline) -> list[list[str]]:
     return rows
 
 
-def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None) -> dict[str, Any]:
+def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None, *, packed: bool = False
+                 ) -> dict[str, Any]:
     """The report's scene (:func:`~screwkit.report.scene.scene_from_motion`) of the pipeline's
     motion with the spec's coupler points as traces (their 3-D paths) and the loads of
     ``[motion] mode`` (``dyn_doc``, from :func:`dynamics_document`; None: no loads), as
-    :func:`~screwkit.report.spec_report.spec_scene` builds it. No balancing or synthesis: they are not redone on every change."""
+    :func:`~screwkit.report.spec_report.spec_scene` builds it. No balancing or synthesis: they
+    are not redone on every change. ``packed``: as the page gets it (report/viewer.py)."""
     from screwkit.report.scene import scene_from_motion
     from screwkit.report.spec_report import seed_tables
 
@@ -201,15 +205,13 @@ def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None) -> dict[str, An
                              dynamics_mode=None if dyn_doc is None else int(pipe.spec.mode),
                              seed_variables=[seed_tables(md) for md in mot.modes],
                              coupler_points={p.name: (p.link, p.point)
-                                             for p in pipe.spec.coupler_points})
+                                             for p in pipe.spec.coupler_points}, packed=packed)
 
 
 def packed_scene(pipe: Pipeline) -> dict[str, Any]:
     """The scene of :func:`design_scene` packed for the page's 3-D view (the report's plots
     left out: the page draws its own)."""
-    from screwkit.report.viewer import pack_scene
-
-    packed = pack_scene(design_scene(pipe, dynamics_document(pipe)[0]))
+    packed = design_scene(pipe, dynamics_document(pipe)[0], packed=True)
     packed["plots"], packed["plot_groups"] = [], []
     return packed
 
@@ -236,7 +238,7 @@ def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True,
         modes.append({
             "index": int(md.index), "label": str(md.label),
             "assembles": [bool(v) for v in np.asarray(md.assembles)],
-            "outputs": {f"{n} [{units.label(_kind_of(n))}]": _series(units.show(
+            "outputs": {f"{n} [{units.label(_kind_of(n))}]": json_series(units.show(
                 _kind_of(n), np.asarray(md.variables[n], dtype=float))) for n in outputs},
         })
     trans, trans_note = _transmission(pipe, units)
@@ -244,7 +246,7 @@ def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True,
     loads = None if dyn_doc is None else _loads(dyn_doc, int(spec.mode), units)
     return {
         "ok": True, "method": mot.method, "mode": int(spec.mode),
-        "input": {"name": input_name, "unit": units.label(x_kind), "values": _series(x_shown)},
+        "input": {"name": input_name, "unit": units.label(x_kind), "values": json_series(x_shown)},
         "modes": modes, "paths": _paths(pipe, units.unit_of("length")[1]),
         "length_unit": units.label("length"),
         "transmission": trans, "transmission_note": trans_note,
@@ -280,6 +282,11 @@ def assembling_values(design: Any, values: dict[str, float], mode: int, name: st
         try:
             spec = design.spec_with({**values, name: float(v)}, mode)
             every = max(1, len(spec.inputs) // SCAN_INPUTS)
+            if design.graph:
+                from screwkit.studio.graph import graph_closes
+
+                ok[k] = graph_closes(spec, every)
+                continue
             mot = solve_motion(spec.linkage, spec.inputs[::every], rates=spec.speed)
             ok[k] = any(np.asarray(md.assembles).any() for md in mot.modes)
         except (ScrewkitError, FloatingPointError, np.linalg.LinAlgError):

@@ -1,7 +1,8 @@
 // screwkit studio page (docs/studio.md): dimension sliders and number boxes, the input slider
 // with play/pause, the mode picker, SVG plots, the numbers table; every change goes to the
 // server over the WebSocket and the answer is redrawn. The 3-D view is the report's viewer in
-// an iframe, reloaded with each new scene. window.studio exposes the state for tests.
+// an iframe; each new scene of the same mechanism is handed to it and drawn in place.
+// window.studio exposes the state for tests.
 'use strict';
 (function () {
   const boot = JSON.parse(document.getElementById('studio-boot').textContent);
@@ -11,6 +12,7 @@
     state: null, result: null, frame: 0, mode: boot.mode, playing: false, seq: 0,
     inflight: null, pending: null, lastChange: 0, latencies: [], viewLatencies: [], errors: [],
     messages: [], viewReady: false,
+    phases: [], // per timed change: ms from the input event to the answer, the scene, the view
   };
   window.studio = S;
 
@@ -61,7 +63,8 @@
 
   function receive(msg) {
     const timed = S.inflight && msg.seq === S.inflight.seq ? S.inflight : null;
-    if (timed) S.inflight = null;
+    if (timed) { S.inflight = null; S.phases.push({ answer: performance.now() - timed.t0 }); }
+    if (msg.type === 'scene' && S.phases.length) S.phases[S.phases.length - 1].scene = performance.now() - S.stateT0;
     if (msg.type === 'state') showState(msg, timed);
     else if (msg.type === 'error') { S.errors.push(msg.message); say(msg.message, 'error'); }
     else if (msg.type === 'saved') say(`saved ${msg.path}`, 'ok');
@@ -287,9 +290,28 @@
   }
 
   // ---- the 3-D view (the report's viewer in an iframe) ---------------------------------
-  // the new scene loads in a second iframe on top of the shown one (transparent until its
-  // viewer is up), which then takes the id 'view': the picture never goes blank
+  // a scene of the same mechanism goes to the shown viewer, which replaces its frames in place
+  // (screwkitViewer.update); another one (the first, or a new topology) loads in a second
+  // iframe on top of the shown one (transparent until its viewer is up), which then takes the
+  // id 'view': the picture never goes blank
   function loadView(scene, t0) {
+    const shown = $('view');
+    const viewer = shown && !document.getElementById('view-next') && shown.contentWindow.screwkitViewer;
+    const t1 = performance.now();
+    if (viewer && viewer.update && viewer.update(scene)) {
+      viewer.pause();
+      S.viewReady = true;
+      setFrame(S.frame);
+      viewer.renderNow();
+      if (S.phases.length) S.phases[S.phases.length - 1].update = performance.now() - t1;
+      S.viewUpdates = (S.viewUpdates || 0) + 1;
+      requestAnimationFrame(() => { // the frame that shows the new view (the curves are drawn)
+        S.viewLatencies.push(performance.now() - t0);
+        if (S.phases.length) S.phases[S.phases.length - 1].view = performance.now() - t0;
+        document.body.dataset.view = String(S.viewLatencies.length);
+      });
+      return;
+    }
     const old = document.getElementById('view-next');
     if (old) old.remove();
     const frame = el('iframe', { id: 'view-next', title: '3-D view', class: 'loading' });
