@@ -17,13 +17,12 @@ is replaced by its nanny and its tasks are run again elsewhere (Dask does this);
 counts such losses by listing the workers after every result and says so in one line
 (:meth:`Engine.notes`). A task whose workers keep dying under it, or a scheduler that goes
 away, stops the run with one sentence (:class:`EngineError`). Dask's logs that only narrate
-these faults are filtered out (:class:`_ExpectedFaults`).
+these faults are filtered out, in this process and in every worker process
+(:class:`screwkit.sweep.worker_setup.ExpectedFaults`).
 """
 
 from __future__ import annotations
 
-import asyncio
-import concurrent.futures
 import logging
 import os
 from collections.abc import Callable, Iterator, Sequence
@@ -32,13 +31,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from screwkit.errors import InputError
-from screwkit.sweep.worker_setup import PRELOAD
+from screwkit.sweep.worker_setup import CANCELLED, PRELOAD, filter_dask_logs
 
 #: environment variable naming an existing scheduler
 SCHEDULER_ENV = "SCREWKIT_SCHEDULER"
-#: Dask's cancellations: a request cut short as a connection ends (asyncio's), a future given up
-#: by the scheduler (distributed.FutureCancelledError derives from concurrent.futures')
-CANCELLED = (asyncio.CancelledError, concurrent.futures.CancelledError)
 #: tries to start the embedded cluster before giving up (bounded: a machine that cannot start a
 #: worker process three times in a row will not on the fourth)
 START_ATTEMPTS = 3
@@ -94,38 +90,6 @@ def _dask() -> Any:
 
 def _shared_value(value: Any) -> Any:
     return value
-
-
-class _ExpectedFaults(logging.Filter):
-    """Drops Dask's logs of faults the engine recovers from or reports itself in one sentence:
-    a result fetched from a worker that has just died (it is fetched again from where it is
-    computed anew), a client giving up on a scheduler that went away, and connections that close
-    or requests cancelled as a client, a cluster or a lost scheduler's connection ends
-    (``CommClosedError``, ``CancelledError``; logged with a traceback, sometimes after the
-    client has closed)."""
-
-    messages = ("Couldn't gather keys", "Batched Comm Closed", "Failed to reconnect to scheduler")
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        from distributed.comm.core import CommClosedError
-
-        exc = record.exc_info[1] if record.exc_info else None
-        seen: set[int] = set()
-        while exc is not None and id(exc) not in seen:  # a chain, possibly with a cycle
-            if isinstance(exc, (CommClosedError, *CANCELLED)):
-                return False
-            seen.add(id(exc))
-            exc = exc.__cause__ or exc.__context__
-        text = record.getMessage()
-        return not any(m in text for m in self.messages)
-
-
-def _filter_dask_logs() -> None:
-    """:class:`_ExpectedFaults` on Dask's log handlers, once; it stays, since Dask logs some of
-    this noise after the engine has stopped."""
-    for handler in logging.getLogger("distributed").handlers:
-        if not any(isinstance(f, _ExpectedFaults) for f in handler.filters):
-            handler.addFilter(_ExpectedFaults())
 
 
 def _ordinal(n: int) -> str:
@@ -250,7 +214,7 @@ def start_engine(config: EngineConfig) -> Iterator[Engine]:
         yield Engine(None, "in this process (no Dask)")
         return
     distributed = _dask()
-    _filter_dask_logs()
+    filter_dask_logs()
     yield from _dask_engine(distributed, config)
 
 
