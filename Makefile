@@ -17,7 +17,7 @@ $(CHROMIUM):
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	$(BIN)/python -m pip install --quiet -e ".[dev,crosscheck]"
 	touch $(STAMP)
 
 VALIDATION := bagci1969/analysis_tables bagci1969/synthesis rahman1996/kinematics rahman1996/dynamics rahman1996/balancing
