@@ -223,6 +223,8 @@ class GraphSpec:
             out.append("dynamics")
         if self.balancing is not None:
             out.append("balance")
+        if self.synthesis is not None:
+            out.append("synthesize")
         return out
 
     # --- helpers ---------------------------------------------------------------------------
