@@ -346,8 +346,10 @@ def synthesize_graph(problem: GraphSynthesisProblem, start: FloatArray | None = 
         x = best["x"]
         values = generated(problem, x)
     r = _residual_parts(problem, values)
-    J = graph_jacobian(problem, x)
-    grad = 2.0 * (J.T @ r) * scales
+    try:
+        grad = 2.0 * (graph_jacobian(problem, x).T @ r) * scales
+    except _Infeasible:  # on the edge of the drawn mode: no two-sided derivative
+        grad = np.full(x.size, np.nan)
     on: dict[str, tuple[str, float]] = {}
     free = np.ones(x.size, dtype=bool)
     for k, v in enumerate(problem.variables):
