@@ -213,11 +213,11 @@ def _target(spec: GraphSpec, t: _Target, k: int) -> GraphTarget:
     outside = np.flatnonzero(np.any((inputs < lo - slack) | (inputs > hi + slack), axis=1))
     if outside.size:
         du = spec.display_units()
-        row = [f"{du.show(in_kinds[c], v):.6g} {du.label(in_kinds[c])}"
-               for c, v in enumerate(inputs[outside[0]])]
+        shown_row = [f"{du.show(in_kinds[c], v):.6g} {du.label(in_kinds[c])}"
+                     for c, v in enumerate(inputs[outside[0]])]
         span = [f"[{du.show(in_kinds[c], a):.6g}, {du.show(in_kinds[c], b):.6g}] "
                 f"{du.label(in_kinds[c])}" for c, (a, b) in enumerate(zip(lo, hi, strict=True))]
-        raise _fail(spec, key, f"target input {', '.join(row)} lies outside the spec's motion "
+        raise _fail(spec, key, f"target input {', '.join(shown_row)} lies outside the spec's motion "
                                f"({'; '.join(span)}); move it inside or widen [motion]")
     label = f"{what} {name}" + (f" ({', '.join('xyz'[c] for c in comps)})"
                                 if what == "point" else "")
@@ -263,7 +263,7 @@ def graph_synthesis_problem(spec: GraphSpec, data: dict[str, Any]) -> GraphSynth
     axes = {k: (None if j.axis is None else np.array([float(a) for a in j.axis]),
                 None if j.axis2 is None else np.array([float(a) for a in j.axis2]))
             for k, j in enumerate(spec.raw.joints)}  # plain numbers (checked at load)
-    ms = table.multistart or _Multistart()
+    ms = table.multistart or _Multistart.model_validate({})
     start = GraphSynthesisProblem(spec.mechanism, axes, variables, targets, lower, upper,
                                   spec.inputs).start_vector()
     out = np.flatnonzero((start < lower) | (start > upper))

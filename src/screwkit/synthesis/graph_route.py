@@ -164,19 +164,20 @@ class GraphSynthesisProblem:
         return replace(m, joints=tuple(joints), points=tuple(points))
 
 
-def _rows(problem: GraphSynthesisProblem) -> tuple[FloatArray, list[FloatArray]]:
+def _rows(problem: GraphSynthesisProblem) -> tuple[FloatArray, list[NDArray[np.intp]]]:
     """The distinct input rows of every target and, per target, the index of each of its rows."""
     stacked = np.vstack([t.inputs for t in problem.targets])
     rows, inverse = np.unique(np.round(stacked, 15), axis=0, return_inverse=True)
     inverse = np.asarray(inverse).reshape(-1)
-    out, at = [], 0
+    out: list[NDArray[np.intp]] = []
+    at = 0
     for t in problem.targets:
-        out.append(inverse[at:at + t.inputs.shape[0]])
+        out.append(inverse[at:at + t.inputs.shape[0]].astype(np.intp))
         at += t.inputs.shape[0]
     return rows, out
 
 
-def _quantity(mode: Any, target: GraphTarget, idx: FloatArray) -> FloatArray:
+def _quantity(mode: Any, target: GraphTarget, idx: NDArray[np.intp]) -> FloatArray:
     if target.what == "point":
         return np.asarray(mode.points[target.name])[idx][:, list(target.components)]
     if target.what == "output":
@@ -306,7 +307,7 @@ def synthesize_graph(problem: GraphSynthesisProblem, start: FloatArray | None = 
     t0 = time.perf_counter()
     deadline = t0 + problem.time_limit
     counts = {"fun": 0, "jac": 0}
-    best = {"x": x0, "E": float(r0 @ r0)}
+    best_x, best_e = [x0], [float(r0 @ r0)]
 
     def fun(x: FloatArray) -> FloatArray:
         if time.perf_counter() > deadline:
@@ -316,8 +317,8 @@ def synthesize_graph(problem: GraphSynthesisProblem, start: FloatArray | None = 
             r = _residual_parts(problem, generated(problem, x))
         except _Infeasible:
             return np.full(r0.size, big)
-        if float(r @ r) <= best["E"]:
-            best.update(x=x.copy(), E=float(r @ r))
+        if float(r @ r) <= best_e[0]:
+            best_x[0], best_e[0] = x.copy(), float(r @ r)
         return r
 
     def jac(x: FloatArray, *_: object) -> FloatArray:
@@ -337,13 +338,13 @@ def synthesize_graph(problem: GraphSynthesisProblem, start: FloatArray | None = 
         if sol.status == 0:
             status = "iteration limit"
     except _TimeUp:
-        x, status = best["x"], "time limit"
+        x, status = best_x[0], "time limit"
         message = f"stopped after the time limit of {problem.time_limit:g} s"
     elapsed = time.perf_counter() - t0
     try:
         values = generated(problem, x)
     except _Infeasible:
-        x = best["x"]
+        x = best_x[0]
         values = generated(problem, x)
     r = _residual_parts(problem, values)
     try:
