@@ -284,6 +284,16 @@ def test_cli_synthesizes_the_suspension_and_writes_a_spec_that_reproduces_it(tmp
         name = row["target"].split()[-1]
         assert md.outputs[name][i] == pytest.approx(row["generated"][0], abs=1e-12)
         assert abs(row["error"][0]) < math.radians(0.01)
+    # its report plots the targets against what the synthesised drawing generates
+    from screwkit.report.graph_scene import graph_spec_scene
+
+    plots = {p["title"]: p for p in graph_spec_scene(spec)["plots"] if p["group"] == "synthesis"}
+    for name in ("camber", "toe"):
+        series = {s["name"]: s for s in plots[f"output {name}: desired vs generated"]["series"]}
+        mine = sorted((r["input"][0], r["generated"][0]) for r in rows
+                      if r["target"] == f"output {name}")
+        np.testing.assert_allclose(series["generated"]["x"], [m[0] for m in mine], atol=1e-15)
+        np.testing.assert_allclose(series["generated"]["y"], [m[1] for m in mine], atol=1e-12)
 
 
 def test_cli_bad_input_exits_2_and_writes_nothing(tmp_path):

@@ -35,7 +35,7 @@ from screwkit.model.mechanism import Mechanism
 from screwkit.synthesis.solve import ON_BOUND_RTOL, SynthesisError
 
 __all__ = ["GraphSynthesisProblem", "GraphSynthesisResult", "GraphTarget", "GraphVariable",
-           "graph_residuals", "graph_jacobian", "synthesize_graph",
+           "graph_residuals", "graph_jacobian", "graph_target_values", "synthesize_graph",
            "synthesize_graph_multistart"]
 
 FloatArray = NDArray[np.float64]
@@ -203,6 +203,16 @@ def generated(problem: GraphSynthesisProblem, x: FloatArray) -> list[FloatArray]
         raise _Infeasible(f"the drawn mode does not assemble (or is singular) at the target "
                           f"input {bad.tolist()} (SI)")
     return [_quantity(md, t, idx) for t, idx in zip(problem.targets, where, strict=True)]
+
+
+def graph_target_values(problem: GraphSynthesisProblem
+                        ) -> tuple[list[FloatArray] | None, str]:
+    """Per target, what the drawing itself generates (SI), or (None, why) where its drawn mode
+    does not reach a target input."""
+    try:
+        return generated(problem, problem.start_vector()), ""
+    except _Infeasible as exc:
+        return None, str(exc)
 
 
 def _residual_parts(problem: GraphSynthesisProblem, values: list[FloatArray]) -> FloatArray:
