@@ -376,6 +376,10 @@ def synthesize_graph(problem: GraphSynthesisProblem, start: FloatArray | None = 
     notes = [message.rstrip(".")] + [
         f"{name} ended on its {side} bound: the best design may lie beyond it; widen the "
         "bound to look" for name, (side, _) in on.items()]
+    if not np.isfinite(grad).all():
+        notes.append("the result lies at the edge of its drawn mode (a target input at a limit "
+                     "position of the design): no two-sided derivative there, so its optimality "
+                     "is not checked")
     if not range_ok:
         notes.append(range_message)
     E = float(r @ r)
@@ -383,7 +387,7 @@ def synthesize_graph(problem: GraphSynthesisProblem, start: FloatArray | None = 
         start=x0, x=np.asarray(x, dtype=float), residuals=r, objective=E,
         rmse=math.sqrt(E / max(r.size, 1)), at_bounds=on, status=status,
         message="; ".join(n for n in notes if n), generated=values, range_ok=range_ok,
-        range_message=range_message, gradient_norm=float(np.linalg.norm(grad[free])),
+        range_message=range_message, gradient_norm=float(np.linalg.norm(grad[free])),  # nan at the edge
         iterations=counts["jac"], evaluations=counts["fun"], time=elapsed, mechanism=mech)
 
 
