@@ -247,8 +247,15 @@ def graph_synthesis_problem(spec: GraphSpec, data: dict[str, Any]) -> GraphSynth
         if len(pair) != 2:
             raise _fail(spec, f"bounds.{text}", f"give [lower, upper]; got {pair!r}")
         j = labels.index(v.label)
-        lo, hi = ((spec.coordinate(b, "length", f"synthesis.bounds.{text}") for b in pair)
-                  if v.kind == "length" else (float(pair[0]), float(pair[1])))
+        if v.kind == "length":
+            lo, hi = (spec.coordinate(b, "length", f"synthesis.bounds.{text}") for b in pair)
+        elif all(isinstance(b, int | float) and not isinstance(b, bool) and math.isfinite(b)
+                 for b in pair):
+            lo, hi = float(pair[0]), float(pair[1])
+        else:
+            raise _fail(spec, f"bounds.{text}", f"an axis component is a plain finite number; "
+                                                f"give [lower, upper] without units, got "
+                                                f"{pair!r}")
         if not lo < hi:
             raise _fail(spec, f"bounds.{text}", f"lower {pair[0]!r} must be below upper "
                                                 f"{pair[1]!r}; swap them")
