@@ -45,13 +45,14 @@ def _residual(mech: Mechanism, conf: Configuration) -> float:
 def test_bundled_examples_decompose_or_say_what_needs_the_homotopy() -> None:
     expect = {"fourbar_graph": 2, "watt_sixbar": 4, "watt_sixbar_balance": 4,
               "watt_sixbar_simulate": 4, "jansen_leg": 8,
-              "double_wishbone": 4}
+              "double_wishbone": 4, "double_wishbone_synthesis": 4}
     for path in sorted(MECHANISMS.glob("*.toml")):
         mech = sk.load_spec(path).mechanism
         dec = decompose(mech)
         if path.stem in expect:
             assert dec.complete and dec.mode_count == expect[path.stem], path.stem
-            kinds = {"double_wishbone": ["RSS", "SS"]}.get(path.stem, ["RRR"] * len(dec.dyads))
+            kinds = {"double_wishbone": ["RSS", "SS"], "double_wishbone_synthesis": ["RSS", "SS"]
+                     }.get(path.stem, ["RRR"] * len(dec.dyads))
             assert [d.kind for d in dec.dyads] == kinds
         else:
             assert not dec.complete, path.stem

@@ -103,7 +103,8 @@ def loop_only(spec: T, command: str) -> T:
     if getattr(spec, "family", None) == "graph":
         user_error(f"{getattr(spec, 'path', '')}: `screwkit {command}` does not take a mechanism "
                    "graph (bodies and joints) yet; graphs work with validate, analyze, mobility, "
-                   "limits, report, dynamics, sweep, tolerance, balance, simulate, export-mjcf "
+                   "limits, report, dynamics, sweep, tolerance, balance, simulate, synthesize, "
+                   "export-mjcf "
                    "and export (docs/mechanisms.md)")
     return spec
 

@@ -12,7 +12,7 @@ from typing import Annotated, Any
 import typer
 from rich.markup import escape
 
-from screwkit.cli.common import console, loop_only, prose
+from screwkit.cli.common import console, prose, user_error
 from screwkit.cli.common import guard as _guard
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 from screwkit.cli.sweep_cmd import SchedulerOpt, WorkersOpt, engine_for, stopped
@@ -250,6 +250,27 @@ def global_synthesis(config: Any, starts: int, scheduler: str | None, workers: i
         stopped(exc, "nothing written")
 
 
+def _graph(spec: Any, out: Any, starts: int | None, spec_out: Path | None, csv: Path | None,
+           plot: Path | None, scheduler: str | None, workers: int | None) -> None:
+    """A graph spec: refuse what it has no counterpart for before any work, then solve."""
+    import importlib.util
+
+    from screwkit.cli.graph_synthesize import graph_synthesize
+
+    for flag, given in (("--csv", csv), ("--plot", plot), ("--scheduler", scheduler),
+                        ("--workers", workers)):
+        if given is not None:
+            user_error(f"{flag} is not available for a graph spec's synthesis; use --json or "
+                       "-o FILE.json (docs/synthesis.md, \"Graphs\")")
+    if out.output is not None and (out.output_format or "json") != "json":
+        user_error(f"-o {out.output}: a graph spec's synthesis writes JSON only; give a .json "
+                   "name")
+    if spec_out is not None and importlib.util.find_spec("tomlkit") is None:
+        user_error("--spec-out writes the synthesised spec with tomlkit, which is not "
+                   "installed: pip install 'screwkit[synthesis]'")
+    graph_synthesize(spec, out, starts, spec_out)
+
+
 def register(app: typer.Typer) -> None:
     """Add the ``synthesize`` command to ``app``."""
 
@@ -266,6 +287,7 @@ def register(app: typer.Typer) -> None:
         starts: Annotated[int | None, typer.Option("--starts", help="Multi-start: number of starts (overrides [synthesis.multistart], or [synthesis.overlay] starts); the least-squares starts run on the sweep engine (docs/sweeps.md).", min=1, max=10000)] = None,
         scheduler: SchedulerOpt = None,
         workers: WorkersOpt = None,
+        spec_out: Annotated[Path | None, typer.Option("--spec-out", help="Graph spec: write the synthesised spec (the input's text with the new hardpoints; comments kept) to this file.")] = None,
     ) -> None:
         """Optimise the mechanism's dimensions to generate a desired screw displacement
         (Bagci 1969 Ch. V: least squares with exact derivatives, dwell and range constraints;
@@ -281,8 +303,16 @@ def register(app: typer.Typer) -> None:
             asked = plot
             plot = _guard(lambda: plot_path(asked))
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
-                              unit=unit, full=full, files={"--plot": plot})
-        s = loop_only(_guard(lambda: load_spec(spec)), "synthesize")
+                              unit=unit, full=full, files={"--plot": plot,
+                                                           "--spec-out": spec_out})
+        loaded = _guard(lambda: load_spec(spec))
+        if getattr(loaded, "family", None) == "graph":
+            _graph(loaded, out, starts, spec_out, csv, plot, scheduler, workers)
+            return
+        if spec_out is not None:
+            user_error("--spec-out is for graph specs (a single loop's result is its "
+                       "dimensions, in the document)")
+        s = loaded
         du = out.units_for(s.units)
         pipe = Pipeline(s, units=du)
         config = _guard(lambda: pipe.synthesis_config())

@@ -43,6 +43,7 @@ from screwkit.model.mechanism_outputs import BodyAngle, Output, PointTravel
 
 if TYPE_CHECKING:
     from screwkit.balancing.config import BalancingConfig
+    from screwkit.synthesis.graph_route import GraphSynthesisProblem
 
 Value = StrictFloat | StrictInt | StrictStr
 MAX_ROWS = 10_000_000
@@ -123,6 +124,7 @@ class GraphSpecFile(_Strict):
     tolerances: dict[str, StrictStr] | None = None  # read by `screwkit tolerance`
     balancing: dict[str, Any] | None = None
     drive: dict[str, Any] | None = None  # checked by io/graph_drive.py when simulating
+    synthesis: dict[str, Any] | None = None  # io/graph_synthesis_table.py
 
 
 def is_graph_spec(data: dict[str, Any]) -> bool:
@@ -191,6 +193,11 @@ class GraphSpec:
         #: that ``validate`` reports what ``simulate`` would refuse
         self.drive: GraphDriveConfig | None = (graph_drive_config(self) if raw.drive is not None
                                                else None)
+        from screwkit.io.graph_synthesis_table import graph_synthesis_problem
+
+        #: the ``[synthesis]`` table (docs/synthesis.md, "Graphs"), checked at load
+        self.synthesis: GraphSynthesisProblem | None = (
+            graph_synthesis_problem(self, raw.synthesis) if raw.synthesis is not None else None)
 
     def _per_input(self, value: Any, kinds: list[str], key: str) -> list[tuple[str, Any, str]]:
         """A rate for every input: one value for all, or a list of one per input."""
@@ -216,6 +223,8 @@ class GraphSpec:
             out.append("dynamics")
         if self.balancing is not None:
             out.append("balance")
+        if self.synthesis is not None:
+            out.append("synthesize")
         return out
 
     # --- helpers ---------------------------------------------------------------------------

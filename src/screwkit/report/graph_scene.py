@@ -245,6 +245,12 @@ def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str 
                               f"{input_name}; the other inputs are plotted too.")
     if loads is not None or balance_doc is not None:
         _add_load_plots(spec, entries, plots, groups, (x, input_name, kind), loads, balance_doc)
+    if getattr(spec, "synthesis", None) is not None:
+        from screwkit.report.graph_synthesis_plots import graph_synthesis_plots
+
+        p, g = graph_synthesis_plots(spec, units)
+        plots += p
+        groups += g
     if topology is None:
         if spec is not None and getattr(spec, "topology", None) is not None:
             topology = list(spec.topology.summary())
