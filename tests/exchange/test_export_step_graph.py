@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from tests.exchange.test_export_step import _read
 from typer.testing import CliRunner
 
 import screwkit as sk
@@ -16,7 +17,6 @@ from screwkit.exchange.step import JOINT_HALF_LENGTH
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.model.mechanism import GROUND
 from screwkit.report.graph_scene import body_polylines
-from tests.exchange.test_export_step import _read
 
 MECHANISMS = Path(__file__).resolve().parents[2] / "examples" / "mechanisms"
 runner = CliRunner()

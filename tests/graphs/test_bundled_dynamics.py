@@ -21,13 +21,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.graphs.test_graph_dynamics_random import _body_motion, _dH
 from typer.testing import CliRunner
 
 import screwkit as sk
 from screwkit.cli.main import app
 from screwkit.dynamics.graph_inverse import graph_inverse_dynamics
 from screwkit.kinematics.graph import solve_mechanism
-from tests.graphs.test_graph_dynamics_random import _body_motion, _dH
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "mechanisms"
 NAMES = sorted(p.stem for p in EXAMPLES.glob("*.toml"))
