@@ -1,6 +1,6 @@
-"""The mechanism (a single loop or a graph of bodies) at chosen inputs to **STEP** (ISO 10303-21, AP214) solids through OpenCASCADE
-(OCP, the ``cadquery-ocp-novtk`` wheel: Apache-2.0 wrapper, OCCT LGPL-2.1; the ``[step]`` extra;
-docs/exchange.md "STEP").
+"""The mechanism (a single loop or a graph of bodies) at chosen inputs to **STEP** (ISO
+10303-21, AP214) solids through OpenCASCADE (OCP, the ``cadquery-ocp-novtk`` wheel: Apache-2.0
+wrapper, OCCT LGPL-2.1; the ``[step]`` extra; docs/exchange.md "STEP").
 
 The geometry is what the report and the glTF scene draw (:func:`screwkit.report.scene.
 link_polylines`), as exact B-rep primitives in the world frame at the input: one named part per
@@ -9,7 +9,7 @@ link (moving links by name, then ``ground``), a compound of
 - a cylinder of radius r along each segment of the link's polyline (from where it leaves its
   joint, along the common normal, to the next joint's centre) longer than round-off, and
 - the solid of the joint it leaves: a sphere of radius 2r for an S joint, else (R, P, C, H, U)
-  a cylinder of radius 2r and length 6r along the joint's axis, centred on the joint's centre,
+  a cylinder of radius 2r and length 6r along the joint's axis, centred on the joint's centre.
 
 A mechanism graph (:func:`graph_step_export`) has one named part per body (the moving bodies in
 ``[[bodies]]`` order, then ``ground``): a cylinder of radius r along each segment of the body's
@@ -17,9 +17,9 @@ drawn polyline (:func:`screwkit.report.graph_scene.body_polylines`: through its 
 and points, round the polygon they span), and the solid of every joint whose first body it is
 (the body whose frame carries the joint's centre and axis), as above.
 
-In both, r = 0.012 × the size of the joint centres' cloud over the sweep (as the glTF scene). Lengths
-are in the spec's ``[units] length`` (metres when it has none), written as the file's length
-unit, so a CAD program scales on import.
+In both, r = 0.012 × the size of the joint centres' cloud over the sweep (as the glTF scene).
+Lengths are in the spec's ``[units] length`` (metres when it has none), written as the file's
+length unit, so a CAD program scales on import.
 """
 
 from __future__ import annotations
