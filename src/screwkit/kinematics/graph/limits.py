@@ -42,10 +42,11 @@ def graph_limit_positions(motion: MechanismMotion, output: str | None = None,
                           dwell_tolerance: float = 1e-6, mode: int = 0) -> LimitPositions:
     """Every limit of ``output`` (a scalar joint freedom; default: every passive R, P, C, H
     freedom) over the motion's input sweep, on ``mode``. A mechanism driven by body freedoms
-    (``[[drives]]``) is handed to :func:`screwkit.kinematics.graph.limits_driven.
-    driven_limit_positions` (any output, along its rows)."""
+    (``[[drives]]``), or a named ``[[outputs]]`` entry asked for (camber, toe), is handed to
+    :func:`screwkit.kinematics.graph.limits_driven.driven_limit_positions` (any output, along
+    the input rows)."""
     mech = motion.mechanism
-    if mech.drives:  # along the rows of its driven body freedoms
+    if mech.drives or output in {o.name for o in mech.outputs}:  # along the input rows
         from screwkit.kinematics.graph.limits_driven import driven_limit_positions
 
         return driven_limit_positions(motion, output, dwell_tolerance, mode)

@@ -1,5 +1,6 @@
 """Limit positions (extremes) of any output of a mechanism graph driven by body freedoms
-(``[[drives]]``: a wheel's travel, a platform's pose; graph/drives.py), along its input rows.
+(``[[drives]]``: a wheel's travel, a platform's pose; graph/drives.py), along its input rows;
+also the limits of a named ``[[outputs]]`` entry of a graph driven by joints.
 
 The rows x_0, x_1, … are joined by straight segments x(t) = x_k + t Δ_k, Δ_k = x_{k+1} − x_k,
 t ∈ [0, 1] (for one driven freedom that is the sweep itself). The output y is a scalar joint
@@ -34,9 +35,9 @@ from screwkit.model.mechanism_outputs import BodyAngle
 
 Array = NDArray[np.float64]
 
-DERIVATIVES = ("first and second exact along the path (stacked screw Jacobian through the "
-               "drives' virtual chains); third and fourth by central differences of the exact "
-               "second")
+DERIVATIVES = ("first and second exact along the path (stacked screw Jacobian, through the "
+               "virtual chains of any [[drives]]); third and fourth by central differences of "
+               "the exact second")
 
 
 def driven_outputs(mech: Mechanism) -> dict[str, str]:
