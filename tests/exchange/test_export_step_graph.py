@@ -101,3 +101,15 @@ def test_stewart_platform_spheres_and_prismatic_legs(tmp_path):
     kinds = {j.kind for j in spec.mechanism.joints}
     assert "S" in kinds and len(kinds) >= 2
     _check_pose(parts, spec.mechanism, motion.mode(spec.mode if hasattr(spec, "mode") else 0), 0)
+
+
+def test_another_assembly_mode_of_the_six_bar(tmp_path):
+    """``--mode 1``: the closed-form dyads' second mode, solved with every mode."""
+    path = MECHANISMS / "watt_sixbar.toml"
+    parts = _read(_export(tmp_path, path, "--mode", "1", "--at", "30"))
+    spec = sk.load_spec(path)
+    motion = solve_mechanism(spec.mechanism, spec.inputs, rates=spec.speed, every_mode=True)
+    md = motion.mode(1)
+    drawn = motion.mode(0)
+    assert np.abs(md.joint_centres[30] - drawn.joint_centres[30]).max() > 1e-3  # another pose
+    _check_pose(parts, spec.mechanism, md, 30)
