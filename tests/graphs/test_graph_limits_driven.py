@@ -172,3 +172,16 @@ def test_named_outputs_of_a_joint_driven_suspension_against_brute_force(tmp_path
         assert doc["outputs"] == [name] and doc["input_name"] == "L.theta"
         n += _check_against_brute(spec.mechanism, spec.inputs, doc, along_rows=False)
     assert n >= 1
+
+
+def test_the_studio_lists_the_limits_of_a_pose_driven_platform() -> None:
+    """The studio's numbers (screwkit.studio.graph) give the same limits, at rows of the path."""
+    from screwkit.studio.graph import GraphRun, graph_numbers
+
+    path = EXAMPLES / "stewart_platform_pose.toml"
+    doc = _limits(path)
+    rows = {r[0]: r[1] for r in graph_numbers(GraphRun(sk.load_spec(path), 0))}
+    assert doc["limits"]
+    for lim in doc["limits"]:
+        text = rows[f"limit of {lim['output']}, mode 0"]
+        assert f"at row {lim['input']:.6g} of the input path (dwell order 1)" in text
