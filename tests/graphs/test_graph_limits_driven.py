@@ -185,3 +185,26 @@ def test_the_studio_lists_the_limits_of_a_pose_driven_platform() -> None:
     for lim in doc["limits"]:
         text = rows[f"limit of {lim['output']}, mode 0"]
         assert f"at row {lim['input']:.6g} of the input path (dwell order 1)" in text
+
+
+def test_the_way_to_a_segment_through_every_row_gives_the_same_limit(tmp_path: Path,
+                                                                      monkeypatch) -> None:
+    """A segment is reached straight from the drawing only when that lands where the motion
+    is; otherwise through every row before it: both routes give the same limit here, and a
+    start the motion is not at is told apart."""
+    import dataclasses
+
+    from screwkit.kinematics.graph import limits_driven
+
+    spec = sk.load_spec(_point_driven_fourbar(tmp_path))
+    motion = solve_mechanism(spec.mechanism, spec.inputs)
+    md = motion.modes[0]
+    X = np.asarray(spec.inputs, dtype=float)
+    assert limits_driven._way_to(spec.mechanism, X, 5, md).shape == (1, 1)
+    moved = dataclasses.replace(md, link_origin=md.link_origin + 1e-6)
+    assert limits_driven._way_to(spec.mechanism, X, 5, moved).shape == (6, 1)
+    straight = graph_limit_positions(motion, "D.theta").limits
+    monkeypatch.setattr(limits_driven, "_way_to", lambda mech, X, k, m: X[:k + 1])
+    (lim,) = graph_limit_positions(motion, "D.theta").limits
+    assert abs(lim.input - straight[0].input) <= 1e-12
+    assert abs(lim.value - straight[0].value) <= 1e-12

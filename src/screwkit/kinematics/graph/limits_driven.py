@@ -10,7 +10,8 @@ first and second derivatives are exact: the motion solved with input rate Δ_k a
 acceleration gives dy/dt and d²y/dt² (graph/newton.py through the mechanism's virtual chains).
 A sign change of dy/dt between a segment's two ends brackets a stationary point; Newton's method
 on dy/dt in t (kept inside the bracket, each step solved by continuation of the drawn mode from
-the drawing through x_k) finds it to round-off. The dwell order counts the vanishing
+the drawing through x_k — straight to x_k when that reaches the motion's configuration there,
+else through every row before it) finds it to round-off. The dwell order counts the vanishing
 derivatives as for joint inputs (graph/limits.py): the first two exact, the third and fourth by
 central differences of the exact second (step 1e-3 rad or 1e-3 of the length scale in the
 driven freedom, 1e-3 of a segment along a path of several).
@@ -66,16 +67,30 @@ def _solve(mech: Mechanism, rows: Array, rate: Array) -> MechanismMode:
     return solve_mechanism(mech, rows, rates=rate, accelerations=0.0).modes[0]
 
 
-def _jets(mech: Mechanism, start: Array, xs: Array, delta: Array, name: str
+def _jets(mech: Mechanism, path: Array, xs: Array, delta: Array, name: str
           ) -> tuple[Array, Array, Array] | None:
-    """Value, d/dt and d²/dt² of ``name`` at the rows ``xs`` (followed from ``start``, the
-    segment's first row) along the direction ``delta``; None where one does not assemble."""
-    rows = np.vstack([start, xs])
+    """Value, d/dt and d²/dt² of ``name`` at the rows ``xs``, followed through the rows
+    ``path`` (ending at the segment's first row) along the direction ``delta``; None where one
+    does not assemble."""
+    rows = np.vstack([path, xs])
     md = _solve(mech, rows, np.broadcast_to(delta, rows.shape))
     if not md.assembles.all():
         return None
     v, d1, d2 = _track(md, name)
-    return v[1:], d1[1:], d2[1:]
+    m = len(path)
+    return v[m:], d1[m:], d2[m:]
+
+
+def _way_to(mech: Mechanism, X: Array, k: int, motion: MechanismMode) -> Array:
+    """The rows to follow to reach row k as the motion did: row k alone (straight from the
+    drawing) when that lands on the motion's configuration there (every body's pose to 1e-9),
+    else every row up to k."""
+    alone = solve_mechanism(mech, X[k:k + 1]).modes[0]
+    scale = mech.length_scale
+    same = bool(alone.assembles[0]) and \
+        np.abs(alone.link_rotation[0] - motion.link_rotation[k]).max() <= 1e-9 and \
+        np.abs(alone.link_origin[0] - motion.link_origin[k]).max() <= 1e-9 * scale
+    return X[k:k + 1] if same else X[:k + 1]
 
 
 def driven_limit_positions(motion: MechanismMotion, output: str | None = None,
@@ -104,6 +119,7 @@ def driven_limit_positions(motion: MechanismMotion, output: str | None = None,
     slide = bool(mech.driven_is_translation()[0])
     h = 1e-3 * (mech.length_scale if slide else 1.0)
     found = []
+    ways: dict[int, Array] = {}  # per segment, the rows that reach its start (_way_to)
     for name in outputs:
         _, s0, _ = _track(at_start, name)
         _, s1, _ = _track(at_end, name)
@@ -112,7 +128,9 @@ def driven_limit_positions(motion: MechanismMotion, output: str | None = None,
             & np.isfinite(b)
         for k in np.nonzero(ok & (np.sign(a) * np.sign(b) < 0))[0]:
             ht = h / abs(float(D[k, 0])) if one else 1e-3
-            lim = _refine(mech, X[k], D[k], name, float(np.sign(a[k])), ht)
+            if int(k) not in ways:
+                ways[int(k)] = _way_to(mech, X, int(k), at_start)
+            lim = _refine(mech, ways[int(k)], D[k], name, float(np.sign(a[k])), ht)
             if lim is None:
                 continue
             t, value, derivs = lim
@@ -142,15 +160,16 @@ def driven_limit_positions(motion: MechanismMotion, output: str | None = None,
                           input_kind=input_kind)
 
 
-def _refine(mech: Mechanism, start: Array, delta: Array, name: str, sign0: float, ht: float
+def _refine(mech: Mechanism, path: Array, delta: Array, name: str, sign0: float, ht: float
             ) -> tuple[float, float, list[float]] | None:
     """Newton's method on dy/dt inside t ∈ [0, 1] (bisecting when a step leaves the bracket;
     ``sign0`` the sign of dy/dt at t = 0), then the derivatives there (module docstring):
     (t, y, [dy/dt … d⁴y/dt⁴]); None if it stops assembling."""
+    start = path[-1]
     lo, hi, t = 0.0, 1.0, 0.5
     jets = None
     for _ in range(60):
-        jets = _jets(mech, start, start + t * delta[None, :], delta, name)
+        jets = _jets(mech, path, start + t * delta[None, :], delta, name)
         if jets is None:
             return None
         d1, d2 = float(jets[1][0]), float(jets[2][0])
@@ -169,7 +188,7 @@ def _refine(mech: Mechanism, start: Array, delta: Array, name: str, sign0: float
     assert jets is not None
     value, d1, d2 = float(jets[0][0]), float(jets[1][0]), float(jets[2][0])
     derivs = [d1, d2]
-    near = _jets(mech, start, start + np.array([t - ht, t + ht])[:, None] * delta, delta, name)
+    near = _jets(mech, path, start + np.array([t - ht, t + ht])[:, None] * delta, delta, name)
     if near is not None:
         d2m, d2p = float(near[2][0]), float(near[2][1])
         derivs += [(d2p - d2m) / (2 * ht), (d2p - 2 * d2 + d2m) / ht**2]
