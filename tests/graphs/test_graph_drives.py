@@ -93,14 +93,31 @@ def test_pose_then_legs_round_trip_with_rates_and_accelerations() -> None:
 
 
 def test_pose_driven_leg_forces_do_the_work_the_energy_takes() -> None:
-    """Σ leg force · leg rate = d(kinetic + potential energy)/dt (five-point derivative along
-    a constant-rate pose path); the platform's Newton–Euler balance holds with the reported
-    ball reactions; the efforts equal those of the same motion driven by the legs."""
+    """Σ leg force · leg rate = d(kinetic + potential energy)/dt, exactly (dT/dt = Σ m v_c·a_c
+    + ω·(I α + ω × I ω), dV/dt = −Σ m g·v_c from the body twists and accelerations, to 1e-9
+    relative) along a pose path with random pose rates and accelerations, and by a five-point
+    derivative of the energy along a constant-rate path (a second, independent route, to 1e-7);
+    the platform's Newton–Euler balance holds with the reported ball reactions; the efforts
+    equal those of the same motion driven by the legs."""
     from tests.graphs.test_graph_dynamics import _energy_and_momentum
+    from tests.graphs.test_graph_dynamics_random import _body_motion, _dH
 
     spec = sk.load_spec(EXAMPLES / "stewart_platform_pose.toml")
     mech = spec.mechanism
-    x0 = _pose_rows(7, 11)[3]
+    rows = _pose_rows(7, 11)
+    rng = np.random.default_rng(5)
+    scale = np.array([0.05 * mech.length_scale] * 3 + [1.0] * 3)
+    exact = solve_mechanism(mech, rows, rates=rng.uniform(-1.0, 1.0, rows.shape) * scale,
+                            accelerations=rng.uniform(-2.0, 2.0, rows.shape) * scale)
+    dyn_x = graph_inverse_dynamics(exact, gravity=G)
+    bodies = _body_motion(mech, exact.modes[0])
+    q_dot = np.stack([exact.modes[0].velocities[n] for n in LEGS], axis=1)
+    power_x = np.einsum("nk,nk->n", dyn_x.efforts, q_dot)
+    dE_x = sum(bd["m"] * np.einsum("ni,ni->n", bd["v"], bd["a"] - G)
+               + np.einsum("ni,ni->n", bd["w"], _dH(bd)) for bd in bodies)
+    assert dyn_x.ok.all() and np.abs(dE_x).min() > 0
+    np.testing.assert_allclose(power_x, dE_x, rtol=0, atol=1e-9 * np.abs(dE_x).max())
+    x0 = rows[3]
     direction = np.array([0.02, -0.01, 0.03, 0.1, -0.05, 0.08])
     h = 1e-3
     X = x0 + np.arange(-2.0, 3.0)[:, None] * h * direction
@@ -173,6 +190,14 @@ def test_wheel_travel_drive_equals_the_arm_driven_suspension() -> None:
     dref = graph_inverse_dynamics(ref_motion, gravity=G)
     assert dyn.input_names == ("L.theta",)
     np.testing.assert_allclose(dyn.efforts, dref.efforts, rtol=1e-9)
+    # the arm's torque times its rate is the power the energy takes, exactly (no differences)
+    from tests.graphs.test_graph_dynamics_random import _body_motion, _dH
+
+    bodies = _body_motion(travel.mechanism, md)
+    dE = sum(bd["m"] * np.einsum("ni,ni->n", bd["v"], bd["a"] - G)
+             + np.einsum("ni,ni->n", bd["w"], _dH(bd)) for bd in bodies)
+    power = dyn.efforts[:, 0] * md.velocities["L.theta"]
+    np.testing.assert_allclose(power, dE, rtol=0, atol=1e-9 * np.abs(dE).max())
 
 
 def _stewart(drives: list[str], inputs: tuple[str, ...] = (), actuated: tuple[str, ...] = ()

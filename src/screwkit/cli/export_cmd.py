@@ -1,7 +1,7 @@
 """``screwkit export SPEC --format dxf|gltf|step -o FILE``: the spec's motion as a CAD exchange
 file — DXF coupler curves (a graph's point paths), joint paths and link (body) skeletons in
 the spec's length unit, or the animated glTF (GLB) scene, of a single loop or a mechanism
-graph, or STEP link solids of a single loop at chosen inputs (the ``[step]`` extra;
+graph, or STEP link (body) solids at chosen inputs (the ``[step]`` extra;
 docs/exchange.md). Registered on the
 main app by ``register(app)``."""
 

@@ -23,7 +23,9 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
 
     prose(f"[bold]{escape(spec.describe(units))}[/]")
     prose(f"method: {doc['method']}; derivatives: {escape(doc['derivatives'])}")
-    xk = variable_kind(doc["input_name"] if doc["method"] == "generic" else "theta0")
+    xk = doc.get("input_kind") or variable_kind(doc["input_name"] if doc["method"] == "generic"
+                                                else "theta0")
+    x_label = "row" if xk == "ratio" else units.label(xk)  # a position along input rows
 
     def shown(x: float | None, kind: str) -> str:
         return "—" if x is None else f"{number(units.show(kind, x), 7)} {units.label(kind)}"
@@ -38,7 +40,8 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
         if v is None:
             return "—"
         out_label, out_factor = ("rad", 1.0) if kind_of(x) == "angle" else units.unit_of("length")
-        in_label, in_factor = ("rad", 1.0) if xk == "angle" else units.unit_of("length")
+        in_label, in_factor = ("rad", 1.0) if xk == "angle" else ("row", 1.0) \
+            if xk == "ratio" else units.unit_of("length")
         return f"{number(v / out_factor * in_factor**2, 4)} {out_label}/{in_label}²"
 
     generic = doc["method"] == "generic"
@@ -47,7 +50,7 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
             TextColumn("kind", [x["kind"] for x in lims], "left"),
             TextColumn("mode" if generic else "branch",
                        [str(x.get("mode", x.get("branch"))) for x in lims]),
-            TextColumn(f"input\n[{units.label(xk)}]",
+            TextColumn(f"input\n[{x_label}]",
                        [number(units.show(xk, x["input"]), 7) for x in lims]),
             TextColumn("value", [shown(x["value"], kind_of(x)) for x in lims]),
             TextColumn("2nd\nderivative", [second(x) for x in lims]),
@@ -58,7 +61,7 @@ def show_limits(spec: Any, doc: dict[str, Any], units: Any) -> None:
         d = doc["dwells_at"]
         kinds = {x["output"]: variable_kind(x["output"]) for x in d}
         cols = [TextColumn("output", [x["output"] for x in d], "left"),
-                TextColumn(f"input\n[{units.label(xk)}]",
+                TextColumn(f"input\n[{x_label}]",
                            [number(units.show(xk, x["input"]), 7) for x in d]),
                 TextColumn("mode" if generic else "inversion",
                            [str(x.get("mode", x.get("inversion_label"))) for x in d]),

@@ -1,7 +1,7 @@
 """``screwkit export``'s computation: a solved motion of a spec (a single loop or a mechanism
 graph, through :mod:`screwkit.exchange.geometry`) to a CAD exchange file — DXF
 curves and skeleton (:mod:`screwkit.exchange.dxf`) or an animated glTF scene
-(:mod:`screwkit.exchange.gltf`) or STEP link solids of a single loop at chosen inputs
+(:mod:`screwkit.exchange.gltf`) or STEP link (body) solids at chosen inputs
 (:mod:`screwkit.exchange.step`, the ``[step]`` extra); docs/exchange.md."""
 
 from __future__ import annotations
@@ -129,6 +129,13 @@ def export_graph_motion(spec: Any, motion: Any, samples: ExportSamples, fmt: str
     the first input's speed."""
     from screwkit.exchange.geometry import graph_geometry
 
+    if fmt == "step":  # body solids (exchange/step.py), of one mode at the --at inputs
+        from screwkit.exchange.step import graph_step_export
+
+        k = getattr(spec, "mode", 0) if mode is None else mode
+        data, notes = graph_step_export(motion, motion.mode(k).index, list(samples.at),
+                                        at_labels, spec_unit=spec.units.get("length"))
+        return Export(data, fmt, notes)
     modes = _modes(spec, motion, fmt, mode)
     speed = float(np.asarray(spec.speed, dtype=float).reshape(-1)[0])
     return write_geometry(spec, graph_geometry(motion, modes), samples, fmt,
@@ -185,9 +192,6 @@ def graph_export(spec: Any, fmt: str, at: Sequence[str] = (), *, mode: int | Non
     from screwkit.kinematics.graph import solve_mechanism
 
     kind = export_format(fmt)
-    if kind == "step":
-        raise ExportError(f"{spec.name}: STEP export takes single loops only so far; export a "
-                          "mechanism graph as --format gltf (animated bodies) or dxf")
     inputs = np.asarray(spec.inputs, dtype=float)
     steps = np.diff(inputs[:, 0])
     if at and (inputs.shape[1] != 1 or not (np.all(steps > 0) or np.all(steps < 0))):

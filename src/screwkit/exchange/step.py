@@ -1,6 +1,6 @@
-"""The mechanism at chosen inputs to **STEP** (ISO 10303-21, AP214) solids through OpenCASCADE
-(OCP, the ``cadquery-ocp-novtk`` wheel: Apache-2.0 wrapper, OCCT LGPL-2.1; the ``[step]`` extra;
-docs/exchange.md "STEP").
+"""The mechanism (a single loop or a graph of bodies) at chosen inputs to **STEP** (ISO
+10303-21, AP214) solids through OpenCASCADE (OCP, the ``cadquery-ocp-novtk`` wheel: Apache-2.0
+wrapper, OCCT LGPL-2.1; the ``[step]`` extra; docs/exchange.md "STEP").
 
 The geometry is what the report and the glTF scene draw (:func:`screwkit.report.scene.
 link_polylines`), as exact B-rep primitives in the world frame at the input: one named part per
@@ -9,11 +9,17 @@ link (moving links by name, then ``ground``), a compound of
 - a cylinder of radius r along each segment of the link's polyline (from where it leaves its
   joint, along the common normal, to the next joint's centre) longer than round-off, and
 - the solid of the joint it leaves: a sphere of radius 2r for an S joint, else (R, P, C, H, U)
-  a cylinder of radius 2r and length 6r along the joint's axis, centred on the joint's centre,
+  a cylinder of radius 2r and length 6r along the joint's axis, centred on the joint's centre.
 
-with r = 0.012 × the size of the joint centres' cloud over the sweep (as the glTF scene). Lengths
-are in the spec's ``[units] length`` (metres when it has none), written as the file's length
-unit, so a CAD program scales on import.
+A mechanism graph (:func:`graph_step_export`) has one named part per body (the moving bodies in
+``[[bodies]]`` order, then ``ground``): a cylinder of radius r along each segment of the body's
+drawn polyline (:func:`screwkit.report.graph_scene.body_polylines`: through its joints' centres
+and points, round the polygon they span), and the solid of every joint whose first body it is
+(the body whose frame carries the joint's centre and axis), as above.
+
+In both, r = 0.012 × the size of the joint centres' cloud over the sweep (as the glTF scene).
+Lengths are in the spec's ``[units] length`` (metres when it has none), written as the file's
+length unit, so a CAD program scales on import.
 """
 
 from __future__ import annotations
@@ -173,4 +179,63 @@ def step_export(motion: Any, mode: int, at: Sequence[int], at_labels: Sequence[s
         suffix = f" at {label}" if len(at) > 1 else ""
         bodies += link_bodies(names, kinds, polylines[i], centres[i],
                               np.asarray(md.joint_axes)[i], radius, metres, suffix)
+    return step_bytes(bodies, unit, metres), []
+
+
+def _joint_solid(body: StepBody, kind: str, centre: Array, axis: Array, r: float) -> None:
+    """Add a joint's solid (module docstring) centred on ``centre`` (file units) to ``body``."""
+    if kind.upper() == "S":
+        body.spheres.append((centre, 2 * r))
+    else:
+        h = JOINT_HALF_LENGTH * r * np.asarray(axis, dtype=float)
+        body.cylinders.append((centre - h, centre + h, 2 * r))
+
+
+def graph_bodies(names: Sequence[str], polylines: Array, owners: Sequence[int],
+                 kinds: Sequence[str], centres: Array, axes: Array, radius: float,
+                 scale: float = 1.0, suffix: str = "") -> list[StepBody]:
+    """The parts (module docstring) of one pose of a graph: body k (``names[k]``) has the
+    polyline ``polylines[k]`` (P, 3; a repeated vertex draws nothing); joint i (``kinds[i]``,
+    centre ``centres[i]``, unit axis ``axes[i]``) is carried by body ``owners[i]``; world
+    metres, divided by ``scale`` (metres per file unit)."""
+    r = radius / scale
+    bodies = [StepBody(f"{name}{suffix}") for name in names]
+    for k, body in enumerate(bodies):
+        pts = np.asarray(polylines[k], dtype=float) / scale
+        for a, b in zip(pts[:-1], pts[1:], strict=True):
+            if np.linalg.norm(b - a) > 1e-9 * r:
+                body.cylinders.append((a, b, r))
+    for i, kind in enumerate(kinds):
+        _joint_solid(bodies[owners[i]], str(kind), np.asarray(centres[i], dtype=float) / scale,
+                     axes[i], r)
+    return bodies
+
+
+def graph_step_export(motion: Any, mode: int, at: Sequence[int], at_labels: Sequence[str], *,
+                      spec_unit: str | None) -> tuple[bytes, list[str]]:
+    """:func:`step_export` for a mechanism graph's ``solve_mechanism`` motion: one part per
+    body and the ground at each sample of ``at``."""
+    from screwkit.model.mechanism import GROUND
+    from screwkit.report.graph_scene import body_polylines
+
+    unit, metres = step_unit(spec_unit)
+    md = motion.mode(mode)
+    mech = motion.mechanism
+    ok = np.asarray(md.assembles, dtype=bool)
+    centres = np.asarray(md.joint_centres, dtype=float)
+    size = float(np.linalg.norm(np.ptp(centres[ok].reshape(-1, 3), axis=0))) if ok.any() else 0
+    radius = 0.012 * (size or 1.0)
+    names = [*mech.body_names, GROUND]
+    owners = [names.index(j.bodies[0]) for j in mech.joints]
+    kinds = [str(j.kind) for j in mech.joints]
+    polylines = body_polylines(mech, md)
+    axes = np.asarray(md.joint_axes, dtype=float)
+    bodies: list[StepBody] = []
+    for i, label in zip(at, at_labels, strict=True):
+        if not ok[i]:
+            raise ExportError(f"assembly mode {md.index} does not assemble at {label}; choose "
+                              "another input (--at) or mode (--mode)")
+        suffix = f" at {label}" if len(at) > 1 else ""
+        bodies += graph_bodies(names, polylines[i], owners, kinds, centres[i], axes[i], radius,
+                               metres, suffix)
     return step_bytes(bodies, unit, metres), []

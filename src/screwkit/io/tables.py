@@ -101,7 +101,9 @@ def limits_table(doc: dict[str, Any]) -> ResultTable:
     cols = [Column("output", "text", np.array([r["output"] for r in lims], dtype=str)),
             Column("kind", "text", np.array([r["kind"] for r in lims], dtype=str)),
             Column("mode", "index", index("mode")), Column("branch", "index", index("branch")),
-            Column("input", variable_kind(doc.get("input_name", "theta0")), col("input")),
+            Column("input", doc.get("input_kind") or variable_kind(doc.get("input_name",
+                                                                          "theta0")),
+                   col("input")),
             Column("value", "angle", col("value", rotation)),
             Column("value_length", "length", col("value", lambda r: not rotation(r))),
             # d²y/dx² per rad² of the input: a rotation's is a plain number (rad/rad²), a

@@ -233,14 +233,17 @@ def graph_numbers(run: GraphRun) -> list[list[str]]:
                      f"and {x[hi]:.6g} {xl})"])
     try:
         lim = graph_limit_positions(run.motion, None, 1e-6, run.shown_mode)
+        at_kind = lim.input_kind or x_kind  # a body-driven graph says what its input is
         for p in lim.limits:
             kind = "angle" if p.kind == "rotation" else "length"
+            where = (f"row {p.input:.6g} of the input path" if at_kind == "ratio" else
+                     f"input {units.show(at_kind, p.input):.6g} {units.label(at_kind)}")
             rows.append([f"limit of {p.output}, mode {md.index}",
-                         f"{units.show(kind, p.value):.6g} {units.label(kind)} at input "
-                         f"{units.show(x_kind, p.input):.6g} {xl} (dwell order "
-                         f"{p.dwell_order})"])
+                         f"{units.show(kind, p.value):.6g} {units.label(kind)} at {where} "
+                         f"(dwell order {p.dwell_order})"])
         if not lim.limits:
-            rows.append(["limit positions", "none of the joint freedoms over the sweep"])
+            what = "outputs" if spec.mechanism.drives else "joint freedoms"
+            rows.append(["limit positions", f"none of the {what} over the sweep"])
     except ScrewkitError as exc:
         rows.append(["limit positions", str(exc)])
     return rows

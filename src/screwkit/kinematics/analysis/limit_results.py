@@ -84,10 +84,14 @@ class LimitPositions:
     dwells_at: list[DwellAt] = field(default_factory=list)
     derivatives: str = ""
     notes: tuple[str, ...] = ()
+    #: what the input is when its name does not say: ``"length"``, ``"angle"`` or ``"ratio"``
+    #: (a position along a path of input rows, counted in rows)
+    input_kind: str | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON document of ``screwkit limits`` (docs/cli.md)."""
-        return {"mechanism": self.mechanism, "family": self.family, "method": self.method,
+        extra = {} if self.input_kind is None else {"input_kind": self.input_kind}
+        return {**extra, "mechanism": self.mechanism, "family": self.family, "method": self.method,
                 "input_name": self.input_name, "outputs": list(self.outputs),
                 "dwell_tolerance": self.dwell_tolerance, "max_order": self.max_order,
                 "derivatives": self.derivatives, "notes": list(self.notes),

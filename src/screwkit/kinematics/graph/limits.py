@@ -41,12 +41,15 @@ def _jet(motion: MechanismMotion, lay: GraphLayout, conf: Configuration, f: int
 def graph_limit_positions(motion: MechanismMotion, output: str | None = None,
                           dwell_tolerance: float = 1e-6, mode: int = 0) -> LimitPositions:
     """Every limit of ``output`` (a scalar joint freedom; default: every passive R, P, C, H
-    freedom) over the motion's input sweep, on ``mode``."""
+    freedom) over the motion's input sweep, on ``mode``. A mechanism driven by body freedoms
+    (``[[drives]]``), or a named ``[[outputs]]`` entry asked for (camber, toe), is handed to
+    :func:`screwkit.kinematics.graph.limits_driven.driven_limit_positions` (any output, along
+    the input rows)."""
     mech = motion.mechanism
-    if mech.drives:
-        raise CapabilityError(f"{mech.name}: limit positions are found along one joint input; "
-                              "this mechanism is driven by body freedoms "
-                              f"({', '.join(mech.driven_names)}): drive a joint instead")
+    if mech.drives or output in {o.name for o in mech.outputs}:  # along the input rows
+        from screwkit.kinematics.graph.limits_driven import driven_limit_positions
+
+        return driven_limit_positions(motion, output, dwell_tolerance, mode)
     if len(mech.inputs) != 1:
         raise CapabilityError(f"{mech.name}: limit positions need one input; this mechanism "
                               f"has {len(mech.inputs)} ({', '.join(mech.inputs)})")
