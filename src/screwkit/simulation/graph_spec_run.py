@@ -36,7 +36,8 @@ class GraphSpecSimulation:
                           "friction": {f.joint: {"rotation": f.rotation,
                                                  "translation": f.translation}
                                        for f in d.friction},
-                          "gravity": d.gravity, "rtol": d.rtol, "atol": d.atol},
+                          "gravity": d.gravity, "rtol": d.rtol, "atol": d.atol,
+                          "load": None if d.load is None else vars(d.load)},
                 **self.simulation.as_dict()}
 
 
@@ -48,7 +49,7 @@ def graph_spec_equation_of_motion(spec: Any, drive: GraphDriveConfig | None = No
     return GraphEquationOfMotion(
         spec.mechanism, motors=d.motors,
         flywheel=d.flywheel if flywheel is None else flywheel, friction=d.friction,
-        gravity=spec.gravity_vector if d.gravity else None)
+        gravity=spec.gravity_vector if d.gravity else None, load=d.load)
 
 
 def simulate_graph_spec(spec: Any, *, duration: float | None = None,
@@ -76,9 +77,15 @@ def graph_simulation_table(sim: GraphSimulation) -> ResultTable:
                  Column(f"{name}.acceleration", kinds[2], sim.accelerations[:, k]),
                  Column(f"{name}.motor", kinds[3], sim.motor[:, k]),
                  Column(f"{name}.friction", kinds[3], sim.friction[:, k])]
+        if sim.load is not None:
+            cols.append(Column(f"{name}.load", kinds[3], sim.load[:, k]))
     cols += [Column("kinetic_energy", "energy", sim.kinetic_energy),
              Column("potential_energy", "energy", sim.potential_energy),
              Column("motor_work", "energy", sim.motor_work),
              Column("friction_work", "energy", sim.friction_work),
+             *([] if sim.load_work is None or sim.output_force is None else
+               [Column("load_work", "energy", sim.load_work),
+                Column("output_force", "force" if str(sim.load_freedom).endswith(".s")
+                       else "moment", sim.output_force)]),
              Column("closure_residual", "ratio", np.asarray(sim.closure_residual))]
     return ResultTable(tuple(cols), "simulation of a mechanism graph: one row per sample")
