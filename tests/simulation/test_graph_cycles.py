@@ -23,7 +23,12 @@ from screwkit.io.graph_drive import graph_drive_config
 from screwkit.io.mechanism_spec import graph_spec_from_data
 from screwkit.model.mechanism import Mechanism
 from screwkit.simulation.drive import equation_of_motion
-from screwkit.simulation.flywheel import SIZING_RTOL, size_flywheel, steady_simulation, with_flywheel
+from screwkit.simulation.flywheel import (
+    SIZING_RTOL,
+    size_flywheel,
+    steady_simulation,
+    with_flywheel,
+)
 from screwkit.simulation.graph_cycles import simulate_graph_cycles, size_graph_flywheel
 from screwkit.simulation.graph_eom import GraphEquationOfMotion
 from screwkit.simulation.graph_mjcf import graph_mjcf_layout, graph_mjcf_model

@@ -118,6 +118,27 @@ def _extremes(t: Array, w: Array) -> tuple[float, float]:
     return top(w), -top(-w)
 
 
+def _cycle_statistics(res: Any, t: float, t_end: float, y: Array, y_end: Array,
+                      motor: Any, sense: float) -> dict[str, float]:
+    """One cycle's statistics (module docstring) from its ``solve_ivp`` result ``res`` (dense
+    output) between ``t`` (state ``y``) and ``t_end`` (state ``y_end``)."""
+    ts = np.asarray(res.sol.ts)
+    ts = ts[ts <= t_end]
+    fine = np.concatenate([np.linspace(a, b, POINTS_PER_STEP, endpoint=False)
+                           for a, b in zip(ts[:-1], ts[1:], strict=True)] + [[t_end]])
+    speed = res.sol(fine)[1]
+    hi, lo = _extremes(fine, speed)
+    T_k = t_end - t
+    dy = y_end - y
+    tau = np.abs(motor_torque(motor, np.array([*speed, hi, lo])))
+    mean = TWO_PI / T_k
+    return {"period": T_k, "mean_speed": sense * mean, "min_speed": lo, "max_speed": hi,
+            "fluctuation": (hi - lo) / mean, "motor_work": float(dy[2]),
+            "friction_work": float(dy[3]), "load_work": float(dy[4]),
+            "motor_torque_rms": float(np.sqrt(dy[5] / T_k)),
+            "motor_torque_peak": float(tau.max())}
+
+
 def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_rate: float,
                           initial_input: float = 0.0, rtol: float = 1e-10,
                           atol: float | None = None, max_time: float | None = None
@@ -191,21 +212,7 @@ def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_ra
             break
         t_end = float(res.t_events[0][0])
         y_end = res.y_events[0][0]
-        ts = np.asarray(res.sol.ts)
-        ts = ts[ts <= t_end]
-        fine = np.concatenate([np.linspace(a, b, POINTS_PER_STEP, endpoint=False)
-                               for a, b in zip(ts[:-1], ts[1:], strict=True)] + [[t_end]])
-        speed = res.sol(fine)[1]
-        hi, lo = _extremes(fine, speed)
-        T_k = t_end - t
-        dy = y_end - y
-        tau = np.abs(motor_torque(motor, np.array([*speed, hi, lo])))
-        mean = TWO_PI / T_k
-        stats.append({"period": T_k, "mean_speed": sense * mean, "min_speed": lo,
-                      "max_speed": hi, "fluctuation": (hi - lo) / mean,
-                      "motor_work": dy[2], "friction_work": dy[3], "load_work": dy[4],
-                      "motor_torque_rms": float(np.sqrt(dy[5] / T_k)),
-                      "motor_torque_peak": float(tau.max())})
+        stats.append(_cycle_statistics(res, t, t_end, y, y_end, motor, sense))
         try:
             T = eom.terms(y_end[:1], y_end[1:2])
         except SimulationError as exc:
