@@ -20,6 +20,9 @@ mechanism (docs/simulation.md, "Graphs"), validated with pydantic and turned, on
     freedom = "slider.s"
     force = "40 N"
     damping = "2 N*s/m"
+    [drive.point_force]           # a constant force (world axes) at a named body point
+    point = "P"
+    force = ["0 N", "-20 N", "0 N"]
     [drive.friction]              # joint -> viscous coefficient, or { rotation, translation }
     OB = "1e-4 N*m*s/rad"
 
@@ -57,6 +60,12 @@ from screwkit.io.drive_table import (
 from screwkit.io.validation import validation_lines
 
 
+class PointForceTable(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    point: StrictStr
+    force: list[Value] = Field(min_length=3, max_length=3)
+
+
 class GraphDriveTable(BaseModel):
     model_config = ConfigDict(extra="forbid")
     duration: Value
@@ -65,6 +74,7 @@ class GraphDriveTable(BaseModel):
     flywheel: Value | dict[StrictStr, Value] = 0.0
     motors: dict[StrictStr, MotorTable] = Field(default_factory=dict)
     load: LoadTable | None = None
+    point_force: PointForceTable | None = None
     friction: dict[StrictStr, Value | FrictionTable] | None = None
     gravity: StrictBool = False
     rtol: StrictFloat = Field(1e-10, gt=0.0, lt=1e-2)
@@ -86,6 +96,7 @@ class GraphDriveConfig:
     rtol: float
     atol: float | None
     load: LoadConfig | None = None
+    point_force: tuple[str, tuple[float, float, float]] | None = None
 
 
 def _fail(spec: Any, key: str, message: str) -> None:
@@ -183,7 +194,24 @@ def graph_drive_config(spec: Any) -> GraphDriveConfig:
     return GraphDriveConfig(duration, t.samples,
                             _per_input(spec, t.initial_speed, rate, "initial_speed"), flywheel,
                             tuple(motors), _friction(spec, t.friction), t.gravity, t.rtol,
-                            t.atol, _load(spec, t.load))
+                            t.atol, _load(spec, t.load), _point_force(spec, t.point_force))
+
+
+def _point_force(spec: Any, t: PointForceTable | None
+                 ) -> tuple[str, tuple[float, float, float]] | None:
+    """``[drive.point_force]``: a named point of a moving body and a constant force (world
+    axes, the spec's force unit)."""
+    if t is None:
+        return None
+    points = {p.name: p for p in spec.mechanism.points}
+    if t.point not in points:
+        _fail(spec, "point_force.point", f"no point {t.point!r}; the points are "
+                                         f"{sorted(points)} (add a [[points]] entry)")
+    if points[t.point].body == "ground":
+        _fail(spec, "point_force.point", f"{t.point!r} is on the ground, which does not move")
+    x, y, z = (spec.quantity(v, "force", f"drive.point_force.force[{i}]")
+               for i, v in enumerate(t.force))
+    return t.point, (x, y, z)
 
 
 def _load(spec: Any, t: LoadTable | None) -> LoadConfig | None:

@@ -238,7 +238,8 @@ def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_ra
 def with_graph_flywheel(eom: GraphEquationOfMotion, flywheel: float) -> GraphEquationOfMotion:
     """The same equations of motion with flywheel ``flywheel`` on the input."""
     return GraphEquationOfMotion(eom.mechanism, motors=eom.motors, flywheel=flywheel,
-                                 friction=eom.friction, gravity=eom.gravity, load=eom.load)
+                                 friction=eom.friction, gravity=eom.gravity, load=eom.load,
+                                 point_force=eom.point_force)
 
 
 def steady_graph_cycle(eom: GraphEquationOfMotion, guess: float, *, initial_input: float = 0.0,

@@ -16,7 +16,7 @@ and Applications*, 1985, ch. 6: generalized active and inertia forces, the parti
     h_k  = Σ_b m a⁰_c·v̂_c,k + (I α⁰ + ω × I ω)·ω̂_k,
     Q_g,k = Σ_b m g·v̂_c,k,
     Q_f,k = −Σ_j c_rot,j ω_rel,j·ω̂_rel,j,k + c_slide,j ṡ_j ŝ_j,k,
-    Q_load,k = Q_out(q̇_out) G_out,k,
+    Q_load,k = Q_out(q̇_out) G_out,k + F·v̂_P,k,
 
 where I = R I_c Rᵀ is a body's inertia about its centre of mass in world axes, a⁰_c and α⁰ its
 accelerations at ẍ = 0 (the velocity-product terms:
@@ -25,7 +25,9 @@ friction is the viscous joint friction of ``[drive.friction]`` (the moment −c 
 joint's two bodies, the force −c ṡ along a slide) and Q_load the ``[drive.load]``: the force
 or torque Q_out (:func:`~screwkit.simulation.drive.output_force`) on one joint freedom q_out,
 carried to the inputs by its partial rates G_out,k = ∂q̇_out/∂ẋ_k (virtual work, as a loop's
-Q_out·r). A motor on a slide input is a force motor (N against m/s, the same laws). h is Lagrange's ½ Ṁ ẋ terms and the
+Q_out·r), plus a constant world force F at a named point P of a body (``[drive.point_force]``),
+whose generalised force is F·v̂_P,k with v̂_P,k = v̂_0,k + ω̂_k × p the point's partial
+velocities (Kane's generalised active force). A motor on a slide input is a force motor (N against m/s, the same laws). h is Lagrange's ½ Ṁ ẋ terms and the
 centripetal ones, so d/dt(½ ẋᵀ(M + J_f)ẋ + V) = (τ + Q_f + Q_load)·ẋ with V = −Σ m g·c: the energy
 balance that the simulation checks.
 
@@ -64,7 +66,7 @@ from screwkit.kinematics.graph.newton import (
 )
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mass import MassProperties
-from screwkit.model.mechanism import Mechanism
+from screwkit.model.mechanism import GROUND, Mechanism
 from screwkit.simulation.drive import motor_torque, output_force
 from screwkit.simulation.reduced import SimulationError
 
@@ -150,13 +152,15 @@ class GraphEquationOfMotion:
     ``motors`` one :class:`~screwkit.io.drive_table.MotorConfig` per input (kind ``none`` for
     an undriven one); ``flywheel`` (n,) inertia on each input (kg·m², kg on a slide);
     ``friction`` joint friction; ``gravity`` (3,) m/s²; ``load`` the load on one joint
-    freedom (:class:`~screwkit.io.drive_table.LoadConfig`). The configuration last closed is kept
+    freedom (:class:`~screwkit.io.drive_table.LoadConfig`); ``point_force`` (point name, force
+    (3,) N in world axes) a constant force at a named point of a body. The configuration last closed is kept
     and starts the next Newton solve (the integrator moves in small steps), so one object
     follows one run."""
 
     def __init__(self, mech: Mechanism, *, motors: Sequence[MotorConfig] | None = None,
                  flywheel: ArrayLike | None = None, friction: Sequence[JointFriction] = (),
-                 gravity: ArrayLike | None = None, load: LoadConfig | None = None) -> None:
+                 gravity: ArrayLike | None = None, load: LoadConfig | None = None,
+                 point_force: tuple[str, ArrayLike] | None = None) -> None:
         self.mechanism = mech
         self.layout: GraphLayout = graph_layout(mech)
         n = len(mech.inputs)
@@ -176,6 +180,8 @@ class GraphEquationOfMotion:
         self.gravity = np.zeros(3) if gravity is None else np.asarray(gravity, dtype=float)
         self.load = load
         self._load_row = None if load is None else self._loaded_freedom(load)
+        self.point_force = point_force
+        self._point = None if point_force is None else self._forced_point(*point_force)
         from screwkit.kinematics.graph.motion import expected_rank
 
         self.rank = expected_rank(mech, self.layout)
@@ -194,6 +200,24 @@ class GraphEquationOfMotion:
                                   f"{names}")
         k = next(i for i, j in enumerate(mech.joints) if load.freedom in j.freedom_names())
         return int(lay.first_freedom[k] + mech.joints[k].freedom_names().index(load.freedom))
+
+    def _forced_point(self, name: str, force: ArrayLike) -> tuple[int, Array, Array]:
+        """The body index, drawn position and force of the point force; clear errors."""
+        mech = self.mechanism
+        points = {p.name: p for p in mech.points}
+        if name not in points:
+            raise SimulationError(f"{mech.name}: a force at point {name!r}, which is not a "
+                                  f"point of it; the points are {sorted(points)} (add it as a "
+                                  "[[points]] entry on its body)")
+        pt = points[name]
+        if pt.body not in self.layout.body_of or pt.body == GROUND:
+            raise SimulationError(f"{mech.name}: point {name!r} is on the ground, which does "
+                                  "not move: a force there does no work on the mechanism")
+        F = np.asarray(force, dtype=float).reshape(-1)
+        if F.shape != (3,) or not np.all(np.isfinite(F)):
+            raise SimulationError(f"{mech.name}: the force at point {name!r} is three finite "
+                                  f"components (N, world axes); got {F.tolist()}")
+        return self.layout.body_of[pt.body], np.asarray(pt.at, dtype=float), F
 
     def start_at(self, x: ArrayLike) -> None:
         """Start the closures from the drawn mode followed to inputs ``x`` (n,) (the graph
@@ -322,6 +346,10 @@ class GraphEquationOfMotion:
         if self._load_row is not None:
             q_out = float(output_force(self.load, qd[self._load_row]))
             Ql = q_out * st.G[self._load_row]
+        if self._point is not None:
+            b, at, F = self._point
+            p = st.lin.frames.R[0, b] @ at + st.lin.frames.p[0, b]
+            Ql = Ql + (V_k[:, b, 3:] + cross(V_k[:, b, :3], np.broadcast_to(p, (self.inputs, 3)))) @ F
         acc = np.linalg.solve(M, tau + Qg + Qf + Ql - h)
         kinetic = 0.5 * (np.einsum("b,bi,bi->", m, v_c, v_c) + np.einsum("bi,bi->", w, Iw)
                          + float(self.flywheel @ xd ** 2))

@@ -39,7 +39,8 @@ class GraphSimulation:
     """One run (SI): ``time`` (K,), ``inputs``/``rates``/``accelerations``/``motor``/
     ``friction``/``load`` (K, n) per input, ``kinetic_energy``/``potential_energy``/
     ``motor_work``/``friction_work``/``load_work`` (K,), ``output_force`` (K,) the load on its
-    freedom, ``closure_residual`` (K,) the scaled loop residual of each sample,
+    freedom, ``load_work`` that of the load and of the ``[drive.point_force]``,
+    ``closure_residual`` (K,) the scaled loop residual of each sample,
     ``energy_error`` the largest |E − E₀ − W_motor − W_friction − W_load| relative to the
     energy scale of the run, ``status`` ``"completed"`` or ``"stopped"`` with a ``message``."""
 
@@ -170,7 +171,7 @@ def _result(eom: GraphEquationOfMotion, rows: list[dict[str, Any]], status: str,
     balance = kinetic + potential - kinetic[0] - potential[0] - w_motor - w_friction - w_load
     scale = max(float(np.max(kinetic)), float(np.ptp(potential)), float(np.max(np.abs(w_motor))),
                 float(np.max(np.abs(w_friction))), float(np.max(np.abs(w_load))), 1e-300)
-    loaded = eom.load is not None
+    loaded = eom.load is not None or eom.point_force is not None
     return GraphSimulation(
         tuple(eom.mechanism.inputs), col("t"), y[:, :n], y[:, n:2 * n], col("acceleration"),
         col("motor"), col("friction"), kinetic, potential, w_motor, w_friction, col("residual"),

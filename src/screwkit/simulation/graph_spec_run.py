@@ -44,7 +44,9 @@ class GraphSpecSimulation:
                                                  "translation": f.translation}
                                        for f in d.friction},
                           "gravity": d.gravity, "rtol": d.rtol, "atol": d.atol,
-                          "load": None if d.load is None else vars(d.load)},
+                          "load": None if d.load is None else vars(d.load),
+                          "point_force": None if d.point_force is None else
+                          {"point": d.point_force[0], "force": list(d.point_force[1])}},
                 **self.simulation.as_dict()}
 
 
@@ -56,7 +58,8 @@ def graph_spec_equation_of_motion(spec: Any, drive: GraphDriveConfig | None = No
     return GraphEquationOfMotion(
         spec.mechanism, motors=d.motors,
         flywheel=d.flywheel if flywheel is None else flywheel, friction=d.friction,
-        gravity=spec.gravity_vector if d.gravity else None, load=d.load)
+        gravity=spec.gravity_vector if d.gravity else None, load=d.load,
+        point_force=d.point_force)
 
 
 def simulate_graph_spec(spec: Any, *, duration: float | None = None,
