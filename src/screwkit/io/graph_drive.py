@@ -205,8 +205,9 @@ def _point_force(spec: Any, t: PointForceTable | None
         return None
     points = {p.name: p for p in spec.mechanism.points}
     if t.point not in points:
-        _fail(spec, "point_force.point", f"no point {t.point!r}; the points are "
-                                         f"{sorted(points)} (add a [[points]] entry)")
+        have = f"the points are {sorted(points)}" if points else "it has no points"
+        _fail(spec, "point_force.point", f"no point {t.point!r}; {have} (add a [[points]] "
+                                         "entry on the body it is fixed to)")
     if points[t.point].body == "ground":
         _fail(spec, "point_force.point", f"{t.point!r} is on the ground, which does not move")
     x, y, z = (spec.quantity(v, "force", f"drive.point_force.force[{i}]")
