@@ -223,8 +223,8 @@ def test_simulate_cli_on_the_example(tmp_path):
     r = runner.invoke(app, ["simulate", str(spec), "--plot", str(tmp_path / "s.png"), "--json"])
     assert r.exit_code == 0, r.output
     assert (tmp_path / "s.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    r = runner.invoke(app, ["simulate", str(spec), "--cycles", "2"])
-    assert r.exit_code == 2 and "[drive] duration" in r.output
+    r = runner.invoke(app, ["simulate", str(spec), "--cycles", "2"])  # it starts at rest
+    assert r.exit_code == 2 and "crank cycles need a nonzero initial rate" in r.output
 
 
 @pytest.mark.parametrize("name", ["watt_sixbar", "double_wishbone"])

@@ -13,16 +13,17 @@ from screwkit.cli.common import prose
 
 def simulate_graph_cli(s: Any, out: Any, *, flywheel: float | None, fluctuation: float | None,
                        cycles: int | None, plot: Path | None) -> None:
-    """Run a graph spec's ``[drive]`` and deliver it (JSON, CSV, terminal)."""
-    from screwkit.cli.common import guard, user_error
+    """Run a graph spec's ``[drive]`` and deliver it (JSON, CSV, terminal): for ``[drive]
+    duration``, or with ``--cycles``/``--fluctuation`` for crank cycles (one rotating input)."""
+    from screwkit.cli.common import guard
     from screwkit.messages import message_units
     from screwkit.simulation.graph_spec_run import graph_simulation_table, simulate_graph_spec
 
-    for flag, value in (("--fluctuation", fluctuation), ("--cycles", cycles)):
-        if value is not None:
-            user_error(f"{s.path}: {flag} is for a single loop's crank cycles; a mechanism graph "
-                       "is simulated for [drive] duration (docs/simulation.md, \"Graphs\")")
     du = out.units_for(s.units)
+    if cycles is not None or fluctuation is not None:
+        _cycles_cli(s, out, du, flywheel=flywheel, fluctuation=fluctuation, cycles=cycles,
+                    plot=plot)
+        return
     with message_units(du):
         run = guard(lambda: simulate_graph_spec(s, flywheel=flywheel))
     doc = guard(lambda: run.as_dict())
@@ -33,6 +34,58 @@ def simulate_graph_cli(s: Any, out: Any, *, flywheel: float | None, fluctuation:
         out.note_written(plot)
     out.deliver(document=lambda: doc, table=lambda: graph_simulation_table(run.simulation),
                 show=lambda: _show(s, run.simulation, du), units=du)
+
+
+def _cycles_cli(s: Any, out: Any, du: Any, *, flywheel: float | None,
+                fluctuation: float | None, cycles: int | None, plot: Path | None) -> None:
+    from screwkit.cli.common import guard, user_error
+    from screwkit.messages import message_units
+    from screwkit.simulation.graph_spec_run import graph_cycles_table, simulate_graph_spec_cycles
+
+    if plot is not None:
+        user_error(f"{s.path}: --plot draws a run over [drive] duration; with --cycles or "
+                   "--fluctuation use --json or --csv for the per-cycle statistics")
+    with message_units(du):
+        run = guard(lambda: simulate_graph_spec_cycles(s, cycles=cycles,
+                                                       fluctuation=fluctuation,
+                                                       flywheel=flywheel))
+    doc = guard(lambda: run.as_dict())
+    out.deliver(document=lambda: doc, table=lambda: graph_cycles_table(run.run),
+                show=lambda: _show_cycles(s, run, du), units=du)
+
+
+def _show_cycles(s: Any, cyc: Any, units: Any) -> None:
+    from rich.markup import escape
+
+    from screwkit.cli.common import console
+    from screwkit.cli.formatting import TextColumn, number, print_columns
+
+    run = cyc.run
+    iu = units.pretty("inertia")
+    prose(f"[bold]{escape(s.describe(units))}[/]")
+    prose(f"{escape(run.message)} ({run.status}); crank {escape(run.input_name)}, flywheel "
+          f"{number(units.show('inertia', run.flywheel))} {iu}; energy balance error "
+          f"{run.energy_error:.2g}")
+    st = run.statistics
+    rpm = 60.0 / (2.0 * np.pi)
+    rows = range(run.cycles)
+    tu = units.pretty("moment")
+    print_columns(console, "per cycle", [
+        TextColumn("cycle", [str(k + 1) for k in rows]),
+        TextColumn("period\n[s]", [number(st["period"][k]) for k in rows]),
+        *[TextColumn(f"{h}\n[rpm]", [number(st[key][k] * rpm) for k in rows])
+          for h, key in (("mean", "mean_speed"), ("min", "min_speed"), ("max", "max_speed"))],
+        TextColumn("C_s", [number(st["fluctuation"][k]) for k in rows]),
+        *[TextColumn(f"{h}\nwork [J]", [number(st[key][k]) for k in rows])
+          for h, key in (("motor", "motor_work"), ("load", "load_work"),
+                         ("friction", "friction_work"))],
+        TextColumn(f"motor τ\nRMS [{tu}]",
+                   [number(units.show("moment", st["motor_torque_rms"][k])) for k in rows])])
+    if cyc.sizing is not None:
+        z = cyc.sizing
+        prose(f"flywheel for C_s = {z.requested:g}: [bold]"
+              f"{number(units.show('inertia', z.flywheel))} {iu}[/] (steady C_s "
+              f"{z.achieved:.6g}, {len(z.iterations)} steady-state searches)")
 
 
 def _show(s: Any, sim: Any, units: Any) -> None:

@@ -95,7 +95,7 @@ def register(app: typer.Typer) -> None:
         cycles: Annotated[int | None, typer.Option("--cycles", help="Cycles to simulate (default: [drive] cycles).", min=1, max=100000)] = None,
         flywheel: Annotated[str | None, typer.Option("--flywheel", help="Flywheel inertia on the input shaft, e.g. \"0.02 kg*m^2\" (overrides [drive] flywheel).")] = None,
     ) -> None:
-        """Forward dynamics of the machine: motor, flywheel and load of the [drive] table; speed fluctuation, motor torque, energy per cycle and every load; --fluctuation sizes the flywheel. A mechanism graph: a motor per input, flywheel and friction over [drive] duration, the loops closed at every step (docs/simulation.md, "Graphs")."""
+        """Forward dynamics of the machine: motor, flywheel and load of the [drive] table; speed fluctuation, motor torque, energy per cycle and every load; --fluctuation sizes the flywheel. A mechanism graph: a motor per input (a force motor on a slide), flywheel, friction and a load over [drive] duration, the loops closed at every step; with one crank, --cycles and --fluctuation as for a loop (docs/simulation.md, "Graphs")."""
         from screwkit.cli.common import guard, loop_only, user_error
         from screwkit.cli.outputs import Outputs
         from screwkit.io.spec import load_spec

@@ -103,6 +103,10 @@ class MotorTable(_Strict):
     no_load_speed: Value | None = None
     speeds: list[Value] | None = None
     torques: list[Value] | None = None
+    # a linear (force) motor on a slide input of a mechanism graph (io/graph_drive.py)
+    force: Value | None = None
+    stall_force: Value | None = None
+    forces: list[Value] | None = None
 
 
 class LoadTable(_Strict):
@@ -149,35 +153,58 @@ def _fail(spec: Any, key: str, message: str) -> None:
     raise DriveConfigError(f"{spec.path}: [drive.{key}] {message}")
 
 
-def motor_config(spec: Any, t: MotorTable) -> MotorConfig:
-    need = {"constant": ("torque",), "linear": ("stall_torque", "no_load_speed"),
-            "table": ("speeds", "torques"), "none": ()}[t.kind]
-    given = {k for k in ("torque", "stall_torque", "no_load_speed", "speeds", "torques")
-             if getattr(t, k) is not None}
+#: the motor keys of a rotating input and of a slide (a force motor: N, m/s)
+ROTARY_KEYS = {"torque": "torque", "stall_torque": "stall_torque", "torques": "torques"}
+SLIDE_KEYS = {"torque": "force", "stall_torque": "stall_force", "torques": "forces"}
+
+
+def motor_config(spec: Any, t: MotorTable, key: str = "motor", slide: bool = False
+                 ) -> MotorConfig:
+    """The motor of table ``t`` (at ``[drive.<key>]``) in SI. On a rotating input it reads
+    torques (N·m) and speeds (rad/s); on a ``slide`` (a linear motor on a P joint's input of a
+    mechanism graph) forces (N: ``force``, ``stall_force``, ``forces``) and speeds (m/s); the
+    :class:`MotorConfig` fields keep their names (``torque`` is then the force)."""
+    names = SLIDE_KEYS if slide else ROTARY_KEYS
+    other = ROTARY_KEYS if slide else SLIDE_KEYS
+    wrong = sorted(other[k] for k in other if getattr(t, other[k]) is not None
+                   and other[k] != names[k])
+    if wrong:
+        what, right = (("a slide", "force, stall_force, forces") if slide
+                       else ("a rotating input", "torque, stall_torque, torques"))
+        _fail(spec, f"{key}.{wrong[0]}", f"the motor drives {what}: give {right}")
+    torque, stall, torques = (getattr(t, names[k]) for k in ("torque", "stall_torque",
+                                                               "torques"))
+    need = {"constant": (names["torque"],), "linear": (names["stall_torque"], "no_load_speed"),
+            "table": ("speeds", names["torques"]), "none": ()}[t.kind]
+    given = {k for k in (*names.values(), "no_load_speed", "speeds") if getattr(t, k) is not None}
     for k in need:
         if k not in given:
-            _fail(spec, f"motor.{k}", f"a {t.kind} motor needs {' and '.join(need)}")
+            _fail(spec, f"{key}.{k}", f"a {t.kind} motor needs {' and '.join(need)}")
     extra = sorted(given - set(need))
     if extra:
-        _fail(spec, "motor", f"{extra} do not apply to a {t.kind!r} motor (it reads "
-                             f"{list(need) or 'nothing'}); remove them or change kind")
+        _fail(spec, key, f"{extra} do not apply to a {t.kind!r} motor (it reads "
+                         f"{list(need) or 'nothing'}); remove them or change kind")
+    effort = "force" if slide else "torque"
+    speed = "velocity" if slide else "angular_velocity"
     if t.kind == "constant":
-        return MotorConfig("constant", torque=_si(spec, t.torque, "torque", "motor.torque"))
+        return MotorConfig("constant", torque=_si(spec, torque, effort,
+                                                  f"{key}.{names['torque']}"))
     if t.kind == "linear":
-        stall = _si(spec, t.stall_torque, "torque", "motor.stall_torque")
-        free = _si(spec, t.no_load_speed, "angular_velocity", "motor.no_load_speed")
+        stall_si = _si(spec, stall, effort, f"{key}.{names['stall_torque']}")
+        free = _si(spec, t.no_load_speed, speed, f"{key}.no_load_speed")
         if not free > 0:
-            _fail(spec, "motor.no_load_speed", f"must be a positive speed; got {t.no_load_speed!r}")
-        return MotorConfig("linear", stall_torque=stall, no_load_speed=free)
+            _fail(spec, f"{key}.no_load_speed", f"must be a positive speed; got "
+                                               f"{t.no_load_speed!r}")
+        return MotorConfig("linear", stall_torque=stall_si, no_load_speed=free)
     if t.kind == "table":
-        speeds = [_si(spec, v, "angular_velocity", "motor.speeds") for v in t.speeds or []]
-        torques = [_si(spec, v, "torque", "motor.torques") for v in t.torques or []]
-        if len(speeds) != len(torques) or len(speeds) < 2:
-            _fail(spec, "motor", f"speeds and torques need the same number of points, at least "
-                                 f"2; got {len(speeds)} and {len(torques)}")
+        speeds = [_si(spec, v, speed, f"{key}.speeds") for v in t.speeds or []]
+        efforts = [_si(spec, v, effort, f"{key}.{names['torques']}") for v in torques or []]
+        if len(speeds) != len(efforts) or len(speeds) < 2:
+            _fail(spec, key, f"speeds and {names['torques']} need the same number of points, "
+                             f"at least 2; got {len(speeds)} and {len(efforts)}")
         if any(b <= a for a, b in zip(speeds, speeds[1:], strict=False)):
-            _fail(spec, "motor.speeds", "the speeds must increase strictly")
-        return MotorConfig("table", speeds=tuple(speeds), torques=tuple(torques))
+            _fail(spec, f"{key}.speeds", "the speeds must increase strictly")
+        return MotorConfig("table", speeds=tuple(speeds), torques=tuple(efforts))
     return MotorConfig("none")
 
 
@@ -192,24 +219,30 @@ def _load(spec: Any, t: LoadTable | None) -> LoadConfig | None:
     if freedom not in lk.joints[-1].freedom_names():
         _fail(spec, "load.freedom", f"the load acts on the output, a freedom of the last joint "
                                     f"(the one to the ground): {lk.joints[-1].freedom_names()}")
+    return load_config(spec, t, freedom)
+
+
+def load_config(spec: Any, t: LoadTable, freedom: str, key: str = "load") -> LoadConfig:
+    """The load of table ``t`` on ``freedom`` (a checked freedom name) in SI: a force on a
+    translation (``….s``), a torque on a rotation."""
     translation = freedom.endswith(".s")
     wrong = "torque" if translation else "force"
     if getattr(t, wrong) is not None:
         what, right = ("a translation", "force") if translation else ("a rotation", "torque")
-        _fail(spec, f"load.{wrong}", f"{freedom!r} is {what}: give {right}")
+        _fail(spec, f"{key}.{wrong}", f"{freedom!r} is {what}: give {right}")
     if (t.force if translation else t.torque) is None and t.damping is None:
-        _fail(spec, "load", f"give {'force' if translation else 'torque'} and/or damping")
+        _fail(spec, key, f"give {'force' if translation else 'torque'} and/or damping")
     constant = 0.0
     if translation and t.force is not None:
-        constant = _si(spec, t.force, "force", "load.force")
+        constant = _si(spec, t.force, "force", f"{key}.force")
     if not translation and t.torque is not None:
-        constant = _si(spec, t.torque, "torque", "load.torque")
+        constant = _si(spec, t.torque, "torque", f"{key}.torque")
     damping = 0.0
     if t.damping is not None:
         kind = "translational_damping" if translation else "rotational_damping"
-        damping = _si(spec, t.damping, kind, "load.damping")
+        damping = _si(spec, t.damping, kind, f"{key}.damping")
     if constant < 0 or damping < 0:
-        _fail(spec, "load", "give the load's size (>= 0): it acts against the motion, or in "
+        _fail(spec, key, "give the load's size (>= 0): it acts against the motion, or in "
                             "the freedom's negative direction with against_motion = false")
     return LoadConfig(freedom, constant, damping, t.against_motion)
 

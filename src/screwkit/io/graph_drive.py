@@ -12,6 +12,17 @@ mechanism (docs/simulation.md, "Graphs"), validated with pydantic and turned, on
     [drive.motors."OA.theta"]     # one motor per driven input, the [drive.motor] of a loop
     kind = "constant"
     torque = "0.05 N*m"
+    [drive.motors."leg1.s"]       # a linear (force) motor on a slide input: N and m/s
+    kind = "linear"
+    stall_force = "200 N"
+    no_load_speed = "0.5 m/s"
+    [drive.load]                  # a load on any joint freedom (the loop's [drive.load])
+    freedom = "slider.s"
+    force = "40 N"
+    damping = "2 N*s/m"
+    [drive.point_force]           # a constant force (world axes) at a named body point
+    point = "P"
+    force = ["0 N", "-20 N", "0 N"]
     [drive.friction]              # joint -> viscous coefficient, or { rotation, translation }
     OB = "1e-4 N*m*s/rad"
 
@@ -38,12 +49,21 @@ from screwkit.io.drive_table import (
     DriveConfigError,
     FrictionTable,
     JointFriction,
+    LoadConfig,
+    LoadTable,
     MotorConfig,
     MotorTable,
     Value,
+    load_config,
     motor_config,
 )
 from screwkit.io.validation import validation_lines
+
+
+class PointForceTable(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    point: StrictStr
+    force: list[Value] = Field(min_length=3, max_length=3)
 
 
 class GraphDriveTable(BaseModel):
@@ -53,6 +73,8 @@ class GraphDriveTable(BaseModel):
     initial_speed: Value | dict[StrictStr, Value] = 0.0
     flywheel: Value | dict[StrictStr, Value] = 0.0
     motors: dict[StrictStr, MotorTable] = Field(default_factory=dict)
+    load: LoadTable | None = None
+    point_force: PointForceTable | None = None
     friction: dict[StrictStr, Value | FrictionTable] | None = None
     gravity: StrictBool = False
     rtol: StrictFloat = Field(1e-10, gt=0.0, lt=1e-2)
@@ -73,6 +95,8 @@ class GraphDriveConfig:
     gravity: bool
     rtol: float
     atol: float | None
+    load: LoadConfig | None = None
+    point_force: tuple[str, tuple[float, float, float]] | None = None
 
 
 def _fail(spec: Any, key: str, message: str) -> None:
@@ -142,10 +166,8 @@ def graph_drive_config(spec: Any) -> GraphDriveConfig:
     motors = []
     for name in inputs:
         table = t.motors.get(name)
-        if table is not None and name.endswith(".s") and table.kind != "none":
-            _fail(spec, f'motors."{name}"', f"{name!r} is a slide: motors drive rotating "
-                                            "inputs (a force motor is not offered yet)")
-        motors.append(MotorConfig() if table is None else motor_config(spec, table))
+        motors.append(MotorConfig() if table is None else
+                      motor_config(spec, table, f'motors."{name}"', slide=name.endswith(".s")))
     freedoms = [f for j in spec.mechanism.joints for f in j.freedom_names()]
     missing = sorted(set(t.motors) - set(freedoms))
     if missing:
@@ -172,4 +194,41 @@ def graph_drive_config(spec: Any) -> GraphDriveConfig:
     return GraphDriveConfig(duration, t.samples,
                             _per_input(spec, t.initial_speed, rate, "initial_speed"), flywheel,
                             tuple(motors), _friction(spec, t.friction), t.gravity, t.rtol,
-                            t.atol)
+                            t.atol, _load(spec, t.load), _point_force(spec, t.point_force))
+
+
+def _point_force(spec: Any, t: PointForceTable | None
+                 ) -> tuple[str, tuple[float, float, float]] | None:
+    """``[drive.point_force]``: a named point of a moving body and a constant force (world
+    axes, the spec's force unit)."""
+    if t is None:
+        return None
+    points = {p.name: p for p in spec.mechanism.points}
+    if t.point not in points:
+        have = f"the points are {sorted(points)}" if points else "it has no points"
+        _fail(spec, "point_force.point", f"no point {t.point!r}; {have} (add a [[points]] "
+                                         "entry on the body it is fixed to)")
+    if points[t.point].body == "ground":
+        _fail(spec, "point_force.point", f"{t.point!r} is on the ground, which does not move")
+    x, y, z = (spec.quantity(v, "force", f"drive.point_force.force[{i}]")
+               for i, v in enumerate(t.force))
+    return t.point, (x, y, z)
+
+
+def _load(spec: Any, t: LoadTable | None) -> LoadConfig | None:
+    """The ``[drive.load]`` on a named freedom of any joint but a ball (whose three rotations
+    are not freedoms one load can act on)."""
+    if t is None:
+        return None
+    joints = {j.name: j for j in spec.mechanism.joints}
+    freedoms = [f for j in spec.mechanism.joints if j.kind != "S" for f in j.freedom_names()]
+    if t.freedom is None:
+        _fail(spec, "load.freedom", f"name the freedom the load acts on, one of {freedoms}")
+    assert t.freedom is not None
+    if t.freedom not in freedoms:
+        joint = joints.get(t.freedom.split(".")[0])
+        why = (f"{joint.name!r} is a ball joint, whose rotations take no single load"
+               if joint is not None and joint.kind == "S" else "no such freedom")
+        _fail(spec, "load.freedom", f"{t.freedom!r}: {why}; the loaded freedom is one of "
+                                    f"{freedoms}")
+    return load_config(spec, t, t.freedom)

@@ -136,19 +136,23 @@ def graph_simulation_plots(doc: dict[str, Any]) -> list[dict[str, Any]]:
     rates = [_series(n, t, np.asarray(v["rate"], dtype=float) * scale(n))
              for n, v in inputs.items()]
     efforts = [_series(f"{n} {part}", t, v[part]) for n, v in inputs.items()
-               for part in ("motor", "friction") if np.any(np.asarray(v[part]))]
+               for part in ("motor", "friction", "load")
+               if part in v and np.any(np.asarray(v[part]))]
     kinetic = np.asarray(doc["kinetic_energy"], dtype=float)
     potential = np.asarray(doc["potential_energy"], dtype=float)
-    works = np.asarray(doc["motor_work"], dtype=float) + np.asarray(doc["friction_work"])
+    load_work = np.asarray(doc.get("load_work", np.zeros_like(t)), dtype=float)
+    works = (np.asarray(doc["motor_work"], dtype=float) + np.asarray(doc["friction_work"])
+             + load_work)
     energy = [_series("kinetic", t, kinetic), _series("potential (from the start)", t,
                                                        potential - potential[0]),
               _series("motor work", t, doc["motor_work"]),
               _series("friction work", t, doc["friction_work"]),
+              *([_series("load work", t, load_work)] if "load_work" in doc else []),
               _series("E − E₀ − W", t, kinetic + potential - kinetic[0] - potential[0] - works)]
     return jsonable([
         _plot("gsim-inputs", "inputs against time", "time (s)", unit(False), values),
         _plot("gsim-rates", "input rates against time", "time (s)", unit(True), rates),
-        _plot("gsim-efforts", "motor and friction efforts on the inputs", "time (s)",
+        _plot("gsim-efforts", "motor, friction and load efforts on the inputs", "time (s)",
               "N·m (N on a slide)", efforts or [_series("none", t, np.zeros_like(t))]),
         _plot("gsim-energy", "energy account", "time (s)", "J", energy)])
 

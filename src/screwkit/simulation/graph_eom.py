@@ -10,19 +10,25 @@ kinematics/graph/idle.py), so each body's angular velocity and centre-of-mass ve
 and Applications*, 1985, ch. 6: generalized active and inertia forces, the partial velocities
 ω̂_k, v̂_c,k) read
 
-    M(x) ẍ = τ_motor(ẋ) + Q_g(x) + Q_f(x, ẋ) − h(x, ẋ),
+    M(x) ẍ = τ_motor(ẋ) + Q_g(x) + Q_f(x, ẋ) + Q_load(x, ẋ) − h(x, ẋ),
 
     M_kl = Σ_b m v̂_c,k·v̂_c,l + ω̂_k·I ω̂_l   (+ J_f,k on the diagonal: a flywheel on input k),
     h_k  = Σ_b m a⁰_c·v̂_c,k + (I α⁰ + ω × I ω)·ω̂_k,
     Q_g,k = Σ_b m g·v̂_c,k,
     Q_f,k = −Σ_j c_rot,j ω_rel,j·ω̂_rel,j,k + c_slide,j ṡ_j ŝ_j,k,
+    Q_load,k = Q_out(q̇_out) G_out,k + F·v̂_P,k,
 
 where I = R I_c Rᵀ is a body's inertia about its centre of mass in world axes, a⁰_c and α⁰ its
 accelerations at ẍ = 0 (the velocity-product terms:
 :func:`~screwkit.kinematics.graph.newton.accelerations` with zero input accelerations) and the
 friction is the viscous joint friction of ``[drive.friction]`` (the moment −c ω_rel between a
-joint's two bodies, the force −c ṡ along a slide). h is Lagrange's ½ Ṁ ẋ terms and the
-centripetal ones, so d/dt(½ ẋᵀ(M + J_f)ẋ + V) = (τ + Q_f)·ẋ with V = −Σ m g·c: the energy
+joint's two bodies, the force −c ṡ along a slide) and Q_load the ``[drive.load]``: the force
+or torque Q_out (:func:`~screwkit.simulation.drive.output_force`) on one joint freedom q_out,
+carried to the inputs by its partial rates G_out,k = ∂q̇_out/∂ẋ_k (virtual work, as a loop's
+Q_out·r), plus a constant world force F at a named point P of a body (``[drive.point_force]``),
+whose generalised force is F·v̂_P,k with v̂_P,k = v̂_0,k + ω̂_k × p the point's partial
+velocities (Kane's generalised active force). A motor on a slide input is a force motor (N against m/s, the same laws). h is Lagrange's ½ Ṁ ẋ terms and the
+centripetal ones, so d/dt(½ ẋᵀ(M + J_f)ẋ + V) = (τ + Q_f + Q_load)·ẋ with V = −Σ m g·c: the energy
 balance that the simulation checks.
 
 Nothing here is tabulated: every evaluation closes the loops anew, so the closure holds to the
@@ -41,7 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dual.spatial import cross
 from screwkit.dynamics.checks import MissingMassError
-from screwkit.io.drive_table import JointFriction, MotorConfig
+from screwkit.io.drive_table import JointFriction, LoadConfig, MotorConfig
 from screwkit.kinematics.graph.closure import (
     GraphLayout,
     body_accelerations,
@@ -60,8 +66,8 @@ from screwkit.kinematics.graph.newton import (
 )
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mass import MassProperties
-from screwkit.model.mechanism import Mechanism
-from screwkit.simulation.drive import motor_torque
+from screwkit.model.mechanism import GROUND, Mechanism
+from screwkit.simulation.drive import motor_torque, output_force
 from screwkit.simulation.reduced import SimulationError
 
 Array = NDArray[np.float64]
@@ -145,13 +151,16 @@ class GraphEquationOfMotion:
 
     ``motors`` one :class:`~screwkit.io.drive_table.MotorConfig` per input (kind ``none`` for
     an undriven one); ``flywheel`` (n,) inertia on each input (kg·m², kg on a slide);
-    ``friction`` joint friction; ``gravity`` (3,) m/s². The configuration last closed is kept
+    ``friction`` joint friction; ``gravity`` (3,) m/s²; ``load`` the load on one joint
+    freedom (:class:`~screwkit.io.drive_table.LoadConfig`); ``point_force`` (point name, force
+    (3,) N in world axes) a constant force at a named point of a body. The configuration last closed is kept
     and starts the next Newton solve (the integrator moves in small steps), so one object
     follows one run."""
 
     def __init__(self, mech: Mechanism, *, motors: Sequence[MotorConfig] | None = None,
                  flywheel: ArrayLike | None = None, friction: Sequence[JointFriction] = (),
-                 gravity: ArrayLike | None = None) -> None:
+                 gravity: ArrayLike | None = None, load: LoadConfig | None = None,
+                 point_force: tuple[str, ArrayLike] | None = None) -> None:
         self.mechanism = mech
         self.layout: GraphLayout = graph_layout(mech)
         n = len(mech.inputs)
@@ -169,12 +178,46 @@ class GraphEquationOfMotion:
         self.flywheel = fw
         self.friction = checked_graph_friction(mech, friction)
         self.gravity = np.zeros(3) if gravity is None else np.asarray(gravity, dtype=float)
+        self.load = load
+        self._load_row = None if load is None else self._loaded_freedom(load)
+        self.point_force = point_force
+        self._point = None if point_force is None else self._forced_point(*point_force)
         from screwkit.kinematics.graph.motion import expected_rank
 
         self.rank = expected_rank(mech, self.layout)
         self._idle = self.rank < len(self.layout.passive)
         self._conf = zero_configuration(self.layout)
         self._last: tuple[Array, Array] | None = None  # inputs and G of the last closure
+
+    def _loaded_freedom(self, load: LoadConfig) -> int:
+        """The row of q (and of G) of the loaded freedom; a clear error for a freedom the
+        mechanism lacks or a ball's rotation."""
+        mech, lay = self.mechanism, self.layout
+        names = [f for j in mech.joints if j.kind != "S" for f in j.freedom_names()]
+        if load.freedom not in names:
+            raise SimulationError(f"{mech.name}: a load on {load.freedom!r}, which is not a "
+                                  f"freedom of it (ball joints excluded); the freedoms are "
+                                  f"{names}")
+        k = next(i for i, j in enumerate(mech.joints) if load.freedom in j.freedom_names())
+        return int(lay.first_freedom[k] + mech.joints[k].freedom_names().index(load.freedom))
+
+    def _forced_point(self, name: str, force: ArrayLike) -> tuple[int, Array, Array]:
+        """The body index, drawn position and force of the point force; clear errors."""
+        mech = self.mechanism
+        points = {p.name: p for p in mech.points}
+        if name not in points:
+            raise SimulationError(f"{mech.name}: a force at point {name!r}, which is not a "
+                                  f"point of it; the points are {sorted(points)} (add it as a "
+                                  "[[points]] entry on its body)")
+        pt = points[name]
+        if pt.body not in self.layout.body_of or pt.body == GROUND:
+            raise SimulationError(f"{mech.name}: point {name!r} is on the ground, which does "
+                                  "not move: a force there does no work on the mechanism")
+        F = np.asarray(force, dtype=float).reshape(-1)
+        if F.shape != (3,) or not np.all(np.isfinite(F)):
+            raise SimulationError(f"{mech.name}: the force at point {name!r} is three finite "
+                                  f"components (N, world axes); got {F.tolist()}")
+        return self.layout.body_of[pt.body], np.asarray(pt.at, dtype=float), F
 
     def start_at(self, x: ArrayLike) -> None:
         """Start the closures from the drawn mode followed to inputs ``x`` (n,) (the graph
@@ -252,20 +295,23 @@ class GraphEquationOfMotion:
         I_w = np.einsum("bij,bjk,blk->bil", R, self.inertia, R)
         return c, I_w
 
-    def _partials(self, st: GraphState, c: Array) -> tuple[Array, Array]:
-        """Partial angular and centre-of-mass velocities (n, B, 3) of every body."""
+    def _partials(self, st: GraphState, c: Array) -> tuple[Array, Array, Array]:
+        """Partial angular and centre-of-mass velocities (n, B, 3) of every body, and the
+        partial twists (n, B + 1, 6) of every body and the ground (the twists are linear in
+        the input rates: every twist is Σ_k ẋ_k of these, so they are computed once)."""
         mech, lay = self.mechanism, self.layout
         nb = len(mech.bodies)
         screws = np.repeat(st.lin.frames.screws, self.inputs, axis=0)
         V, _ = body_twists(mech, lay, screws, st.G.T)
         w = V[:, :nb, :3]
-        return w, V[:, :nb, 3:] + cross(w, np.broadcast_to(c, w.shape))
+        return w, V[:, :nb, 3:] + cross(w, np.broadcast_to(c, w.shape)), V
 
     # --- dynamics ----------------------------------------------------------------------
     def terms(self, x: ArrayLike, xd: ArrayLike) -> dict[str, Any]:
         """Every term of the equations of motion at (x, ẋ) (module docstring): ``mass_matrix``
         M + diag(J_f) (n, n), ``velocity_terms`` h, ``gravity`` Q_g, ``friction`` Q_f,
-        ``motor`` τ, ``acceleration`` ẍ, ``kinetic_energy``, ``potential_energy`` (−Σ m g·c),
+        ``load`` Q_load (n,), ``output_force`` Q_out on the loaded freedom, ``motor`` τ,
+        ``acceleration`` ẍ, ``kinetic_energy``, ``potential_energy`` (−Σ m g·c),
         the ``state`` and the closure ``residual``."""
         mech, lay = self.mechanism, self.layout
         xd = np.asarray(xd, dtype=float)
@@ -273,7 +319,7 @@ class GraphEquationOfMotion:
         if st.singular_ratio < SINGULAR_RATIO:
             raise self._singular_error(np.asarray(x, dtype=float))
         c, I_w = self._body_frames(st)
-        w_k, v_k = self._partials(st, c)
+        w_k, v_k, V_k = self._partials(st, c)
         m = self.mass
         M = (np.einsum("b,kbi,lbi->kl", m, v_k, v_k)
              + np.einsum("kbi,bij,lbj->kl", w_k, I_w, w_k)) + np.diag(self.flywheel)
@@ -284,7 +330,7 @@ class GraphEquationOfMotion:
 
             qdd = hold_rod_spin(mech, lay, st.lin, qdd, bias)
         nb = len(mech.bodies)
-        V, _ = body_twists(mech, lay, st.lin.frames.screws, qd[None])
+        V = np.einsum("k,kbj->bj", xd, V_k)[None]  # the twists at ẋ (linear in ẋ)
         A = body_accelerations(mech, lay, st.lin.frames.screws, qdd, bias)
         w, v0 = V[0, :nb, :3], V[0, :nb, 3:]
         al, a0 = A[0, :nb, :3], A[0, :nb, 3:]
@@ -294,25 +340,31 @@ class GraphEquationOfMotion:
         moment = np.einsum("bij,bj->bi", I_w, al) + cross(w, Iw)
         h = np.einsum("b,bi,kbi->k", m, a_c, v_k) + np.einsum("bi,kbi->k", moment, w_k)
         Qg = np.einsum("b,i,kbi->k", m, self.gravity, v_k)
-        Qf = self._friction(st, V[0], qd)
+        Qf = self._friction(st, V[0], V_k, qd)
         tau = np.array([float(motor_torque(mo, xd[k])) for k, mo in enumerate(self.motors)])
-        acc = np.linalg.solve(M, tau + Qg + Qf - h)
+        q_out, Ql = 0.0, np.zeros(self.inputs)
+        if self._load_row is not None:
+            q_out = float(output_force(self.load, qd[self._load_row]))
+            Ql = q_out * st.G[self._load_row]
+        if self._point is not None:
+            b, at, F = self._point
+            p = st.lin.frames.R[0, b] @ at + st.lin.frames.p[0, b]
+            Ql = Ql + (V_k[:, b, 3:] + cross(V_k[:, b, :3], np.broadcast_to(p, (self.inputs, 3)))) @ F
+        acc = np.linalg.solve(M, tau + Qg + Qf + Ql - h)
         kinetic = 0.5 * (np.einsum("b,bi,bi->", m, v_c, v_c) + np.einsum("bi,bi->", w, Iw)
                          + float(self.flywheel @ xd ** 2))
         return {"mass_matrix": M, "velocity_terms": h, "gravity": Qg, "friction": Qf,
-                "motor": tau, "acceleration": acc, "kinetic_energy": float(kinetic),
+                "load": Ql, "output_force": q_out, "motor": tau, "acceleration": acc, "kinetic_energy": float(kinetic),
                 "potential_energy": float(-np.einsum("b,i,bi->", m, self.gravity, c)),
                 "state": st, "residual": st.residual}
 
-    def _friction(self, st: GraphState, V: Array, qd: Array) -> Array:
+    def _friction(self, st: GraphState, V: Array, Vk: Array, qd: Array) -> Array:
         """Q_f (n,): the joints' viscous friction on the inputs (module docstring)."""
         mech, lay = self.mechanism, self.layout
         Q = np.zeros(self.inputs)
         if not self.friction:
             return Q
         index = {j.name: i for i, j in enumerate(mech.joints)}
-        screws = np.repeat(st.lin.frames.screws, self.inputs, axis=0)
-        Vk, _ = body_twists(mech, lay, screws, st.G.T)
         for f in self.friction:
             i = index[f.joint]
             a, b = (lay.body_of[x] for x in mech.joints[i].bodies)

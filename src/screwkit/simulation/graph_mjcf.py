@@ -10,7 +10,14 @@ becomes the body tree and every chord — the joint that closes a loop — an eq
   redundant one along the axis, which MuJoCo's soft constraints accept — the single-loop export's
   choice, simulation/mjcf.py). A ``weld`` would remove the chord's freedom and a joint equality
   cannot act across the cut, so neither is used;
-* P, C, U and H chords are not exported (a clear error names the joint).
+* a loop is never cut at a P, C or U joint: MuJoCo's equality constraints (``connect``,
+  ``weld``) cannot leave a slide free, and a helper body sliding on a weld would add its mass.
+  Where the mechanism's own spanning tree closes a loop at such a joint (a slider-crank listed
+  crank first, slider last), the export takes another spanning tree (:func:`export_tree`): the
+  P, C or U joint goes into the body tree as a ``slide`` (a ``hinge`` + ``slide``, two
+  ``hinge`` joints) and the loop is cut at one of its R or S joints instead — the same
+  mechanism, exactly, with no added mass. A loop with no R or S joint to cut (besides its
+  inputs) is refused, naming it; H joints are not exported.
 
 The model is written in the drawn configuration (and, given a ``start``, with a keyframe
 ``start`` at the drawn mode followed to those inputs): every body frame is the world frame of the
@@ -51,12 +58,65 @@ from screwkit.simulation.reduced import SimulationError
 
 @dataclass(frozen=True)
 class GraphMjcfLayout:
-    """Which joints are in the tree and which close loops (``chords``), and the MuJoCo joint
-    name of every exported freedom (``dofs``: ``"OA.theta"`` → ``"OA_theta"``; a ball's three
-    freedoms share one ``"TI_ball"``)."""
+    """Which joints are in the tree (``tree``: (joint, parent, child), parents first) and which
+    close loops (``chords``), and the MuJoCo joint name of every exported freedom (``dofs``:
+    ``"OA.theta"`` → ``"OA_theta"``; a ball's three freedoms share one ``"TI_ball"``)."""
 
     chords: tuple[str, ...]
     dofs: dict[str, str]
+    tree: tuple[tuple[int, str, str], ...] = ()
+    chord_joints: tuple[int, ...] = ()
+
+
+def _cuttable(mech: Mechanism, k: int, inputs: set[str]) -> bool:
+    j = mech.joints[k]
+    return j.kind in ("R", "S") and j.name not in inputs
+
+
+def export_tree(mech: Mechanism) -> tuple[tuple[tuple[int, str, str], ...], tuple[int, ...]]:
+    """The spanning tree of the export and its chords (module docstring): the mechanism's own
+    topology when every chord is an R or S joint that is not an input; otherwise the tree grown
+    (Kruskal's algorithm on the body graph) from the joints that cannot be cut — inputs, P, C,
+    U, H — first, then the R and S joints, the topology's own chords last, so that every chord
+    is an R or S joint wherever the loop has one. Parents are listed before their children
+    (breadth-first from the ground)."""
+    top = mech.topology
+    inputs = {name.split(".")[0] for name in mech.inputs}
+    if all(_cuttable(mech, k, inputs) for k in top.chords):
+        return top.tree, top.chords
+
+    def rank(k: int) -> tuple[int, int]:
+        if not _cuttable(mech, k, inputs):
+            return (0, k)
+        return (2 if k in top.chords else 1, k)
+
+    parent = {b: b for b in (GROUND, *mech.body_names)}
+
+    def root(b: str) -> str:
+        while parent[b] != b:
+            parent[b] = parent[parent[b]]
+            b = parent[b]
+        return b
+
+    used: list[int] = []
+    for k in sorted(range(len(mech.joints)), key=rank):
+        a, b = (root(x) for x in mech.joints[k].bodies)
+        if a != b:
+            parent[a] = b
+            used.append(k)
+    order: list[tuple[int, str, str]] = []
+    seen, queue = {GROUND}, [GROUND]
+    while queue:
+        body = queue.pop(0)
+        for k in sorted(used):
+            a, b = mech.joints[k].bodies
+            if body in (a, b):
+                other = b if a == body else a
+                if other not in seen:
+                    seen.add(other)
+                    order.append((k, body, other))
+                    queue.append(other)
+    return tuple(order), tuple(k for k in range(len(mech.joints)) if k not in used)
 
 
 def graph_mjcf_layout(mech: Mechanism) -> GraphMjcfLayout:
@@ -66,13 +126,15 @@ def graph_mjcf_layout(mech: Mechanism) -> GraphMjcfLayout:
     if bad:
         raise SimulationError(f"{mech.name}: MJCF export does not write H (helical) joints; "
                               f"{bad} are")
-    chords = [mech.joints[k] for k in mech.topology.chords]
+    tree, chord_joints = export_tree(mech)
+    chords = [mech.joints[k] for k in chord_joints]
     for j in chords:
         if j.kind not in ("R", "S"):
             raise SimulationError(
-                f"{mech.name}: joint {j.name!r} ({j.kind}) closes a loop, and MJCF export "
-                "closes loops only at R or S joints (by connect constraints); list the "
-                "joints so that an R or S joint is the last of its loop")
+                f"{mech.name}: the loop closed by joint {j.name!r} ({j.kind}) has no R or S "
+                "joint other than an input to cut it at, and MJCF export closes loops only at "
+                "R or S joints (by connect constraints; MuJoCo has no equality that leaves a "
+                "slide free)")
     inputs = {name.split(".")[0] for name in mech.inputs}
     driven_chords = sorted(inputs & {j.name for j in chords})
     if driven_chords:
@@ -83,7 +145,7 @@ def graph_mjcf_layout(mech: Mechanism) -> GraphMjcfLayout:
     for j in mech.joints:
         for f in j.freedoms:
             dofs[f"{j.name}.{f}"] = f"{j.name}_ball" if j.kind == "S" else f"{j.name}_{f}"
-    return GraphMjcfLayout(tuple(j.name for j in chords), dofs)
+    return GraphMjcfLayout(tuple(j.name for j in chords), dofs, tree, chord_joints)
 
 
 def _joint_lines(mech: Mechanism, k: int, reversed_: bool, indent: str,
@@ -141,11 +203,11 @@ def _body_lines(mech: Mechanism, body: str, children: dict[str, list[tuple[int, 
     return [*lines, indent + "</body>"]
 
 
-def _equality_lines(mech: Mechanism, solref: tuple[float, ...], solimp: tuple[float, ...]
-                    ) -> list[str]:
+def _equality_lines(mech: Mechanism, chords: tuple[int, ...], solref: tuple[float, ...],
+                    solimp: tuple[float, ...]) -> list[str]:
     soft = f'solref="{xml_numbers(np.array(solref))}" solimp="{xml_numbers(np.array(solimp))}"'
     lines = []
-    for k in mech.topology.chords:
+    for k in chords:
         j = mech.joints[k]
         a, b = j.bodies
         if a == GROUND:  # connect's first body must move: anchor it in the second
@@ -230,7 +292,7 @@ def graph_mjcf_model(mech: Mechanism, *, gravity: ArrayLike | None = None,
     armature = {lay.dofs[name]: float(fw[k]) for k, name in enumerate(mech.inputs)}
     g = np.zeros(3) if gravity is None else np.asarray(gravity, dtype=float)
     children: dict[str, list[tuple[int, str]]] = {}
-    for k, parent, child in mech.topology.tree:
+    for k, parent, child in lay.tree:
         children.setdefault(parent, []).append((k, child))
     lines = [f"<mujoco model={quoteattr(mech.name)}>",
              "  <!-- written by screwkit export-mjcf: SI units, the drawn configuration; the "
@@ -244,7 +306,7 @@ def graph_mjcf_model(mech: Mechanism, *, gravity: ArrayLike | None = None,
              "  <worldbody>"]
     for k, child in children.get(GROUND, []):
         lines += _body_lines(mech, child, children, 0, damping, armature, k)
-    lines += ["  </worldbody>", "  <equality>", *_equality_lines(mech, solref, solimp),
+    lines += ["  </worldbody>", "  <equality>", *_equality_lines(mech, lay.chord_joints, solref, solimp),
               "  </equality>"]
     if start is not None:
         qpos = _start_qpos(mech, children, start)

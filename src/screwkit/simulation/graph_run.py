@@ -1,9 +1,9 @@
 """Forward integration of a mechanism graph's equations of motion
 (:mod:`screwkit.simulation.graph_eom`) over a time span, sampled at equal times.
 
-The state is (x, ẋ, W_motor, W_friction): the input coordinates and rates, and the work of the
-motors and of the joint friction integrated with the motion to the same tolerance, so the energy
-balance E(t) − E(0) = W_motor + W_friction is checked at every sample without quadrature.
+The state is (x, ẋ, W_motor, W_friction, W_load): the input coordinates and rates, and the work
+of the motors, of the joint friction and of the ``[drive.load]`` integrated with the motion to
+the same tolerance, so the energy balance E(t) − E(0) = W_motor + W_friction + W_load is checked at every sample without quadrature.
 scipy's ``solve_ivp`` (DOP853, the single-loop path's integrator) runs from one sample time to
 the next; every right-hand side closes the loops by the graph Newton from the configuration last
 closed (the projection onto the constraint manifold: the passive freedoms are never states, so
@@ -37,10 +37,12 @@ EVALUATION_COST = 25.0
 @dataclass(frozen=True, eq=False)
 class GraphSimulation:
     """One run (SI): ``time`` (K,), ``inputs``/``rates``/``accelerations``/``motor``/
-    ``friction`` (K, n) per input, ``kinetic_energy``/``potential_energy``/``motor_work``/
-    ``friction_work`` (K,), ``closure_residual`` (K,) the scaled loop residual of each sample,
-    ``energy_error`` the largest |E − E₀ − W_motor − W_friction| relative to the energy scale
-    of the run, ``status`` ``"completed"`` or ``"stopped"`` with a ``message``."""
+    ``friction``/``load`` (K, n) per input, ``kinetic_energy``/``potential_energy``/
+    ``motor_work``/``friction_work``/``load_work`` (K,), ``output_force`` (K,) the load on its
+    freedom, ``load_work`` that of the load and of the ``[drive.point_force]``,
+    ``closure_residual`` (K,) the scaled loop residual of each sample,
+    ``energy_error`` the largest |E − E₀ − W_motor − W_friction − W_load| relative to the
+    energy scale of the run, ``status`` ``"completed"`` or ``"stopped"`` with a ``message``."""
 
     input_names: tuple[str, ...]
     time: Array
@@ -57,16 +59,25 @@ class GraphSimulation:
     energy_error: float
     status: str
     message: str
+    load: Array | None = None
+    output_force: Array | None = None
+    load_work: Array | None = None
+    load_freedom: str | None = None
 
     def as_dict(self) -> dict[str, Any]:
         per_input = {n: {"value": self.inputs[:, k], "rate": self.rates[:, k],
                          "acceleration": self.accelerations[:, k],
-                         "motor": self.motor[:, k], "friction": self.friction[:, k]}
+                         "motor": self.motor[:, k], "friction": self.friction[:, k],
+                         **({} if self.load is None else {"load": self.load[:, k]})}
                      for k, n in enumerate(self.input_names)}
+        extra = ({} if self.load_work is None else
+                 {"output_force": self.output_force, "load_work": self.load_work,
+                  "load_freedom": self.load_freedom})
         return {"status": self.status, "message": self.message, "time": self.time,
                 "inputs": per_input, "kinetic_energy": self.kinetic_energy,
                 "potential_energy": self.potential_energy, "motor_work": self.motor_work,
-                "friction_work": self.friction_work, "closure_residual": self.closure_residual,
+                "friction_work": self.friction_work, **extra,
+                "closure_residual": self.closure_residual,
                 "energy_error": self.energy_error,
                 "units": {"time": "s", "angle": "rad", "length": "m", "energy": "J",
                           "torque": "N*m", "force": "N"}}
@@ -113,10 +124,11 @@ def simulate_graph(eom: GraphEquationOfMotion, *, duration: float, samples: int 
     def rhs(t: float, y: Array) -> Array:
         T = eom.terms(y[:n], y[n:2 * n])
         xd = y[n:2 * n]
-        return np.concatenate([xd, T["acceleration"], [T["motor"] @ xd, T["friction"] @ xd]])
+        return np.concatenate([xd, T["acceleration"], [T["motor"] @ xd, T["friction"] @ xd,
+                                                       T["load"] @ xd]])
 
     rows: list[dict[str, Any]] = []
-    y = np.concatenate([x0, v0, [0.0, 0.0]])
+    y = np.concatenate([x0, v0, [0.0, 0.0, 0.0]])
     status, message = "completed", f"simulated {duration:.6g} s"
     a_tol = rtol if atol is None else atol
     step = None
@@ -155,11 +167,14 @@ def _result(eom: GraphEquationOfMotion, rows: list[dict[str, Any]], status: str,
 
     y = np.array([r["y"] for r in rows])
     kinetic, potential = col("kinetic_energy"), col("potential_energy")
-    w_motor, w_friction = y[:, 2 * n], y[:, 2 * n + 1]
-    balance = kinetic + potential - kinetic[0] - potential[0] - w_motor - w_friction
+    w_motor, w_friction, w_load = y[:, 2 * n], y[:, 2 * n + 1], y[:, 2 * n + 2]
+    balance = kinetic + potential - kinetic[0] - potential[0] - w_motor - w_friction - w_load
     scale = max(float(np.max(kinetic)), float(np.ptp(potential)), float(np.max(np.abs(w_motor))),
-                float(np.max(np.abs(w_friction))), 1e-300)
+                float(np.max(np.abs(w_friction))), float(np.max(np.abs(w_load))), 1e-300)
+    loaded = eom.load is not None or eom.point_force is not None
     return GraphSimulation(
         tuple(eom.mechanism.inputs), col("t"), y[:, :n], y[:, n:2 * n], col("acceleration"),
         col("motor"), col("friction"), kinetic, potential, w_motor, w_friction, col("residual"),
-        float(np.max(np.abs(balance)) / scale), status, message)
+        float(np.max(np.abs(balance)) / scale), status, message,
+        col("load") if loaded else None, col("output_force") if loaded else None,
+        w_load if loaded else None, eom.load.freedom if eom.load is not None else None)
