@@ -128,6 +128,17 @@ def create_app(studio: Studio) -> Any:
     def scene(tab: Tab, seq: int) -> str:
         return to_json(guarded(lambda: tab.scene(seq)))
 
+    def check(tab: Tab, seq: int) -> list[str]:
+        """After a warm-started answer and its scene: confirm it (``checked``) or, where the
+        generic solver's root search finds other modes, the answer of the state solved anew
+        and its scene (Tab.verify)."""
+        outcome = guarded(lambda: {"type": "verify", "seq": seq, "replaced": tab.verify()})
+        if outcome["type"] != "verify" or outcome["replaced"] is None:
+            return [] if outcome["type"] == "verify" else [to_json(outcome)]
+        if not outcome["replaced"]:
+            return [to_json({"type": "checked", "seq": seq})]
+        return [to_json(guarded(lambda: tab.answer(seq))), scene(tab, seq)]
+
     async def updates(ws: WebSocket) -> None:
         origin = ws.headers.get("origin")
         host = ws.headers.get("host", "")
@@ -149,6 +160,8 @@ def create_app(studio: Studio) -> Any:
                 await ws.send_text(answer)
                 if solved is not None:  # the 3-D scene right after the curves
                     await ws.send_text(await anyio.to_thread.run_sync(scene, tab, solved))
+                    for follow in await anyio.to_thread.run_sync(check, tab, solved):
+                        await ws.send_text(follow)
             message = await ws.receive()
             if message["type"] == "websocket.disconnect":
                 return

@@ -38,7 +38,12 @@
   const ws = new WebSocket(wsUrl);
   S.send = (msg) => { msg.seq = ++S.seq; ws.send(JSON.stringify(msg)); return msg.seq; };
   S.sendRaw = (text) => ws.send(text);
-  ws.onmessage = (ev) => receive(JSON.parse(ev.data));
+  ws.onmessage = (ev) => {
+    const t = performance.now();
+    const msg = JSON.parse(ev.data);
+    S.parsed = performance.now() - t; // ms to parse this message (timed answers keep it)
+    receive(msg);
+  };
   ws.onclose = () => say('the studio server has stopped; restart `screwkit studio` and reload', 'error');
 
   function say(text, kind) {
@@ -63,11 +68,12 @@
 
   function receive(msg) {
     const timed = S.inflight && msg.seq === S.inflight.seq ? S.inflight : null;
-    if (timed) { S.inflight = null; S.phases.push({ answer: performance.now() - timed.t0 }); }
+    if (timed) { S.inflight = null; S.phases.push({ answer: performance.now() - timed.t0, parse: S.parsed }); }
     if (msg.type === 'scene' && S.phases.length) S.phases[S.phases.length - 1].scene = performance.now() - S.stateT0;
     if (msg.type === 'state') showState(msg, timed);
     else if (msg.type === 'error') { S.errors.push(msg.message); say(msg.message, 'error'); }
     else if (msg.type === 'saved') say(`saved ${msg.path}`, 'ok');
+    else if (msg.type === 'checked') { S.checked = msg.seq; document.body.dataset.checked = String(msg.seq); }
     else if (msg.type === 'scene') { if (S.state && msg.seq === S.state.seq) loadView(msg.scene, S.stateT0); }
     else if (msg.type === 'numbers') { S.numbers = msg.numbers; drawNumbers(msg.numbers); $('numbers').classList.remove('stale'); document.body.dataset.numbers = String(msg.seq); }
     else if (msg.type === 'download') download(msg);
@@ -375,8 +381,10 @@
     $('assembly').className = r.assembly.length ? 'warn' : '';
     S.result = r;
     $('frame').max = String(r.input.values.length - 1);
+    const t1 = performance.now();
     drawPlots(r);
     drawTables(r);
+    if (timed && S.phases.length) S.phases[S.phases.length - 1].draw = performance.now() - t1;
     S.frame = Math.min(S.frame, r.input.values.length - 1);
     S.stateT0 = timed ? timed.t0 : performance.now();
     S.viewReady = false; // until the scene that follows this state is loaded
