@@ -10,7 +10,9 @@ Gauss–Newton to round-off, with Deuflhard's contraction test, vectorised over 
 result is kept only when it is provably the generic solver's answer:
 
 1. every sample of every mode converges and contracts (a start outside its root's basin of
-   quadratic convergence does not), to the round-off closure the tracker's samples have;
+   quadratic convergence does not), to the round-off closure the generic solver's samples
+   have (:func:`closed_as`), so the two agree to within that closure error over the passive
+   Jacobian's smallest singular value;
 2. no branch switch: each mode's joint centres and axes (its signature, the tracker's
    measure) move between neighbouring samples by at most :data:`STEP_GROWTH` times their
    move before the change, plus :data:`STEP_SLACK` (a jump to another branch at some samples
@@ -39,6 +41,7 @@ from numpy.typing import ArrayLike
 from screwkit.kinematics.motion import Motion, as_input_array, per_sample
 from screwkit.kinematics.registry import family_of
 from screwkit.kinematics.solve_motion import _with_seed_names
+from screwkit.kinematics.tracker.continuation import FILL_TOL
 from screwkit.kinematics.tracker.generic_motion import (
     SAME_ROOT,
     _root_search,
@@ -113,12 +116,23 @@ def warm_motion(linkage: Linkage, inputs: ArrayLike, previous: Motion, *,
     Xdd = per_sample(linkage, accelerations, "accelerations", X)
     mask = np.ones(N, dtype=bool)
     modes = []
+    closed = closed_as(previous)
     for k, m in enumerate(order):
         conf = fixed.conf.take(slice(m * N, (m + 1) * N))
         md = mode_from_configuration(linkage, lay, conf, mask.copy(), X, Xd, Xdd, [])
+        if not np.all(md.closure_residual <= closed):
+            return None
         modes.append(_with_seed_names(linkage, replace(md, index=k, label=f"branch {k}")))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="generic",
                   solver=previous.solver, notes=previous.notes)
+
+
+def closed_as(previous: Motion) -> float:
+    """The closure error a warm-started sample may have: what the generic solver's samples
+    have — round-off (its fill's FILL_TOL, or the largest error among the samples of
+    ``previous``, the same solver's motion at nearby dimensions, if more)."""
+    worst = max(float(np.nanmax(md.closure_residual, initial=0.0)) for md in previous.modes)
+    return max(FILL_TOL, worst)
 
 
 def same_modes_as_search(motion: Motion, starts: int = 48, seed: int = 0) -> bool:
@@ -148,4 +162,4 @@ def _signature_at(linkage: Linkage, lay: Layout, conf: Configuration, samples: A
     return signature(linkage, conf.take(np.asarray(samples, dtype=np.intp)), lay)
 
 
-__all__ = ["same_modes_as_search", "warm_motion"]
+__all__ = ["closed_as", "same_modes_as_search", "warm_motion"]

@@ -11,6 +11,7 @@ never reads a file path from a page, and writes only the spec it was started wit
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import math
@@ -153,22 +154,51 @@ def create_app(studio: Studio) -> Any:
             return
 
     async def serve_tab(ws: WebSocket, tab: Tab) -> None:
+        sending = anyio.Lock()
+
+        async def send(text: str) -> None:
+            async with sending:
+                await ws.send_text(text)
+
+        async def numbers(job: Callable[[], dict[str, Any] | None]) -> None:
+            """A numbers table, computed beside the messages that follow (Tab.numbers_job)."""
+            def run() -> str | None:
+                try:
+                    reply = job()
+                except Exception as exc:  # a bug: say so, keep serving
+                    log.exception("studio: the numbers table failed")
+                    reply = {"type": "error", "seq": 0, "message": f"internal error ({exc!r})"}
+                return None if reply is None else to_json(reply)
+
+            answer = await anyio.to_thread.run_sync(run)
+            if answer is not None:
+                with contextlib.suppress(Exception):  # the tab may have closed meanwhile
+                    await send(answer)
+
         text: str | None = '{"type": "state", "seq": 0}'
-        while True:
-            if text is not None:
-                answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
-                await ws.send_text(answer)
-                if solved is not None:  # the 3-D scene right after the curves
-                    await ws.send_text(await anyio.to_thread.run_sync(scene, tab, solved))
-                    for follow in await anyio.to_thread.run_sync(check, tab, solved):
-                        await ws.send_text(follow)
-            message = await ws.receive()
-            if message["type"] == "websocket.disconnect":
-                return
-            text = message.get("text")
-            if text is None:
-                await ws.send_text(json.dumps({"type": "error", "seq": 0, "message":
+        async with anyio.create_task_group() as tasks:
+            try:
+                while True:
+                    if text is not None:
+                        job = await anyio.to_thread.run_sync(tab.numbers_job, text)
+                        if job is not None:
+                            tasks.start_soon(numbers, job)
+                        else:
+                            answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
+                            await send(answer)
+                            if solved is not None:  # the 3-D scene right after the curves
+                                await send(await anyio.to_thread.run_sync(scene, tab, solved))
+                                for follow in await anyio.to_thread.run_sync(check, tab, solved):
+                                    await send(follow)
+                    message = await ws.receive()
+                    if message["type"] == "websocket.disconnect":
+                        return
+                    text = message.get("text")
+                    if text is None:
+                        await send(json.dumps({"type": "error", "seq": 0, "message":
                                                "send JSON text messages, not binary"}))
+            except WebSocketDisconnect:  # the tab was closed while an answer was on its way
+                return
 
     return Starlette(routes=[Route("/", page), Route("/static/{name}", static),
                              WebSocketRoute("/ws", updates)])

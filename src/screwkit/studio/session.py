@@ -29,6 +29,7 @@ followed, when solved, by ``{"type": "scene", "seq", "scene"}`` (the 3-D view's 
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -269,6 +270,44 @@ class Tab:
             return self.answer(seq)
         except ScrewkitError as exc:
             return {"type": "error", "seq": seq, "message": str(exc)}
+
+    def numbers_job(self, text: str) -> Callable[[], dict[str, Any] | None] | None:
+        """For a ``numbers`` message: a job that answers it from the current state's pipeline
+        (taken now), which the server runs beside the messages that follow (the table takes
+        up to a few hundred ms; a change sent meanwhile is not kept waiting); the job answers
+        None when a later change has made the table stale. None for any other message (and
+        for a malformed one, which :meth:`handle` answers)."""
+        try:
+            msg = parse_message(text)
+        except ScrewkitError:
+            return None
+        if not (isinstance(msg, StepMessage) and msg.type == "numbers"):
+            return None
+        state, seq = self.state, msg.seq
+        try:
+            pipe = self.pipeline()
+        except ScrewkitError as exc:
+            failed = {"type": "error", "seq": seq, "message": str(exc)}
+            return lambda: failed
+
+        def job() -> dict[str, Any] | None:
+            if self.state != state:
+                return None
+            try:
+                return {"type": "numbers", "seq": seq, "numbers": self._numbers_of(pipe)}
+            except ScrewkitError as exc:
+                return {"type": "error", "seq": seq, "message": str(exc)}
+
+        return job
+
+    def _numbers_of(self, pipe: Any) -> list[list[str]]:
+        if self.design.graph:
+            from screwkit.studio.graph import graph_numbers
+
+            return graph_numbers(pipe)
+        from screwkit.studio.solve import numbers_table
+
+        return numbers_table(pipe)
 
     def numbers(self) -> list[list[str]]:
         """The numbers table of the current state."""

@@ -56,6 +56,7 @@
   // a dimension change: sent at once, or after the answer in flight (only the latest values)
   function change(values, mode) {
     const t0 = performance.now();
+    clearTimeout(restTimer);
     if (S.inflight !== null) {
       S.pending = { values: { ...(S.pending ? S.pending.values : {}), ...values }, mode: mode ?? (S.pending ? S.pending.mode : null), t0 };
       return;
@@ -75,7 +76,11 @@
     else if (msg.type === 'saved') say(`saved ${msg.path}`, 'ok');
     else if (msg.type === 'checked') { S.checked = msg.seq; document.body.dataset.checked = String(msg.seq); }
     else if (msg.type === 'scene') { if (S.state && msg.seq === S.state.seq) loadView(msg.scene, S.stateT0); }
-    else if (msg.type === 'numbers') { S.numbers = msg.numbers; drawNumbers(msg.numbers); $('numbers').classList.remove('stale'); document.body.dataset.numbers = String(msg.seq); }
+    else if (msg.type === 'numbers') {
+      if (msg.seq > S.lastChange) { // else asked for before a later change: stale
+        S.numbers = msg.numbers; drawNumbers(msg.numbers); $('numbers').classList.remove('stale'); document.body.dataset.numbers = String(msg.seq);
+      }
+    }
     else if (msg.type === 'download') download(msg);
     if (S.inflight === null && S.pending) {
       const p = S.pending;
@@ -83,8 +88,18 @@
       change(p.values, p.mode);
       if (S.inflight) S.inflight.t0 = p.t0;
     } else if (S.inflight === null && msg.type === 'state' && msg.result.ok) {
-      S.send({ type: 'numbers' }); // the slower table, once the curves are drawn
+      numbersAtRest(); // the slower table, once the curves are drawn and the design rests
     }
+  }
+
+  // the numbers table (limit positions: up to a few hundred ms on the server) is asked for
+  // once no change has been made for REST ms, so a drag never queues it; the server computes
+  // it beside later changes, which are answered without waiting for it
+  const REST = 150;
+  let restTimer = null;
+  function numbersAtRest() {
+    clearTimeout(restTimer);
+    restTimer = setTimeout(() => { if (S.inflight === null && !S.pending) S.send({ type: 'numbers' }); }, REST);
   }
 
   function download(msg) {
@@ -117,7 +132,7 @@
   }
 
   // ---- controls ------------------------------------------------------------------------
-  const step = (type) => { S.inflight = { seq: S.send({ type }), t0: performance.now() }; S.lastChange = S.inflight.seq; };
+  const step = (type) => { clearTimeout(restTimer); S.inflight = { seq: S.send({ type }), t0: performance.now() }; S.lastChange = S.inflight.seq; };
   $('undo').onclick = () => step('undo');
   $('redo').onclick = () => step('redo');
   $('save').onclick = () => S.send({ type: 'save' });
