@@ -51,11 +51,15 @@ def finite(doc: Any) -> Any:
 
 
 def to_json(doc: Any) -> str:
-    """The document as compact JSON, a NaN or infinity as ``null`` (:func:`finite`; a copy is
-    made only when the document holds one: the answers' series already say ``None``)."""
+    """The document as compact JSON, a NaN or infinity as ``null`` (orjson, which writes every
+    float as Python's shortest round-trip repr does and a NaN or infinity as ``null``, several
+    times faster than :mod:`json` on the answers' long series; :func:`finite` and :mod:`json`
+    for a document orjson does not take)."""
+    import orjson
+
     try:
-        return json.dumps(doc, separators=(",", ":"), allow_nan=False)
-    except ValueError:
+        return orjson.dumps(doc, option=orjson.OPT_SERIALIZE_NUMPY).decode()
+    except (orjson.JSONEncodeError, TypeError):
         return json.dumps(finite(doc), separators=(",", ":"))
 
 
