@@ -36,16 +36,16 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from screwkit.kinematics.motion import Motion, as_input_array, per_sample
 from screwkit.kinematics.registry import family_of
-from screwkit.kinematics.solve_motion import _with_seed_names
+from screwkit.kinematics.solve_motion import with_seed_names
 from screwkit.kinematics.tracker.continuation import FILL_TOL
 from screwkit.kinematics.tracker.generic_motion import (
     SAME_ROOT,
-    _root_search,
     anchor_samples,
+    root_search,
 )
 from screwkit.kinematics.tracker.loop import Array, Configuration, Layout, layout
 from screwkit.kinematics.tracker.mode_frames import mode_from_configuration
@@ -60,8 +60,8 @@ REACH = 1.0
 CONTRACTION = 0.5
 #: a mode's signature may move between neighbouring samples by this many times its move before
 #: the change, plus STEP_SLACK (signature units: lengths / length scale, axis components)
-STEP_GROWTH = 2.0
-STEP_SLACK = 1e-3
+STEP_GROWTH = 3.0
+STEP_SLACK = 1e-6
 #: signature distance below which two modes are the same configuration (the generic solver's
 #: merge test, generic_motion._same_samples)
 DISTINCT = 1e-5
@@ -122,7 +122,7 @@ def warm_motion(linkage: Linkage, inputs: ArrayLike, previous: Motion, *,
         md = mode_from_configuration(linkage, lay, conf, mask.copy(), X, Xd, Xdd, [])
         if not np.all(md.closure_residual <= closed):
             return None
-        modes.append(_with_seed_names(linkage, replace(md, index=k, label=f"branch {k}")))
+        modes.append(with_seed_names(linkage, replace(md, index=k, label=f"branch {k}")))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="generic",
                   solver=previous.solver, notes=previous.notes)
 
@@ -142,7 +142,7 @@ def same_modes_as_search(motion: Motion, starts: int = 48, seed: int = 0) -> boo
     each mode at some anchor."""
     linkage, X = motion.linkage, motion.inputs
     lay = layout(linkage)
-    samples, asm = _root_search(linkage, X, anchor_samples(linkage, X), starts, seed)
+    samples, asm = root_search(linkage, X, anchor_samples(linkage, X), starts, seed)
     modes = np.stack([_signature_at(linkage, lay, md.conf, samples) for md in motion.modes])
     seen = np.zeros(len(motion.modes), dtype=bool)
     for r in range(samples.size):
@@ -158,8 +158,9 @@ def same_modes_as_search(motion: Motion, starts: int = 48, seed: int = 0) -> boo
     return bool(seen.all())
 
 
-def _signature_at(linkage: Linkage, lay: Layout, conf: Configuration, samples: Array) -> Array:
-    return signature(linkage, conf.take(np.asarray(samples, dtype=np.intp)), lay)
+def _signature_at(linkage: Linkage, lay: Layout, conf: Configuration,
+                  samples: NDArray[np.intp]) -> Array:
+    return signature(linkage, conf.take(samples), lay)
 
 
 __all__ = ["closed_as", "same_modes_as_search", "warm_motion"]

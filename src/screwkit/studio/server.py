@@ -83,7 +83,6 @@ def _static(name: str) -> tuple[bytes, str]:
 
 def create_app(studio: Studio) -> Any:
     """The Starlette application of a studio."""
-    import anyio
     from starlette.applications import Starlette
     from starlette.requests import Request
     from starlette.responses import HTMLResponse, PlainTextResponse, Response
@@ -153,59 +152,67 @@ def create_app(studio: Studio) -> Any:
             return
         await ws.accept()
         try:
-            await serve_tab(ws, Tab(studio.design, studio.save_as))
+            await serve_tab(ws, Tab(studio.design, studio.save_as), handle, scene, check)
         except WebSocketDisconnect:  # the tab was closed while an answer was on its way
             return
 
-    async def serve_tab(ws: WebSocket, tab: Tab) -> None:
-        sending = anyio.Lock()
-
-        async def send(text: str) -> None:
-            async with sending:
-                await ws.send_text(text)
-
-        async def numbers(job: Callable[[], dict[str, Any] | None]) -> None:
-            """A numbers table, computed beside the messages that follow (Tab.numbers_job)."""
-            def run() -> str | None:
-                try:
-                    reply = job()
-                except Exception as exc:  # a bug: say so, keep serving
-                    log.exception("studio: the numbers table failed")
-                    reply = {"type": "error", "seq": 0, "message": f"internal error ({exc!r})"}
-                return None if reply is None else to_json(reply)
-
-            answer = await anyio.to_thread.run_sync(run)
-            if answer is not None:
-                with contextlib.suppress(Exception):  # the tab may have closed meanwhile
-                    await send(answer)
-
-        text: str | None = '{"type": "state", "seq": 0}'
-        async with anyio.create_task_group() as tasks:
-            try:
-                while True:
-                    if text is not None:
-                        job = await anyio.to_thread.run_sync(tab.numbers_job, text)
-                        if job is not None:
-                            tasks.start_soon(numbers, job)
-                        else:
-                            answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
-                            await send(answer)
-                            if solved is not None:  # the 3-D scene right after the curves
-                                await send(await anyio.to_thread.run_sync(scene, tab, solved))
-                                for follow in await anyio.to_thread.run_sync(check, tab, solved):
-                                    await send(follow)
-                    message = await ws.receive()
-                    if message["type"] == "websocket.disconnect":
-                        return
-                    text = message.get("text")
-                    if text is None:
-                        await send(json.dumps({"type": "error", "seq": 0, "message":
-                                               "send JSON text messages, not binary"}))
-            except WebSocketDisconnect:  # the tab was closed while an answer was on its way
-                return
-
     return Starlette(routes=[Route("/", page), Route("/static/{name}", static),
                              WebSocketRoute("/ws", updates)])
+
+
+async def serve_tab(ws: Any, tab: Tab, handle: Callable[[Tab, str], tuple[str, int | None]],
+                    scene: Callable[[Tab, int], str],
+                    check: Callable[[Tab, int], list[str]]) -> None:
+    """One tab's WebSocket: each message answered in turn (``handle``; a solved state is
+    followed by its 3-D ``scene`` and a warm start's ``check``), except a numbers table,
+    computed beside the messages that follow (Tab.numbers_job)."""
+    import anyio
+    from starlette.websockets import WebSocketDisconnect
+
+    sending = anyio.Lock()
+
+    async def send(text: str) -> None:
+        async with sending:
+            await ws.send_text(text)
+
+    async def numbers(job: Callable[[], dict[str, Any] | None]) -> None:
+        def run() -> str | None:
+            try:
+                reply = job()
+            except Exception as exc:  # a bug: say so, keep serving
+                log.exception("studio: the numbers table failed")
+                reply = {"type": "error", "seq": 0, "message": f"internal error ({exc!r})"}
+            return None if reply is None else to_json(reply)
+
+        answer = await anyio.to_thread.run_sync(run)
+        if answer is not None:
+            with contextlib.suppress(Exception):  # the tab may have closed meanwhile
+                await send(answer)
+
+    text: str | None = '{"type": "state", "seq": 0}'
+    async with anyio.create_task_group() as tasks:
+        try:
+            while True:
+                if text is not None:
+                    job = await anyio.to_thread.run_sync(tab.numbers_job, text)
+                    if job is not None:
+                        tasks.start_soon(numbers, job)
+                    else:
+                        answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
+                        await send(answer)
+                        if solved is not None:  # the 3-D scene right after the curves
+                            await send(await anyio.to_thread.run_sync(scene, tab, solved))
+                            for follow in await anyio.to_thread.run_sync(check, tab, solved):
+                                await send(follow)
+                message = await ws.receive()
+                if message["type"] == "websocket.disconnect":
+                    return
+                text = message.get("text")
+                if text is None:
+                    await send(json.dumps({"type": "error", "seq": 0, "message":
+                                           "send JSON text messages, not binary"}))
+        except WebSocketDisconnect:  # the tab was closed while an answer was on its way
+            return
 
 
 def bind(host: str, port: int) -> socket.socket:
