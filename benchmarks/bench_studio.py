@@ -9,6 +9,7 @@ new design too (the whole page redrawn: the view updates in place), median of 10
 from __future__ import annotations
 
 import json
+import os
 import statistics
 import tempfile
 import threading
@@ -164,4 +165,7 @@ def run() -> list[dict[str, Any]]:
                          f"update {shown['update']:.0f} ms; warm starts confirmed: "
                          f"{shown['warm']}/{shown['moves']}"},
             ]
+    rows.append({"name": "machine load during the run (1-min load average, 2 cores)",
+                 "value": os.getloadavg()[0], "unit": "", "target": "",
+                 "note": "wall times above grow with it; CPU times do not"})
     return rows

@@ -158,13 +158,18 @@ class Tab:
         (:func:`~screwkit.kinematics.warm_motion.warm_motion`: batched Newton on every sample
         of every mode, checked for closure, continuity and distinct modes); True if it did.
         Anything else (a closed form, a mode that does not assemble everywhere, a change too
-        large for Newton) is solved anew when the motion is first asked for."""
+        large for Newton) is solved anew when the motion is first asked for. A change of the
+        mode alone keeps the motion (every mode is solved; the mode picks the loads)."""
         from screwkit.kinematics.warm_motion import warm_motion
 
         before = None if self._solved is None else self._solved[1]
         motion = None if before is None else before.__dict__.get("motion")
         if motion is None:
             return False
+        assert self._solved is not None
+        if self._solved[0].values == self.state.values:  # only the mode changed: the same loop
+            pipe.motion = motion
+            return self._unchecked
         spec = pipe.spec
         try:
             warm = warm_motion(spec.linkage, spec.inputs, motion, rates=spec.speed,
