@@ -21,7 +21,10 @@ A page sends JSON objects with a ``type``:
 Answers: ``{"type": "state", "seq", "values", "mode", "can_undo", "can_redo", "result"}``
 (``result`` is :func:`~screwkit.studio.solve.solve_spec`'s dictionary without the scene and
 the numbers, or ``{"ok": false, "error": sentence}`` where the design cannot be solved),
-followed, when solved, by ``{"type": "scene", "seq", "scene"}`` (the 3-D view's scene), ``{"type": "saved", "seq", "path"}``,
+followed, when solved, by ``{"type": "scene", "seq", "scene"}`` (the 3-D view's scene) and,
+for a warm-started joint list (``result["warm"]``), by ``{"type": "checked", "seq"}`` once
+:meth:`Tab.verify` confirms it or by the state solved anew and its scene;
+``{"type": "saved", "seq", "path"}``,
 ``{"type": "numbers", "seq", "numbers"}``, ``{"type": "download", "seq", "name", "mime", "text"}`` and ``{"type": "error", "seq",
 "message"}``. No message carries a file path to the server.
 """
