@@ -141,3 +141,31 @@ def test_a_warm_start_missing_a_mode_is_replaced(open_studio: Any, served: Any, 
                                    np.degrees(np.array(entry["variables"]["output.theta"],
                                                        dtype=float)), rtol=1e-12, atol=1e-12)
     assert not page.errors
+
+
+def test_the_server_checks_a_warm_start_unless_another_change_waits(served: Any) -> None:
+    """Over the WebSocket: two changes sent at once (a drag) — the first's warm answer and
+    scene come without a check (the second was waiting: that state is past), the second's
+    are confirmed (``checked``); a change sent right after a numbers request is answered
+    without waiting for the table."""
+    from websockets.sync.client import connect
+
+    def until(ws: Any, kind: str, seq: int) -> list[tuple[str, int]]:
+        seen = []
+        while True:
+            msg = json.loads(ws.recv(timeout=120))
+            seen.append((msg["type"], msg["seq"]))
+            if (msg["type"], msg["seq"]) == (kind, seq):
+                return seen
+
+    with connect(served.ws_url, open_timeout=10, max_size=None) as ws:
+        assert until(ws, "scene", 0) == [("state", 0), ("scene", 0)]
+        ws.send(json.dumps({"type": "set", "seq": 1, "values": {KEY: 112.5}}))
+        ws.send(json.dumps({"type": "set", "seq": 2, "values": {KEY: 113.0}}))
+        seen = until(ws, "checked", 2)
+        assert seen == [("state", 1), ("scene", 1), ("state", 2), ("scene", 2), ("checked", 2)]
+        ws.send(json.dumps({"type": "numbers", "seq": 3}))
+        ws.send(json.dumps({"type": "set", "seq": 4, "values": {KEY: 113.5}}))
+        seen = until(ws, "checked", 4)
+        assert seen[0] == ("state", 4)  # not kept waiting for the table (300 ms), which comes
+        # after it or, made stale by the change before it started, not at all

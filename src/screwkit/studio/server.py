@@ -189,10 +189,32 @@ async def serve_tab(ws: Any, tab: Tab, handle: Callable[[Tab, str], tuple[str, i
             with contextlib.suppress(Exception):  # the tab may have closed meanwhile
                 await send(answer)
 
+    async def read(inbox: Any) -> None:
+        """Every message of the tab into ``inbox``, so that the loop below can see whether
+        another is waiting."""
+        async with inbox:
+            while True:
+                try:
+                    message = await ws.receive()
+                except Exception:  # the connection is gone (a disconnect already read)
+                    message = {"type": "websocket.disconnect", "code": 1006}
+                await inbox.send(message)
+                if message["type"] == "websocket.disconnect":
+                    return
+
+    def waiting(outbox: Any) -> dict[str, Any] | None:
+        try:
+            return dict(outbox.receive_nowait())
+        except (anyio.WouldBlock, anyio.EndOfStream):
+            return None
+
     text: str | None = '{"type": "state", "seq": 0}'
-    async with anyio.create_task_group() as tasks:
+    inbox, outbox = anyio.create_memory_object_stream[dict[str, Any]](math.inf)
+    async with anyio.create_task_group() as tasks, outbox:
+        tasks.start_soon(read, inbox)
         try:
             while True:
+                message: dict[str, Any] | None = None
                 if text is not None:
                     job = await anyio.to_thread.run_sync(tab.numbers_job, text)
                     if job is not None:
@@ -202,18 +224,25 @@ async def serve_tab(ws: Any, tab: Tab, handle: Callable[[Tab, str], tuple[str, i
                         await send(answer)
                         if solved is not None:  # the 3-D scene right after the curves
                             await send(await anyio.to_thread.run_sync(scene, tab, solved))
-                            for follow in await anyio.to_thread.run_sync(check, tab, solved):
-                                await send(follow)
-                message = await ws.receive()
+                            # a warm start's check, unless the page has sent another message
+                            # meanwhile (a drag): that state is then past, and whatever comes
+                            # next is checked on its own (Tab.pipeline, Tab.verify)
+                            message = waiting(outbox)
+                            if message is None:
+                                for follow in await anyio.to_thread.run_sync(check, tab, solved):
+                                    await send(follow)
+                if message is None:
+                    message = dict(await outbox.receive())
                 if message["type"] == "websocket.disconnect":
                     return
                 text = message.get("text")
                 if text is None:
                     await send(json.dumps({"type": "error", "seq": 0, "message":
                                            "send JSON text messages, not binary"}))
-        except WebSocketDisconnect:  # the tab was closed while an answer was on its way
+        except (WebSocketDisconnect, anyio.EndOfStream):  # the tab closed meanwhile
             return
-
+        finally:
+            tasks.cancel_scope.cancel()
 
 def bind(host: str, port: int) -> socket.socket:
     """A listening socket on ``host:port`` (port 0: a free port chosen by the system)."""
