@@ -1,10 +1,11 @@
 """``screwkit studio``: the time from a dimension change to the redrawn page for a single loop at
-360 samples (target ≤ 100 ms, issue 29). Server side: one tab's answer to a ``set`` message
-(solve with the closed form or the tracker, curves, loads, JSON) and the 3-D scene sent after
-it, for the RSSR (closed form) and the RRSRR joint list (tracker), wall and CPU time; in the
-browser (headless Debian chromium,
-when installed): input event → curves redrawn, and → the frame where the 3-D view shows the
-new design too (the whole page redrawn: the view updates in place), median of 10 moves."""
+360 samples (target ≤ 100 ms, issue 29), side by side for the RSSR (closed form, with loads)
+and the RRSRR joint list (the tracker, warm-started from the design before: docs/studio.md,
+"Speed"). Server side: one tab's answer to a ``set`` message (solve, curves, loads, JSON), the
+3-D scene sent after it and the warm start's check after both, wall and CPU time; in the
+browser (headless Debian chromium, when installed): input event → curves redrawn, and → the
+frame where the 3-D view shows the new design too (the whole page redrawn: the view updates in
+place), median of 10 moves, with the page's phases; and the machine's load during the run."""
 
 from __future__ import annotations
 

@@ -25,7 +25,8 @@ result is kept only when it is provably the generic solver's answer:
    the whole sweep that search is the only place the generic solver finds modes (it searches
    again only where a branch ends), so the warm modes are then its modes.
 
-Only motions whose every mode assembles at every sample with no singular sample, of a loop
+Only motions whose every mode assembles at every sample with no singular sample (before and
+after the change), of a loop
 without S–S rods (whose idle spin the root search fixes at random), are warm-started; anything
 else returns None and the caller solves anew. The modes are built, numbered and named exactly as
 :func:`~screwkit.kinematics.solve_motion.solve_motion` builds a generic motion.
@@ -120,8 +121,8 @@ def warm_motion(linkage: Linkage, inputs: ArrayLike, previous: Motion, *,
     for k, m in enumerate(order):
         conf = fixed.conf.take(slice(m * N, (m + 1) * N))
         md = mode_from_configuration(linkage, lay, conf, mask.copy(), X, Xd, Xdd, [])
-        if not np.all(md.closure_residual <= closed):
-            return None
+        if not np.all(md.closure_residual <= closed) or md.singular.any():
+            return None  # not closed as well, or a singular sample (the solver's own care)
         modes.append(with_seed_names(linkage, replace(md, index=k, label=f"branch {k}")))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="generic",
                   solver=previous.solver, notes=previous.notes)
