@@ -1,14 +1,16 @@
 """``screwkit studio``: the time from a dimension change to the redrawn page for a single loop at
-360 samples (target ≤ 100 ms, issue 29). Server side: one tab's answer to a ``set`` message
-(solve with the closed form or the tracker, curves, loads, JSON) and the 3-D scene sent after
-it, for the RSSR (closed form) and the RRSRR joint list (tracker), wall and CPU time; in the
-browser (headless Debian chromium,
-when installed): input event → curves redrawn, and → the frame where the 3-D view shows the
-new design too (the whole page redrawn: the view updates in place), median of 10 moves."""
+360 samples (target ≤ 100 ms, issue 29), side by side for the RSSR (closed form, with loads)
+and the RRSRR joint list (the tracker, warm-started from the design before: docs/studio.md,
+"Speed"). Server side: one tab's answer to a ``set`` message (solve, curves, loads, JSON), the
+3-D scene sent after it and the warm start's check after both, wall and CPU time; in the
+browser (headless Debian chromium, when installed): input event → curves redrawn, and → the
+frame where the 3-D view shows the new design too (the whole page redrawn: the view updates in
+place), median of 10 moves, with the page's phases; and the machine's load during the run."""
 
 from __future__ import annotations
 
 import json
+import os
 import statistics
 import tempfile
 import threading
@@ -29,16 +31,21 @@ def _at_360(name: str, folder: Path) -> Path:
 
 def _server_side(spec: Path, key: str, value: float) -> dict[str, float]:
     """Median wall and CPU time (ms) of a tab's answers to a ``set`` message: the ``state``
-    (solve, curves, loads, JSON) and the ``scene`` that follows it. CPU time (this thread's)
+    (solve, curves, loads, JSON), the ``scene`` that follows it and a warm start's check after
+    both (Tab.verify), and how many answers were warm starts. CPU time (this thread's)
     is what the answer costs on an idle machine; wall time what it took here."""
     from screwkit.studio.design import Design
     from screwkit.studio.server import to_json
     from screwkit.studio.session import Tab
 
     tab = Tab(Design(spec))
-    times: dict[str, list[float]] = {"state": [], "state_cpu": [], "scene": [], "scene_cpu": []}
+    warm = 0
+    times: dict[str, list[float]] = {"state": [], "state_cpu": [], "scene": [], "scene_cpu": [],
+                                     "check": [], "check_cpu": []}
+    tab.handle(json.dumps({"type": "state", "seq": 0}))
+    tab.verify()
     for k in range(7):
-        message = json.dumps({"type": "set", "seq": k + 1, "values": {key: value + 0.01 * k}})
+        message = json.dumps({"type": "set", "seq": k + 1, "values": {key: value + 0.01 * (k + 1)}})
         t, c = time.perf_counter(), time.thread_time()
         reply = tab.handle(message)
         to_json(reply)
@@ -49,10 +56,26 @@ def _server_side(spec: Path, key: str, value: float) -> dict[str, float]:
         to_json(tab.scene(k + 1))
         times["scene"].append(time.perf_counter() - t)
         times["scene_cpu"].append(time.thread_time() - c)
-    return {k: statistics.median(v) * 1e3 for k, v in times.items()}
+        t, c = time.perf_counter(), time.thread_time()
+        checked = tab.verify()  # a warm start's confirmation (None: nothing to confirm)
+        times["check"].append(time.perf_counter() - t)
+        times["check_cpu"].append(time.thread_time() - c)
+        assert checked is not True, "a warm start was replaced"
+        warm += checked is False
+    return {**{k: statistics.median(v) * 1e3 for k, v in times.items()}, "warm": warm}
 
 
-def _browser(spec: Path) -> tuple[float, float, dict[str, float]] | None:
+#: the page is idle: the last change's curves and 3-D view drawn, a warm start confirmed
+IDLE = """() => { const s = window.studio; return s.inflight === null && !s.pending
+          && +document.body.dataset.drawn === s.lastChange && s.viewReady
+          && (!s.result || !s.result.warm || s.checked === s.state.seq); }"""
+
+
+def _browser(spec: Path, key: str, values: list[float]) -> dict[str, Any] | None:
+    """Input event → curves redrawn and → page redrawn (curves and 3-D view) for slider moves
+    of ``key`` to ``values`` (each after the page is idle), medians; the phases of the page
+    (answer arrived, its JSON parsed, curves drawn, scene arrived, view updated); how many
+    answers were warm starts."""
     if not CHROMIUM.exists():
         return None
     from playwright.sync_api import sync_playwright
@@ -66,31 +89,37 @@ def _browser(spec: Path) -> tuple[float, float, dict[str, float]] | None:
     thread.start()
     while not server.started:
         time.sleep(0.02)
-    wait = """() => { const s = window.studio; return s.inflight === null && !s.pending
-              && +document.body.dataset.drawn === s.lastChange && s.viewReady; }"""
+    n = len(values)
     try:
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=str(CHROMIUM), headless=True,
                                         args=["--no-sandbox", "--disable-gpu"])
             page = browser.new_page(viewport={"width": 1400, "height": 900})
             page.goto(url_of(sock, studio.token))
-            page.wait_for_function(wait, timeout=60_000)
-            slider = page.locator(".dim[data-name='dimensions.d2'] input[type=range]")
-            for k in range(10):
-                slider.fill(str(101 + k))
-                page.wait_for_function(wait, timeout=60_000)
-            page.wait_for_function("window.studio.viewLatencies.length >= 11", timeout=60_000)
-            curves = page.evaluate("window.studio.latencies")[-10:]
-            view = page.evaluate("window.studio.viewLatencies")[-10:]
-            assert page.evaluate("window.studio.viewUpdates") >= 10  # in place, no reload
-            phases = page.evaluate("window.studio.phases.slice(-10)")
+            page.wait_for_function(IDLE, timeout=60_000)
+            slider = page.locator(f".dim[data-name='{key}'] input[type=range]")
+            warm = 0
+            for v in values:
+                slider.fill(str(v))
+                page.wait_for_function(IDLE, timeout=60_000)
+                warm += bool(page.evaluate("window.studio.result.warm === true && "
+                                           "window.studio.checked === window.studio.state.seq"))
+            page.wait_for_function(f"window.studio.viewLatencies.length >= {n + 1}",
+                                   timeout=60_000)
+            curves = page.evaluate("window.studio.latencies")[-n:]
+            view = page.evaluate("window.studio.viewLatencies")[-n:]
+            assert page.evaluate("window.studio.viewUpdates") >= n  # in place, no reload
+            phases = page.evaluate(f"window.studio.phases.slice(-{n})")
             browser.close()
     finally:
         server.should_exit = True
         thread.join(10)
         sock.close()
-    parts = {k: statistics.median(p[k] for p in phases) for k in ("answer", "scene", "update")}
-    return statistics.median(curves), statistics.median(view), parts
+    out = {k: statistics.median(p[k] for p in phases)
+           for k in ("answer", "parse", "draw", "scene", "update")}
+    out.update(curves=statistics.median(curves), view=statistics.median(view),
+               view_max=max(view), warm=warm, moves=n)
+    return out
 
 
 def run() -> list[dict[str, Any]]:
@@ -109,19 +138,35 @@ def run() -> list[dict[str, Any]]:
                  "note": f"solve + curves + loads + JSON; CPU {t['state_cpu']:.0f} ms"},
                 {"name": f"server: 3-D scene after it, {label}", "value": t["scene"],
                  "unit": "ms", "target": "", "note": f"CPU {t['scene_cpu']:.0f} ms"},
+                {"name": f"server: the warm start's check after that, {label}",
+                 "value": t["check"] if t["warm"] else None, "unit": "ms", "target": "",
+                 "note": f"CPU {t['check_cpu']:.0f} ms; {t['warm']}/7 answers warm-started"
+                         if t["warm"] else "not warm-started (a closed form)"},
             ]
-        shown = _browser(rssr)
-        if shown is None:
-            rows.append({"name": "browser: input → redraw", "value": None, "unit": "ms",
-                         "target": "≤ 100", "note": "no /usr/bin/chromium: not measured"})
-        else:
+        for label, spec, key, values in (
+                ("RSSR (closed form, loads)", rssr, "dimensions.d2", [101.0 + k for k in range(10)]),
+                ("RRSRR joint list (tracker)", loop, "joints[1].length",
+                 [112.0 + k for k in range(10)])):
+            shown = _browser(spec, key, values)
+            if shown is None:
+                rows.append({"name": f"browser: input → redraw, {label}", "value": None,
+                             "unit": "ms", "target": "≤ 100",
+                             "note": "no /usr/bin/chromium: not measured"})
+                continue
             rows += [
-                {"name": "browser: input event → curves redrawn, RSSR 360 samples",
-                 "value": shown[0], "unit": "ms", "target": "≤ 100", "note": "median of 10"},
-                {"name": "browser: input event → page redrawn (curves and 3-D view), RSSR 360 "
-                 "samples", "value": shown[1], "unit": "ms", "target": "≤ 100",
-                 "note": f"median of 10; the view updated in place; answer at "
-                         f"{shown[2]['answer']:.0f} ms, scene at {shown[2]['scene']:.0f} ms, "
-                         f"the view's update {shown[2]['update']:.0f} ms"},
+                {"name": f"browser: input event → curves redrawn, {label}, 360 samples",
+                 "value": shown["curves"], "unit": "ms", "target": "≤ 100",
+                 "note": f"median of {shown['moves']}"},
+                {"name": f"browser: input event → page redrawn (curves and 3-D view), {label}, "
+                 "360 samples", "value": shown["view"], "unit": "ms", "target": "≤ 100",
+                 "note": f"median of {shown['moves']} (max {shown['view_max']:.0f}); the view "
+                         f"updated in place; answer at {shown['answer']:.0f} ms (its JSON "
+                         f"parsed in {shown['parse']:.0f}), curves drawn in "
+                         f"{shown['draw']:.0f}, scene at {shown['scene']:.0f} ms, the view's "
+                         f"update {shown['update']:.0f} ms; warm starts confirmed: "
+                         f"{shown['warm']}/{shown['moves']}"},
             ]
+    rows.append({"name": "machine load during the run (1-min load average, 2 cores)",
+                 "value": os.getloadavg()[0], "unit": "", "target": "",
+                 "note": "wall times above grow with it; CPU times do not"})
     return rows

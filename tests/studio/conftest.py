@@ -102,10 +102,12 @@ class StudioPage:
 
     def wait_drawn(self) -> None:
         """Until the answer to the page's last change is drawn (curves) and its 3-D view is
-        loaded."""
+        loaded, and, for a warm-started answer (a joint list's motion from the design before),
+        until the server has confirmed it (``checked``) or sent the answer solved anew."""
         self.page.wait_for_function(
             """() => { const s = window.studio; return s.inflight === null && !s.pending
-              && +document.body.dataset.drawn === s.lastChange && s.viewReady; }""",
+              && +document.body.dataset.drawn === s.lastChange && s.viewReady
+              && (!s.result || !s.result.warm || s.checked === s.state.seq); }""",
             timeout=30_000)
 
     def wait_numbers(self) -> None:

@@ -327,7 +327,15 @@ def to_si(value: Any, kind: str, default_unit: str | None = None) -> float:
 
 def unit_factor(unit: str, kind: str) -> float:
     """The SI value of one ``unit`` of ``kind`` (``unit_factor("deg", "angle")`` is π/180);
-    a :class:`UnitError` for a unit that cannot be read or is of another kind."""
+    a :class:`UnitError` for a unit that cannot be read or is of another kind. Remembered per
+    (unit, kind): a spec's units are read again with every studio change."""
+    if isinstance(unit, str) and isinstance(kind, str):
+        return _unit_factor(unit, kind)
+    return _unit_factor.__wrapped__(unit, kind)
+
+
+@lru_cache(maxsize=1024)
+def _unit_factor(unit: str, kind: str) -> float:
     check_unit(unit, kind)
     names = parse_unit(unit)
     common = common_unit_factor(names, kind)

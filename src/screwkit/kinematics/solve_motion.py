@@ -95,7 +95,7 @@ def solve_motion(
     with progress_reporter(progress, N, seconds=seconds) as report:
         motion = generic_motion(linkage, X, Xd, Xdd, starts=starts, seed=seed,
                                 progress=report if report is not None else False)
-    modes = tuple(_with_seed_names(linkage, md) for md in motion.modes)
+    modes = tuple(with_seed_names(linkage, md) for md in motion.modes)
     notes = motion.notes
     if closed is not None:
         modes = _numbered_as(modes, closed(linkage, X, Xd, Xdd).modes, linkage.length_scale)
@@ -175,7 +175,7 @@ def _families_with_closed_forms() -> list:  # type: ignore[type-arg]
     return [f for f in FAMILIES.values() if f.closed_form is not None]
 
 
-def _with_seed_names(linkage: Linkage, mode: ModeMotion) -> ModeMotion:
+def with_seed_names(linkage: Linkage, mode: ModeMotion) -> ModeMotion:
     """A generic mode with the seed's variable names added (from its joint variables)."""
     named = seed_variables(linkage, mode)
     tables = tuple({**n, **general} for n, general in

@@ -11,6 +11,7 @@ never reads a file path from a page, and writes only the spec it was started wit
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import math
@@ -50,11 +51,15 @@ def finite(doc: Any) -> Any:
 
 
 def to_json(doc: Any) -> str:
-    """The document as compact JSON, a NaN or infinity as ``null`` (:func:`finite`; a copy is
-    made only when the document holds one: the answers' series already say ``None``)."""
+    """The document as compact JSON, a NaN or infinity as ``null`` (orjson, which writes every
+    float as Python's shortest round-trip repr does and a NaN or infinity as ``null``, several
+    times faster than :mod:`json` on the answers' long series; :func:`finite` and :mod:`json`
+    for a document orjson does not take)."""
+    import orjson
+
     try:
-        return json.dumps(doc, separators=(",", ":"), allow_nan=False)
-    except ValueError:
+        return orjson.dumps(doc, option=orjson.OPT_SERIALIZE_NUMPY).decode()
+    except (orjson.JSONEncodeError, TypeError):
         return json.dumps(finite(doc), separators=(",", ":"))
 
 
@@ -78,7 +83,6 @@ def _static(name: str) -> tuple[bytes, str]:
 
 def create_app(studio: Studio) -> Any:
     """The Starlette application of a studio."""
-    import anyio
     from starlette.applications import Starlette
     from starlette.requests import Request
     from starlette.responses import HTMLResponse, PlainTextResponse, Response
@@ -128,6 +132,17 @@ def create_app(studio: Studio) -> Any:
     def scene(tab: Tab, seq: int) -> str:
         return to_json(guarded(lambda: tab.scene(seq)))
 
+    def check(tab: Tab, seq: int) -> list[str]:
+        """After a warm-started answer and its scene: confirm it (``checked``) or, where the
+        generic solver's root search finds other modes, the answer of the state solved anew
+        and its scene (Tab.verify)."""
+        outcome = guarded(lambda: {"type": "verify", "seq": seq, "replaced": tab.verify()})
+        if outcome["type"] != "verify" or outcome["replaced"] is None:
+            return [] if outcome["type"] == "verify" else [to_json(outcome)]
+        if not outcome["replaced"]:
+            return [to_json({"type": "checked", "seq": seq})]
+        return [to_json(guarded(lambda: tab.answer(seq))), scene(tab, seq)]
+
     async def updates(ws: WebSocket) -> None:
         origin = ws.headers.get("origin")
         host = ws.headers.get("host", "")
@@ -137,29 +152,97 @@ def create_app(studio: Studio) -> Any:
             return
         await ws.accept()
         try:
-            await serve_tab(ws, Tab(studio.design, studio.save_as))
+            await serve_tab(ws, Tab(studio.design, studio.save_as), handle, scene, check)
         except WebSocketDisconnect:  # the tab was closed while an answer was on its way
             return
-
-    async def serve_tab(ws: WebSocket, tab: Tab) -> None:
-        text: str | None = '{"type": "state", "seq": 0}'
-        while True:
-            if text is not None:
-                answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
-                await ws.send_text(answer)
-                if solved is not None:  # the 3-D scene right after the curves
-                    await ws.send_text(await anyio.to_thread.run_sync(scene, tab, solved))
-            message = await ws.receive()
-            if message["type"] == "websocket.disconnect":
-                return
-            text = message.get("text")
-            if text is None:
-                await ws.send_text(json.dumps({"type": "error", "seq": 0, "message":
-                                               "send JSON text messages, not binary"}))
 
     return Starlette(routes=[Route("/", page), Route("/static/{name}", static),
                              WebSocketRoute("/ws", updates)])
 
+
+async def serve_tab(ws: Any, tab: Tab, handle: Callable[[Tab, str], tuple[str, int | None]],
+                    scene: Callable[[Tab, int], str],
+                    check: Callable[[Tab, int], list[str]]) -> None:
+    """One tab's WebSocket: each message answered in turn (``handle``; a solved state is
+    followed by its 3-D ``scene`` and a warm start's ``check``), except a numbers table,
+    computed beside the messages that follow (Tab.numbers_job)."""
+    import anyio
+    from starlette.websockets import WebSocketDisconnect
+
+    sending = anyio.Lock()
+
+    async def send(text: str) -> None:
+        async with sending:
+            await ws.send_text(text)
+
+    async def numbers(job: Callable[[], dict[str, Any] | None]) -> None:
+        def run() -> str | None:
+            try:
+                reply = job()
+            except Exception as exc:  # a bug: say so, keep serving
+                log.exception("studio: the numbers table failed")
+                reply = {"type": "error", "seq": 0, "message": f"internal error ({exc!r})"}
+            return None if reply is None else to_json(reply)
+
+        answer = await anyio.to_thread.run_sync(run)
+        if answer is not None:
+            with contextlib.suppress(Exception):  # the tab may have closed meanwhile
+                await send(answer)
+
+    async def read(inbox: Any) -> None:
+        """Every message of the tab into ``inbox``, so that the loop below can see whether
+        another is waiting."""
+        async with inbox:
+            while True:
+                try:
+                    message = await ws.receive()
+                except Exception:  # the connection is gone (a disconnect already read)
+                    message = {"type": "websocket.disconnect", "code": 1006}
+                await inbox.send(message)
+                if message["type"] == "websocket.disconnect":
+                    return
+
+    def waiting(outbox: Any) -> dict[str, Any] | None:
+        try:
+            return dict(outbox.receive_nowait())
+        except (anyio.WouldBlock, anyio.EndOfStream):
+            return None
+
+    text: str | None = '{"type": "state", "seq": 0}'
+    inbox, outbox = anyio.create_memory_object_stream[dict[str, Any]](math.inf)
+    async with anyio.create_task_group() as tasks, outbox:
+        tasks.start_soon(read, inbox)
+        try:
+            while True:
+                message: dict[str, Any] | None = None
+                if text is not None:
+                    job = await anyio.to_thread.run_sync(tab.numbers_job, text)
+                    if job is not None:
+                        tasks.start_soon(numbers, job)
+                    else:
+                        answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
+                        await send(answer)
+                        if solved is not None:  # the 3-D scene right after the curves
+                            await send(await anyio.to_thread.run_sync(scene, tab, solved))
+                            # a warm start's check, unless the page has sent another message
+                            # meanwhile (a drag): that state is then past, and whatever comes
+                            # next is checked on its own (Tab.pipeline, Tab.verify)
+                            message = waiting(outbox)
+                            if message is None:
+                                for follow in await anyio.to_thread.run_sync(check, tab, solved):
+                                    await send(follow)
+                if message is None:
+                    message = dict(await outbox.receive())
+                if message["type"] == "websocket.disconnect":
+                    return
+                text = message.get("text")
+                if text is None:
+                    await send(json.dumps({"type": "error", "seq": 0, "message":
+                                           "send JSON text messages, not binary"}))
+        except (WebSocketDisconnect, anyio.EndOfStream):  # the tab closed meanwhile
+            return
+        finally:
+            tasks.cancel_scope.cancel()
 
 def bind(host: str, port: int) -> socket.socket:
     """A listening socket on ``host:port`` (port 0: a free port chosen by the system)."""

@@ -21,7 +21,10 @@ A page sends JSON objects with a ``type``:
 Answers: ``{"type": "state", "seq", "values", "mode", "can_undo", "can_redo", "result"}``
 (``result`` is :func:`~screwkit.studio.solve.solve_spec`'s dictionary without the scene and
 the numbers, or ``{"ok": false, "error": sentence}`` where the design cannot be solved),
-followed, when solved, by ``{"type": "scene", "seq", "scene"}`` (the 3-D view's scene), ``{"type": "saved", "seq", "path"}``,
+followed, when solved, by ``{"type": "scene", "seq", "scene"}`` (the 3-D view's scene) and,
+for a warm-started joint list (``result["warm"]``), by ``{"type": "checked", "seq"}`` once
+:meth:`Tab.verify` confirms it or by the state solved anew and its scene;
+``{"type": "saved", "seq", "path"}``,
 ``{"type": "numbers", "seq", "numbers"}``, ``{"type": "download", "seq", "name", "mime", "text"}`` and ``{"type": "error", "seq",
 "message"}``. No message carries a file path to the server.
 """
@@ -29,6 +32,7 @@ followed, when solved, by ``{"type": "scene", "seq", "scene"}`` (the 3-D view's 
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -115,6 +119,7 @@ class Tab:
         d = self.design
         self.state = DesignState(tuple(d.initial_values.items()), d.initial_mode)
         self._solved: tuple[DesignState, Any] | None = None
+        self._unchecked = False  # the solved state's motion is a warm start not yet confirmed
 
     def set(self, values: dict[str, float], mode: int | None) -> None:
         merged = {**self.state.as_dict, **values}
@@ -132,9 +137,11 @@ class Tab:
             target.append(self.state)
             self.state = source.pop()
 
-    def pipeline(self) -> Any:
+    def pipeline(self, checked: bool = True) -> Any:
         """The pipeline of the current state (solved once per state); for a graph spec a
-        :class:`~screwkit.studio.graph.GraphRun`."""
+        :class:`~screwkit.studio.graph.GraphRun`. A joint list solved by the generic solver
+        is warm-started from the state before (:meth:`_warm`); ``checked``: first confirm a
+        warm start by the generic solver's own root search (:meth:`verify`)."""
         if self._solved is None or self._solved[0] != self.state:
             spec = self.design.spec_with(self.state.as_dict, self.state.mode)
             if self.design.graph:
@@ -142,8 +149,61 @@ class Tab:
 
                 self._solved = (self.state, GraphRun(spec, self.state.mode))
             else:
-                self._solved = (self.state, Pipeline(spec))
+                pipe = Pipeline(spec)
+                self._unchecked = self._warm(pipe)
+                self._solved = (self.state, pipe)
+        if checked:
+            self.verify()
         return self._solved[1]
+
+    def _warm(self, pipe: Pipeline) -> bool:
+        """Give ``pipe`` the motion warm-started from the last solved state's
+        (:func:`~screwkit.kinematics.warm_motion.warm_motion`: batched Newton on every sample
+        of every mode, checked for closure, continuity and distinct modes); True if it did.
+        Anything else (a closed form, a mode that does not assemble everywhere, a change too
+        large for Newton) is solved anew when the motion is first asked for. A change of the
+        mode alone keeps the motion (every mode is solved; the mode picks the loads)."""
+        from screwkit.kinematics.warm_motion import warm_motion
+
+        before = None if self._solved is None else self._solved[1]
+        motion = None if before is None else before.__dict__.get("motion")
+        if motion is None:
+            return False
+        assert self._solved is not None
+        if self._solved[0].values == self.state.values:  # only the mode changed: the same loop
+            pipe.motion = motion
+            return self._unchecked
+        spec = pipe.spec
+        try:
+            warm = warm_motion(spec.linkage, spec.inputs, motion, rates=spec.speed,
+                               accelerations=spec.acceleration)
+        except (ScrewkitError, FloatingPointError, np.linalg.LinAlgError):
+            warm = None
+        if warm is None:
+            return False
+        pipe.motion = warm  # the cached property's value (Pipeline.motion)
+        return True
+
+    @property
+    def warm(self) -> bool:
+        """Whether the current state's motion is a warm start not yet confirmed."""
+        return self._unchecked and self._solved is not None and self._solved[0] == self.state
+
+    def verify(self) -> bool | None:
+        """Confirm a warm-started motion (:func:`~screwkit.kinematics.warm_motion.
+        same_modes_as_search`: the generic solver's first root search finds exactly its
+        modes) or, where it does not, solve the state anew. None: nothing to confirm; False:
+        confirmed; True: replaced by the generic solver's motion (the page's answer changes)."""
+        if not self.warm:
+            return None
+        from screwkit.kinematics.warm_motion import same_modes_as_search
+
+        self._unchecked = False
+        assert self._solved is not None
+        if same_modes_as_search(self._solved[1].motion):
+            return False
+        self._solved = (self.state, Pipeline(self._solved[1].spec))
+        return True
 
     def solved(self, *, numbers: bool, scene: bool) -> dict[str, Any]:
         """The page's picture of the current state (studio/solve.py, studio/graph.py)."""
@@ -153,7 +213,8 @@ class Tab:
             return solve_graph(self.pipeline(), numbers=numbers, scene=scene)
         from screwkit.studio.solve import solve_spec
 
-        return solve_spec(self.pipeline(), numbers=numbers, scene=scene)
+        return {**solve_spec(self.pipeline(checked=False), numbers=numbers, scene=scene),
+                "warm": self.warm}
 
     def answer(self, seq: int) -> dict[str, Any]:
         """The ``state`` answer: the values, the history flags and the solved design (without
@@ -195,7 +256,7 @@ class Tab:
             return {"type": "scene", "seq": seq, "scene": graph_scene(run, run.dynamics()[0])}
         from screwkit.studio.solve import packed_scene
 
-        return {"type": "scene", "seq": seq, "scene": packed_scene(self.pipeline())}
+        return {"type": "scene", "seq": seq, "scene": packed_scene(self.pipeline(checked=False))}
 
     def handle(self, text: str) -> dict[str, Any]:
         """The answer to one message from the page (never raises for a page's mistake)."""
@@ -217,6 +278,44 @@ class Tab:
             return self.answer(seq)
         except ScrewkitError as exc:
             return {"type": "error", "seq": seq, "message": str(exc)}
+
+    def numbers_job(self, text: str) -> Callable[[], dict[str, Any] | None] | None:
+        """For a ``numbers`` message: a job that answers it from the current state's pipeline
+        (taken now), which the server runs beside the messages that follow (the table takes
+        up to a few hundred ms; a change sent meanwhile is not kept waiting); the job answers
+        None when a later change has made the table stale. None for any other message (and
+        for a malformed one, which :meth:`handle` answers)."""
+        try:
+            msg = parse_message(text)
+        except ScrewkitError:
+            return None
+        if not (isinstance(msg, StepMessage) and msg.type == "numbers"):
+            return None
+        state, seq = self.state, msg.seq
+        try:
+            pipe = self.pipeline()
+        except ScrewkitError as exc:
+            failed = {"type": "error", "seq": seq, "message": str(exc)}
+            return lambda: failed
+
+        def job() -> dict[str, Any] | None:
+            if self.state != state:
+                return None
+            try:
+                return {"type": "numbers", "seq": seq, "numbers": self._numbers_of(pipe)}
+            except ScrewkitError as exc:
+                return {"type": "error", "seq": seq, "message": str(exc)}
+
+        return job
+
+    def _numbers_of(self, pipe: Any) -> list[list[str]]:
+        if self.design.graph:
+            from screwkit.studio.graph import graph_numbers
+
+            return graph_numbers(pipe)
+        from screwkit.studio.solve import numbers_table
+
+        return numbers_table(pipe)
 
     def numbers(self) -> list[list[str]]:
         """The numbers table of the current state."""

@@ -11,6 +11,7 @@ Every number comes from the same functions as the CLI's; nothing here recomputes
 
 from __future__ import annotations
 
+import weakref
 from typing import Any
 
 import numpy as np
@@ -101,9 +102,21 @@ def _transmission(pipe: Pipeline, units: Any) -> tuple[list[dict[str, Any]] | No
     return out, None
 
 
+#: the dynamics document of each pipeline still in use: the ``state`` answer and the ``scene``
+#: after it both draw it, solved once
+_DYNAMICS: weakref.WeakKeyDictionary[Pipeline, tuple[dict[str, Any] | None, str | None]] = \
+    weakref.WeakKeyDictionary()
+
+
 def dynamics_document(pipe: Pipeline) -> tuple[dict[str, Any] | None, str | None]:
     """The dynamics document of ``[motion] mode`` (no gravity, as ``screwkit dynamics``
-    without ``--gravity``), or why there is none."""
+    without ``--gravity``), or why there is none (once per pipeline)."""
+    if pipe not in _DYNAMICS:
+        _DYNAMICS[pipe] = _dynamics_document(pipe)
+    return _DYNAMICS[pipe]
+
+
+def _dynamics_document(pipe: Pipeline) -> tuple[dict[str, Any] | None, str | None]:
     if any(link.mass is None for link in pipe.spec.linkage.links):
         return None, "no loads: the spec gives no mass properties ([links.<name>] mass)"
     try:

@@ -281,15 +281,24 @@ def nonnegative_least_squares(A: Array, b: Array, max_iterations: int) -> Array:
     """min ‖Ax − b‖ over x ≥ 0: the active-set method of Lawson & Hanson ("Solving Least
     Squares Problems", 1974, ch. 23; scipy.optimize.nnls implements the same method). Written
     here for the few rows of the smallest-cone problem, whose passive set stays small, so that
-    analyze does not import scipy.optimize (0.3 s of start-up)."""
+    analyze does not import scipy.optimize (0.3 s of start-up). A passive set met a second time
+    ends it: the method then cycles on round-off at the optimum (seen on the RSSR example with
+    d2 = 103 mm: 12 800 iterations, 1 s, for the answer of the first)."""
     m, n = A.shape
     x = np.zeros(n)
     passive = np.zeros(n, dtype=bool)
     tol = 10 * np.finfo(float).eps * np.linalg.norm(A, 1) * max(m, n)
     w = A.T @ (b - A @ x)
+    seen: set[bytes] = set()
     for _ in range(max_iterations):
         if passive.all() or not (w[~passive] > tol).any():
             break
+        # a passive set met again: the method cycles on round-off at the optimum (a multiplier
+        # of a tied constraint a hair over tol), where x already is the solution
+        key = np.packbits(passive).tobytes()
+        if key in seen:
+            break
+        seen.add(key)
         passive[int(np.argmax(np.where(passive, -np.inf, w)))] = True
         while True:
             z = np.zeros(n)

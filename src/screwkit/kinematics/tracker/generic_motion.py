@@ -236,7 +236,7 @@ def _new_seeds(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray
     return out
 
 
-def _root_search(linkage: Linkage, X: Array, samples: NDArray[np.intp], starts: int,
+def root_search(linkage: Linkage, X: Array, samples: NDArray[np.intp], starts: int,
                  seed: int) -> tuple[NDArray[np.intp], Assemblies]:
     """Every root at ``samples`` by Newton from random starts, in one vectorised search:
     ``starts`` at the first sample of the sweep, half as many at the others (the safety net:
@@ -257,7 +257,7 @@ def _seed_from(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray
     if any root was new."""
     if samples.size == 0:
         return False
-    samples, asm = _root_search(linkage, X, samples, starts, seed)
+    samples, asm = root_search(linkage, X, samples, starts, seed)
     return _seed_from_search(linkage, lay, tracker, samples, asm)
 
 

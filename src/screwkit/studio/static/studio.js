@@ -38,7 +38,12 @@
   const ws = new WebSocket(wsUrl);
   S.send = (msg) => { msg.seq = ++S.seq; ws.send(JSON.stringify(msg)); return msg.seq; };
   S.sendRaw = (text) => ws.send(text);
-  ws.onmessage = (ev) => receive(JSON.parse(ev.data));
+  ws.onmessage = (ev) => {
+    const t = performance.now();
+    const msg = JSON.parse(ev.data);
+    S.parsed = performance.now() - t; // ms to parse this message (timed answers keep it)
+    receive(msg);
+  };
   ws.onclose = () => say('the studio server has stopped; restart `screwkit studio` and reload', 'error');
 
   function say(text, kind) {
@@ -51,6 +56,7 @@
   // a dimension change: sent at once, or after the answer in flight (only the latest values)
   function change(values, mode) {
     const t0 = performance.now();
+    clearTimeout(restTimer);
     if (S.inflight !== null) {
       S.pending = { values: { ...(S.pending ? S.pending.values : {}), ...values }, mode: mode ?? (S.pending ? S.pending.mode : null), t0 };
       return;
@@ -63,13 +69,18 @@
 
   function receive(msg) {
     const timed = S.inflight && msg.seq === S.inflight.seq ? S.inflight : null;
-    if (timed) { S.inflight = null; S.phases.push({ answer: performance.now() - timed.t0 }); }
+    if (timed) { S.inflight = null; S.phases.push({ answer: performance.now() - timed.t0, parse: S.parsed }); }
     if (msg.type === 'scene' && S.phases.length) S.phases[S.phases.length - 1].scene = performance.now() - S.stateT0;
     if (msg.type === 'state') showState(msg, timed);
     else if (msg.type === 'error') { S.errors.push(msg.message); say(msg.message, 'error'); }
     else if (msg.type === 'saved') say(`saved ${msg.path}`, 'ok');
+    else if (msg.type === 'checked') { S.checked = msg.seq; document.body.dataset.checked = String(msg.seq); }
     else if (msg.type === 'scene') { if (S.state && msg.seq === S.state.seq) loadView(msg.scene, S.stateT0); }
-    else if (msg.type === 'numbers') { S.numbers = msg.numbers; drawNumbers(msg.numbers); $('numbers').classList.remove('stale'); document.body.dataset.numbers = String(msg.seq); }
+    else if (msg.type === 'numbers') {
+      if (msg.seq > S.lastChange) { // else asked for before a later change: stale
+        S.numbers = msg.numbers; drawNumbers(msg.numbers); $('numbers').classList.remove('stale'); document.body.dataset.numbers = String(msg.seq);
+      }
+    }
     else if (msg.type === 'download') download(msg);
     if (S.inflight === null && S.pending) {
       const p = S.pending;
@@ -77,8 +88,18 @@
       change(p.values, p.mode);
       if (S.inflight) S.inflight.t0 = p.t0;
     } else if (S.inflight === null && msg.type === 'state' && msg.result.ok) {
-      S.send({ type: 'numbers' }); // the slower table, once the curves are drawn
+      numbersAtRest(); // the slower table, once the curves are drawn and the design rests
     }
+  }
+
+  // the numbers table (limit positions: up to a few hundred ms on the server) is asked for
+  // once no change has been made for REST ms, so a drag never queues it; the server computes
+  // it beside later changes, which are answered without waiting for it
+  const REST = 150;
+  let restTimer = null;
+  function numbersAtRest() {
+    clearTimeout(restTimer);
+    restTimer = setTimeout(() => { if (S.inflight === null && !S.pending) S.send({ type: 'numbers' }); }, REST);
   }
 
   function download(msg) {
@@ -111,7 +132,7 @@
   }
 
   // ---- controls ------------------------------------------------------------------------
-  const step = (type) => { S.inflight = { seq: S.send({ type }), t0: performance.now() }; S.lastChange = S.inflight.seq; };
+  const step = (type) => { clearTimeout(restTimer); S.inflight = { seq: S.send({ type }), t0: performance.now() }; S.lastChange = S.inflight.seq; };
   $('undo').onclick = () => step('undo');
   $('redo').onclick = () => step('redo');
   $('save').onclick = () => S.send({ type: 'save' });
@@ -375,8 +396,10 @@
     $('assembly').className = r.assembly.length ? 'warn' : '';
     S.result = r;
     $('frame').max = String(r.input.values.length - 1);
+    const t1 = performance.now();
     drawPlots(r);
     drawTables(r);
+    if (timed && S.phases.length) S.phases[S.phases.length - 1].draw = performance.now() - t1;
     S.frame = Math.min(S.frame, r.input.values.length - 1);
     S.stateT0 = timed ? timed.t0 : performance.now();
     S.viewReady = false; // until the scene that follows this state is loaded
