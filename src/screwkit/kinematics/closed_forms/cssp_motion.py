@@ -279,7 +279,7 @@ def cssp_block_rows(
         centres=centres, axes=axes, s4=(s4, s4d, s4dd),
         closure=dims.a2 * np.abs(span - 1.0),  # ||P − D1| − a2|
         loop={"ct": ct, "st": st, "rod": rod, "w_rod": w_rod, "al_rod": al_rod, "w": w,
-              "wd": wd, "slider_R": slider_R},
+              "wd": wd, "slider_R": slider_R, "u": u, "u_dot": ud, "u_ddot": udd},
     )
 
 
@@ -306,6 +306,41 @@ def _ball_joint_block(loop: dict[str, Any], REL_st: Array, RATE_st: Array, sl: s
         RATE_st[1, j, sl] = _dot3(col, rel_a)
         RATE_st[2, j, sl] = _combine(-St[j], w_rod)
         RATE_st[3, j, sl] = _combine(-St[j], al_rod)
+
+
+#: Rahman's joint angles of the rod and the slider ball (SPEC §1.1), with :data:`_SEED_ROWS`
+#: rows of :func:`_seed_angle_block`: each angle, then its rate, then its acceleration
+SEED_ANGLES = ("theta2", "eta2", "theta3", "eta3")
+
+
+def _seed_angle_block(dims: CSSPDimensions, th: Array, loop: dict[str, Any], ok: NDArray[np.bool_],
+                      SEED_st: Array, sl: slice) -> None:
+    """Rahman's θ2, η2 (rod) and θ3, η3 (the rod seen from the slider) with their exact rates
+    (:func:`screwkit.kinematics.closed_forms.cssp.rod_and_slider_angles`) for one block, from the
+    closed form's u, u̇, ü in the loop frame {1}; rows as :data:`SEED_ANGLES`, rates, accelerations.
+    θ2 is wrapped into (−π, π] here; the caller makes each run continuous."""
+    from screwkit.kinematics.closed_forms.cssp import rod_and_slider_angles
+
+    u, ud, udd = (np.stack(loop[key]).T for key in ("u", "u_dot", "u_ddot"))
+    with np.errstate(divide="ignore", invalid="ignore"):  # placeholders where it does not assemble
+        got = rod_and_slider_angles(dims, th, loop["w"], loop["wd"], u, ud, udd, ok, True,
+                                    frame=False)
+    for r, name in enumerate(SEED_ANGLES):
+        SEED_st[r, sl] = got[name]  # type: ignore[assignment]
+        SEED_st[4 + r, sl] = got[f"{name}_dot"]  # type: ignore[assignment]
+        SEED_st[8 + r, sl] = got[f"{name}_ddot"]  # type: ignore[assignment]
+
+
+def _rotation_vector_block(REL_st: Array, RV_st: Array, ok: NDArray[np.bool_], sl: slice) -> None:
+    """The two ball joints' rotation vectors for one block from their relative rotations (the
+    block of the component-major storage, read in place): :func:`rotation_vector` (skew part and
+    trace, axis from the symmetric part near a half turn); the identity where the CSSP does not
+    assemble (NaN afterwards)."""
+    for r in range(2):
+        rel = np.moveaxis(REL_st[r, :, :, sl], -1, 0)
+        if not ok.all():
+            rel = np.where(ok[:, None, None], np.nan_to_num(rel), np.eye(3))
+        RV_st[r, :, sl] = rotation_vector(rel).T
 
 
 def _write(storage: Array, rows: Rows, sl: slice) -> None:
@@ -426,12 +461,11 @@ def cssp_sweep(
 
 
 def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
-                  rotations: tuple[Array, Array] | None, rates: Array | None,
+                  vectors: Array | None, rates: Array | None,
                   ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array]]:
     """The joint variables of a CSSP mode, their rates and accelerations by name: the crank's
-    θ1 (and s1 when driven), the ball joints' rotation vectors (when ``rotations`` holds their
-    relative rotations) and child-frame rates (when ``rates`` holds them), the slider's s4."""
-    ok = sw.assembles
+    θ1 (and s1 when driven), the ball joints' rotation vectors (rows of ``vectors`` (2, 3, N),
+    when given) and child-frame rates (when ``rates`` holds them), the slider's s4."""
     first = linkage.joints[0].name
     pin, ball, slider = (j.name for j in linkage.joints[1:])
     variables: dict[str, Array] = {f"{first}.theta": sw.theta1}
@@ -441,19 +475,12 @@ def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
         variables[f"{first}.s"] = sw.full("s1")
         velocities[f"{first}.s"] = sw.full("s1_dot")
         accelerations[f"{first}.s"] = sw.full("s1_ddot")
-    vectors: list[Array | None] = [None, None]
-    if rotations is not None:
-        # the relative rotations are orthonormal products: their vector from the skew part and
-        # the trace (scipy's from_matrix would re-orthonormalise each first, 4x the cost)
-        vectors = [rotation_vector(rel if ok.all() else
-                                   np.where(ok[:, None, None], np.nan_to_num(rel), np.eye(3)))
-                   for rel in rotations]
-    for name, r, rv in ((pin, 0, vectors[0]), (ball, 2, vectors[1])):
+    for name, r in ((pin, 0), (ball, 2)):
         if rates is None:
             break
         for a, ax in enumerate("xyz"):
-            if rv is not None:
-                variables[f"{name}.r{ax}"] = np.where(ok, rv[:, a], np.nan)
+            if vectors is not None:  # NaN where it does not assemble: _mask_unassembled
+                variables[f"{name}.r{ax}"] = vectors[r // 2, a]
             velocities[f"{name}.w{ax}"] = rates[r, a]
             accelerations[f"{name}.w{ax}"] = rates[r + 1, a]
     variables[f"{slider}.s"] = s4_st[0]
@@ -475,6 +502,7 @@ def cssp_mode_motion(
     allow_partial: bool = False,
     joint_rotations: bool = True,
     ball_joints: bool = True,
+    seed_angles: bool = False,
 ) -> ModeMotion:
     """One assembly mode of a CSSP over N crank angles, from the closed form (no Newton).
 
@@ -493,6 +521,8 @@ def cssp_mode_motion(
     is then a read-only NaN view) and their rates (``pin.w*``, ``ball.w*`` in ``velocities`` and
     ``accelerations``): everything inverse dynamics reads — link frames and their rates, joint
     centres and axes, the scalar joint variables — is kept, at two thirds of the cost.
+    ``seed_angles=True`` adds Rahman's θ2, η2, θ3, η3 and their rates (SPEC §1.1; θ2 wrapped
+    into (−π, π]) to the tables, from the closed form's u, u̇, ü block by block.
 
     Computed in blocks of :data:`BLOCK_SAMPLES` samples in structure-of-arrays form. The (N, …)
     arrays are views of component-major storage (every component contiguous over the samples;
@@ -513,12 +543,16 @@ def cssp_mode_motion(
     C_st, joint_centres = _component_major(n, 4, 3)
     X_st, joint_axes = _component_major(n, 4, 3)
     joint_rotations = joint_rotations and ball_joints
+    RV_st: Array | None = None
     if ball_joints:
         # pin: R_crankᵀR_rod, ball: R_rodᵀR_slider; pin, ball joint rates and "accelerations"
         REL_st, relative = _component_major(n, 2, 3, 3)
         RATE_st, _ = _component_major(n, 4, 3)
+        if joint_rotations:  # the ball joints' rotation vectors
+            RV_st = np.empty((2, 3, n))
     else:
         relative = np.broadcast_to(np.nan, (n, 2, 3, 3))
+    SEED_st = np.empty((12, n)) if seed_angles else None
     s4_st = np.empty((3, n))  # s4, ṡ4, s̈4
     closure = np.empty(n)
     base_R, base_p = linkage.base.real, linkage.base.translation
@@ -535,14 +569,21 @@ def cssp_mode_motion(
         closure[sl] = rows.closure
         if ball_joints:
             _ball_joint_block(rows.loop, REL_st, RATE_st, sl)
+            if RV_st is not None:
+                _rotation_vector_block(REL_st, RV_st, ok[sl], sl)
+        if SEED_st is not None:
+            _seed_angle_block(sw.dims, th[sl], rows.loop, ok[sl], SEED_st, sl)
 
-    pin_rel, ball_rel = relative[:, 0], relative[:, 1]
     s1_all = sw.full("s1")
     scalars = [th] + ([s1_all] if driven_offset else []) + [s4_st[0]]
     conf = Configuration(np.stack(scalars, -1), relative)
     variables, velocities, accelerations = _joint_tables(
-        linkage, sw, s4_st, (pin_rel, ball_rel) if joint_rotations else None,
-        RATE_st if ball_joints else None)
+        linkage, sw, s4_st, RV_st, RATE_st if ball_joints else None)
+    if SEED_st is not None:
+        for r, name in enumerate(SEED_ANGLES):
+            variables[name] = SEED_st[r]
+            velocities[name] = SEED_st[4 + r]
+            accelerations[name] = SEED_st[8 + r]
 
     arrays = [link_rotation, link_origin, link_angular_velocity, link_origin_velocity,
               link_angular_acceleration, link_origin_acceleration, joint_centres, joint_axes]
