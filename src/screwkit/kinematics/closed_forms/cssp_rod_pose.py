@@ -149,7 +149,10 @@ def rod_turn(dims: CSSPDimensions, root: int, theta1: Array, ct: Array, st: Arra
                             sw[:, 2]], -1)  # Z(θ1)·x
         start_phi[starts] = signed_angle(frame_start, start_x, u_start)
     # φ_k = φ_{k−1} + step_k along a run, φ = start_phi at its first sample
-    total = np.cumsum(phi_step)
+    total = np.cumsum(phi_step, out=phi_step)
+    if starts.size == 1 and ok.all():  # one run: the whole sweep
+        total += start_phi[starts[0]] - total[starts[0]]
+        return total
     is_start = np.zeros(n, dtype=bool)
     is_start[starts] = True
     run_id = np.maximum(np.cumsum(is_start) - 1, 0)
