@@ -337,10 +337,25 @@ def _rotation_vector_block(REL_st: Array, RV_st: Array, ok: NDArray[np.bool_], s
     trace, axis from the symmetric part near a half turn); the identity where the CSSP does not
     assemble (NaN afterwards)."""
     for r in range(2):
-        rel = np.moveaxis(REL_st[r, :, :, sl], -1, 0)
+        R = REL_st[r, :, :, sl]
         if not ok.all():
-            rel = np.where(ok[:, None, None], np.nan_to_num(rel), np.eye(3))
-        RV_st[r, :, sl] = rotation_vector(rel).T
+            rel = np.where(ok[:, None, None], np.nan_to_num(np.moveaxis(R, -1, 0)), np.eye(3))
+            RV_st[r, :, sl] = rotation_vector(rel).T
+            continue
+        # rotation_vector's formulas, by components: the axis from the skew part, the angle
+        # from it and the trace
+        vee = RV_st[r, :, sl]
+        np.subtract(R[2, 1], R[1, 2], out=vee[0])
+        np.subtract(R[0, 2], R[2, 0], out=vee[1])
+        np.subtract(R[1, 0], R[0, 1], out=vee[2])
+        vee *= 0.5
+        cos = np.clip(0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1.0), -1.0, 1.0)
+        sin = np.sqrt(vee[0] * vee[0] + vee[1] * vee[1] + vee[2] * vee[2])
+        angle = np.arctan2(sin, cos)
+        vee *= np.where(sin > 1e-300, angle / np.maximum(sin, 1e-300), 1.0)
+        near_half = np.flatnonzero(cos < -0.9)  # the axis from the symmetric part there
+        if near_half.size:
+            vee[:, near_half] = rotation_vector(np.moveaxis(R[:, :, near_half], -1, 0)).T
 
 
 def _write(storage: Array, rows: Rows, sl: slice) -> None:
@@ -574,8 +589,7 @@ def cssp_mode_motion(
         if SEED_st is not None:
             _seed_angle_block(sw.dims, th[sl], rows.loop, ok[sl], SEED_st, sl)
 
-    s1_all = sw.full("s1")
-    scalars = [th] + ([s1_all] if driven_offset else []) + [s4_st[0]]
+    scalars = [th] + ([sw.full("s1")] if driven_offset else []) + [s4_st[0]]
     conf = Configuration(np.stack(scalars, -1), relative)
     variables, velocities, accelerations = _joint_tables(
         linkage, sw, s4_st, RV_st, RATE_st if ball_joints else None)
