@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.dual.spatial import GIMBAL_TOL, rot_x
+from screwkit.dual.spatial import GIMBAL_TOL, rot_x, wrap_angle
 from screwkit.errors import InputError
 from screwkit.kinematics.closed_forms.cssp import (
     SEED_ROOT,
@@ -313,22 +313,50 @@ def _ball_joint_block(loop: dict[str, Any], REL_st: Array, RATE_st: Array, sl: s
 SEED_ANGLES = ("theta2", "eta2", "theta3", "eta3")
 
 
+def _elevation_azimuth_rows(v: tuple[Array, Array, Array], vd: tuple[Array, Array, Array],
+                            vdd: tuple[Array, Array, Array]) -> tuple[Array, ...]:
+    """:func:`screwkit.dual.spatial.elevation_azimuth` by components (the same formulas): where
+    v is defined (ρ > GIMBAL_TOL), E, Ė, Ë, A, Ȧ, Ä (rates and A NaN elsewhere)."""
+    vx, vy, vz = v
+    rho = np.sqrt(vx * vx + vy * vy)
+    defined = rho > GIMBAL_TOL
+    elevation = np.arctan2(vz, rho)
+    azimuth = np.where(defined, np.arctan2(vy, vx), np.nan)
+    safe_rho = np.where(defined, rho, 1.0)
+    safe_rho2 = safe_rho * safe_rho
+    e_dot = vd[2] / safe_rho
+    e_ddot = (vdd[2] + vz * (e_dot * e_dot)) / safe_rho
+    a_dot = (vx * vd[1] - vy * vd[0]) / safe_rho2
+    a_ddot = ((vx * vdd[1] - vy * vdd[0]) / safe_rho2
+              - 2 * a_dot * (vx * vd[0] + vy * vd[1]) / safe_rho2)
+    nan = np.nan
+    return (defined, elevation, np.where(defined, e_dot, nan), np.where(defined, e_ddot, nan),
+            azimuth, np.where(defined, a_dot, nan), np.where(defined, a_ddot, nan))
+
+
 def _seed_angle_block(dims: CSSPDimensions, th: Array, loop: dict[str, Any], ok: NDArray[np.bool_],
                       SEED_st: Array, sl: slice) -> None:
     """Rahman's θ2, η2 (rod) and θ3, η3 (the rod seen from the slider) with their exact rates
-    (:func:`screwkit.kinematics.closed_forms.cssp.rod_and_slider_angles`) for one block, from the
-    closed form's u, u̇, ü in the loop frame {1}; rows as :data:`SEED_ANGLES`, rates, accelerations.
-    θ2 is wrapped into (−π, π] here; the caller makes each run continuous."""
-    from screwkit.kinematics.closed_forms.cssp import rod_and_slider_angles
-
-    u, ud, udd = (np.stack(loop[key]).T for key in ("u", "u_dot", "u_ddot"))
+    for one block, from the closed form's u, u̇, ü in the loop frame {1}: the formulas of
+    :func:`screwkit.kinematics.closed_forms.cssp.rod_and_slider_angles` by components; rows as
+    :data:`SEED_ANGLES`, then their rates, then their accelerations. θ2 is wrapped into
+    (−π, π] here; the caller makes each run continuous."""
+    u, ud, udd = loop["u"], loop["u_dot"], loop["u_ddot"]
+    ca, sa = float(np.cos(dims.alpha4)), float(np.sin(dims.alpha4))  # X(α4) = R_{4←1}, by rows
+    seen = [(v[0], ca * v[1] - sa * v[2], sa * v[1] + ca * v[2]) for v in (u, ud, udd)]
     with np.errstate(divide="ignore", invalid="ignore"):  # placeholders where it does not assemble
-        got = rod_and_slider_angles(dims, th, loop["w"], loop["wd"], u, ud, udd, ok, True,
-                                    frame=False)
-    for r, name in enumerate(SEED_ANGLES):
-        SEED_st[r, sl] = got[name]  # type: ignore[assignment]
-        SEED_st[4 + r, sl] = got[f"{name}_dot"]  # type: ignore[assignment]
-        SEED_st[8 + r, sl] = got[f"{name}_ddot"]  # type: ignore[assignment]
+        rod_ok, elev, e_d, e_dd, phi, phi_d, phi_dd = _elevation_azimuth_rows(u, ud, udd)
+        _, th3, th3_d, th3_dd, eta3, eta3_d, eta3_dd = _elevation_azimuth_rows(*seen)
+        rod_ok &= ok
+        SEED_st[0, sl] = np.where(rod_ok, wrap_angle(phi - th), np.nan)
+        np.negative(elev, out=SEED_st[1, sl])
+        SEED_st[2, sl], SEED_st[3, sl] = th3, eta3
+        SEED_st[4, sl] = phi_d - loop["w"]
+        np.negative(e_d, out=SEED_st[5, sl])
+        SEED_st[6, sl], SEED_st[7, sl] = th3_d, eta3_d
+        SEED_st[8, sl] = phi_dd - loop["wd"]
+        np.negative(e_dd, out=SEED_st[9, sl])
+        SEED_st[10, sl], SEED_st[11, sl] = th3_dd, eta3_dd
 
 
 def _rotation_vector_block(REL_st: Array, RV_st: Array, ok: NDArray[np.bool_], sl: slice) -> None:
@@ -353,9 +381,28 @@ def _rotation_vector_block(REL_st: Array, RV_st: Array, ok: NDArray[np.bool_], s
         sin = np.sqrt(vee[0] * vee[0] + vee[1] * vee[1] + vee[2] * vee[2])
         angle = np.arctan2(sin, cos)
         vee *= np.where(sin > 1e-300, angle / np.maximum(sin, 1e-300), 1.0)
-        near_half = np.flatnonzero(cos < -0.9)  # the axis from the symmetric part there
+        near_half = np.flatnonzero(cos < -0.9)
         if near_half.size:
-            vee[:, near_half] = rotation_vector(np.moveaxis(R[:, :, near_half], -1, 0)).T
+            vee[:, near_half] = _half_turn_axes(R, vee, cos, angle, near_half)
+
+
+def _half_turn_axes(R: Array, vee: Array, cos: Array, angle: Array,
+                    at: NDArray[np.intp]) -> Array:
+    """:func:`rotation_vector` near a half turn (cos θ < −0.9), by components (3, m) at the
+    samples ``at``: the axis from the symmetric part (R + Rᵀ)/2 − cos θ·I = (1 − cos θ) u uᵀ,
+    its column of largest diagonal entry, signed by the skew part ``vee``."""
+    c = cos[at]
+    Rh = [[R[i, j][at] for j in range(3)] for i in range(3)]
+    # B = (R + Rᵀ)/2 − c I, as rotation_vector forms it
+    B = [[0.5 * (Rh[i][j] + Rh[j][i]) - (c if i == j else 0.0) for j in range(3)]
+         for i in range(3)]
+    k = np.argmax(np.stack([B[0][0], B[1][1], B[2][2]], -1), axis=-1)
+    u = [np.where(k == 0, B[i][0], np.where(k == 1, B[i][1], B[i][2])) for i in range(3)]
+    norm = np.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+    u = [x / norm for x in u]
+    v = vee[:, at]
+    sign = np.where(u[0] * v[0] + u[1] * v[1] + u[2] * v[2] < 0, -1.0, 1.0) * angle[at]
+    return np.stack([x * sign for x in u])
 
 
 def _write(storage: Array, rows: Rows, sl: slice) -> None:
