@@ -314,7 +314,8 @@ SEED_ANGLES = ("theta2", "eta2", "theta3", "eta3")
 
 
 def _elevation_azimuth_rows(v: tuple[Array, Array, Array], vd: tuple[Array, Array, Array],
-                            vdd: tuple[Array, Array, Array]) -> tuple[Array, ...]:
+                            vdd: tuple[Array, Array, Array]
+                            ) -> tuple[NDArray[np.bool_], Array, Array, Array, Array, Array, Array]:
     """:func:`screwkit.dual.spatial.elevation_azimuth` by components (the same formulas): where
     v is defined (ρ > GIMBAL_TOL), E, Ė, Ë, A, Ȧ, Ä (rates and A NaN elsewhere)."""
     vx, vy, vz = v
