@@ -136,12 +136,16 @@ def unwrap_in_place(run: Array) -> None:
 def unwrap_runs(angle: Array, ok: NDArray[np.bool_]) -> Array:
     """Continuous angles along each run of assembling samples, each run starting in (−π, π]."""
     out = np.array(angle, dtype=float)
-    idx = np.flatnonzero(ok & np.isfinite(out))
-    if idx.size == 0:
-        return out
-    breaks = np.flatnonzero(np.diff(idx) > 1)
-    starts = [int(idx[0])] + (idx[breaks + 1] if breaks.size else idx[:0]).tolist()
-    stops = (idx[breaks] if breaks.size else idx[:0]).tolist() + [int(idx[-1])]
+    good = ok & np.isfinite(out)
+    if out.size and good.all():  # one run, the whole sweep
+        starts, stops = [0], [out.size - 1]
+    else:
+        idx = np.flatnonzero(good)
+        if idx.size == 0:
+            return out
+        breaks = np.flatnonzero(np.diff(idx) > 1)
+        starts = [int(idx[0])] + (idx[breaks + 1] if breaks.size else idx[:0]).tolist()
+        stops = (idx[breaks] if breaks.size else idx[:0]).tolist() + [int(idx[-1])]
     for a, b in zip(starts, stops, strict=True):
         run = out[a:b + 1]
         unwrap_in_place(run)
