@@ -47,6 +47,47 @@ def _frame_x(k: dict[str, Any], e_body: Array) -> tuple[Array, Array, Array]:
             u[2] * e0 + y3[2] * e1 + z3[2] * e2)
 
 
+def _steps(u: tuple[Array, Array, Array], ud: tuple[Array, Array, Array],
+           udd: tuple[Array, Array, Array], x: tuple[Array, Array, Array],
+           cont: NDArray[np.bool_]) -> Array:
+    """φ_i − φ_{i−1} (module docstring) for the steps between consecutive samples of a block
+    (u, its derivatives along the step arriving at each sample, the body vector x; ``cont``
+    the steps that stay on a run), by components."""
+    # step from sample i−1 (p) to i (q) for every i of the block after the first
+    m = u[0].shape[0]
+    p, q = slice(0, m - 1), slice(1, m)
+    ax, ay, az = u[0][p], u[1][p], u[2][p]
+    bx, by, bz = u[0][q], u[1][q], u[2][q]
+    kx, ky, kz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    c = ax * bx + ay * by + az * bz
+    inv = 1.0 / (1.0 + c)
+    dx, dy, dz = ud[0][q], ud[1][q], ud[2][q]
+    f1 = (kx * dx + ky * dy + kz * dz) * inv
+    f1_dot = ((kx * udd[0][q] + ky * udd[1][q] + kz * udd[2][q]) * inv
+              - f1 * (ax * dx + ay * dy + az * dz) * inv)
+    corr = -(0.5 * f1 - f1_dot / 12.0)
+    corr[~np.isfinite(corr)] = 0.0
+    # carried = M x_{i−1}: the least rotation taking u_{i−1} to u_i
+    vx, vy, vz = x[0][p], x[1][p], x[2][p]
+    kv = (kx * vx + ky * vy + kz * vz) * inv
+    cx = c * vx + (ky * vz - kz * vy) + kv * kx
+    cy = c * vy + (kz * vx - kx * vz) + kv * ky
+    cz = c * vz + (kx * vy - ky * vx) + kv * kz
+    wx, wy, wz = x[0][q], x[1][q], x[2][q]
+    turn = np.arctan2(bx * (cy * wz - cz * wy) + by * (cz * wx - cx * wz)
+                      + bz * (cx * wy - cy * wx), cx * wx + cy * wy + cz * wz)
+    step = corr - turn
+    opposite = cont & ~(1.0 + c >= 1e-12)  # u turned by a half turn in one step
+    if opposite.any():
+        r = np.flatnonzero(opposite)
+        moved = minimal_rotation_apply(
+            np.stack([ax[r], ay[r], az[r]], -1), np.stack([bx[r], by[r], bz[r]], -1),
+            np.stack([vx[r], vy[r], vz[r]], -1))
+        bq = np.stack([bx[r], by[r], bz[r]], -1)
+        step[r] = corr[r] - signed_angle(moved, np.stack([wx[r], wy[r], wz[r]], -1), bq)
+    return step
+
+
 def rod_turn(dims: CSSPDimensions, root: int, theta1: Array, ct: Array, st: Array,
              given: dict[str, Any], disc: Array, ok: NDArray[np.bool_]) -> Array:
     """φ (N,) for a sweep (module docstring): 0 where the CSSP does not assemble."""
@@ -104,39 +145,8 @@ def rod_turn(dims: CSSPDimensions, root: int, theta1: Array, ct: Array, st: Arra
                 u_start[j:j + len(here)] = np.stack([c[here] for c in u], -1)
             if b - lo < 2:
                 continue
-            # step from sample i−1 (p) to i (q) for every i of the block after the first
-            p, q = slice(0, b - lo - 1), slice(1, b - lo)
-            ax, ay, az = u[0][p], u[1][p], u[2][p]
-            bx, by, bz = u[0][q], u[1][q], u[2][q]
-            kx, ky, kz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-            c = ax * bx + ay * by + az * bz
-            inv = 1.0 / (1.0 + c)
-            dx, dy, dz = ud[0][q], ud[1][q], ud[2][q]
-            f1 = (kx * dx + ky * dy + kz * dz) * inv
-            f1_dot = ((kx * udd[0][q] + ky * udd[1][q] + kz * udd[2][q]) * inv
-                      - f1 * (ax * dx + ay * dy + az * dz) * inv)
-            corr = -(0.5 * f1 - f1_dot / 12.0)
-            corr[~np.isfinite(corr)] = 0.0
-            # carried = M x_{i−1}: the least rotation taking u_{i−1} to u_i
-            vx, vy, vz = x[0][p], x[1][p], x[2][p]
-            kv = (kx * vx + ky * vy + kz * vz) * inv
-            cx = c * vx + (ky * vz - kz * vy) + kv * kx
-            cy = c * vy + (kz * vx - kx * vz) + kv * ky
-            cz = c * vz + (kx * vy - ky * vx) + kv * kz
-            wx, wy, wz = x[0][q], x[1][q], x[2][q]
-            turn = np.arctan2(bx * (cy * wz - cz * wy) + by * (cz * wx - cx * wz)
-                              + bz * (cx * wy - cy * wx), cx * wx + cy * wy + cz * wz)
-            step = corr - turn
             cont = continues[lo + 1:b]
-            opposite = cont & ~(1.0 + c >= 1e-12)  # u turned by a half turn in one step
-            if opposite.any():
-                r = np.flatnonzero(opposite)
-                moved = minimal_rotation_apply(
-                    np.stack([ax[r], ay[r], az[r]], -1), np.stack([bx[r], by[r], bz[r]], -1),
-                    np.stack([vx[r], vy[r], vz[r]], -1))
-                bq = np.stack([bx[r], by[r], bz[r]], -1)
-                step[r] = corr[r] - signed_angle(moved, np.stack([wx[r], wy[r], wz[r]], -1), bq)
-            phi_step[lo + 1:b] = np.where(cont, step, 0.0)
+            phi_step[lo + 1:b] = np.where(cont, _steps(u, ud, udd, x, cont), 0.0)
     # the wanted frame at a run's start: the proximal ball is a pure swing from rest
     start_phi = np.zeros(n)
     if starts.size:
