@@ -349,7 +349,7 @@ def solve_motion_rows(lk: Any, theta: np.ndarray, omega: float, dyn: float,
     rows = [{"name": "CSSP kinematics through solve_motion (both modes, every field)",
              "value": both, "unit": "us/sample", "target": None,
              "note": f"{per_mode:.2f} per mode; 6.2 before issue 30's fixes (5.6 in the issue), "
-                     "~2.0-2.7 before the fused blocks of cssp30 (same machine, 10^6 samples)"},
+                     "2.7-3.6 before cssp30's fused blocks (this machine, loaded, 10^6 samples)"},
             {"name": "its memory floor: the Motion's bytes written once into fresh memory",
              "value": floor["us"], "unit": "us/sample", "target": None,
              "note": f"{floor['bytes']:.0f} bytes/sample (both modes); np.ones of that size, "
