@@ -345,9 +345,15 @@ def solve_motion_rows(lk: Any, theta: np.ndarray, omega: float, dyn: float,
     solve_motion(lk, theta[:2000], rates=omega)  # warm-up
     both = _best_time(lambda: solve_motion(lk, theta, rates=omega)) / theta.size * 1e6
     per_mode = both / 2
+    floor = motion_memory_floor(solve_motion(lk, theta, rates=omega))
     rows = [{"name": "CSSP kinematics through solve_motion (both modes, every field)",
              "value": both, "unit": "us/sample", "target": None,
-             "note": f"{per_mode:.2f} per mode; 6.2 before issue 30's fixes (5.6 in the issue)"}]
+             "note": f"{per_mode:.2f} per mode; 6.2 before issue 30's fixes (5.6 in the issue), "
+                     "2.7-3.6 before cssp30's fused blocks (this machine, loaded, 10^6 samples)"},
+            {"name": "its memory floor: the Motion's bytes written once into fresh memory",
+             "value": floor["us"], "unit": "us/sample", "target": None,
+             "note": f"{floor['bytes']:.0f} bytes/sample (both modes); np.ones of that size, "
+                     "best of 3: what any route that returns these arrays pays"}]
     if peer.get("value"):
         rows.append({"name": "CSSP solve_motion + inverse_dynamics / pinocchio "
                              "constraintDynamics, per sample", "value": (both + dyn)
@@ -355,6 +361,32 @@ def solve_motion_rows(lk: Any, theta: np.ndarray, omega: float, dyn: float,
                      "note": f"one mode's kinematics: {(per_mode + dyn) / peer['value']:.2f}x; "
                              f"peer {peer['value']:.2f} us/call"})
     return rows
+
+
+def motion_memory_floor(motion: Any) -> dict[str, float]:
+    """Bytes per sample of a Motion's arrays (every mode: link frames and rates, joint centres
+    and axes, configurations, every table) and the CPU time of writing as many bytes once into
+    freshly allocated memory (the kernel's zeroed pages and one pass of stores), µs/sample."""
+    total = 0
+    for md in motion.modes:
+        arrays = [md.assembles, md.singular, md.conf.scalars, md.conf.spherical,
+                  md.link_rotation, md.link_origin, md.link_angular_velocity,
+                  md.link_origin_velocity, md.link_angular_acceleration,
+                  md.link_origin_acceleration, md.joint_centres, md.joint_axes,
+                  md.closure_residual]
+        arrays += [v for t in (md.variables, md.velocities, md.accelerations)
+                   for v in t.values()]
+        seen: set[int] = set()
+        for a in arrays:
+            base = a if a.base is None else a.base
+            while getattr(base, "base", None) is not None:
+                base = base.base
+            if id(base) not in seen and not isinstance(base, bytes):
+                seen.add(id(base))
+                total += int(np.asarray(base).nbytes)
+    n = motion.samples
+    seconds = _best_time(lambda: np.ones(total // 8))
+    return {"bytes": total / n, "us": seconds / n * 1e6}
 
 
 def _check_finite(label: str, values: dict[str, np.ndarray] | Any) -> None:

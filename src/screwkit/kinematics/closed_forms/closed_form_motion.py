@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -55,17 +55,22 @@ CSSP_SOLVER = "CSSP closed form: quadratic in s4 (Rahman 1996 §1.2)"
 
 
 def _with_seed(mode: ModeMotion, index: int, label: str, seed: tuple[dict[str, Array], ...],
-               singular: NDArray[np.bool_] | None = None) -> ModeMotion:
-    """``mode`` with the seed's variables added (NaN outside the mask) and its index; samples
-    the closed form finds singular (e.g. a locked RSRC) lose their rates too."""
+               singular: NDArray[np.bool_] | None = None, masked: bool = False) -> ModeMotion:
+    """``mode`` with the seed's variables added (NaN outside the mask; with ``masked`` they
+    already are, and are taken as they are) and its index; samples the closed form finds
+    singular (e.g. a locked RSRC) lose their rates too."""
     ok = mode.assembles
     tables = []
     for general, named in zip((mode.variables, mode.velocities, mode.accelerations), seed,
                               strict=True):
-        merged = {k: np.where(ok, np.asarray(v, dtype=float), np.nan) for k, v in named.items()}
+        merged = (dict(named) if masked else
+                  {k: np.where(ok, np.asarray(v, dtype=float), np.nan) for k, v in named.items()})
         merged.update(general)
         tables.append(merged)
     sing = mode.singular if singular is None else (mode.singular | singular)
+    if not sing.any():
+        return replace(mode, variables=tables[0], velocities=tables[1],
+                       accelerations=tables[2], singular=sing, index=index, label=label)
     for v in [*tables[1].values(), *tables[2].values(), mode.link_angular_velocity,
               mode.link_origin_velocity, mode.link_angular_acceleration,
               mode.link_origin_acceleration]:
@@ -170,40 +175,49 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     p = dict(linkage.parameters)
     dims = CSSPDimensions(p["a1"], p["a2"], p["a4"], p["alpha4"], p.get("s1", 0.0))
     theta = X[:, 0]
-    names = ("s4", "theta2", "eta2", "theta3", "eta3")
+    angles = ("theta2", "eta2", "theta3", "eta3")
     modes: list[ModeMotion] = []
+    driven = len(linkage.inputs) == 2  # the crank offset s1 is a second input
+    # a rate the same at every sample goes in as a number: the closed form then does scalar
+    # arithmetic (same values)
+    w, wd = (_constant_or(Xd[:, 0]), _constant_or(Xdd[:, 0]))
+    slider = linkage.joints[3].name
     for root, label in ((1, "s4 = -b + sqrt(b^2 - c)"), (-1, "s4 = -b - sqrt(b^2 - c)")):
-        driven = len(linkage.inputs) == 2  # the crank offset s1 is a second input
-        md = cssp_mode_motion(linkage, theta, Xd[:, 0], Xdd[:, 0], root=root, allow_partial=True,
+        # the seed's angles with their closed-form rates, block by block, for a fixed crank
+        # offset (with a driven one the registry's names from the link frames are used)
+        md = cssp_mode_motion(linkage, theta, w, wd, root=root, allow_partial=True,
                               s1=X[:, 1] if driven else None, s1_dot=Xd[:, 1] if driven else 0.0,
-                              s1_ddot=Xdd[:, 1] if driven else 0.0)
+                              s1_ddot=Xdd[:, 1] if driven else 0.0, seed_angles=not driven)
         ok = np.asarray(md.assembles)
         if not ok.any():
             continue
-        # the seed's angles with their closed-form rates (for a fixed crank offset; with a
-        # driven one the registry's names from the link frames are used)
-        cf = None if driven else _cssp_seed_angles(linkage, dims, md, theta, Xd[:, 0],
-                                                   Xdd[:, 0])
-        seed_v: dict[str, Array] = {"theta1": theta}
-        seed_d: dict[str, Array] = {"theta1": Xd[:, 0]}
-        seed_dd: dict[str, Array] = {"theta1": Xdd[:, 0]}
-        if cf is not None:
-            s4 = md.variables[f"{linkage.joints[3].name}.s"]
-            cf.update(s4=s4, s4_dot=md.velocities[f"{linkage.joints[3].name}.s"],
-                      s4_ddot=md.accelerations[f"{linkage.joints[3].name}.s"])
-            for n in names:
-                seed_v[n] = cf[n]
-                seed_d[n] = cf[f"{n}_dot"]
-                seed_dd[n] = cf[f"{n}_ddot"]
-            for key in ("theta2", "eta2", "theta3", "eta3"):
-                seed_v[key] = unwrap_runs(np.where(ok, seed_v[key], np.nan), ok)
+        full = ok.all()
+        seed_v: dict[str, Array] = {"theta1": theta.copy() if full else
+                                    np.where(ok, theta, np.nan)}
+        seed_d: dict[str, Array] = {"theta1": Xd[:, 0].copy() if full else
+                                    np.where(ok, Xd[:, 0], np.nan)}
+        seed_dd: dict[str, Array] = {"theta1": Xdd[:, 0].copy() if full else
+                                     np.where(ok, Xdd[:, 0], np.nan)}
+        tables = (dict(md.variables), dict(md.velocities), dict(md.accelerations))
+        if not driven:
+            # the tables' s4 and angles are NaN where the mode does not assemble already
+            seed_v["s4"] = md.variables[f"{slider}.s"].copy()
+            seed_d["s4"] = md.velocities[f"{slider}.s"].copy()
+            seed_dd["s4"] = md.accelerations[f"{slider}.s"].copy()
+            for key in angles:
+                seed_v[key] = tables[0].pop(key)
+                seed_d[key] = tables[1].pop(key)
+                seed_dd[key] = tables[2].pop(key)
+                seed_v[key] = unwrap_runs(seed_v[key], ok)
+            md = replace(md, variables=tables[0], velocities=tables[1],
+                         accelerations=tables[2])
         stops = np.nonzero(ok[:-1] & ~ok[1:])[0]
         starts = np.nonzero(~ok[:-1] & ok[1:])[0] + 1
         events = [f"stops assembling after input {format_inputs(linkage, X[i])} (branch point "
                   f"before {format_inputs(linkage, X[i + 1])})" for i in stops]
         events += [f"starts assembling at input {format_inputs(linkage, X[i])}" for i in starts]
         md = replace(md, events=events)
-        modes.append(_with_seed(md, len(modes), label, (seed_v, seed_d, seed_dd)))
+        modes.append(_with_seed(md, len(modes), label, (seed_v, seed_d, seed_dd), masked=True))
     if not modes:
         from screwkit.kinematics.closed_forms.cssp import assembly_intervals
         from screwkit.kinematics.tracker.assembly_range import describe_intervals
@@ -213,34 +227,12 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=CSSP_SOLVER)
 
 
-def _cssp_seed_angles(linkage: Linkage, dims: Any, md: ModeMotion, theta: Array, w: Array,
-                      wd: Array) -> dict[str, Any]:
-    """Rahman's θ2, η2, θ3, η3 with their rates (cssp.rod_and_slider_angles) from the rod of a
-    solved mode: u = (ball − pin)/a2 in the loop frame {1}, u̇ = ω × u, ü = α × u + ω × u̇
-    (ω, α the rod's, whatever its spin about u), instead of solving the closed form again."""
-    from screwkit.kinematics.closed_forms.cssp import rod_and_slider_angles
-
-    base = np.asarray(linkage.base.real, dtype=float)
-
-    def loop_frame(x: Array) -> Array:  # world → loop frame: x ↦ baseᵀ x (rows: x @ base)
-        return np.ascontiguousarray(x) if np.array_equal(base, np.eye(3)) else x @ base
-
-    c = md.joint_centres
-    u = loop_frame(c[:, 2] - c[:, 1]) / dims.a2
-    om = loop_frame(md.link_angular_velocity[:, 1])
-    al = loop_frame(md.link_angular_acceleration[:, 1])
-    ud = _cross(om, u)
-    udd = _cross(al, u) + _cross(om, ud)
-    return rod_and_slider_angles(dims, theta, w, wd, u, ud, udd, np.asarray(md.assembles),
-                                 True, frame=False)
-
-
-def _cross(a: Array, b: Array) -> Array:
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
-    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out
+def _constant_or(values: Array) -> float | Array:
+    """``values`` (N,) as one float when every sample holds the same (finite) number."""
+    v0 = values[0] if values.size else 0.0
+    if values.size and np.isfinite(v0) and not np.any(values != v0):
+        return float(v0)
+    return values
 
 
 def _branch_events(linkage: Linkage, X: Array, ok: NDArray[np.bool_]) -> list[str]:

@@ -50,8 +50,15 @@ from screwkit.kinematics.closed_forms.cssp import (
     assembly_message,
     check_root,
 )
+from screwkit.kinematics.closed_forms.cssp_joint_rows import (
+    SEED_ANGLES,
+    ball_joint_block,
+    combine,
+    rotation_vector_block,
+    seed_angle_block,
+)
 from screwkit.kinematics.motion import ModeMotion
-from screwkit.kinematics.tracker.loop import Configuration, rotation_vector
+from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 
@@ -140,18 +147,6 @@ def cssp_closed_form_block(
     }
 
 
-def _combine(coefficients: Array, values: tuple[Any, Any, Any]) -> Any:
-    """Σ c_k v_k for constants c_k, skipping zero constants (and zero values given as 0.0):
-    the slider frame X(−(α4 + π/2)) and the rod frame's y3 have zero entries."""
-    total: Any = 0.0
-    for c, v in zip(coefficients.tolist(), values, strict=True):
-        if c == 0.0 or (type(v) is float and v == 0.0):
-            continue
-        term = v if c == 1.0 else (-v if c == -1.0 else c * v)
-        total = term if type(total) is float and total == 0.0 else total + term
-    return total
-
-
 def rahman_rod_axes(u: tuple[Any, Any, Any]) -> tuple[tuple[Any, Any, Any], tuple[Any, Any, Any]]:
     """y3 and z3 of Rahman's rod frame {3} = Z(θ1 + θ2)·Y(η2) with x3 = u:
     y3 = (−u_y, u_x, 0)/ρ, z3 = u × y3 (SPEC §1.1; y3 = (0, 1, 0) where u is vertical)."""
@@ -162,15 +157,6 @@ def rahman_rod_axes(u: tuple[Any, Any, Any]) -> tuple[tuple[Any, Any, Any], tupl
           np.zeros_like(rho2))
     z3 = (-u[2] * y3[1], u[2] * y3[0], u[0] * y3[1] - u[1] * y3[0])
     return y3, z3
-
-
-def _dot3(a: tuple[Any, Any, Any], b: tuple[Any, Any, Any]) -> Any:
-    """a·b where an entry of ``a`` may be the constant 0.0 (the rod frame's y3_z)."""
-    terms = [x * y for x, y in zip(a, b, strict=True) if not (type(x) is float and x == 0.0)]
-    total = terms[0]
-    for t in terms[1:]:
-        total = total + t
-    return total
 
 
 def _cross3(a: tuple[Any, Any, Any], b: tuple[Any, Any, Any]) -> tuple[Any, Any, Any]:
@@ -218,7 +204,7 @@ def _place(rows: Rows, R: Array, p: Array | None, rotations: bool = False) -> Ro
     for idx in groups:
         v = (rows[idx[0]], rows[idx[1]], rows[idx[2]])
         for i, k in enumerate(idx):
-            value = _combine(R[i], v)
+            value = combine(R[i], v)
             if p is not None and p[i] != 0.0:
                 value = float(p[i]) if type(value) is float and value == 0.0 else value + p[i]
             out[k] = value
@@ -279,33 +265,18 @@ def cssp_block_rows(
         centres=centres, axes=axes, s4=(s4, s4d, s4dd),
         closure=dims.a2 * np.abs(span - 1.0),  # ||P − D1| − a2|
         loop={"ct": ct, "st": st, "rod": rod, "w_rod": w_rod, "al_rod": al_rod, "w": w,
-              "wd": wd, "slider_R": slider_R},
+              "wd": wd, "slider_R": slider_R, "u": u, "u_dot": ud, "u_ddot": udd},
     )
 
 
-def _ball_joint_block(loop: dict[str, Any], REL_st: Array, RATE_st: Array, sl: slice) -> None:
-    """The ball joints' relative rotations and rates for one block (loop frame; the base
-    cancels): pin R_crankᵀ R_rod (crank Z(θ1)), ball R_rodᵀ R_slider; rates in the child frame:
-    pin R_rod·ω_b = ω_rod − ω_crank and R_rod·ω̇_b = α_rod − α_crank + ω_rod × ω_crank; ball
-    (the slider does not turn) R_slider·ω_b = −ω_rod and R_slider·ω̇_b = −α_rod."""
-    ct, st, rod = loop["ct"], loop["st"], loop["rod"]
-    w_rod, al_rod, w, wd = loop["w_rod"], loop["al_rod"], loop["w"], loop["wd"]
-    slider_R = loop["slider_R"]
-    for j in range(3):
-        REL_st[0, 0, j, sl] = ct * rod[0][j] + st * rod[1][j]
-        REL_st[0, 1, j, sl] = ct * rod[1][j] - st * rod[0][j]
-        REL_st[0, 2, j, sl] = rod[2][j]
-        for i in range(3):
-            REL_st[1, i, j, sl] = _combine(slider_R[:, j], (rod[0][i], rod[1][i], rod[2][i]))
-    rel_w = (w_rod[0], w_rod[1], w_rod[2] - w)
-    rel_a = (al_rod[0] + w_rod[1] * w, al_rod[1] - w_rod[0] * w, al_rod[2] - wd)
-    St = slider_R.T
-    for j in range(3):
-        col = (rod[0][j], rod[1][j], rod[2][j])
-        RATE_st[0, j, sl] = _dot3(col, rel_w)
-        RATE_st[1, j, sl] = _dot3(col, rel_a)
-        RATE_st[2, j, sl] = _combine(-St[j], w_rod)
-        RATE_st[3, j, sl] = _combine(-St[j], al_rod)
+def _write_rows(stores: tuple[Array, ...], rows: CSSPBlockRows, sl: slice) -> None:
+    """Store a block's link rows (rotation, origin, velocity, acceleration, angular velocity
+    and acceleration, joint centres, axes) into their component-major storage."""
+    for storage, component_rows in zip(stores, (
+            rows.rotation, rows.origin, rows.velocity, rows.acceleration,
+            rows.angular_velocity, rows.angular_acceleration, rows.centres, rows.axes),
+            strict=True):
+        _write(storage, component_rows, sl)
 
 
 def _write(storage: Array, rows: Rows, sl: slice) -> None:
@@ -426,12 +397,12 @@ def cssp_sweep(
 
 
 def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
-                  rotations: tuple[Array, Array] | None, rates: Array | None,
+                  vectors: Array | None, rates: Array | None, seed: Array | None = None,
                   ) -> tuple[dict[str, Array], dict[str, Array], dict[str, Array]]:
     """The joint variables of a CSSP mode, their rates and accelerations by name: the crank's
-    θ1 (and s1 when driven), the ball joints' rotation vectors (when ``rotations`` holds their
-    relative rotations) and child-frame rates (when ``rates`` holds them), the slider's s4."""
-    ok = sw.assembles
+    θ1 (and s1 when driven), the ball joints' rotation vectors (rows of ``vectors`` (2, 3, N),
+    when given) and child-frame rates (when ``rates`` holds them), the slider's s4, and
+    Rahman's angles with their rates (rows of ``seed`` (12, N), when given)."""
     first = linkage.joints[0].name
     pin, ball, slider = (j.name for j in linkage.joints[1:])
     variables: dict[str, Array] = {f"{first}.theta": sw.theta1}
@@ -441,24 +412,20 @@ def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
         variables[f"{first}.s"] = sw.full("s1")
         velocities[f"{first}.s"] = sw.full("s1_dot")
         accelerations[f"{first}.s"] = sw.full("s1_ddot")
-    vectors: list[Array | None] = [None, None]
-    if rotations is not None:
-        # the relative rotations are orthonormal products: their vector from the skew part and
-        # the trace (scipy's from_matrix would re-orthonormalise each first, 4x the cost)
-        vectors = [rotation_vector(rel if ok.all() else
-                                   np.where(ok[:, None, None], np.nan_to_num(rel), np.eye(3)))
-                   for rel in rotations]
-    for name, r, rv in ((pin, 0, vectors[0]), (ball, 2, vectors[1])):
+    for name, r in ((pin, 0), (ball, 2)):
         if rates is None:
             break
         for a, ax in enumerate("xyz"):
-            if rv is not None:
-                variables[f"{name}.r{ax}"] = np.where(ok, rv[:, a], np.nan)
+            if vectors is not None:  # NaN where it does not assemble: _mask_unassembled
+                variables[f"{name}.r{ax}"] = vectors[r // 2, a]
             velocities[f"{name}.w{ax}"] = rates[r, a]
             accelerations[f"{name}.w{ax}"] = rates[r + 1, a]
     variables[f"{slider}.s"] = s4_st[0]
     velocities[f"{slider}.s"] = s4_st[1]
     accelerations[f"{slider}.s"] = s4_st[2]
+    for r, key in enumerate(SEED_ANGLES if seed is not None else ()):
+        assert seed is not None
+        variables[key], velocities[key], accelerations[key] = seed[r], seed[4 + r], seed[8 + r]
     return variables, velocities, accelerations
 
 
@@ -475,6 +442,7 @@ def cssp_mode_motion(
     allow_partial: bool = False,
     joint_rotations: bool = True,
     ball_joints: bool = True,
+    seed_angles: bool = False,
 ) -> ModeMotion:
     """One assembly mode of a CSSP over N crank angles, from the closed form (no Newton).
 
@@ -493,6 +461,8 @@ def cssp_mode_motion(
     is then a read-only NaN view) and their rates (``pin.w*``, ``ball.w*`` in ``velocities`` and
     ``accelerations``): everything inverse dynamics reads — link frames and their rates, joint
     centres and axes, the scalar joint variables — is kept, at two thirds of the cost.
+    ``seed_angles=True`` adds Rahman's θ2, η2, θ3, η3 and their rates (SPEC §1.1; θ2 wrapped
+    into (−π, π]) to the tables, from the closed form's u, u̇, ü block by block.
 
     Computed in blocks of :data:`BLOCK_SAMPLES` samples in structure-of-arrays form. The (N, …)
     arrays are views of component-major storage (every component contiguous over the samples;
@@ -513,36 +483,36 @@ def cssp_mode_motion(
     C_st, joint_centres = _component_major(n, 4, 3)
     X_st, joint_axes = _component_major(n, 4, 3)
     joint_rotations = joint_rotations and ball_joints
+    RV_st: Array | None = None
     if ball_joints:
         # pin: R_crankᵀR_rod, ball: R_rodᵀR_slider; pin, ball joint rates and "accelerations"
         REL_st, relative = _component_major(n, 2, 3, 3)
         RATE_st, _ = _component_major(n, 4, 3)
+        if joint_rotations:  # the ball joints' rotation vectors
+            RV_st = np.empty((2, 3, n))
     else:
         relative = np.broadcast_to(np.nan, (n, 2, 3, 3))
+    SEED_st = np.empty((12, n)) if seed_angles else None
     s4_st = np.empty((3, n))  # s4, ṡ4, s̈4
     closure = np.empty(n)
     base_R, base_p = linkage.base.real, linkage.base.translation
     for start in range(0, n, BLOCK_SAMPLES):
         sl = slice(start, min(start + BLOCK_SAMPLES, n))
         rows = cssp_block_rows(sw, sl, base_R, base_p)
-        for storage, component_rows in ((R_st, rows.rotation), (O_st, rows.origin),
-                                (V_st, rows.velocity), (A_st, rows.acceleration),
-                                (W_st, rows.angular_velocity),
-                                (AL_st, rows.angular_acceleration), (C_st, rows.centres),
-                                (X_st, rows.axes)):
-            _write(storage, component_rows, sl)
+        _write_rows((R_st, O_st, V_st, A_st, W_st, AL_st, C_st, X_st), rows, sl)
         s4_st[0, sl], s4_st[1, sl], s4_st[2, sl] = rows.s4
         closure[sl] = rows.closure
         if ball_joints:
-            _ball_joint_block(rows.loop, REL_st, RATE_st, sl)
+            ball_joint_block(rows.loop, REL_st, RATE_st, sl)
+            if RV_st is not None:
+                rotation_vector_block(REL_st, RV_st, ok[sl], sl)
+        if SEED_st is not None:
+            seed_angle_block(sw.dims, th[sl], rows.loop, ok[sl], SEED_st, sl)
 
-    pin_rel, ball_rel = relative[:, 0], relative[:, 1]
-    s1_all = sw.full("s1")
-    scalars = [th] + ([s1_all] if driven_offset else []) + [s4_st[0]]
+    scalars = [th] + ([sw.full("s1")] if driven_offset else []) + [s4_st[0]]
     conf = Configuration(np.stack(scalars, -1), relative)
     variables, velocities, accelerations = _joint_tables(
-        linkage, sw, s4_st, (pin_rel, ball_rel) if joint_rotations else None,
-        RATE_st if ball_joints else None)
+        linkage, sw, s4_st, RV_st, RATE_st if ball_joints else None, SEED_st)
 
     arrays = [link_rotation, link_origin, link_angular_velocity, link_origin_velocity,
               link_angular_acceleration, link_origin_acceleration, joint_centres, joint_axes]

@@ -60,9 +60,12 @@ def cssp_names(linkage: Linkage, mode: ModeMotion) -> tuple[Named, Named, Named]
     θ3 and azimuth η3 in the slider frame X(α4)·u (reference SPEC §1.1)."""
     a2 = linkage.parameters["a2"]
     c = mode.joint_centres
-    u = (c[:, 2] - c[:, 1]) / a2
-    w = mode.link_angular_velocity[:, 1]
-    al = mode.link_angular_acceleration[:, 1]
+    # in the loop frame {1} (world → loop: x ↦ baseᵀ x, by rows x @ base), where Rahman's
+    # angles are defined (the closed form's, cssp.rod_and_slider_angles)
+    base = np.asarray(linkage.base.real, dtype=float)
+    u = (c[:, 2] - c[:, 1]) @ base / a2
+    w = mode.link_angular_velocity[:, 1] @ base
+    al = mode.link_angular_acceleration[:, 1] @ base
     ud = np.cross(w, u)
     udd = np.cross(al, u) + np.cross(w, ud)
     crank = linkage.joints[0].name

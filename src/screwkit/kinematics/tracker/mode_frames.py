@@ -105,14 +105,53 @@ def start_in_half_open(run: Array) -> Array:
     return np.asarray(run - 2 * np.pi * np.ceil((run[0] - np.pi) / (2 * np.pi)))
 
 
+#: jumps of 2π in a run above which :func:`unwrap_in_place` leaves the work to ``np.unwrap``
+_SPARSE_JUMPS = 256
+
+
+def unwrap_in_place(run: Array) -> None:
+    """``run[:] = np.unwrap(run)`` (period 2π, jumps of π or more) for a 1-D run of finite
+    angles, the same values, but by touching only the samples after a jump: np.unwrap adds the
+    running sum of its corrections, which is zero until the first jump and constant between
+    two, so the corrections are summed at the jumps only (in the same order)."""
+    if run.size < 2:
+        return
+    dd = run[1:] - run[:-1]
+    jumps = np.flatnonzero(~(np.abs(dd) < np.pi))
+    if jumps.size == 0:
+        return
+    if jumps.size > _SPARSE_JUMPS:
+        run[:] = np.unwrap(run)
+        return
+    d = dd[jumps]
+    ddmod = np.mod(d + np.pi, 2.0 * np.pi) - np.pi  # np.unwrap's, term by term
+    ddmod[(ddmod == -np.pi) & (d > 0)] = np.pi
+    total = np.cumsum(ddmod - d)
+    ends = np.append(jumps[1:] + 1, run.size)
+    for start, end, shift in zip((jumps + 1).tolist(), ends.tolist(), total.tolist(),
+                                 strict=True):
+        run[start:end] += shift
+
+
 def unwrap_runs(angle: Array, ok: NDArray[np.bool_]) -> Array:
     """Continuous angles along each run of assembling samples, each run starting in (−π, π]."""
     out = np.array(angle, dtype=float)
-    idx = np.flatnonzero(ok & np.isfinite(out))
-    if idx.size == 0:
-        return out
-    for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1):
-        out[run] = start_in_half_open(np.unwrap(out[run]))
+    good = ok & np.isfinite(out)
+    if out.size and good.all():  # one run, the whole sweep
+        starts, stops = [0], [out.size - 1]
+    else:
+        idx = np.flatnonzero(good)
+        if idx.size == 0:
+            return out
+        breaks = np.flatnonzero(np.diff(idx) > 1)
+        starts = [int(idx[0])] + (idx[breaks + 1] if breaks.size else idx[:0]).tolist()
+        stops = (idx[breaks] if breaks.size else idx[:0]).tolist() + [int(idx[-1])]
+    for a, b in zip(starts, stops, strict=True):
+        run = out[a:b + 1]
+        unwrap_in_place(run)
+        turns = np.ceil((run[0] - np.pi) / (2 * np.pi))  # start_in_half_open
+        if turns != 0.0:
+            run -= 2 * np.pi * turns
     return out
 
 
