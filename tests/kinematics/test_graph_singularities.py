@@ -198,3 +198,88 @@ def test_stewart_conditions_hold_along_the_bundled_motion() -> None:
         c = md.jacobian_condition[name]
         assert c.shape == (12,) and np.all(np.isfinite(c)) and np.all(c >= 1.0)
     assert set(md.singular_class) == {""}
+
+
+def _rot(a: np.ndarray, th: float) -> np.ndarray:
+    K = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+    return np.eye(3) + np.sin(th) * K + (1 - np.cos(th)) * (K @ K)
+
+
+def _delta_at(mech: Mechanism, thetas: list[float], t: np.ndarray) -> Configuration:
+    """The Delta robot with arm k turned by θ_k and the plate translated by t, decoded into
+    joint variables (each rod turned by the least rotation onto its new direction)."""
+    from screwkit.kinematics.modes.rod_loops import _least_rotation
+    from screwkit.kinematics.modes.stewart_decode import joint_values
+
+    J = {j.name: j for j in mech.joints}
+    poses = {"plate": (np.eye(3)[None], t[None])}
+    for k, th in enumerate(thetas, start=1):
+        sh = J[f"R{k}"]
+        R = _rot(sh.axis, th)
+        poses[f"arm{k}"] = (R[None], (sh.at - R @ sh.at)[None])
+        for side in "ab":
+            E0, P0 = J[f"E{k}{side}"].at, J[f"P{k}{side}"].at
+            E = sh.at + R @ (E0 - sh.at)
+            Rr = _least_rotation(P0 - E0, (P0 + t - E)[None])
+            poses[f"rod{k}{side}"] = (Rr, (E - Rr[0] @ E0)[None])
+    return joint_values(mech, graph_layout(mech), poses)
+
+
+def _arm_angle(mech: Mechanism, k: int, t: np.ndarray) -> float | None:
+    """Arm k's angle (nearer the drawing) that reaches the plate at t: |E(θ) − P| = ℓ is
+    A cos θ + B sin θ = C."""
+    J = {j.name: j for j in mech.joints}
+    sh, E0, P0 = J[f"R{k}"], J[f"E{k}a"].at, J[f"P{k}a"].at
+    a, ell = sh.axis, np.linalg.norm(E0 - P0)
+    v = E0 - sh.at
+    c, r = (v @ a) * a, v - (v @ a) * a
+    q = P0 + t - sh.at
+    A, B = 2 * r @ (c - q), 2 * np.cross(a, r) @ (c - q)
+    C = ell**2 - (c - q) @ (c - q) - r @ r
+    rho = np.hypot(A, B)
+    if abs(C) > rho:
+        return None
+    roots = np.arctan2(B, A) + np.array([1, -1]) * np.arccos(C / rho)
+    roots = np.angle(np.exp(1j * roots))
+    return float(roots[np.argmin(np.abs(roots))])
+
+
+def test_delta_input_singularity_with_an_arm_and_its_rods_in_line() -> None:
+    spec = sk.load_spec(EXAMPLES / "delta_robot.toml")
+    mech = spec.mechanism
+    lay = graph_layout(mech)
+    J = {j.name: j for j in mech.joints}
+    sh, E0, P0 = J["R1"], J["E1a"].at, J["P1a"].at
+    a, ell = sh.axis, np.linalg.norm(E0 - P0)
+    r0 = (E0 - sh.at) - ((E0 - sh.at) @ a) * a
+    best = None
+    for th in np.radians(np.arange(-180.0, 180.0, 0.5)):  # arm 1 straight along its rods
+        E = sh.at + _rot(a, th) @ (E0 - sh.at)
+        t = E + ell * (_rot(a, th) @ r0) / np.linalg.norm(r0) - P0
+        others = [_arm_angle(mech, k, t) for k in (2, 3)]
+        if all(o is not None for o in others):
+            best = (th, others, t)
+            break
+    assert best is not None
+    th, (t2, t3), t = best
+    straight = _delta_at(mech, [th, t2, t3], t)
+    # a regular pose nearby: arm 1 bent back 0.1 rad, the plate where all three arms reach
+    t_in = t + 0.05 * (sh.at - t - P0) / np.linalg.norm(sh.at - t - P0)
+    bent = [_arm_angle(mech, k, t_in) for k in (1, 2, 3)]
+    assert all(b is not None for b in bent)
+    regular = _delta_at(mech, bent, t_in)  # type: ignore[arg-type]
+    conf = Configuration(np.concatenate([straight.scalars, regular.scalars]),
+                         np.concatenate([straight.spherical, regular.spherical]))
+    assert np.abs(graph_forward(mech, lay, conf).residual).max() < 1e-12
+    X = conf.scalars[:, [lay.scalar_col[f] for f in lay.inputs]]
+    md = build_mode(mech, lay, conf, np.ones(2, dtype=bool), X, np.zeros_like(X),
+                    np.zeros_like(X))
+    assert md.singular_class.tolist() == ["input", ""]
+    assert not md.singular.any()  # the forward rates exist at an input singularity
+    cond = md.jacobian_condition
+    assert cond["platform_held"][0] > 1e7 > 1e3 > cond["platform_held"][1]
+    assert max(cond["passive"]) < 1e4
+    assert any("input singularity (serial, type I): R1.theta" in e for e in md.events)
+    # along the bundled motion: regular throughout
+    m = solve_mechanism(mech, spec.inputs[:10]).modes[0]
+    assert set(m.singular_class) == {""} and np.all(m.jacobian_condition["platform_held"] < 1e4)

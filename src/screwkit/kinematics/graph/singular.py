@@ -11,7 +11,8 @@ has at the drawing (idle freedoms such as a rod's spin and redundant constraints
   (angular velocity and the velocity of its joints' centroid, over the length scale) as a
   linear map of every freedom's rate along the spanning tree.
 
-``jacobian_condition`` holds σ₁/σ_r of each (r its rank at the drawing; ∞ where σ_r = 0):
+``jacobian_condition`` holds σ₁/σ_r of each (r its rank at the drawing; at most 1/ε, ε the
+machine epsilon, where σ_r vanishes to round-off):
 ``passive``, ``closure`` and, with a platform, ``platform_held``. A sample is singular for
 one of them where 1/condition falls below :data:`SINGULAR_TOL`. The class
 (Gosselin & Angeles 1990, "Singularity analysis of closed-loop kinematic chains", IEEE Trans.
@@ -120,14 +121,13 @@ def _ranks(mech: Mechanism, lay: GraphLayout, platform: str | None) -> tuple[int
 
 
 def _condition(A: Array, r: int) -> tuple[Array, Array]:
-    """σ₁/σ_r (N,) of A (N, …) and the right singular vector of σ_r (N, cols)."""
+    """σ₁/σ_r (N,) of A (N, …) (at most 1/ε) and the right singular vector of σ_r."""
     N = A.shape[0]
     if r == 0 or A.size == 0:
         return np.ones(N), np.zeros((N, A.shape[2]))
     _, s, Vt = np.linalg.svd(A)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cond = np.where(s[:, r - 1] > 0, s[:, 0] / s[:, r - 1], np.inf)
-    return cond, Vt[:, r - 1]
+    tiny = np.maximum(s[:, 0] * np.finfo(float).eps, 1e-300)
+    return s[:, 0] / np.maximum(s[:, r - 1], tiny), Vt[:, r - 1]
 
 
 def singularities(mech: Mechanism, lay: GraphLayout, conf: Configuration,
@@ -156,10 +156,9 @@ def singularities(mech: Mechanism, lay: GraphLayout, conf: Configuration,
         condition["platform_held"][idx] = cM
     else:
         cM = vM = np.zeros(0)
-    with np.errstate(divide="ignore"):
-        p_sing = ~(1.0 / cp > SINGULAR_TOL)
-        J_sing = ~(1.0 / cJ > SINGULAR_TOL)
-        M_sing = ~(1.0 / cM > SINGULAR_TOL) if K is not None else np.zeros(idx.size, bool)
+    p_sing = ~(1.0 / cp > SINGULAR_TOL)
+    J_sing = ~(1.0 / cJ > SINGULAR_TOL)
+    M_sing = ~(1.0 / cM > SINGULAR_TOL) if K is not None else np.zeros(idx.size, bool)
     loops = [{k for k, _ in loop} for loop in mech.topology.loops]
 
     def moving(v: Array, cols: list[int]) -> set[int]:
