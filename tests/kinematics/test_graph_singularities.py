@@ -16,7 +16,6 @@ from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
 from screwkit.kinematics.graph.motion import build_mode
 from screwkit.kinematics.graph.newton import column_scale, row_scale
-from screwkit.kinematics.graph.singular import singularities
 from screwkit.kinematics.modes.stewart_decode import decode_poses, stewart_formulation
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
@@ -208,7 +207,7 @@ def _rot(a: np.ndarray, th: float) -> np.ndarray:
 def _delta_at(mech: Mechanism, thetas: list[float], t: np.ndarray) -> Configuration:
     """The Delta robot with arm k turned by θ_k and the plate translated by t, decoded into
     joint variables (each rod turned by the least rotation onto its new direction)."""
-    from screwkit.kinematics.modes.rod_loops import _least_rotation
+    from screwkit.kinematics.modes.rod_loops import least_rotation
     from screwkit.kinematics.modes.stewart_decode import joint_values
 
     J = {j.name: j for j in mech.joints}
@@ -220,7 +219,7 @@ def _delta_at(mech: Mechanism, thetas: list[float], t: np.ndarray) -> Configurat
         for side in "ab":
             E0, P0 = J[f"E{k}{side}"].at, J[f"P{k}{side}"].at
             E = sh.at + R @ (E0 - sh.at)
-            Rr = _least_rotation(P0 - E0, (P0 + t - E)[None])
+            Rr = least_rotation(P0 - E0, (P0 + t - E)[None])
             poses[f"rod{k}{side}"] = (Rr, (E - Rr[0] @ E0)[None])
     return joint_values(mech, graph_layout(mech), poses)
 

@@ -32,8 +32,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import PolynomialSystem
 from screwkit.algebraic.solve import StartSolutions
-from screwkit.kinematics.graph.closure import GraphLayout, _axis_rotation, graph_layout
-from screwkit.kinematics.modes.rod_loops import _least_rotation
+from screwkit.errors import CapabilityError
+from screwkit.kinematics.graph.closure import GraphLayout, axis_rotation, graph_layout
+from screwkit.kinematics.modes.rod_loops import least_rotation
 from screwkit.kinematics.modes.stewart import (
     StewartMechanism,
     pose_from_study,
@@ -70,10 +71,10 @@ def u_rotation(e1: Array, e2: Array, w: Array, d: Array) -> Array:
     roots = np.stack([phi + off, phi - off])
     roots = np.angle(np.exp(1j * roots))  # wrapped to (−π, π]
     beta = roots[np.argmin(np.abs(roots), axis=0), np.arange(len(w))]
-    Rb = _axis_rotation(e2, beta)
+    Rb = axis_rotation(e2, beta)
     v = np.einsum("nij,nj->ni", Rb, w)
     alpha = _angle_about(e1, v, d)
-    return np.asarray(_axis_rotation(e1, alpha) @ Rb)
+    return np.asarray(axis_rotation(e1, alpha) @ Rb)
 
 
 def joint_values(mech: Mechanism, lay: GraphLayout, poses: dict[str, Pose]) -> Configuration:
@@ -104,13 +105,15 @@ def joint_values(mech: Mechanism, lay: GraphLayout, poses: dict[str, Pose]) -> C
             assert j.axis2 is not None
             e1, e2 = j.axis, j.axis2
             th1 = _angle_about(e1, np.broadcast_to(e2, (N, 3)), MR @ e2)
-            Q = _axis_rotation(e1, -th1) @ MR
+            Q = axis_rotation(e1, -th1) @ MR
             ref = np.cross(e2, [1.0, 0.0, 0.0] if abs(e2[0]) < 0.9 else [0.0, 1.0, 0.0])
             scalars[:, lay.scalar_col[f0]] = th1
             scalars[:, lay.scalar_col[f0 + 1]] = _angle_about(
                 e2, np.broadcast_to(ref, (N, 3)), Q @ ref)
         else:
-            raise ValueError(f"joint {j.name!r}: a {j.kind} joint is not decoded from poses")
+            raise CapabilityError(f"{mech.name}: joint {j.name!r} is a {j.kind} joint; joint "
+                                  "values are decoded from body poses for R, P, U and S "
+                                  "joints only")
     return Configuration(scalars, spherical)
 
 
@@ -164,7 +167,7 @@ def decode_poses(sm: StewartMechanism, R: Array, t: Array, input_values: ArrayLi
             else:  # drawn ground-last: R_c⁻¹ = Rot(e₁, θ₁) Rot(e₂, θ₂)
                 Rc = u_rotation(base.axis2, base.axis, w, d)
         else:
-            Rc = _least_rotation(w[0], d)
+            Rc = least_rotation(w[0], d)
         pc = a - Rc @ a
         poses[lower] = (Rc, pc)
         poses[upper] = (Rc, pc + Rc @ (x[col] * u))
