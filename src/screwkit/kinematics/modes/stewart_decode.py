@@ -125,6 +125,9 @@ class StewartFormulation:
 
     mechanism: Mechanism
     stewart: StewartMechanism
+    #: measured homotopy time per anchor and generic solution (docs/kinematics.md: ~1.4 s per
+    #: instance in a batch, 40 paths), for the time budget of modes/along.py
+    seconds_per_root: float = 0.035
 
     @property
     def system(self) -> PolynomialSystem:
