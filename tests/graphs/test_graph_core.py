@@ -126,7 +126,7 @@ def test_limits_and_mobility_commands_on_a_graph() -> None:
     assert json.loads(r.output)["mobility"] == 1
 
 
-def test_a_dead_centre_is_flagged_and_named() -> None:
+def test_a_change_point_is_flagged_and_named() -> None:
     # a parallelogram four-bar: crank, coupler and rocker fall in line at input −90°
     pg = Mechanism("parallelogram", (Body("crank"), Body("coupler"), Body("rocker")),
                    (joint("A", "R", "ground", "crank", [0, 0, 0]),
@@ -135,7 +135,12 @@ def test_a_dead_centre_is_flagged_and_named() -> None:
                     joint("D", "R", "rocker", "ground", [2, 0, 0])), ("A.theta",))
     m = solve_mechanism(pg, np.radians(np.arange(0.0, -120.0, -1.0))).modes[0]
     assert np.nonzero(m.singular)[0].tolist() == [90]
-    assert any("singular at A.theta = -90 deg: a dead centre of loop 1" in e for e in m.events)
+    # every joint in line: the closure Jacobian loses rank too, the parallelogram's change
+    # point (it may go on as a parallelogram or an antiparallelogram)
+    assert any("singular at A.theta = -90 deg: a bifurcation (change point)" in e
+               for e in m.events)
+    assert m.singular_class[90] == "bifurcation" and set(m.singular_class[:90]) == {""}
+    assert m.jacobian_condition["passive"][90] > 1e7 > m.jacobian_condition["passive"][89]
     # up to the dead centre the rocker turns with the crank (D turns the ground on the rocker,
     # so its angle is the rocker's with the sign changed)
     np.testing.assert_allclose(m.variables["D.theta"][:90], -m.variables["A.theta"][:90],

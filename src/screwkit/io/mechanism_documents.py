@@ -30,6 +30,8 @@ def mechanism_document(motion: MechanismMotion, topology: MechanismTopology | No
             "label": md.label or "drawn",
             "assembles": md.assembles,
             "singular": md.singular,
+            "singular_class": [str(c) for c in md.singular_class],
+            "jacobian_condition": dict(md.jacobian_condition),
             "events": list(md.events),
             "variables": md.variables,
             "velocities": md.velocities,

@@ -41,6 +41,7 @@ from numpy.typing import NDArray
 from screwkit.errors import InputError
 from screwkit.io.results import jsonable
 from screwkit.model.mechanism import GROUND, Mechanism
+from screwkit.report.mode_marks import mode_chart, mode_marks
 from screwkit.report.scene import SCENE_FORMAT, display_length, is_full_turn
 from screwkit.report.scene_plots import kinematic_plots
 from screwkit.report.scene_text import link_span_variation
@@ -154,6 +155,7 @@ def _mode_entry(mech: Mechanism, md: Any) -> dict[str, Any]:
         "assembles": ok.tolist(),
         "singular": np.asarray(md.singular, dtype=bool).tolist(),
         "events": [str(e) for e in md.events],
+        "marks": mode_marks(ok, getattr(md, "singular_class", None)),
         "joint_centres": np.asarray(md.joint_centres, dtype=float),
         "joint_axes": np.asarray(md.joint_axes, dtype=float),
         "second_axes": second,
@@ -243,6 +245,11 @@ def scene_from_mechanism(spec_or_mechanism: Any, motion: Any, *, spec_text: str 
     if len(mech.driven_names) > 1:
         groups[0]["note"] += (f" Every variable is plotted against the first input, "
                               f"{input_name}; the other inputs are plotted too.")
+    if len(modes) > 1 or any(e["marks"] for e in entries):  # births, deaths, crossings
+        chart, group = mode_chart(entries, plots[0]["x_label"] if plots else input_name,
+                                  plots[0]["x_scale"] if plots else 1.0)
+        plots.insert(0, chart)
+        groups.insert(0, group)
     if loads is not None or balance_doc is not None:
         _add_load_plots(spec, entries, plots, groups, (x, input_name, kind), loads, balance_doc)
     if getattr(spec, "synthesis", None) is not None:

@@ -72,7 +72,7 @@ def zero_configuration(lay: GraphLayout, count: int = 1) -> Configuration:
                          np.broadcast_to(np.eye(3), (count, lay.n_spherical, 3, 3)).copy())
 
 
-def _axis_rotation(u: Array, th: Array) -> Array:
+def axis_rotation(u: Array, th: Array) -> Array:
     """Rotations (N, 3, 3) by angles θ (N,) about the fixed unit axis u (Rodrigues:
     I + sin θ K + (1 − cos θ) K², K = [u]×, K² = u uᵀ − I)."""
     K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
@@ -102,11 +102,11 @@ def joint_motion(mech: Mechanism, lay: GraphLayout, conf: Configuration, i: int
         return np.broadcast_to(np.eye(3), (N, 3, 3)), slide
     elif j.kind == "U":
         assert j.axis2 is not None
-        R = (_axis_rotation(u, conf.scalars[:, lay.scalar_col[f0]])
-             @ _axis_rotation(j.axis2, conf.scalars[:, lay.scalar_col[f0 + 1]]))
+        R = (axis_rotation(u, conf.scalars[:, lay.scalar_col[f0]])
+             @ axis_rotation(j.axis2, conf.scalars[:, lay.scalar_col[f0 + 1]]))
     else:  # R, C, H
         th = conf.scalars[:, lay.scalar_col[f0]]
-        R = _axis_rotation(u, th)
+        R = axis_rotation(u, th)
     p = c - R @ c
     if j.kind == "C":
         p = p + conf.scalars[:, lay.scalar_col[f0 + 1], None] * u

@@ -36,6 +36,7 @@ from screwkit.kinematics.graph.newton import (
     rates,
     scaled_residual,
 )
+from screwkit.kinematics.graph.singular import SINGULAR_TOL
 from screwkit.kinematics.graph.subchains import Decomposition, decompose
 from screwkit.kinematics.graph.track import follow_drawn_mode
 from screwkit.kinematics.motion import AssemblyError, ModeMotion
@@ -44,9 +45,8 @@ from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]
 
-#: a sample is singular where the passive block's smallest kept singular value falls below this
-#: fraction of its largest (the inputs no longer fix the mechanism there)
-SINGULAR_TOL = 1e-7
+#: a sample is singular where the passive block's smallest kept singular value falls below
+#: SINGULAR_TOL of its largest (the inputs no longer fix the mechanism there; graph/singular.py)
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,6 +62,12 @@ class MechanismMode(ModeMotion):
     outputs: dict[str, Array] = field(default_factory=dict)
     output_rates: dict[str, Array] = field(default_factory=dict)
     output_accelerations: dict[str, Array] = field(default_factory=dict)
+    #: per sample: σ₁/σ_r of the passive block, the closure Jacobian and (with a platform) the
+    #: Jacobian with the platform held (graph/singular.py), NaN where the mode does not assemble
+    jacobian_condition: dict[str, Array] = field(default_factory=dict)
+    #: per sample: "" or the singularity's class (input, output, constraint, dead centre,
+    #: bifurcation; graph/singular.py)
+    singular_class: NDArray[np.str_] = field(default_factory=lambda: np.zeros(0, dtype=str))
 
 
 @dataclass(frozen=True, eq=False)
@@ -480,13 +486,12 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
     for arr in twists:
         arr[singular] = np.nan
     residual[bad] = np.nan
-    events: list[str] = []
-    if singular.any():
-        from screwkit.kinematics.graph.singular import singular_events
+    from screwkit.kinematics.graph.singular import singular_events, singularities
 
-        idx = np.nonzero(singular)[0]
-        events = singular_events(mech, lay, conf, rank, idx,
-                                 {int(k): input_text(mech, lay, X[k]) for k in idx})
+    sing = singularities(mech, lay, conf, mask, lin)
+    idx = np.flatnonzero(sing.kind != "")
+    events = singular_events({int(k): input_text(mech, lay, X[k]) for k in idx}, sing) \
+        if idx.size else []
     return MechanismMode(mask, singular, conf, variables, velocities, accels,
                          link_rotation=frames[0], link_origin=frames[1],
                          link_angular_velocity=twists[0], link_origin_velocity=twists[1],
@@ -494,7 +499,8 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
                          joint_centres=centres, joint_axes=axes, closure_residual=residual,
                          events=events, points=points, point_velocities=pv,
                          point_accelerations=pa, outputs=outs[0], output_rates=outs[1],
-                         output_accelerations=outs[2])
+                         output_accelerations=outs[2], jacobian_condition=sing.condition,
+                         singular_class=sing.kind)
 
 
 def _outputs(mech: Mechanism, lay: GraphLayout, R: Array, V: Array, A: Array,

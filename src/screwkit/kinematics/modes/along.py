@@ -189,7 +189,8 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     N = X.shape[0]
     form = closure_formulation(mech)
     roots = formulation_start(form).generic_count
-    anchors = anchor_samples(N, SECONDS_PER_ANCHOR_ROOT * roots)
+    per_root = getattr(form, "seconds_per_root", SECONDS_PER_ANCHOR_ROOT)
+    anchors = anchor_samples(N, per_root * roots)
     check_cost(mech, N * max(roots, 1))  # at most every generic solution tracked throughout
     solved = every_mode(mech, X[anchors])
     chains: list[_Chain] = []

@@ -3,7 +3,9 @@
 :func:`closure_formulation` picks the formulation of this package that fits the mechanism (a
 planar R-joint graph; a single loop of R joints with six free; an RSSR, RSRC or RCCC driven at
 a ground R joint) and :func:`every_mode` solves it for every row of inputs in one batched
-parameter homotopy from the topology's start solutions. Each real solution is turned into the
+parameter homotopy from the topology's start solutions; a 6-6 Stewart–Gough platform (U–P–S or
+S–P–S legs) by the Study-coordinate system, its poses decoded into joint variables
+(modes/stewart_decode.py). Each real solution is turned into the
 graph tracker's :class:`Configuration` and kept only if the tracker's own closure
 (``graph_forward``, the exact SE(3) logarithm round every loop) is within
 :data:`CLOSURE_TOLERANCE` of the length scale: the check is independent of the polynomial
@@ -90,11 +92,16 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         return rod_loop(mech)
     if single and sorted(j.kind for j in mech.joints) == ["C", "C", "C", "R"]:
         return rccc_loop(mech)
+    if kinds <= {"U", "P", "S"} and len(mech.joints) == 18:
+        from screwkit.kinematics.modes.stewart_decode import stewart_formulation
+
+        return stewart_formulation(mech)  # a CapabilityError where the legs are not found
     raise CapabilityError(
         f"{mech.name}: no polynomial formulation takes this mechanism yet (joints "
         f"{sorted(j.kind for j in mech.joints)}, {len(mech.topology.loops)} loops); there are "
-        "formulations for planar R-joint graphs, single R loops with six free joints, and "
-        "RSSR, RSRC and RCCC loops driven at a ground R joint")
+        "formulations for planar R-joint graphs, single R loops with six free joints, "
+        "RSSR, RSRC and RCCC loops driven at a ground R joint, and 6-6 Stewart–Gough "
+        "platforms (U–P–S or S–P–S legs driven at the P joints)")
 
 
 @dataclass(frozen=True)
@@ -118,7 +125,10 @@ class MechanismModes:
 
 def formulation_start(form: Formulation) -> StartSolutions:
     """The start solutions of ``form``'s topology (cached per topology, modes/starts.py)."""
-    return loop6r_start() if isinstance(form, _RLoopFormulation) else start_solutions(form.system)
+    if isinstance(form, _RLoopFormulation):
+        return loop6r_start()
+    own = getattr(form, "start", None)  # a formulation with its own (monodromy) start
+    return own() if callable(own) else start_solutions(form.system)
 
 
 def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:

@@ -167,7 +167,7 @@ class RodLoop:
         if self.kind == "RSSR":  # the rod: the least rotation from its drawn direction
             Q0 = mech.joints[walk[2][0]].at
             Q = np.einsum("nij,j->ni", pose[bodies[3]][0], Q0) + pose[bodies[3]][1]
-            R = _least_rotation(Q0 - ball, Q - P)
+            R = least_rotation(Q0 - ball, Q - P)
         else:  # the coupler turns about its R line on the output until it carries the ball
             r0, a0 = mech.joints[walk[2][0]].at, mech.joints[walk[2][0]].axis
             Ro, po = pose[bodies[3]]
@@ -182,7 +182,7 @@ class RodLoop:
         return _joint_values(mech, pose, q, phi, slide, walk), graph_layout(mech)
 
 
-def _least_rotation(d0: Array, d: Array) -> Array:
+def least_rotation(d0: Array, d: Array) -> Array:
     """The rotations (N, 3, 3) turning d0 onto d (N, 3) about d0 × d (equal lengths)."""
     u = d0 / np.linalg.norm(d0)
     v = d / np.linalg.norm(d, axis=-1)[:, None]

@@ -195,6 +195,9 @@ class StewartMechanism:
     top: Array
     slide_axes: Array
     input_columns: tuple[int, ...]
+    #: per leg: the index of its P joint and of its joint to the ground (U or S)
+    slide_joints: tuple[int, ...] = ()
+    base_joints: tuple[int, ...] = ()
 
     def parameters(self, input_values: ArrayLike) -> Array:
         """Parameters (N, 42) at rows of input values (N, n_inputs) (metres from the drawing)."""
@@ -207,13 +210,14 @@ class StewartMechanism:
 
 
 def _beyond(mech: Mechanism, joint: MechanismJoint, body: str, kinds: str
-            ) -> tuple[str, Array] | None:
-    """The body across ``body``'s only other joint (of one of ``kinds``) and that joint's
-    centre, or None."""
-    near = [j for j in mech.joints if body in j.bodies and j is not joint]
-    if len(near) != 1 or near[0].kind not in kinds:
+            ) -> tuple[str, Array, int] | None:
+    """The body across ``body``'s only other joint (of one of ``kinds``), that joint's
+    centre and its index, or None."""
+    near = [k for k, j in enumerate(mech.joints) if body in j.bodies and j is not joint]
+    if len(near) != 1 or mech.joints[near[0]].kind not in kinds:
         return None
-    return (near[0].bodies[1] if near[0].bodies[0] == body else near[0].bodies[0], near[0].at)
+    j = mech.joints[near[0]]
+    return (j.bodies[1] if j.bodies[0] == body else j.bodies[0], j.at, near[0])
 
 
 def stewart_from_mechanism(mech: Mechanism) -> StewartMechanism:
@@ -228,12 +232,14 @@ def stewart_from_mechanism(mech: Mechanism) -> StewartMechanism:
         down, up = _beyond(mech, joint, lower, "US"), _beyond(mech, joint, upper, "S")
         if down is None or up is None or down[0] != GROUND:
             continue
-        legs.append((col, up[0], down[1], up[1], joint.axis))
+        legs.append((col, up[0], down[1], up[1], joint.axis, k, down[2]))
     platforms = {leg[1] for leg in legs}
-    if len(legs) != 6 or len(platforms) != 1 or len(mech.bodies) != 13:
+    if len(legs) != 6 or len(platforms) != 1 or len(mech.bodies) != 13 or \
+            len(mech.inputs) != 6:
         raise CapabilityError(f"{mech.name}: not a 6-6 Stewart–Gough platform (six legs, each "
                               "a driven P joint between a body jointed to the ground by a U or "
                               "S joint and one jointed to the platform by an S joint)")
     return StewartMechanism(mech, platforms.pop(), np.array([leg[2] for leg in legs]),
                             np.array([leg[3] for leg in legs]), np.array([leg[4] for leg in legs]),
-                            tuple(leg[0] for leg in legs))
+                            tuple(leg[0] for leg in legs), tuple(leg[5] for leg in legs),
+                            tuple(leg[6] for leg in legs))
