@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from screwkit.constants import STANDARD_GRAVITY
-from screwkit.dynamics import Dynamics, inverse_dynamics
 from screwkit.errors import InputError, ScrewkitError, expect_instance
 from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec
@@ -24,12 +23,11 @@ from screwkit.kinematics.analysis.limit_positions import (
     limit_positions,
     uses_closed_form,
 )
-from screwkit.kinematics.analysis.loop_mobility import LinkageMobility, mobility
 from screwkit.kinematics.analysis.transmission import Transmission, transmission
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.kinematics.tracker.loop import Array
-from screwkit.messages import message_units, number
+from screwkit.messages import listing, message_units, number
 from screwkit.tables import ResultTable, UnitChoice
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -47,9 +45,12 @@ def _in_spec_units(job: F) -> F:
     return run  # type: ignore[return-value]
 
 
-if TYPE_CHECKING:  # balancing and synthesis load scipy.optimize: imported where they are used
+if TYPE_CHECKING:  # balancing and synthesis load scipy.optimize, dynamics and mobility take
+    # 25 ms of start-up that analyze does not need (issue 30): imported where they are used
     from screwkit.balancing.config import BalancingConfig
     from screwkit.balancing.result import BalanceResult
+    from screwkit.dynamics import Dynamics
+    from screwkit.kinematics.analysis.loop_mobility import LinkageMobility
     from screwkit.synthesis.config import SynthesisConfig, SynthesisRun
 
 
@@ -129,11 +130,14 @@ class Pipeline:
     def dynamics(self, gravity: bool = False) -> Dynamics:
         """Shaking force and moment, joint reactions and input efforts of ``[motion] mode``
         (loads are null where the mode does not assemble)."""
+        from screwkit.dynamics import inverse_dynamics
+
         s = self.spec
         missing = [link.name for link in s.linkage.links if link.mass is None]
         if missing:
             raise SpecError(f"{s.path}: dynamics needs mass properties for every link; add "
-                            f"[links.{missing[0]}] (missing: {missing}; see docs/spec-format.md)")
+                            f"[links.{missing[0]}] (missing for {listing(missing)}; see "
+                            "docs/spec-format.md)")
         mode = self.mode()
         partial = self.not_assembling(mode) is not None
         return inverse_dynamics(s.linkage, mode, self.gravity_vector if gravity else None,
@@ -281,6 +285,8 @@ class Pipeline:
     @_in_spec_units
     def mobility(self) -> LinkageMobility:
         """Formula and Jacobian mobility at the first input where the loop assembles."""
+        from screwkit.kinematics.analysis.loop_mobility import mobility
+
         return mobility(self.spec.linkage, self.spec.inputs)
 
 

@@ -249,7 +249,7 @@ def smallest_cone(directions: Array) -> tuple[Array, float]:
     V = directions[np.isfinite(directions).all(axis=1)]
     if V.shape[0] == 0:
         return np.full(3, np.nan), float("nan")
-    work = np.unique(np.linspace(0, V.shape[0] - 1, min(V.shape[0], 256)).astype(int))
+    work = _distinct(np.linspace(0, V.shape[0] - 1, min(V.shape[0], 256)).astype(int))
     while True:
         p = _hull_min_norm_point(V[work])
         if np.linalg.norm(p) < 1e-9:  # the directions surround the centre: wider than 90°
@@ -263,9 +263,16 @@ def smallest_cone(directions: Array) -> tuple[Array, float]:
         if outside.size == 0:
             break
         worst = outside[np.argsort(dots[outside])[:256]]
-        work = np.union1d(work, worst)
+        work = _distinct(np.concatenate([work, worst]))
     axis = p / np.linalg.norm(p)
     return axis, float(np.arccos(np.clip(np.min(V @ axis), -1.0, 1.0)))
+
+
+def _distinct(indices: Array) -> Array:
+    """The distinct values of an integer array, sorted (``np.unique``'s result, without the
+    import of numpy.ma that ``np.unique`` makes: 35 ms of ``analyze``'s start-up)."""
+    s = np.sort(indices)
+    return np.asarray(s[np.concatenate([[True], s[1:] != s[:-1]])]) if s.size else s
 
 
 def _hull_min_norm_point(V: Array) -> Array:
