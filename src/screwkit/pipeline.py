@@ -16,13 +16,6 @@ from screwkit.constants import STANDARD_GRAVITY
 from screwkit.errors import InputError, ScrewkitError, expect_instance
 from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec
-from screwkit.kinematics.analysis.coupler_curves import coupler_curves
-from screwkit.kinematics.analysis.limit_positions import (
-    LimitPositions,
-    LimitsConfig,
-    limit_positions,
-    uses_closed_form,
-)
 from screwkit.kinematics.analysis.transmission import Transmission, transmission
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
@@ -46,10 +39,11 @@ def _in_spec_units(job: F) -> F:
 
 
 if TYPE_CHECKING:  # balancing and synthesis load scipy.optimize, dynamics and mobility take
-    # 25 ms of start-up that analyze does not need (issue 30): imported where they are used
+    # limits 40 ms of start-up that analyze does not need (issue 30): imported where they are used
     from screwkit.balancing.config import BalancingConfig
     from screwkit.balancing.result import BalanceResult
     from screwkit.dynamics import Dynamics
+    from screwkit.kinematics.analysis.limit_positions import LimitPositions
     from screwkit.kinematics.analysis.loop_mobility import LinkageMobility
     from screwkit.synthesis.config import SynthesisConfig, SynthesisRun
 
@@ -196,6 +190,12 @@ class Pipeline:
         """Limit positions and dwell orders of the loop's outputs (``at`` in radians, or metres
         for a translation input): Bagci App. D's closed form where it answers, else the generic
         route on the pipeline's motion. Arguments left out come from the spec's ``[limits]``."""
+        from screwkit.kinematics.analysis.limit_positions import (
+            LimitsConfig,
+            limit_positions,
+            uses_closed_form,
+        )
+
         c = self.spec.limits or LimitsConfig()
         out = output if output is not None else c.output
         how = method if method is not None else c.method
@@ -250,6 +250,8 @@ class Pipeline:
     @_in_spec_units
     def coupler_curves(self) -> list[dict[str, Array]]:
         """Per mode, the world path (N, 3) of every coupler point of the spec, by name."""
+        from screwkit.kinematics.analysis.coupler_curves import coupler_curves
+
         return coupler_curves(self.motion, self.spec.coupler_points)
 
     @_in_spec_units

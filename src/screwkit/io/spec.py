@@ -233,11 +233,11 @@ class Spec:
     def _limits(self) -> LimitsConfig | None:
         """``[limits]`` as a :class:`LimitsConfig`, checked against the loop (the output names
         a variable it has; the closed form is there when asked for)."""
-        from screwkit.kinematics.analysis.limit_positions import LimitsConfig, check_limits_config
-
         t = self.raw.limits
         if t is None:
             return None
+        from screwkit.kinematics.analysis.limit_positions import LimitsConfig, check_limits_config
+
         kind = "angle" if self.input_is_angle else "length"
         at = tuple(self.quantity(v, kind, "limits.at") for v in t.at)
         config = LimitsConfig(t.output, float(t.dwell_tolerance), t.max_order, at, t.method)
