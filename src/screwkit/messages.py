@@ -91,3 +91,16 @@ def shown_range(low_si: Any, high_si: Any, kind: str, units: UnitChoice | None =
         label, factor = "", 1.0
     return (f"[{number(float(low_si) / factor, digits)}, "
             f"{number(float(high_si) / factor, digits)}] {label}").rstrip()
+
+
+def listing(items: Any, last: str = "and") -> str:
+    """Names for a sentence: ``"crank, coupler and rocker"`` (``last="or"`` for a choice:
+    ``"a, b or c"``), each item as plain text (``str``), in the given order; ``"none"`` for no
+    items. A message that lists names uses this rather than a Python list's repr
+    (``['crank', 'coupler']``), which reads as code (issue 30)."""
+    words = [str(x) for x in items]
+    if not words:
+        return "none"
+    if len(words) == 1:
+        return words[0]
+    return f"{', '.join(words[:-1])} {last} {words[-1]}"

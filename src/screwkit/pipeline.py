@@ -13,23 +13,14 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from screwkit.constants import STANDARD_GRAVITY
-from screwkit.dynamics import Dynamics, inverse_dynamics
 from screwkit.errors import InputError, ScrewkitError, expect_instance
 from screwkit.io.errors import SpecError
 from screwkit.io.spec import Spec
-from screwkit.kinematics.analysis.coupler_curves import coupler_curves
-from screwkit.kinematics.analysis.limit_positions import (
-    LimitPositions,
-    LimitsConfig,
-    limit_positions,
-    uses_closed_form,
-)
-from screwkit.kinematics.analysis.loop_mobility import LinkageMobility, mobility
 from screwkit.kinematics.analysis.transmission import Transmission, transmission
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.kinematics.tracker.loop import Array
-from screwkit.messages import message_units, number
+from screwkit.messages import listing, message_units, number
 from screwkit.tables import ResultTable, UnitChoice
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -47,9 +38,13 @@ def _in_spec_units(job: F) -> F:
     return run  # type: ignore[return-value]
 
 
-if TYPE_CHECKING:  # balancing and synthesis load scipy.optimize: imported where they are used
+if TYPE_CHECKING:  # balancing and synthesis load scipy.optimize, dynamics and mobility take
+    # limits 40 ms of start-up that analyze does not need (issue 30): imported where they are used
     from screwkit.balancing.config import BalancingConfig
     from screwkit.balancing.result import BalanceResult
+    from screwkit.dynamics import Dynamics
+    from screwkit.kinematics.analysis.limit_positions import LimitPositions
+    from screwkit.kinematics.analysis.loop_mobility import LinkageMobility
     from screwkit.synthesis.config import SynthesisConfig, SynthesisRun
 
 
@@ -129,11 +124,14 @@ class Pipeline:
     def dynamics(self, gravity: bool = False) -> Dynamics:
         """Shaking force and moment, joint reactions and input efforts of ``[motion] mode``
         (loads are null where the mode does not assemble)."""
+        from screwkit.dynamics import inverse_dynamics
+
         s = self.spec
         missing = [link.name for link in s.linkage.links if link.mass is None]
         if missing:
             raise SpecError(f"{s.path}: dynamics needs mass properties for every link; add "
-                            f"[links.{missing[0]}] (missing: {missing}; see docs/spec-format.md)")
+                            f"[links.{missing[0]}] (missing for {listing(missing)}; see "
+                            "docs/spec-format.md)")
         mode = self.mode()
         partial = self.not_assembling(mode) is not None
         return inverse_dynamics(s.linkage, mode, self.gravity_vector if gravity else None,
@@ -192,6 +190,12 @@ class Pipeline:
         """Limit positions and dwell orders of the loop's outputs (``at`` in radians, or metres
         for a translation input): Bagci App. D's closed form where it answers, else the generic
         route on the pipeline's motion. Arguments left out come from the spec's ``[limits]``."""
+        from screwkit.kinematics.analysis.limit_positions import (
+            LimitsConfig,
+            limit_positions,
+            uses_closed_form,
+        )
+
         c = self.spec.limits or LimitsConfig()
         out = output if output is not None else c.output
         how = method if method is not None else c.method
@@ -246,6 +250,8 @@ class Pipeline:
     @_in_spec_units
     def coupler_curves(self) -> list[dict[str, Array]]:
         """Per mode, the world path (N, 3) of every coupler point of the spec, by name."""
+        from screwkit.kinematics.analysis.coupler_curves import coupler_curves
+
         return coupler_curves(self.motion, self.spec.coupler_points)
 
     @_in_spec_units
@@ -281,6 +287,8 @@ class Pipeline:
     @_in_spec_units
     def mobility(self) -> LinkageMobility:
         """Formula and Jacobian mobility at the first input where the loop assembles."""
+        from screwkit.kinematics.analysis.loop_mobility import mobility
+
         return mobility(self.spec.linkage, self.spec.inputs)
 
 

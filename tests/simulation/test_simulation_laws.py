@@ -155,12 +155,13 @@ def test_bad_drive_tables_are_named(tmp_path, table, message):
     spec.write_text((EXAMPLES / "rahman_cssp.toml").read_text() + "\n[drive]\n" + table)
     r = CliRunner().invoke(app, ["simulate", str(spec)])
     assert r.exit_code == 2
-    assert message in r.output and "Traceback" not in r.output
+    assert message in " ".join(r.output.split())  # the error is wrapped at 80 columns
+    assert "Traceback" not in r.output
 
 
 def test_simulate_without_drive_table_says_how():
     r = CliRunner().invoke(app, ["simulate", str(EXAMPLES / "rahman_cssp.toml")])
-    assert r.exit_code == 2 and "no [drive] table" in r.output
+    assert r.exit_code == 2 and "no [drive] table" in " ".join(r.output.split())
 
 
 def test_a_load_against_the_motion_does_its_exact_work_every_cycle():

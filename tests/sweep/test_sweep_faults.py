@@ -62,6 +62,19 @@ def _sweep_command(out: Path, designs: int, workers: int, *extra: str) -> list[s
             str(workers), "--batch-size", "1", *extra]
 
 
+def _lines(text: str) -> list[str]:
+    """The messages of ``text``, one per item: the CLI wraps a message between words at the
+    terminal width with its continuation lines indented by two (issue 30, the 80-column
+    promise); each continuation is joined back to its message with the space it replaced."""
+    out: list[str] = []
+    for line in text.splitlines():
+        if line.startswith("  ") and out:
+            out[-1] += " " + line.strip()
+        else:
+            out.append(line)
+    return out
+
+
 def _start(cmd: list[str], preload: Path | None = None, marker: Path | None = None,
            group: bool = False) -> subprocess.Popen[str]:
     env = {**os.environ, "COLUMNS": "200", "PYTHONPATH": str(SRC)}
@@ -124,7 +137,7 @@ def test_a_worker_killed_while_the_cluster_starts_is_retried(tmp_path):
     os.kill(int(marker.read_text()), signal.SIGKILL)  # the worker, while it starts
     stdout, err = _finish(proc)
     assert proc.returncode == 0, err
-    assert err.splitlines() == [
+    assert _lines(err) == [
         "note: the embedded Dask cluster started at the second attempt (a worker process "
         "stopped while starting: Nanny failed to start worker process)"]
     assert read_table(out) == _reference(tmp_path, 3)  # the same rows as in this process
@@ -138,7 +151,7 @@ def test_workers_that_die_at_every_start_stop_the_command_with_one_sentence(tmp_
     proc = _start(_sweep_command(out, 3, 1), preload)
     stdout, err = _finish(proc)
     assert proc.returncode == 2, err
-    assert err.splitlines() == [
+    assert _lines(err) == [
         "error: the embedded Dask cluster of 1 worker process(es) did not start in 3 attempts "
         "(a worker process stopped while starting: Nanny failed to start worker process); "
         "check the machine's free memory and run again, with fewer --workers, or with "
@@ -157,9 +170,9 @@ def test_a_worker_lost_mid_sweep_is_replaced_and_reported(tmp_path, reference):
     os.kill(workers[0].pid, signal.SIGKILL)
     stdout, err = _finish(proc)
     assert proc.returncode == 0, err
-    assert len(err.splitlines()) == 1, err
-    assert err.startswith("note: 1 worker process was lost"), err
-    assert err.rstrip().endswith("during the run; every design was evaluated"), err
+    assert len(_lines(err)) == 1, err
+    assert _lines(err)[0].startswith("note: 1 worker process was lost"), err
+    assert _lines(err)[0].endswith("during the run; every design was evaluated"), err
     assert read_table(out) == reference  # every row, the same values
 
 
@@ -181,7 +194,7 @@ def test_a_stopped_sweep_says_so_in_one_line(tmp_path, request, name, group, cod
     stdout, err = _finish(proc)
     assert proc.returncode == code, err
     folder = checkpoint_folder(out)
-    assert err.splitlines() == [
+    assert _lines(err) == [
         f"{how}: no table written; the finished designs are kept in {folder} — run the same "
         "command with --resume to continue"]  # no traceback, no leaked semaphores
     assert not out.exists() and _batches(out) >= 2
@@ -220,8 +233,8 @@ def test_a_scheduler_lost_mid_sweep_stops_with_one_sentence(tmp_path, reference)
                 p.wait(timeout=30)
     assert proc.returncode == 2, err
     folder = checkpoint_folder(out)
-    assert len(err.splitlines()) == 1, err
-    [line] = err.splitlines()
+    assert len(_lines(err)) == 1, err
+    [line] = _lines(err)
     assert line.startswith(f"error: the run lost its connection to the Dask scheduler "
                            f"{address} ("), line
     assert line.endswith("); check that the scheduler is running and run again; the finished "
@@ -279,15 +292,15 @@ def test_a_rerun_without_resume_refuses_the_checkpoint(tmp_path):
     kept = sorted((p.name, p.read_bytes()) for p in folder.iterdir())
     r = runner.invoke(app, args)
     assert r.exit_code == 2
-    assert r.stderr.splitlines() == [
+    assert _lines(r.stderr) == [
         f"error: {folder} holds 4 finished design(s) of an interrupted run of this sweep; pass "
         "--resume to continue it, or --fresh to discard them and start again"]
     assert sorted((p.name, p.read_bytes()) for p in folder.iterdir()) == kept  # untouched
     r = runner.invoke(app, [*args, "--resume", "--fresh"])
-    assert r.exit_code == 2 and "pass one of them" in r.stderr
+    assert r.exit_code == 2 and "pass one of them" in " ".join(_lines(r.stderr))
     r = runner.invoke(app, [*args, "--fresh"])
     assert r.exit_code == 0, r.output
-    assert r.stderr.splitlines() == [
+    assert _lines(r.stderr) == [
         f"note: --fresh: discarded the 4 finished design(s) of an earlier run kept in {folder}"]
     assert "│        6 │       0 │" in r.stdout  # all 6 computed, none resumed
     assert not folder.exists() and len(read_table(out)) == 6

@@ -28,6 +28,7 @@ from screwkit.balancing.qp import QPSolution, solve_qp
 from screwkit.balancing.variables import DesignVariables, LinearConstraint
 from screwkit.dynamics import Regressor
 from screwkit.dynamics.graph_regressor import GraphRegressor
+from screwkit.messages import listing, number
 
 Array = NDArray[np.float64]
 
@@ -36,7 +37,8 @@ def check_weights(weights: Mapping[str, float]) -> dict[str, float]:
     """W1…W5 by measure name; missing ones are 0; all ≥ 0 and not all zero."""
     unknown = sorted(set(weights) - set(MEASURES))
     if unknown:
-        raise BalancingError(f"unknown weight(s) {unknown}; the measures are {list(MEASURES)} "
+        raise BalancingError(f"unknown weight(s) {listing(unknown)}; the measures are "
+                             f"{listing(MEASURES)} "
                              "(F shaking force, T shaking moment, R bearing forces, "
                              "M bearing moments, T0 input torque)")
     text = {k: v for k, v in weights.items() if isinstance(v, str | bytes | bool)
@@ -46,7 +48,8 @@ def check_weights(weights: Mapping[str, float]) -> dict[str, float]:
     w = {k: float(weights.get(k, 0.0)) for k in MEASURES}
     bad = {k: v for k, v in w.items() if not (np.isfinite(v) and v >= 0)}
     if bad:
-        raise BalancingError(f"weights must be finite and >= 0; got {bad}")
+        raise BalancingError("weights must be finite and >= 0; got "
+                             f"{listing(f'{k} = {number(v)}' for k, v in bad.items())}")
     if not any(w.values()):
         raise BalancingError("all weights are zero: the objective would be constant. Give at "
                              "least one of F, T, R, M, T0 a positive weight")

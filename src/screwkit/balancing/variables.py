@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.balancing.errors import BalancingError
 from screwkit.errors import expect_instance, expect_number
-from screwkit.messages import shown
+from screwkit.messages import listing, shown
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import (
     EQUIVALENT_POINT_LABELS,
@@ -132,7 +132,7 @@ def _link_index(linkage: Subject, link: str) -> int:
     if link not in names:
         word = part_word(linkage)
         raise BalancingError(f"no moving {word} named {link!r}; the "
-                             f"{'bodies' if word == 'body' else 'links'} are {names}")
+                             f"{'bodies' if word == 'body' else 'links'} are {listing(names)}")
     return names.index(link)
 
 

@@ -1,11 +1,11 @@
 """What every ``screwkit`` subcommand shares: the consoles and the rule that a user mistake
 exits with status 2 and a one-paragraph message (the output options: :mod:`screwkit.cli.outputs`).
 
-Errors and ``wrote <path>`` lines are never wrapped (``soft_wrap``): one message is one line
-whatever ``COLUMNS`` says, so paths stay whole for grep and copy-paste. Everything else a
-command prints fits the width — the terminal's, or ``COLUMNS``, or 80 for a pipe or a file:
-tables by :mod:`screwkit.cli.formatting`, prose (headers, notes, bullets) by :func:`prose`,
-which breaks lines between words with a hanging indent and never inside a word."""
+Everything a command prints fits the width — the terminal's, or ``COLUMNS``, or 80 for a pipe
+or a file: tables by :mod:`screwkit.cli.formatting`; prose (headers, notes, bullets) and error
+messages by :func:`prose`, which breaks lines between words with a hanging indent and never
+inside a word, so a path stays whole (on a line of its own if it is longer than the width) for
+grep and copy-paste. ``wrote <path>`` lines are never wrapped (``soft_wrap``)."""
 
 from __future__ import annotations
 
@@ -81,19 +81,25 @@ def guard(fn: Callable[[], T]) -> T:
         with np.errstate(over="raise", divide="raise", invalid="raise"):
             return fn()
     except FloatingPointError as exc:
-        err_console.print(
-            f"[bold red]error:[/] the computation failed numerically ({escape(str(exc))}); the "
-            "input values are probably outside the range it can handle — check the magnitudes "
-            "and units in the spec (limits: docs/reliability.md)", highlight=False)
+        print_error(f"the computation failed numerically ({exc}); the input values are "
+                    "probably outside the range it can handle — check the magnitudes and "
+                    "units in the spec (limits: docs/reliability.md)")
         raise typer.Exit(2) from None
     except user_errors() as exc:
-        err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
+        print_error(str(exc))
         raise typer.Exit(2) from None
+
+
+def print_error(message: str) -> None:
+    """Print ``message`` (plain text, not markup) on stderr after a red ``error:``, wrapped
+    between words at the width of stderr with the continuation lines indented by two: one
+    sentence, never cut inside a word (issue 30, the 80-column promise)."""
+    prose(f"[bold red]error:[/] {escape(message)}", hang=2, to=err_console)
 
 
 def user_error(message: str) -> NoReturn:
-    """Print ``message`` as a user error (one line) and exit with status 2."""
-    err_console.print(f"[bold red]error:[/] {escape(message)}", highlight=False)
+    """Print ``message`` as a user error (one sentence) and exit with status 2."""
+    print_error(message)
     raise typer.Exit(2)
 
 

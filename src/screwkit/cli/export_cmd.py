@@ -30,7 +30,7 @@ def register(app: typer.Typer) -> None:
         """Write the spec's motion for CAD: DXF curves and skeletons, an animated glTF scene, or STEP link solids."""
         from rich.markup import escape
 
-        from screwkit.cli.common import check_paths, console, err_console, guard
+        from screwkit.cli.common import check_paths, console, err_console, guard, prose
         from screwkit.exchange.export import check_suffix, export_format, graph_export
         from screwkit.io.outputs import write_bytes_atomic
         from screwkit.io.spec import load_spec
@@ -50,5 +50,5 @@ def register(app: typer.Typer) -> None:
                                                binary=binary, max_points=max_points))
         guard(lambda: write_bytes_atomic(output, result.data, [spec], "--output"))
         for note in result.notes:
-            err_console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
+            prose(f"[yellow]note:[/] {escape(note)}", to=err_console)
         console.print(f"wrote {escape(str(output))}", highlight=False)

@@ -139,7 +139,7 @@ class Outputs:
             self.written.append(str(csv))
         if self.output is not None:
             extra = "".join(f"; wrote {p}" for p in self.written)
-            console.print(line + extra, highlight=False, markup=False)
+            console.print(line + extra, highlight=False, markup=False, emoji=False)
             return
         if self.as_json:
             if doc is None:

@@ -11,23 +11,28 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-
-from rich.progress import ProgressColumn, Task
-from rich.text import Text
+from typing import Any
 
 #: what a long library call is given: ``advance(done, total)``
 ProgressCallback = Callable[[int, int], None]
 
 
-class RateColumn(ProgressColumn):
-    """Items per second (or seconds per item when slower than one a second)."""
+def _rate_column() -> Any:
+    """A column of items per second (or seconds per item when slower than one a second);
+    rich.progress is imported only when a bar is drawn (15 ms of every command's start-up,
+    issue 30)."""
+    from rich.progress import ProgressColumn, Task
+    from rich.text import Text
 
-    def render(self, task: Task) -> Text:
-        speed = task.finished_speed or task.speed
-        if not speed:
-            return Text("  —/s", style="progress.data.speed")
-        text = f"{speed:.3g}/s" if speed >= 1 else f"{1 / speed:.3g} s each"
-        return Text(text, style="progress.data.speed")
+    class RateColumn(ProgressColumn):
+        def render(self, task: Task) -> Text:
+            speed = task.finished_speed or task.speed
+            if not speed:
+                return Text("  —/s", style="progress.data.speed")
+            text = f"{speed:.3g}/s" if speed >= 1 else f"{1 / speed:.3g} s each"
+            return Text(text, style="progress.data.speed")
+
+    return RateColumn()
 
 
 def _silent(done: int, total: int) -> None:
@@ -54,7 +59,7 @@ def progress_bar(description: str, total: int | None = None,
     )
 
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-               RateColumn(), TextColumn("eta"), TimeRemainingColumn(), TimeElapsedColumn())
+               _rate_column(), TextColumn("eta"), TimeRemainingColumn(), TimeElapsedColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task(description, total=total)
 

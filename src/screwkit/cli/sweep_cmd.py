@@ -17,7 +17,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from screwkit.cli.common import check_paths, console, err_console, guard, prose
+from screwkit.cli.common import check_paths, console, err_console, guard, print_error, prose
 
 SchedulerOpt = Annotated[str | None, typer.Option(
     "--scheduler", help="Run on an existing Dask scheduler (tcp://HOST:PORT) and its workers "
@@ -85,7 +85,7 @@ def engine_for(scheduler: str | None, workers: int | None, what: str = "task"
 def print_notes(notes: Iterable[str]) -> None:
     """One line per note on stderr."""
     for note in notes:
-        err_console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
+        prose(f"[yellow]note:[/] {escape(note)}", to=err_console)
 
 
 def stopped(exc: KeyboardInterrupt, what: str) -> NoReturn:
@@ -93,7 +93,7 @@ def stopped(exc: KeyboardInterrupt, what: str) -> NoReturn:
     it): one line saying so and ``what`` is kept or written."""
     how, code = ("terminated (SIGTERM)", 143) if isinstance(exc, _Terminated) \
         else ("interrupted", 130)
-    err_console.print(f"[yellow]{how}:[/] {what}", highlight=False)
+    prose(f"[yellow]{how}:[/] {what}", to=err_console)
     raise typer.Exit(code)
 
 
@@ -175,7 +175,6 @@ def register(app: typer.Typer) -> None:
             guard(lambda: plot_sweep(result.rows, definition.metadata(), plot, column, [spec]))
         _summary(result, output, plot)
         if result.errors:
-            err_console.print(f"[bold red]error:[/] {result.errors} design(s) hit an internal "
-                              "error (status 'error' in the table); please report it",
-                              highlight=False)
+            print_error(f"{result.errors} design(s) hit an internal error (status 'error' in "
+                        "the table); please report it")
             raise typer.Exit(1)

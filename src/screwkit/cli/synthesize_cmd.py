@@ -234,8 +234,8 @@ def global_synthesis(config: Any, starts: int, scheduler: str | None, workers: i
     from screwkit.sweep.multistart import synthesize_on_engine
 
     if importlib.util.find_spec("distributed") is None and scheduler is None and not workers:
-        err_console.print("[yellow]note:[/] Dask (pip install 'screwkit[sweep]') is not "
-                          "installed; the starts run in this process", highlight=False)
+        prose("[yellow]note:[/] Dask (pip install 'screwkit\\[sweep]') is not installed; the "
+              "starts run in this process", to=err_console)
         with progress_bar("synthesis starts", None) as advance:
             return _guard(lambda: pipe.synthesize(starts, progress=advance))
     from screwkit.messages import message_units

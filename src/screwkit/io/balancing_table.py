@@ -27,6 +27,7 @@ from screwkit.balancing.variables import (
 )
 from screwkit.io.errors import SpecError
 from screwkit.io.validation import Name
+from screwkit.messages import listing
 
 Value = float | int | str
 
@@ -130,7 +131,7 @@ def _link_blocks(spec: Any, table: BalancingTable) -> list[VariableBlock]:
             word = part_word(lk)
             raise BalancingConfigError(f"{spec.path}: [balancing.links.{link}] no moving {word} "
                                        f"named {link!r}; the "
-                                       f"{'bodies' if word == 'body' else 'links'} are {names}")
+                                       f"{'bodies' if word == 'body' else 'links'} are {listing(names)}")
         if not t.variables:
             raise BalancingConfigError(f"{spec.path}: [balancing.links.{link}] has no variables; "
                                        f"list some of {list(POINT_MASS_NAMES)} or remove the table")
@@ -202,7 +203,7 @@ def _check_ellipsoid(spec: Any, key: str, link: str, centre: list[float],
     if link not in links:
         word = part_word(subject)
         raise BalancingConfigError(f"{spec.path}: [balancing.{key}] no {word} {link!r}; the "
-                                   f"{'bodies' if word == 'body' else 'links'} are {list(links)}")
+                                   f"{'bodies' if word == 'body' else 'links'} are {listing(links)}")
     mass = links[link].mass
     if mass is None:
         return  # named by the dynamics' own check

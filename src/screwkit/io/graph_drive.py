@@ -58,6 +58,7 @@ from screwkit.io.drive_table import (
     motor_config,
 )
 from screwkit.io.validation import validation_lines
+from screwkit.messages import listing
 
 
 class PointForceTable(BaseModel):
@@ -171,13 +172,13 @@ def graph_drive_config(spec: Any) -> GraphDriveConfig:
     freedoms = [f for j in spec.mechanism.joints for f in j.freedom_names()]
     missing = sorted(set(t.motors) - set(freedoms))
     if missing:
-        _fail(spec, "motors", f"a motor on {missing}: no such freedom in {spec.name!r}; motors "
-                              f"drive its inputs {inputs}")
+        _fail(spec, "motors", f"a motor on {listing(missing)}: no such freedom in {spec.name!r}; "
+                              f"motors drive its inputs {listing(inputs)}")
     unknown = sorted(set(t.motors) - set(inputs))
     if unknown:
-        _fail(spec, "motors", f"a motor on {unknown}, which {'is' if len(unknown) == 1 else 'are'}"
+        _fail(spec, "motors", f"a motor on {listing(unknown)}, which {'is' if len(unknown) == 1 else 'are'}"
                               f" not an input of {spec.name!r}: motors drive inputs, and the "
-                              f"inputs are {inputs} (mark input = true on the joint to drive)")
+                              f"inputs are {listing(inputs)} (mark input = true on the joint to drive)")
     duration = spec.quantity(t.duration, "time", "drive.duration")
     if not duration > 0:
         _fail(spec, "duration", f"the simulated time must be positive; got {t.duration!r}")

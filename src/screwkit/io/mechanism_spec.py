@@ -27,8 +27,10 @@ from pydantic import (
 from screwkit.errors import ScrewkitError
 from screwkit.io.display_units import DisplayUnits, display_units
 from screwkit.io.errors import SpecError
+from screwkit.io.spec_kind import is_graph_spec as is_graph_spec  # re-exported (sweep, studio)
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
 from screwkit.io.validation import validation_lines
+from screwkit.messages import listing
 from screwkit.model.mass import MassProperties
 from screwkit.model.mechanism import (
     MAX_BODIES,
@@ -125,15 +127,6 @@ class GraphSpecFile(_Strict):
     balancing: dict[str, Any] | None = None
     drive: dict[str, Any] | None = None  # checked by io/graph_drive.py when simulating
     synthesis: dict[str, Any] | None = None  # io/graph_synthesis_table.py
-
-
-def is_graph_spec(data: dict[str, Any]) -> bool:
-    """Whether parsed TOML describes a mechanism graph (``[[bodies]]`` or ``between``)."""
-    if "bodies" in data:
-        return True
-    joints = data.get("joints")
-    return isinstance(joints, list) and any(isinstance(j, dict) and "between" in j
-                                            for j in joints)
 
 
 class GraphSpec:
@@ -374,7 +367,7 @@ class GraphSpec:
         for n in names:
             if n not in freedoms:
                 self._fail(f"{key}.{what}", f"joint {j.name!r} ({j.kind}) has no freedom "
-                                            f"{n!r}; its freedoms are {list(freedoms)}")
+                                            f"{n!r}; its freedoms are {listing(freedoms)}")
         return [f"{j.name}.{n}" for n in names]
 
     def _mass(self, b: BodyTable, k: int) -> MassProperties | None:

@@ -32,7 +32,7 @@ from screwkit.io.toml_file import SpecFileError, read_toml
 from screwkit.io.units import KIND_UNITS, UnitError, check_unit, to_si
 from screwkit.io.validation import Name, refuse_formula, validation_lines
 from screwkit.kinematics.registry import family, require
-from screwkit.messages import message_units
+from screwkit.messages import listing, message_units
 from screwkit.model.linkage import Link, Linkage, LinkageError
 
 if TYPE_CHECKING:
@@ -233,11 +233,11 @@ class Spec:
     def _limits(self) -> LimitsConfig | None:
         """``[limits]`` as a :class:`LimitsConfig`, checked against the loop (the output names
         a variable it has; the closed form is there when asked for)."""
-        from screwkit.kinematics.analysis.limit_positions import LimitsConfig, check_limits_config
-
         t = self.raw.limits
         if t is None:
             return None
+        from screwkit.kinematics.analysis.limit_positions import LimitsConfig, check_limits_config
+
         kind = "angle" if self.input_is_angle else "length"
         at = tuple(self.quantity(v, kind, "limits.at") for v in t.at)
         config = LimitsConfig(t.output, float(t.dwell_tolerance), t.max_order, at, t.method)
@@ -282,10 +282,12 @@ class Spec:
         wanted = fam.dimensions
         unknown = sorted(set(self.raw.dimensions) - set(wanted))
         if unknown:
-            self._fail("dimensions", f"unknown key(s) {unknown} for a {self.family}; expected {sorted(wanted)}")
+            self._fail("dimensions", f"unknown key(s) {listing(unknown)} for a {self.family}; "
+                                     f"expected {listing(sorted(wanted))}")
         missing = sorted(set(wanted) - set(self.raw.dimensions) - set(fam.optional))
         if missing:
-            self._fail("dimensions", f"missing {missing} for a {self.family} (e.g. d1 = \"2.0 in\")")
+            self._fail("dimensions", f"missing {listing(missing)} for a {self.family} "
+                                     "(e.g. d1 = \"2.0 in\")")
         return {k: self.quantity(v, wanted[k], f"dimensions.{k}") for k, v in self.raw.dimensions.items()}
 
     def _input_samples(self) -> np.ndarray:
@@ -319,7 +321,8 @@ class Spec:
 
         unknown = sorted(set(self.raw.links) - set(link_names))
         if unknown:
-            self._fail("links", f"no link named {unknown} in a {self.family}; links are {link_names}")
+            self._fail("links", f"no link named {listing(unknown, 'or')} in a {self.family}; "
+                                f"the links are {listing(link_names)}")
         g = self.gravity_magnitude if self.gravity_magnitude is not None else STANDARD_GRAVITY
         # (gravity > 0 is checked at load)
         out = []
@@ -470,9 +473,11 @@ def load_spec(path: str | Path) -> Spec:
         data = read_toml(p)  # size, encoding, nesting and string-length checks
     except SpecFileError as exc:
         raise SpecError(str(exc)) from None
-    from screwkit.io.mechanism_spec import graph_spec_from_data, is_graph_spec
+    from screwkit.io.spec_kind import is_graph_spec
 
-    if is_graph_spec(data):
+    if is_graph_spec(data):  # the graph model is imported for graph specs only
+        from screwkit.io.mechanism_spec import graph_spec_from_data
+
         return graph_spec_from_data(data, p)  # type: ignore[return-value]
     return spec_from_data(data, p)
 

@@ -28,6 +28,7 @@ from screwkit.errors import InputError
 from screwkit.io.errors import SpecError
 from screwkit.io.units import UnitError, to_si
 from screwkit.kinematics.registry import family_of, require
+from screwkit.messages import listing
 from screwkit.synthesis.config import Multistart, Problem, SynthesisConfig
 from screwkit.synthesis.loop_route import LoopSynthesisProblem
 from screwkit.synthesis.overlay import OverlayDwell
@@ -91,7 +92,7 @@ class ComponentTable(_Strict):
         given = [k for k in ("function", "expression", "data") if getattr(self, k) is not None]
         if len(given) != 1:
             raise InputError("give exactly one of function, expression or data "
-                             f"(got {given or 'none'})")
+                             f"(got {listing(given)})")
         if self.function is not None and self.function not in LIBRARY:
             raise InputError(f"unknown function {self.function!r}; choose one of {sorted(LIBRARY)}")
         if self.design_points is None and self.data is None:

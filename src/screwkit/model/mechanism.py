@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.errors import InputError, UnknownNameError
+from screwkit.messages import listing
 from screwkit.model.joints import JOINT_DESCRIPTIONS, JOINT_FREEDOMS
 from screwkit.model.mass import MassProperties
 from screwkit.model.mechanism_drives import DRIVE_FREEDOMS, BodyDrive
@@ -207,7 +208,7 @@ class Mechanism:
         for p in self.points:
             if p.body not in known:
                 raise UnknownNameError(f"point {p.name!r}: body {p.body!r} is not a body of "
-                                       f"{self.name!r}; bodies are {sorted(known)}")
+                                       f"{self.name!r}; the bodies are {listing(sorted(known))}")
         self._check_inputs()
         self._check_outputs(known)
         self._check_drives(known)
@@ -227,7 +228,7 @@ class Mechanism:
         for body in (a, b):
             if body not in known:
                 raise UnknownNameError(f"joint {j.name!r}: body {body!r} is not a body of "
-                                       f"{self.name!r}; bodies are {sorted(known)}")
+                                       f"{self.name!r}; the bodies are {listing(sorted(known))}")
         if a == b:
             raise MechanismError(f"joint {j.name!r} joins body {a!r} to itself; "
                                  "give two different bodies in 'between'")
@@ -289,7 +290,7 @@ class Mechanism:
                                      "point; give the output its own name")
             if isinstance(o, BodyAngle) and o.body not in known:
                 raise UnknownNameError(f"output {o.name!r}: body {o.body!r} is not a body of "
-                                       f"{self.name!r}; bodies are {sorted(known)}")
+                                       f"{self.name!r}; the bodies are {listing(sorted(known))}")
             if isinstance(o, BodyAngle) and np.linalg.norm(np.cross(o.vector, o.about)) < 1e-9:
                 raise MechanismError(f"output {o.name!r}: 'vector' lies along 'about', so it "
                                      "turns through no angle about it; choose another vector")
@@ -327,7 +328,7 @@ class Mechanism:
                                      f"freedom is one of {', '.join(DRIVE_FREEDOMS)}")
             if d.body == GROUND or d.body not in known:
                 raise UnknownNameError(f"{where}: {d.body!r} is not a moving body of "
-                                       f"{self.name!r}; bodies are {list(self.body_names)}")
+                                       f"{self.name!r}; the bodies are {listing(self.body_names)}")
             if d.name in taken:
                 raise MechanismError(f"{where}: the body's {d.freedom} is driven twice, or the "
                                      "name is taken by a freedom, point or output")
@@ -432,8 +433,9 @@ class Mechanism:
         loose = [b for b in self.body_names if b not in depth]
         if loose:
             raise MechanismError(
-                f"mechanism {self.name!r}: bodies {loose} are attached to nothing that leads "
-                "to the ground; join each to the mechanism with a joint")
+                f"mechanism {self.name!r}: {'body' if len(loose) == 1 else 'bodies'} "
+                f"{listing(loose)} {'is' if len(loose) == 1 else 'are'} attached to nothing that "
+                "leads to the ground; join each to the mechanism with a joint")
         chords = tuple(k for k in range(len(self.joints)) if k not in used)
         loops = tuple(self._loop_of(c, parent_joint, depth) for c in chords)
         return Topology(tuple(order), chords, loops, depth)

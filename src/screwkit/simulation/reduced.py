@@ -43,6 +43,7 @@ from screwkit.errors import InputError
 from screwkit.io.drive_table import DriveConfigError, checked_friction
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.messages import listing
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import MassProperties
 
@@ -63,7 +64,7 @@ def _masses(linkage: Linkage) -> list[MassProperties]:
     missing = [link.name for link in linkage.links if link.mass is None]
     if missing:
         raise SimulationError(f"{linkage.name}: the equation of motion needs mass properties for "
-                              f"every moving link; missing for {missing}")
+                              f"every moving link; missing for {listing(missing)}")
     return [link.mass for link in linkage.links]  # type: ignore[misc]
 
 

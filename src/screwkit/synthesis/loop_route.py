@@ -44,6 +44,7 @@ from screwkit.kinematics.tracker.loop import (
     layout,
 )
 from screwkit.kinematics.tracker.loop_jets import close_loop
+from screwkit.messages import listing
 from screwkit.model.geometry import LoopGeometry
 from screwkit.model.linkage import Linkage, LinkageError
 from screwkit.synthesis.residuals import Evaluation, NotAssembled
@@ -88,8 +89,8 @@ class LoopSynthesisProblem:
             raise InputError(f"unknowns must be distinct and not empty, got {self.unknowns!r}")
         bad = [u for u in self.unknowns if u not in allowed]
         if bad:
-            raise InputError(f"unknown(s) {bad} cannot be solved for; choose among "
-                             f"{sorted(allowed)}")
+            raise InputError(f"unknown(s) {listing(bad)} cannot be solved for; choose among "
+                             f"{listing(sorted(allowed))}")
         missing = sorted(allowed - set(self.start))
         if missing:
             raise InputError(f"start/constants lack {missing}: give a value for every dimension")

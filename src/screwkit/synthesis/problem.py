@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.errors import InputError
-from screwkit.messages import shown
+from screwkit.messages import listing, shown
 from screwkit.synthesis.constraints import output_crank_from_constraints, q_from_dwell
 from screwkit.synthesis.targets import ScrewTarget
 
@@ -125,8 +125,8 @@ class RSRCSynthesisProblem:
         if bad:
             why = (" (with parameters of constraint d3, a and b are derived by eqs. 5.19-5.21)"
                    if self.construction is not None else "")
-            raise InputError(f"unknown(s) {bad} cannot be solved for; choose among "
-                             f"{sorted(allowed)}{why}")
+            raise InputError(f"unknown(s) {listing(bad)} cannot be solved for; choose among "
+                             f"{listing(sorted(allowed))}{why}")
         missing_free = sorted(self.free_q_names - set(self.unknowns))
         if missing_free:
             raise InputError(f"{missing_free}: a 'free' parameter of constraint must be an unknown")
