@@ -11,7 +11,9 @@ accelerations of its driven freedoms (joint inputs, or a body's pose / a wheel's
   dH_c/dt = I α + ω × I ω from the body's pose, twist and acceleration);
 * input power Σ effort × rate of each effort's freedom (the actuated freedoms: leg slides of a
   pose-driven platform, the arm's angle of a travel-driven wheel) = d(KE + PE)/dt
-  = Σ m v_c·(a_c − g) + ω·(I α + ω × I ω).
+  = Σ m v_c·(a_c − g) + ω·(I α + ω × I ω);
+* shaking force = weight − dP/dt and shaking moment (about the origin) = Σ c × m g − dH_O/dt;
+* the load regressor times the stacked inertial parameters = the direct efforts.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from typer.testing import CliRunner
 
 import screwkit as sk
 from screwkit.cli.main import app
-from screwkit.dynamics.graph_inverse import graph_inverse_dynamics
+from screwkit.dynamics.graph_inverse import graph_inverse_dynamics, graph_regressor
 from screwkit.kinematics.graph import solve_mechanism
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "mechanisms"
@@ -98,3 +100,15 @@ def test_bundled_example_loads_obey_newton_euler_and_power(name: str) -> None:
                 for bd in bodies)
     assert np.abs(power - dE)[ok].max() <= 1e-9 * P, name
     assert np.abs(dE[ok]).max() > 1e-3 * P  # the law is not met trivially (0 = 0)
+    # shaking force and moment (about the origin) = weight − dP/dt, Σ c × m g − dH_O/dt
+    weight = sum(bd["m"] for bd in bodies) * g
+    dP = sum(bd["m"] * bd["a"] for bd in bodies)
+    dHO = sum(np.cross(bd["c"], bd["m"] * bd["a"]) + _dH(bd) for bd in bodies)
+    moment_g = sum(np.cross(bd["c"], bd["m"] * g) for bd in bodies)
+    assert np.abs(dyn.shaking_force - (weight - dP))[ok].max() <= 1e-9 * F, name
+    assert np.abs(dyn.shaking_moment - (moment_g - dHO))[ok].max() <= 1e-9 * Mscale, name
+    # regressor · π = the direct efforts
+    Y = graph_regressor(motion, gravity=g)
+    pi = np.concatenate([b.mass.inertial_parameters() for b in mech.bodies])
+    E = np.abs(dyn.efforts[ok]).max()
+    assert np.abs(Y @ pi - dyn.efforts)[ok].max() <= 1e-9 * E, name

@@ -232,6 +232,13 @@ def test_multistart_keeps_the_best_and_reports_bounds():
     assert best.at_bounds["joints.D.at[0]"] == ("upper", pytest.approx(0.041))
     assert "ended on its upper bound" in best.message
     assert all(best.objective <= r.objective for r in results)
+    # the Python front door takes the graph's problem too: the same results
+    import screwkit as sk
+
+    again = sk.synthesize(problem)
+    assert [r.objective for r in again] == [r.objective for r in results]
+    with pytest.raises(sk.ScrewkitError, match="synthesize: starts"):
+        sk.synthesize(problem, starts=0)
 
 
 @pytest.mark.parametrize(("change", "words"), [

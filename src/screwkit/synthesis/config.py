@@ -10,8 +10,14 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import overload
 
 from screwkit.errors import expect_instance, expect_number
+from screwkit.synthesis.graph_route import (
+    GraphSynthesisProblem,
+    GraphSynthesisResult,
+    synthesize_graph_multistart,
+)
 from screwkit.synthesis.loop_route import LoopSynthesisProblem
 from screwkit.synthesis.loop_solve import synthesize_loop, synthesize_loop_multistart
 from screwkit.synthesis.overlay_synthesis import OverlayOutcome, OverlayProblem, synthesize_overlay
@@ -76,11 +82,27 @@ def _reported(run: SynthesisRun, names: tuple[str, ...] | None) -> SynthesisRun:
     return SynthesisRun(results, overlay)
 
 
+@overload
+def run_synthesis(config: GraphSynthesisProblem, *, starts: int | None = None,
+                  seed: int | None = None,
+                  progress: Callable[[int, int], None] | None = None,
+                  multistart: Callable[..., list[SynthesisResult]] | None = None
+                  ) -> list[GraphSynthesisResult]: ...
+
+
+@overload
 def run_synthesis(config: SynthesisConfig | Problem, *, starts: int | None = None,
                   seed: int | None = None,
                   progress: Callable[[int, int], None] | None = None,
                   multistart: Callable[..., list[SynthesisResult]] | None = None
-                  ) -> SynthesisRun:
+                  ) -> SynthesisRun: ...
+
+
+def run_synthesis(config: SynthesisConfig | Problem | GraphSynthesisProblem, *,
+                  starts: int | None = None, seed: int | None = None,
+                  progress: Callable[[int, int], None] | None = None,
+                  multistart: Callable[..., list[SynthesisResult]] | None = None
+                  ) -> SynthesisRun | list[GraphSynthesisResult]:
     """Dimensional synthesis of an RSRC (or its plane 4R case) for a desired screw displacement
     ψ_d(θ) + ε S_d(θ) (Bagci 1969 ch. V): least squares with exact derivatives (Programs B and C,
     dwell and range constraints by the parameters of constraint, eqs. 5.13–5.21), or the overlay
@@ -93,14 +115,22 @@ def run_synthesis(config: SynthesisConfig | Problem, *, starts: int | None = Non
     ``seed`` the multistart's random seed. One start with a given inversion (or parameters of
     constraint) is a single solve. ``progress(done, total)`` is called after each start of a
     multistart. ``multistart`` replaces `synthesize_multistart` for the least-squares route
-    (same arguments and results; screwkit.sweep runs its starts on a cluster)."""
+    (same arguments and results; screwkit.sweep runs its starts on a cluster).
+
+    A mechanism graph's problem (:class:`~screwkit.synthesis.graph_route.GraphSynthesisProblem`,
+    ``load_spec(graph spec).synthesis``; docs/synthesis.md "Graphs") gives its results, best
+    first (:func:`~screwkit.synthesis.graph_route.synthesize_graph_multistart`; ``multistart``
+    does not apply)."""
     expect_instance(config, (SynthesisConfig, RSRCSynthesisProblem, OverlayProblem,
-                             LoopSynthesisProblem), "synthesize: config",
+                             LoopSynthesisProblem, GraphSynthesisProblem), "synthesize: config",
                     "a SynthesisConfig (load_spec(...).synthesis) or a synthesis problem")
     if starts is not None:
         expect_number(starts, "synthesize: starts", integer=True, positive=True)
     if seed is not None:
         expect_number(seed, "synthesize: seed", integer=True)
+    if isinstance(config, GraphSynthesisProblem):
+        graph = config if seed is None else dataclasses.replace(config, seed=seed)
+        return synthesize_graph_multistart(graph, starts, progress)
     if not isinstance(config, SynthesisConfig):
         config = SynthesisConfig(config)
     problem = config.problem
