@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.algebraic.endgame import cauchy_endgame
 from screwkit.algebraic.path import Homotopy, TrackOptions, line, newton, track
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
+from screwkit.algebraic.quadrics import DenseQuadrics, dense_quadrics_apply
 from screwkit.errors import InputError
 
 __all__ = ["PathStatus", "TrackOptions", "TrackResult", "track_parameter_homotopy",
@@ -230,9 +231,12 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
     rng = np.random.default_rng(options.seed)
     patch = ((rng.standard_normal(system.n + 1) + 1j * rng.standard_normal(system.n + 1))
              / 2).astype(complex)
-    hom = Homotopy(hsys, patch, ps, pt - ps)
-    _, instance = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_inverse=True)
+    first, instance = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_index=True,
+                                return_inverse=True)[1:]
     instance = instance.reshape(-1).astype(np.intp)
+    dense = (DenseQuadrics.build(hsys, ps[first], pt[first] - ps[first])
+             if options.dense and dense_quadrics_apply(hsys) else None)
+    hom = Homotopy(hsys, patch, ps, pt - ps, dense, instance if dense is not None else None)
     rows = np.arange(P)
     out = _run_in_chunks(system, hom, x, rows, options)
     retracked = np.zeros(P, dtype=bool)

@@ -1,0 +1,156 @@
+"""Dense evaluation of a homotopy of quadrics: F_i(y; σ) = yᵀ Q_i(σ) y + L_i(σ)·y.
+
+When every equation of a system has degree ≤ 2 in the unknowns (the Stewart–Gough system in
+Study coordinates, the 6R loop in its axis directions, dense quadrics), its homogenisation
+(:meth:`PolynomialSystem.homogenized`) is a set of homogeneous quadrics and linear forms in
+y = (h, h·x). Along the parameter segment p(σ) = p_start + σ·d of a parameter homotopy
+(Sommese & Wampler 2005, ch. 7) each coefficient is a polynomial in σ of degree D (the largest
+total degree of a term in the parameters), so per instance
+
+    F_i(y; σ) = Σ_{k=0..D} σ^k (yᵀ Q_ik y + L_ik·y),   Q_ik symmetric (m × m),
+
+    ∂F_i/∂y = Σ_k σ^k (2 Q_ik y + L_ik),   ∂F_i/∂σ = Σ_k k σ^(k−1) (yᵀ Q_ik y + L_ik·y).
+
+The σ-coefficients are exact: the coefficients at D+1 points σ_j = e^(2πij/(D+1)) on the unit
+circle (:meth:`PolynomialSystem.coefficients_at`) give them by a discrete Fourier transform,
+which is unitary, so no interpolation error is added. One evaluation for a set of paths is then
+one matrix product y·[Q_ik] per instance (V_ik = Q_ik y for every i, k at once) and a few
+contractions with the powers of σ, in place of the sparse term-by-term sums of
+:mod:`.polynomial`: the same homotopy, evaluated in a different order (equal to rounding).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.algebraic.polynomial import Complex, PolynomialSystem
+
+Index = NDArray[np.intp]
+
+
+def dense_quadrics_apply(hsys: PolynomialSystem) -> bool:
+    """Whether :class:`DenseQuadrics` applies to the homogenised system ``hsys``: every term of
+    degree 1 or 2 in the unknowns (and so every equation, being homogeneous, a quadric or a
+    linear form)."""
+    unknown = hsys.sym < hsys.n
+    degree = np.where(unknown, hsys.pw, 0).sum(axis=1)
+    return bool(len(degree)) and bool(((degree >= 1) & (degree <= 2)).all())
+
+
+@dataclass(frozen=True)
+class DenseQuadrics:
+    """The σ-coefficients of F^h(y; p_start + σ·d) for B instances (module docstring).
+
+    ``Qt`` (B, m, K·N·m): row j, column (k, i, l) is Q_ik[l, j] (= Q_ik[j, l]), so that
+    y @ Qt[b] gives every Q_ik y at once; ``L`` (B_L, K_L, N_L, m): the linear forms of the
+    equations ``linear`` (B_L = 1 when every instance has the same, K_L = 1 when they do not
+    depend on σ)."""
+
+    Qt: Complex
+    L: Complex
+    linear: Index
+    K: int
+    N: int
+    m: int
+
+    @staticmethod
+    def build(hsys: PolynomialSystem, p_start: Complex, direction: Complex) -> DenseQuadrics:
+        """The coefficients of the instances whose segments start at the rows of ``p_start``
+        (B, k) and move along the rows of ``direction`` (B, k)."""
+        B, m, N = len(p_start), hsys.n, hsys.size
+        param = hsys.sym >= hsys.n
+        K = int(np.where(param, hsys.pw, 0).sum(axis=1).max(initial=0)) + 1
+        roots = np.exp(2j * np.pi * np.arange(K) / K)
+        p = (p_start[:, None, :] + roots[None, :, None] * direction[:, None, :])
+        eq, exps, values = hsys.coefficients_at(p.reshape(B * K, -1))
+        coef = np.fft.fft(values.reshape(B, K, -1), axis=1) / K  # (B, K, G): σ^k coefficients
+        degree = exps.sum(axis=1)
+        Q = np.zeros((B, K, N, m, m), dtype=complex)
+        quad = np.flatnonzero(degree == 2)
+        # the two unknowns of each quadratic monomial (the same one twice for a square)
+        pair = np.repeat(np.tile(np.arange(m), len(quad)), exps[quad].ravel()).reshape(-1, 2)
+        half = 0.5 * coef[:, :, quad]
+        np.add.at(Q, (slice(None), slice(None), eq[quad], pair[:, 0], pair[:, 1]), half)
+        np.add.at(Q, (slice(None), slice(None), eq[quad], pair[:, 1], pair[:, 0]), half)
+        lin = np.flatnonzero(degree == 1)
+        linear = np.unique(eq[lin]).astype(np.intp)
+        L = np.zeros((B, K, len(linear), m), dtype=complex)
+        if lin.size:
+            np.add.at(L, (slice(None), slice(None), np.searchsorted(linear, eq[lin]),
+                          exps[lin].argmax(axis=1)), coef[:, :, lin])
+            if not np.any(L[:, 1:]):
+                L = L[:, :1]
+            if np.all(L == L[:1]):
+                L = L[:1]
+        Qt = Q.transpose(0, 4, 1, 2, 3).reshape(B, m, K * N * m)
+        return DenseQuadrics(np.ascontiguousarray(Qt), L, linear, K, N, m)
+
+    def block(self, instance: Index) -> DenseBlock:
+        """The layout of one set of paths (``instance`` (P,): each path's instance)."""
+        used, inverse, counts = np.unique(instance, return_inverse=True, return_counts=True)
+        inverse = inverse.reshape(-1)
+        order = np.argsort(inverse, kind="stable")
+        slot = np.empty(len(instance), dtype=np.intp)
+        starts = np.cumsum(counts) - counts
+        slot[order] = np.arange(len(instance)) - np.repeat(starts, counts)
+        Lp = self.L if len(self.L) == 1 else self.L[instance]
+        return DenseBlock(self, self.Qt[used], inverse.astype(np.intp), slot,
+                          int(counts.max(initial=0)), Lp)
+
+
+@dataclass(frozen=True)
+class DenseBlock:
+    """:class:`DenseQuadrics` gathered for a set of paths: the matrices of the instances in
+    use ``Qt`` (U, m, K·N·m), each path's index among them and slot within its instance (the
+    paths of an instance are multiplied together, one matrix product per instance), and the
+    linear forms ``L`` per path (or shared)."""
+
+    dense: DenseQuadrics
+    Qt: Complex
+    group: Index
+    slot: Index
+    width: int
+    L: Complex
+
+    def evaluate(self, y: Complex, sigma: Complex, dsigma: Complex | None
+                 ) -> tuple[Complex, Complex, Complex | None]:
+        """F (P, N), ∂F/∂y (P, N, m) and, when ``dsigma`` is given, (∂F/∂σ)·dσ (P, N)."""
+        d = self.dense
+        P, K, N, m = len(y), d.K, d.N, d.m
+        if len(self.Qt) == 1:
+            V = (y @ self.Qt[0]).reshape(P, K, N, m)
+        else:
+            padded = np.zeros((len(self.Qt), self.width, m), dtype=complex)
+            padded[self.group, self.slot] = y
+            V = np.matmul(padded, self.Qt)[self.group, self.slot].reshape(P, K, N, m)
+        yV = np.matmul(V.reshape(P, K * N, m), y[:, :, None]).reshape(P, K, N)
+        powers = np.ones((P, K), dtype=complex)
+        for k in range(1, K):
+            powers[:, k] = powers[:, k - 1] * sigma
+        F = np.matmul(powers[:, None, :], yV)[:, 0]
+        QY = V[:, 0] * powers[:, 0, None, None]
+        for k in range(1, K):
+            QY = QY + V[:, k] * powers[:, k, None, None]
+        J = 2.0 * QY
+        Ft = None
+        if dsigma is not None:
+            slope = np.zeros((P, K), dtype=complex)
+            for k in range(1, K):
+                slope[:, k] = k * powers[:, k - 1] * dsigma
+            Ft = np.matmul(slope[:, None, :], yV)[:, 0]
+        if len(d.linear):
+            KL = self.L.shape[1]
+            Lp = self.L
+            Ls = Lp[:, 0] if KL == 1 else np.einsum("pk,pkem->pem", powers[:, :KL],
+                                                    np.broadcast_to(Lp, (P, *Lp.shape[1:])))
+            Ls = np.broadcast_to(Ls, (P, *Ls.shape[1:]))
+            F[:, d.linear] += np.matmul(Ls, y[:, :, None])[..., 0]
+            J[:, d.linear] += Ls
+            if Ft is not None and KL > 1:
+                Lt = np.einsum("pk,pkem->pem", slope[:, :KL],
+                               np.broadcast_to(Lp, (P, *Lp.shape[1:])))
+                Ft[:, d.linear] += np.matmul(Lt, y[:, :, None])[..., 0]
+        return F, J, Ft
