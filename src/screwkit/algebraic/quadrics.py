@@ -131,10 +131,7 @@ class DenseBlock:
         for k in range(1, K):
             powers[:, k] = powers[:, k - 1] * sigma
         F = np.matmul(powers[:, None, :], yV)[:, 0]
-        QY = V[:, 0] * powers[:, 0, None, None]
-        for k in range(1, K):
-            QY = QY + V[:, k] * powers[:, k, None, None]
-        J = 2.0 * QY
+        J = np.matmul(2.0 * powers[:, None, :], V.reshape(P, K, N * m)).reshape(P, N, m)
         Ft = None
         if dsigma is not None:
             slope = np.zeros((P, K), dtype=complex)
