@@ -90,6 +90,9 @@ class DenseQuadrics:
 
     def block(self, instance: Index) -> DenseBlock:
         """The layout of one set of paths (``instance`` (P,): each path's instance)."""
+        if len(self.Qt) == 1:  # one instance: one product, no grouping
+            zero = np.zeros(len(instance), dtype=np.intp)
+            return DenseBlock(self, self.Qt, zero, zero, len(instance), self.L[:1])
         used, inverse, counts = np.unique(instance, return_inverse=True, return_counts=True)
         inverse = inverse.reshape(-1)
         order = np.argsort(inverse, kind="stable")
