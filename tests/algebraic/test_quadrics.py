@@ -63,13 +63,12 @@ def test_sigma_coefficients_reproduce_the_parameter_segment():
     dense = DenseQuadrics.build(hsys, p0, d)
     sigma = 0.37
     direct = DenseQuadrics.build(hsys, p0 + sigma * d, np.zeros_like(d))
-    K, N, m = dense.K, dense.N, dense.m
-    Q = dense.Qt[0].reshape(m, K, N, m)
-    combined = sum(sigma**k * Q[:, k] for k in range(K))
-    at = direct.Qt[0].reshape(m, direct.K, N, m)[:, 0]
-    assert np.abs(combined - at).max() <= 1e-12 * np.abs(at).max()
-    assert np.abs(direct.Qt[0].reshape(m, direct.K, N, m)[:, 1:]).max() <= 1e-12 * np.abs(
-        at).max()
+    Q = dense.matrices(0)
+    combined = sum(sigma**k * Q[k] for k in range(dense.K))
+    at = direct.matrices(0)
+    assert np.abs(combined - at[0]).max() <= 1e-12 * np.abs(at[0]).max()
+    assert direct.K == dense.K == 3 and not np.any(at[1:])  # d = 0: no σ terms, exactly
+    assert np.allclose(Q, Q.transpose(0, 1, 3, 2), rtol=0, atol=0)  # symmetric
 
 
 def test_tracks_agree_with_the_sparse_evaluation():

@@ -44,12 +44,14 @@ def dense_quadrics_apply(hsys: PolynomialSystem) -> bool:
 class DenseQuadrics:
     """The σ-coefficients of F^h(y; p_start + σ·d) for B instances (module docstring).
 
-    ``Qt`` (B, m, K·N·m): row j, column (k, i, l) is Q_ik[l, j] (= Q_ik[j, l]), so that
-    y @ Qt[b] gives every Q_ik y at once; ``L`` (B_L, K_L, N_L, m): the linear forms of the
+    ``Qt`` (B, m, C): row j, column c is Q_ik[l, j] (= Q_ik[j, l]) for (k, i, l) the c-th of
+    the ``columns`` (flat indices into K·N·m) with a nonzero entry, so that y @ Qt[b] gives
+    every nonzero (Q_ik y)_l at once; ``L`` (B_L, K_L, N_L, m): the linear forms of the
     equations ``linear`` (B_L = 1 when every instance has the same, K_L = 1 when they do not
     depend on σ)."""
 
     Qt: Complex
+    columns: Index
     L: Complex
     linear: Index
     K: int
@@ -67,26 +69,48 @@ class DenseQuadrics:
         p = (p_start[:, None, :] + roots[None, :, None] * direction[:, None, :])
         eq, exps, values = hsys.coefficients_at(p.reshape(B * K, -1))
         coef = np.fft.fft(values.reshape(B, K, -1), axis=1) / K  # (B, K, G): σ^k coefficients
+        # a monomial's coefficient has σ-degree at most the largest parameter degree of its
+        # terms: the higher σ^k (rounding noise of the transform) are exactly zero
+        unknown_exps = np.zeros((len(hsys.eq), m), dtype=np.intp)
+        rows = np.nonzero(~param)
+        np.add.at(unknown_exps, (rows[0], hsys.sym[rows]), hsys.pw[rows])
+        group = np.unique(np.column_stack([hsys.eq, unknown_exps]), axis=0,
+                          return_inverse=True)[1].reshape(-1)
+        top = np.zeros(len(eq), dtype=np.intp)
+        np.maximum.at(top, group, np.where(param, hsys.pw, 0).sum(axis=1))
+        coef[:, np.arange(K)[:, None] > top[None, :]] = 0.0
         degree = exps.sum(axis=1)
-        Q = np.zeros((B, K, N, m, m), dtype=complex)
         quad = np.flatnonzero(degree == 2)
-        # the two unknowns of each quadratic monomial (the same one twice for a square)
+        # the two unknowns of each quadratic monomial (the same one twice for a square), its
+        # coefficient split in halves over the cells (j, l) and (l, j)
         pair = np.repeat(np.tile(np.arange(m), len(quad)), exps[quad].ravel()).reshape(-1, 2)
-        half = 0.5 * coef[:, :, quad]
-        np.add.at(Q, (slice(None), slice(None), eq[quad], pair[:, 0], pair[:, 1]), half)
-        np.add.at(Q, (slice(None), slice(None), eq[quad], pair[:, 1], pair[:, 0]), half)
+        half = 0.5 * coef[:, :, quad].reshape(B * K, -1).T  # (G_quad, B·K)
+        cells = np.zeros((N * m * m, B * K), dtype=complex)
+        np.add.at(cells, (eq[quad] * m + pair[:, 0]) * m + pair[:, 1], half)
+        np.add.at(cells, (eq[quad] * m + pair[:, 1]) * m + pair[:, 0], half)
+        Q = cells.T.reshape(B, K, N, m, m)
         lin = np.flatnonzero(degree == 1)
         linear = np.unique(eq[lin]).astype(np.intp)
-        L = np.zeros((B, K, len(linear), m), dtype=complex)
+        forms = np.zeros((len(linear) * m, B * K), dtype=complex)
+        np.add.at(forms, np.searchsorted(linear, eq[lin]) * m + exps[lin].argmax(axis=1),
+                  coef[:, :, lin].reshape(B * K, -1).T)
+        L = forms.T.reshape(B, K, len(linear), m)
         if lin.size:
-            np.add.at(L, (slice(None), slice(None), np.searchsorted(linear, eq[lin]),
-                          exps[lin].argmax(axis=1)), coef[:, :, lin])
             if not np.any(L[:, 1:]):
                 L = L[:, :1]
             if np.all(L == L[:1]):
                 L = L[:1]
         Qt = Q.transpose(0, 4, 1, 2, 3).reshape(B, m, K * N * m)
-        return DenseQuadrics(np.ascontiguousarray(Qt), L, linear, K, N, m)
+        # only the columns (k, i, l) with a nonzero entry take part in the product
+        columns = np.flatnonzero(np.any(Qt != 0, axis=(0, 1))).astype(np.intp)
+        return DenseQuadrics(np.ascontiguousarray(Qt[:, :, columns]), columns, L, linear, K,
+                             N, m)
+
+    def matrices(self, b: int) -> Complex:
+        """The symmetric Q_ik of instance b, (K, N, m, m)."""
+        full = np.zeros((self.m, self.K * self.N * self.m), dtype=complex)
+        full[:, self.columns] = self.Qt[b]
+        return full.reshape(self.m, self.K, self.N, self.m).transpose(1, 2, 3, 0)
 
     def block(self, instance: Index) -> DenseBlock:
         """The layout of one set of paths (``instance`` (P,): each path's instance)."""
@@ -123,12 +147,14 @@ class DenseBlock:
         """F (P, N), ∂F/∂y (P, N, m) and, when ``dsigma`` is given, (∂F/∂σ)·dσ (P, N)."""
         d = self.dense
         P, K, N, m = len(y), d.K, d.N, d.m
+        full = np.zeros((P, K * N * m), dtype=complex)
         if len(self.Qt) == 1:
-            V = (y @ self.Qt[0]).reshape(P, K, N, m)
+            full[:, d.columns] = y @ self.Qt[0]
         else:
             padded = np.zeros((len(self.Qt), self.width, m), dtype=complex)
             padded[self.group, self.slot] = y
-            V = np.matmul(padded, self.Qt)[self.group, self.slot].reshape(P, K, N, m)
+            full[:, d.columns] = np.matmul(padded, self.Qt)[self.group, self.slot]
+        V = full.reshape(P, K, N, m)
         yV = np.matmul(V.reshape(P, K * N, m), y[:, :, None]).reshape(P, K, N)
         powers = np.ones((P, K), dtype=complex)
         for k in range(1, K):
