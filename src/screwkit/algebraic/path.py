@@ -64,6 +64,8 @@ class TrackOptions:
     #: endpoints of one instance closer than this (relative) are the same point
     same_point_tolerance: float = 1e-7
     retrack: bool = True
+    #: paths whose tracking failed are tracked again through a random complex parameter point
+    detour: bool = True
     seed: int = 0
     #: paths tracked together (larger batches run in chunks of this many)
     chunk: int = 512
