@@ -245,15 +245,16 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
         # every path of an instance with a failed path, through the detour (all of them: a
         # detour for some paths only could permute the solutions they reach, by monodromy);
         # kept for the instances where fewer paths fail than on the straight segment
-        again = np.flatnonzero(np.isin(instance, instance[failed]))
-        other = _detour(system, hsys, patch, ps[again], pt[again], x[again], rng, options)
-        before = np.bincount(instance[again], weights=failed[again], minlength=P)
-        after = np.bincount(instance[again],
+        touched = np.flatnonzero(np.isin(instance, instance[failed]))
+        other = _detour(system, hsys, patch, ps[touched], pt[touched], x[touched], rng,
+                        options)
+        before = np.bincount(instance[touched], weights=failed[touched], minlength=P)
+        after = np.bincount(instance[touched],
                             weights=other["status"] == PathStatus.FAILED, minlength=P)
-        better = (after < before)[instance[again]]
+        better = (after < before)[instance[touched]]
         for key, value in other.items():
-            out[key][again[better]] = value[better]
-        retracked[again[better]] = True
+            out[key][touched[better]] = value[better]
+        retracked[touched[better]] = True
     jumped = _jumps(out["y"], out["status"], instance, options)
     if jumped.size and options.retrack:
         again = _run_in_chunks(system, hom, x[jumped], rows[jumped], options.tighter())
