@@ -169,14 +169,19 @@ class DenseBlock:
             Ft = np.matmul(slope[:, None, :], yV)[:, 0]
         if len(d.linear):
             KL = self.L.shape[1]
-            Lp = self.L
-            Ls = Lp[:, 0] if KL == 1 else np.einsum("pk,pkem->pem", powers[:, :KL],
-                                                    np.broadcast_to(Lp, (P, *Lp.shape[1:])))
-            Ls = np.broadcast_to(Ls, (P, *Ls.shape[1:]))
-            F[:, d.linear] += np.matmul(Ls, y[:, :, None])[..., 0]
-            J[:, d.linear] += Ls
+            forms = np.broadcast_to(self.L, (P, *self.L.shape[1:]))
+            if KL == 1:  # the forms do not move with σ (a patch): no ∂/∂σ term
+                Ls = self.L[:, 0]  # (1 or P, N_L, m)
+            else:
+                Ls = np.einsum("pk,pkem->pem", powers[:, :KL], forms)
+            if len(Ls) == 1:  # shared by every path: one product
+                Fl = y @ Ls[0].T
+            else:
+                Fl = np.matmul(Ls, y[:, :, None])[..., 0]
+            for e, row in enumerate(d.linear):  # basic indexing: in place, no gather
+                F[:, row] += Fl[:, e]
+                J[:, row] += Ls[:, e]
             if Ft is not None and KL > 1:
-                Lt = np.einsum("pk,pkem->pem", slope[:, :KL],
-                               np.broadcast_to(Lp, (P, *Lp.shape[1:])))
+                Lt = np.einsum("pk,pkem->pem", slope[:, :KL], forms)
                 Ft[:, d.linear] += np.matmul(Lt, y[:, :, None])[..., 0]
         return F, J, Ft
