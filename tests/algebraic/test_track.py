@@ -116,3 +116,21 @@ def test_bad_shapes_are_refused_with_the_expected_shape():
         track_parameter_homotopy(system, c0, [1.0, 2.0], roots0)
     with pytest.raises(InputError, match="p_start must be finite"):
         track_parameter_homotopy(system, [np.nan, 0, 0], c0, roots0)
+
+
+def test_a_segment_through_a_double_root_fails_straight_and_is_detoured():
+    """x⁴ + … from the roots ±1, ±2 to ±i, ±2 along a real segment: the roots ±1 meet at 0
+    half-way (the segment crosses the discriminant), so the straight paths of those two fail.
+    The detour through a random complex point tracks all four again and ends at every root,
+    each once, against numpy.roots."""
+    system = univariate(4)
+    roots = np.array([1.0, -1.0, 2.0, -2.0])
+    start = np.poly(roots)[::-1][:4]
+    target = np.poly([1j, -1j, 2.0, -2.0])[::-1][:4].real
+    straight = track_parameter_homotopy(system, start, target, roots[:, None],
+                                        TrackOptions(detour=False))
+    assert straight.counts()["failed"] == 2 and not straight.retracked.any()
+    result = track_parameter_homotopy(system, start, target, roots[:, None])
+    assert result.counts()["regular"] == 4 and result.retracked.all()
+    expected = np.roots(np.r_[1.0, target[::-1]])
+    assert _matches(result.x[:, 0], expected, 1e-10)

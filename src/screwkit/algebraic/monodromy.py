@@ -17,7 +17,7 @@ proof of it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -69,6 +69,9 @@ def _loops(system: PolynomialSystem, p0: Complex, x: Complex, count: int,
     loop = np.repeat(np.arange(count), m)
     points = np.tile(x, (count, 1))
     tracked = failed = 0
+    # no detour for failed paths: a loop's failed path is dropped (other loops reach its
+    # solutions), and the detour's extra random point only reshuffles which loops are taken
+    options = replace(options, detour=False)
     for a, b in zip(corners[:-1], corners[1:], strict=True):
         result = track_parameter_homotopy(system, a[loop], b[loop], points, options)
         ok = result.status == PathStatus.REGULAR

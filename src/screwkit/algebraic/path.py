@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
+from screwkit.algebraic.quadrics import DenseBlock, DenseQuadrics
 
 Real = NDArray[np.float64]
 Index = NDArray[np.intp]
@@ -63,9 +64,13 @@ class TrackOptions:
     #: endpoints of one instance closer than this (relative) are the same point
     same_point_tolerance: float = 1e-7
     retrack: bool = True
+    #: paths whose tracking failed are tracked again through a random complex parameter point
+    detour: bool = True
     seed: int = 0
     #: paths tracked together (larger batches run in chunks of this many)
     chunk: int = 512
+    #: evaluate a system of quadrics densely (:mod:`.quadrics`); False: the sparse term table
+    dense: bool = True
 
     def tighter(self) -> TrackOptions:
         """The options for a retrack after suspected path jumping: 10× smaller steps and
@@ -78,24 +83,49 @@ class TrackOptions:
 
 @dataclass(frozen=True)
 class Homotopy:
-    """F^h(y; p_start + σ·direction) with the patch row a·y − 1, for a set of paths (rows)."""
+    """F^h(y; p_start + σ·direction) with the patch row a·y − 1, for a set of paths (rows).
+
+    With ``dense`` (a system of quadrics, :mod:`.quadrics`) and ``instance`` (each row's index
+    into it) the system is evaluated densely, one matrix product per instance; otherwise by
+    the sparse term table of :class:`PolynomialSystem`. Both evaluate the same homotopy."""
 
     system: PolynomialSystem  # homogenised: n+1 unknowns, n equations
     patch: Complex  # (n+1,)
     p_start: Complex  # (P, k)
     direction: Complex  # (P, k)
+    dense: DenseQuadrics | None = None
+    instance: Index | None = None
+    block: DenseBlock | None = None
 
     def restricted(self, rows: Index) -> Homotopy:
         """The homotopy of the paths ``rows`` only (their parameters gathered once)."""
+        if self.dense is not None and self.instance is not None:
+            instance = self.instance[rows]
+            return Homotopy(self.system, self.patch, self.p_start[rows], self.direction[rows],
+                            self.dense, instance, self.dense.block(instance))
         return Homotopy(self.system, self.patch, self.p_start[rows], self.direction[rows])
+
+    def _evaluate(self, y: Complex, rows: Index | None, sigma: Complex,
+                  dsigma: Complex | None) -> tuple[Complex, Complex, Complex | None]:
+        """F^h (B, n), ∂F^h/∂y (B, n, n+1) and (∂F^h/∂σ)·dσ/dτ (B, n) or None."""
+        if self.dense is not None and self.instance is not None:
+            if rows is not None:
+                return self.restricted(rows)._evaluate(y, None, sigma, dsigma)
+            block = self.block
+            if block is None:
+                block = self.dense.block(self.instance)
+                object.__setattr__(self, "block", block)
+            return block.evaluate(y, sigma, dsigma)
+        d = self.direction if rows is None else self.direction[rows]
+        p = (self.p_start if rows is None else self.p_start[rows]) + sigma[:, None] * d
+        F, Jy, Fd = self.system.evaluate_directional(y, p, None if dsigma is None else d)
+        return F, Jy, (None if Fd is None or dsigma is None else Fd * dsigma[:, None])
 
     def parts(self, y: Complex, rows: Index | None, sigma: Complex,
               dsigma: Complex | None = None) -> tuple[Complex, Complex, Complex | None]:
         """H (B, n+1), ∂H/∂y (B, n+1, n+1) and, when ``dsigma`` is given, ∂H/∂τ (B, n+1), for
         the paths ``rows`` (None: every path of this homotopy, in order)."""
-        d = self.direction if rows is None else self.direction[rows]
-        p = (self.p_start if rows is None else self.p_start[rows]) + sigma[:, None] * d
-        F, Jy, Fd = self.system.evaluate_directional(y, p, None if dsigma is None else d)
+        F, Jy, Ft = self._evaluate(y, rows, sigma, dsigma)
         B, m = y.shape
         H = np.empty((B, m), dtype=complex)
         H[:, :-1] = F
@@ -105,9 +135,9 @@ class Homotopy:
         J[:, -1] = self.patch
         if dsigma is None:
             return H, J, None
-        assert Fd is not None and dsigma is not None
+        assert Ft is not None
         Ht = np.zeros((B, m), dtype=complex)
-        Ht[:, :-1] = Fd * dsigma[:, None]
+        Ht[:, :-1] = Ft
         return H, J, Ht
 
     def to_patch(self, x: Complex) -> Complex:

@@ -16,6 +16,11 @@ endgame (:mod:`.endgame`) from s = 1 − r, which gives their end point and wind
 are then classified singular (with the number of paths that reach the same point as its
 multiplicity estimate), at infinity, or failed.
 
+A path whose tracking fails (its step collapses where the segment passes close to the
+discriminant and Newton stops contracting) is not given up at once: every path of its instance
+is tracked again through a random complex parameter point (p_start → p_mid → p_target, both legs
+generic), and that instance's new ends are kept when fewer of its paths fail.
+
 Path jumping: two paths of one instance ending at the same regular solution cannot both be
 right (a regular solution is the end of exactly one path). Both are tracked again with 10×
 smaller steps; a pair that still coincides is marked failed.
@@ -32,6 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.algebraic.endgame import cauchy_endgame
 from screwkit.algebraic.path import Homotopy, TrackOptions, line, newton, track
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
+from screwkit.algebraic.quadrics import DenseQuadrics, dense_quadrics_apply
 from screwkit.errors import InputError
 
 __all__ = ["PathStatus", "TrackOptions", "TrackResult", "track_parameter_homotopy",
@@ -57,8 +63,8 @@ class TrackResult:
     ``residual`` (P,) ‖F(x; p_target)‖∞ at finite end points; ``winding`` (P,) the cycle
     number from the endgame (1 for paths that did not need it); ``multiplicity`` (P,) the number
     of paths of the same instance ending at the same point (1 for a regular end); ``steps`` (P,)
-    predictor–corrector steps taken; ``retracked`` (P,) paths tracked again after a suspected
-    jump; ``instance`` (P,) the index of each path's homotopy (its pair p_start, p_target)
+    predictor–corrector steps taken; ``retracked`` (P,) paths tracked again (after a suspected
+    jump, or through the detour of an instance with a failed path); ``instance`` (P,) the index of each path's homotopy (its pair p_start, p_target)
     among the distinct pairs: paths of one instance are one homotopy, whose regular ends must
     differ."""
 
@@ -230,12 +236,25 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
     rng = np.random.default_rng(options.seed)
     patch = ((rng.standard_normal(system.n + 1) + 1j * rng.standard_normal(system.n + 1))
              / 2).astype(complex)
-    hom = Homotopy(hsys, patch, ps, pt - ps)
-    _, instance = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_inverse=True)
-    instance = instance.reshape(-1).astype(np.intp)
+    hom, instance = _homotopy(hsys, patch, ps, pt, options)
     rows = np.arange(P)
     out = _run_in_chunks(system, hom, x, rows, options)
     retracked = np.zeros(P, dtype=bool)
+    failed = out["status"] == PathStatus.FAILED
+    if failed.any() and options.detour:
+        # every path of an instance with a failed path, through the detour (all of them: a
+        # detour for some paths only could permute the solutions they reach, by monodromy);
+        # kept for the instances where fewer paths fail than on the straight segment
+        touched = np.flatnonzero(np.isin(instance, instance[failed]))
+        other = _detour(system, hsys, patch, ps[touched], pt[touched], x[touched], rng,
+                        options)
+        before = np.bincount(instance[touched], weights=failed[touched], minlength=P)
+        after = np.bincount(instance[touched],
+                            weights=other["status"] == PathStatus.FAILED, minlength=P)
+        better = (after < before)[instance[touched]]
+        for key, value in other.items():
+            out[key][touched[better]] = value[better]
+        retracked[touched[better]] = True
     jumped = _jumps(out["y"], out["status"], instance, options)
     if jumped.size and options.retrack:
         again = _run_in_chunks(system, hom, x[jumped], rows[jumped], options.tighter())
@@ -247,6 +266,52 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
     elif jumped.size:
         out["status"][jumped] = PathStatus.FAILED
     return _result(system, out, pt, instance, retracked, options)
+
+
+def _homotopy(hsys: PolynomialSystem, patch: Complex, ps: Complex, pt: Complex,
+              options: TrackOptions) -> tuple[Homotopy, NDArray[np.intp]]:
+    """The homotopy of the segments ps → pt (one row per path), evaluated densely when the
+    system is made of quadrics, and each path's instance (index of its distinct segment)."""
+    first, instance = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_index=True,
+                                return_inverse=True)[1:]
+    instance = instance.reshape(-1).astype(np.intp)
+    dense = (DenseQuadrics.build(hsys, ps[first], pt[first] - ps[first])
+             if options.dense and dense_quadrics_apply(hsys) else None)
+    return (Homotopy(hsys, patch, ps, pt - ps, dense, instance if dense is not None else None),
+            instance)
+
+
+def _detour(system: PolynomialSystem, hsys: PolynomialSystem, patch: Complex, ps: Complex,
+            pt: Complex, x: Complex, rng: np.random.Generator,
+            options: TrackOptions) -> dict[str, np.ndarray]:
+    """The paths of instances where tracking failed on the straight segment (the step
+    collapsed where the segment passes close to the discriminant, Newton no longer
+    contracting), tracked again through a random complex point: p_start → p_mid → p_target. With p_mid generic both legs
+    miss the discriminant with probability one (Sommese & Wampler 2005, §7.1: any generic
+    path of parameters carries every isolated solution); the first leg ends at regular
+    solutions of the generic p_mid, the second is classified as usual (endgame included)."""
+    scale = np.abs(pt - ps).max(axis=1, keepdims=True) + 1.0
+    groups, which = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_inverse=True)
+    kick = (rng.standard_normal(groups.shape[:1] + ps.shape[1:])
+            + 1j * rng.standard_normal(groups.shape[:1] + ps.shape[1:]))
+    mid = 0.5 * (ps + pt) + 0.5 * scale * kick[which.reshape(-1)]
+    rows = np.arange(len(x))
+    hom, _ = _homotopy(hsys, patch, ps, mid, options)
+    leg = _run_in_chunks(system, hom, x, rows, options)
+    out = {"y": np.full_like(leg["y"], np.nan),
+           "status": np.full(len(x), PathStatus.FAILED, dtype=np.int8),
+           "condition": np.full(len(x), np.inf), "winding": np.ones(len(x), dtype=np.int64),
+           "steps": leg["steps"].copy()}
+    through = np.flatnonzero(leg["status"] == PathStatus.REGULAR)
+    if through.size:
+        y = leg["y"][through]
+        hom, _ = _homotopy(hsys, patch, mid[through], pt[through], options)
+        second = _run_in_chunks(system, hom, y[:, 1:] / y[:, :1], np.arange(len(through)),
+                                options)
+        for key, value in second.items():
+            out[key][through] = value
+        out["steps"][through] += leg["steps"][through]
+    return out
 
 
 def _jumps(y: Complex, status: NDArray[np.int8], instance: NDArray[np.intp],
