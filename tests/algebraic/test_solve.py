@@ -56,6 +56,21 @@ def test_dense_quadrics_batch_matches_total_degree_and_one_at_a_time():
     assert batch.real_count.sum() == batch.certified_real_count.sum() > 0
 
 
+def test_the_same_target_twice_in_one_batch_is_solved_twice():
+    """A closed motion's first and last rows are the same instance. In one batch each copy is
+    its own problem: its paths' equal ends are no jumps, and both copies find every root (the
+    path-jump check once grouped the copies into one homotopy and failed all their paths)."""
+    system = univariate(5)
+    start = StartSolutions.by_total_degree(system)
+    targets = np.random.default_rng(11).standard_normal((3, 5))
+    batch = solve_all(system, targets[[0, 1, 0, 2, 0]], start)
+    assert (batch.found == 5).all() and (batch.failed == 0).all()
+    for b in (0, 2, 4):
+        assert _same_sets(batch.of(b), batch.of(0), 1e-12)
+    alone = solve_all(system, targets[0], start)
+    assert _same_sets(alone.of(0), batch.of(4), 1e-12)
+
+
 def test_a_wrong_target_shape_is_refused():
     system = univariate(3)
     start = StartSolutions.by_total_degree(system)

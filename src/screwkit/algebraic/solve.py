@@ -127,9 +127,9 @@ def solve_all(system: PolynomialSystem, p_target: ArrayLike,
     if start.x.shape[1:] != (system.n,) or start.p.shape != (system.k,):
         raise InputError(f"start solutions of shape {start.x.shape} at p {start.p.shape} do not "
                          f"fit the system of {system.n} unknowns and {system.k} parameters")
-    result = track_parameter_homotopy(system, start.p, np.repeat(targets, m, axis=0),
-                                      np.tile(start.x, (B, 1)), options)
     instance = np.repeat(np.arange(B), m)
+    result = track_parameter_homotopy(system, start.p, np.repeat(targets, m, axis=0),
+                                      np.tile(start.x, (B, 1)), options, instance=instance)
     finite = np.flatnonzero((result.status == PathStatus.REGULAR)
                             | (result.status == PathStatus.SINGULAR))
     x, p = result.x[finite], targets[instance[finite]]

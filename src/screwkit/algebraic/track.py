@@ -221,14 +221,21 @@ def _run_in_chunks(system: PolynomialSystem, hom: Homotopy, x: Complex,
 
 def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
                              p_target: ArrayLike, x_start: ArrayLike,
-                             options: TrackOptions | None = None) -> TrackResult:
+                             options: TrackOptions | None = None,
+                             instance: ArrayLike | None = None) -> TrackResult:
     """Track the start solutions ``x_start`` (P, n) of F(x; p_start) = 0 to F(x; p_target) = 0
     along p(s) = (1 − s)·p_start + s·p_target (Sommese & Wampler 2005, ch. 7).
 
     ``p_start`` and ``p_target`` are (k,) or (P, k), one row per path, so a batch of many
     instances times their start solutions is one call. ``p_start`` should be generic complex
     (random complex parameters) for the paths to be smooth; the caller's start solutions must
-    solve F(x; p_start) = 0 to tracking accuracy. Returns a :class:`TrackResult`."""
+    solve F(x; p_start) = 0 to tracking accuracy. Returns a :class:`TrackResult`.
+
+    ``instance`` (P,) names each path's problem: the paths of one instance are one homotopy,
+    whose regular ends must differ (path-jump check) and which a detour retracks together.
+    Default: paths on the same segment (p_start, p_target) are one instance. A caller that
+    solves the same target twice in one batch (a closed motion's first and last rows) gives
+    its own rows, or the two copies' equal ends would read as jumps."""
     options = options or TrackOptions()
     ps, pt, x = _check(system, p_start, p_target, x_start)
     P = x.shape[0]
@@ -236,7 +243,13 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
     rng = np.random.default_rng(options.seed)
     patch = ((rng.standard_normal(system.n + 1) + 1j * rng.standard_normal(system.n + 1))
              / 2).astype(complex)
-    hom, instance = _homotopy(hsys, patch, ps, pt, options)
+    hom, segment = _homotopy(hsys, patch, ps, pt, options)
+    given = segment if instance is None else np.asarray(instance, dtype=np.intp).reshape(-1)
+    if given.shape != (P,):
+        raise InputError(f"instance must give one index per path ({P}); got shape "
+                         f"{given.shape}")
+    group: NDArray[np.intp] = np.unique(given, return_inverse=True)[1].reshape(-1).astype(
+        np.intp)
     rows = np.arange(P)
     out = _run_in_chunks(system, hom, x, rows, options)
     retracked = np.zeros(P, dtype=bool)
@@ -245,27 +258,27 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
         # every path of an instance with a failed path, through the detour (all of them: a
         # detour for some paths only could permute the solutions they reach, by monodromy);
         # kept for the instances where fewer paths fail than on the straight segment
-        touched = np.flatnonzero(np.isin(instance, instance[failed]))
+        touched = np.flatnonzero(np.isin(group, group[failed]))
         other = _detour(system, hsys, patch, ps[touched], pt[touched], x[touched], rng,
                         options)
-        before = np.bincount(instance[touched], weights=failed[touched], minlength=P)
-        after = np.bincount(instance[touched],
+        before = np.bincount(group[touched], weights=failed[touched], minlength=P)
+        after = np.bincount(group[touched],
                             weights=other["status"] == PathStatus.FAILED, minlength=P)
-        better = (after < before)[instance[touched]]
+        better = (after < before)[group[touched]]
         for key, value in other.items():
             out[key][touched[better]] = value[better]
         retracked[touched[better]] = True
-    jumped = _jumps(out["y"], out["status"], instance, options)
+    jumped = _jumps(out["y"], out["status"], group, options)
     if jumped.size and options.retrack:
         again = _run_in_chunks(system, hom, x[jumped], rows[jumped], options.tighter())
         for key, value in again.items():
             out[key][jumped] = value
         retracked[jumped] = True
-        still = _jumps(out["y"], out["status"], instance, options)
+        still = _jumps(out["y"], out["status"], group, options)
         out["status"][still] = PathStatus.FAILED
     elif jumped.size:
         out["status"][jumped] = PathStatus.FAILED
-    return _result(system, out, pt, instance, retracked, options)
+    return _result(system, out, pt, group, retracked, options)
 
 
 def _homotopy(hsys: PolynomialSystem, patch: Complex, ps: Complex, pt: Complex,
