@@ -1,4 +1,4 @@
-"""Every assembly mode against Bertini 2 (validation/bertini/crosscheck.py): the same closure
+"""Every assembly mode against Bertini 2 (validation/bertini/bertini_crosscheck.py): the same closure
 polynomials solved by screwkit's parameter homotopy and by Bertini's own total-degree homotopy
 with adaptive precision give the same finite solutions one to one, and the same real ones.
 
@@ -18,7 +18,7 @@ pytest.importorskip("bertini", reason="the crosscheck extra (Bertini 2) is not i
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "validation" / "bertini"))
 
-from crosscheck import FAMILIES, compare  # noqa: E402
+from bertini_crosscheck import FAMILIES, compare  # noqa: E402
 
 
 def test_every_stewart_pose_equals_bertini():
@@ -42,7 +42,7 @@ def test_a_wrong_system_is_told_apart():
     make, start, draw = FAMILIES["Stewart–Gough 6-6"]
     system, s = make(), start()
     p, _ = draw(np.random.default_rng(8), 2)
-    from crosscheck import _mismatch, bertini_solutions
+    from bertini_crosscheck import _mismatch, bertini_solutions
     from screwkit.algebraic.solve import solve_all
 
     ours = solve_all(system, p[0].real.astype(complex), s).of(0)
@@ -55,7 +55,7 @@ def test_the_bundled_stewart_platform_equals_bertini():
     the 40 generic poses stay finite. Bertini finds the same 28 at its first row, with the same
     16 real ones, as screwkit's formulation of the spec (every_mode's parameters)."""
     import screwkit as sk
-    from crosscheck import _real_count, bertini_solutions
+    from bertini_crosscheck import _real_count, bertini_solutions
     from screwkit.algebraic.solve import solve_all
     from screwkit.kinematics.modes.every_mode import closure_formulation, formulation_start
 
@@ -66,6 +66,6 @@ def test_the_bundled_stewart_platform_equals_bertini():
     theirs = bertini_solutions(form.system, p)
     assert len(ours) == len(theirs) == 28
     assert _real_count(ours) == _real_count(theirs) == 16
-    from crosscheck import _mismatch
+    from bertini_crosscheck import _mismatch
 
     assert _mismatch(ours, theirs) < 1e-7

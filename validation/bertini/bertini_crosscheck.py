@@ -12,7 +12,7 @@ one, and the same real ones:
 * 6-6 Stewart–Gough platforms in Study coordinates (40 generic poses; 128 total-degree paths);
 * 6R loops in their joint-axis directions (16 generic assemblies).
 
-Run: ``python validation/bertini/crosscheck.py`` (prints a Markdown table).
+Run: ``python validation/bertini/bertini_crosscheck.py`` (prints a Markdown table).
 """
 
 from __future__ import annotations
