@@ -43,6 +43,7 @@ def test_a_wrong_system_is_told_apart():
     system, s = make(), start()
     p, _ = draw(np.random.default_rng(8), 2)
     from bertini_crosscheck import _mismatch, bertini_solutions
+
     from screwkit.algebraic.solve import solve_all
 
     ours = solve_all(system, p[0].real.astype(complex), s).of(0)
@@ -54,8 +55,9 @@ def test_the_bundled_stewart_platform_equals_bertini():
     """The bundled platform is not generic (its legs meet the plates in symmetric pairs): 28 of
     the 40 generic poses stay finite. Bertini finds the same 28 at its first row, with the same
     16 real ones, as screwkit's formulation of the spec (every_mode's parameters)."""
-    import screwkit as sk
     from bertini_crosscheck import _real_count, bertini_solutions
+
+    import screwkit as sk
     from screwkit.algebraic.solve import solve_all
     from screwkit.kinematics.modes.every_mode import closure_formulation, formulation_start
 
