@@ -16,6 +16,7 @@ until the steady-state coefficient C_s is within :data:`SIZING_RTOL` of the requ
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -159,20 +160,30 @@ def size_flywheel(eom: EquationOfMotion, fluctuation: float, guess_speed: float
     c0 = fluct(0.0)
     if c0 <= fluctuation:
         return FlywheelSizing(fluctuation, 0.0, c0, estimate, history, cache[0.0])
-    a, b = 0.0, max(estimate["flywheel"], 1e-3 * estimate["total_inertia"], 1e-12)
-    ha, hb = 1.0 / c0 - 1.0 / fluctuation, 1.0 / fluct(b) - 1.0 / fluctuation
+    b, achieved = secant_flywheel(
+        fluct, 0.0, c0, max(estimate["flywheel"], 1e-3 * estimate["total_inertia"], 1e-12),
+        fluctuation)
+    return FlywheelSizing(fluctuation, b, achieved, estimate, history, cache[b])
+
+
+def secant_flywheel(fluct: Callable[[float], float], a: float, c_a: float, b: float,
+                    fluctuation: float) -> tuple[float, float]:
+    """The flywheel J_f whose steady fluctuation ``fluct(J_f)`` is ``fluctuation``, to
+    :data:`SIZING_RTOL`, and that fluctuation: the secant method on 1/C_s(J_f) − 1/δ (nearly
+    linear in J_f, C_s ∝ 1/J), from ``a`` (with its fluctuation ``c_a``) and the estimate ``b``,
+    never stepping below half the last flywheel; a run that does not get there is an error."""
+    c_b = fluct(b)
+    ha, hb = 1.0 / c_a - 1.0 / fluctuation, 1.0 / c_b - 1.0 / fluctuation
     for _ in range(SIZING_STEPS):
-        if abs(cache[b].steady()["fluctuation"] / fluctuation - 1.0) < SIZING_RTOL:
-            break
-        if hb == ha:
+        if abs(c_b / fluctuation - 1.0) < SIZING_RTOL or hb == ha:
             break
         a, ha, b = b, hb, max(b - hb * (b - a) / (hb - ha), 0.5 * b)
-        hb = 1.0 / fluct(b) - 1.0 / fluctuation
-    achieved = cache[b].steady()["fluctuation"]
-    if abs(achieved / fluctuation - 1.0) > 10 * SIZING_RTOL:
-        raise SimulationError(f"flywheel sizing did not converge: fluctuation {achieved:.6g} "
+        c_b = fluct(b)
+        hb = 1.0 / c_b - 1.0 / fluctuation
+    if abs(c_b / fluctuation - 1.0) > 10 * SIZING_RTOL:
+        raise SimulationError(f"flywheel sizing did not converge: fluctuation {c_b:.6g} "
                               f"with {shown(b, 'inertia')} for a request of {fluctuation}")
-    return FlywheelSizing(fluctuation, b, achieved, estimate, history, cache[b])
+    return b, c_b
 
 
 def fluctuation_curve(eom: EquationOfMotion, flywheels: Array, guess_speed: float) -> Array:

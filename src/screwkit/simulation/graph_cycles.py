@@ -35,7 +35,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from screwkit.simulation.drive import motor_torque
-from screwkit.simulation.flywheel import SIZING_RTOL, SIZING_STEPS
+from screwkit.simulation.flywheel import secant_flywheel
 from screwkit.simulation.graph_eom import Array, GraphEquationOfMotion
 from screwkit.simulation.reduced import SimulationError
 
@@ -324,18 +324,6 @@ def size_graph_flywheel(eom: GraphEquationOfMotion, fluctuation: float, guess: f
     plain.start_at([initial_input])
     inertia = float(plain.terms([initial_input], [guess])["mass_matrix"][0, 0])
     estimate = max((inertia + base) * c0 / fluctuation - inertia, 1e-12)
-    a, b = base, estimate
-    ha, hb = 1.0 / c0 - 1.0 / fluctuation, 1.0 / fluct(b) - 1.0 / fluctuation
-    for _ in range(SIZING_STEPS):
-        if abs(cache[b].steady()["fluctuation"] / fluctuation - 1.0) < SIZING_RTOL:
-            break
-        if hb == ha:
-            break
-        a, ha, b = b, hb, max(b - hb * (b - a) / (hb - ha), 0.5 * b)
-        hb = 1.0 / fluct(b) - 1.0 / fluctuation
-    achieved = cache[b].steady()["fluctuation"]
-    if abs(achieved / fluctuation - 1.0) > 10 * SIZING_RTOL:
-        raise SimulationError(f"flywheel sizing did not converge: fluctuation {achieved:.6g} "
-                              f"with {b:.6g} kg*m^2 for a request of {fluctuation}")
+    b, achieved = secant_flywheel(fluct, base, c0, estimate, fluctuation)
     return GraphFlywheelSizing(fluctuation, b, achieved, estimate, history, cache[b])
 
