@@ -143,13 +143,30 @@ def _cycle_statistics(res: Any, t: float, t_end: float, y: Array, y_end: Array,
             "motor_torque_peak": float(tau.max())}
 
 
+#: what ``GraphCycles.samples`` holds, in this order
+SAMPLE_KEYS = ("time", "angle", "cycle_angle", "speed", "motor_torque")
+
+
+def _cycle_samples(res: Any, t: float, t_end: float, start: float, sense: float, motor: Any,
+                   n: int) -> Array:
+    """``n`` samples (rows: :data:`SAMPLE_KEYS`) at equal time steps of the cycle from ``t``
+    (input ``start``) to ``t_end``, read from the dense output ``res.sol``."""
+    ts = np.linspace(t, t_end, n, endpoint=False)
+    xs, ws = res.sol(ts)[:2]
+    return np.vstack([ts, xs, sense * (xs - start), ws, motor_torque(motor, ws)])
+
+
+def _stack_samples(kept: list[Array]) -> dict[str, Array]:
+    return dict(zip(SAMPLE_KEYS, np.hstack(kept) if kept else np.zeros((5, 0)), strict=True))
+
+
 def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_rate: float,
                           initial_input: float = 0.0, rtol: float = 1e-10,
                           atol: float | None = None, max_time: float | None = None,
                           samples_per_cycle: int = 0) -> GraphCycles:
     """Integrate ``cycles`` turns of the crank from ``initial_input`` at ``initial_rate``
     (module docstring); ``samples_per_cycle`` > 0 keeps that many samples of every completed
-    cycle (``GraphCycles.samples``, read from the dense output: no new right-hand sides)."""
+    cycle (``GraphCycles.samples``, from the dense output: no new right-hand sides)."""
     name = crank_input(eom)
     if not (np.isfinite(initial_rate) and initial_rate != 0):
         raise SimulationError(f"{eom.mechanism.name}: crank cycles need a nonzero initial "
@@ -220,10 +237,8 @@ def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_ra
         y_end = res.y_events[0][0]
         stats.append(_cycle_statistics(res, t, t_end, y, y_end, motor, sense))
         if samples_per_cycle > 0:
-            ts = np.linspace(t, t_end, samples_per_cycle, endpoint=False)
-            xs, ws = res.sol(ts)[:2]
-            kept.append(np.vstack([ts, xs, sense * (xs - (target - sense * TWO_PI)), ws,
-                                   motor_torque(motor, ws)]))
+            kept.append(_cycle_samples(res, t, t_end, target - sense * TWO_PI, sense, motor,
+                                       samples_per_cycle))
         try:
             T = eom.terms(y_end[:1], y_end[1:2])
         except SimulationError as exc:
@@ -241,14 +256,9 @@ def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_ra
     table = {key: np.array([s[key] for s in stats], dtype=float) for key in keys}
     work = np.abs(np.array(ends)[:, 2:5]).max() if ends else 0.0
     scale = max(energy, float(work), 1e-300)
-    samples = None
-    if samples_per_cycle > 0:
-        cols = np.hstack(kept) if kept else np.zeros((5, 0))
-        samples = dict(zip(("time", "angle", "cycle_angle", "speed", "motor_torque"), cols,
-                           strict=True))
     return GraphCycles(name, float(eom.flywheel[0]), np.array(times), table,
                        (float(y[0]), float(y[1])), float(np.max(np.abs(balance)) / scale),
-                       status, message, samples)
+                       status, message, _stack_samples(kept) if samples_per_cycle else None)
 
 
 def with_graph_flywheel(eom: GraphEquationOfMotion, flywheel: float) -> GraphEquationOfMotion:
