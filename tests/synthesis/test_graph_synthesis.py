@@ -312,5 +312,49 @@ def test_cli_bad_input_exits_2_and_writes_nothing(tmp_path):
     r = runner.invoke(app, ["synthesize", str(bad), "--spec-out", str(out)])
     assert r.exit_code == 2 and "swap" in r.output and not out.exists()
     r = runner.invoke(app, ["synthesize", str(MECH / "double_wishbone_synthesis.toml"),
-                            "--csv", str(tmp_path / "x.csv")])
-    assert r.exit_code == 2 and "--csv" in r.output and not (tmp_path / "x.csv").exists()
+                            "--plot", str(tmp_path / "x.txt"), "--csv", str(tmp_path / "x.csv")])
+    assert r.exit_code == 2 and "--plot" in r.output and ".png" in r.output
+    assert not (tmp_path / "x.txt").exists() and not (tmp_path / "x.csv").exists()
+    r = runner.invoke(app, ["synthesize", str(MECH / "double_wishbone_synthesis.toml"),
+                            "--workers", "2"])
+    assert r.exit_code == 2 and "--workers" in r.output
+
+
+def test_cli_csv_and_plot_of_a_graph_synthesis(tmp_path):
+    import csv
+
+    from screwkit.report.graph_synthesis_plots import _dense_curve
+
+    spec_path = MECH / "double_wishbone_synthesis.toml"
+    table, png = tmp_path / "rows.csv", tmp_path / "fit.png"
+    r = runner.invoke(app, ["synthesize", str(spec_path), "--json", "--csv", str(table),
+                            "--plot", str(png)])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    # the CSV (the spec's units: mm, deg) read back equals the JSON rows (SI) to round-off
+    with table.open(encoding="utf-8", newline="") as fh:
+        lines = list(csv.DictReader(fh))
+    expected = [(row, c) for row in doc["rows"] for c in range(len(row["desired"]))]
+    assert len(lines) == len(expected) == 17  # 9 camber rows, 8 toe rows
+    for line, (row, c) in zip(lines, expected, strict=True):
+        assert (line["target"], line["kind"], line["component"]) == (row["target"], row["kind"], "")
+        assert float(line["input_L.theta [deg]"]) == pytest.approx(
+            math.degrees(row["input"][0]), rel=1e-14, abs=1e-13)
+        scale, unit = (math.degrees(1.0), "deg") if row["kind"] == "angle" else (1e3, "mm")
+        other = "length [mm]" if row["kind"] == "angle" else "angle [deg]"
+        for q in ("desired", "generated", "error"):
+            assert float(line[f"{q}_{row['kind']} [{unit}]"]) == pytest.approx(
+                row[q][c] * scale, rel=1e-13, abs=1e-15)
+            assert line[f"{q}_{other}"] == ""
+    # the plot is a PNG; its curve (the design solved anew on 121 inputs) passes through the
+    # generated values of the document at the target inputs (-10, -7.5, ..., 10 deg: grid
+    # points, the grid's step being 1/6 deg)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
+    problem = load_spec(spec_path).synthesis
+    x = np.array([doc["x"][v.label] for v in problem.variables])
+    for k, t in enumerate(problem.targets):
+        grid, vals = _dense_curve(problem, x, k)
+        gen = [row["generated"][0] for row in doc["rows"] if row["target"] == t.label]
+        at = np.rint((t.inputs[:, 0] - grid[0]) / (grid[1] - grid[0])).astype(int)
+        np.testing.assert_allclose(grid[at], t.inputs[:, 0], atol=1e-15)
+        np.testing.assert_allclose(vals[at, 0], gen, atol=1e-10)

@@ -10,6 +10,10 @@ import numpy as np
 
 from screwkit.cli.common import prose
 
+#: samples of every crank cycle kept for ``simulate --cycles --plot`` (a loop's [drive]
+#: samples_per_cycle default)
+PLOT_SAMPLES_PER_CYCLE = 72
+
 
 def simulate_graph_cli(s: Any, out: Any, *, flywheel: float | None, fluctuation: float | None,
                        cycles: int | None, plot: Path | None) -> None:
@@ -42,14 +46,22 @@ def _cycles_cli(s: Any, out: Any, du: Any, *, flywheel: float | None,
     from screwkit.messages import message_units
     from screwkit.simulation.graph_spec_run import graph_cycles_table, simulate_graph_spec_cycles
 
-    if plot is not None:
-        user_error(f"{s.path}: --plot draws a run over [drive] duration; with --cycles or "
-                   "--fluctuation use --json or --csv for the per-cycle statistics")
+    keep = 0 if plot is None else PLOT_SAMPLES_PER_CYCLE
     with message_units(du):
         run = guard(lambda: simulate_graph_spec_cycles(s, cycles=cycles,
                                                        fluctuation=fluctuation,
-                                                       flywheel=flywheel))
+                                                       flywheel=flywheel,
+                                                       samples_per_cycle=keep))
     doc = guard(lambda: run.as_dict())
+    if plot is not None and run.run.cycles == 0:
+        user_error(f"{s.path}: --plot: no cycle was completed ({run.run.message}); nothing "
+                   "to draw")
+    if plot is not None:
+        from screwkit.report.simulation_plots import write_graph_cycles_png
+
+        samples = run.run.samples
+        guard(lambda: write_graph_cycles_png(doc, samples or {}, plot))
+        out.note_written(plot)
     out.deliver(document=lambda: doc, table=lambda: graph_cycles_table(run.run),
                 show=lambda: _show_cycles(s, run, du), units=du)
 

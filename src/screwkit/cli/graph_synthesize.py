@@ -1,7 +1,8 @@
 """``screwkit synthesize`` on a graph spec (docs/synthesis.md, "Graphs"): the drawing's hardpoints
 and axes fitted to the targets of its ``[synthesis]`` table on the drawn mode; prints the
 variables before and after (and which ended on a bound), E, the RMSE and the targets against
-what the result generates; ``--spec-out`` writes the synthesised spec (comments kept)."""
+what the result generates; ``--spec-out`` writes the synthesised spec (comments kept), ``--csv``
+(or ``-o`` .csv/.parquet/.npz) the target rows, ``--plot`` desired against generated."""
 
 from __future__ import annotations
 
@@ -62,11 +63,13 @@ def _show(spec: Any, problem: Any, doc: dict[str, Any], du: Any, full: bool) -> 
               "it to see the mechanism)")
 
 
-def graph_synthesize(spec: Any, out: Any, starts: int | None, spec_out: Path | None) -> None:
+def graph_synthesize(spec: Any, out: Any, starts: int | None, spec_out: Path | None,
+                     plot: Path | None = None) -> None:
     """Run the graph spec's ``[synthesis]`` and deliver the result (module docstring)."""
     from screwkit.cli.progress import progress_bar
     from screwkit.io.graph_synthesis_output import (
         graph_synthesis_document,
+        graph_synthesis_table,
         synthesised_spec_text,
     )
     from screwkit.io.results import write_atomic
@@ -83,5 +86,11 @@ def graph_synthesize(spec: Any, out: Any, starts: int | None, spec_out: Path | N
         text = _guard(lambda: synthesised_spec_text(spec, problem, results[0].x))
         _guard(lambda: write_atomic(spec_out, text, [spec.path], "--spec-out"))
         out.note_written(spec_out)
-    out.deliver(document=lambda: doc, table=None,
+    if plot is not None:
+        from screwkit.report.graph_synthesis_plots import write_graph_synthesis_plot
+
+        x = results[0].x
+        _guard(lambda: write_graph_synthesis_plot(spec, problem, doc, x, du, plot))
+        out.note_written(plot)
+    out.deliver(document=lambda: doc, table=lambda: graph_synthesis_table(spec, problem, doc),
                 show=lambda: _show(spec, problem, doc, du, out.full), units=du)

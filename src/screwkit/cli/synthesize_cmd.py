@@ -250,25 +250,23 @@ def global_synthesis(config: Any, starts: int, scheduler: str | None, workers: i
         stopped(exc, "nothing written")
 
 
-def _graph(spec: Any, out: Any, starts: int | None, spec_out: Path | None, csv: Path | None,
-           plot: Path | None, scheduler: str | None, workers: int | None) -> None:
+def _graph(spec: Any, out: Any, starts: int | None, spec_out: Path | None, plot: Path | None,
+           scheduler: str | None, workers: int | None) -> None:
     """A graph spec: refuse what it has no counterpart for before any work, then solve."""
     import importlib.util
 
     from screwkit.cli.graph_synthesize import graph_synthesize
 
-    for flag, given in (("--csv", csv), ("--plot", plot), ("--scheduler", scheduler),
-                        ("--workers", workers)):
+    for flag, given in (("--scheduler", scheduler), ("--workers", workers)):
         if given is not None:
-            user_error(f"{flag} is not available for a graph spec's synthesis; use --json or "
-                       "-o FILE.json (docs/synthesis.md, \"Graphs\")")
-    if out.output is not None and (out.output_format or "json") != "json":
-        user_error(f"-o {out.output}: a graph spec's synthesis writes JSON only; give a .json "
-                   "name")
+            user_error(f"{flag} is not available for a graph spec's synthesis (its starts run "
+                       "in this process; docs/synthesis.md, \"Graphs\")")
+    if plot is not None and plot.suffix.lower() not in (".png", ".svg", ".pdf"):
+        user_error(f"--plot {plot}: give a file ending in .png, .svg or .pdf")
     if spec_out is not None and importlib.util.find_spec("tomlkit") is None:
         user_error("--spec-out writes the synthesised spec with tomlkit, which is not "
                    "installed: pip install 'screwkit[synthesis]'")
-    graph_synthesize(spec, out, starts, spec_out)
+    graph_synthesize(spec, out, starts, spec_out, plot)
 
 
 def register(app: typer.Typer) -> None:
@@ -307,7 +305,7 @@ def register(app: typer.Typer) -> None:
                                                            "--spec-out": spec_out})
         loaded = _guard(lambda: load_spec(spec))
         if getattr(loaded, "family", None) == "graph":
-            _graph(loaded, out, starts, spec_out, csv, plot, scheduler, workers)
+            _graph(loaded, out, starts, spec_out, plot, scheduler, workers)
             return
         if spec_out is not None:
             user_error("--spec-out is for graph specs (a single loop's result is its "

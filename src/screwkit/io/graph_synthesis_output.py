@@ -14,7 +14,8 @@ import numpy as np
 from screwkit.errors import InputError
 from screwkit.synthesis.graph_route import GraphSynthesisProblem, GraphSynthesisResult
 
-__all__ = ["graph_synthesis_document", "synthesised_spec_text", "variable_rows"]
+__all__ = ["graph_synthesis_document", "graph_synthesis_table", "synthesised_spec_text",
+           "variable_rows"]
 
 
 def _in_spec_units(spec: Any, kind: str, si: float) -> float:
@@ -106,3 +107,36 @@ def synthesised_spec_text(spec: Any, problem: GraphSynthesisProblem, x: np.ndarr
         vec[v.component] = _number(vec[v.component], shown, unit if v.kind == "length"
                                    else None)
     return tomlkit.dumps(doc)
+
+
+def graph_synthesis_table(spec: Any, problem: GraphSynthesisProblem, doc: dict[str, Any]) -> Any:
+    """The target rows of the best result as a table (``--csv``, ``-o FILE.csv``): one line per
+    target row and component — target, kind, component (x/y/z of a point, else empty), every
+    input, then desired, generated and error (desired − generated, angles wrapped to (−π, π]) in
+    ``*_angle`` or ``*_length`` columns by the target's kind (the other pair empty). SI here;
+    written in the display units (the spec's by default), as the document's ``rows``."""
+    from screwkit.tables import Column, ResultTable
+
+    names = list(spec.mechanism.driven_names)
+    slides = list(spec.mechanism.driven_is_translation())
+    comps = {t.label: t.components if t.what == "point" else None for t in problem.targets}
+    text: dict[str, list[str]] = {"target": [], "kind": [], "component": []}
+    inputs: list[list[float]] = []
+    vals: dict[str, list[float]] = {f"{q}_{k}": [] for k in ("angle", "length")
+                                    for q in ("desired", "generated", "error")}
+    for r in doc["rows"]:
+        cs = comps.get(r["target"])
+        for c in range(len(r["desired"])):
+            text["target"].append(r["target"])
+            text["kind"].append(r["kind"])
+            text["component"].append("xyz"[cs[c]] if cs is not None else "")
+            inputs.append(r["input"])
+            for q in ("desired", "generated", "error"):
+                for k in ("angle", "length"):
+                    vals[f"{q}_{k}"].append(r[q][c] if r["kind"] == k else math.nan)
+    x = np.array(inputs, dtype=float).reshape(-1, len(names))
+    cols = [Column(k, "text", np.array(v, dtype=str)) for k, v in text.items()]
+    cols += [Column(f"input_{n}", "length" if s else "angle", x[:, i])
+             for i, (n, s) in enumerate(zip(names, slides, strict=True))]
+    cols += [Column(k, k.split("_")[-1], np.array(v, dtype=float)) for k, v in vals.items()]
+    return ResultTable(tuple(cols), "graph synthesis: targets against the synthesised design")

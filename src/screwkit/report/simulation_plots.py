@@ -161,3 +161,32 @@ def write_graph_simulation_png(doc: dict[str, Any], path: str | Path) -> None:
     """The four plots of :func:`graph_simulation_plots` in one PNG (or SVG/PDF)."""
     plots_png(graph_simulation_plots(doc), f"{doc['name']}: simulation", path)
 
+
+
+def graph_cycles_plots(doc: dict[str, Any], samples: dict[str, Any]) -> list[dict[str, Any]]:
+    """The loop's four cycle plots for a graph's crank cycles (``GraphSpecCycles``: ``doc`` its
+    ``as_dict``, ``samples`` its run's samples): the crank speed against the angle turned in
+    the cycle (one curve per cycle) and against time, the motor torque against time, and C_s
+    per cycle."""
+    s = {k: np.asarray(v, dtype=float) for k, v in samples.items()}
+    n = len(doc["cycles"]["period"])
+    per = s["time"].size // n if n else 0
+    by_cycle = [_series(f"cycle {k + 1}", s["cycle_angle"][k * per:(k + 1) * per],
+                        s["speed"][k * per:(k + 1) * per]) for k in range(n)]
+    name = doc["input"]
+    return jsonable([
+        _plot("gcyc-speed-angle", f"{name} speed against its turn in the cycle (one curve per "
+              "cycle)", "angle in the cycle (deg)", "speed (rpm)", by_cycle, DEG, RPM),
+        _plot("gcyc-speed-time", f"{name} speed against time", "time (s)", "speed (rpm)",
+              [_series("speed", s["time"], s["speed"])], 1.0, RPM),
+        _plot("gcyc-torque-time", "motor torque", "time (s)", "torque (N·m)",
+              [_series("motor", s["time"], s["motor_torque"])]),
+        _plot("gcyc-fluctuation", "coefficient of speed fluctuation per cycle", "cycle", "C_s",
+              [_series("C_s", np.arange(1, n + 1), doc["cycles"]["fluctuation"],
+                       "line+points")])])
+
+
+def write_graph_cycles_png(doc: dict[str, Any], samples: dict[str, Any], path: str | Path
+                           ) -> None:
+    """The four plots of :func:`graph_cycles_plots` in one PNG (or SVG/PDF)."""
+    plots_png(graph_cycles_plots(doc, samples), f"{doc['name']}: crank cycles", path)

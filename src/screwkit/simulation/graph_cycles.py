@@ -69,7 +69,10 @@ class GraphCycles:
     ``period``, ``mean_speed``, ``min_speed``, ``max_speed``, ``fluctuation``, ``motor_work``,
     ``friction_work``, ``load_work``, ``motor_torque_rms``, ``motor_torque_peak``; the end
     state ``end`` (x, ẋ); ``energy_error`` the largest |E − E₀ − W| over the cycle ends relative
-    to the energy scale; ``status`` ``completed``, ``stalled`` or ``stopped``; ``flywheel``."""
+    to the energy scale; ``status`` ``completed``, ``stalled`` or ``stopped``; ``flywheel``;
+    ``samples`` (when asked for: ``time``, ``angle``, ``cycle_angle`` — the turn from the start
+    of its cycle in the sense of rotation, in [0, 2π) — ``speed`` and ``motor_torque`` at equal
+    time steps in every completed cycle, from the dense output; not in ``as_dict``)."""
 
     input_name: str
     flywheel: float
@@ -79,6 +82,7 @@ class GraphCycles:
     energy_error: float
     status: str
     message: str
+    samples: dict[str, Array] | None = None
 
     @property
     def cycles(self) -> int:
@@ -139,12 +143,30 @@ def _cycle_statistics(res: Any, t: float, t_end: float, y: Array, y_end: Array,
             "motor_torque_peak": float(tau.max())}
 
 
+#: what ``GraphCycles.samples`` holds, in this order
+SAMPLE_KEYS = ("time", "angle", "cycle_angle", "speed", "motor_torque")
+
+
+def _cycle_samples(res: Any, t: float, t_end: float, start: float, sense: float, motor: Any,
+                   n: int) -> Array:
+    """``n`` samples (rows: :data:`SAMPLE_KEYS`) at equal time steps of the cycle from ``t``
+    (input ``start``) to ``t_end``, read from the dense output ``res.sol``."""
+    ts = np.linspace(t, t_end, n, endpoint=False)
+    xs, ws = res.sol(ts)[:2]
+    return np.vstack([ts, xs, sense * (xs - start), ws, motor_torque(motor, ws)])
+
+
+def _stack_samples(kept: list[Array]) -> dict[str, Array]:
+    return dict(zip(SAMPLE_KEYS, np.hstack(kept) if kept else np.zeros((5, 0)), strict=True))
+
+
 def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_rate: float,
                           initial_input: float = 0.0, rtol: float = 1e-10,
-                          atol: float | None = None, max_time: float | None = None
-                          ) -> GraphCycles:
+                          atol: float | None = None, max_time: float | None = None,
+                          samples_per_cycle: int = 0) -> GraphCycles:
     """Integrate ``cycles`` turns of the crank from ``initial_input`` at ``initial_rate``
-    (module docstring)."""
+    (module docstring); ``samples_per_cycle`` > 0 keeps that many samples of every completed
+    cycle (``GraphCycles.samples``, from the dense output: no new right-hand sides)."""
     name = crank_input(eom)
     if not (np.isfinite(initial_rate) and initial_rate != 0):
         raise SimulationError(f"{eom.mechanism.name}: crank cycles need a nonzero initial "
@@ -177,6 +199,7 @@ def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_ra
     stall.direction = -1.0  # type: ignore[attr-defined]
     y = np.array([x0, w0, 0.0, 0.0, 0.0, 0.0])
     times, stats, ends = [0.0], [], [y.copy()]
+    kept: list[Array] = []
     e0 = first["kinetic_energy"] + first["potential_energy"]
     balance = [0.0]
     # the first step, and the longest: short enough that the closure's first-order predictor
@@ -213,6 +236,9 @@ def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_ra
         t_end = float(res.t_events[0][0])
         y_end = res.y_events[0][0]
         stats.append(_cycle_statistics(res, t, t_end, y, y_end, motor, sense))
+        if samples_per_cycle > 0:
+            kept.append(_cycle_samples(res, t, t_end, target - sense * TWO_PI, sense, motor,
+                                       samples_per_cycle))
         try:
             T = eom.terms(y_end[:1], y_end[1:2])
         except SimulationError as exc:
@@ -232,7 +258,7 @@ def simulate_graph_cycles(eom: GraphEquationOfMotion, *, cycles: int, initial_ra
     scale = max(energy, float(work), 1e-300)
     return GraphCycles(name, float(eom.flywheel[0]), np.array(times), table,
                        (float(y[0]), float(y[1])), float(np.max(np.abs(balance)) / scale),
-                       status, message)
+                       status, message, _stack_samples(kept) if samples_per_cycle else None)
 
 
 def with_graph_flywheel(eom: GraphEquationOfMotion, flywheel: float) -> GraphEquationOfMotion:

@@ -93,10 +93,12 @@ class GraphSpecCycles:
 
 def simulate_graph_spec_cycles(spec: Any, *, cycles: int | None = None,
                                fluctuation: float | None = None,
-                               flywheel: float | None = None) -> GraphSpecCycles:
+                               flywheel: float | None = None,
+                               samples_per_cycle: int = 0) -> GraphSpecCycles:
     """``cycles`` turns (default 10) of a one-input graph spec's crank from its first
     ``[motion]`` row at the ``[drive] initial_speed``; with ``fluctuation`` first size the
-    flywheel for that steady C_s (simulation/graph_cycles.py) and run with it."""
+    flywheel for that steady C_s (simulation/graph_cycles.py) and run with it;
+    ``samples_per_cycle`` keeps samples of every cycle (``run.samples``, for ``--plot``)."""
     d = graph_drive_config(spec)
     eom = graph_spec_equation_of_motion(spec, d, flywheel)
     x0 = float(np.asarray(spec.inputs[0], dtype=float).reshape(-1)[0])
@@ -106,7 +108,8 @@ def simulate_graph_spec_cycles(spec: Any, *, cycles: int | None = None,
         sizing = size_graph_flywheel(eom, fluctuation, w0, initial_input=x0, rtol=d.rtol)
         eom = with_graph_flywheel(eom, sizing.flywheel)
     run = simulate_graph_cycles(eom, cycles=cycles or DEFAULT_CYCLES, initial_rate=w0,
-                                initial_input=x0, rtol=d.rtol, atol=d.atol)
+                                initial_input=x0, rtol=d.rtol, atol=d.atol,
+                                samples_per_cycle=samples_per_cycle)
     return GraphSpecCycles(spec, d, run, sizing)
 
 
