@@ -142,9 +142,9 @@ def test_an_output_fifo_is_refused_without_blocking(tmp_path: Path) -> None:
 
 
 def test_ctrl_c_leaves_no_file_and_no_traceback(tmp_path: Path) -> None:
-    # a run of a minute or more (generic solver, 0.05° steps), interrupted once it is under way:
-    # the process says when its imports are done, and the signal comes a second later
-    spec = (SPECS / "rsrc.toml").read_text().replace('step = "10 deg"', 'step = "0.05 deg"')
+    # a run of about 5 s (generic solver, 0.004° steps: 90,000 samples), interrupted once it is
+    # under way: the process says when its imports are done, and the signal comes a second later
+    spec = (SPECS / "rsrc.toml").read_text().replace('step = "10 deg"', 'step = "0.004 deg"')
     (tmp_path / "long.toml").write_text(spec)
     out = tmp_path / "out.json"
     start = ("import sys; from screwkit.cli.main import app; "
@@ -164,7 +164,8 @@ def test_ctrl_c_leaves_no_file_and_no_traceback(tmp_path: Path) -> None:
         proc.kill()
         pytest.fail("screwkit did not stop on Ctrl-C")
     assert "Traceback" not in stderr, stderr
-    if proc.returncode == 0:  # it finished first: the file is whole
+    if proc.returncode in (0, -2) and out.exists():  # it finished first: the file is whole
+        # (-2: the signal came as the interpreter shut down, after the file was in place)
         json.loads(out.read_text())
     else:  # typer exits with 130 (128 + SIGINT) and says nothing
         assert proc.returncode in (1, 130) and not out.exists(), (proc.returncode, stderr)
