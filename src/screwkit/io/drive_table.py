@@ -295,6 +295,22 @@ def checked_friction(linkage: Any, friction: Any) -> tuple[JointFriction, ...]:
     return tuple(JointFriction(name, *merged[name]) for name in order if name in merged)
 
 
+def split_friction(spec: Any, key: str, name: str, kind: str, value: Any
+                   ) -> tuple[Any, Any]:
+    """One ``[drive.friction]`` entry as its (rotation, translation) coefficients as written
+    (None where absent): a ``{ rotation = …, translation = … }`` table, or one value, which is
+    translational for a P joint and rotational otherwise; a C joint (both) needs the table.
+    Shared by single loops and mechanism graphs (io/graph_drive.py)."""
+    if isinstance(value, FrictionTable):
+        if value.rotation is None and value.translation is None:
+            _fail(spec, key, "give rotation and/or translation")
+        return value.rotation, value.translation
+    if kind == "C":
+        _fail(spec, key, f"{name!r} is a C joint, which turns and slides: give "
+                         "{ rotation = …, translation = … } (N·m·s/rad and N·s/m)")
+    return (None, value) if kind == "P" else (value, None)
+
+
 def _friction(spec: Any, table: dict[str, Any] | None) -> tuple[JointFriction, ...]:
     """``[drive.friction]``: joint name -> a viscous coefficient (rotational for R, H, U, S;
     translational for P) or ``{ rotation = …, translation = … }`` (a C joint has both)."""
@@ -305,17 +321,7 @@ def _friction(spec: Any, table: dict[str, Any] | None) -> tuple[JointFriction, .
     for name, value in table.items():
         key = f"friction.{name}"
         kind = joints[name].kind if name in joints else ""
-        if isinstance(value, FrictionTable):
-            rotation, translation = value.rotation, value.translation
-            if rotation is None and translation is None:
-                _fail(spec, key, "give rotation and/or translation")
-        elif kind == "C":
-            _fail(spec, key, f"{name!r} is a C joint, which turns and slides: give "
-                             "{ rotation = …, translation = … } (N·m·s/rad and N·s/m)")
-        elif kind == "P":
-            rotation, translation = None, value
-        else:
-            rotation, translation = value, None
+        rotation, translation = split_friction(spec, key, name, kind, value)
         problem = friction_problem(spec.linkage, name, rotation is not None,
                                    translation is not None)
         if problem is not None:

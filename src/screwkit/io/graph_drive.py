@@ -56,6 +56,7 @@ from screwkit.io.drive_table import (
     Value,
     load_config,
     motor_config,
+    split_friction,
 )
 from screwkit.io.validation import validation_lines
 from screwkit.messages import listing
@@ -125,18 +126,7 @@ def _friction(spec: Any, table: dict[str, Any] | None) -> tuple[JointFriction, .
         key = f"friction.{name}"
         if name not in joints:
             _fail(spec, key, f"no joint {name!r}; the joints are {list(joints)}")
-        kind = joints[name].kind
-        if isinstance(value, FrictionTable):
-            rotation, translation = value.rotation, value.translation
-            if rotation is None and translation is None:
-                _fail(spec, key, "give rotation and/or translation")
-        elif kind == "C":
-            _fail(spec, key, f"{name!r} is a C joint, which turns and slides: give "
-                             "{ rotation = …, translation = … } (N·m·s/rad and N·s/m)")
-        elif kind == "P":
-            rotation, translation = None, value
-        else:
-            rotation, translation = value, None
+        rotation, translation = split_friction(spec, key, name, joints[name].kind, value)
         c_r = 0.0 if rotation is None else spec.quantity(rotation, "rotational_damping",
                                                          f"drive.{key}")
         c_t = 0.0 if translation is None else spec.quantity(translation,
