@@ -202,6 +202,15 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     Xd = _per_sample(rates, N, n_in, "rates")
     Xdd = _per_sample(accelerations, N, n_in, "accelerations")
     lay = graph_layout(mech)
+    from screwkit.kinematics.graph.loop_subchain import loop_chain, loop_motion
+
+    chain = loop_chain(mech)
+    if chain is not None:  # one loop: the loop engine is its sub-chain solver
+        looped = loop_motion(mech, lay, chain, X, Xd, Xdd, every_mode)
+        if looped is not None:
+            if callable(progress):
+                progress(N, N)
+            return looped  # type: ignore[return-value]
     dec = decompose(mech)
     if dec.complete and not misfits(mech):  # seat offsets (tolerances): re-assembled below
         motion = _closed_form_motion(mech, lay, dec, X, Xd, Xdd, every_mode)

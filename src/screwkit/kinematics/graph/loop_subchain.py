@@ -1,0 +1,518 @@
+"""A mechanism that is one loop, solved by the loop engine as a sub-chain of the graph (issue 26:
+one solving path for loops and graphs).
+
+:func:`loop_chain` recognises a mechanism that is a single loop — one independent cycle through
+every joint and moving body, no driven body freedoms, no part made off its drawing, joints
+R/P/C/H/U/S (a U joint's axes perpendicular, as the loop's U joint has them) — and builds the
+equivalent :class:`~screwkit.model.linkage.Linkage` from the drawing: the inverse of
+graph/from_loop.py. The loop runs from the ground through the input joint (when the input is on
+the ground) round to the ground. Two forms:
+
+* a planar four-bar drawn with four parallel R axes, its input on the ground, is the 4R family
+  (:func:`screwkit.model.families.fourbar`, Bagci's frame a, crank d1, coupler d2, rocker d3
+  measured off the drawing), placed in the world by the linkage ``base``, so that
+  ``solve_motion`` uses its closed form (Bagci 1969 eqs. 3.59–3.82, the δ0 = λ0 = b = e = 0
+  case);
+* any other loop as a joint list whose joint i has the frame F_i (origin the joint's drawn
+  point, z its axis, signed so the loop runs from the joint's first body to its second; a U
+  joint's y axis its second axis) and the link transforms L_i = F_i⁻¹ F_{i+1} (Rahman eq. 2.2
+  with a general screw matrix in place of X(α + εa)), base F_1. Then every joint variable is 0
+  at the drawing and equals the graph's: the graph's M_j(q) (model/mechanism.py) is
+  F_i J_i(q) F_i⁻¹, or its inverse with the axis reversed (R, P, C, H: the same variable; a U
+  joint's two angles swap). Such a loop goes to the generic loop solver, or the RCCC closed form
+  where it applies.
+
+:func:`loop_modes` solves the loop with :func:`~screwkit.kinematics.solve_motion.solve_motion`
+on the inputs from the drawing (every input 0) along a straight approach to the first row and
+then along the rows, and returns each loop mode as the graph's body poses (the link frames
+times the drawn link frames' inverse: every body frame is the world frame in the drawing) and
+joint variables, angles counted continuously from the drawing for the drawn mode (the mode whose
+joint lines are the drawing's at the first sample). graph/motion.py builds the rest of each
+mode (rates, accelerations, points, outputs, singularities) as for every graph.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.dual import ScrewMatrix
+from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.motion import Motion
+from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.model.joints import Joint
+from screwkit.model.linkage import Link, Linkage
+from screwkit.model.mechanism import GROUND, Mechanism
+
+Array = NDArray[np.float64]
+
+#: drawn lines and loop joint lines agree within this fraction of the length scale (and the
+#: axes within this angle, rad): the test that picks the drawn mode and checks the 4R's reading
+LINE_TOL = 1e-7
+#: the largest input step (rad, or this fraction of the length scale for a slide) on the
+#: straight approach from the drawing to the first input row (as graph/closed_modes.py)
+APPROACH_STEP = 0.05
+#: axes closer to parallel than this (|u × v|) are parallel for the 4R reading
+PARALLEL_TOL = 1e-12
+
+
+@dataclass(frozen=True)
+class LoopChain:
+    """A single-loop mechanism as a loop: loop joint i is graph joint ``joints[i]``, traversed
+    from graph body ``bodies[i]`` to ``bodies[i + 1]`` (``bodies[0]`` and ``bodies[-1]`` the
+    ground); loop link k is graph body ``bodies[k + 1]``. Loop input k = ``offset[k]`` +
+    ``sign[k]`` · graph input ``order[k]``."""
+
+    linkage: Linkage
+    joints: tuple[int, ...]
+    bodies: tuple[str, ...]
+    order: tuple[int, ...]
+    sign: Array
+    offset: Array
+
+    def loop_inputs(self, X: Array) -> Array:
+        """Graph input rows (N, n_in) as the loop's input rows."""
+        return self.offset + self.sign * X[:, list(self.order)]
+
+
+def loop_chain(mech: Mechanism) -> LoopChain | None:
+    """The loop of ``mech`` when it is a single loop the loop engine solves (module
+    docstring), else None."""
+    if mech.drives or any(j.seat_offset is not None for j in mech.joints):
+        return None
+    top = mech.topology
+    if len(top.loops) != 1 or len(top.loops[0]) != len(mech.joints) or len(mech.joints) < 2:
+        return None
+    for j in mech.joints:
+        if j.kind == "U" and abs(float(j.axis @ j.axis2)) > 1e-12:  # type: ignore[operator]
+            return None
+    order = _loop_order(mech)
+    if order is None:
+        return None
+    joints, bodies = order
+    for family in (_fourbar, _rsrc):
+        found = family(mech, joints, bodies)
+        if found is not None:
+            return found
+    return _joint_list(mech, joints, bodies)
+
+
+def frame_form(mech: Mechanism) -> LoopChain | None:
+    """The loop of ``mech`` as a joint list in frame form (module docstring), or None."""
+    if loop_chain(mech) is None:
+        return None
+    order = _loop_order(mech)
+    assert order is not None
+    return _joint_list(mech, *order)
+
+
+def _loop_order(mech: Mechanism) -> tuple[tuple[int, ...], tuple[str, ...]] | None:
+    """The joints in loop order from the ground (through a ground input joint first, when
+    there is one) and the bodies between them."""
+    on_ground = [k for k, j in enumerate(mech.joints) if GROUND in j.bodies]
+    if len(on_ground) != 2:
+        return None
+    driven = {x.split(".")[0] for x in mech.inputs}
+    first = next((k for k in on_ground if mech.joints[k].name in driven), on_ground[0])
+    joints, bodies = [first], [GROUND]
+    body = _other(mech, first, GROUND)
+    while body != GROUND:
+        bodies.append(body)
+        nxt = [k for k, j in enumerate(mech.joints) if body in j.bodies and k != joints[-1]]
+        if len(nxt) != 1:
+            return None
+        joints.append(nxt[0])
+        body = _other(mech, nxt[0], body)
+    bodies.append(GROUND)
+    if len(joints) != len(mech.joints):
+        return None
+    return tuple(joints), tuple(bodies)
+
+
+def _other(mech: Mechanism, k: int, body: str) -> str:
+    a, b = mech.joints[k].bodies
+    return b if a == body else a
+
+
+def _frame(z: Array, y_hint: Array | None, origin: Array) -> Array:
+    """A 4×4 frame with z axis ``z`` (and y axis ``y_hint`` when given, perpendicular to z)."""
+    if y_hint is None:
+        helper = np.eye(3)[int(np.argmin(np.abs(z)))]
+        x = np.cross(helper, z)
+        x /= np.linalg.norm(x)
+        y = np.cross(z, x)
+    else:
+        y = y_hint
+        x = np.cross(y, z)
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([x, y, z])
+    T[:3, 3] = origin
+    return T
+
+
+def _screw(T: Array) -> ScrewMatrix:
+    return ScrewMatrix.from_rotation_translation(T[:3, :3], T[:3, 3])
+
+
+def _joint_list(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]) -> LoopChain:
+    """The frame form (module docstring)."""
+    frames, loop_joints, rename = [], [], {}
+    for i, k in enumerate(joints):
+        j = mech.joints[k]
+        forward = j.bodies == (bodies[i], bodies[i + 1])
+        s = 1.0 if forward else -1.0
+        if j.kind == "S":
+            frames.append(_frame(np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0]), j.at))
+        elif j.kind == "U":
+            assert j.axis2 is not None
+            z, y = (j.axis, j.axis2) if forward else (-j.axis2, -j.axis)
+            frames.append(_frame(z, y, j.at))
+            if not forward:
+                rename[f"{j.name}.theta1"] = f"{j.name}.theta2"
+                rename[f"{j.name}.theta2"] = f"{j.name}.theta1"
+        else:
+            frames.append(_frame(s * j.axis, None, j.at))
+        loop_joints.append(Joint(j.name, j.kind, 0.0, j.pitch))
+    n = len(joints)
+    transforms = tuple(_screw(np.linalg.inv(frames[i]) @ frames[(i + 1) % n]) for i in range(n))
+    graph_inputs = list(mech.inputs)
+    loop_inputs = tuple(rename.get(x, x) for x in graph_inputs)
+    lk = Linkage(mech.name, tuple(loop_joints), transforms,
+                 tuple(Link(b) for b in bodies[1:-1]), loop_inputs, base=_screw(frames[0]))
+    order = tuple(graph_inputs.index(rename.get(x, x)) for x in loop_inputs)
+    n_in = len(loop_inputs)
+    return LoopChain(lk, joints, bodies, order, np.ones(n_in), np.zeros(n_in))
+
+
+def _fourbar(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
+             ) -> LoopChain | None:
+    """A planar four-bar with its input on the ground as the 4R family (module docstring)."""
+    from screwkit.model.families import fourbar
+
+    J = [mech.joints[k] for k in joints]
+    if len(J) != 4 or any(j.kind != "R" for j in J) or len(mech.inputs) != 1 \
+            or mech.inputs[0] != f"{J[0].name}.theta":
+        return None
+    z = J[0].axis if J[0].bodies == (GROUND, bodies[1]) else -J[0].axis
+    if any(float(np.linalg.norm(np.cross(z, j.axis))) > PARALLEL_TOL for j in J):
+        return None
+    o = J[0].at
+    pts = [j.at - ((j.at - o) @ z) * z for j in J]  # every pivot in the input's plane
+    d = [float(np.linalg.norm(pts[(i + 1) % 4] - pts[i])) for i in range(4)]
+    if min(d) <= 1e-9 * mech.length_scale:
+        return None
+    x = (pts[3] - o) / d[3]
+    crank = (pts[1] - o) / d[0]
+    theta0 = float(np.arctan2(np.cross(x, crank) @ z, x @ crank))
+    lk = fourbar(a=d[3], d1=d[0], d2=d[1], d3=d[2])
+    base = _frame(z, np.cross(z, x), o)
+    lk = replace(lk, name=mech.name, links=tuple(Link(b) for b in bodies[1:-1]),
+                 base=_screw(base) @ lk.base)
+    return LoopChain(lk, joints, bodies, (0,), np.ones(1), np.array([theta0]))
+
+
+def _line_foot(c: Array, u: Array, point: Array) -> Array:
+    return c + ((point - c) @ u) * u
+
+
+def _common_normal(c1: Array, u1: Array, c2: Array, u2: Array) -> tuple[Array, Array] | None:
+    """The feet on lines (c1, u1) and (c2, u2) of their common normal (None: parallel)."""
+    n = np.cross(u1, u2)
+    if float(np.linalg.norm(n)) < 1e-9:
+        return None
+    d = c2 - c1
+    b = float(u1 @ u2)
+    t1 = (d @ u1 - b * (d @ u2)) / (1.0 - b * b)
+    t2 = (b * (d @ u1) - d @ u2) / (1.0 - b * b)
+    return c1 + t1 * u1, c2 + t2 * u2
+
+
+def _rsrc(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
+          ) -> LoopChain | None:
+    """An R–S–R–C loop driven at its ground R joint as Bagci's RSRC
+    (:func:`screwkit.model.families.rsrc`): the input axis is its X axis, through the foot O of
+    the ball centre (the crank d1 in the plane X = 0, θ0 from +Y about +X); Y is the common
+    normal to the output axis u3 = (cos λ0, 0, −sin λ0), which passes through (b, a, 0); d2 is the
+    ball centre's distance from the coupler R axis, d3 and δ0 that axis's common normal and
+    angle to the output axis, e the offset along it between the two feet. The signs of u3, e and
+    δ0 the drawing does not fix are those whose loop draws the drawing's joint lines."""
+    from screwkit.model.families import rsrc
+
+    J = [mech.joints[k] for k in joints]
+    if [j.kind for j in J] != ["R", "S", "R", "C"] or len(mech.inputs) != 1 \
+            or mech.inputs[0] != f"{J[0].name}.theta":
+        return None
+    X = J[0].axis if J[0].bodies == (GROUND, bodies[1]) else -J[0].axis
+    ball = J[1].at
+    O = _line_foot(J[0].at, X, ball)
+    d1 = float(np.linalg.norm(ball - O))
+    c3 = J[3].at
+    n = np.cross(X, J[3].axis)
+    if float(np.linalg.norm(n)) < 1e-9:  # parallel axes: the normal from the input axis
+        n = (c3 - O) - ((c3 - O) @ X) * X
+    if d1 <= 1e-9 * mech.length_scale or float(np.linalg.norm(n)) <= 1e-9 * mech.length_scale:
+        return None
+    Y = n / np.linalg.norm(n)
+    Z = np.cross(X, Y)
+    feet = _common_normal(O, X, c3, J[3].axis)
+    f3 = feet[1] if feet is not None else c3 - ((c3 - O) @ X) * X
+    a, b = float((f3 - O) @ Y), float((f3 - O) @ X)
+    c2, u2 = J[2].at, J[2].axis
+    d2 = float(np.linalg.norm(ball - _line_foot(c2, u2, ball)))
+    normal = _common_normal(c2, u2, c3, J[3].axis)
+    if normal is None:
+        return None
+    d3 = float(np.linalg.norm(normal[1] - normal[0]))
+    e = float(np.linalg.norm(normal[0] - _line_foot(c2, u2, ball)))
+    delta = float(np.arccos(np.clip(abs(float(u2 @ J[3].axis)), 0.0, 1.0)))
+    theta0 = float(np.arctan2((ball - O) @ Z, (ball - O) @ Y))
+    W = np.eye(4)
+    W[:3, :3] = np.column_stack([X, Y, Z])
+    W[:3, 3] = O
+    for s3 in (1.0, -1.0):
+        u3 = s3 * J[3].axis
+        lam = float(np.arctan2(-(u3 @ Z), u3 @ X))
+        for ee in (e, -e):
+            for dd in (delta, -delta, np.pi - delta, delta - np.pi):
+                try:
+                    lk = rsrc(d1, d2, d3, a, b, ee, dd, lam)
+                except ValueError:
+                    return None
+                lk = replace(lk, name=mech.name, links=tuple(Link(x) for x in bodies[1:-1]),
+                             base=_screw(W) @ lk.base)
+                chain = LoopChain(lk, joints, bodies, (0,), np.ones(1), np.array([theta0]))
+                if _draws(mech, chain):
+                    return chain
+    return None
+
+
+def _draws(mech: Mechanism, chain: LoopChain) -> bool:
+    """Whether some mode of the chain's loop at its drawn input is the drawing (closed form,
+    two samples)."""
+    from screwkit.kinematics.registry import family_of
+
+    closed = family_of(chain.linkage).closed_form_for(chain.linkage)
+    assert closed is not None
+    X = chain.offset[None, :] + np.array([[0.0], [1e-3]])
+    try:
+        motion = closed(chain.linkage, X, np.ones_like(X), np.zeros_like(X))
+    except ValueError:
+        return False
+    return any(_is_drawing(mech, chain, md) for md in motion.modes)
+
+
+@dataclass(frozen=True)
+class LoopModes:
+    """The loop's solution as graph modes: per loop mode (in ``solve_motion``'s order) the
+    samples where it assembles (M, N), the graph configurations (one per mode) and which mode is
+    the drawn one (None: none passes through the drawing)."""
+
+    motion: Motion
+    assembles: NDArray[np.bool_]
+    confs: tuple[Configuration, ...]
+    drawn: int | None
+
+
+def approach(lay: GraphLayout, X: Array) -> Array:
+    """Input rows from the drawing (every input 0) along the straight way to ``X[0]``, in
+    steps of at most APPROACH_STEP (rad, or of the length scale), the drawing first and
+    ``X[0]`` left out."""
+    scale = np.array([lay.length if lay.is_translation[f] else 1.0 for f in lay.inputs])
+    steps = max(1, int(np.ceil(float(np.max(np.abs(X[0]) / scale)) / APPROACH_STEP)))
+    return np.linspace(0.0, 1.0, steps + 1)[:-1, None] * X[0][None, :]
+
+
+def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array) -> LoopModes:
+    """Every loop mode over the approach (:func:`approach`) and ``X``, as graph configurations
+    over the rows of ``X`` (module docstring)."""
+    from screwkit.kinematics.solve_motion import solve_motion
+
+    A = approach(lay, X)
+    rows = np.vstack([A, X])
+    motion = solve_motion(chain.linkage, chain.loop_inputs(rows), progress=False)
+    a = A.shape[0]
+    drawn = next((m for m, md in enumerate(motion.modes) if _is_drawing(mech, chain, md)), None)
+    if drawn is None:
+        return LoopModes(motion, np.zeros((0, X.shape[0]), dtype=bool), (), None)
+    R0 = motion.modes[drawn].link_rotation[0]
+    p0 = motion.modes[drawn].link_origin[0]
+    confs, masks = [], []
+    for m, md in enumerate(motion.modes):
+        ok = np.array(md.assembles)
+        if m == drawn:  # followed from the drawing: it ends where it first stops assembling
+            stop = int(np.argmin(ok)) if not ok.all() else ok.size
+            ok[stop:] = False
+        R, p = _body_poses(mech, chain, md, R0, p0, ok)
+        conf = _configuration(mech, lay, R, p, rows, ok, m == drawn)
+        confs.append(conf.take(slice(a, None)))
+        masks.append(ok[a:])
+    return LoopModes(motion, np.array(masks), tuple(confs), drawn)
+
+
+def _is_drawing(mech: Mechanism, chain: LoopChain, md: object) -> bool:
+    """Whether a loop mode's joint lines at its first sample are the drawing's."""
+    ok = md.assembles  # type: ignore[attr-defined]
+    if not ok[0]:
+        return False
+    tol = LINE_TOL * mech.length_scale
+    c, u = md.joint_centres[0], md.joint_axes[0]  # type: ignore[attr-defined]
+    for i, k in enumerate(chain.joints):
+        j = mech.joints[k]
+        if j.kind == "S":
+            if np.linalg.norm(c[i] - j.at) > tol:
+                return False
+            continue
+        axes = [j.axis] if j.kind != "U" else [j.axis, j.axis2]
+        if min(float(np.linalg.norm(np.cross(u[i], v))) for v in axes) > LINE_TOL:
+            return False
+        if j.kind != "P":
+            off = j.at - c[i]
+            if np.linalg.norm(off - (off @ u[i]) * u[i]) > tol:
+                return False
+    return True
+
+
+def _body_poses(mech: Mechanism, chain: LoopChain, md: object, R0: Array, p0: Array,
+                ok: NDArray[np.bool_]) -> tuple[Array, Array]:
+    """The graph's body poses (N, B+1, …; the ground last, the identity) from a loop mode's
+    link frames: T_body = T_link · T_link(drawing)⁻¹."""
+    N = ok.shape[0]
+    B = len(mech.bodies) + 1
+    R = np.broadcast_to(np.eye(3), (N, B, 3, 3)).copy()
+    p = np.zeros((N, B, 3))
+    LR = np.where(ok[:, None, None, None], md.link_rotation, np.eye(3))  # type: ignore[attr-defined]
+    Lp = np.where(ok[:, None, None], md.link_origin, 0.0)  # type: ignore[attr-defined]
+    for k, name in enumerate(chain.bodies[1:-1]):
+        b = mech.body_index(name)
+        R[:, b] = LR[:, k] @ R0[k].T
+        p[:, b] = Lp[:, k] - np.einsum("nij,j->ni", R[:, b], p0[k])
+    return R, p
+
+
+def _configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Array,
+                   ok: NDArray[np.bool_], from_drawing: bool) -> Configuration:
+    """Every joint variable from the body poses (the inverse of graph/closure.py's joint
+    motions M_j(q) on T_a⁻¹T_b): a rotation angle about the axis (atan2 of its sine and
+    cosine), a slide along it, an H joint's turns from its slide, a U joint's two angles, an S
+    joint's rotation; angles counted continuously along each run where the mode assembles
+    (from the drawing, every variable 0, for the drawn mode), the inputs as given."""
+    from screwkit.kinematics.graph.closed_modes import _runs
+
+    N = R.shape[0]
+    q = np.zeros((N, lay.n_scalar))
+    balls = np.empty((N, lay.n_spherical, 3, 3))
+    for i, j in enumerate(mech.joints):
+        a, b = (lay.body_of[x] for x in j.bodies)
+        Ra = R[:, a]
+        Rr = np.swapaxes(Ra, -1, -2) @ R[:, b]
+        pr = np.einsum("nji,nj->ni", Ra, p[:, b] - p[:, a])
+        if j.kind == "S":
+            balls[:, lay.spherical_of_joint[i]] = Rr
+            continue
+        col = lay.scalar_col[lay.first_freedom[i]]
+        u = j.axis
+        if j.kind == "P":
+            q[:, col] = pr @ u
+            continue
+        if j.kind == "U":
+            assert j.axis2 is not None
+            v = j.axis2
+            Rv = Rr @ v
+            Ru = np.swapaxes(Rr, -1, -2) @ u
+            q[:, col] = np.arctan2(np.cross(v, Rv) @ u, Rv @ v)
+            q[:, col + 1] = -np.arctan2(np.cross(u, Ru) @ v, Ru @ u)
+            continue
+        vee = np.stack([Rr[:, 2, 1] - Rr[:, 1, 2], Rr[:, 0, 2] - Rr[:, 2, 0],
+                        Rr[:, 1, 0] - Rr[:, 0, 1]], axis=1)
+        th = np.arctan2(0.5 * (vee @ u), 0.5 * (np.trace(Rr, axis1=1, axis2=2) - 1.0))
+        if j.kind == "H":  # the slide pitch·θ counts the turns
+            th = th + 2 * np.pi * np.round((pr @ u / j.pitch - th) / (2 * np.pi))
+        q[:, col] = th
+        if j.kind == "C":
+            q[:, col + 1] = pr @ u
+    turning = [lay.scalar_col[f] for f in range(lay.m)
+               if not lay.is_translation[f] and lay.scalar_col[f] >= 0]
+    for s, e in _runs(ok):
+        run = q[s:e, turning]
+        if s == 0 and from_drawing:
+            q[s:e, turning] = np.unwrap(np.vstack([np.zeros(len(turning)), run]), axis=0)[1:]
+        else:
+            q[s:e, turning] = np.unwrap(run, axis=0)
+    q[~ok] = 0.0
+    balls[~ok] = np.eye(3)
+    for k, f in enumerate(lay.inputs):
+        q[:, lay.scalar_col[f]] = X[:, k]
+    return Configuration(q, balls)
+
+
+LOOP_SOLVER = "the loop engine on the mechanism's one loop (graph/loop_subchain.py): {solver}; " \
+              "rates and accelerations from the stacked loop closure"
+
+
+def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, Xd: Array,
+                Xdd: Array, every: bool) -> object | None:
+    """The :class:`~screwkit.kinematics.graph.motion.MechanismMotion` of a single-loop
+    mechanism from the loop engine (module docstring): mode 0 the drawn mode, followed from the
+    drawing until it first stops assembling; with ``every`` then every other loop mode in
+    ``solve_motion``'s order. None where no loop mode passes through the drawing (the 4R
+    reading is then retried in frame form; then the caller follows the drawing itself)."""
+    from screwkit.kinematics.graph.motion import (
+        AssemblyError,
+        MechanismMotion,
+        build_mode,
+        input_text,
+        with_events,
+    )
+
+    lm = loop_modes(mech, lay, chain, X)
+    if lm.drawn is None and chain.linkage.family is not None:
+        chain = _joint_list(mech, chain.joints, chain.bodies)
+        lm = loop_modes(mech, lay, chain, X)
+    if lm.drawn is None:
+        return None
+    N = X.shape[0]
+    d = lm.drawn
+    if not lm.assembles[d, 0]:
+        raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
+                            f"first input row {input_text(mech, lay, X[0])}: the mechanism stops "
+                            "assembling before it")
+    order = [d] + ([m for m in range(len(lm.confs)) if m != d and lm.assembles[m].any()]
+                   if every else [])
+    modes = []
+    for m in order:
+        ok = lm.assembles[m]
+        md = build_mode(mech, lay, lm.confs[m], ok, X, Xd, Xdd)
+        events = _mask_events(mech, lay, X, ok, drawn=m == d)
+        label = "drawn" if m == d else f"loop mode {m}"
+        modes.append(replace(with_events(md, [*events, *md.events]), label=label,
+                             index=len(modes)))
+    motion = lm.motion
+    notes: tuple[str, ...] = ()
+    if every:
+        notes = (f"{len(motion.modes)} assembly mode(s) of the loop ({motion.method} solver); "
+                 f"{len(modes)} assemble over these inputs; mode 0 is the drawn one (the loop's "
+                 f"mode {d})", *motion.notes)
+    return MechanismMotion(mech, X, Xd, Xdd, tuple(modes), method=f"graph (loop, {motion.method})",
+                           solver=LOOP_SOLVER.format(solver=motion.solver or motion.method),
+                           notes=notes)
+
+
+def _mask_events(mech: Mechanism, lay: GraphLayout, X: Array, ok: NDArray[np.bool_],
+                 drawn: bool) -> list[str]:
+    """Where a mode stops and starts assembling, between the samples around it."""
+    from screwkit.kinematics.graph.motion import input_text
+
+    events = []
+    for k in np.flatnonzero(ok[:-1] != ok[1:]):
+        k = int(k)
+        if ok[k]:
+            events.append(f"stops assembling after input {input_text(mech, lay, X[k])} (a limit "
+                          f"position or dead centre before {input_text(mech, lay, X[k + 1])})")
+        else:
+            events.append(f"is born at input {input_text(mech, lay, X[k + 1])} (after "
+                          f"{input_text(mech, lay, X[k])})")
+        if drawn:
+            break
+    return events
