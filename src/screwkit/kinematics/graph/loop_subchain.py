@@ -472,7 +472,6 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
         lm = loop_modes(mech, lay, chain, X)
     if lm.drawn is None:
         return None
-    N = X.shape[0]
     d = lm.drawn
     if not lm.assembles[d, 0]:
         raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
