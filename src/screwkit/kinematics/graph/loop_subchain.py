@@ -364,7 +364,7 @@ def _is_drawing(mech: Mechanism, chain: LoopChain, md: object) -> bool:
             if np.linalg.norm(c[i] - j.at) > tol:
                 return False
             continue
-        axes = [j.axis] if j.kind != "U" else [j.axis, j.axis2]
+        axes = [j.axis] if j.axis2 is None else [j.axis, j.axis2]
         if min(float(np.linalg.norm(np.cross(u[i], v))) for v in axes) > LINE_TOL:
             return False
         if j.kind != "P":
@@ -460,6 +460,7 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
     reading is then retried in frame form; then the caller follows the drawing itself)."""
     from screwkit.kinematics.graph.motion import (
         AssemblyError,
+        MechanismMode,
         MechanismMotion,
         build_mode,
         input_text,
@@ -479,7 +480,7 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
                             "assembling before it")
     order = [d] + ([m for m in range(len(lm.confs)) if m != d and lm.assembles[m].any()]
                    if every else [])
-    modes = []
+    modes: list[MechanismMode] = []
     for m in order:
         ok = lm.assembles[m]
         md = build_mode(mech, lay, lm.confs[m], ok, X, Xd, Xdd)
@@ -504,8 +505,8 @@ def _mask_events(mech: Mechanism, lay: GraphLayout, X: Array, ok: NDArray[np.boo
     from screwkit.kinematics.graph.motion import input_text
 
     events = []
-    for k in np.flatnonzero(ok[:-1] != ok[1:]):
-        k = int(k)
+    for kk in np.flatnonzero(ok[:-1] != ok[1:]):
+        k = int(kk)
         if ok[k]:
             events.append(f"stops assembling after input {input_text(mech, lay, X[k])} (a limit "
                           f"position or dead centre before {input_text(mech, lay, X[k + 1])})")
