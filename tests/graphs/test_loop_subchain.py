@@ -126,23 +126,32 @@ def test_a_reversed_input_joint_turns_the_loop_the_other_way() -> None:
                                atol=1e-10)
 
 
-def test_a_loop_without_a_closed_form_goes_to_the_generic_loop_solver() -> None:
-    """An RCCC driven at a cylinder (no closed form): the joint list in frame form, every joint
-    variable 0 at the drawing and equal to the loop's."""
+def test_a_loop_without_a_closed_form_stays_on_the_graph_route_and_its_joint_list_agrees() -> None:
+    """An RCCC driven at a cylinder (no closed form) is followed by the graph tracker; its
+    joint list in frame form (loop_chain(generic=True)) solved by the generic loop solver gives
+    the same motion, every joint variable 0 at the drawing and equal to the loop's."""
+    from screwkit.kinematics.graph.closure import graph_layout
+    from screwkit.kinematics.graph.loop_subchain import loop_motion
+
     lk = sk.rccc((1.0, 1.5, 1.2, 1.4), (0.3, 0.5, -0.4, 0.6))
     lk = replace(lk, inputs=("C2.theta",), family=None)
     x = np.radians(np.arange(0.0, 30.0, 2.0))
     motion = sk.solve_motion(lk, x)
     md = motion.mode(0)
     mech = mechanism_from_loop(motion, 0, 0)
-    chain = loop_chain(mech)
+    assert loop_chain(mech) is None
+    chain = loop_chain(mech, generic=True)
     assert chain is not None and chain.linkage.family is None
-    g = solve_mechanism(mech, x - x[0])
-    assert g.method == "graph (loop, generic)"
-    gm = g.modes[0]
+    X0 = (x - x[0])[:, None]
+    ones, zeros = np.ones_like(X0), np.zeros_like(X0)
+    looped = loop_motion(mech, graph_layout(mech), chain, X0, ones, zeros, False)
+    tracked = solve_mechanism(mech, x - x[0])
+    assert tracked.method == "graph" and looped.method == "graph (loop, generic)"
     ok = md.assembles
-    for f in lk.freedom_names:
-        np.testing.assert_allclose(gm.variables[f][ok], md.variables[f][ok] - md.variables[f][0],
-                                   atol=1e-10, err_msg=f)
-        np.testing.assert_allclose(gm.velocities[f][ok], md.velocities[f][ok], atol=1e-9,
-                                   err_msg=f)
+    for gm in (looped.modes[0], tracked.modes[0]):
+        for f in lk.freedom_names:
+            np.testing.assert_allclose(gm.variables[f][ok],
+                                       md.variables[f][ok] - md.variables[f][0], atol=1e-10,
+                                       err_msg=f)
+            np.testing.assert_allclose(gm.velocities[f][ok], md.velocities[f][ok], atol=1e-9,
+                                       err_msg=f)

@@ -10,17 +10,24 @@ the ground) round to the ground. Two forms:
 
 * a planar four-bar drawn with four parallel R axes, its input on the ground, is the 4R family
   (:func:`screwkit.model.families.fourbar`, Bagci's frame a, crank d1, coupler d2, rocker d3
-  measured off the drawing), placed in the world by the linkage ``base``, so that
-  ``solve_motion`` uses its closed form (Bagci 1969 eqs. 3.59–3.82, the δ0 = λ0 = b = e = 0
-  case);
-* any other loop as a joint list whose joint i has the frame F_i (origin the joint's drawn
-  point, z its axis, signed so the loop runs from the joint's first body to its second; a U
-  joint's y axis its second axis) and the link transforms L_i = F_i⁻¹ F_{i+1} (Rahman eq. 2.2
-  with a general screw matrix in place of X(α + εa)), base F_1. Then every joint variable is 0
-  at the drawing and equals the graph's: the graph's M_j(q) (model/mechanism.py) is
-  F_i J_i(q) F_i⁻¹, or its inverse with the axis reversed (R, P, C, H: the same variable; a U
-  joint's two angles swap). Such a loop goes to the generic loop solver, or the RCCC closed form
-  where it applies.
+  measured off the drawing), and an R–S–R–C loop driven at its ground R joint is Bagci's RSRC
+  (:func:`_rsrc`), each placed in the world by the linkage ``base``, so that ``solve_motion``
+  uses the family's closed form (Bagci 1969 eqs. 3.59–3.82; the 4R its δ0 = λ0 = b = e = 0
+  case) and gives every mode;
+* any loop as a joint list (``generic=True``) whose joint i has the frame F_i (origin the
+  joint's drawn point, z its axis, signed so the loop runs from the joint's first body to its
+  second; a U joint's y axis its second axis) and the link transforms L_i = F_i⁻¹ F_{i+1}
+  (Rahman eq. 2.2 with a general screw matrix in place of X(α + εa)), base F_1. Then every
+  joint variable is 0 at the drawing and equals the graph's: the graph's M_j(q)
+  (model/mechanism.py) is F_i J_i(q) F_i⁻¹, or its inverse with the axis reversed (R, P, C, H:
+  the same variable; a U joint's two angles swap). This is the joint list the generic loop
+  solver takes.
+
+Which single loops take this path (docs/mechanisms.md, "A single loop"): those with a closed
+form. Any other single loop stays on the graph's own continuation (graph/track.py) and every-mode
+homotopy (modes/), the generic solver for every topology: measured in benchmarks/bench_graph.py,
+the generic loop solver on the frame-form joint list takes 2–4 times the graph tracker's time
+for the drawn mode, and gains nothing that the graph's every-mode route does not give.
 
 :func:`loop_modes` solves the loop with :func:`~screwkit.kinematics.solve_motion.solve_motion`
 on the inputs from the drawing (every input 0) along a straight approach to the first row and
@@ -77,9 +84,10 @@ class LoopChain:
         return self.offset + self.sign * X[:, list(self.order)]
 
 
-def loop_chain(mech: Mechanism) -> LoopChain | None:
-    """The loop of ``mech`` when it is a single loop the loop engine solves (module
-    docstring), else None."""
+def loop_chain(mech: Mechanism, *, generic: bool = False) -> LoopChain | None:
+    """The loop of ``mech`` as a family with a closed form (4R, RSRC), when it is a single loop
+    the drawing shows to be one (module docstring); else None, or with ``generic`` the joint
+    list in frame form that the generic loop solver takes."""
     if mech.drives or any(j.seat_offset is not None for j in mech.joints):
         return None
     top = mech.topology
@@ -92,20 +100,13 @@ def loop_chain(mech: Mechanism) -> LoopChain | None:
     if order is None:
         return None
     joints, bodies = order
+    if generic:
+        return _joint_list(mech, joints, bodies)
     for family in (_fourbar, _rsrc):
         found = family(mech, joints, bodies)
         if found is not None:
             return found
-    return _joint_list(mech, joints, bodies)
-
-
-def frame_form(mech: Mechanism) -> LoopChain | None:
-    """The loop of ``mech`` as a joint list in frame form (module docstring), or None."""
-    if loop_chain(mech) is None:
-        return None
-    order = _loop_order(mech)
-    assert order is not None
-    return _joint_list(mech, *order)
+    return None
 
 
 def _loop_order(mech: Mechanism) -> tuple[tuple[int, ...], tuple[str, ...]] | None:
@@ -456,8 +457,8 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
     """The :class:`~screwkit.kinematics.graph.motion.MechanismMotion` of a single-loop
     mechanism from the loop engine (module docstring): mode 0 the drawn mode, followed from the
     drawing until it first stops assembling; with ``every`` then every other loop mode in
-    ``solve_motion``'s order. None where no loop mode passes through the drawing (the 4R
-    reading is then retried in frame form; then the caller follows the drawing itself)."""
+    ``solve_motion``'s order. None where no loop mode passes through the drawing (then the
+    caller follows the drawing itself)."""
     from screwkit.kinematics.graph.motion import (
         AssemblyError,
         MechanismMode,
@@ -468,9 +469,6 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
     )
 
     lm = loop_modes(mech, lay, chain, X)
-    if lm.drawn is None and chain.linkage.family is not None:
-        chain = _joint_list(mech, chain.joints, chain.bodies)
-        lm = loop_modes(mech, lay, chain, X)
     if lm.drawn is None:
         return None
     d = lm.drawn
