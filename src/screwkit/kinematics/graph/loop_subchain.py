@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual import ScrewMatrix
-from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, _screws
 from screwkit.kinematics.motion import Motion
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.joints import Joint
@@ -307,12 +307,14 @@ def _draws(mech: Mechanism, chain: LoopChain) -> bool:
 @dataclass(frozen=True)
 class LoopModes:
     """The loop's solution as graph modes: per loop mode (in ``solve_motion``'s order) the
-    samples where it assembles (M, N), the graph configurations (one per mode) and which mode is
-    the drawn one (None: none passes through the drawing)."""
+    samples where it assembles (M, N), the graph configurations and body frames (None for a
+    mode not asked for) and which mode is the drawn one (None: none passes through the
+    drawing)."""
 
     motion: Motion
     assembles: NDArray[np.bool_]
-    confs: tuple[Configuration, ...]
+    confs: tuple[Configuration | None, ...]
+    frames: tuple[GraphFrames | None, ...]
     drawn: int | None
 
 
@@ -325,9 +327,11 @@ def approach(lay: GraphLayout, X: Array) -> Array:
     return np.linspace(0.0, 1.0, steps + 1)[:-1, None] * X[0][None, :]
 
 
-def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array) -> LoopModes:
+def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
+               every: bool = True) -> LoopModes:
     """Every loop mode over the approach (:func:`approach`) and ``X``, as graph configurations
-    over the rows of ``X`` (module docstring)."""
+    and body frames over the rows of ``X`` (module docstring): of the drawn mode alone unless
+    ``every``."""
     from screwkit.kinematics.solve_motion import solve_motion
 
     A = approach(lay, X)
@@ -336,20 +340,29 @@ def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array) ->
     a = A.shape[0]
     drawn = next((m for m, md in enumerate(motion.modes) if _is_drawing(mech, chain, md)), None)
     if drawn is None:
-        return LoopModes(motion, np.zeros((0, X.shape[0]), dtype=bool), (), None)
+        return LoopModes(motion, np.zeros((0, X.shape[0]), dtype=bool), (), (), None)
     R0 = motion.modes[drawn].link_rotation[0]
     p0 = motion.modes[drawn].link_origin[0]
-    confs, masks = [], []
+    confs: list[Configuration | None] = []
+    frames: list[GraphFrames | None] = []
+    masks = []
     for m, md in enumerate(motion.modes):
         ok = np.array(md.assembles)
         if m == drawn:  # followed from the drawing: it ends where it first stops assembling
             stop = int(np.argmin(ok)) if not ok.all() else ok.size
             ok[stop:] = False
+        masks.append(ok[a:])
+        if m != drawn and not every:
+            confs.append(None)
+            frames.append(None)
+            continue
         R, p = _body_poses(mech, chain, md, R0, p0, ok)
         conf = _configuration(mech, lay, R, p, rows, ok, m == drawn)
         confs.append(conf.take(slice(a, None)))
-        masks.append(ok[a:])
-    return LoopModes(motion, np.array(masks), tuple(confs), drawn)
+        R, p = R[a:], p[a:]
+        screws, centres, axes = _screws(mech, lay, R, p)
+        frames.append(GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes))
+    return LoopModes(motion, np.array(masks), tuple(confs), tuple(frames), drawn)
 
 
 def _is_drawing(mech: Mechanism, chain: LoopChain, md: object) -> bool:
@@ -468,7 +481,7 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
         with_events,
     )
 
-    lm = loop_modes(mech, lay, chain, X)
+    lm = loop_modes(mech, lay, chain, X, every)
     if lm.drawn is None:
         return None
     d = lm.drawn
@@ -481,7 +494,9 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
     modes: list[MechanismMode] = []
     for m in order:
         ok = lm.assembles[m]
-        md = build_mode(mech, lay, lm.confs[m], ok, X, Xd, Xdd)
+        conf = lm.confs[m]
+        assert conf is not None
+        md = build_mode(mech, lay, conf, ok, X, Xd, Xdd, lm.frames[m])
         events = _mask_events(mech, lay, X, ok, drawn=m == d)
         label = "drawn" if m == d else f"loop mode {m}"
         modes.append(replace(with_events(md, [*events, *md.events]), label=label,
