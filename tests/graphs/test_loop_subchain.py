@@ -155,3 +155,28 @@ def test_a_loop_without_a_closed_form_stays_on_the_graph_route_and_its_joint_lis
                                        err_msg=f)
             np.testing.assert_allclose(gm.velocities[f][ok], md.velocities[f][ok], atol=1e-9,
                                        err_msg=f)
+
+
+@pytest.mark.parametrize("family", ["4R", "RSSR", "RCCC"])
+def test_each_family_read_off_its_drawing_gives_the_closed_form_modes(family: str) -> None:
+    """The 4R, RSSR (with its output crank off the crank plane) and RCCC (with an input offset)
+    drawn as graphs are read back as their families; every graph mode is a loop mode, sample
+    by sample."""
+    lk = {"4R": sk.fourbar(a=4.0, d1=1.0, d2=3.5, d3=3.0),
+          "RSSR": sk.rssr(1.0, 3.0, 2.0, 2.5, 1.0, 0.3, 0.4),
+          "RCCC": sk.rccc((1.0, 1.5, 1.2, 1.4), (0.3, 0.5, -0.4, 0.6), 0.3)}[family]
+    x = np.radians(np.arange(0.0, 360.0, 10.0))
+    motion = sk.solve_motion(lk, x)
+    k0 = int(np.argmax(motion.mode(1).assembles))
+    mech = mechanism_from_loop(motion, 1, k0)  # drawn in the loop's mode 1
+    chain = loop_chain(mech)
+    assert chain is not None and chain.linkage.family == family
+    g = solve_mechanism(mech, x[k0:] - x[k0], every_mode=True)
+    assert g.method == "graph (loop, closed)" and len(g.modes) == len(motion.modes) == 2
+    scale = mech.length_scale
+    ref = [motion.mode(m) for m in (1, 0)]  # the drawn mode first
+    for gm, md in zip(g.modes, ref, strict=True):
+        ok = md.assembles[k0:]
+        assert np.array_equal(gm.assembles, ok)
+        assert _match(gm.joint_centres[ok], md.joint_centres[k0:][ok], scale)
+        assert np.nanmax(gm.closure_residual) < 1e-12

@@ -102,7 +102,7 @@ def loop_chain(mech: Mechanism, *, generic: bool = False) -> LoopChain | None:
     joints, bodies = order
     if generic:
         return _joint_list(mech, joints, bodies)
-    for family in (_fourbar, _rsrc):
+    for family in (_fourbar, _rsrc, _rssr, _rccc):
         found = family(mech, joints, bodies)
         if found is not None:
             return found
@@ -230,21 +230,27 @@ def _common_normal(c1: Array, u1: Array, c2: Array, u2: Array) -> tuple[Array, A
     return c1 + t1 * u1, c2 + t2 * u2
 
 
-def _rsrc(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
-          ) -> LoopChain | None:
-    """An R–S–R–C loop driven at its ground R joint as Bagci's RSRC
-    (:func:`screwkit.model.families.rsrc`): the input axis is its X axis, through the foot O of
-    the ball centre (the crank d1 in the plane X = 0, θ0 from +Y about +X); Y is the common
-    normal to the output axis u3 = (cos λ0, 0, −sin λ0), which passes through (b, a, 0); d2 is the
-    ball centre's distance from the coupler R axis, d3 and δ0 that axis's common normal and
-    angle to the output axis, e the offset along it between the two feet. The signs of u3, e and
-    δ0 the drawing does not fix are those whose loop draws the drawing's joint lines."""
-    from screwkit.model.families import rsrc
+@dataclass(frozen=True)
+class _BagciFrame:
+    """The RSRC's and RSSR's frame read off a drawing: the world frame W (X the input axis, Y
+    the common normal to the output axis, origin O the foot of the first ball centre on the input
+    axis), d1, a, b, the foot f3 on the output axis and θ0 of the drawing."""
 
-    J = [mech.joints[k] for k in joints]
-    if [j.kind for j in J] != ["R", "S", "R", "C"] or len(mech.inputs) != 1 \
-            or mech.inputs[0] != f"{J[0].name}.theta":
-        return None
+    W: Array
+    d1: float
+    a: float
+    b: float
+    f3: Array
+    theta0: float
+
+    def lam(self, u3: Array) -> float:
+        """λ0 of the output axis direction u3 = (cos λ0, 0, −sin λ0) in W."""
+        return float(np.arctan2(-(u3 @ self.W[:3, 2]), u3 @ self.W[:3, 0]))
+
+
+def _bagci_frame(mech: Mechanism, J: list, bodies: tuple[str, ...]) -> _BagciFrame | None:
+    """The frame of the RSRC's and RSSR's dimensions (Bagci 1969 Fig. 5; families.py sketches)
+    read off the input joint J[0], the first ball J[1] and the output joint J[3]."""
     X = J[0].axis if J[0].bodies == (GROUND, bodies[1]) else -J[0].axis
     ball = J[1].at
     O = _line_foot(J[0].at, X, ball)
@@ -259,34 +265,148 @@ def _rsrc(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
     Z = np.cross(X, Y)
     feet = _common_normal(O, X, c3, J[3].axis)
     f3 = feet[1] if feet is not None else c3 - ((c3 - O) @ X) * X
-    a, b = float((f3 - O) @ Y), float((f3 - O) @ X)
+    W = np.eye(4)
+    W[:3, :3] = np.column_stack([X, Y, Z])
+    W[:3, 3] = O
+    return _BagciFrame(W, d1, float((f3 - O) @ Y), float((f3 - O) @ X), f3,
+                       float(np.arctan2((ball - O) @ Z, (ball - O) @ Y)))
+
+
+def _placed(mech: Mechanism, lk: Linkage, W: Array, joints: tuple[int, ...],
+            bodies: tuple[str, ...], theta0: float) -> LoopChain | None:
+    """A family's loop placed in the world by W, kept if its closed form draws the drawing."""
+    lk = replace(lk, name=mech.name, links=tuple(Link(x) for x in bodies[1:-1]),
+                 base=_screw(W) @ lk.base)
+    chain = LoopChain(lk, joints, bodies, (0,), np.ones(1), np.array([theta0]))
+    return chain if _draws(mech, chain) else None
+
+
+def _driven_at_ground(mech: Mechanism, J: list, kinds: str) -> bool:
+    return "".join(j.kind for j in J) == kinds and len(mech.inputs) == 1 \
+        and mech.inputs[0] == f"{J[0].name}.theta"
+
+
+def _rsrc(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
+          ) -> LoopChain | None:
+    """An R–S–R–C loop driven at its ground R joint as Bagci's RSRC
+    (:func:`screwkit.model.families.rsrc`): the input axis is its X axis, through the foot O of
+    the ball centre (the crank d1 in the plane X = 0, θ0 from +Y about +X); Y is the common
+    normal to the output axis u3 = (cos λ0, 0, −sin λ0), which passes through (b, a, 0); d2 is the
+    ball centre's distance from the coupler R axis, d3 and δ0 that axis's common normal and
+    angle to the output axis, e the offset along it between the two feet. The signs of u3, e and
+    δ0 the drawing does not fix are those whose loop draws the drawing's joint lines."""
+    from screwkit.model.families import rsrc
+
+    J = [mech.joints[k] for k in joints]
+    if not _driven_at_ground(mech, J, "RSRC"):
+        return None
+    fr = _bagci_frame(mech, J, bodies)
+    if fr is None:
+        return None
+    ball = J[1].at
     c2, u2 = J[2].at, J[2].axis
     d2 = float(np.linalg.norm(ball - _line_foot(c2, u2, ball)))
-    normal = _common_normal(c2, u2, c3, J[3].axis)
-    if normal is None:
+    normal = _common_normal(c2, u2, J[3].at, J[3].axis)
+    if normal is None or d2 <= 1e-9 * mech.length_scale:
         return None
     d3 = float(np.linalg.norm(normal[1] - normal[0]))
     e = float(np.linalg.norm(normal[0] - _line_foot(c2, u2, ball)))
     delta = float(np.arccos(np.clip(abs(float(u2 @ J[3].axis)), 0.0, 1.0)))
-    theta0 = float(np.arctan2((ball - O) @ Z, (ball - O) @ Y))
-    W = np.eye(4)
-    W[:3, :3] = np.column_stack([X, Y, Z])
-    W[:3, 3] = O
     for s3 in (1.0, -1.0):
-        u3 = s3 * J[3].axis
-        lam = float(np.arctan2(-(u3 @ Z), u3 @ X))
+        lam = fr.lam(s3 * J[3].axis)
         for ee in (e, -e):
             for dd in (delta, -delta, np.pi - delta, delta - np.pi):
-                try:
-                    lk = rsrc(d1, d2, d3, a, b, ee, dd, lam)
-                except ValueError:
-                    return None
-                lk = replace(lk, name=mech.name, links=tuple(Link(x) for x in bodies[1:-1]),
-                             base=_screw(W) @ lk.base)
-                chain = LoopChain(lk, joints, bodies, (0,), np.ones(1), np.array([theta0]))
-                if _draws(mech, chain):
+                chain = _placed(mech, rsrc(fr.d1, d2, d3, fr.a, fr.b, ee, dd, lam), fr.W,
+                                joints, bodies, fr.theta0)
+                if chain is not None:
                     return chain
     return None
+
+
+def _rssr(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
+          ) -> LoopChain | None:
+    """An R–S–S–R loop driven at its ground R joint as the RSSR family
+    (:func:`screwkit.model.families.rssr`): the RSRC's frame (:func:`_rsrc`), d2 the distance
+    between the ball centres, d3 the second ball's distance from the output axis and
+    ``output_offset`` its offset along u3 from the foot (b, a, 0)."""
+    from screwkit.model.families import rssr
+
+    J = [mech.joints[k] for k in joints]
+    if not _driven_at_ground(mech, J, "RSSR"):
+        return None
+    fr = _bagci_frame(mech, J, bodies)
+    if fr is None:
+        return None
+    ball2 = J[2].at
+    d2 = float(np.linalg.norm(ball2 - J[1].at))
+    d3 = float(np.linalg.norm(ball2 - _line_foot(J[3].at, J[3].axis, ball2)))
+    if min(d2, d3) <= 1e-9 * mech.length_scale:
+        return None
+    for s3 in (1.0, -1.0):
+        u3 = s3 * J[3].axis
+        chain = _placed(mech, rssr(fr.d1, d2, d3, fr.a, fr.b, fr.lam(u3),
+                                   float((ball2 - fr.f3) @ u3)),
+                        fr.W, joints, bodies, fr.theta0)
+        if chain is not None:
+            return chain
+    return None
+
+
+def _rccc(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
+          ) -> LoopChain | None:
+    """An R–C–C–C loop driven at its ground R joint as the RCCC family
+    (:func:`screwkit.model.families.rccc`) in Hartenberg–Denavit form: axis i signed so the loop
+    runs from the joint's first body to its second, x_i the common normal from axis i to axis
+    i+1 (a_i its length, α_i the angle from axis i to axis i+1 about it), the ground frame at the
+    foot of the normal from axis 4 on axis 1 (Rahman eq. 2.2); the input's offset s1 is the
+    distance along axis 1 between the feet of its two normals, the drawn θ1 the angle between
+    them."""
+    from screwkit.model.families import rccc
+
+    J = [mech.joints[k] for k in joints]
+    if not _driven_at_ground(mech, J, "RCCC"):
+        return None
+    u = [j.axis if j.bodies == (bodies[i], bodies[i + 1]) else -j.axis
+         for i, j in enumerate(J)]
+    c = [j.at for j in J]
+    xs, out_feet, in_feet = [], [], []  # per normal i → i+1: x, foot on i, foot on i+1
+    for i in range(4):
+        k = (i + 1) % 4
+        feet = _common_normal(c[i], u[i], c[k], u[k])
+        if feet is None:  # parallel axes: the normal from axis i's drawn point
+            f = c[i]
+            g = _line_foot(c[k], u[k], f)
+        else:
+            f, g = feet
+        d = g - f
+        if float(np.linalg.norm(d)) > 1e-12 * mech.length_scale:
+            x = d / np.linalg.norm(d)
+        else:
+            x = np.cross(u[i], u[k])
+            if float(np.linalg.norm(x)) < 1e-9:
+                return None
+            x /= np.linalg.norm(x)
+        xs.append(x)
+        out_feet.append(f)
+        in_feet.append(g)
+    lengths = [float((in_feet[i] - out_feet[i]) @ xs[i]) for i in range(4)]
+    twists = [float(np.arctan2(np.cross(u[i], u[(i + 1) % 4]) @ xs[i], u[i] @ u[(i + 1) % 4]))
+              for i in range(4)]
+    g1 = in_feet[3]  # the foot of the normal 4 → 1 on axis 1
+    s1 = float((out_feet[0] - g1) @ u[0])
+    theta1 = float(np.arctan2(np.cross(xs[3], xs[0]) @ u[0], xs[3] @ xs[0]))
+    W = np.eye(4)
+    W[:3, :3] = np.column_stack([xs[3], np.cross(u[0], xs[3]), u[0]])
+    W[:3, 3] = g1
+    try:
+        lk = rccc(tuple(lengths), tuple(twists), s1)  # type: ignore[arg-type]
+    except ValueError:
+        return None
+    from screwkit.kinematics.registry import family_of
+
+    if family_of(lk).closed_form_for(lk) is None:
+        return None
+    return _placed(mech, lk, W, joints, bodies, theta1)
 
 
 def _draws(mech: Mechanism, chain: LoopChain) -> bool:
