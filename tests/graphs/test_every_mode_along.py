@@ -117,7 +117,7 @@ def test_a_fourbar_through_the_anchored_path_has_the_closed_form_modes() -> None
     lay = graph_layout(mech)
     Xf = np.radians(np.arange(0.0, 361.0, 15.0))[:, None]
     closed = solve_mechanism(mech, Xf, every_mode=True)
-    assert closed.method == "graph (closed forms)" and len(closed.modes) == 2
+    assert closed.method == "graph (loop, closed)" and len(closed.modes) == 2
     along = modes_along(mech, lay, Xf, str)
     assert len(along.configurations) == 2 and all(m.all() for m in along.masks)
     for md in closed.modes:
