@@ -8,12 +8,14 @@ equivalent :class:`~screwkit.model.linkage.Linkage` from the drawing: the invers
 graph/from_loop.py. The loop runs from the ground through the input joint (when the input is on
 the ground) round to the ground. Two forms:
 
-* a planar four-bar drawn with four parallel R axes, its input on the ground, is the 4R family
-  (:func:`screwkit.model.families.fourbar`, Bagci's frame a, crank d1, coupler d2, rocker d3
-  measured off the drawing), and an R–S–R–C loop driven at its ground R joint is Bagci's RSRC
-  (:func:`_rsrc`), each placed in the world by the linkage ``base``, so that ``solve_motion``
-  uses the family's closed form (Bagci 1969 eqs. 3.59–3.82; the 4R its δ0 = λ0 = b = e = 0
-  case) and gives every mode;
+* a loop driven at a ground R joint whose drawing is a family with a closed form: a planar
+  four-bar (four parallel R axes) the 4R (:func:`screwkit.model.families.fourbar`, Bagci's frame
+  a, crank d1, coupler d2, rocker d3 measured off the drawing), an R–S–R–C loop Bagci's RSRC
+  (:func:`_rsrc`), an R–S–S–R loop the RSSR (:func:`_rssr`), an R–C–C–C loop the RCCC
+  (:func:`_rccc`), each placed in the world by the linkage ``base`` and kept only if its closed
+  form draws the drawing's joint lines, so that ``solve_motion`` uses the family's closed form
+  (Bagci 1969 eqs. 3.59–3.82, the 4R its δ0 = λ0 = b = e = 0 case; the RSSR's and the RCCC's
+  A cos φ + B sin φ = C) and gives every mode;
 * any loop as a joint list (``generic=True``) whose joint i has the frame F_i (origin the
   joint's drawn point, z its axis, signed so the loop runs from the joint's first body to its
   second; a U joint's y axis its second axis) and the link transforms L_i = F_i⁻¹ F_{i+1}
@@ -85,7 +87,8 @@ class LoopChain:
 
 
 def loop_chain(mech: Mechanism, *, generic: bool = False) -> LoopChain | None:
-    """The loop of ``mech`` as a family with a closed form (4R, RSRC), when it is a single loop
+    """The loop of ``mech`` as a family with a closed form (4R, RSRC, RSSR, RCCC), when it is a
+    single loop
     the drawing shows to be one (module docstring); else None, or with ``generic`` the joint
     list in frame form that the generic loop solver takes."""
     if mech.drives or any(j.seat_offset is not None for j in mech.joints):
