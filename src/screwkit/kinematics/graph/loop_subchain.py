@@ -88,9 +88,8 @@ class LoopChain:
 
 def loop_chain(mech: Mechanism, *, generic: bool = False) -> LoopChain | None:
     """The loop of ``mech`` as a family with a closed form (4R, RSRC, RSSR, RCCC), when it is a
-    single loop
-    the drawing shows to be one (module docstring); else None, or with ``generic`` the joint
-    list in frame form that the generic loop solver takes."""
+    single loop the drawing shows to be one (module docstring); else None, or with
+    ``generic`` the joint list in frame form that the generic loop solver takes."""
     if mech.drives or any(j.seat_offset is not None for j in mech.joints):
         return None
     top = mech.topology
