@@ -128,7 +128,8 @@ def _single_loop_rows(theta: np.ndarray) -> list[dict[str, Any]]:
     generic loop solver on the loop's joint list (frame form) against the graph tracker."""
     from screwkit.kinematics.graph.closure import graph_layout
     from screwkit.kinematics.graph.from_loop import mechanism_from_loop
-    from screwkit.kinematics.graph.loop_subchain import loop_chain, loop_motion
+    from screwkit.kinematics.graph.loop_motion import loop_motion
+    from screwkit.kinematics.graph.loop_subchain import loop_chain
 
     rows: list[dict[str, Any]] = []
     for name, lk in (("4R", sk.fourbar(a=4.0, d1=1.0, d2=3.5, d3=3.0)),

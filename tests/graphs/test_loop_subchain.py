@@ -131,7 +131,7 @@ def test_a_loop_without_a_closed_form_stays_on_the_graph_route_and_its_joint_lis
     joint list in frame form (loop_chain(generic=True)) solved by the generic loop solver gives
     the same motion, every joint variable 0 at the drawing and equal to the loop's."""
     from screwkit.kinematics.graph.closure import graph_layout
-    from screwkit.kinematics.graph.loop_subchain import loop_motion
+    from screwkit.kinematics.graph.loop_motion import loop_motion
 
     lk = sk.rccc((1.0, 1.5, 1.2, 1.4), (0.3, 0.5, -0.4, 0.6))
     lk = replace(lk, inputs=("C2.theta",), family=None)

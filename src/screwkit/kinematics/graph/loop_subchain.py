@@ -31,13 +31,7 @@ homotopy (modes/), the generic solver for every topology: measured in benchmarks
 the generic loop solver on the frame-form joint list takes 2–4 times the graph tracker's time
 for the drawn mode, and gains nothing that the graph's every-mode route does not give.
 
-:func:`loop_modes` solves the loop with :func:`~screwkit.kinematics.solve_motion.solve_motion`
-on the inputs from the drawing (every input 0) along a straight approach to the first row and
-then along the rows, and returns each loop mode as the graph's body poses (the link frames
-times the drawn link frames' inverse: every body frame is the world frame in the drawing) and
-joint variables, angles counted continuously from the drawing for the drawn mode (the mode whose
-joint lines are the drawing's at the first sample). graph/motion.py builds the rest of each
-mode (rates, accelerations, points, outputs, singularities) as for every graph.
+The motion itself is graph/loop_motion.py's.
 """
 
 from __future__ import annotations
@@ -48,9 +42,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual import ScrewMatrix
-from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, _screws
-from screwkit.kinematics.motion import Motion
-from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.joints import Joint
 from screwkit.model.linkage import Link, Linkage
 from screwkit.model.mechanism import GROUND, Mechanism
@@ -426,67 +417,6 @@ def _draws(mech: Mechanism, chain: LoopChain) -> bool:
     return any(_is_drawing(mech, chain, md) for md in motion.modes)
 
 
-@dataclass(frozen=True)
-class LoopModes:
-    """The loop's solution as graph modes: per loop mode (in ``solve_motion``'s order) the
-    samples where it assembles (M, N), the graph configurations and body frames (None for a
-    mode not asked for) and which mode is the drawn one (None: none passes through the
-    drawing)."""
-
-    motion: Motion
-    assembles: NDArray[np.bool_]
-    confs: tuple[Configuration | None, ...]
-    frames: tuple[GraphFrames | None, ...]
-    drawn: int | None
-
-
-def approach(lay: GraphLayout, X: Array) -> Array:
-    """Input rows from the drawing (every input 0) along the straight way to ``X[0]``, in
-    steps of at most APPROACH_STEP (rad, or of the length scale), the drawing first and
-    ``X[0]`` left out."""
-    scale = np.array([lay.length if lay.is_translation[f] else 1.0 for f in lay.inputs])
-    steps = max(1, int(np.ceil(float(np.max(np.abs(X[0]) / scale)) / APPROACH_STEP)))
-    return np.linspace(0.0, 1.0, steps + 1)[:-1, None] * X[0][None, :]
-
-
-def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
-               every: bool = True) -> LoopModes:
-    """Every loop mode over the approach (:func:`approach`) and ``X``, as graph configurations
-    and body frames over the rows of ``X`` (module docstring): of the drawn mode alone unless
-    ``every``."""
-    from screwkit.kinematics.solve_motion import solve_motion
-
-    A = approach(lay, X)
-    rows = np.vstack([A, X])
-    motion = solve_motion(chain.linkage, chain.loop_inputs(rows), progress=False)
-    a = A.shape[0]
-    drawn = next((m for m, md in enumerate(motion.modes) if _is_drawing(mech, chain, md)), None)
-    if drawn is None:
-        return LoopModes(motion, np.zeros((0, X.shape[0]), dtype=bool), (), (), None)
-    R0 = motion.modes[drawn].link_rotation[0]
-    p0 = motion.modes[drawn].link_origin[0]
-    confs: list[Configuration | None] = []
-    frames: list[GraphFrames | None] = []
-    masks = []
-    for m, md in enumerate(motion.modes):
-        ok = np.array(md.assembles)
-        if m == drawn:  # followed from the drawing: it ends where it first stops assembling
-            stop = int(np.argmin(ok)) if not ok.all() else ok.size
-            ok[stop:] = False
-        masks.append(ok[a:])
-        if m != drawn and not every:
-            confs.append(None)
-            frames.append(None)
-            continue
-        R, p = _body_poses(mech, chain, md, R0, p0, ok)
-        conf = _configuration(mech, lay, R, p, rows, ok, m == drawn)
-        confs.append(conf.take(slice(a, None)))
-        R, p = R[a:], p[a:]
-        screws, centres, axes = _screws(mech, lay, R, p)
-        frames.append(GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes))
-    return LoopModes(motion, np.array(masks), tuple(confs), tuple(frames), drawn)
-
-
 def _is_drawing(mech: Mechanism, chain: LoopChain, md: object) -> bool:
     """Whether a loop mode's joint lines at its first sample are the drawing's."""
     ok = md.assembles  # type: ignore[attr-defined]
@@ -508,146 +438,3 @@ def _is_drawing(mech: Mechanism, chain: LoopChain, md: object) -> bool:
             if np.linalg.norm(off - (off @ u[i]) * u[i]) > tol:
                 return False
     return True
-
-
-def _body_poses(mech: Mechanism, chain: LoopChain, md: object, R0: Array, p0: Array,
-                ok: NDArray[np.bool_]) -> tuple[Array, Array]:
-    """The graph's body poses (N, B+1, …; the ground last, the identity) from a loop mode's
-    link frames: T_body = T_link · T_link(drawing)⁻¹."""
-    N = ok.shape[0]
-    B = len(mech.bodies) + 1
-    R = np.broadcast_to(np.eye(3), (N, B, 3, 3)).copy()
-    p = np.zeros((N, B, 3))
-    LR = np.where(ok[:, None, None, None], md.link_rotation, np.eye(3))  # type: ignore[attr-defined]
-    Lp = np.where(ok[:, None, None], md.link_origin, 0.0)  # type: ignore[attr-defined]
-    for k, name in enumerate(chain.bodies[1:-1]):
-        b = mech.body_index(name)
-        R[:, b] = LR[:, k] @ R0[k].T
-        p[:, b] = Lp[:, k] - np.einsum("nij,j->ni", R[:, b], p0[k])
-    return R, p
-
-
-def _configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Array,
-                   ok: NDArray[np.bool_], from_drawing: bool) -> Configuration:
-    """Every joint variable from the body poses (the inverse of graph/closure.py's joint
-    motions M_j(q) on T_a⁻¹T_b): a rotation angle about the axis (atan2 of its sine and
-    cosine), a slide along it, an H joint's turns from its slide, a U joint's two angles, an S
-    joint's rotation; angles counted continuously along each run where the mode assembles
-    (from the drawing, every variable 0, for the drawn mode), the inputs as given."""
-    from screwkit.kinematics.graph.closed_modes import _runs
-
-    N = R.shape[0]
-    q = np.zeros((N, lay.n_scalar))
-    balls = np.empty((N, lay.n_spherical, 3, 3))
-    for i, j in enumerate(mech.joints):
-        a, b = (lay.body_of[x] for x in j.bodies)
-        Ra = R[:, a]
-        Rr = np.swapaxes(Ra, -1, -2) @ R[:, b]
-        pr = np.einsum("nji,nj->ni", Ra, p[:, b] - p[:, a])
-        if j.kind == "S":
-            balls[:, lay.spherical_of_joint[i]] = Rr
-            continue
-        col = lay.scalar_col[lay.first_freedom[i]]
-        u = j.axis
-        if j.kind == "P":
-            q[:, col] = pr @ u
-            continue
-        if j.kind == "U":
-            assert j.axis2 is not None
-            v = j.axis2
-            Rv = Rr @ v
-            Ru = np.swapaxes(Rr, -1, -2) @ u
-            q[:, col] = np.arctan2(np.cross(v, Rv) @ u, Rv @ v)
-            q[:, col + 1] = -np.arctan2(np.cross(u, Ru) @ v, Ru @ u)
-            continue
-        vee = np.stack([Rr[:, 2, 1] - Rr[:, 1, 2], Rr[:, 0, 2] - Rr[:, 2, 0],
-                        Rr[:, 1, 0] - Rr[:, 0, 1]], axis=1)
-        th = np.arctan2(0.5 * (vee @ u), 0.5 * (np.trace(Rr, axis1=1, axis2=2) - 1.0))
-        if j.kind == "H":  # the slide pitch·θ counts the turns
-            th = th + 2 * np.pi * np.round((pr @ u / j.pitch - th) / (2 * np.pi))
-        q[:, col] = th
-        if j.kind == "C":
-            q[:, col + 1] = pr @ u
-    turning = [lay.scalar_col[f] for f in range(lay.m)
-               if not lay.is_translation[f] and lay.scalar_col[f] >= 0]
-    for s, e in _runs(ok):
-        run = q[s:e, turning]
-        if s == 0 and from_drawing:
-            q[s:e, turning] = np.unwrap(np.vstack([np.zeros(len(turning)), run]), axis=0)[1:]
-        else:
-            q[s:e, turning] = np.unwrap(run, axis=0)
-    q[~ok] = 0.0
-    balls[~ok] = np.eye(3)
-    for k, f in enumerate(lay.inputs):
-        q[:, lay.scalar_col[f]] = X[:, k]
-    return Configuration(q, balls)
-
-
-LOOP_SOLVER = "the loop engine on the mechanism's one loop (graph/loop_subchain.py): {solver}; " \
-              "rates and accelerations from the stacked loop closure"
-
-
-def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, Xd: Array,
-                Xdd: Array, every: bool) -> object | None:
-    """The :class:`~screwkit.kinematics.graph.motion.MechanismMotion` of a single-loop
-    mechanism from the loop engine (module docstring): mode 0 the drawn mode, followed from the
-    drawing until it first stops assembling; with ``every`` then every other loop mode in
-    ``solve_motion``'s order. None where no loop mode passes through the drawing (then the
-    caller follows the drawing itself)."""
-    from screwkit.kinematics.graph.motion import (
-        AssemblyError,
-        MechanismMode,
-        MechanismMotion,
-        build_mode,
-        input_text,
-        with_events,
-    )
-
-    lm = loop_modes(mech, lay, chain, X, every)
-    if lm.drawn is None:
-        return None
-    d = lm.drawn
-    if not lm.assembles[d, 0]:
-        raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
-                            f"first input row {input_text(mech, lay, X[0])}: the mechanism stops "
-                            "assembling before it")
-    order = [d] + ([m for m in range(len(lm.confs)) if m != d and lm.assembles[m].any()]
-                   if every else [])
-    modes: list[MechanismMode] = []
-    for m in order:
-        ok = lm.assembles[m]
-        conf = lm.confs[m]
-        assert conf is not None
-        md = build_mode(mech, lay, conf, ok, X, Xd, Xdd, lm.frames[m])
-        events = _mask_events(mech, lay, X, ok, drawn=m == d)
-        label = "drawn" if m == d else f"loop mode {m}"
-        modes.append(replace(with_events(md, [*events, *md.events]), label=label,
-                             index=len(modes)))
-    motion = lm.motion
-    notes: tuple[str, ...] = ()
-    if every:
-        notes = (f"{len(motion.modes)} assembly mode(s) of the loop ({motion.method} solver); "
-                 f"{len(modes)} assemble over these inputs; mode 0 is the drawn one (the loop's "
-                 f"mode {d})", *motion.notes)
-    return MechanismMotion(mech, X, Xd, Xdd, tuple(modes), method=f"graph (loop, {motion.method})",
-                           solver=LOOP_SOLVER.format(solver=motion.solver or motion.method),
-                           notes=notes)
-
-
-def _mask_events(mech: Mechanism, lay: GraphLayout, X: Array, ok: NDArray[np.bool_],
-                 drawn: bool) -> list[str]:
-    """Where a mode stops and starts assembling, between the samples around it."""
-    from screwkit.kinematics.graph.motion import input_text
-
-    events = []
-    for kk in np.flatnonzero(ok[:-1] != ok[1:]):
-        k = int(kk)
-        if ok[k]:
-            events.append(f"stops assembling after input {input_text(mech, lay, X[k])} (a limit "
-                          f"position or dead centre before {input_text(mech, lay, X[k + 1])})")
-        else:
-            events.append(f"is born at input {input_text(mech, lay, X[k + 1])} (after "
-                          f"{input_text(mech, lay, X[k])})")
-        if drawn:
-            break
-    return events

@@ -202,7 +202,8 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     Xd = _per_sample(rates, N, n_in, "rates")
     Xdd = _per_sample(accelerations, N, n_in, "accelerations")
     lay = graph_layout(mech)
-    from screwkit.kinematics.graph.loop_subchain import loop_chain, loop_motion
+    from screwkit.kinematics.graph.loop_motion import loop_motion
+    from screwkit.kinematics.graph.loop_subchain import loop_chain
 
     chain = loop_chain(mech)
     if chain is not None:  # one loop: the loop engine is its sub-chain solver
