@@ -195,10 +195,13 @@ def test_the_four_bar_as_a_graph_reaches_the_loop_routes_optimum():
     assert ref.relative_gradient < 1e-8 and ours.range_ok and ref.range_check.ok
     bx, by, cx, cy = ours.x  # the graph's hardpoints as the loop's dimensions
     dims = ref.dimensions
-    assert math.hypot(bx, by) == pytest.approx(dims["d1"], rel=1e-7)
-    assert math.atan2(by, bx) % (2 * math.pi) == pytest.approx(dims["theta01"], rel=1e-7)
-    assert math.hypot(cx - bx, cy - by) == pytest.approx(dims["d2"], rel=1e-7)
-    assert math.hypot(cx - 3 * IN, cy) == pytest.approx(dims["d3"], rel=1e-7)
+    # the optimum lies in a flat valley: two graph solves whose residuals differ only in
+    # round-off (~5e-15 against 4.5e-4; the dyads' route and the loop engine's) end 1.3e-7
+    # apart with objectives equal to 1.3e-12, so the dimensions are fixed to ~1e-6, not better
+    assert math.hypot(bx, by) == pytest.approx(dims["d1"], rel=1e-6)
+    assert math.atan2(by, bx) % (2 * math.pi) == pytest.approx(dims["theta01"], rel=1e-6)
+    assert math.hypot(cx - bx, cy - by) == pytest.approx(dims["d2"], rel=1e-6)
+    assert math.hypot(cx - 3 * IN, cy) == pytest.approx(dims["d3"], rel=1e-6)
 
 
 def test_a_design_whose_drawn_mode_does_not_assemble_is_infeasible_not_switched():
