@@ -25,11 +25,13 @@ the ground) round to the ground. Two forms:
   the same variable; a U joint's two angles swap). This is the joint list the generic loop
   solver takes.
 
-Which single loops take this path (docs/mechanisms.md, "A single loop"): those with a closed
-form. Any other single loop stays on the graph's own continuation (graph/track.py) and every-mode
-homotopy (modes/), the generic solver for every topology: measured in benchmarks/bench_graph.py,
-the generic loop solver on the frame-form joint list takes 2–4 times the graph tracker's time
-for the drawn mode, and gains nothing that the graph's every-mode route does not give.
+Which single loops take this path (docs/mechanisms.md, "How a single loop drawn as a graph is
+solved"): those with a closed form. Any other single loop stays on the graph's own continuation
+(graph/track.py) and every-mode homotopy (modes/), the generic solver for every topology:
+measured in benchmarks/bench_graph.py, the generic loop solver on the frame-form joint list
+takes 4–5 times the graph tracker's time for the drawn mode (which every analysis needs); for
+every mode it was faster on one loop (an RSRC: ~45 against 680 µs per sample) and slower on
+another (an RSSR: ~120 against 48).
 
 The motion itself is graph/loop_motion.py's.
 """
