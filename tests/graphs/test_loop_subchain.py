@@ -157,14 +157,15 @@ def test_a_loop_without_a_closed_form_stays_on_the_graph_route_and_its_joint_lis
                                        err_msg=f)
 
 
-@pytest.mark.parametrize("family", ["4R", "RSSR", "RCCC"])
+@pytest.mark.parametrize("family", ["4R", "RSSR", "RCCC", "CSSP"])
 def test_each_family_read_off_its_drawing_gives_the_closed_form_modes(family: str) -> None:
-    """The 4R, RSSR (with its output crank off the crank plane) and RCCC (with an input offset)
-    drawn as graphs are read back as their families; every graph mode is a loop mode, sample
+    """The 4R, RSSR (with its output crank off the crank plane), RCCC (with an input offset) and
+    CSSP (with a crank offset) drawn as graphs are read back as their families; every graph mode is a loop mode, sample
     by sample."""
     lk = {"4R": sk.fourbar(a=4.0, d1=1.0, d2=3.5, d3=3.0),
           "RSSR": sk.rssr(1.0, 3.0, 2.0, 2.5, 1.0, 0.3, 0.4),
-          "RCCC": sk.rccc((1.0, 1.5, 1.2, 1.4), (0.3, 0.5, -0.4, 0.6), 0.3)}[family]
+          "RCCC": sk.rccc((1.0, 1.5, 1.2, 1.4), (0.3, 0.5, -0.4, 0.6), 0.3),
+          "CSSP": sk.cssp(1.0, 3.0, 1.5, 0.4, -0.5)}[family]
     x = np.radians(np.arange(0.0, 360.0, 10.0))
     motion = sk.solve_motion(lk, x)
     k0 = int(np.argmax(motion.mode(1).assembles))

@@ -12,7 +12,8 @@ the ground) round to the ground. Two forms:
   four-bar (four parallel R axes) the 4R (:func:`screwkit.model.families.fourbar`, Bagci's frame
   a, crank d1, coupler d2, rocker d3 measured off the drawing), an R–S–R–C loop Bagci's RSRC
   (:func:`_rsrc`), an R–S–S–R loop the RSSR (:func:`_rssr`), an R–C–C–C loop the RCCC
-  (:func:`_rccc`), each placed in the world by the linkage ``base`` and kept only if its closed
+  (:func:`_rccc`), an R–S–S–P loop Rahman's slider-crank CSSP (:func:`_cssp`; its quadratic in
+  s4, Rahman 1996 §1.2), each placed in the world by the linkage ``base`` and kept only if its closed
   form draws the drawing's joint lines, so that ``solve_motion`` uses the family's closed form
   (Bagci 1969 eqs. 3.59–3.82, the 4R its δ0 = λ0 = b = e = 0 case; the RSSR's and the RCCC's
   A cos φ + B sin φ = C) and gives every mode;
@@ -29,7 +30,7 @@ Which single loops take this path (docs/mechanisms.md, "How a single loop drawn 
 solved"): those with a closed form. Any other single loop stays on the graph's own continuation
 (graph/track.py) and every-mode homotopy (modes/), the generic solver for every topology:
 measured in benchmarks/bench_graph.py, the generic loop solver on the frame-form joint list
-takes 4–5 times the graph tracker's time for the drawn mode (which every analysis needs); for
+takes 2.5–5 times the graph tracker's time for the drawn mode (which every analysis needs); for
 every mode it was faster on one loop (an RSRC: ~45 against 680 µs per sample) and slower on
 another (an RSSR: ~120 against 48).
 
@@ -80,7 +81,7 @@ class LoopChain:
 
 
 def loop_chain(mech: Mechanism, *, generic: bool = False) -> LoopChain | None:
-    """The loop of ``mech`` as a family with a closed form (4R, RSRC, RSSR, RCCC), when it is a
+    """The loop of ``mech`` as a family with a closed form (4R, RSRC, RSSR, RCCC, CSSP), when it is a
     single loop the drawing shows to be one (module docstring); else None, or with
     ``generic`` the joint list in frame form that the generic loop solver takes."""
     if mech.drives or any(j.seat_offset is not None for j in mech.joints):
@@ -97,7 +98,7 @@ def loop_chain(mech: Mechanism, *, generic: bool = False) -> LoopChain | None:
     joints, bodies = order
     if generic:
         return _joint_list(mech, joints, bodies)
-    for family in (_fourbar, _rsrc, _rssr, _rccc):
+    for family in (_fourbar, _rsrc, _rssr, _rccc, _cssp):
         found = family(mech, joints, bodies)
         if found is not None:
             return found
@@ -402,6 +403,55 @@ def _rccc(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
     if family_of(lk).closed_form_for(lk) is None:
         return None
     return _placed(mech, lk, W, joints, bodies, theta1)
+
+
+def _cssp(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
+          ) -> LoopChain | None:
+    """An R–S–S–P loop driven at its ground R joint as Rahman's slider-crank
+    (:func:`screwkit.model.families.cssp`, Hartenberg–Denavit form M1 L2 L3 M4 = I): the ground
+    frame's z axis is the crank axis, its origin the foot on it of the common normal from the
+    slider's line (the second ball's path along the slide direction), its x axis along that
+    normal (a4 its length, α4 the slide direction's angle to z about x); a1 and s1 the first
+    ball's distance from the crank axis and its foot's height on it, a2 the distance between the
+    balls."""
+    from screwkit.model.families import cssp
+
+    J = [mech.joints[k] for k in joints]
+    if not _driven_at_ground(mech, J, "RSSP"):
+        return None
+    z = J[0].axis if J[0].bodies == (GROUND, bodies[1]) else -J[0].axis
+    pin, ball, uP = J[1].at, J[2].at, J[3].axis
+    feet = _common_normal(J[0].at, z, ball, uP)
+    if feet is None:  # parallel: the normal through the ball
+        f1, fP = _line_foot(J[0].at, z, ball), ball
+    else:
+        f1, fP = feet
+    a4 = float(np.linalg.norm(f1 - fP))
+    crank = pin - _line_foot(J[0].at, z, pin)
+    a1, a2 = float(np.linalg.norm(crank)), float(np.linalg.norm(ball - pin))
+    if min(a1, a2) <= 1e-9 * mech.length_scale:
+        return None
+    if a4 > 1e-12 * mech.length_scale:
+        xs = [(f1 - fP) / a4]
+    else:  # the slide line meets the crank axis: either way round the normal
+        n = np.cross(uP, z)
+        if float(np.linalg.norm(n)) < 1e-9:
+            return None
+        xs = [n / np.linalg.norm(n), -n / np.linalg.norm(n)]
+    s1 = float((_line_foot(J[0].at, z, pin) - f1) @ z)
+    for x in xs:
+        y = np.cross(z, x)
+        theta0 = float(np.arctan2(crank @ y, crank @ x))
+        W = np.eye(4)
+        W[:3, :3] = np.column_stack([x, y, z])
+        W[:3, 3] = f1
+        for sign in (1.0, -1.0):
+            z4 = sign * uP
+            chain = _placed(mech, cssp(a1, a2, a4, float(np.arctan2(z4 @ y, z4 @ z)), s1), W,
+                            joints, bodies, theta0)
+            if chain is not None:
+                return chain
+    return None
 
 
 def _draws(mech: Mechanism, chain: LoopChain) -> bool:
