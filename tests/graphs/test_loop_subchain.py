@@ -181,3 +181,31 @@ def test_each_family_read_off_its_drawing_gives_the_closed_form_modes(family: st
         assert np.array_equal(gm.assembles, ok)
         assert _match(gm.joint_centres[ok], md.joint_centres[k0:][ok], scale)
         assert np.nanmax(gm.closure_residual) < 1e-12
+
+
+def test_random_loops_of_every_family_are_read_back_as_their_family() -> None:
+    """Seeded random dimensions of each family, drawn in each of their modes: every drawing is
+    read back as its family (the reading is checked against the closed form's joint lines)."""
+    rng = np.random.default_rng(5)
+    x = np.radians(np.arange(0.0, 360.0, 30.0))
+    seen: dict[str, int] = {}
+    for _ in range(4):
+        d1, d2, d3, a = rng.uniform(0.5, 3.0, 4)
+        b, e = rng.uniform(-1.0, 1.0, 2)
+        de, la = rng.uniform(-1.5, 1.5, 2)
+        for fam, lk in (("RSRC", sk.rsrc(d1, d2, d3, a, b, e, de, la)),
+                        ("RSSR", sk.rssr(d1, d2 + 1.0, d3, a, b, la, e)),
+                        ("CSSP", sk.cssp(d1, d2 + 2.0, abs(b), la, e)),
+                        ("RCCC", sk.rccc((d1, d2, d3, a), (de, la, b, e), e)),
+                        ("4R", sk.fourbar(a, d1, d2, d3))):
+            try:
+                motion = sk.solve_motion(lk, x)
+            except sk.AssemblyError:
+                continue  # these dimensions do not close over these inputs
+            for m, md in enumerate(motion.modes):
+                if md.assembles.any():
+                    mech = mechanism_from_loop(motion, m, int(np.argmax(md.assembles)))
+                    chain = loop_chain(mech)
+                    assert chain is not None and chain.linkage.family == fam, (fam, m)
+                    seen[fam] = seen.get(fam, 0) + 1
+    assert set(seen) == {"RSRC", "RSSR", "CSSP", "RCCC", "4R"}

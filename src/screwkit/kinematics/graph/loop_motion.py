@@ -249,11 +249,20 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
                  f"{input_text(mech, lay, X[k])} and {input_text(mech, lay, X[k + 1])}")
                 for r, k in zip(rows, ks, strict=True)]
     x0, x1 = X[ks], X[ks + 1]
+    rsrc = None
+    if chain.linkage.family in ("RSRC", "4R"):  # its quartic's real roots, without the modes
+        from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
+        from screwkit.kinematics.closed_forms.rsrc.positions import rsrc_positions
+
+        rsrc = rsrc_dimensions(chain.linkage)[0]
 
     def count(t: Array) -> NDArray[np.intp]:
-        """Real solutions at the inputs x0 + t (x1 − x0), the drawing appended (so that at
-        least one input assembles)."""
+        """Real solutions at the inputs x0 + t (x1 − x0): the RSRC's quartic roots (Bagci 1969
+        eq. 3.63, as its own limit search counts them), else the closed form's modes there, the
+        drawing appended (so that at least one input assembles)."""
         L = chain.loop_inputs(np.vstack([x0 + t[:, None] * (x1 - x0), np.zeros((1, X.shape[1]))]))
+        if rsrc is not None:
+            return np.asarray(rsrc_positions(rsrc, L[:-1, 0]).n_assemblies)
         mo = closed(chain.linkage, L, np.zeros_like(L), np.zeros_like(L))
         return np.sum([md.assembles for md in mo.modes], axis=0)[:-1]
 

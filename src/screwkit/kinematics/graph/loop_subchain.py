@@ -244,9 +244,20 @@ class _BagciFrame:
         return float(np.arctan2(-(u3 @ self.W[:3, 2]), u3 @ self.W[:3, 0]))
 
 
-def _bagci_frame(mech: Mechanism, J: list, bodies: tuple[str, ...]) -> _BagciFrame | None:
+def _bagci_frames(mech: Mechanism, J: list, bodies: tuple[str, ...]) -> list[_BagciFrame]:
     """The frame of the RSRC's and RSSR's dimensions (Bagci 1969 Fig. 5; families.py sketches)
-    read off the input joint J[0], the first ball J[1] and the output joint J[3]."""
+    read off the input joint J[0], the first ball J[1] and the output joint J[3]: with Y along
+    the common normal towards the output axis (a ≥ 0) first, then turned by π about X."""
+    fr = _bagci_frame(mech, J, bodies)
+    if fr is None:
+        return []
+    W = fr.W.copy()
+    W[:3, 1:3] *= -1.0
+    return [fr, _BagciFrame(W, fr.d1, -fr.a, fr.b, fr.f3, float(np.angle(-np.exp(1j * fr.theta0))))]
+
+
+def _bagci_frame(mech: Mechanism, J: list, bodies: tuple[str, ...]) -> _BagciFrame | None:
+    """:func:`_bagci_frames`' first frame."""
     X = J[0].axis if J[0].bodies == (GROUND, bodies[1]) else -J[0].axis
     ball = J[1].at
     O = _line_foot(J[0].at, X, ball)
@@ -257,10 +268,12 @@ def _bagci_frame(mech: Mechanism, J: list, bodies: tuple[str, ...]) -> _BagciFra
         n = (c3 - O) - ((c3 - O) @ X) * X
     if d1 <= 1e-9 * mech.length_scale or float(np.linalg.norm(n)) <= 1e-9 * mech.length_scale:
         return None
-    Y = n / np.linalg.norm(n)
-    Z = np.cross(X, Y)
     feet = _common_normal(O, X, c3, J[3].axis)
     f3 = feet[1] if feet is not None else c3 - ((c3 - O) @ X) * X
+    Y = n / np.linalg.norm(n)
+    if float((f3 - O) @ Y) < 0.0:
+        Y = -Y
+    Z = np.cross(X, Y)
     W = np.eye(4)
     W[:3, :3] = np.column_stack([X, Y, Z])
     W[:3, 3] = O
@@ -296,9 +309,6 @@ def _rsrc(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
     J = [mech.joints[k] for k in joints]
     if not _driven_at_ground(mech, J, "RSRC"):
         return None
-    fr = _bagci_frame(mech, J, bodies)
-    if fr is None:
-        return None
     ball = J[1].at
     c2, u2 = J[2].at, J[2].axis
     d2 = float(np.linalg.norm(ball - _line_foot(c2, u2, ball)))
@@ -308,14 +318,15 @@ def _rsrc(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
     d3 = float(np.linalg.norm(normal[1] - normal[0]))
     e = float(np.linalg.norm(normal[0] - _line_foot(c2, u2, ball)))
     delta = float(np.arccos(np.clip(abs(float(u2 @ J[3].axis)), 0.0, 1.0)))
-    for s3 in (1.0, -1.0):
-        lam = fr.lam(s3 * J[3].axis)
-        for ee in (e, -e):
-            for dd in (delta, -delta, np.pi - delta, delta - np.pi):
-                chain = _placed(mech, rsrc(fr.d1, d2, d3, fr.a, fr.b, ee, dd, lam), fr.W,
-                                joints, bodies, fr.theta0)
-                if chain is not None:
-                    return chain
+    for fr in _bagci_frames(mech, J, bodies):
+        for s3 in (1.0, -1.0):
+            lam = fr.lam(s3 * J[3].axis)
+            for ee in (e, -e):
+                for dd in (delta, -delta, np.pi - delta, delta - np.pi):
+                    chain = _placed(mech, rsrc(fr.d1, d2, d3, fr.a, fr.b, ee, dd, lam), fr.W,
+                                    joints, bodies, fr.theta0)
+                    if chain is not None:
+                        return chain
     return None
 
 
@@ -330,21 +341,19 @@ def _rssr(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
     J = [mech.joints[k] for k in joints]
     if not _driven_at_ground(mech, J, "RSSR"):
         return None
-    fr = _bagci_frame(mech, J, bodies)
-    if fr is None:
-        return None
     ball2 = J[2].at
     d2 = float(np.linalg.norm(ball2 - J[1].at))
     d3 = float(np.linalg.norm(ball2 - _line_foot(J[3].at, J[3].axis, ball2)))
     if min(d2, d3) <= 1e-9 * mech.length_scale:
         return None
-    for s3 in (1.0, -1.0):
-        u3 = s3 * J[3].axis
-        chain = _placed(mech, rssr(fr.d1, d2, d3, fr.a, fr.b, fr.lam(u3),
-                                   float((ball2 - fr.f3) @ u3)),
-                        fr.W, joints, bodies, fr.theta0)
-        if chain is not None:
-            return chain
+    for fr in _bagci_frames(mech, J, bodies):
+        for s3 in (1.0, -1.0):
+            u3 = s3 * J[3].axis
+            chain = _placed(mech, rssr(fr.d1, d2, d3, fr.a, fr.b, fr.lam(u3),
+                                       float((ball2 - fr.f3) @ u3)),
+                            fr.W, joints, bodies, fr.theta0)
+            if chain is not None:
+                return chain
     return None
 
 
