@@ -137,7 +137,7 @@ def test_a_hardpoint_where_part_of_the_turn_assembles(tmp_path: Path) -> None:
                     encoding="utf-8")
     tab = Tab(Design(spec))
     assert tab.handle(json.dumps({"type": "state"}))["result"]["assembly"][0].startswith(
-        "2 branch combination")
+        "2 assembly mode(s) of the loop")  # a single loop: the loop engine's modes
     r = tab.handle(json.dumps({"type": "set", "values": {"joints.B.at[0]": 20.0}}))["result"]
     assert r["ok"]
     assert r["assembly"][0] == "mode 0 (drawn) assembles only at input 0 … 128 deg"
