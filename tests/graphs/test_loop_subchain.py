@@ -209,3 +209,17 @@ def test_random_loops_of_every_family_are_read_back_as_their_family() -> None:
                     assert chain is not None and chain.linkage.family == fam, (fam, m)
                     seen[fam] = seen.get(fam, 0) + 1
     assert set(seen) == {"RSRC", "RSSR", "CSSP", "RCCC", "4R"}
+
+
+def test_the_rod_between_two_balls_turns_as_its_angular_velocity_says() -> None:
+    """An RSSR drawn as a graph: the rod's pose comes from the closed form, its angular velocity
+    from the stacked closure with the idle spin held still; the pose's derivative (central
+    differences) is that angular velocity, the spin about the rod included."""
+    lk = sk.rssr(1.0, 3.0, 2.0, 2.5, 1.0, 0.3)
+    mech = mechanism_from_loop(sk.solve_motion(lk, np.radians([0.0, 1.0])))
+    h = 1e-6
+    g = solve_mechanism(mech, np.array([0.4, 0.4 - h, 0.4 + h])).modes[0]
+    R = g.link_rotation[:, 1]  # the coupler rod
+    W = (R[2] - R[1]) / (2 * h) @ R[0].T
+    np.testing.assert_allclose([W[2, 1], W[0, 2], W[1, 0]], g.link_angular_velocity[0, 1],
+                               atol=1e-8)
