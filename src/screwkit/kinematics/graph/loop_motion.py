@@ -31,6 +31,7 @@ Array = NDArray[np.float64]
 #: bisection steps locating a fold between two samples (2⁻⁵⁰ of their input step)
 FOLD_STEPS = 50
 
+
 @dataclass(frozen=True)
 class LoopModes:
     """The loop's solution as graph modes: per loop mode (in ``solve_motion``'s order) the
