@@ -71,8 +71,10 @@ DOUBLE_ROOT_IMAG = 1e-6
 #: a solution this large (in any unknown) is a path on its way to infinity: its row is not
 #: complete
 FAR_OUT = 1e8
-#: random starts of the search for a drawing (inputs free)
+#: random starts of the search for a drawing (inputs free), and how many closed ones are enough
+#: to choose from
 DRAWING_STARTS = 24
+DRAWINGS = 4
 
 
 @dataclass(frozen=True)
@@ -105,7 +107,8 @@ def closed_somewhere(linkage: Linkage, lay: Layout, starts: int = DRAWING_STARTS
     """Closed configurations of the loop at any input value (inputs free): damped minimum-norm
     Gauss–Newton over every freedom from ``starts`` random configurations
     (:func:`~screwkit.kinematics.tracker.solve.random_configurations`), vectorised; the
-    converged ones (scaled residual ≤ 1e-12), possibly none."""
+    converged ones (scaled residual ≤ 1e-12; it stops once :data:`DRAWINGS` are closed to
+    1e-13), possibly none."""
     L = constants(linkage, lay)[2]
     rows = np.array([1.0, 1.0, 1.0, 1.0 / L, 1.0 / L, 1.0 / L])
     cols = np.array([L if t else 1.0 for t in lay.is_translation])
@@ -113,7 +116,7 @@ def closed_somewhere(linkage: Linkage, lay: Layout, starts: int = DRAWING_STARTS
     for _ in range(iterations):
         fr = forward(linkage, conf, lay, frames=False)
         xi = closure_twist(fr.closure_R, fr.closure_p) * rows
-        if np.max(np.abs(xi)) <= 1e-13:
+        if np.sum(np.max(np.abs(xi), axis=-1) <= 1e-13) >= DRAWINGS:
             break
         J = fr.screws * rows[:, None] * cols[None, :]
         JJt = J @ np.swapaxes(J, -1, -2)
@@ -211,7 +214,8 @@ def algebraic_roots(lf: LoopFormulation, linkage: Linkage, lay: Layout, X: Array
     continuum = np.zeros(B, dtype=bool)
     singular = np.flatnonzero(sol.status == PathStatus.SINGULAR)
     if singular.size:
-        on = on_a_continuum(form.system, sol.x[singular], np.asarray(p[sol.instance[singular]], dtype=complex))
+        on = on_a_continuum(form.system, sol.x[singular],
+                            np.asarray(p[sol.instance[singular]], dtype=complex))
         continuum[np.unique(sol.instance[singular][on])] = True
     # a singular end point off a continuum is a double root: a real dead centre (a fold) when
     # nearly real (the endgame's accuracy there is ~√ε, and its closure is checked below)

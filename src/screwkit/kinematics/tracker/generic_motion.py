@@ -3,10 +3,15 @@
 Assembly modes are continuous branches (``../shared/DESIGN.md``), found by continuation
 (:mod:`screwkit.kinematics.tracker.continuation`), not by a root search at every sample:
 
-1. a global root search (:func:`~screwkit.kinematics.tracker.solve.find_assemblies`, Newton from many
-   random starts) runs at the first sample and, as a safety net with half as many starts, at
-   a coarse stride of *anchor* samples (every :data:`ANCHOR_SPAN` rad of input, or that
-   fraction of the length scale for a sliding input);
+1. a global root search runs at the first sample and at a coarse stride of *anchor* samples
+   (every :data:`ANCHOR_SPAN` rad of input, or that fraction of the length scale for a sliding
+   input): where a polynomial formulation fits the loop, every real solution of one batched
+   parameter homotopy over those samples (:mod:`screwkit.kinematics.tracker.algebraic_roots`,
+   issue 27; the stretches next to an anchor with a complex root are searched again every
+   :data:`DENSE_SPAN`, and a sample where the homotopy's count falls short is searched by random
+   starts too), otherwise Newton from many random starts
+   (:func:`~screwkit.kinematics.tracker.solve.find_assemblies`; half as many at the anchors,
+   as a safety net) — :class:`RootEngine`;
 2. every root not on a known branch seeds a new branch, which is followed forwards and
    backwards to where it ends (so a mode born after the first sample is found over all of its
    life, not from the anchor that found it);
@@ -16,7 +21,9 @@ Assembly modes are continuous branches (``../shared/DESIGN.md``), found by conti
    Jacobian's null direction (:func:`_seed_fold_partners`);
 4. a continuum of closed configurations at one input (a motion left free with the input
    fixed) is one degenerate set, seeded once (:mod:`screwkit.kinematics.tracker.degenerate`), and
-   branches that turn out to be the same (found from two anchors) are merged.
+   branches that turn out to be the same (found from two anchors) are merged; where the
+   homotopy finds a sample on a continuum (a curve of solutions at that input), no mode holds
+   it (:func:`_off_continua`).
 
 Rates, accelerations, link frames and singular samples then follow from the loop's rate
 equations (:mod:`screwkit.kinematics.tracker.mode_frames`).
@@ -138,9 +145,12 @@ def generic_motion(
     starts: int = 48,
     seed: int = 0,
     progress: Progress | bool | None = None,
+    homotopy: bool = True,
 ) -> Motion:
     """Positions, velocities and accelerations of every freedom and link over an input sweep,
     in every assembly mode (generic solver; works for any single loop; module docstring).
+    ``homotopy=False`` searches roots by random starts alone, also where a polynomial
+    formulation fits the loop (the solver before issue 27; for comparisons).
 
     ``starts`` random starts per root search and their ``seed``; ``progress`` a callback
     ``(samples done, samples to do)`` (the samples followed, then each mode's build counting
@@ -160,7 +170,7 @@ def generic_motion(
             if report is not None:
                 report(done, total)
 
-        engine = RootEngine(linkage, lay, starts, seed)
+        engine = RootEngine(linkage, lay, starts, seed, algebraic=homotopy)
         tracks = all_branches(linkage, lay, X, starts, seed,
                                tracking if report is not None else None, engine=engine)
         if not tracks:
@@ -265,6 +275,7 @@ class RootEngine:
     def __init__(self, linkage: Linkage, lay: Layout, starts: int, seed: int,
                  algebraic: bool = True) -> None:
         self.linkage, self.lay, self.starts, self.seed = linkage, lay, starts, seed
+        self.algebraic = algebraic
         self.formulation: LoopFormulation | None = (
             loop_formulation(linkage, lay, seed) if algebraic else None)
         self.rows = self.roots = self.uncertified = self.continua = self.fallback = 0
@@ -335,19 +346,22 @@ class RootEngine:
         self.search(X, todo, self.seed)
         return self.continuum_samples - before
 
+    def _why(self) -> str:
+        return ("no polynomial formulation takes this loop" if self.algebraic
+                else "the homotopy was not asked for")
+
     def how(self) -> str:
         """How the roots were searched, for the Motion's solver string."""
         if self.formulation is None:
-            return (f"by Newton from {self.starts} random starts (no polynomial formulation "
-                    "takes this loop)")
+            return f"by Newton from {self.starts} random starts ({self._why()})"
         return (f"by every real solution of the {self.formulation.name} polynomial homotopy "
                 f"(generic count {self.generic_count})")
 
     def notes(self) -> tuple[str, ...]:
         """The Motion's notes on the root searches."""
         if self.formulation is None:
-            return ("root searches: Newton from random starts (no polynomial formulation takes "
-                    "this loop), which cannot promise every mode",)
+            return (f"root searches: Newton from random starts ({self._why()}), which cannot "
+                    "promise every mode",)
         out = [f"root searches: {self.formulation.name} polynomial homotopy at {self.rows} "
                f"samples, {self.roots} real roots ({self.roots - self.uncertified} certified "
                "by Smale's alpha test), every one closing the loop to 1e-9"]
