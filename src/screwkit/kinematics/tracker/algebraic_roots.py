@@ -92,6 +92,12 @@ class LoopFormulation:
     name: str
 
 
+def _form_inputs(form: Formulation, rel: Array) -> Array:
+    """Rows of inputs (B, n_inputs) as ``form`` reads them: (B,) for the one-input rod loops
+    and the RCCC, (B, n_inputs) for the planar and 6R formulations."""
+    return rel[:, 0] if formulation_name(form) in ("RSSR", "RSRC", "RCCC") else rel
+
+
 def formulation_name(form: Formulation) -> str:
     """A short name of the formulation: "planar R loop", "6R", "RSSR", "RSRC" or "RCCC"."""
     if isinstance(form, PlanarFormulation):
@@ -155,8 +161,7 @@ def loop_formulation(linkage: Linkage, lay: Layout, seed: int = 0) -> LoopFormul
     try:
         mech = mechanism_drawn(linkage, fr.centres[best], fr.axes[best])
         form = closure_formulation(mech)
-        form.parameters(np.zeros((1, len(linkage.inputs))) if isinstance(
-            form, PlanarFormulation) or len(linkage.inputs) > 1 else np.zeros(1))
+        form.parameters(_form_inputs(form, np.zeros((1, len(linkage.inputs)))))
     except ScrewkitError:  # e.g. an R loop without six free joints
         return None
     inputs = np.array([drawn.scalars[0, lay.scalar_col[lay.names.index(n)]]
@@ -208,8 +213,7 @@ def algebraic_roots(lf: LoopFormulation, linkage: Linkage, lay: Layout, X: Array
     B = X.shape[0]
     rel = X - lf.drawn_inputs
     start = formulation_start(form)
-    p = form.parameters(rel if isinstance(form, PlanarFormulation) or rel.shape[1] > 1
-                        else rel[:, 0])
+    p = form.parameters(_form_inputs(form, rel))
     sol = solve_all(form.system, p, start)
     continuum = np.zeros(B, dtype=bool)
     singular = np.flatnonzero(sol.status == PathStatus.SINGULAR)
@@ -226,8 +230,7 @@ def algebraic_roots(lf: LoopFormulation, linkage: Linkage, lay: Layout, X: Array
                           & ~continuum[sol.instance])
     inst = sol.instance[take]
     if take.size and lf.name != "6R":
-        arg = rel[inst] if isinstance(form, PlanarFormulation) else rel[inst, 0]
-        graph, glay = form.configuration(sol.x[take], arg)
+        graph, glay = form.configuration(sol.x[take], _form_inputs(form, rel[inst]))
     elif take.size:  # the 6R instances differ per row: their way back is per row
         take = take[np.argsort(inst, kind="stable")]
         inst = sol.instance[take]

@@ -86,6 +86,9 @@ ANCHOR_SPAN = np.radians(15.0)
 #: where a pair of complex roots may turn real (:meth:`RootEngine.between`; rad, or × the
 #: length scale): an island of modes at least this long is seen by a search
 DENSE_SPAN = np.radians(1.0)
+#: ... or wider, so that those searches track at most this many homotopy paths in all (a 6R
+#: loop's 16 paths a sample: 2.8° over a whole turn)
+DENSE_PATHS = 2048
 #: a sweep at least this long shows a progress bar on a terminal (when no callback is given)
 PROGRESS_SAMPLES = 50_000
 #: ... or a solve estimated (solve_motion.motion_seconds) to take this long, seconds
@@ -104,11 +107,18 @@ def anchor_samples(linkage: Linkage, X: Array, every: float = ANCHOR_SPAN) -> ND
     N = X.shape[0]
     if N == 1:
         return np.array([0])
-    L = linkage.length_scale
-    scale = np.array([1.0 / L if n.endswith(".s") else 1.0 for n in linkage.inputs])
-    span = np.concatenate([[0.0], np.cumsum(np.max(np.abs(np.diff(X, axis=0)) * scale, axis=1))])
+    span = _input_span(linkage, X)
     marks = np.searchsorted(span, np.arange(0.0, span[-1], every))
     return np.unique(np.concatenate([[0], marks, [N - 1]]).clip(0, N - 1))
+
+
+def _input_span(linkage: Linkage, X: Array) -> Array:
+    """How far the inputs have moved (N,) from the first sample, along the sweep: the largest
+    input step each time (rad, or fraction of the length scale for a slide)."""
+    L = linkage.length_scale
+    scale = np.array([1.0 / L if n.endswith(".s") else 1.0 for n in linkage.inputs])
+    steps = np.max(np.abs(np.diff(X, axis=0)) * scale, axis=1) if X.shape[0] > 1 else []
+    return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 @contextmanager
@@ -317,18 +327,25 @@ class RootEngine:
             _rows_array(asm.radius, first, short, B, 1.0)))
 
     def between(self, X: Array, anchors: NDArray[np.intp]) -> NDArray[np.intp]:
-        """The samples to search next: every :data:`DENSE_SPAN` of input within each stretch
+        """The samples to search next: every :data:`DENSE_SPAN` of input (or wider, within
+        :data:`DENSE_PATHS`) within each stretch
         between two anchors where either anchor has a root that is not real (a complex pair,
         which can turn real at a fold in between: an island of modes between anchors, which
         meets no known branch); none without a formulation, or where every root is real."""
         if self.formulation is None or not self.nonreal:
             return np.zeros(0, dtype=np.intp)
-        fine = anchor_samples(self.linkage, X, DENSE_SPAN)
         flagged = np.isin(anchors, np.array(sorted(self.nonreal)))
+        # the stretches' input movement, and a spacing that keeps their paths within budget
+        span = _input_span(self.linkage, X)
+        lo, hi = anchors[:-1], anchors[1:]
+        near = flagged[:-1] | flagged[1:]
+        moved = float(np.sum((span[hi] - span[lo])[near]))
+        every = max(DENSE_SPAN, moved * max(self.generic_count, 1) / DENSE_PATHS)
+        fine = anchor_samples(self.linkage, X, every)
         stretch = np.searchsorted(anchors, fine)  # fine sample in (anchors[k-1], anchors[k]]
-        near = flagged[np.clip(stretch, 0, len(anchors) - 1)] | flagged[
+        near2 = flagged[np.clip(stretch, 0, len(anchors) - 1)] | flagged[
             np.clip(stretch - 1, 0, len(anchors) - 1)]
-        todo = fine[near & ~np.isin(fine, np.array(sorted(self.searched), dtype=np.intp))]
+        todo = fine[near2 & ~np.isin(fine, np.array(sorted(self.searched), dtype=np.intp))]
         return np.asarray(todo, dtype=np.intp)
 
     def singular_continua(self, X: Array, modes: list[ModeMotion]) -> set[int]:
