@@ -100,3 +100,35 @@ def test_a_loop_without_a_formulation_says_it_used_random_starts() -> None:
     m = solve_motion(lk, np.radians(np.arange(0.0, 60.0, 10.0)), method="generic")
     assert "random starts" in m.solver
     assert any("cannot promise every mode" in n for n in m.notes)
+
+
+def test_a_7r_loop_at_one_input_gets_every_root_newton_finds_and_closes() -> None:
+    # the 6R route (a 7R loop driven at one joint: six free joints, 16 complex solutions): every
+    # root that Newton from random starts finds is among the homotopy's, and each of those
+    # closes the loop's own chain
+    from screwkit.kinematics.tracker.algebraic_roots import algebraic_roots, loop_formulation
+    from screwkit.kinematics.tracker.loop import closure_error, forward, layout
+    from screwkit.kinematics.tracker.solve import find_assemblies
+    from screwkit.model.joints import Joint
+    from screwkit.model.linkage import Linkage
+
+    rng = np.random.default_rng(5)
+    lk = Linkage.from_hartenberg_denavit(
+        "7R", [Joint(f"J{i + 1}", "R") for i in range(7)], list(rng.uniform(0.5, 2.0, 7)),
+        list(rng.uniform(-1.2, 1.2, 7)), inputs=["J1.theta"])
+    lay = layout(lk)
+    lf = loop_formulation(lk, lay)
+    assert lf is not None and lf.name == "6R"
+    X = np.radians([[40.0], [200.0]])
+    roots = algebraic_roots(lf, lk, lay, X)
+    assert roots.generic_count == 16 and roots.complete.all()
+    newton = find_assemblies(lk, X, starts=96, seed=1)
+    asm = roots.assemblies
+    for r in range(2):
+        mine = asm.signature[r][asm.found[r]]
+        theirs = newton.signature[r][newton.found[r]]
+        assert len(mine) >= len(theirs) >= 2
+        d = np.abs(theirs[:, None, :] - mine[None, :, :]).max(axis=-1).min(axis=1)
+        assert d.max() < 1e-6
+    fr = forward(lk, asm.conf.take(np.flatnonzero(asm.found.ravel())), lay, frames=False)
+    assert np.abs(closure_error(fr.closure_R, fr.closure_p)).max() < 1e-10
