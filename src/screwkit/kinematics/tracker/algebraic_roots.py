@@ -137,15 +137,26 @@ def closed_somewhere(linkage: Linkage, lay: Layout, starts: int = DRAWING_STARTS
     return conf.take(np.flatnonzero(np.isfinite(res) & (res <= 1e-12)))
 
 
+def _may_fit(linkage: Linkage, lay: Layout) -> bool:
+    """Whether a formulation may take the loop, from its joints alone (before the drawing is
+    searched): R joints only, planar (every link keeps the z axis, up to its sign) or with six
+    free joints; or
+    four joints making an RSSR, RSRC or RCCC."""
+    kinds = sorted(j.kind for j in linkage.joints)
+    if set(kinds) == {"R"}:
+        planar = bool(np.all(np.abs(np.abs(constants(linkage, lay)[0][:, 2, 2]) - 1.0)
+                             < 1e-12))
+        return planar or len(kinds) - len(linkage.inputs) == 6
+    return len(linkage.inputs) == 1 and kinds in (["R", "R", "S", "S"], ["C", "R", "R", "S"],
+                                                  ["C", "C", "C", "R"])
+
+
 def loop_formulation(linkage: Linkage, lay: Layout, seed: int = 0) -> LoopFormulation | None:
     """The formulation that fits ``linkage``, drawn at a closed configuration (module
     docstring, step 1), or None: no formulation takes this loop (its joints; a U joint, whose
     second axis a drawing does not keep; an input not at a ground R joint ...), or the loop
     closes nowhere."""
-    kinds = {j.kind for j in linkage.joints}
-    if kinds & {"U", "H"} or not kinds <= {"R", "S", "C", "P"}:
-        return None
-    if "S" in kinds and len(linkage.joints) != 4:  # only RSSR and RSRC have balls
+    if not _may_fit(linkage, lay):
         return None
     closed = closed_somewhere(linkage, lay, seed=seed)
     if closed.size == 0:
