@@ -132,3 +132,10 @@ def test_a_7r_loop_at_one_input_gets_every_root_newton_finds_and_closes() -> Non
         assert d.max() < 1e-6
     fr = forward(lk, asm.conf.take(np.flatnonzero(asm.found.ravel())), lay, frames=False)
     assert np.abs(closure_error(fr.closure_R, fr.closure_p)).max() < 1e-10
+
+
+def test_a_deltoid_solved_only_at_its_continuum_says_so() -> None:
+    from screwkit.kinematics.motion import AssemblyError
+
+    with pytest.raises(AssemblyError, match="closes only on continua"):
+        solve_motion(fourbar(1.0, 1.0, 2.0, 2.0), np.array([0.0]), method="generic")

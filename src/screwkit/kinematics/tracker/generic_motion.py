@@ -184,7 +184,7 @@ def generic_motion(
         tracks = all_branches(linkage, lay, X, starts, seed,
                                tracking if report is not None else None, engine=engine)
         if not tracks:
-            raise closes_nowhere(linkage, X)
+            raise closes_nowhere(linkage, X, engine.continuum_samples)
 
         def building(done: int, total: int) -> None:  # after the samples followed
             if report is not None:
@@ -202,7 +202,7 @@ def generic_motion(
         if continua:  # rare: a sample on a continuum that no root search had looked at
             tracks = _off_continua(tracks, continua)
             if not tracks:
-                raise closes_nowhere(linkage, X)
+                raise closes_nowhere(linkage, X, engine.continuum_samples)
             modes = build(tracks, None)
     modes = [replace(md, index=k, label=f"branch {k}") for k, md in enumerate(modes)]
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="generic",
@@ -212,8 +212,17 @@ def generic_motion(
                          "(docs/kinematics.md)", notes=engine.notes())
 
 
-def closes_nowhere(linkage: Linkage, X: Array) -> AssemblyError:
-    """The error of a sweep where the generic solver finds no closed configuration at all."""
+def closes_nowhere(linkage: Linkage, X: Array, continua: set[int] | None = None
+                   ) -> AssemblyError:
+    """The error of a sweep where the generic solver finds no closed configuration at all (or,
+    with ``continua``, only continua of them: curves of closures at single inputs)."""
+    if continua:
+        at = sorted(continua)
+        return AssemblyError(
+            f"{linkage.name}: the loop closes only on continua of configurations (a curve of "
+            f"closures with the input held, no assembly mode) at {len(at)} of the "
+            f"{X.shape[0]} inputs, first at {format_inputs(linkage, X[at[0]])}; move the "
+            "inputs off them, or check the dimensions")
     return AssemblyError(
         f"{linkage.name}: the loop does not close at any of the {X.shape[0]} inputs "
         f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
