@@ -21,6 +21,9 @@ rows searched, instead of Newton from random starts, which cannot promise every 
    is within :data:`~screwkit.kinematics.modes.every_mode.CLOSURE_TOLERANCE`. A row whose
    singular end points lie on a curve of solutions is a continuum
    (:func:`~screwkit.kinematics.modes.continuum.on_a_continuum`): no root is reported there.
+   A row whose paths do not end at the generic count of distinct finite solutions (a double
+   root at a fold; a non-generic mechanism whose paths run off to infinity) is not
+   ``complete``: the generic solver searches it by random starts as well.
 3. **Back to the loop.** Each graph configuration becomes the loop's: scalar freedoms are the
    drawing's plus the graph's (both measure the same joint about the same drawn line); a ball
    joint's rotation is S = Bᵀ G B S₀, with G the graph's relative rotation of its two bodies
