@@ -12,6 +12,10 @@
 * RSSR, examples/rssr_spatial.toml, 3 600 samples with the generic solver: time (target < 1 s)
   and the peak resident memory of the whole process that imports screwkit, reads the spec and
   solves (target < 200 MB), measured in a fresh subprocess (its VmHWM).
+* The bundled loops examples/rrsrr_loop.toml, rccc_loop.toml and rssr_spatial.toml at their
+  own input samples: the generic solver's time with its root searches by the polynomial
+  homotopy where a formulation fits the loop (issue 27) and by random starts alone
+  (``homotopy=False``, the solver before), side by side, and which engine was used.
 * 10⁶ samples of a planar 4R through the generic solver (accepted; the progress bar shows on a
   terminal): time and peak memory of the process. ``BENCH_GENERIC_MILLION=0`` skips this row.
 
@@ -146,6 +150,31 @@ def _rssr_rows() -> list[dict[str, Any]]:
     ]
 
 
+def _bundled_loop_rows() -> list[dict[str, Any]]:
+    from screwkit.io.spec import load_spec
+    from screwkit.kinematics.tracker.generic_motion import generic_motion
+
+    rows = []
+    for name in ("rrsrr_loop", "rccc_loop", "rssr_spatial"):
+        spec = load_spec(ROOT / "examples" / f"{name}.toml")
+        lk, X = spec.linkage, spec.inputs
+        generic_motion(lk, X, progress=False)  # warm-up (the topology's start solutions)
+        best = {}
+        for _ in range(2):  # alternated: the shared machine's speed drifts
+            for homotopy in (True, False):
+                t = _best(lambda h=homotopy, lk=lk, X=X: generic_motion(
+                    lk, X, progress=False, homotopy=h))
+                best[homotopy] = min(best.get(homotopy, np.inf), t)
+        m = generic_motion(lk, X, progress=False)
+        engine = ("random starts (no formulation)" if "random starts" in m.solver
+                  else m.solver.split("by every real solution of the ")[1].split(" (")[0])
+        rows.append({"name": f"{name}.toml, {len(X)} samples: generic solver",
+                     "value": best[True] * 1e3, "unit": "ms", "target": "report",
+                     "note": f"root searches by {engine}; random starts alone "
+                             f"{best[False] * 1e3:.1f} ms ({len(m.modes)} modes)"})
+    return rows
+
+
 def _million_rows() -> list[dict[str, Any]]:
     if os.environ.get("BENCH_GENERIC_MILLION", "1") == "0":
         return []
@@ -168,7 +197,7 @@ def _million_rows() -> list[dict[str, Any]]:
 
 
 def run() -> list[dict[str, Any]]:
-    return _rsrc_rows() + _rssr_rows() + _million_rows()
+    return _bundled_loop_rows() + _rsrc_rows() + _rssr_rows() + _million_rows()
 
 
 if __name__ == "__main__":

@@ -5,9 +5,11 @@ given as a graph can be compared sample by sample (docs/mechanisms.md)."""
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.motion import Motion
+from screwkit.model.linkage import Linkage
 from screwkit.model.mechanism import GROUND, Body, Mechanism, MechanismJoint
 
 
@@ -20,6 +22,13 @@ def mechanism_from_loop(motion: Motion, mode: int = 0, sample: int = 0) -> Mecha
     md = motion.mode(mode)
     if not md.assembles[sample]:
         raise CapabilityError(f"{lk.name}: mode {mode} does not assemble at sample {sample}")
+    return mechanism_drawn(lk, md.joint_centres[sample], md.joint_axes[sample])
+
+
+def mechanism_drawn(lk: Linkage, centres: ArrayLike, axes: ArrayLike) -> Mechanism:
+    """The loop ``lk`` drawn with its joints on the lines through ``centres`` (n, 3) along
+    ``axes`` (n, 3) (one closed configuration; :func:`mechanism_from_loop`)."""
+    centres, axes = np.asarray(centres, dtype=float), np.asarray(axes, dtype=float)
     names = [link.name for link in lk.links]
     n = len(lk.joints)
     joints = []
@@ -29,8 +38,7 @@ def mechanism_from_loop(motion: Motion, mode: int = 0, sample: int = 0) -> Mecha
                                   "is not kept by a Motion, so the loop cannot be redrawn")
         first = GROUND if i == 0 else names[i - 1]
         second = GROUND if i == n - 1 else names[i]
-        joints.append(MechanismJoint(j.name, j.kind, (first, second),
-                                     np.array(md.joint_centres[sample, i]),
-                                     np.array(md.joint_axes[sample, i]), None, j.pitch))
+        joints.append(MechanismJoint(j.name, j.kind, (first, second), np.array(centres[i]),
+                                     np.array(axes[i]), None, j.pitch))
     bodies = tuple(Body(link.name, None) for link in lk.links)
     return Mechanism(lk.name, bodies, tuple(joints), tuple(lk.inputs))

@@ -3,10 +3,15 @@
 Assembly modes are continuous branches (``../shared/DESIGN.md``), found by continuation
 (:mod:`screwkit.kinematics.tracker.continuation`), not by a root search at every sample:
 
-1. a global root search (:func:`~screwkit.kinematics.tracker.solve.find_assemblies`, Newton from many
-   random starts) runs at the first sample and, as a safety net with half as many starts, at
-   a coarse stride of *anchor* samples (every :data:`ANCHOR_SPAN` rad of input, or that
-   fraction of the length scale for a sliding input);
+1. a global root search runs at the first sample and at a coarse stride of *anchor* samples
+   (every :data:`ANCHOR_SPAN` rad of input, or that fraction of the length scale for a sliding
+   input): where a polynomial formulation fits the loop, every real solution of one batched
+   parameter homotopy over those samples (:mod:`screwkit.kinematics.tracker.algebraic_roots`,
+   issue 27; the stretches next to an anchor with a complex root are searched again every
+   :data:`DENSE_SPAN`, and a sample where the homotopy's count falls short is searched by random
+   starts too), otherwise Newton from many random starts
+   (:func:`~screwkit.kinematics.tracker.solve.find_assemblies`; half as many at the anchors,
+   as a safety net) — :class:`RootEngine`;
 2. every root not on a known branch seeds a new branch, which is followed forwards and
    backwards to where it ends (so a mode born after the first sample is found over all of its
    life, not from the anchor that found it);
@@ -16,7 +21,9 @@ Assembly modes are continuous branches (``../shared/DESIGN.md``), found by conti
    Jacobian's null direction (:func:`_seed_fold_partners`);
 4. a continuum of closed configurations at one input (a motion left free with the input
    fixed) is one degenerate set, seeded once (:mod:`screwkit.kinematics.tracker.degenerate`), and
-   branches that turn out to be the same (found from two anchors) are merged.
+   branches that turn out to be the same (found from two anchors) are merged; where the
+   homotopy finds a sample on a continuum (a curve of solutions at that input), no mode holds
+   it (:func:`_off_continua`).
 
 Rates, accelerations, link frames and singular samples then follow from the loop's rate
 equations (:mod:`screwkit.kinematics.tracker.mode_frames`).
@@ -34,10 +41,17 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.motion import (
     AssemblyError,
+    ModeMotion,
     Motion,
     as_input_array,
     format_inputs,
     per_sample,
+)
+from screwkit.kinematics.tracker.algebraic_roots import (
+    AlgebraicRoots,
+    LoopFormulation,
+    algebraic_roots,
+    loop_formulation,
 )
 from screwkit.kinematics.tracker.continuation import Tracker
 from screwkit.kinematics.tracker.degenerate import seeds_off_continua
@@ -68,6 +82,13 @@ from screwkit.model.linkage import Linkage
 #: input movement between two anchor samples of the safety-net root search (rad; × the length
 #: scale for a sliding input)
 ANCHOR_SPAN = np.radians(15.0)
+#: input movement between two samples searched by the homotopy inside a stretch between anchors
+#: where a pair of complex roots may turn real (:meth:`RootEngine.between`; rad, or × the
+#: length scale): an island of modes at least this long is seen by a search
+DENSE_SPAN = np.radians(1.0)
+#: ... or wider, so that those searches track at most this many homotopy paths in all (a 6R
+#: loop's 16 paths a sample: 2.8° over a whole turn)
+DENSE_PATHS = 2048
 #: a sweep at least this long shows a progress bar on a terminal (when no callback is given)
 PROGRESS_SAMPLES = 50_000
 #: ... or a solve estimated (solve_motion.motion_seconds) to take this long, seconds
@@ -80,17 +101,24 @@ SAME_ROOT = 1e-6  # signature distance (length-scale units) of two copies of one
 Progress = Callable[[int, int], None]
 
 
-def anchor_samples(linkage: Linkage, X: Array) -> NDArray[np.intp]:
+def anchor_samples(linkage: Linkage, X: Array, every: float = ANCHOR_SPAN) -> NDArray[np.intp]:
     """The first and last samples and every sample where the inputs have moved another
-    :data:`ANCHOR_SPAN` since the previous anchor (measured along the sweep)."""
+    ``every`` (:data:`ANCHOR_SPAN`) since the previous anchor (measured along the sweep)."""
     N = X.shape[0]
     if N == 1:
         return np.array([0])
+    span = _input_span(linkage, X)
+    marks = np.searchsorted(span, np.arange(0.0, span[-1], every))
+    return np.unique(np.concatenate([[0], marks, [N - 1]]).clip(0, N - 1))
+
+
+def _input_span(linkage: Linkage, X: Array) -> Array:
+    """How far the inputs have moved (N,) from the first sample, along the sweep: the largest
+    input step each time (rad, or fraction of the length scale for a slide)."""
     L = linkage.length_scale
     scale = np.array([1.0 / L if n.endswith(".s") else 1.0 for n in linkage.inputs])
-    span = np.concatenate([[0.0], np.cumsum(np.max(np.abs(np.diff(X, axis=0)) * scale, axis=1))])
-    marks = np.searchsorted(span, np.arange(0.0, span[-1], ANCHOR_SPAN))
-    return np.unique(np.concatenate([[0], marks, [N - 1]]).clip(0, N - 1))
+    steps = np.max(np.abs(np.diff(X, axis=0)) * scale, axis=1) if X.shape[0] > 1 else []
+    return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 @contextmanager
@@ -127,9 +155,12 @@ def generic_motion(
     starts: int = 48,
     seed: int = 0,
     progress: Progress | bool | None = None,
+    homotopy: bool = True,
 ) -> Motion:
     """Positions, velocities and accelerations of every freedom and link over an input sweep,
     in every assembly mode (generic solver; works for any single loop; module docstring).
+    ``homotopy=False`` searches roots by random starts alone, also where a polynomial
+    formulation fits the loop (the solver before issue 27; for comparisons).
 
     ``starts`` random starts per root search and their ``seed``; ``progress`` a callback
     ``(samples done, samples to do)`` (the samples followed, then each mode's build counting
@@ -149,31 +180,49 @@ def generic_motion(
             if report is not None:
                 report(done, total)
 
+        engine = RootEngine(linkage, lay, starts, seed, algebraic=homotopy)
         tracks = all_branches(linkage, lay, X, starts, seed,
-                               tracking if report is not None else None)
+                               tracking if report is not None else None, engine=engine)
         if not tracks:
-            raise closes_nowhere(linkage, X)
+            raise closes_nowhere(linkage, X, engine.continuum_samples)
 
         def building(done: int, total: int) -> None:  # after the samples followed
             if report is not None:
                 report(reached[0] + done, reached[0] + total)
 
-        modes = []
-        with build_progress(building if report is not None else None, N):
-            expect_modes(len(tracks))
-            for tr in tracks:
-                modes.append(mode_from_configuration(linkage, lay, tr.configuration(),
-                                                     tr.mask.copy(), X, Xd, Xdd,
-                                                     _events(linkage, X, tr)))
+        def build(tracks: list[Track], progress: Progress | None) -> list[ModeMotion]:
+            with build_progress(progress, N):
+                expect_modes(len(tracks))
+                return [mode_from_configuration(linkage, lay, tr.configuration(),
+                                                tr.mask.copy(), X, Xd, Xdd,
+                                                _events(linkage, X, tr)) for tr in tracks]
+
+        modes = build(tracks, building if report is not None else None)
+        continua = engine.singular_continua(X, modes)
+        if continua:  # rare: a sample on a continuum that no root search had looked at
+            tracks = _off_continua(tracks, continua)
+            if not tracks:
+                raise closes_nowhere(linkage, X, engine.continuum_samples)
+            modes = build(tracks, None)
     modes = [replace(md, index=k, label=f"branch {k}") for k, md in enumerate(modes)]
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="generic",
                   solver="generic loop solver: continuation along the input (second-order "
                          "predictor, Newton corrector) from root searches at the first sample, "
-                         "at anchors and where branches end (docs/kinematics.md)")
+                         f"at anchors and where branches end, {engine.how()} "
+                         "(docs/kinematics.md)", notes=engine.notes())
 
 
-def closes_nowhere(linkage: Linkage, X: Array) -> AssemblyError:
-    """The error of a sweep where the generic solver finds no closed configuration at all."""
+def closes_nowhere(linkage: Linkage, X: Array, continua: set[int] | None = None
+                   ) -> AssemblyError:
+    """The error of a sweep where the generic solver finds no closed configuration at all (or,
+    with ``continua``, only continua of them: curves of closures at single inputs)."""
+    if continua:
+        at = sorted(continua)
+        return AssemblyError(
+            f"{linkage.name}: the loop closes only on continua of configurations (a curve of "
+            f"closures with the input held, no assembly mode) at {len(at)} of the "
+            f"{X.shape[0]} inputs, first at {format_inputs(linkage, X[at[0]])}; move the "
+            "inputs off them, or check the dimensions")
     return AssemblyError(
         f"{linkage.name}: the loop does not close at any of the {X.shape[0]} inputs "
         f"(from {format_inputs(linkage, X[0])} to {format_inputs(linkage, X[-1])}); "
@@ -236,6 +285,159 @@ def _new_seeds(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray
     return out
 
 
+class RootEngine:
+    """The root searches of one sweep: every real solution of the polynomial homotopy where a
+    formulation fits the loop (:mod:`screwkit.kinematics.tracker.algebraic_roots`), Newton from
+    random starts (:func:`root_search`) where none does; it keeps count of what it found for
+    the Motion's solver string and notes."""
+
+    def __init__(self, linkage: Linkage, lay: Layout, starts: int, seed: int,
+                 algebraic: bool = True) -> None:
+        self.linkage, self.lay, self.starts, self.seed = linkage, lay, starts, seed
+        self.algebraic = algebraic
+        self.formulation: LoopFormulation | None = (
+            loop_formulation(linkage, lay, seed) if algebraic else None)
+        self.rows = self.roots = self.uncertified = self.continua = self.fallback = 0
+        self.generic_count = 0
+        #: searched samples on a continuum of closed configurations (no mode there)
+        self.continuum_samples: set[int] = set()
+        self.searched: set[int] = set()
+        #: searched samples with a root that is not real (a complex pair that may turn real)
+        self.nonreal: set[int] = set()
+
+    def search(self, X: Array, samples: NDArray[np.intp], seed: int
+               ) -> tuple[NDArray[np.intp], Assemblies]:
+        """Every root at ``samples`` (one batched solve): the sample of each row, the roots."""
+        if self.formulation is None:
+            return root_search(self.linkage, X, samples, self.starts, seed)
+        found: AlgebraicRoots = algebraic_roots(self.formulation, self.linkage, self.lay,
+                                                X[samples])
+        self.rows += samples.size
+        self.searched.update(samples.tolist())
+        self.roots += int(found.assemblies.found.sum())
+        self.uncertified += int(np.sum(found.assemblies.found & ~found.certified))
+        self.continua += int(found.continuum.sum())
+        self.continuum_samples.update(samples[found.continuum].tolist())
+        self.nonreal.update(samples[found.found > found.assemblies.found.sum(axis=1)].tolist())
+        self.generic_count = found.generic_count
+        short = np.flatnonzero(~found.complete)
+        if short.size == 0:
+            return samples, found.assemblies
+        # where the homotopy's count falls short (a non-generic mechanism), random starts too
+        self.fallback += short.size
+        rows, asm = root_search(self.linkage, X, samples[short], self.starts, seed)
+        first = len(rows) - short.size  # sample 0's extra copies come first (root_search)
+        B = samples.size
+        extra = np.zeros((B, asm.found.shape[1]), dtype=bool)
+        extra[short] = asm.found[first:]
+        return samples, merged(found.assemblies, Assemblies(
+            _rows_conf(asm, first, short, B, found.assemblies), extra,
+            _rows_array(asm.signature, first, short, B),
+            _rows_array(asm.radius, first, short, B, 1.0)))
+
+    def between(self, X: Array, anchors: NDArray[np.intp]) -> NDArray[np.intp]:
+        """The samples to search next: every :data:`DENSE_SPAN` of input (or wider, within
+        :data:`DENSE_PATHS`) within each stretch
+        between two anchors where either anchor has a root that is not real (a complex pair,
+        which can turn real at a fold in between: an island of modes between anchors, which
+        meets no known branch); none without a formulation, or where every root is real."""
+        if self.formulation is None or not self.nonreal:
+            return np.zeros(0, dtype=np.intp)
+        flagged = np.isin(anchors, np.array(sorted(self.nonreal)))
+        # the stretches' input movement, and a spacing that keeps their paths within budget
+        span = _input_span(self.linkage, X)
+        lo, hi = anchors[:-1], anchors[1:]
+        near = flagged[:-1] | flagged[1:]
+        moved = float(np.sum((span[hi] - span[lo])[near]))
+        every = max(DENSE_SPAN, moved * max(self.generic_count, 1) / DENSE_PATHS)
+        fine = anchor_samples(self.linkage, X, every)
+        stretch = np.searchsorted(anchors, fine)  # fine sample in (anchors[k-1], anchors[k]]
+        near2 = flagged[np.clip(stretch, 0, len(anchors) - 1)] | flagged[
+            np.clip(stretch - 1, 0, len(anchors) - 1)]
+        todo = fine[near2 & ~np.isin(fine, np.array(sorted(self.searched), dtype=np.intp))]
+        return np.asarray(todo, dtype=np.intp)
+
+    def singular_continua(self, X: Array, modes: list[ModeMotion]) -> set[int]:
+        """The samples, singular on some mode and not searched yet, that the homotopy finds on
+        a continuum of closed configurations (a branch followed through one: a 4R deltoid's
+        crank on its frame between two anchors); none without a formulation."""
+        if self.formulation is None:
+            return set()
+        singular = np.any([md.singular & md.assembles for md in modes], axis=0)
+        todo = np.array(sorted(set(np.flatnonzero(singular).tolist()) - self.searched),
+                        dtype=np.intp)
+        if todo.size == 0:
+            return set()
+        before = set(self.continuum_samples)
+        self.search(X, todo, self.seed)
+        return self.continuum_samples - before
+
+    def _why(self) -> str:
+        return ("no polynomial formulation takes this loop" if self.algebraic
+                else "the homotopy was not asked for")
+
+    def how(self) -> str:
+        """How the roots were searched, for the Motion's solver string."""
+        if self.formulation is None:
+            return f"by Newton from {self.starts} random starts ({self._why()})"
+        return (f"by every real solution of the {self.formulation.name} polynomial homotopy "
+                f"(generic count {self.generic_count})")
+
+    def notes(self) -> tuple[str, ...]:
+        """The Motion's notes on the root searches."""
+        if self.formulation is None:
+            return (f"root searches: Newton from random starts ({self._why()}), which cannot "
+                    "promise every mode",)
+        out = [f"root searches: {self.formulation.name} polynomial homotopy at {self.rows} "
+               f"samples, {self.roots} real roots ({self.roots - self.uncertified} certified "
+               "by Smale's alpha test), every one closing the loop to 1e-9"]
+        if self.fallback:
+            out.append(f"at {self.fallback} samples the homotopy's paths did not end at the "
+                       f"generic count of distinct finite solutions (a non-generic mechanism): "
+                       "Newton from random starts searched there too")
+        if self.continua:
+            out.append(f"{self.continua} searched samples lie on a continuum of closed "
+                       "configurations (a curve of solutions): no mode is reported there")
+        return tuple(out)
+
+
+def _rows_array(a: Array, first: int, rows: NDArray[np.intp], B: int, fill: float = 0.0
+                ) -> Array:
+    """Rows ``first:`` of a search's per-row array placed at ``rows`` of B rows."""
+    out = np.full((B,) + a.shape[1:], fill)
+    out[rows] = a[first:]
+    return out
+
+
+def _rows_conf(asm: Assemblies, first: int, rows: NDArray[np.intp], B: int,
+               filler: Assemblies) -> Configuration:
+    """The configurations of rows ``first:`` of a search placed at ``rows`` of B rows (the
+    other slots hold ``filler``'s first configuration, marked not found)."""
+    K = asm.found.shape[1]
+    n, m = filler.conf.scalars.shape[1], filler.conf.spherical.shape[1]
+    q = np.repeat(filler.conf.scalars[:1], B * K, axis=0).reshape(B, K, n)
+    s = np.repeat(filler.conf.spherical[:1], B * K, axis=0).reshape(B, K, m, 3, 3)
+    q[rows] = asm.conf.scalars[first * K:].reshape(rows.size, K, n)
+    s[rows] = asm.conf.spherical[first * K:].reshape(rows.size, K, m, 3, 3)
+    return Configuration(q.reshape(B * K, n), s.reshape(B * K, m, 3, 3))
+
+
+def merged(a: Assemblies, b: Assemblies) -> Assemblies:
+    """Two searches of the same rows as one: each row's slots of ``a``, then of ``b``."""
+    B, Ka, Kb = a.found.shape[0], a.found.shape[1], b.found.shape[1]
+
+    def join(x: Array, y: Array) -> Array:
+        tail = x.shape[1:]
+        return np.concatenate([x.reshape((B, Ka) + tail), y.reshape((B, Kb) + tail)],
+                              axis=1).reshape((B * (Ka + Kb),) + tail)
+
+    return Assemblies(Configuration(join(a.conf.scalars, b.conf.scalars),
+                                    join(a.conf.spherical, b.conf.spherical)),
+                      np.concatenate([a.found, b.found], axis=1),
+                      np.concatenate([a.signature, b.signature], axis=1),
+                      np.concatenate([a.radius, b.radius], axis=1))
+
+
 def root_search(linkage: Linkage, X: Array, samples: NDArray[np.intp], starts: int,
                  seed: int) -> tuple[NDArray[np.intp], Assemblies]:
     """Every root at ``samples`` by Newton from random starts, in one vectorised search:
@@ -250,14 +452,14 @@ def root_search(linkage: Linkage, X: Array, samples: NDArray[np.intp], starts: i
 
 
 def _seed_from(linkage: Linkage, lay: Layout, tracker: Tracker, samples: NDArray[np.intp],
-               X: Array, starts: int, seed: int) -> bool:
-    """Root search at ``samples`` (vectorised over them); then, in the order of the samples,
+               X: Array, engine: RootEngine, seed: int) -> bool:
+    """Root search at ``samples`` (vectorised over them; ``engine``'s); then, in the order of the samples,
     follow the roots on no known branch at the first sample that has some, and look again at
     the later samples — so a branch found at one sample is not seeded again at the next. True
     if any root was new."""
     if samples.size == 0:
         return False
-    samples, asm = root_search(linkage, X, samples, starts, seed)
+    samples, asm = engine.search(X, samples, seed)
     return _seed_from_search(linkage, lay, tracker, samples, asm)
 
 
@@ -284,11 +486,13 @@ def _seed_from_search(linkage: Linkage, lay: Layout, tracker: Tracker,
 
 def all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int,
                   report: Progress | None, rates: tuple[Array, Array] | None = None,
-                  ) -> list[Track]:
+                  engine: RootEngine | None = None) -> list[Track]:
     """Every branch over the sweep (module docstring); with the inputs' ``rates`` and
     accelerations, each track also carries the rates the tracker found on the way
-    (:class:`~screwkit.kinematics.tracker.continuation.TrackRates`)."""
+    (:class:`~screwkit.kinematics.tracker.continuation.TrackRates`). ``engine`` does the root
+    searches (by default the homotopy where a formulation fits the loop: :class:`RootEngine`)."""
     N = X.shape[0]
+    engine = engine or RootEngine(linkage, lay, starts, seed)
     done = [0]
 
     def count(n: int) -> None:
@@ -297,7 +501,9 @@ def all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int
             report(done[0], N * max(1, len(tracker.tracks)))
 
     tracker = Tracker(linkage, lay, X, count if report is not None else None, rates)
-    _seed_from(linkage, lay, tracker, anchor_samples(linkage, X), X, starts, seed)
+    anchors = anchor_samples(linkage, X)
+    _seed_from(linkage, lay, tracker, anchors, X, engine, seed)
+    _seed_from(linkage, lay, tracker, engine.between(X, anchors), X, engine, seed)
     searched: set[int] = set()
     partnered: set[tuple[int, int]] = set()
     for round_ in range(4):  # births where branches die; rarely more than one round
@@ -309,13 +515,27 @@ def all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int
                 ends.update((k - 1, k))
         todo = np.array(sorted(s for s in ends - searched if 0 <= s < N), dtype=np.intp)
         searched |= set(todo.tolist())
-        found = _seed_from(linkage, lay, tracker, todo, X, starts, seed + 1 + round_)
+        found = _seed_from(linkage, lay, tracker, todo, X, engine, seed + 1 + round_)
         if not (_seed_fold_partners(linkage, lay, tracker, X, partnered) or found):
             break
     tracks = _attach_turning_points(linkage, lay, _merge_duplicates(linkage, lay, tracker.tracks))
+    tracks = _off_continua(tracks, engine.continuum_samples)
     tracks = _attach_lone_ends(linkage, lay, tracks)
     _pair_ends(linkage, lay, tracks)
     return sorted(tracks, key=lambda tr: _order_key(linkage, lay, tr))
+
+
+def _off_continua(tracks: list[Track], samples: set[int]) -> list[Track]:
+    """The tracks without the ``samples`` the homotopy found on a continuum of closed
+    configurations (a curve of solutions at one input, as a 4R deltoid with its crank on the
+    frame): there a branch followed by continuation passes through one point of the curve,
+    which is no mode (the closed forms report none there either); tracks left empty go."""
+    if not samples:
+        return tracks
+    idx = np.array(sorted(samples), dtype=np.intp)
+    for tr in tracks:
+        tr.mask[idx] = False
+    return [tr for tr in tracks if tr.mask.any()]
 
 
 #: steps (scaled freedoms) along the passive Jacobian's null direction from a branch's last
@@ -573,4 +793,4 @@ def _order_key(linkage: Linkage, lay: Layout, tr: Track) -> tuple[float, ...]:
     return (float(first), *np.round(sig, 9).tolist())
 
 
-__all__ = ["ANCHOR_SPAN", "all_branches", "closes_nowhere", "anchor_samples", "generic_motion", "progress_reporter"]
+__all__ = ["ANCHOR_SPAN", "RootEngine", "all_branches", "closes_nowhere", "anchor_samples", "generic_motion", "progress_reporter"]
