@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 import screwkit as sk
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
-from screwkit.kinematics.graph.motion import solve_mechanism
+from screwkit.kinematics.graph.motion import build_mode, solve_mechanism
 from screwkit.kinematics.graph.track import follow_drawn_mode
 from screwkit.kinematics.modes.along import pose_vectors
 from screwkit.kinematics.modes.delta import (
@@ -208,8 +208,8 @@ def test_every_mode_against_newton_from_many_starts() -> None:
 
 def test_the_two_plate_positions_meet_at_a_fold() -> None:
     """Arm 1 turned with the others held: the closed form's discriminant crosses zero near
-    120°; there the two positions are one (reported singular), and the homotopy's translating
-    modes go from two to none across it."""
+    120°; there the two positions are one (reported singular, and an output singularity of
+    the graph), and the homotopy's level modes go from two to none across it."""
     mech = _spec().mechanism
     dm = delta_from_mechanism(mech)
 
@@ -219,6 +219,15 @@ def test_the_two_plate_positions_meet_at_a_fold() -> None:
     th = brentq(disc, np.radians(110.0), np.radians(125.0), xtol=1e-14)
     at = plate_positions(dm, [[th, 0.0, 0.0]])
     assert at.singular[0] and np.abs(at.t[0, 0] - at.t[0, 1]).max() < 1e-6
+    # the graph's singularity classes call it an output singularity; 0.05 rad back, regular
+    lay = graph_layout(mech)
+    Xs = np.array([[th, 0.0, 0.0], [th - 0.05, 0.0, 0.0]])
+    conf = delta_configuration(dm, Xs, np.broadcast_to(np.eye(3), (2, 3, 3)),
+                               plate_positions(dm, Xs).t[:, 0])
+    md = build_mode(mech, lay, conf, np.ones(2, dtype=bool), Xs, np.zeros_like(Xs),
+                    np.zeros_like(Xs))
+    assert list(md.singular_class) == ["output", ""]
+    assert md.jacobian_condition["passive"][0] > 1e8 > 1e4 > md.jacobian_condition["passive"][1]
     side = np.radians(0.5)
     X = np.array([[th - side, 0.0, 0.0], [th + side, 0.0, 0.0]])
     pp = plate_positions(dm, X)
@@ -273,3 +282,17 @@ def test_the_cli_lists_every_mode(tmp_path: Path) -> None:
     assert labels[0] == "drawn" and len(labels) >= 16
     assert doc["notes"][0].startswith("every mode along the motion")
     assert all("jacobian_condition" in m for m in doc["modes"])
+
+
+def test_the_front_door_verbs() -> None:
+    spec = _spec()
+    X = np.asarray(spec.inputs)[:3]
+    fk = sk.delta_forward(spec.mechanism, X)
+    np.testing.assert_allclose(fk.t, plate_positions(delta_from_mechanism(spec.mechanism),
+                                                     X).t, atol=0)
+    ik = sk.delta_inverse(spec.mechanism, fk.t[:, 1])
+    assert np.abs(np.angle(np.exp(1j * (ik.angles - X[:, :, None])))).min(axis=2).max() < 1e-10
+    with pytest.raises(sk.ScrewkitError, match="arm angles"):
+        sk.delta_forward(spec.mechanism, np.zeros((2, 2)))
+    with pytest.raises(CapabilityError, match="not a Delta robot"):
+        sk.delta_forward(sk.load_spec(EXAMPLES / "stewart_platform.toml").mechanism, X)

@@ -319,14 +319,17 @@ def delta_formulation(mech: Mechanism) -> DeltaFormulation:
 
 
 def delta_forward(mech: Mechanism, input_values: ArrayLike) -> PlatePositions:
-    """Forward kinematics of a Delta robot drawn as ``mech``: every real plate translation at
-    each row of arm angles (N, 3), radians from the drawing (:func:`plate_positions`). Every
-    assembly mode, the plate's rotated ones too, comes from
-    ``every_mode(mech, inputs)`` (modes/every_mode.py)."""
+    """Forward kinematics of a Delta robot drawn as ``mech``: every real plate translation
+    (metres from the drawing, the plate level) at each row of arm angles (N, 3), radians from
+    the drawing: the intersection of three spheres (Tsai 1999 §3.6; docs/kinematics.md,
+    "Every mode of a mechanism"), flagged singular where the two meet. Every assembly mode,
+    the plate's turned ones too, comes from ``solve_mechanism(mech, inputs, every_mode=True)``
+    or ``every_mode(mech, inputs)`` (modes/every_mode.py)."""
     return plate_positions(delta_from_mechanism(mech), input_values)
 
 
 def delta_inverse(mech: Mechanism, plate_translations: ArrayLike) -> ArmBranches:
-    """Inverse kinematics of a Delta robot drawn as ``mech``: each arm's two angles (radians
-    from the drawing) for plate translations (M, 3) from the drawing (:func:`arm_angles`)."""
+    """Inverse kinematics of a Delta robot drawn as ``mech``: each arm's two angles (rad from
+    the drawing, both leg branches, flagged singular where they meet) for level plate
+    translations (M, 3), metres from the drawing (:func:`arm_angles`; docs/kinematics.md)."""
     return arm_angles(delta_from_mechanism(mech), plate_translations)
