@@ -29,7 +29,8 @@ Stewart–Gough platform whose base points are the elbow balls (placed by the in
 Study-coordinate system of modes/stewart.py (generic count 40) solves them with every plate
 rotation, not only R = I. A Delta with ball-jointed rods has real modes with the plate turned
 (the parallelograms twisted into skew quadrilaterals with equal opposite sides): 14 besides the
-two translating ones at the bundled example's rows. Each real pose is decoded into the graph's
+two translating ones at the bundled example's first input rows, some of them born or dying at
+folds along its motion. Each real pose is decoded into the graph's
 joint variables: each arm turned by its input, the plate at (R, t), each rod turned from its
 drawn direction onto its closed one by the least rotation (its spin about its own axis is idle,
 as in graph/legs.py), every joint's variable from the two poses it joins (modes/stewart_decode.py
