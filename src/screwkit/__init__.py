@@ -52,6 +52,8 @@ _EXPORTS: dict[str, str] = {
     "solve_mechanism": "screwkit.kinematics.graph.motion",
     "MechanismMotion": "screwkit.kinematics.graph.motion",
     "mechanism_topology": "screwkit.kinematics.graph.topology",
+    "delta_forward": "screwkit.kinematics.modes.delta",
+    "delta_inverse": "screwkit.kinematics.modes.delta",
     "family": "screwkit.kinematics.registry",
     # kinematics
     "solve_motion": "screwkit.kinematics.solve_motion",
@@ -110,6 +112,8 @@ __all__ = [
     "counterweight_variables",
     "coupler_point_path",
     "cssp",
+    "delta_forward",
+    "delta_inverse",
     "family",
     "fourbar",
     "inverse_dynamics",
@@ -166,6 +170,7 @@ if TYPE_CHECKING:
     from screwkit.kinematics.analysis.transmission import transmission
     from screwkit.kinematics.graph.motion import MechanismMotion, solve_mechanism
     from screwkit.kinematics.graph.topology import mechanism_topology
+    from screwkit.kinematics.modes.delta import delta_forward, delta_inverse
     from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
     from screwkit.kinematics.registry import family
     from screwkit.kinematics.solve_motion import solve_motion

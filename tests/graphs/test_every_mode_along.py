@@ -127,10 +127,18 @@ def test_a_fourbar_through_the_anchored_path_has_the_closed_form_modes() -> None
 
 
 def test_without_a_formulation_only_the_drawn_mode_with_the_reason() -> None:
+    """The Delta robot with one plate ball moved 5 mm (its drawing still closes, but arm 1's
+    rods are no parallelogram): no formulation takes it, so only the drawn mode, and why."""
+    from dataclasses import replace
+
     mech = sk.load_spec(EXAMPLES / "delta_robot.toml").mechanism
+    mech = replace(mech, joints=tuple(
+        replace(j, at=j.at + np.array([0.0, 0.0, 0.005])) if j.name == "P1a" else j
+        for j in mech.joints))
     m = solve_mechanism(mech, np.zeros((2, len(mech.inputs))), every_mode=True)
     assert len(m.modes) == 1
-    assert "only the drawn mode" in m.notes[0] and "no polynomial formulation" in m.notes[0]
+    assert "only the drawn mode" in m.notes[0] and "not a Delta robot" in m.notes[0]
+    assert "parallelogram" in m.notes[0]
 
 
 def test_a_mode_that_meets_no_anchor_mode_is_cut_not_switched(

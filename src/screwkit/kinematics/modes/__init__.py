@@ -9,6 +9,8 @@ value is an instance with the same number of isolated solutions), which is what 
 homotopy started at a random complex instance needs to find every solution.
 
 - :mod:`.stewart`: 6-6 Stewart–Gough forward kinematics in Study coordinates (40 solutions);
+- :mod:`.delta`: a Delta robot read from its graph: plate positions (three spheres), leg
+  branches, every plate pose by the Stewart system with the elbow balls as base points;
 - :mod:`.loop6r`: a 6R loop, the inverse kinematics of a 6R arm (:mod:`.arm6r`), a 7R loop at
   one input (16);
 - :mod:`.planar`: planar R-joint mechanisms as graphs (distance equations; 4R: 2, Stephenson III: 6);

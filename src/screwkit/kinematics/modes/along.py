@@ -121,12 +121,29 @@ def anchor_samples(N: int, per_anchor: float) -> NDArray[np.intp]:
 
 
 def pose_vectors(mech: Mechanism, lay: GraphLayout, conf: Configuration) -> Array:
-    """Every body's pose as one row per sample (rotation entries, positions / length)."""
+    """Every body's pose as one row per sample (rotation entries, positions / length). A rod
+    held by two balls (graph/idle.py) has an idle spin about its own line, which the tracker's
+    corrector and a formulation's decoding set differently: its rotation R is written as
+    (R u) uᵀ (u its drawn unit line) and its position as its first ball's centre, which that
+    spin does not change."""
+    from screwkit.kinematics.graph.idle import rods
+
     if conf.size == 0:  # (every_mode's empty rows have no columns either)
         return np.zeros((0, 12 * (len(mech.bodies) + 1)))
     fr = graph_forward(mech, lay, conf)
     n = conf.size
-    return np.concatenate([fr.R.reshape(n, -1), fr.p.reshape(n, -1) / lay.length], axis=1)
+    R, p = fr.R, fr.p
+    idle = rods(mech)
+    if idle:
+        R, p = R.copy(), p.copy()
+        for body, j1, j2 in idle:
+            c = mech.joints[j1].at
+            u = mech.joints[j2].at - c
+            u = u / np.linalg.norm(u)
+            b = lay.body_of[body]
+            p[:, b] = p[:, b] + R[:, b] @ c  # the first ball's centre, on the spin's line
+            R[:, b] = np.einsum("ni,j->nij", R[:, b] @ u, u)
+    return np.concatenate([R.reshape(n, -1), p.reshape(n, -1) / lay.length], axis=1)
 
 
 def pose_distance(mech: Mechanism, lay: GraphLayout, a: Configuration, b: Configuration

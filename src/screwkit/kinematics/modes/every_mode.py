@@ -5,7 +5,8 @@ planar R-joint graph; a single loop of R joints with six free; an RSSR, RSRC or 
 a ground R joint) and :func:`every_mode` solves it for every row of inputs in one batched
 parameter homotopy from the topology's start solutions; a 6-6 Stewart–Gough platform (U–P–S or
 S–P–S legs) by the Study-coordinate system, its poses decoded into joint variables
-(modes/stewart_decode.py). Each real solution is turned into the
+(modes/stewart_decode.py); a Delta robot by the same system with the elbow balls as base
+points (modes/delta.py). Each real solution is turned into the
 graph tracker's :class:`Configuration` and kept only if the tracker's own closure
 (``graph_forward``, the exact SE(3) logarithm round every loop) is within
 :data:`CLOSURE_TOLERANCE` of the length scale: the check is independent of the polynomial
@@ -96,12 +97,17 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         from screwkit.kinematics.modes.stewart_decode import stewart_formulation
 
         return stewart_formulation(mech)  # a CapabilityError where the legs are not found
+    if kinds == {"R", "S"} and len(mech.joints) == 15:
+        from screwkit.kinematics.modes.delta import delta_formulation
+
+        return delta_formulation(mech)  # a CapabilityError where it is not a Delta robot
     raise CapabilityError(
         f"{mech.name}: no polynomial formulation takes this mechanism yet (joints "
         f"{sorted(j.kind for j in mech.joints)}, {len(mech.topology.loops)} loops); there are "
         "formulations for planar R-joint graphs, single R loops with six free joints, "
-        "RSSR, RSRC and RCCC loops driven at a ground R joint, and 6-6 Stewart–Gough "
-        "platforms (U–P–S or S–P–S legs driven at the P joints)")
+        "RSSR, RSRC and RCCC loops driven at a ground R joint, 6-6 Stewart–Gough "
+        "platforms (U–P–S or S–P–S legs driven at the P joints) and Delta robots (three "
+        "driven arms, each with an S–S parallelogram to the plate)")
 
 
 @dataclass(frozen=True)
