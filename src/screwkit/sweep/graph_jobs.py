@@ -38,9 +38,15 @@ def check_graph_job(spec: Any, job: str) -> None:
                          f"{', '.join(missing)} {'has' if len(missing) == 1 else 'have'} none "
                          "(mass, com and inertia in its [[bodies]] entry)")
     if job == "modes":
+        from screwkit.errors import CapabilityError
         from screwkit.kinematics.modes.every_mode import closure_formulation
 
-        closure_formulation(spec.mechanism)  # a CapabilityError that says why, before any run
+        try:
+            closure_formulation(spec.mechanism)
+        except CapabilityError as exc:
+            raise CapabilityError(f"{spec.path}: --job modes solves every assembly mode by the "
+                                  f"homotopy, and {exc}; --job analyze follows the drawn mode "
+                                  "of any graph") from None
 
 
 def graph_outputs(motion: Any) -> dict[str, np.ndarray]:
