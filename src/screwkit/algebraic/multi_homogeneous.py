@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -148,7 +148,7 @@ class LinearProduct:
     def solutions(self) -> Complex:
         """Every solution (B_m, n) of G = 0: per assignment of equations to groups, each
         group's chosen factors solved as one batch of linear systems."""
-        N, m = self.degrees.shape
+        m = self.degrees.shape[1]
         n = sum(len(g) for g in self.groups)
         sizes = [len(g) for g in self.groups]
         out = []
@@ -159,8 +159,7 @@ class LinearProduct:
             parts = []
             for j, r in enumerate(rows):
                 pick = np.array(choices[j], dtype=np.intp).reshape(len(choices[j]), len(r))
-                A = np.stack([np.stack([self.coef[i][j][pick[:, a]] for a, i in enumerate(r)],
-                                       axis=1)]).reshape(len(pick), len(r), sizes[j])
+                A = np.stack([self.coef[i][j][pick[:, a]] for a, i in enumerate(r)], axis=1)
                 b = -np.stack([self.const[i][j][pick[:, a]] for a, i in enumerate(r)], axis=1)
                 parts.append(np.linalg.solve(A, b[..., None])[..., 0])  # (choices_j, n_j)
             for combo in itertools.product(*(range(len(p)) for p in parts)):
@@ -172,7 +171,7 @@ class LinearProduct:
 
 
 def _assignments(degrees: NDArray[np.intp], sizes: Sequence[int]) -> list[NDArray[np.intp]]:
-    """Every map i ↦ j(i) with d_{i,j(i)} > 0 and #{i: j(i) = j} = n_j."""
+    """Every map i ↦ j(i) with d_{i,j(i)} > 0 and #{i: j(i) = j} = n_j (depth-first)."""
     N, m = degrees.shape
     found: list[NDArray[np.intp]] = []
 
@@ -201,8 +200,8 @@ def mhom_bezout_of(system: PolynomialSystem, grouping: Grouping) -> int:
 
 @dataclass(frozen=True)
 class MultiHomogeneousResult:
-    """The paths' :class:`TrackResult` (its ``x`` in the original unknowns, already mapped
-    back by the basis) and the m-homogeneous Bézout number (the paths tracked)."""
+    """The paths' :class:`TrackResult` (its ``x`` in the original unknowns, mapped back by
+    the basis; its patch points ``y`` stay in the grouping's unknowns u) and the m-homogeneous Bézout number (the paths tracked)."""
 
     result: TrackResult
     bezout: int
@@ -245,6 +244,4 @@ def solve_multi_homogeneous(system: PolynomialSystem, p: Complex, grouping: Grou
     res = track_parameter_homotopy(extended, p_start, np.tile(p_target, (len(u0), 1)), u0,
                                    options)
     T = np.eye(n, dtype=complex) if grouping.basis is None else np.asarray(grouping.basis)
-    from dataclasses import replace
-
     return MultiHomogeneousResult(replace(res, x=res.x @ T.T), count)
