@@ -2,8 +2,9 @@
 process that has forgotten them reads them back without tracking a path, equal to what was
 written; a file is written whole (no temporary file is left) and is trusted only when its key
 matches and every point solves the start system again (a moved point, another key, a damaged
-file, or fewer solutions than a known generic count are refused and solved anew); ``SCREWKIT_CACHE_DIR=off`` writes
-nothing; the folder follows the environment."""
+file, or fewer solutions than a known generic count are refused and solved anew);
+``SCREWKIT_CACHE_DIR=off`` writes nothing; the folder follows the environment; a multi-homogeneous start with a failed path is
+not trusted to be complete and the total-degree homotopy solves it."""
 
 from __future__ import annotations
 
@@ -101,3 +102,22 @@ def test_the_folder_follows_the_environment(monkeypatch, tmp_path):
         assert start_store.cache_dir() == tmp_path / "screwkit" / "starts"
     monkeypatch.setenv(start_store.CACHE_ENV, str(tmp_path / "mine"))
     assert start_store.cache_dir() == tmp_path / "mine" / "starts"
+
+
+def test_a_multi_homogeneous_start_with_a_failed_path_falls_back_to_total_degree(
+        store, sixbar, monkeypatch):
+    from screwkit.algebraic.track import PathStatus
+
+    real = starts.solve_multi_homogeneous
+
+    def one_failed(*args, **kwargs):
+        solved = real(*args, **kwargs)
+        status = solved.result.status.copy()
+        status[0] = PathStatus.FAILED
+        return replace(solved, result=replace(solved.result, status=status))
+
+    monkeypatch.setattr(starts, "solve_multi_homogeneous", one_failed)
+    before = starts.first_solve_paths()
+    found = _solve(sixbar)
+    assert starts.first_solve_paths() - before == 6 + 16  # both homotopies' paths
+    assert found.how_found.startswith("total-degree") and found.generic_count == 6
