@@ -21,3 +21,19 @@ def playwright_driver() -> Iterator[Any]:
     with sync_playwright() as p:
         yield p
 
+
+
+@pytest.fixture(scope="session", autouse=True)
+def start_solution_store(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
+    """The store of start solutions (kinematics/modes/start_store.py) in a folder of this
+    session, not the user's cache; Dask workers started by the tests inherit it."""
+    import os
+
+    folder = tmp_path_factory.mktemp("screwkit-cache")
+    before = os.environ.get("SCREWKIT_CACHE_DIR")
+    os.environ["SCREWKIT_CACHE_DIR"] = str(folder)
+    yield folder
+    if before is None:
+        os.environ.pop("SCREWKIT_CACHE_DIR", None)
+    else:
+        os.environ["SCREWKIT_CACHE_DIR"] = before

@@ -6,6 +6,13 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -71,3 +78,38 @@ def command_json(*args: str) -> dict[str, Any]:
     r = runner.invoke(app, [*args, "--json"])
     assert r.exit_code == 0, r.output
     return json.loads(r.stdout)
+
+
+@contextmanager
+def real_dask(folder: Path, workers: int = 2, env: dict[str, str] | None = None) -> Iterator[str]:
+    """A ``dask scheduler`` and ``workers`` ``dask worker`` processes on 127.0.0.1 (random free
+    ports; ``env`` added to their environment), stopped on exit; yields the address."""
+    dask = Path(sys.executable).with_name("dask")
+    assert dask.exists(), "the dask command comes with the [sweep] extra"
+    info = folder / "scheduler.json"
+    full = {**os.environ, "PYTHONWARNINGS": "ignore", **(env or {})}
+    procs = [subprocess.Popen([str(dask), "scheduler", "--host", "127.0.0.1", "--port", "0",
+                               "--no-dashboard", "--scheduler-file", str(info)],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=full)]
+    try:
+        deadline = time.monotonic() + 60
+        while not info.exists() and time.monotonic() < deadline:
+            time.sleep(0.2)
+        time.sleep(0.3)
+        address = json.loads(info.read_text())["address"]
+        for _ in range(workers):
+            procs.append(subprocess.Popen(
+                [str(dask), "worker", address, "--nthreads", "1", "--nworkers", "1",
+                 "--host", "127.0.0.1", "--no-dashboard"],
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=full))
+        yield address
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.send_signal(signal.SIGTERM)
+        for p in procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait(timeout=10)

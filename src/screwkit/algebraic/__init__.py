@@ -6,6 +6,8 @@ This package knows nothing of mechanisms (docs/kinematics.md, "How every mode is
 - :mod:`.track` (with :mod:`.path` and :mod:`.endgame`): the parameter homotopy
   ``track_parameter_homotopy``, its Cauchy endgame and path-jump check;
 - :mod:`.total_degree`: ``solve_total_degree``, the first solve of a small system;
+- :mod:`.multi_homogeneous`: ``solve_multi_homogeneous``, the first solve from a linear-product
+  start system when a grouping of the unknowns has a smaller Bézout number;
 - :mod:`.monodromy`: ``monodromy_solve``, every solution at a generic point from one;
 - :mod:`.certify`: Smale's α-test, real and distinct certificates;
 - :mod:`.solve`: ``solve_all`` from ``StartSolutions``.

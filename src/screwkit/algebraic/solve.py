@@ -36,12 +36,14 @@ from screwkit.errors import InputError
 class StartSolutions:
     """Every solution x (m, n) of the system at one generic complex parameter vector p (k,):
     the start of every later parameter homotopy of this system (cache it per topology).
-    ``generic_count`` is m; ``how_found`` says by which method and how complete it is."""
+    ``generic_count`` is m; ``how_found`` says by which method and how complete it is;
+    ``paths`` counts the paths tracked to find them."""
 
     p: Complex
     x: Complex
     generic_count: int
     how_found: str
+    paths: int = 0
 
     @staticmethod
     def by_total_degree(system: PolynomialSystem, seed: int = 0,
@@ -55,7 +57,7 @@ class StartSolutions:
         how = (f"total-degree homotopy: {len(x)} regular of {bezout_number(system)} paths "
                f"({counts['at_infinity']} at infinity, {counts['singular']} singular, "
                f"{counts['failed']} failed)")
-        return StartSolutions(p, x, len(x), how)
+        return StartSolutions(p, x, len(x), how, bezout_number(system))
 
     @staticmethod
     def by_monodromy(system: PolynomialSystem, p0: ArrayLike, x0: ArrayLike,
@@ -65,7 +67,7 @@ class StartSolutions:
                                       np.asarray(x0, dtype=complex), options)
         how = (f"monodromy: {stats.found} solutions after {stats.loops} loops, stopped by "
                f"{stats.stopped_by}")
-        return StartSolutions(p, x, stats.found, how)
+        return StartSolutions(p, x, stats.found, how, stats.paths_tracked)
 
 
 @dataclass(frozen=True)

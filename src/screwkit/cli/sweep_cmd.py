@@ -133,7 +133,7 @@ def register(app: typer.Typer) -> None:
         spec: Annotated[Path, typer.Argument(help="Spec file (TOML): the nominal design.")],
         vary: Annotated[list[str], typer.Option("--vary", help="KEY=START:STOP:COUNT (grid), KEY=START:STOP (with --sample lhs:N) or KEY=V1,V2,…; KEY is a dotted path into the spec (dimensions.d2 or d2, links.coupler.mass, motion.speed …); numbers in the spec's units unless written with theirs (d2=4in:5in:11). Repeatable.")],
         output: Annotated[Path, typer.Option("--output", "-o", help="The table: .parquet (needs pyarrow) or .csv; written atomically when every design is done.")],
-        job: Annotated[str, typer.Option("--job", help="analyze, limits, mobility, dynamics, balance or synthesize.")] = "analyze",
+        job: Annotated[str, typer.Option("--job", help="analyze, limits, mobility, dynamics, balance or synthesize; a graph spec: analyze, dynamics or modes (every assembly mode, docs/sweeps.md).")] = "analyze",
         sample: Annotated[str | None, typer.Option("--sample", help="grid (default) or lhs:N (N designs by Latin hypercube over the KEY=START:STOP box).")] = None,
         seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of --sample lhs:N (the same seed gives the same designs).")] = 0,
         plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG: a line over one key, a heat map over two (grid), a scatter matrix otherwise.")] = None,

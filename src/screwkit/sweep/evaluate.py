@@ -11,7 +11,7 @@ never holds a number the single-spec command would have refused.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -35,6 +35,8 @@ class SweepTask:
     keys: tuple[SpecKey, ...]
     job: str
     options: JobOptions
+    #: start solutions by topology key, found on the scheduler's side (sweep/modes_job.py)
+    starts: dict[str, Any] = field(default_factory=dict)
 
 
 def numeric_failure(exc: FloatingPointError) -> str:
@@ -81,7 +83,12 @@ def evaluate_design(task: SweepTask, values: np.ndarray) -> Row:
 
 def evaluate_batch(task: SweepTask, indices: np.ndarray, values: np.ndarray) -> list[Row]:
     """The rows of a batch of designs (``indices`` their numbers, ``values`` (n, k)), each with
-    its design number first; what one engine task computes."""
+    its design number first; what one engine task computes. Start solutions shipped with
+    the task are kept in this process first (sweep/modes_job.py)."""
+    if task.starts:
+        from screwkit.kinematics.modes.starts import install
+
+        install(task.starts)
     rows = []
     for i, v in zip(indices.tolist(), values, strict=True):
         row: Row = {"design": int(i)}

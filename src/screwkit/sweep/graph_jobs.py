@@ -11,7 +11,8 @@ as-built scatter of a part, where the drawing no longer closes, is the tolerance
 inputs) its ``min``, ``max``, ``mean`` and ``range`` (max − min) over the samples where the mode
 assembles; ``dynamics``: RMS and peak of every input's effort, the shaking force and moment and
 every joint's reaction force and moment (:func:`~screwkit.dynamics.graph_inverse.
-graph_inverse_dynamics`).
+graph_inverse_dynamics`); ``modes``: every real assembly mode of each design by the
+parameter homotopy from the topology's stored start solutions (:mod:`screwkit.sweep.modes_job`).
 """
 
 from __future__ import annotations
@@ -23,19 +24,29 @@ import numpy as np
 from screwkit.errors import InputError
 from screwkit.sweep.jobs import JobOptions, Row, where_text
 
-GRAPH_JOBS = ("analyze", "dynamics")
+GRAPH_JOBS = ("analyze", "dynamics", "modes")
 
 
 def check_graph_job(spec: Any, job: str) -> None:
     """Refuse, before any design runs, a job a graph spec cannot have."""
     if job not in GRAPH_JOBS:
         raise InputError(f"--job {job!r}: a graph spec (bodies and joints) takes "
-                         f"{' or '.join(GRAPH_JOBS)} in a sweep (docs/sweeps.md, \"Graph specs\")")
+                         f"{', '.join(GRAPH_JOBS[:-1])} or {GRAPH_JOBS[-1]} in a sweep (docs/sweeps.md, \"Graph specs\")")
     missing = [b.name for b in spec.mechanism.bodies if b.mass is None]
     if job == "dynamics" and missing:
         raise InputError(f"{spec.path}: --job dynamics needs mass properties for every body; "
                          f"{', '.join(missing)} {'has' if len(missing) == 1 else 'have'} none "
                          "(mass, com and inertia in its [[bodies]] entry)")
+    if job == "modes":
+        from screwkit.errors import CapabilityError
+        from screwkit.kinematics.modes.every_mode import closure_formulation
+
+        try:
+            closure_formulation(spec.mechanism)
+        except CapabilityError as exc:
+            raise CapabilityError(f"{spec.path}: --job modes solves every assembly mode by the "
+                                  f"homotopy, and {exc}; --job analyze follows the drawn mode "
+                                  "of any graph") from None
 
 
 def graph_outputs(motion: Any) -> dict[str, np.ndarray]:
@@ -100,6 +111,10 @@ def graph_row(spec: Any, job: str, options: JobOptions) -> Row:
     drawn mode does not reach its first input row raises (an AssemblyError: a failed row)."""
     from screwkit.kinematics.graph import solve_mechanism
 
+    if job == "modes":
+        from screwkit.sweep.modes_job import modes_row
+
+        return modes_row(spec)
     motion = solve_mechanism(spec.mechanism, spec.inputs, rates=spec.speed,
                              accelerations=spec.acceleration)
     row = graph_assembly(spec, motion)

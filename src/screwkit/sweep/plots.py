@@ -24,7 +24,8 @@ Row = dict[str, Any]
 
 #: the column a job's picture shows unless ``--plot-column`` says otherwise
 HEADLINE = {"dynamics": "shaking_force.rms", "balance": "G.after", "synthesize": "E",
-            "mobility": "numeric.mobility", "limits": "limits", "analyze": "assembling_samples"}
+            "mobility": "numeric.mobility", "limits": "limits", "analyze": "assembling_samples",
+            "modes": "modes"}
 
 
 def default_column(job: str, rows: Sequence[Row]) -> str:

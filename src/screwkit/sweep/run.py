@@ -73,18 +73,25 @@ class SweepDefinition:
                 "screwkit": __version__}
 
     def task(self) -> SweepTask:
+        """What every batch shares; for the ``modes`` job with the topology's start solutions,
+        found here once (sweep/modes_job.py) and shipped to the workers with the task."""
+        starts: dict[str, Any] = {}
+        if self.job == "modes":
+            from screwkit.sweep.modes_job import sweep_starts
+
+            starts = sweep_starts(self.spec)
         return SweepTask(self.data, str(self.spec_path), self.designs.keys, self.job,
-                         self.options)
+                         self.options, starts)
 
 
 def check_job_on_spec(spec: Spec, job: str) -> None:
     """Refuse, before any design runs, a job the spec cannot have (every row would fail)."""
-    check_job(job)
     if getattr(spec, "family", None) == "graph":  # io.mechanism_spec.GraphSpec
         from screwkit.sweep.graph_jobs import check_graph_job
 
         check_graph_job(spec, job)
         return
+    check_job(job)
     require(spec.linkage, job)
     if job == "dynamics" and any(link.mass is None for link in spec.linkage.links):
         raise SpecError(f"{spec.path}: --job dynamics needs mass properties for every link "

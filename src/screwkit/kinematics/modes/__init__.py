@@ -17,7 +17,8 @@ homotopy started at a random complex instance needs to find every solution.
 - :mod:`.rod_loops`: the RSSR (2) and RSRC (4) loops at one input;
 - :mod:`.rccc`: the RCCC loop at one input, in Plücker coordinates (2);
 - :mod:`.r_loop`: a Mechanism's single R loop (6R, 7R at one input) as a 6R instance;
-- :mod:`.starts`: start solutions per topology; :mod:`.continuum`: a continuum told from
+- :mod:`.starts`: start solutions per topology, kept on disk by :mod:`.start_store`;
+  :mod:`.continuum`: a continuum told from
   isolated roots at a singular end point.
 - :mod:`.every_mode`: every real mode of a Mechanism at given inputs; :mod:`.along`: every mode
   over a motion (the homotopy at anchor samples, the graph tracker between them).

@@ -134,7 +134,9 @@ def formulation_start(form: Formulation) -> StartSolutions:
     if isinstance(form, _RLoopFormulation):
         return loop6r_start()
     own = getattr(form, "start", None)  # a formulation with its own (monodromy) start
-    return own() if callable(own) else start_solutions(form.system)
+    if callable(own):
+        return own()  # type: ignore[no-any-return]
+    return start_solutions(form.system, grouping=getattr(form, "grouping", None))
 
 
 def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.algebraic.multi_homogeneous import Grouping
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout
@@ -78,6 +79,31 @@ class PlanarFormulation:
                 M = (drawn[m] - drawn[joints[0]]) / d
                 cols += [np.full(X.shape[0], M.real), np.full(X.shape[0], M.imag)]
         return np.stack(cols, -1)
+
+    @property
+    def grouping(self) -> Grouping:
+        """The isotropic coordinates z = x + iy, z̄ = x − iy of the unknown joints, in two
+        groups (every z, every z̄), with each rigid body's pair of carried-joint equations
+        mixed into (x-eq + i·y-eq, x-eq − i·y-eq): a distance equation is then bilinear
+        (z2 − z1)(z̄2 − z̄1) = L² and a carried joint's equations linear in one group each
+        (Wampler 2001), so the multi-homogeneous start system
+        (:mod:`screwkit.algebraic.multi_homogeneous`) tracks C(d, d/2)-like counts (6 for a
+        Stephenson III six-bar) instead of the total degree (16)."""
+        n = self.system.n
+        basis = np.zeros((n, n), dtype=complex)
+        for j in range(n // 2):  # x = (z + z̄)/2, y = (z − z̄)/(2i); u = (z_j, z̄_j) per joint
+            basis[2 * j, 2 * j], basis[2 * j, 2 * j + 1] = 0.5, 0.5
+            basis[2 * j + 1, 2 * j], basis[2 * j + 1, 2 * j + 1] = -0.5j, 0.5j
+        mix = np.zeros((n, n), dtype=complex)
+        row = 0
+        for _, js in self.rigid:
+            mix[row, row] = 1.0
+            row += 1
+            for _ in js[2:]:
+                mix[row, row], mix[row, row + 1] = 1.0, 1.0j
+                mix[row + 1, row], mix[row + 1, row + 1] = 1.0, -1.0j
+                row += 2
+        return Grouping((tuple(range(0, n, 2)), tuple(range(1, n, 2))), basis, mix)
 
     def _placed_body_of(self, joint: int) -> str:
         names = [b for b, _ in self.placed]

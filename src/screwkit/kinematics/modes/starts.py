@@ -1,28 +1,39 @@
-"""Start solutions per topology, found once per process and kept in memory (issue 27).
+"""Start solutions per topology, found once and then kept: in memory and on disk (issue 27).
 
 A parameter homotopy needs every solution of the system at one generic complex parameter
 vector (:class:`~screwkit.algebraic.solve.StartSolutions`). Small systems get them from the
-total-degree homotopy, which is complete when no path fails; the Stewart–Gough and 6R systems
-(Bézout numbers 256 and 4,096) by monodromy from one random complex instance with a known
-solution, stopped at the generic count the literature proves (40, 16), so that their start set
-is complete as well. Nothing is stored on disk: a process finds them on first use.
+total-degree homotopy, or from the multi-homogeneous one when a formulation gives a grouping of
+its unknowns whose m-homogeneous Bézout number is smaller (:mod:`screwkit.algebraic.
+multi_homogeneous`); either is complete when no path fails. The Stewart–Gough and 6R systems
+(Bézout numbers 256 and 4,096) are solved by monodromy from one random complex instance with a
+known solution, stopped at the generic count the literature proves (40, 16), so that their start
+set is complete as well.
+
+Found once per topology (:func:`system_key`): a process looks in memory, then in the store on
+disk (:mod:`.start_store`, checked on load), and only then solves, writing what it found to the
+store. A sweep finds them on the scheduler's side and ships them to its workers
+(:func:`install`), so no worker solves them again. :func:`first_solve_paths` counts the paths
+this process tracked to find start solutions (0 when every topology came from memory or disk).
 """
 
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
 from screwkit.algebraic.monodromy import MonodromyOptions
+from screwkit.algebraic.multi_homogeneous import Grouping, mhom_bezout_of, solve_multi_homogeneous
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.solve import StartSolutions
 from screwkit.algebraic.total_degree import bezout_number
+from screwkit.kinematics.modes import start_store
 
 #: systems with at most this many total-degree paths are started by the total-degree homotopy
 TOTAL_DEGREE_PATHS = 64
 _CACHE: dict[str, StartSolutions] = {}
+_PATHS = [0]
 
 RandomInstance = Callable[[np.random.Generator], tuple[Complex, Complex]]
 
@@ -37,20 +48,80 @@ def system_key(system: PolynomialSystem) -> str:
 
 
 def start_solutions(system: PolynomialSystem, random_instance: RandomInstance | None = None,
-                    generic_count: int | None = None, seed: int = 0) -> StartSolutions:
-    """Every solution of ``system`` at a generic complex parameter vector, cached per
-    topology: by total degree for a Bézout number ≤ :data:`TOTAL_DEGREE_PATHS` (or when no
-    random instance is given), otherwise by monodromy from ``random_instance(rng)`` (p (1, k),
-    x (1, n), complex) until ``generic_count`` solutions are known."""
+                    generic_count: int | None = None, seed: int = 0,
+                    grouping: Grouping | None = None) -> StartSolutions:
+    """Every solution of ``system`` at a generic complex parameter vector, kept per topology
+    (module docstring): for a Bézout number ≤ :data:`TOTAL_DEGREE_PATHS` (or when no random
+    instance is given) by the multi-homogeneous homotopy of ``grouping`` when its count is
+    below the total degree, else by total degree; otherwise by monodromy from
+    ``random_instance(rng)`` (p (1, k), x (1, n), complex) until ``generic_count`` solutions
+    are known."""
     key = system_key(system)
     if key not in _CACHE:
-        if random_instance is None or bezout_number(system) <= TOTAL_DEGREE_PATHS:
-            _CACHE[key] = _by_total_degree(system, seed)
-        else:
-            p0, x0 = random_instance(np.random.default_rng(seed))
-            options = MonodromyOptions(expected=generic_count, seed=seed)
-            _CACHE[key] = StartSolutions.by_monodromy(system, p0[0], x0[0], options)
+        found = start_store.load(key, system, generic_count)
+        if found is None:
+            found = _solve(system, random_instance, generic_count, seed, grouping)
+            start_store.save(key, found)
+        _CACHE[key] = found
     return _CACHE[key]
+
+
+def install(starts: Mapping[str, StartSolutions]) -> None:
+    """Keep ``starts`` (topology key → start solutions, e.g. shipped by a sweep's scheduler)
+    in this process's memory, as if found here."""
+    _CACHE.update(starts)
+
+
+def known() -> dict[str, StartSolutions]:
+    """The start solutions this process holds, by topology key."""
+    return dict(_CACHE)
+
+
+def forget() -> None:
+    """Drop the start solutions held in memory (the store on disk is kept)."""
+    _CACHE.clear()
+
+
+def first_solve_paths() -> int:
+    """Paths this process has tracked to find start solutions (module docstring)."""
+    return _PATHS[0]
+
+
+def _solve(system: PolynomialSystem, random_instance: RandomInstance | None,
+           generic_count: int | None, seed: int, grouping: Grouping | None) -> StartSolutions:
+    if random_instance is None or bezout_number(system) <= TOTAL_DEGREE_PATHS:
+        if grouping is not None and mhom_bezout_of(system, grouping) < bezout_number(system):
+            found = _by_multi_homogeneous(system, grouping, seed)
+            if found is not None:
+                return found
+        found = _by_total_degree(system, seed)
+    else:
+        p0, x0 = random_instance(np.random.default_rng(seed))
+        options = MonodromyOptions(expected=generic_count, seed=seed)
+        found = StartSolutions.by_monodromy(system, p0[0], x0[0], options)
+    _PATHS[0] += found.paths
+    return found
+
+
+def _by_multi_homogeneous(system: PolynomialSystem, grouping: Grouping,
+                          seed: int) -> StartSolutions | None:
+    """Solve at a random complex p by the multi-homogeneous homotopy of ``grouping``; None when
+    a path failed, since the start set is then not known to be complete (the caller falls back
+    to the total-degree homotopy; a planar Jansen leg's 20 paths end 8 regular, 6 at infinity
+    and 6 failed, where the total degree's 64 all end)."""
+    rng = np.random.default_rng(seed)
+    p = (rng.standard_normal(system.k) + 1j * rng.standard_normal(system.k)).astype(complex)
+    solved = solve_multi_homogeneous(system, p, grouping, seed=seed)
+    result = solved.result
+    x = result.x[result.regular]
+    counts = result.counts()
+    _PATHS[0] += solved.bezout  # tracked even when they are not used
+    if counts["failed"]:
+        return None
+    how = (f"multi-homogeneous homotopy: {len(x)} regular of {solved.bezout} paths (total "
+           f"degree {bezout_number(system)}; {counts['at_infinity']} at infinity, "
+           f"{counts['singular']} singular, {counts['failed']} failed)")
+    return StartSolutions(p, x, len(x), how, solved.bezout)
 
 
 def _by_total_degree(system: PolynomialSystem, seed: int) -> StartSolutions:
