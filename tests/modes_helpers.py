@@ -1,5 +1,6 @@
 """Helpers of the every-mode tests (kinematics/modes/): random loops of R joints, the relative
-residual of a polynomial system and its Jacobians against central differences."""
+residual of a polynomial system and its Jacobians against central differences, and the RSSR
+island (:data:`ISLAND_RSSR`)."""
 
 from __future__ import annotations
 
@@ -48,3 +49,31 @@ def random_r_loop(rng: np.random.Generator, n: int, inputs: list[int]) -> Mechan
         joints.append(MechanismJoint(f"j{i}", "R", (a, b), rng.normal(size=3),
                                      rng.normal(size=3)))
     return Mechanism("loop", tuple(bodies), tuple(joints), tuple(f"j{k}.theta" for k in inputs))
+
+
+#: An RSSR (model.families.rssr's parameters d1, d2, d3, a, b, λ0, output offset) that
+#: assembles only over an island of two modes, input 168.04° … 176.39° (8.4°): on a 5° grid
+#: (72 samples from 0°) two samples, 170° and 175° (indices 34, 35), lie on it, neither a
+#: multiple of 15° (the loop solver's root-search anchors) nor of 40° (the graph route's every
+#: 8th sample). Found by scanning 200,000 random RSSRs of test_never_miss_a_mode's draws with
+#: the distance test of :func:`rssr_reach` (tests/kinematics/test_rssr_island.py).
+ISLAND_RSSR = (0.58878, 4.30529, 1.55105, 2.07143, -0.93211, 0.74000, 0.29829)
+#: the island's ends (deg), to 0.01°, and its samples on the 72-sample 5° grid
+ISLAND_DEG = (168.04, 176.39)
+ISLAND_SAMPLES = (34, 35)
+
+
+def rssr_reach(params: tuple[float, ...], theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The nearest and farthest distance (N,) from the input crank's ball to the circle the
+    output crank's ball runs on, at input angles ``theta`` (rad), in the family's frame (input
+    axis x through the origin, output axis u3 = (cos λ0, 0, −sin λ0) through (b, a, 0), the
+    circle's centre ``output_offset`` along u3): the loop closes where the coupler's length d2
+    lies between them. Independent of the closed form (plain geometry of a point and a
+    circle), up to the input angle's origin."""
+    d1, _, d3, a, b, lam, off = params
+    P = d1 * np.stack([np.zeros_like(theta), np.cos(theta), np.sin(theta)], axis=1)
+    u3 = np.array([np.cos(lam), 0.0, -np.sin(lam)])
+    w = P - (np.array([b, a, 0.0]) + off * u3)
+    along = w @ u3
+    across = np.linalg.norm(w - along[:, None] * u3, axis=1)
+    return np.hypot(along, across - d3), np.hypot(along, across + d3)

@@ -105,3 +105,28 @@ def test_a_mechanism_that_is_not_a_stewart_platform_is_refused() -> None:
 
     with pytest.raises(CapabilityError, match="not a 6-6 Stewart"):
         stewart_from_mechanism(sk.load_spec(EXAMPLES / "watt_sixbar.toml").mechanism)
+
+
+def test_equal_rows_are_solved_once_with_the_same_modes(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """A closed motion's first and last rows (both anchors of modes/along.py) are one homotopy:
+    the batch holds each distinct row once, and each copy gets that row's modes."""
+    import screwkit.kinematics.modes.every_mode as em
+
+    mech = sk.load_spec(Path(__file__).parents[2] / "examples" / "mechanisms" /
+                        "fourbar_graph.toml").mechanism
+    X = np.array([[0.0], [0.3], [0.0], [0.3], [-0.2]])
+    batches: list[int] = []
+    solve = em.solve_all
+
+    def counted(system, p, start):  # type: ignore[no-untyped-def]
+        batches.append(len(np.atleast_1d(p)))
+        return solve(system, p, start)
+
+    monkeypatch.setattr(em, "solve_all", counted)
+    got = every_mode(mech, X)
+    assert batches == [3]
+    alone = every_mode(mech, X[[0, 1, 4]])
+    for k, j in enumerate([0, 1, 0, 1, 2]):
+        assert np.array_equal(got.configurations[k].scalars, alone.configurations[j].scalars)
+        assert got.found[k] == alone.found[j]
+    assert np.array_equal(got.inputs, X) and all(c.size == 2 for c in got.configurations)

@@ -10,7 +10,7 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 
-from screwkit.cli.common import prose
+from screwkit.cli.common import MODES_HELP, prose
 from screwkit.cli.outputs import CsvOpt, FullOpt, JsonOpt, OutputOpt, UnitOpt, UnitsOpt
 
 T = TypeVar("T")
@@ -123,9 +123,10 @@ def register(app: typer.Typer) -> None:
         full: FullOpt = False,
         method: Annotated[str, typer.Option("--method", help="auto (closed form where the family has one), closed, or generic (any loop; every joint variable).")] = "auto",
         plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of every variable and its rates over the input (display units), the coupler curves (projections and 3-D) and the transmission quality.")] = None,
+        modes: Annotated[str, typer.Option("--modes", help=MODES_HELP)] = "every",
     ) -> None:
         """Positions, velocities and accelerations of every joint variable in every assembly mode, the coupler curves of the spec's coupler points and the transmission quality over the cycle."""
-        from screwkit.cli.common import guard
+        from screwkit.cli.common import every_modes, guard
         from screwkit.cli.outputs import Outputs
         from screwkit.cli.progress import SWEEP_PROGRESS_SAMPLES, staged_progress
         from screwkit.io.spec import load_spec
@@ -134,10 +135,11 @@ def register(app: typer.Typer) -> None:
         out = Outputs.prepare([spec], as_json=as_json, output=output, csv=csv, units=units,
                               unit=unit, full=full, files={"--plot": plot})
         s = guard(lambda: load_spec(spec))
+        every = every_modes(modes, s)
         if getattr(s, "family", None) == "graph":  # any mechanism as a graph
             from screwkit.cli.graph_views import analyze_graph
 
-            return analyze_graph(s, out, plot)
+            return analyze_graph(s, out, plot, every_mode=every)
         du = out.units_for(s.units)
         stages = ["solving", "coupler curves and transmission", "tables"]
         # a long sweep shows its stages (stderr, terminals only; the solver's own bar is off);

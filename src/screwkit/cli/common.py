@@ -115,6 +115,29 @@ def loop_only(spec: T, command: str) -> T:
     return spec
 
 
+#: ``--modes`` of analyze, report and export (graph specs): every mode (the default) or the
+#: drawn one only (no homotopy; docs/cli.md)
+MODES_HELP = ("Graph specs: every (every assembly mode: closed-form sub-chains or the homotopy, "
+              "the default) or drawn (the drawn mode only, by continuation: far faster where "
+              "the homotopy is needed, e.g. a Stewart platform). Loop specs always give every "
+              "mode their solver finds.")
+
+
+def every_modes(modes: str, spec: object) -> bool:
+    """``--modes`` as solve_mechanism's ``every_mode``: True for "every", False for "drawn";
+    a one-line refusal (exit 2) for anything else, and for "drawn" with a loop spec, whose
+    modes all come from one solve (docs/cli.md)."""
+    if modes not in ("every", "drawn"):
+        user_error(f"--modes {modes!r}: give every (every assembly mode, the default) or drawn "
+                   "(the drawn mode only)")
+    if modes == "drawn" and getattr(spec, "family", None) != "graph":
+        user_error(f"--modes drawn: {getattr(spec, 'path', 'this spec')} is a single loop, "
+                   "whose modes all come from one solve; --modes drawn is for mechanism graphs "
+                   "(bodies and joints); pick a loop's mode with --mode where the command has "
+                   "it")
+    return modes == "every"
+
+
 def attempt(fn: Callable[[], T]) -> tuple[bool, T | None]:
     """Like :func:`guard`, but a user error is printed and returned as ``(False, None)`` so
     that a command over several inputs can report every one."""

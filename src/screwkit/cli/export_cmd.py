@@ -12,6 +12,8 @@ from typing import Annotated
 
 import typer
 
+from screwkit.cli.common import MODES_HELP
+
 
 def register(app: typer.Typer) -> None:
     """Add the ``export`` command to ``app``."""
@@ -26,11 +28,19 @@ def register(app: typer.Typer) -> None:
         splines: Annotated[bool, typer.Option("--splines", help="DXF: curves as fit-point splines instead of polylines.")] = False,
         max_points: Annotated[int, typer.Option("--max-points", help="DXF: a curve over more samples goes through every k-th of them (exact samples, about 14,000 vertices a second to write); 0 draws every sample.", min=0)] = 5000,
         method: Annotated[str, typer.Option("--method", help="auto, closed or generic (as for analyze).")] = "auto",
+        modes: Annotated[str, typer.Option("--modes", help=MODES_HELP)] = "every",
     ) -> None:
         """Write the spec's motion for CAD: DXF curves and skeletons, an animated glTF scene, or STEP link solids."""
         from rich.markup import escape
 
-        from screwkit.cli.common import check_paths, console, err_console, guard, prose
+        from screwkit.cli.common import (
+            check_paths,
+            console,
+            err_console,
+            every_modes,
+            guard,
+            prose,
+        )
         from screwkit.exchange.export import check_suffix, export_format, graph_export
         from screwkit.io.outputs import write_bytes_atomic
         from screwkit.io.spec import load_spec
@@ -41,9 +51,11 @@ def register(app: typer.Typer) -> None:
         guard(lambda: check_suffix(kind, output))
         binary = output.suffix.lower() != ".gltf"  # a .gltf file is JSON, anything else GLB
         s = guard(lambda: load_spec(spec))
+        every = every_modes(modes, s)
         if getattr(s, "family", None) == "graph":  # bodies and joints: solve_mechanism
             result = guard(lambda: graph_export(s, kind, at or (), mode=mode, splines=splines,
-                                                binary=binary, max_points=max_points))
+                                                binary=binary, max_points=max_points,
+                                                every_mode=every))
         else:
             pipe = Pipeline(s, method=method)
             result = guard(lambda: pipe.export(kind, at or (), mode=mode, splines=splines,

@@ -41,12 +41,13 @@ def graph_limits(spec: Any, output: str | None, dwell_tolerance: float | None
                                  1e-6 if dwell_tolerance is None else dwell_tolerance).as_dict()
 
 
-def analyze_graph(spec: Any, out: Any, plot: Path | None) -> None:
-    """``screwkit analyze`` on a graph spec: tables in the spec's units, or the document."""
+def analyze_graph(spec: Any, out: Any, plot: Path | None, every_mode: bool = True) -> None:
+    """``screwkit analyze`` on a graph spec: tables in the spec's units, or the document;
+    every mode, or the drawn one only (``--modes drawn``)."""
     from screwkit.cli.common import guard
     from screwkit.io.mechanism_documents import mechanism_document, mechanism_table
 
-    motion = guard(lambda: solved(spec, every_mode=True))
+    motion = guard(lambda: solved(spec, every_mode=every_mode))
     du = out.units_for(spec.units)
     if plot is not None:  # the loops' picture of every variable and point path fits a graph
         from screwkit.report.plots import plot_analysis

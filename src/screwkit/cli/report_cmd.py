@@ -13,6 +13,7 @@ from typing import Annotated
 
 import typer
 
+from screwkit.cli.common import MODES_HELP
 from screwkit.errors import InputError
 
 STILL_SUFFIXES = (".png", ".svg", ".pdf")
@@ -42,11 +43,12 @@ def register(app: typer.Typer) -> None:
         mode: Annotated[int, typer.Option("--mode", help="Assembly mode of the --plot outputs (0, 1, …).", min=0)] = 0,
         frame: Annotated[int, typer.Option("--frame", help="Frame (input sample, from 0) of a still --plot.", min=0)] = 0,
         gravity: Annotated[bool, typer.Option("--gravity/--no-gravity", help="Include gravity in the dynamics (as `screwkit dynamics --gravity`).")] = False,
+        modes: Annotated[str, typer.Option("--modes", help=MODES_HELP)] = "every",
     ) -> None:
         """Write a self-contained HTML report: animated 3-D view, linked plots of every variable, dynamics, balancing and synthesis results (works offline, from a file)."""
         from rich.markup import escape
 
-        from screwkit.cli.common import console
+        from screwkit.cli.common import console, every_modes
         from screwkit.cli.common import guard as _guard
         from screwkit.io.results import write_atomic
         from screwkit.io.spec import load_spec
@@ -56,12 +58,13 @@ def register(app: typer.Typer) -> None:
         plots = list(plot or [])
         _guard(lambda: check_plot_paths(plots))
         s = _guard(lambda: load_spec(spec))
+        every = every_modes(modes, s)
         out = output if output is not None else Path(f"{spec.stem}.html")
         if getattr(s, "family", None) == "graph":  # any mechanism (docs/mechanisms.md)
             from screwkit.cli.graph_views import solved
             from screwkit.report.graph_scene import graph_spec_scene
 
-            scene = _guard(lambda: graph_spec_scene(s, solved(s, every_mode=True),
+            scene = _guard(lambda: graph_spec_scene(s, solved(s, every_mode=every),
                                                     gravity=gravity))
         else:
             scene = _guard(lambda: spec_scene(s, gravity=gravity))

@@ -184,9 +184,10 @@ def input_is_angle(spec: Any) -> bool:
 
 
 def graph_export(spec: Any, fmt: str, at: Sequence[str] = (), *, mode: int | None = None,
-                 splines: bool = False, binary: bool = True, max_points: int = 5000) -> Export:
-    """``screwkit export`` of a mechanism graph's spec: its motion (every mode the closed-form
-    sub-chains find, else the drawn one) over the spec's inputs, with the ``--at`` inputs
+                 splines: bool = False, binary: bool = True, max_points: int = 5000,
+                 every_mode: bool = True) -> Export:
+    """``screwkit export`` of a mechanism graph's spec: its motion (with ``every_mode`` every
+    mode solve_mechanism finds, else the drawn one only) over the spec's inputs, with the ``--at`` inputs
     solved with them. ``--at`` needs one input swept monotonically (a start/stop/step
     sweep); a graph driven by rows is drawn at its first row."""
     from screwkit.kinematics.graph import solve_mechanism
@@ -208,7 +209,7 @@ def graph_export(spec: Any, fmt: str, at: Sequence[str] = (), *, mode: int | Non
         labels = samples_for(spec)[1] if inputs.shape[1] == 1 else ["row 1"]
     x = inputs if len(samples.inputs) == len(inputs) else samples.inputs[:, None]
     motion = solve_mechanism(spec.mechanism, x, rates=spec.speed,
-                             accelerations=spec.acceleration, every_mode=True)
+                             accelerations=spec.acceleration, every_mode=every_mode)
     return export_graph_motion(spec, motion, samples, kind, at_labels=labels, mode=mode,
                                splines=splines, binary=binary, max_points=max_points)
 

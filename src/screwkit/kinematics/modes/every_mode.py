@@ -141,9 +141,24 @@ def formulation_start(form: Formulation) -> StartSolutions:
 
 def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:
     """Every real assembly mode of ``mech`` at each row of ``inputs`` (B, n_inputs), radians
-    and metres from the drawing (module docstring)."""
-    form = closure_formulation(mech)
+    and metres from the drawing (module docstring). Equal rows are solved once (a closed
+    motion's first and last rows, both anchors of modes/along.py: one homotopy of the
+    Stewart example's eight)."""
     X = np.atleast_2d(np.asarray(inputs, dtype=float)).reshape(-1, len(mech.inputs))
+    distinct, back = np.unique(X, axis=0, return_inverse=True)
+    if len(distinct) == len(X):
+        return _every_mode_rows(mech, X)
+    once = _every_mode_rows(mech, distinct)
+    idx = back.reshape(-1)
+    return MechanismModes(mech, X, tuple(once.configurations[i] for i in idx),
+                          tuple(once.certified[i] for i in idx), once.found[idx],
+                          once.continuum[idx], once.generic_count, once.how_found,
+                          once.worst_closure)
+
+
+def _every_mode_rows(mech: Mechanism, X: Array) -> MechanismModes:
+    """:func:`every_mode` at rows ``X`` (B, n_inputs), each solved (one batched solve)."""
+    form = closure_formulation(mech)
     start = formulation_start(form)
     p = form.parameters(X)  # (B, n_in); the one-input loops read it as (B,)
     sol = solve_all(form.system, p, start)

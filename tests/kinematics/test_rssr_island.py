@@ -1,0 +1,72 @@
+"""The RSSR island of issue 27 ("a two-sample RSSR island between anchors is missed"): an RSSR
+(tests/modes_helpers.py's :data:`ISLAND_RSSR`) whose two modes exist only over 168.04° …
+176.39°, shorter than the spacing of the loop solver's root-search anchors (15°) and of the
+graph route's homotopy anchors (8 samples). The closed form and the graph route's every mode
+must find the island whole: both modes at both of its samples, nothing elsewhere, its ends
+where a point-to-circle distance test puts them."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from screwkit.kinematics.graph import solve_mechanism
+from screwkit.kinematics.graph.from_loop import mechanism_from_loop
+from screwkit.kinematics.solve_motion import solve_motion
+from screwkit.model.families import rssr
+
+sys.path.insert(0, str(Path(__file__).parents[1]))
+from modes_helpers import ISLAND_DEG, ISLAND_RSSR, ISLAND_SAMPLES, rssr_reach  # noqa: E402
+
+THETA = np.radians(np.arange(0.0, 360.0, 5.0))
+
+
+def _counts(motion) -> np.ndarray:  # type: ignore[no-untyped-def]
+    return np.sum([md.assembles for md in motion.modes], axis=0)
+
+
+def test_the_distance_test_puts_the_island_where_the_closed_form_does() -> None:
+    fine = np.radians(np.arange(0.0, 360.0, 0.01))
+    near, far = rssr_reach(ISLAND_RSSR, fine)
+    d2 = ISLAND_RSSR[1]
+    closes = (near <= d2) & (d2 <= far)
+    ends = np.degrees(fine[closes][[0, -1]])
+    assert np.abs(ends - ISLAND_DEG).max() <= 0.011
+    assert np.count_nonzero(closes[1:] != closes[:-1]) == 2  # one island, no other interval
+    assert ISLAND_DEG[1] - ISLAND_DEG[0] < 15.0  # shorter than the anchor spacing
+    closed = solve_motion(rssr(*ISLAND_RSSR), fine[(fine > np.radians(160)) &
+                                                    (fine < np.radians(185))], method="closed")
+    on = _counts(closed) > 0
+    assert np.abs(np.degrees(fine[(fine > np.radians(160)) & (fine < np.radians(185))][on][
+        [0, -1]]) - ISLAND_DEG).max() <= 0.011
+
+
+def test_the_closed_form_finds_the_island_whole() -> None:
+    closed = solve_motion(rssr(*ISLAND_RSSR), THETA, method="closed")
+    count = _counts(closed)
+    assert np.flatnonzero(count).tolist() == list(ISLAND_SAMPLES)
+    assert count[list(ISLAND_SAMPLES)].tolist() == [2, 2]
+    for md in closed.modes:
+        assert np.nanmax(md.closure_residual[md.assembles]) <= 1e-10
+
+
+def test_the_graph_routes_every_mode_finds_the_island_whole() -> None:
+    """The graph, drawn at 175° (the only way to draw it is on the island), turned once round
+    backward from there: both modes at 175° and 170°, born and dead at the island's ends."""
+    closed = solve_motion(rssr(*ISLAND_RSSR), THETA, method="closed")
+    a, b = ISLAND_SAMPLES
+    mech = mechanism_from_loop(closed, 0, b)
+    X = -np.radians(np.arange(0.0, 360.0, 5.0))  # 175°, 170°, 165°, … , 180°
+    motion = solve_mechanism(mech, X[:, None], every_mode=True)
+    count = _counts(motion)
+    assert np.flatnonzero(count).tolist() == [0, 1] and count[:2].tolist() == [2, 2]
+    assert len(motion.modes) == 2
+    folds = [float(e.split("= ")[1].split(" deg")[0]) for md in motion.modes
+             for e in md.events if e.startswith(("dies at", "is born at"))]
+    # both modes die at the island's start, 175° − 168.04° = 6.96° back from the drawing
+    assert np.allclose(folds, -(np.degrees(THETA[b]) - ISLAND_DEG[0]), atol=0.011)
+    # each closes
+    for md in motion.modes:
+        assert np.nanmax(md.closure_residual[md.assembles]) <= 1e-10
