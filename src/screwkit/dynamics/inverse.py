@@ -59,6 +59,7 @@ from screwkit.dynamics.sample_blocks import (
 from screwkit.dynamics.screws import freedom_screws
 from screwkit.errors import expect_instance
 from screwkit.kinematics.motion import ModeMotion, Motion
+from screwkit.messages import listing, shown_values
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 
@@ -111,8 +112,8 @@ def _setup(
             input_arr = np.zeros((N, 0))  # not N rows of numbers: named below
         if input_arr.shape[1] != len(linkage.inputs):
             raise DynamicsInputError(
-                f"inputs must have one column per input {list(linkage.inputs)}; "
-                f"got shape {np.shape(inputs)}"
+                f"inputs must have one column per input ({listing(linkage.inputs)}); "
+                f"got shape {shown_values(np.shape(inputs))}"
             )
     valid = valid_samples(linkage, mode, input_arr, allow_partial, check_finite=check_finite)
     idx = np.flatnonzero(valid)

@@ -98,7 +98,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         return stewart_formulation(mech)  # a CapabilityError where the legs are not found
     raise CapabilityError(
         f"{mech.name}: no polynomial formulation takes this mechanism yet (joints "
-        f"{sorted(j.kind for j in mech.joints)}, {len(mech.topology.loops)} loops); there are "
+        f"{''.join(sorted(j.kind for j in mech.joints))}, {len(mech.topology.loops)} loops); there are "
         "formulations for planar R-joint graphs, single R loops with six free joints, "
         "RSSR, RSRC and RCCC loops driven at a ground R joint, and 6-6 Stewart–Gough "
         "platforms (U–P–S or S–P–S legs driven at the P joints)")
