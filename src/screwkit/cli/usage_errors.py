@@ -15,6 +15,8 @@ from typing import IO, Any
 
 from typer.core import TyperGroup
 
+from screwkit.errors import ScrewkitError
+
 try:  # typer >= 0.20 runs on its own copy of click (typer._click), older typer on click
     from typer import _click as click  # type: ignore[attr-defined,unused-ignore]
     from typer._click.exceptions import NoArgsIsHelpError  # type: ignore[import-not-found,unused-ignore]
@@ -23,9 +25,10 @@ except ImportError:  # pragma: no cover - older typer
     from click.exceptions import NoArgsIsHelpError  # type: ignore[assignment,no-redef,unused-ignore]
 
 
-class WrappedUsageError(click.ClickException):
+class WrappedUsageError(click.ClickException, ScrewkitError):
     """A click error (``original``) that prints as a ``screwkit`` error: usage and hint, then
-    the message wrapped at the terminal width; same exit status as ``original``."""
+    the message wrapped at the terminal width; same exit status as ``original``. A user's
+    mistake, so a :class:`~screwkit.errors.ScrewkitError` too."""
 
     def __init__(self, original: click.ClickException) -> None:
         super().__init__(original.format_message())

@@ -75,6 +75,8 @@ def _subset(mode: ModeMotion, sel: Selection) -> ModeMotion:
     slice)."""
     from dataclasses import replace
 
+    from screwkit.kinematics.lazy_fields import mapped_table
+
     return replace(
         mode,
         link_rotation=mode.link_rotation[sel],
@@ -85,7 +87,7 @@ def _subset(mode: ModeMotion, sel: Selection) -> ModeMotion:
         link_origin_acceleration=mode.link_origin_acceleration[sel],
         joint_centres=mode.joint_centres[sel],
         joint_axes=mode.joint_axes[sel],
-        variables={k: v[sel] for k, v in mode.variables.items()},
+        variables=mapped_table(mode.variables, lambda v: v[sel]),  # lazy entries stay lazy
     )
 
 
