@@ -616,7 +616,7 @@ def run(samples: int = SAMPLES, families: bool = True) -> list[dict[str, Any]]:
     rnea = _pinocchio()
     rows.append(rnea)
     if rnea.get("value"):
-        rows.append({"name": "CSSP inverse_dynamics (the row above) / pinocchio rnea, per "
+        rows.append({"name": "CSSP inverse_dynamics (closed-form statics, blocked) / pinocchio rnea, per "
                              "sample", "value": dyn / rnea["value"], "unit": "ratio",
                      "target": 0.34, "note": f"rnea {rnea['value']:.2f} us/call (issue 30: "
                                              "the dynamics step alone stays at 0.34x)"})
