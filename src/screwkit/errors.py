@@ -52,15 +52,17 @@ def expect_number(value: object, name: str, *, positive: bool = False,
     import math
     import numbers
 
+    from screwkit.messages import given  # messages → tables → errors: imported here
+
     kind = numbers.Integral if integer else numbers.Real
     if isinstance(value, bool) or not isinstance(value, kind):
         raise InputTypeError(f"{name} must be {'an integer' if integer else 'a number'}; got "
                              f"{type(value).__name__} {value!r:.40}")
     x = float(value)  # type: ignore[arg-type]
     if not math.isfinite(x):
-        raise InputError(f"{name} must be finite; got {value!r}")
+        raise InputError(f"{name} must be finite; got {given(value)}")
     if positive and not x > 0:
-        raise InputError(f"{name} must be positive; got {value!r}")
+        raise InputError(f"{name} must be positive; got {given(value)}")
     return x
 
 

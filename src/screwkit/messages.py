@@ -104,3 +104,36 @@ def listing(items: Any, last: str = "and") -> str:
     if len(words) == 1:
         return words[0]
     return f"{', '.join(words[:-1])} {last} {words[-1]}"
+
+
+def shown_values(values: Any, kind: str | None = None, units: UnitChoice | None = None,
+                 digits: int = DIGITS) -> str:
+    """``"(0.1, 0, 2) m"``: several numbers (a vector, a shape, the values of a table) for a
+    sentence, each with ``digits`` significant digits and the unit once: in ``units`` for a
+    quantity ``kind`` (as :func:`shown`), plain numbers for ``kind=None``. Never a numpy
+    repr (``array([...])``, ``np.float64(…)``) nor a Python list's brackets (issue 30)."""
+    flat = np.asarray(values, dtype=float).ravel()
+    label, factor = "", 1.0
+    if kind is not None and kind not in UNITLESS:
+        label, factor = (units or current_units()).unit_of(kind)
+    text = ", ".join(number(x / factor, digits) if np.isfinite(x) else str(float(x))
+                     for x in flat)
+    return f"({text}) {label}".rstrip()
+
+
+def given(value: Any) -> str:
+    """What a caller passed, quoted in an error message: a number as a plain number
+    (``-1.5``, never ``np.float64(-1.5)``), an array, list or tuple as ``(1, 2, 'x')`` (each
+    item so; a large array by its shape), text and anything else by its repr."""
+    if isinstance(value, bool | np.bool_):
+        return str(bool(value))
+    if isinstance(value, int | float | np.integer | np.floating):
+        x = float(value)
+        return number(x) if math.isfinite(x) else str(x)
+    if isinstance(value, np.ndarray):
+        if value.size > 12:
+            return f"an array of shape {' × '.join(map(str, value.shape))}"
+        return f"({', '.join(given(x) for x in value.ravel().tolist())})"
+    if isinstance(value, list | tuple):
+        return f"({', '.join(given(x) for x in value)})"
+    return repr(value)

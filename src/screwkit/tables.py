@@ -66,7 +66,7 @@ class Column:
     def __post_init__(self) -> None:
         if self.kind not in SI_LABELS:
             raise InputError(f"column {self.name!r}: unknown kind {self.kind!r}; kinds are "
-                             f"{sorted(SI_LABELS)}")
+                             f"{', '.join(sorted(SI_LABELS))}")
 
 
 @dataclass(frozen=True)
@@ -80,7 +80,8 @@ class ResultTable:
     def __post_init__(self) -> None:
         lengths = {c.values.shape[0] for c in self.columns}
         if len(lengths) > 1:
-            raise InputError(f"columns of different lengths {sorted(lengths)} in {self.title!r}")
+            raise InputError(f"columns of different lengths ({', '.join(map(str, sorted(lengths)))}) in "
+                             f"{self.title!r}")
         names = [c.name for c in self.columns]
         if len(set(names)) != len(names):
             raise InputError(f"repeated column names in {self.title!r}")
@@ -100,7 +101,7 @@ class ResultTable:
         for c in self.columns:
             if c.name == name:
                 return c
-        raise UnknownNameError(f"no column {name!r}; the columns are {list(self.names)}")
+        raise UnknownNameError(f"no column {name!r}; the columns are {', '.join(self.names)}")
 
     def __iter__(self) -> Iterator[Column]:
         return iter(self.columns)

@@ -29,6 +29,9 @@ SPECS = HERE / "specs"
 CASES: list[dict[str, Any]] = tomllib.loads((HERE / "cases.toml").read_text())["case"]
 #: seconds one case may take before it counts as a hang
 TIMEOUT = 30.0
+#: what a Python or numpy repr leaves in a message: names and numbers are written as prose
+#: (messages.listing, messages.shown_values, messages.given; issue 30)
+PYTHON_REPRS = ("np.float64", "np.int64", "array(", "dtype=", "['", "{'", "[np.")
 
 
 def _make(folder: Path, name: str, how: str) -> None:
@@ -108,6 +111,8 @@ def test_bad_input(case: dict[str, Any], tmp_path: Path) -> None:
     assert "RuntimeWarning" not in output, where
     assert result.exit_code == case["status"], where
     assert _flat(case["message"]) in _flat(output), where
+    reprs = [r for r in PYTHON_REPRS if r in output]
+    assert not reprs, f"Python reprs {reprs} in the message of {where}"
     after = _snapshot(tmp_path)
     allowed = set(case.get("outputs", []))
     changed = sorted(k for k in before if k not in allowed and after.get(k) != before[k])

@@ -162,7 +162,7 @@ def test_input_errors() -> None:
         cssp_positions(dims, np.zeros((2, 2)))
     with pytest.raises(ValueError, match="theta1_dot has 3 entries but theta1 has 2"):
         cssp_motion(dims, [0.0, 1.0], [1.0, 2.0, 3.0])
-    with pytest.raises(ValueError, match=r"theta1 must be finite .* samples \[1\]"):
+    with pytest.raises(ValueError, match=r"theta1 must be finite .* samples 1, counted from 0"):
         cssp_positions(dims, [0.0, np.nan])
 
 

@@ -25,6 +25,7 @@ from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.track import TrackResult, track_parameter_homotopy
 from screwkit.errors import InputError
+from screwkit.messages import shown_values
 
 #: the largest Bézout number :func:`solve_total_degree` tracks
 MAX_PATHS = 5000
@@ -73,11 +74,11 @@ def solve_total_degree(system: PolynomialSystem, p: Complex,
     are the nonsingular isolated solutions."""
     if any(d < 1 for d in system.degrees):
         raise InputError("every equation must involve the unknowns (total degree ≥ 1); "
-                         f"the degrees are {system.degrees}")
+                         f"the degrees are {shown_values(system.degrees)}")
     count = bezout_number(system)
     if count > MAX_PATHS:
         raise InputError(f"the total-degree homotopy would track {count} paths (the Bézout "
-                         f"number Π d_i with d = {system.degrees}), more than {MAX_PATHS}; "
+                         f"number Π d_i with d = {shown_values(system.degrees)}), more than {MAX_PATHS}; "
                          "use monodromy_solve from one known solution instead")
     p = np.asarray(p, dtype=complex)
     if p.shape[-1:] != (system.k,) or p.ndim not in (1, 2):

@@ -38,7 +38,7 @@ from screwkit.dynamics.graph_inverse import GraphDynamics
 from screwkit.dynamics.graph_regressor import GraphRegressor
 from screwkit.errors import expect_instance, expect_number
 from screwkit.kinematics.motion import ModeMotion, Motion
-from screwkit.messages import shown
+from screwkit.messages import listing, shown
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 from screwkit.model.mechanism import Mechanism
@@ -148,8 +148,8 @@ def check_free_counterweights(blocks: Sequence[VariableBlock], weights: Mapping[
     others = {k: w for k, w in weights.items() if k != "F" and w > 0}
     if free and others:
         raise BalancingError(
-            f"free-position counterweight(s) {[b.names[0].rsplit('.', 1)[0] for b in free]} "
-            f"enter the measures {sorted(others)} through their second moments μ·p·pᵀ, which are "
+            f"free-position counterweight(s) {listing(b.names[0].rsplit('.', 1)[0] for b in free)} "
+            f"enter the measures {listing(sorted(others))} through their second moments μ·p·pᵀ, which are "
             "not linear in the variables (μ, μ·p): give them a fixed position ('at') or weight "
             "only the shaking force F"
         )

@@ -27,6 +27,7 @@ from screwkit.balancing.errors import BalancingError
 from screwkit.dynamics import Regressor
 from screwkit.dynamics.graph_regressor import GraphRegressor
 from screwkit.kinematics.motion import ModeMotion
+from screwkit.messages import given
 from screwkit.model.linkage import Linkage
 from screwkit.model.mechanism import GROUND, Mechanism
 
@@ -98,7 +99,7 @@ def default_normalisation(
         )
     for key, val in (("mass", mass), ("length", length), ("bearing_length", bearing_length)):
         if not (np.isfinite(val) and val > 0):
-            raise BalancingError(f"[balancing.normalisation] {key} must be > 0; got {val!r}")
+            raise BalancingError(f"[balancing.normalisation] {key} must be > 0; got {given(val)}")
     return Normalisation(float(mass), float(length), abs(float(speed)), float(bearing_length))
 
 

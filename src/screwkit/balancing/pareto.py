@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 from screwkit.balancing.balance import BalancingSetup, solve_setup
 from screwkit.balancing.errors import BalancingError
 from screwkit.balancing.measures import MEASURES
+from screwkit.messages import listing
 
 Array = NDArray[np.float64]
 
@@ -54,8 +55,8 @@ def pareto_front(setup: BalancingSetup, measures: Sequence[str] = ("F", "T", "T0
     ``progress(done, total)`` is called after each weighting."""
     bad = [k for k in measures if k not in MEASURES]
     if bad or len(measures) < 2:
-        raise BalancingError(f"pareto measures must be at least two of {list(MEASURES)}; "
-                             f"got {list(measures)}")
+        raise BalancingError(f"pareto measures must be at least two of {listing(MEASURES)}; "
+                             f"got {listing(measures)}")
     if divisions < 1:
         raise BalancingError(f"divisions must be >= 1; got {divisions}")
     grid = simplex_grid(len(measures), divisions)

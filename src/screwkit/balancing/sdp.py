@@ -28,6 +28,7 @@ from screwkit.balancing.variables import (
     moving_parts,
     part_word,
 )
+from screwkit.messages import given, listing
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 
 Array = NDArray[np.float64]
@@ -58,7 +59,7 @@ def ellipsoid_row(centre: ArrayLike, semi_axes: ArrayLike) -> Array:
     d = np.asarray(semi_axes, dtype=float)
     if c.shape != (3,) or d.shape != (3,) or np.any(d <= 0):
         raise BalancingError(f"ellipsoid needs a centre (3) and 3 positive semi-axes; got "
-                             f"{c.tolist()}, {d.tolist()}")
+                             f"{given(centre)} and {given(semi_axes)}")
     w = 1.0 / d**2
     # ∫ 1 dm = m;  ∫ w·(p − c)² dm = Σ w_k (Σ_kk − 2 c_k h_k + c_k² m)
     a = np.zeros(N_INERTIAL_PARAMETERS)
@@ -94,8 +95,8 @@ def redistribution_bound(
     names = [link.name for link in parts]
     unknown = sorted(set(ellipsoids) - set(names))
     if unknown or not ellipsoids:
-        raise BalancingError(f"ellipsoids must name moving {part_word(setup.linkage)}s {names}; "
-                             f"got {list(ellipsoids)}")
+        raise BalancingError(f"ellipsoids must name moving {part_word(setup.linkage)}s among "
+                             f"{listing(names)}; got {listing(ellipsoids)}")
     P = N_INERTIAL_PARAMETERS * len(names)
     pi0 = np.concatenate([link.mass.inertial_parameters() for link in parts
                           if link.mass is not None])

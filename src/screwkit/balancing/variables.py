@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.balancing.errors import BalancingError
 from screwkit.errors import expect_instance, expect_number
-from screwkit.messages import listing, shown
+from screwkit.messages import given, listing, shown, shown_values
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import (
     EQUIVALENT_POINT_LABELS,
@@ -167,15 +167,15 @@ def point_mass_variables(
     if fractions.shape != (4,) or np.any(fractions < 0) or abs(fractions.sum() - 1.0) > 1e-9:
         raise BalancingError(
             f"link {link!r}: split must be four fractions >= 0 of the link mass summing to 1 "
-            f"(m1, m2, m3, m4); got {np.asarray(split).tolist()}"
+            f"(m1, m2, m3, m4); got {given(split)}"
         )
     if not 0.0 <= max_decrease <= 1.0:
         raise BalancingError(
             f"link {link!r}: max_decrease must be a fraction in [0, 1] (w′ = 0.05 for 5 %); "
-            f"got {max_decrease!r}"
+            f"got {given(max_decrease)}"
         )
     if max_increase is not None and max_increase < 0.0:
-        raise BalancingError(f"link {link!r}: max_increase must be >= 0; got {max_increase!r}")
+        raise BalancingError(f"link {link!r}: max_increase must be >= 0; got {given(max_increase)}")
     for key, val in (("pair_sum", pair_sum), ("link_mass", link_mass)):
         if val not in ("equal", "at_most", "free"):
             raise BalancingError(
@@ -184,8 +184,8 @@ def point_mass_variables(
     unknown = [v for v in variables if v not in POINT_MASS_NAMES]
     if unknown or not variables:
         raise BalancingError(
-            f"link {link!r}: variables must be a non-empty subset of {list(POINT_MASS_NAMES)}; "
-            f"got {list(variables)}"
+            f"link {link!r}: variables must be a non-empty subset of {listing(POINT_MASS_NAMES)}; "
+            f"got {listing(variables)}"
         )
     masses = fractions * props.mass
     model = equivalent_point_masses(props, masses)
@@ -278,7 +278,7 @@ def counterweight_variables(
     if lo.shape != (3,) or hi.shape != (3,) or np.any(lo > hi):
         raise BalancingError(
             f"counterweight {name!r}: box must be two corners (3 coordinates each) with "
-            f"lower <= upper; got {lo.tolist()}, {hi.tolist()}"
+            f"lower <= upper; got {shown_values(lo, 'length')} and {shown_values(hi, 'length')}"
         )
     col = np.zeros((P, 4))
     col[rows.start, 0] = 1.0
@@ -329,7 +329,7 @@ def assemble(linkage: Subject, blocks: Sequence[VariableBlock]) -> DesignVariabl
             pi[rows] = b.replaces[rows]
     names = tuple(n for b in blocks for n in b.names)
     if len(set(names)) != len(names):
-        raise BalancingError(f"design variable names repeat: {names}")
+        raise BalancingError(f"design variable names repeat: {listing(names)}")
     n = len(names)
     cons: list[LinearConstraint] = []
     start = 0

@@ -15,6 +15,7 @@ import typer
 
 from screwkit import __version__
 from screwkit.cli.common import attempt, console, err_console, guard, prose
+from screwkit.cli.usage_errors import ScrewkitGroup
 
 app = typer.Typer(
     name="screwkit",
@@ -24,6 +25,8 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     # help texts are plain text: "[drive]" is a spec table, not rich markup (which would eat it)
     rich_markup_mode=None,
+    # click's usage errors print like screwkit's own, wrapped at the width (cli/usage_errors.py)
+    cls=ScrewkitGroup,
 )
 
 

@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.errors import InputError
 from screwkit.kinematics.motion import ModeMotion
+from screwkit.messages import given, listing
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import (
     MassProperties,
@@ -56,7 +57,7 @@ def check_vector3(value: ArrayLike | None, name: str) -> Array:
         arr = np.full(1, np.nan)  # not numbers: the message below names the argument
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
         raise DynamicsInputError(
-            f"{name} must be a finite 3-vector in the world frame (SI units); got {value!r}"
+            f"{name} must be a finite 3-vector in the world frame (SI units); got {given(value)}"
         )
     return arr
 
@@ -107,7 +108,7 @@ def check_external_loads(
         if name not in names:
             raise DynamicsInputError(
                 f"external load on {name!r}: no such moving link in {linkage.name}; "
-                f"moving links are {names}"
+                f"moving links are {listing(names)}"
             )
         if not isinstance(load, ExternalLoad):
             raise DynamicsInputError(f"external load on {name!r} must be an ExternalLoad(force, "

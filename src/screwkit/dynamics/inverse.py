@@ -59,6 +59,7 @@ from screwkit.dynamics.sample_blocks import (
 from screwkit.dynamics.screws import freedom_screws
 from screwkit.errors import expect_instance
 from screwkit.kinematics.motion import ModeMotion, Motion
+from screwkit.messages import listing, shown_values
 from screwkit.model.linkage import Linkage
 from screwkit.model.mass import N_INERTIAL_PARAMETERS, MassProperties
 
@@ -74,6 +75,8 @@ def _subset(mode: ModeMotion, sel: Selection) -> ModeMotion:
     slice)."""
     from dataclasses import replace
 
+    from screwkit.kinematics.lazy_fields import mapped_table
+
     return replace(
         mode,
         link_rotation=mode.link_rotation[sel],
@@ -84,7 +87,7 @@ def _subset(mode: ModeMotion, sel: Selection) -> ModeMotion:
         link_origin_acceleration=mode.link_origin_acceleration[sel],
         joint_centres=mode.joint_centres[sel],
         joint_axes=mode.joint_axes[sel],
-        variables={k: v[sel] for k, v in mode.variables.items()},
+        variables=mapped_table(mode.variables, lambda v: v[sel]),  # lazy entries stay lazy
     )
 
 
@@ -111,8 +114,8 @@ def _setup(
             input_arr = np.zeros((N, 0))  # not N rows of numbers: named below
         if input_arr.shape[1] != len(linkage.inputs):
             raise DynamicsInputError(
-                f"inputs must have one column per input {list(linkage.inputs)}; "
-                f"got shape {np.shape(inputs)}"
+                f"inputs must have one column per input ({listing(linkage.inputs)}); "
+                f"got shape {shown_values(np.shape(inputs))}"
             )
     valid = valid_samples(linkage, mode, input_arr, allow_partial, check_finite=check_finite)
     idx = np.flatnonzero(valid)

@@ -134,7 +134,7 @@ def _link_blocks(spec: Any, table: BalancingTable) -> list[VariableBlock]:
                                        f"{'bodies' if word == 'body' else 'links'} are {listing(names)}")
         if not t.variables:
             raise BalancingConfigError(f"{spec.path}: [balancing.links.{link}] has no variables; "
-                                       f"list some of {list(POINT_MASS_NAMES)} or remove the table")
+                                       f"list some of {listing(POINT_MASS_NAMES)} or remove the table")
         try:
             blocks.append(point_mass_variables(
                 lk, link, split=t.split, max_decrease=t.max_decrease,
@@ -242,7 +242,7 @@ def balancing_config(spec: Any) -> BalancingConfig:
         measures, divisions = table.pareto.measures, table.pareto.divisions
         if any(k not in MEASURES for k in measures) or len(measures) < 2:
             raise BalancingConfigError(f"{spec.path}: [balancing.pareto.measures] must be at "
-                                       f"least two of {list(MEASURES)}; got {list(measures)}")
+                                       f"least two of {listing(MEASURES)}; got {listing(measures)}")
         if divisions < 1:
             raise BalancingConfigError(f"{spec.path}: [balancing.pareto.divisions] must be >= 1; "
                                        f"got {divisions}")

@@ -25,6 +25,7 @@ from pydantic import (
 from screwkit.io.errors import SpecError
 from screwkit.io.validation import validation_lines
 from screwkit.kinematics.tracker.rates import spin_links
+from screwkit.messages import listing
 
 Value = StrictFloat | StrictInt | StrictStr
 MOTOR_KINDS = ("none", "constant", "linear", "table")
@@ -182,8 +183,8 @@ def motor_config(spec: Any, t: MotorTable, key: str = "motor", slide: bool = Fal
             _fail(spec, f"{key}.{k}", f"a {t.kind} motor needs {' and '.join(need)}")
     extra = sorted(given - set(need))
     if extra:
-        _fail(spec, key, f"{extra} do not apply to a {t.kind!r} motor (it reads "
-                         f"{list(need) or 'nothing'}); remove them or change kind")
+        _fail(spec, key, f"{listing(extra)} do not apply to a {t.kind!r} motor (it reads "
+                         f"{listing(need) if need else 'nothing'}); remove them or change kind")
     effort = "force" if slide else "torque"
     speed = "velocity" if slide else "angular_velocity"
     if t.kind == "constant":
@@ -215,7 +216,7 @@ def _load(spec: Any, t: LoadTable | None) -> LoadConfig | None:
     freedom = t.freedom or lk.joints[-1].freedom_names()[0]
     if freedom not in lk.freedom_names:
         _fail(spec, "load.freedom", f"no freedom {freedom!r}; the freedoms are "
-                                    f"{lk.freedom_names}")
+                                    f"{listing(lk.freedom_names)}")
     if freedom not in lk.joints[-1].freedom_names():
         _fail(spec, "load.freedom", f"the load acts on the output, a freedom of the last joint "
                                     f"(the one to the ground): {lk.joints[-1].freedom_names()}")
@@ -258,7 +259,7 @@ def friction_problem(linkage: Any, joint: str, rotation: bool, translation: bool
     the reason); None when it can. One rule for spec files and the Python API."""
     joints = {j.name: j for j in linkage.joints}
     if joint not in joints:
-        return "", f"no joint {joint!r}; the joints are {list(joints)}"
+        return "", f"no joint {joint!r}; the joints are {listing(joints)}"
     kind = joints[joint].kind
     rods = {linkage.joints[k].name: linkage.links[i].name
             for i in spin_links(linkage) for k in (i, i + 1)}

@@ -114,7 +114,8 @@ def _per_input(spec: Any, value: Any, kind: Callable[[str], str], key: str
         return tuple(spec.quantity(value, kind(name), f"drive.{key}") for name in inputs)
     unknown = sorted(set(value) - set(inputs))
     if unknown:
-        _fail(spec, key, f"{unknown} are not inputs of {spec.name!r}; the inputs are {inputs}")
+        _fail(spec, key, f"{listing(unknown)} are not inputs of {spec.name!r}; the inputs are "
+                         f"{listing(inputs)}")
     return tuple(spec.quantity(value.get(name, 0.0), kind(name), f"drive.{key}.{name}")
                  for name in inputs)
 
@@ -125,7 +126,7 @@ def _friction(spec: Any, table: dict[str, Any] | None) -> tuple[JointFriction, .
     for name, value in (table or {}).items():
         key = f"friction.{name}"
         if name not in joints:
-            _fail(spec, key, f"no joint {name!r}; the joints are {list(joints)}")
+            _fail(spec, key, f"no joint {name!r}; the joints are {listing(joints)}")
         rotation, translation = split_friction(spec, key, name, joints[name].kind, value)
         c_r = 0.0 if rotation is None else spec.quantity(rotation, "rotational_damping",
                                                          f"drive.{key}")
@@ -196,7 +197,7 @@ def _point_force(spec: Any, t: PointForceTable | None
         return None
     points = {p.name: p for p in spec.mechanism.points}
     if t.point not in points:
-        have = f"the points are {sorted(points)}" if points else "it has no points"
+        have = f"the points are {listing(sorted(points))}" if points else "it has no points"
         _fail(spec, "point_force.point", f"no point {t.point!r}; {have} (add a [[points]] "
                                          "entry on the body it is fixed to)")
     if points[t.point].body == "ground":
@@ -214,12 +215,13 @@ def _load(spec: Any, t: LoadTable | None) -> LoadConfig | None:
     joints = {j.name: j for j in spec.mechanism.joints}
     freedoms = [f for j in spec.mechanism.joints if j.kind != "S" for f in j.freedom_names()]
     if t.freedom is None:
-        _fail(spec, "load.freedom", f"name the freedom the load acts on, one of {freedoms}")
+        _fail(spec, "load.freedom", f"name the freedom the load acts on, one of "
+                                    f"{listing(freedoms, 'or')}")
     assert t.freedom is not None
     if t.freedom not in freedoms:
         joint = joints.get(t.freedom.split(".")[0])
         why = (f"{joint.name!r} is a ball joint, whose rotations take no single load"
                if joint is not None and joint.kind == "S" else "no such freedom")
         _fail(spec, "load.freedom", f"{t.freedom!r}: {why}; the loaded freedom is one of "
-                                    f"{freedoms}")
+                                    f"{listing(freedoms, 'or')}")
     return load_config(spec, t, t.freedom)

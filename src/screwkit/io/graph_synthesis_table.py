@@ -22,6 +22,7 @@ from pydantic import BaseModel, ConfigDict, Field, StrictInt, StrictStr, Validat
 
 from screwkit.io.errors import SpecError
 from screwkit.io.validation import validation_lines
+from screwkit.messages import listing
 from screwkit.synthesis.expressions import parse_expression
 from screwkit.synthesis.graph_route import GraphSynthesisProblem, GraphTarget, GraphVariable
 
@@ -156,7 +157,7 @@ def _target(spec: GraphSpec, t: _Target, k: int) -> GraphTarget:
                                               f"{', '.join(names) or 'none (add [[points]])'}")
         coords = t.coordinates or ["x", "y", "z"]
         if any(c not in _XYZ for c in coords) or len(set(coords)) != len(coords):
-            raise _fail(spec, f"{key}.coordinates", f"{coords!r}: give distinct names among "
+            raise _fail(spec, f"{key}.coordinates", f"{listing(coords)}: give distinct names among "
                                                     "'x', 'y', 'z'")
         comps, kind = tuple(_XYZ[c] for c in coords), "length"
     elif what == "output":
@@ -237,7 +238,7 @@ def graph_synthesis_problem(spec: GraphSpec, data: dict[str, Any]) -> GraphSynth
     variables = tuple(_variable(spec, u) for u in table.unknowns)
     labels = [v.label for v in variables]
     if len(set(labels)) != len(labels):
-        raise _fail(spec, "unknowns", f"each unknown once; got {table.unknowns}")
+        raise _fail(spec, "unknowns", f"each unknown once; got {listing(table.unknowns)}")
     lower = np.full(len(variables), -np.inf)
     upper = np.full(len(variables), np.inf)
     for text, pair in table.bounds.items():

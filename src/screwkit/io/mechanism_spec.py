@@ -360,7 +360,7 @@ class GraphSpec:
         if value is True:
             if len(freedoms) > 1:
                 self._fail(f"{key}.{what}", f"joint {j.name!r} ({j.kind}) has freedoms "
-                                            f"{list(freedoms)}: say which is {verb}, e.g. "
+                                            f"{listing(freedoms)}: say which is {verb}, e.g. "
                                             f"{what} = {freedoms[0]!r}")
             return [f"{j.name}.{freedoms[0]}"]
         names = [x.strip() for x in str(value).split(",")]

@@ -296,7 +296,7 @@ class Spec:
         if kind == "length":
             missing = [k for k in ("start", "stop", "step") if k not in m.model_fields_set]
             if missing:
-                self._fail("motion", f"the input is a translation: give {missing} as lengths "
+                self._fail("motion", f"the input is a translation: give {listing(missing)} as lengths "
                                      f"(e.g. start = \"0 mm\", stop = \"50 mm\", step = \"1 mm\")")
         start = self.quantity(m.start, kind, "motion.start")
         stop = self.quantity(m.stop, kind, "motion.stop")

@@ -94,7 +94,8 @@ class ComponentTable(_Strict):
             raise InputError("give exactly one of function, expression or data "
                              f"(got {listing(given)})")
         if self.function is not None and self.function not in LIBRARY:
-            raise InputError(f"unknown function {self.function!r}; choose one of {sorted(LIBRARY)}")
+            raise InputError(f"unknown function {self.function!r}; choose one of "
+                             f"{listing(sorted(LIBRARY), 'or')}")
         if self.design_points is None and self.data is None:
             raise InputError("design_points are needed (a list, or {start, stop, step})")
         return self
@@ -202,12 +203,12 @@ class SynthesisTable(_Strict):
         unused += ["bounds"] if self.bounds else []
         unused += ["inversion"] if self.inversion != "all" else []
         if unused:
-            raise InputError(f"{unused} not used by method = \"overlay\" (it finds the output "
+            raise InputError(f"{listing(unused)} not used by method = \"overlay\" (it finds the output "
                              "circle and the assembly mode from the overlay; dwells go in "
                              "[synthesis.overlay] dwells)")
         if self.unknowns is not None and set(self.unknowns) not in OVERLAY_UNKNOWNS:
             raise InputError(f"unknowns of the overlay are [\"d3\", \"a\", \"b\"] or, to refine "
-                             f"the coupler too, [\"d2\", \"d3\", \"a\", \"b\"]; got {self.unknowns}")
+                             f"the coupler too, [\"d2\", \"d3\", \"a\", \"b\"]; got {listing(self.unknowns)}")
         return self
 
 

@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.errors import InputError, InputTypeError, UnknownNameError
 from screwkit.kinematics.tracker.loop import Array, Configuration
-from screwkit.messages import shown
+from screwkit.messages import listing, shown, shown_values
 from screwkit.model.linkage import Linkage
 
 if TYPE_CHECKING:
@@ -124,7 +124,7 @@ class Motion:
         table = tables[derivative]
         if name not in table:
             raise UnknownNameError(f"{self.linkage.name}: no variable {name!r} in mode {mode}; "
-                                   f"the variables are {sorted(table)}")
+                                   f"the variables are {listing(sorted(table))}")
         return table[name]
 
     def table(self, coupler_point: Any = None, coupler_link: int = 1, *,
@@ -168,7 +168,7 @@ def as_input_array(linkage: Linkage, values: ArrayLike, name: str) -> Array:
         a = a[:, None] if n_in == 1 else a[None, :]
     if a.ndim != 2 or a.shape[-1] != n_in:
         raise InputError(f"{name}: expected {n_in} value(s) per sample for inputs "
-                         f"{list(linkage.inputs)}; got shape {np.shape(values)}")
+                         f"({listing(linkage.inputs)}); got shape {shown_values(np.shape(values))}")
     if a.shape[0] == 0:
         raise InputError(f"{name}: give at least one sample")
     if not np.all(np.isfinite(a)):
@@ -189,11 +189,18 @@ def per_sample(linkage: Linkage, values: ArrayLike, name: str, X: Array) -> Arra
     return np.array(np.broadcast_to(a, X.shape))
 
 
-def format_inputs(linkage: Linkage, x: Array) -> str:
+def format_inputs(linkage: Any, x: ArrayLike) -> str:
     """Input values for a message, ``input.theta = 250 deg``, in the units of
     :func:`screwkit.messages.message_units` (the spec's, through a Pipeline; else degrees and
-    metres)."""
-    parts = []
-    for name, v in zip(linkage.inputs, np.atleast_1d(x), strict=True):
-        parts.append(f"{name} = {shown(v, 'length' if name.endswith('.s') else 'angle')}")
-    return ", ".join(parts)
+    metres). ``linkage`` is a Linkage or a Mechanism (whose rows hold its joint inputs, then its
+    driven body freedoms: ``driven_names``)."""
+    values = np.atleast_1d(np.asarray(x, dtype=float))
+    names = tuple(getattr(linkage, "driven_names", linkage.inputs))
+    if hasattr(linkage, "driven_is_translation"):
+        slides = list(linkage.driven_is_translation())
+    else:
+        slides = [name.endswith(".s") for name in names]
+    if len(names) != values.size:  # not one row of this mechanism's inputs
+        return shown_values(values)
+    return ", ".join(f"{name} = {shown(v, 'length' if slide else 'angle')}"
+                     for name, v, slide in zip(names, values, slides, strict=True))

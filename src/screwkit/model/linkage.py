@@ -22,6 +22,7 @@ import numpy as np
 
 from screwkit.dual import ScrewMatrix
 from screwkit.errors import InputError
+from screwkit.messages import listing
 from screwkit.model.joints import Joint
 from screwkit.model.mass import MassProperties
 
@@ -83,7 +84,7 @@ class Linkage:
         names = [j.name for j in self.joints]
         dup = sorted({x for x in names if names.count(x) > 1})
         if dup:
-            raise LinkageError(f"linkage {self.name!r}: joint names must be unique; repeated: {dup}")
+            raise LinkageError(f"linkage {self.name!r}: joint names must be unique; repeated: {listing(dup)}")
         lnames = [lk.name for lk in self.links]
         dupl = sorted({x for x in lnames if lnames.count(x) > 1})
         if dupl:
@@ -108,14 +109,15 @@ class Linkage:
             if inp not in all_freedoms:
                 raise LinkageError(
                     f"linkage {self.name!r}: input {inp!r} is not a freedom of this loop; "
-                    f"freedoms are {all_freedoms}"
+                    f"freedoms are {listing(all_freedoms)}"
                 )
             if inp.split(".")[0] in {j.name for j in self.joints if j.kind == "S"}:
                 raise LinkageError(
                     f"linkage {self.name!r}: a spherical joint cannot be driven ({inp!r})"
                 )
         if len(set(self.inputs)) != len(self.inputs):
-            raise LinkageError(f"linkage {self.name!r}: an input is named twice: {list(self.inputs)}")
+            raise LinkageError(f"linkage {self.name!r}: an input is named twice: "
+                               f"{listing(self.inputs)}")
 
     # --- construction -------------------------------------------------------------------
     @classmethod
@@ -193,7 +195,7 @@ class Linkage:
     def describe(self) -> str:
         """One line per joint: what the loop is made of."""
         lines = [f"{self.name}: {len(self.joints)} joints "
-                 f"({''.join(j.kind for j in self.joints)}), inputs {list(self.inputs)}"]
+                 f"({''.join(j.kind for j in self.joints)}), inputs {listing(self.inputs)}"]
         return "\n".join(lines)
 
 

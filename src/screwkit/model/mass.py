@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.constants import STANDARD_GRAVITY
 from screwkit.errors import InputError, InputTypeError
+from screwkit.messages import given, shown_values
 
 Array = NDArray[np.float64]
 
@@ -115,7 +116,7 @@ def physical_consistency_violations(
     if inertia_arr.shape != (3, 3) or not np.all(np.isfinite(inertia_arr)):
         raise InputError(f"inertia must be a finite (3, 3) array, got shape {inertia_arr.shape}")
     if not np.isfinite(mass) or mass <= 0.0:
-        problems.append(f"mass must be > 0, got {mass!r} kg")
+        problems.append(f"mass must be > 0, got {given(mass)} kg")
     scale = float(np.max(np.abs(inertia_arr)))
     asym = float(np.max(np.abs(inertia_arr - inertia_arr.T)))
     if asym > max(rtol * scale, atol):
@@ -246,9 +247,9 @@ class MassProperties:
         before calling.
         """
         if not np.isfinite(gravity) or gravity <= 0.0:
-            raise InputError(f"gravity must be a positive acceleration in m/s^2, got {gravity!r}")
+            raise InputError(f"gravity must be a positive acceleration in m/s^2, got {given(gravity)}")
         if not np.isfinite(weight) or weight <= 0.0:
-            raise InputError(f"weight must be a positive force in N, got {weight!r}")
+            raise InputError(f"weight must be a positive force in N, got {given(weight)}")
         mass = float(weight) / float(gravity)
         if (inertia is None) == (radii_of_gyration is None):
             raise InputError("give exactly one of inertia= or radii_of_gyration=")
@@ -276,7 +277,7 @@ class MassProperties:
         mass = float(pi[0])
         if mass <= 0.0:
             raise PhysicalConsistencyError(
-                f"inertial parameters: mass must be > 0, got {mass!r} kg"
+                f"inertial parameters: mass must be > 0, got {given(mass)} kg"
             )
         com = pi[1:4] / mass
         ixx, iyy, izz, ixy, ixz, iyz = pi[4:]
@@ -368,7 +369,8 @@ class PointMassModel:
         if np.any(masses < 0.0):
             bad = np.flatnonzero(masses < 0.0)
             raise PhysicalConsistencyError(
-                f"point masses must be >= 0; masses[{bad.tolist()}] = {masses[bad].tolist()} kg"
+                f"point masses must be >= 0; masses {shown_values(bad)} (counted from 0) are "
+                f"{shown_values(masses[bad], 'mass')}"
             )
         if masses.sum() <= 0.0:
             raise PhysicalConsistencyError("the point masses must have a positive total mass")
@@ -416,7 +418,7 @@ def point_mass_distances(principal_moments: ArrayLike, pair_masses: ArrayLike) -
     moments = _vector3(principal_moments, "principal_moments")
     masses = _vector3(pair_masses, "pair_masses")
     if np.any(masses < 0.0):
-        raise PointMassSplitError(f"pair masses must be >= 0, got {masses} kg")
+        raise PointMassSplitError(f"pair masses must be >= 0, got {shown_values(masses, 'mass')}")
     lam1, lam2, lam3 = moments
     needs = 0.5 * np.array([-lam1 + lam2 + lam3, lam1 - lam2 + lam3, lam1 + lam2 - lam3])
     tol = CONSISTENCY_RTOL * float(np.max(np.abs(moments)))
@@ -426,7 +428,7 @@ def point_mass_distances(principal_moments: ArrayLike, pair_masses: ArrayLike) -
         if need < -tol:
             raise PointMassSplitError(
                 f"m{k + 1}·{label}² = {need:.6e} kg m^2 < 0: the principal moments "
-                f"{moments} violate a triangle inequality, so no real {label}-pair exists"
+                f"{shown_values(moments, 'inertia')} violate a triangle inequality, so no real {label}-pair exists"
             )
         need = max(need, 0.0)
         if masses[k] == 0.0:
@@ -469,7 +471,7 @@ def equivalent_point_masses(
         split_arr = np.asarray(split, dtype=float)
         if split_arr.shape != (4,) or not np.all(np.isfinite(split_arr)):
             raise PointMassSplitError(
-                f"split must be four finite masses (m1, m2, m3, m4) in kg, got {split_arr!r}"
+                f"split must be four finite masses (m1, m2, m3, m4) in kg, got {given(split_arr)}"
             )
         if np.any(split_arr < 0.0):
             raise PointMassSplitError(f"split masses must be >= 0, got {split_arr} kg")

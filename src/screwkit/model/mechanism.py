@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.errors import InputError, UnknownNameError
-from screwkit.messages import listing
+from screwkit.messages import given, listing
 from screwkit.model.joints import JOINT_DESCRIPTIONS, JOINT_FREEDOMS
 from screwkit.model.mass import MassProperties
 from screwkit.model.mechanism_drives import DRIVE_FREEDOMS, BodyDrive
@@ -153,9 +153,9 @@ def unit_vector(value: ArrayLike, what: str) -> Array:
     try:
         v = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise MechanismError(f"{what} must be three numbers; got {value!r}") from None
+        raise MechanismError(f"{what} must be three numbers; got {given(value)}") from None
     if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise MechanismError(f"{what} must be three finite numbers; got {value!r}")
+        raise MechanismError(f"{what} must be three finite numbers; got {given(value)}")
     v = v / max(float(np.max(np.abs(v))), 1e-300)  # scaled first: no overflow in the norm
     n = float(np.linalg.norm(v))
     if n == 0.0:
@@ -167,9 +167,9 @@ def point3(value: ArrayLike, what: str) -> Array:
     try:
         v = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise MechanismError(f"{what} must be three numbers [x, y, z]; got {value!r}") from None
+        raise MechanismError(f"{what} must be three numbers [x, y, z]; got {given(value)}") from None
     if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise MechanismError(f"{what} must be three finite numbers [x, y, z]; got {value!r}")
+        raise MechanismError(f"{what} must be three finite numbers [x, y, z]; got {given(value)}")
     return v
 
 
@@ -296,13 +296,13 @@ class Mechanism:
                                      "turns through no angle about it; choose another vector")
             if isinstance(o, PointTravel) and o.point not in points:
                 raise UnknownNameError(f"output {o.name!r}: point {o.point!r} is not a point of "
-                                       f"{self.name!r}; points are {sorted(points)}")
+                                       f"{self.name!r}; points are {listing(sorted(points))}")
 
     def _check_inputs(self) -> None:
         freedoms = self.freedom_names
         if len(set(self.inputs)) != len(self.inputs):
             raise MechanismError(f"mechanism {self.name!r}: an input is named twice: "
-                                 f"{list(self.inputs)}")
+                                 f"{listing(self.inputs)}")
         balls = {j.name for j in self.joints if j.kind == "S"}
         for inp in self.inputs:
             if inp.split(".")[0] in balls:
@@ -311,7 +311,7 @@ class Mechanism:
             if inp not in freedoms:
                 joint = inp.split(".")[0]
                 own = [f for f in freedoms if f.split(".")[0] == joint]
-                hint = (f"joint {joint!r} has {own}" if own else
+                hint = (f"joint {joint!r} has {listing(own)}" if own else
                         f"there is no joint {joint!r}")
                 raise MechanismError(f"input {inp!r} is not a freedom of {self.name!r} ({hint})")
 
@@ -341,14 +341,14 @@ class Mechanism:
                 points[d.body] = d.at
         if len(set(self.actuated)) != len(self.actuated):
             raise MechanismError(f"mechanism {self.name!r}: a freedom is actuated twice: "
-                                 f"{list(self.actuated)}")
+                                 f"{listing(self.actuated)}")
         freedoms = self.freedom_names
         balls = {j.name for j in self.joints if j.kind == "S"}
         for a in self.actuated:
             joint = a.split(".")[0]
             if joint in balls or a not in freedoms:
                 own = [f for f in freedoms if f.split(".")[0] == joint]
-                hint = (f"joint {joint!r} has {own}" if own else f"there is no joint {joint!r}")
+                hint = (f"joint {joint!r} has {listing(own)}" if own else f"there is no joint {joint!r}")
                 if joint in balls:
                     hint = "a ball joint has no freedom a motor can drive"
                 raise MechanismError(f"actuated freedom {a!r} is not a motorised freedom of "

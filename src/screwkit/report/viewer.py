@@ -91,7 +91,7 @@ def _pack(values: Any, dtype: str) -> dict[str, Any]:
     if np.isinf(a).any():
         from screwkit.io.results import NonFiniteResultError
 
-        raise NonFiniteResultError(f"an infinite value in an array of shape {list(a.shape)} of "
+        raise NonFiniteResultError(f"an infinite value in an array of shape {' × '.join(map(str, a.shape))} of "
                                    "the scene; strict JSON has no Infinity")
     raw = a.astype("<f8" if dtype == "f8" else "<f4").tobytes()
     return {"$b64": base64.b64encode(raw).decode("ascii"), "dtype": dtype, "shape": list(a.shape)}

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from screwkit.messages import listing
 from screwkit.simulation.drive import motor_torque
 from screwkit.simulation.flywheel import secant_flywheel
 from screwkit.simulation.graph_eom import Array, GraphEquationOfMotion
@@ -54,7 +55,7 @@ def crank_input(eom: GraphEquationOfMotion) -> str:
     if eom.inputs != 1:
         raise SimulationError(
             f"{mech.name}: crank cycles (statistics, --fluctuation) need one input that "
-            f"turns; this mechanism has {eom.inputs} inputs {list(mech.inputs)}, which have "
+            f"turns; this mechanism has {eom.inputs} inputs ({listing(mech.inputs)}), which have "
             "no common period (simulate for [drive] duration instead)")
     name = mech.inputs[0]
     if name.endswith(".s"):

@@ -65,6 +65,7 @@ from screwkit.kinematics.graph.newton import (
     rates,
 )
 from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.messages import given, listing
 from screwkit.model.mass import MassProperties
 from screwkit.model.mechanism import GROUND, Mechanism
 from screwkit.simulation.drive import motor_torque, output_force
@@ -111,7 +112,7 @@ def checked_graph_friction(mech: Mechanism, friction: Sequence[JointFriction]
         j = names.get(f.joint)
         if j is None:
             raise SimulationError(f"{mech.name}: friction on joint {f.joint!r}, which is not a "
-                                  f"joint of it; joints are {sorted(names)}")
+                                  f"joint of it; joints are {listing(sorted(names))}")
         if not (f.rotation >= 0 and f.translation >= 0):
             raise SimulationError(f"{mech.name}: joint {f.joint!r}: friction coefficients are "
                                   ">= 0")
@@ -197,7 +198,7 @@ class GraphEquationOfMotion:
         if load.freedom not in names:
             raise SimulationError(f"{mech.name}: a load on {load.freedom!r}, which is not a "
                                   f"freedom of it (ball joints excluded); the freedoms are "
-                                  f"{names}")
+                                  f"{listing(names)}")
         k = next(i for i, j in enumerate(mech.joints) if load.freedom in j.freedom_names())
         return int(lay.first_freedom[k] + mech.joints[k].freedom_names().index(load.freedom))
 
@@ -207,7 +208,7 @@ class GraphEquationOfMotion:
         points = {p.name: p for p in mech.points}
         if name not in points:
             raise SimulationError(f"{mech.name}: a force at point {name!r}, which is not a "
-                                  f"point of it; the points are {sorted(points)} (add it as a "
+                                  f"point of it; the points are {listing(sorted(points))} (add it as a "
                                   "[[points]] entry on its body)")
         pt = points[name]
         if pt.body not in self.layout.body_of or pt.body == GROUND:
@@ -216,7 +217,7 @@ class GraphEquationOfMotion:
         F = np.asarray(force, dtype=float).reshape(-1)
         if F.shape != (3,) or not np.all(np.isfinite(F)):
             raise SimulationError(f"{mech.name}: the force at point {name!r} is three finite "
-                                  f"components (N, world axes); got {F.tolist()}")
+                                  f"components (N, world axes); got {given(F)}")
         return self.layout.body_of[pt.body], np.asarray(pt.at, dtype=float), F
 
     def start_at(self, x: ArrayLike) -> None:

@@ -49,7 +49,9 @@ from scipy.spatial.transform import Rotation
 
 from screwkit.io.drive_table import JointFriction
 from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.motion import format_inputs
 from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.messages import listing, shown_values
 from screwkit.model.mechanism import GROUND, Mechanism
 from screwkit.simulation.graph_eom import Array, checked_graph_friction, graph_masses
 from screwkit.simulation.mjcf import DEFAULT_SOLIMP, DEFAULT_SOLREF, DEFAULT_TIMESTEP, xml_numbers
@@ -125,7 +127,7 @@ def graph_mjcf_layout(mech: Mechanism) -> GraphMjcfLayout:
     bad = [j.name for j in mech.joints if j.kind == "H"]
     if bad:
         raise SimulationError(f"{mech.name}: MJCF export does not write H (helical) joints; "
-                              f"{bad} are")
+                              f"{listing(bad)} {'is' if len(bad) == 1 else 'are'}")
     tree, chord_joints = export_tree(mech)
     chords = [mech.joints[k] for k in chord_joints]
     for j in chords:
@@ -251,7 +253,7 @@ def _start_qpos(mech: Mechanism, children: dict[str, list[tuple[int, str]]],
     md = solve_mechanism(mech, X, rates=0.0, accelerations=0.0).mode(0)
     if not md.assembles[0]:
         raise SimulationError(f"{mech.name}: the drawn mode does not assemble at the start "
-                              f"inputs {X[0].tolist()}")
+                              f"inputs {format_inputs(mech, X[0])}")
     lay = graph_layout(mech)
     out: list[float] = []
 
@@ -281,7 +283,7 @@ def graph_mjcf_model(mech: Mechanism, *, gravity: ArrayLike | None = None,
     n = len(mech.inputs)
     fw = np.zeros(n) if flywheel is None else np.asarray(flywheel, dtype=float) * np.ones(n)
     if not np.all(np.isfinite(fw) & (fw >= 0)):
-        raise SimulationError(f"{mech.name}: a flywheel is an inertia >= 0; got {fw.tolist()}")
+        raise SimulationError(f"{mech.name}: a flywheel is an inertia >= 0; got {shown_values(fw, 'inertia')}")
     damping = {f.joint: (float(f.rotation), float(f.translation))
                for f in checked_graph_friction(mech, friction)}
     damped_chords = sorted(c for c in lay.chords if any(damping.get(c, (0.0, 0.0))))

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.integrate import solve_ivp
 
+from screwkit.messages import given
 from screwkit.simulation.graph_eom import Array, GraphEquationOfMotion
 from screwkit.simulation.reduced import SimulationError
 
@@ -103,7 +104,7 @@ def _check(eom: GraphEquationOfMotion, duration: float, samples: int, x0: Array,
     for what, v in (("initial inputs", x0), ("initial rates", v0)):
         if v.shape != (n,) or not np.all(np.isfinite(v)):
             raise SimulationError(f"{name}: give {n} finite {what} (one per input "
-                                  f"{', '.join(eom.mechanism.inputs)}); got {v.tolist()}")
+                                  f"{', '.join(eom.mechanism.inputs)}); got {given(v)}")
 
 
 def simulate_graph(eom: GraphEquationOfMotion, *, duration: float, samples: int = 201,

@@ -42,7 +42,7 @@ from scipy.spatial.transform import Rotation
 
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.kinematics.solve_motion import solve_motion
-from screwkit.messages import shown
+from screwkit.messages import listing, shown
 from screwkit.model.linkage import Linkage
 from screwkit.simulation.reduced import Array, SimulationError, joint_friction
 
@@ -77,7 +77,7 @@ def loop_layout(linkage: Linkage) -> MjcfLayout:
     bad = [j.name for j in linkage.joints if j.kind in ("H", "U")]
     if bad:
         raise SimulationError(f"{linkage.name}: MJCF export handles R, P, C and S joints; "
-                              f"{bad} are H or U joints")
+                              f"{listing(bad)} {'is an H or U joint' if len(bad) == 1 else 'are H or U joints'}")
     inputs = {name.split(".")[0] for name in linkage.inputs}
     spheres = [k for k, kind in enumerate(kinds) if kind == "S"]
     hinges = [k for k, kind in enumerate(kinds)
@@ -214,7 +214,7 @@ def mjcf_model(linkage: Linkage, *, start: float = 0.0, mode: int = 0,
                               f"{flywheel!r}")
     if len(linkage.inputs) != 1:
         raise SimulationError(f"{linkage.name}: MJCF export drives one input; this loop has "
-                              f"{list(linkage.inputs)}")
+                              f"{listing(linkage.inputs)}")
     layout = loop_layout(linkage)
     damping: Damping = {f.joint: (float(f.rotation), float(f.translation))
                         for f in joint_friction(linkage, friction)}

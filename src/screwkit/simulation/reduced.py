@@ -283,7 +283,7 @@ class ReducedModel:
 def _one_input_crank(linkage: Linkage) -> None:
     if len(linkage.inputs) != 1:
         raise SimulationError(f"{linkage.name}: the reduced equation of motion is for a loop "
-                              f"with one input; this one has {list(linkage.inputs)}")
+                              f"with one input; this one has {listing(linkage.inputs)}")
     if linkage.inputs[0].endswith(".s"):
         raise SimulationError(f"{linkage.name}: simulation needs a rotating input (a crank that "
                               f"turns); the input {linkage.inputs[0]!r} is a translation")
@@ -323,7 +323,7 @@ def reduced_model(linkage: Linkage, *, mode: int = 0, start: float = 0.0,
     for name in ratios:
         if name not in linkage.freedom_names:
             raise SimulationError(f"{linkage.name}: no freedom {name!r}; the freedoms are "
-                                  f"{linkage.freedom_names}")
+                                  f"{listing(linkage.freedom_names)}")
     n = int(samples_per_cycle)
     if n < 8:
         raise SimulationError(f"samples_per_cycle must be at least 8; got {n}")

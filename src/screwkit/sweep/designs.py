@@ -21,6 +21,7 @@ import numpy as np
 from screwkit.errors import InputError
 from screwkit.io.quantity import QuantitySyntaxError, parse_quantity
 from screwkit.io.spec import Spec
+from screwkit.messages import listing
 from screwkit.sweep.keys import SpecKey, SpecKeyError, spec_key, unit_of
 
 #: the most designs one sweep may have (a typing mistake in COUNT should not fill the disk)
@@ -55,7 +56,7 @@ def _numbers(items: list[str], where: str) -> tuple[list[float], str | None]:
         if unit is not None:
             units.add(unit)
     if len(units) > 1:
-        raise DesignError(f"{where}: give every value in one unit (got {sorted(units)})")
+        raise DesignError(f"{where}: give every value in one unit (got {listing(sorted(units))})")
     return numbers, (units.pop() if units else None)
 
 
@@ -126,7 +127,7 @@ def _keys(data: dict[str, Any], spec: Spec, varies: list[VaryText]) -> list[Spec
     texts = [k.text for k in keys]
     repeated = sorted({t for t in texts if texts.count(t) > 1})
     if repeated:
-        raise DesignError(f"--vary names {repeated} more than once; give each key once")
+        raise DesignError(f"--vary names {listing(repeated)} more than once; give each key once")
     return keys
 
 

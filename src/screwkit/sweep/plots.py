@@ -17,6 +17,7 @@ import numpy as np
 
 from screwkit.errors import InputError
 from screwkit.io.outputs import atomic_path
+from screwkit.messages import listing
 from screwkit.report.plots import tidy_axes
 from screwkit.report.sweep_pictures import PICTURE_SOFTWARE
 
@@ -121,7 +122,7 @@ def plot_sweep(rows: Sequence[Row], metadata: dict[str, Any], path: Path, column
 
     if not any(column in r for r in rows):
         raise InputError(f"--plot-column {column!r}: the table has no such column; its columns "
-                         f"include {sorted({k for r in rows for k in r})[:12]}")
+                         f"include {listing(sorted({k for r in rows for k in r})[:12])}")
     labels = [k["column"] for k in metadata["keys"]]
     keys = np.array([[float(r[c]) for c in labels] for r in rows]).reshape(len(rows), -1)
     z = _values(rows, column)

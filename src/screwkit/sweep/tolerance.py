@@ -30,6 +30,7 @@ from screwkit.kinematics.analysis.sensitivity import (
 )
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.kinematics.tracker.loop import Array
+from screwkit.messages import listing
 from screwkit.model.linkage import Linkage
 from screwkit.pipeline import Pipeline
 from screwkit.sweep.keys import SpecKey, SpecKeyError, spec_key, unit_of, with_values
@@ -132,7 +133,7 @@ def make_tolerances(data: dict[str, Any], spec: Spec, texts: list[str]) -> list[
         out.append(Tolerance(key, _nominal_number(data, spec, key), t))
     names = [tol.key.text for tol in out]
     if len(set(names)) != len(names):
-        raise ToleranceError(f"--tol names a key more than once: {names}")
+        raise ToleranceError(f"--tol names a key more than once: {listing(names)}")
     return out
 
 

@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.errors import InputError
-from screwkit.kinematics.motion import AssemblyError
+from screwkit.kinematics.motion import AssemblyError, format_inputs
 from screwkit.model.mechanism import Mechanism
 from screwkit.synthesis.solve import ON_BOUND_RTOL, SynthesisError
 
@@ -201,7 +201,7 @@ def generated(problem: GraphSynthesisProblem, x: FloatArray) -> list[FloatArray]
     if not ok.all():
         bad = rows[~ok][0]
         raise _Infeasible(f"the drawn mode does not assemble (or is singular) at the target "
-                          f"input {bad.tolist()} (SI)")
+                          f"input {format_inputs(mech, bad)}")
     return [_quantity(md, t, idx) for t, idx in zip(problem.targets, where, strict=True)]
 
 
@@ -293,7 +293,7 @@ def _range_check(problem: GraphSynthesisProblem, mech: Mechanism) -> tuple[bool,
         return True, f"the drawn mode runs over all {X.shape[0]} motion rows of the spec"
     bad = X[~ok]
     return False, (f"the drawn mode does not assemble (or is singular) at {int((~ok).sum())} of "
-                   f"{X.shape[0]} motion rows, first at input {bad[0].tolist()} (SI)")
+                   f"{X.shape[0]} motion rows, first at input {format_inputs(mech, bad[0])}")
 
 
 def synthesize_graph(problem: GraphSynthesisProblem, start: FloatArray | None = None, *,

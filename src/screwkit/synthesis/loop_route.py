@@ -44,7 +44,7 @@ from screwkit.kinematics.tracker.loop import (
     layout,
 )
 from screwkit.kinematics.tracker.loop_jets import close_loop
-from screwkit.messages import listing
+from screwkit.messages import given, listing
 from screwkit.model.geometry import LoopGeometry
 from screwkit.model.linkage import Linkage, LinkageError
 from screwkit.synthesis.residuals import Evaluation, NotAssembled
@@ -93,10 +93,10 @@ class LoopSynthesisProblem:
                              f"{listing(sorted(allowed))}")
         missing = sorted(allowed - set(self.start))
         if missing:
-            raise InputError(f"start/constants lack {missing}: give a value for every dimension")
+            raise InputError(f"start/constants lack {listing(missing)}: give a value for every dimension")
         for name, value in self.start.items():
             if not math.isfinite(float(value)):
-                raise InputError(f"start value of {name} must be finite, got {value!r}")
+                raise InputError(f"start value of {name} must be finite, got {given(value)}")
         for name, (lo, hi) in self.bounds.items():
             if name not in self.unknowns:
                 raise InputError(f"bounds given for {name!r}, which is not an unknown")
@@ -111,7 +111,7 @@ class LoopSynthesisProblem:
         if self.input_direction not in (1, -1) or self.output_direction not in (1, -1):
             raise InputError("input_direction and output_direction must be +1 or -1")
         if not (self.length_scale > 0.0 and math.isfinite(self.length_scale)):
-            raise InputError(f"length_scale must be a positive length, got {self.length_scale!r}")
+            raise InputError(f"length_scale must be a positive length, got {given(self.length_scale)}")
         if self.mode is not None and self.mode < 0:
             raise InputError(f"mode must be an assembly mode index ≥ 0, got {self.mode}")
 

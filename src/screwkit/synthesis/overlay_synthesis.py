@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from screwkit.dual.spatial import wrap_angle
 from screwkit.errors import InputError
 from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, rsrc_positions
-from screwkit.messages import shown
+from screwkit.messages import given, shown
 from screwkit.synthesis.overlay import (
     OverlayCircle,
     OverlayDwell,
@@ -86,7 +86,7 @@ class OverlayProblem:
         for name in ("d1", "d2"):
             value = getattr(self, name)
             if not (value > 0.0 and math.isfinite(value)):
-                raise InputError(f"{name} must be a positive length, got {value!r}")
+                raise InputError(f"{name} must be a positive length, got {given(value)}")
         for name in ("lambda0", "theta01", "e"):
             if not math.isfinite(getattr(self, name)):
                 raise InputError(f"{name} must be finite")
@@ -99,7 +99,7 @@ class OverlayProblem:
         if self.max_iterations < 1 or not self.time_limit > 0.0:
             raise InputError("max_iterations must be >= 1 and time_limit > 0")
         if not (self.length_scale > 0.0 and math.isfinite(self.length_scale)):
-            raise InputError(f"length_scale must be a positive length, got {self.length_scale!r}")
+            raise InputError(f"length_scale must be a positive length, got {given(self.length_scale)}")
 
 
 @dataclass(frozen=True)

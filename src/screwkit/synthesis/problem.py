@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.errors import InputError
-from screwkit.messages import listing, shown
+from screwkit.messages import given, listing, shown
 from screwkit.synthesis.constraints import output_crank_from_constraints, q_from_dwell
 from screwkit.synthesis.targets import ScrewTarget
 
@@ -129,14 +129,15 @@ class RSRCSynthesisProblem:
                              f"{listing(sorted(allowed))}{why}")
         missing_free = sorted(self.free_q_names - set(self.unknowns))
         if missing_free:
-            raise InputError(f"{missing_free}: a 'free' parameter of constraint must be an unknown")
+            raise InputError(f"{listing(missing_free)}: a 'free' parameter of a constraint "
+                             "must be an unknown")
         needed = set(DIMENSION_NAMES) - (set(DERIVED_BY_CONSTRAINTS) if self.construction else set())
         missing = sorted(needed - set(self.start))
         if missing:
-            raise InputError(f"start/constants lack {missing}: give a value for every dimension")
+            raise InputError(f"start/constants lack {listing(missing)}: give a value for every dimension")
         for name, value in self.start.items():
             if not math.isfinite(float(value)):
-                raise InputError(f"start value of {name} must be finite, got {value!r}")
+                raise InputError(f"start value of {name} must be finite, got {given(value)}")
         for name, (lo, hi) in self.bounds.items():
             if name not in self.unknowns:
                 raise InputError(f"bounds given for {name!r}, which is not an unknown")
@@ -147,7 +148,7 @@ class RSRCSynthesisProblem:
         if self.input_direction not in (1, -1) or self.output_direction not in (1, -1):
             raise InputError("input_direction and output_direction must be +1 or -1")
         if not (self.length_scale > 0.0 and math.isfinite(self.length_scale)):
-            raise InputError(f"length_scale must be a positive length, got {self.length_scale!r}")
+            raise InputError(f"length_scale must be a positive length, got {given(self.length_scale)}")
         if self.max_iterations < 1 or not self.time_limit > 0.0:
             raise InputError("max_iterations must be >= 1 and time_limit > 0")
         if self.construction is not None:

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.errors import InputError
+from screwkit.messages import listing
 from screwkit.synthesis.expressions import parse_expression
 
 __all__ = ["LIBRARY", "DesiredFunction", "ScrewTarget", "data_function", "library_function"]
@@ -66,7 +67,7 @@ def library_function(name: str, **parameters: float) -> DesiredFunction:
     """A function of `LIBRARY` by name; a wrong name or parameter raises ValueError."""
     factory = LIBRARY.get(name)
     if factory is None:
-        raise InputError(f"unknown desired function {name!r}; choose one of {sorted(LIBRARY)} or "
+        raise InputError(f"unknown desired function {name!r}; choose one of {listing(sorted(LIBRARY))}, or "
                          "give an expression")
     for pname, value in parameters.items():
         if not np.isfinite(float(value)):

@@ -20,7 +20,7 @@ from screwkit.errors import InputError, expect_instance
 from screwkit.kinematics.motion import ModeMotion, Motion
 from screwkit.kinematics.registry import coupler_link_index
 from screwkit.kinematics.tracker.loop import Array
-from screwkit.messages import shown
+from screwkit.messages import given, shown, shown_values
 from screwkit.model.linkage import Linkage
 
 __all__ = ["CouplerPoint", "coupler_curves", "coupler_point", "coupler_point_path"]
@@ -65,7 +65,7 @@ def coupler_point(linkage: Linkage, point: ArrayLike, link: str | None = None,
     has no defined path (module docstring)."""
     p = _point(point)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
+        raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {given(point)}")
     k = coupler_link_index(linkage, link)
     axis = idle_axis(linkage, k)
     if axis is not None:
@@ -79,7 +79,7 @@ def coupler_point(linkage: Linkage, point: ArrayLike, link: str | None = None,
                 f"that line have a defined path; this point is {shown(off, 'length')} off it (the "
                 f"nearest point on it is {shown(along, 'length')} along the line from {j1}, "
                 "direction "
-                f"{np.round(axis, 9).tolist()} in the link frame)")
+                f"{shown_values(np.round(axis, 9))} in the link frame)")
     return CouplerPoint(name, k, linkage.links[k].name, (float(p[0]), float(p[1]), float(p[2])))
 
 
@@ -93,7 +93,7 @@ def coupler_point_path(mode: ModeMotion, point: ArrayLike, link: int = 1) -> Arr
     if isinstance(link, bool) or not isinstance(link, int | np.integer):
         raise InputError(f"coupler_point_path: link must be a moving link's index; got {link!r}")
     if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {point!r}")
+        raise InputError(f"a coupler point is 3 finite coordinates in the link frame; got {given(point)}")
     n_links = mode.link_rotation.shape[1]
     if not 0 <= link < n_links:
         raise InputError(f"link index {link} out of range: the loop has {n_links} moving links")

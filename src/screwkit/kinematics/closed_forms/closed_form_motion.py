@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.errors import InputError
+from screwkit.kinematics.lazy_fields import derived_table, table_keys
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion, format_inputs
 from screwkit.kinematics.tracker.loop import (
     Array,
@@ -187,37 +188,38 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         # offset (with a driven one the registry's names from the link frames are used)
         md = cssp_mode_motion(linkage, theta, w, wd, root=root, allow_partial=True,
                               s1=X[:, 1] if driven else None, s1_dot=Xd[:, 1] if driven else 0.0,
-                              s1_ddot=Xdd[:, 1] if driven else 0.0, seed_angles=not driven)
+                              s1_ddot=Xdd[:, 1] if driven else 0.0, seed_angles=not driven,
+                              lazy=True)
         ok = np.asarray(md.assembles)
         if not ok.any():
             continue
         full = ok.all()
-        seed_v: dict[str, Array] = {"theta1": theta.copy() if full else
-                                    np.where(ok, theta, np.nan)}
-        seed_d: dict[str, Array] = {"theta1": Xd[:, 0].copy() if full else
-                                    np.where(ok, Xd[:, 0], np.nan)}
-        seed_dd: dict[str, Array] = {"theta1": Xdd[:, 0].copy() if full else
-                                     np.where(ok, Xdd[:, 0], np.nan)}
-        tables = (dict(md.variables), dict(md.velocities), dict(md.accelerations))
+        seed: tuple[dict[str, Array], ...] = tuple(
+            {"theta1": x.copy() if full else np.where(ok, x, np.nan)}
+            for x in (Xd[:, 0], Xdd[:, 0]))
+        seed = ({"theta1": theta.copy() if full else np.where(ok, theta, np.nan)}, *seed)
         if not driven:
             # the tables' s4 and angles are NaN where the mode does not assemble already
-            seed_v["s4"] = md.variables[f"{slider}.s"].copy()
-            seed_d["s4"] = md.velocities[f"{slider}.s"].copy()
-            seed_dd["s4"] = md.accelerations[f"{slider}.s"].copy()
-            for key in angles:
-                seed_v[key] = tables[0].pop(key)
-                seed_d[key] = tables[1].pop(key)
-                seed_dd[key] = tables[2].pop(key)
-                seed_v[key] = unwrap_runs(seed_v[key], ok)
-            md = replace(md, variables=tables[0], velocities=tables[1],
-                         accelerations=tables[2])
+            for table, named in zip((md.variables, md.velocities, md.accelerations), seed,
+                                    strict=True):
+                named["s4"] = table[f"{slider}.s"].copy()
+        # the seed's names first, then the joints' (the seed's angles move from the joint
+        # tables to the seed's, θ2 … unwrapped along each run); the angles stay lazy
+        unwrap = {key: (lambda a, ok=ok: unwrap_runs(a, ok)) for key in angles}
+        tables = []
+        for k, (table, named) in enumerate(zip(
+                (md.variables, md.velocities, md.accelerations), seed, strict=True)):
+            moved = [] if driven else list(angles)
+            rest = [key for key in table_keys(table) if key not in angles]
+            tables.append(derived_table(table, [*named, *moved, *rest], named,
+                                        unwrap if k == 0 else None))
+        md = replace(md, variables=tables[0], velocities=tables[1], accelerations=tables[2])
         stops = np.nonzero(ok[:-1] & ~ok[1:])[0]
         starts = np.nonzero(~ok[:-1] & ok[1:])[0] + 1
         events = [f"stops assembling after input {format_inputs(linkage, X[i])} (branch point "
                   f"before {format_inputs(linkage, X[i + 1])})" for i in stops]
         events += [f"starts assembling at input {format_inputs(linkage, X[i])}" for i in starts]
-        md = replace(md, events=events)
-        modes.append(_with_seed(md, len(modes), label, (seed_v, seed_d, seed_dd), masked=True))
+        modes.append(replace(md, events=events, index=len(modes), label=label))
     if not modes:
         from screwkit.kinematics.closed_forms.cssp import assembly_intervals
         from screwkit.kinematics.tracker.assembly_range import describe_intervals

@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dual.spatial import elevation_azimuth, wrap_angle
 from screwkit.errors import InputError
-from screwkit.messages import shown, shown_range
+from screwkit.messages import given, listing, shown, shown_range
 
 Array = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -75,7 +75,7 @@ class CSSPDimensions:
                 value
             ):
                 raise InputError(
-                    f"CSSPDimensions.{name} must be a finite real number, got {value!r}"
+                    f"CSSPDimensions.{name} must be a finite real number, got {given(value)}"
                 )
             object.__setattr__(self, name, float(value))
         for name in ("a1", "a2"):
@@ -375,7 +375,8 @@ def as_sample_array(value: ArrayLike | None, n: int, name: str, default: float) 
         raise InputError(f"{name} has {arr.shape[0]} entries but theta1 has {n}") from exc
     if not np.all(np.isfinite(out)):
         raise InputError(
-            f"{name} must be finite (got NaN/inf at samples {np.flatnonzero(~np.isfinite(out)).tolist()})"
+            f"{name} must be finite (got NaN/inf at samples "
+            f"{listing(np.flatnonzero(~np.isfinite(out))[:12].tolist())}, counted from 0)"
         )
     return out
 

@@ -95,7 +95,7 @@ BLOCK_SAMPLES = 16384
 """Samples per block of :func:`cssp_mode_motion` (its temporaries stay in the CPU caches)."""
 
 
-def _component_major(n: int, *shape: int) -> tuple[Array, Array]:
+def component_major(n: int, *shape: int) -> tuple[Array, Array]:
     """Zeroed storage (shape…, n) and its (n, shape…) view: every component of every sample
     row is contiguous over the samples, which the closed form writes (and the blocked inverse
     dynamics reads) without transposing. Entries never written stay zero at no cost."""
@@ -443,6 +443,7 @@ def cssp_mode_motion(
     joint_rotations: bool = True,
     ball_joints: bool = True,
     seed_angles: bool = False,
+    lazy: bool = False,
 ) -> ModeMotion:
     """One assembly mode of a CSSP over N crank angles, from the closed form (no Newton).
 
@@ -463,6 +464,12 @@ def cssp_mode_motion(
     centres and axes, the scalar joint variables — is kept, at two thirds of the cost.
     ``seed_angles=True`` adds Rahman's θ2, η2, θ3, η3 and their rates (SPEC §1.1; θ2 wrapped
     into (−π, π]) to the tables, from the closed form's u, u̇, ü block by block.
+    ``lazy=True`` computes the ball joints' fields and Rahman's angles (what ``ball_joints`` and
+    ``seed_angles`` add) when they are first read, in a second blocked pass
+    (:mod:`screwkit.kinematics.closed_forms.cssp_joint_fields`; the same values, the same keys
+    in the same order): ``conf`` is then a
+    :class:`~screwkit.kinematics.lazy_fields.LazyConfiguration` and the tables
+    :class:`~screwkit.kinematics.lazy_fields.LazyTable` s.
 
     Computed in blocks of :data:`BLOCK_SAMPLES` samples in structure-of-arrays form. The (N, …)
     arrays are views of component-major storage (every component contiguous over the samples;
@@ -471,23 +478,31 @@ def cssp_mode_motion(
     """
     sw = cssp_sweep(linkage, theta1, theta1_dot, theta1_ddot, root, s1=s1, s1_dot=s1_dot,
                     s1_ddot=s1_ddot, allow_partial=allow_partial)
+    joint_rotations = joint_rotations and ball_joints
+    if lazy and (ball_joints or seed_angles):
+        return _lazy_mode_motion(linkage, sw, joint_rotations, ball_joints, seed_angles)
+    return _mode_motion(linkage, sw, joint_rotations, ball_joints, seed_angles)
+
+
+def _mode_motion(linkage: Linkage, sw: CSSPSweep, joint_rotations: bool, ball_joints: bool,
+                 seed_angles: bool) -> ModeMotion:
+    """:func:`cssp_mode_motion` of a checked sweep, every field computed now."""
     driven_offset, n, ok = sw.driven_offset, sw.n, sw.assembles
     th = sw.theta1
 
-    R_st, link_rotation = _component_major(n, 3, 3, 3)
-    O_st, link_origin = _component_major(n, 3, 3)
-    V_st, link_origin_velocity = _component_major(n, 3, 3)
-    A_st, link_origin_acceleration = _component_major(n, 3, 3)
-    W_st, link_angular_velocity = _component_major(n, 3, 3)
-    AL_st, link_angular_acceleration = _component_major(n, 3, 3)
-    C_st, joint_centres = _component_major(n, 4, 3)
-    X_st, joint_axes = _component_major(n, 4, 3)
-    joint_rotations = joint_rotations and ball_joints
+    R_st, link_rotation = component_major(n, 3, 3, 3)
+    O_st, link_origin = component_major(n, 3, 3)
+    V_st, link_origin_velocity = component_major(n, 3, 3)
+    A_st, link_origin_acceleration = component_major(n, 3, 3)
+    W_st, link_angular_velocity = component_major(n, 3, 3)
+    AL_st, link_angular_acceleration = component_major(n, 3, 3)
+    C_st, joint_centres = component_major(n, 4, 3)
+    X_st, joint_axes = component_major(n, 4, 3)
     RV_st: Array | None = None
     if ball_joints:
         # pin: R_crankᵀR_rod, ball: R_rodᵀR_slider; pin, ball joint rates and "accelerations"
-        REL_st, relative = _component_major(n, 2, 3, 3)
-        RATE_st, _ = _component_major(n, 4, 3)
+        REL_st, relative = component_major(n, 2, 3, 3)
+        RATE_st, _ = component_major(n, 4, 3)
         if joint_rotations:  # the ball joints' rotation vectors
             RV_st = np.empty((2, 3, n))
     else:
@@ -529,6 +544,30 @@ def cssp_mode_motion(
         link_origin=arrays[1], link_angular_velocity=arrays[2], link_origin_velocity=arrays[3],
         link_angular_acceleration=arrays[4], link_origin_acceleration=arrays[5],
         joint_centres=arrays[6], joint_axes=arrays[7], closure_residual=closure, events=events)
+
+
+def _lazy_mode_motion(linkage: Linkage, sw: CSSPSweep, vectors: bool, ball_joints: bool,
+                      seed: bool) -> ModeMotion:
+    """:func:`cssp_mode_motion` with ``lazy=True``: the lean pass now, the joint fields of
+    :func:`~screwkit.kinematics.closed_forms.cssp_joint_fields.joint_fields` on first read."""
+    from screwkit.kinematics.closed_forms.cssp_joint_fields import joint_fields, joint_names
+    from screwkit.kinematics.lazy_fields import LazyConfiguration, LazyFields, LazyTable
+
+    lean = _mode_motion(linkage, sw, False, False, False)
+    fields = LazyFields(lambda: joint_fields(linkage, sw, BLOCK_SAMPLES, vectors, seed))
+    orders = joint_names(linkage, sw.driven_offset, ball_joints, vectors, seed)
+    tables = []
+    for key, order, eager in zip(("variables", "velocities", "accelerations"), orders,
+                                 (lean.variables, lean.velocities, lean.accelerations),
+                                 strict=True):
+        tables.append(LazyTable(order, eager, [k for k in order if k not in eager],
+                                lambda key=key: fields.get()[key]))  # type: ignore[misc]
+    conf = (LazyConfiguration(lean.conf.scalars, lambda: fields.get()["spherical"])
+            if ball_joints else lean.conf)
+    from dataclasses import replace
+
+    return replace(lean, conf=conf, variables=tables[0], velocities=tables[1],
+                   accelerations=tables[2])
 
 
 def _mask_unassembled(ok: NDArray[np.bool_], arrays: list[Array], conf: Configuration,

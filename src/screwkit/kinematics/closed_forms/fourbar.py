@@ -30,6 +30,7 @@ from screwkit.dual.spatial import wrap_angle_near
 from screwkit.errors import InputError
 from screwkit.kinematics.closed_forms.quartic import DEFAULT_DOUBLE_ROOT_TOL, sin_cos
 from screwkit.kinematics.closed_forms.rsrc.dimensions import RSRCDimensions, check_input_angles
+from screwkit.messages import given
 
 __all__ = [
     "FourBarDimensions",
@@ -70,9 +71,9 @@ class FourBarDimensions:
             try:
                 number = float(value)
             except (TypeError, ValueError):
-                raise InputError(f"fourbar {name} ({role}) must be a number, got {value!r}") from None
+                raise InputError(f"fourbar {name} ({role}) must be a number, got {given(value)}") from None
             if not (math.isfinite(number) and number > 0.0):
-                raise InputError(f"fourbar {name} ({role}) must be finite and > 0, got {value!r}")
+                raise InputError(f"fourbar {name} ({role}) must be finite and > 0, got {given(value)}")
             object.__setattr__(self, name, number)
 
     def as_rsrc(self) -> RSRCDimensions:

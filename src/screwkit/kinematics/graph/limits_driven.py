@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from screwkit.errors import CapabilityError, UnknownNameError
 from screwkit.kinematics.analysis.limit_results import LimitPosition, LimitPositions
 from screwkit.kinematics.graph.motion import MechanismMode, MechanismMotion, solve_mechanism
+from screwkit.messages import listing
 from screwkit.model.mechanism import Mechanism
 from screwkit.model.mechanism_outputs import BodyAngle
 
@@ -104,7 +105,7 @@ def driven_limit_positions(motion: MechanismMotion, output: str | None = None,
     kinds = driven_outputs(mech)
     if output is not None and output not in kinds:
         raise UnknownNameError(f"{mech.name}: no output {output!r}; the outputs are "
-                               f"{list(kinds)}")
+                               f"{listing(kinds)}")
     outputs = [output] if output is not None else list(kinds)
     X = np.asarray(motion.inputs, dtype=float)
     N, n = X.shape

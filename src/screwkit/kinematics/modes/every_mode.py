@@ -103,7 +103,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         return delta_formulation(mech)  # a CapabilityError where it is not a Delta robot
     raise CapabilityError(
         f"{mech.name}: no polynomial formulation takes this mechanism yet (joints "
-        f"{sorted(j.kind for j in mech.joints)}, {len(mech.topology.loops)} loops); there are "
+        f"{''.join(sorted(j.kind for j in mech.joints))}, {len(mech.topology.loops)} loops); there are "
         "formulations for planar R-joint graphs, single R loops with six free joints, "
         "RSSR, RSRC and RCCC loops driven at a ground R joint, 6-6 Stewart–Gough "
         "platforms (U–P–S or S–P–S legs driven at the P joints) and Delta robots (three "

@@ -32,6 +32,7 @@ from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout
 from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.messages import listing
 from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]
@@ -171,7 +172,7 @@ class PlanarFormulation:
 def _plane(mech: Mechanism) -> tuple[Array, Array, Array, Array]:
     bad = [j.name for j in mech.joints if j.kind != "R"]
     if bad:
-        raise CapabilityError(f"{mech.name}: joints {bad} are not R joints; the planar "
+        raise CapabilityError(f"{mech.name}: joints {listing(bad)} are not R joints; the planar "
                               "formulation takes R joints only")
     n = mech.joints[0].axis
     if any(np.linalg.norm(np.cross(j.axis, n)) > 1e-9 for j in mech.joints):

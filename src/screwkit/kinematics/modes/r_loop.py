@@ -24,6 +24,7 @@ from screwkit.kinematics.modes.loop6r import (
     loop6r_parameters,
 )
 from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.messages import listing
 from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]
@@ -80,7 +81,7 @@ def _walk(mech: Mechanism) -> tuple[list[int], list[Array]]:
                               f"loops and {len(mech.joints)} joints")
     bad = [j.name for j in mech.joints if j.kind != "R"]
     if bad:
-        raise CapabilityError(f"{mech.name}: joints {bad} are not R joints; the 6R "
+        raise CapabilityError(f"{mech.name}: joints {listing(bad)} are not R joints; the 6R "
                               "formulation takes loops of R joints only")
     order, axes, body, used = [], [], GROUND, set()
     while True:
@@ -105,7 +106,7 @@ def r_loop_instance(mech: Mechanism, input_values: ArrayLike = ()) -> RLoopInsta
     values = np.atleast_1d(np.asarray(input_values, dtype=float))
     if values.shape != (len(mech.inputs),):
         raise InputError(f"{mech.name}: {len(mech.inputs)} input values are needed "
-                         f"({list(mech.inputs)}); got {values.shape[0]}")
+                         f"({listing(mech.inputs)}); got {values.shape[0]}")
     joint_index = {j.name: k for k, j in enumerate(mech.joints)}
     fixed = {joint_index[name.split(".")[0]]: float(v)
              for name, v in zip(mech.inputs, values, strict=True)}

@@ -31,6 +31,7 @@ from screwkit.kinematics.tracker.generic_motion import (
 from screwkit.kinematics.tracker.loop import Array, Configuration, forward, layout
 from screwkit.kinematics.tracker.mode_frames import idle_spin_held
 from screwkit.kinematics.tracker.rates import joint_rates, rate_equations, spin_links
+from screwkit.messages import listing
 from screwkit.model.linkage import Linkage
 
 
@@ -75,7 +76,7 @@ class JointMotion:
             raise InputError(f"derivative must be 0, 1 or 2; got {derivative!r}")
         if name not in self.names:
             raise UnknownNameError(f"{self.linkage.name}: no freedom {name!r}; the freedoms "
-                                   f"are {list(self.names)}")
+                                   f"are {listing(self.names)}")
         f = self.names.index(name)
         if derivative:
             return np.asarray((self.rates, self.accelerations)[derivative - 1][mode][:, f])

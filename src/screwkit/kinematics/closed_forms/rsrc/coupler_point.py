@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 from screwkit.errors import InputError
 from screwkit.kinematics.closed_forms.rsrc.dimensions import RSRCDimensions
 from screwkit.kinematics.closed_forms.rsrc.positions import RSRCPositions
+from screwkit.messages import given
 
 __all__ = ["RSRCCouplerPoint", "rsrc_coupler_point"]
 
@@ -48,7 +49,7 @@ def rsrc_coupler_point(
     """
     for name, value in (("f", f), ("g", g), ("h", h)):
         if not math.isfinite(float(value)):
-            raise InputError(f"coupler point coordinate {name} must be finite, got {value!r}")
+            raise InputError(f"coupler point coordinate {name} must be finite, got {given(value)}")
     f, g, h = float(f), float(g), float(h)
     sl, cl = math.sin(dims.lambda0), math.cos(dims.lambda0)
     sd, cd = math.sin(dims.delta0), math.cos(dims.delta0)

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.errors import InputError
+from screwkit.messages import given
 
 __all__ = [
     "SPECIAL_ANGLE_TOL",
@@ -69,10 +70,10 @@ class RSRCDimensions:
                 number = float(value)
             except (TypeError, ValueError):
                 raise InputError(
-                    f"RSRCDimensions.{name} must be a real number, got {value!r}"
+                    f"RSRCDimensions.{name} must be a real number, got {given(value)}"
                 ) from None
             if not math.isfinite(number):
-                raise InputError(f"RSRCDimensions.{name} must be finite, got {number!r}")
+                raise InputError(f"RSRCDimensions.{name} must be finite, got {given(number)}")
             object.__setattr__(self, name, number)
         if self.d1 <= 0.0:
             raise InputError(

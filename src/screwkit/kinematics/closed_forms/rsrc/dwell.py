@@ -12,6 +12,7 @@ from screwkit.errors import InputError
 from screwkit.kinematics.closed_forms.rsrc.dimensions import RSRCDimensions, check_input_angles
 from screwkit.kinematics.closed_forms.rsrc.loop_equation import loop_residual
 from screwkit.kinematics.closed_forms.rsrc.rates import LOCK_TOL
+from screwkit.messages import given
 
 __all__ = ["dwell_order", "rsrc_dwell_order", "rsrc_output_derivatives"]
 
@@ -139,7 +140,7 @@ def dwell_order(derivatives: ArrayLike, tol: float) -> IntArray:
     if d.ndim != 2:
         raise InputError(f"derivatives must have shape (M, K), got {d.shape}")
     if not tol >= 0.0:
-        raise InputError(f"tol must be >= 0, got {tol!r}")
+        raise InputError(f"tol must be >= 0, got {given(tol)}")
     small = np.abs(d) <= tol
     leading = np.cumprod(small, axis=1)
     return leading.sum(axis=1).astype(np.int64)
