@@ -41,6 +41,7 @@ from screwkit.kinematics.graph.subchains import Decomposition, decompose
 from screwkit.kinematics.graph.track import follow_drawn_mode
 from screwkit.kinematics.motion import AssemblyError, ModeMotion
 from screwkit.kinematics.tracker.loop import Configuration, rotation_vector
+from screwkit.messages import given, listing
 from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]
@@ -109,7 +110,7 @@ class MechanismMotion:
         table = (md.variables, md.velocities, md.accelerations)[derivative]
         if name not in table:
             raise UnknownNameError(f"{self.mechanism.name}: no variable {name!r}; the "
-                                   f"variables are {sorted(table)}")
+                                   f"variables are {listing(sorted(table))}")
         return table[name]
 
     def point(self, name: str, mode: int = 0, *, derivative: int = 0) -> Array:
@@ -117,7 +118,7 @@ class MechanismMotion:
         table = (md.points, md.point_velocities, md.point_accelerations)[derivative]
         if name not in table:
             raise UnknownNameError(f"{self.mechanism.name}: no point {name!r}; the points "
-                                   f"are {sorted(md.points)}")
+                                   f"are {listing(sorted(md.points))}")
         return table[name]
 
 
@@ -127,7 +128,7 @@ def _per_sample(values: ArrayLike | None, N: int, n_in: int, name: str) -> Array
     try:
         a = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
-        raise InputError(f"{name} must be numbers; got {values!r}") from None
+        raise InputError(f"{name} must be numbers; got {given(values)}") from None
     if a.ndim == 0:
         a = np.full((N, n_in), float(a))
     elif a.ndim == 1 and a.shape[0] == N and n_in == 1:
@@ -136,7 +137,7 @@ def _per_sample(values: ArrayLike | None, N: int, n_in: int, name: str) -> Array
         a = np.broadcast_to(a, (N, n_in))
     if a.shape != (N, n_in) or not np.all(np.isfinite(a)):
         raise InputError(f"{name}: give one finite value per input ({n_in}) or one per sample "
-                         f"and input ({N}×{n_in}); got shape {np.shape(values)}")
+                         f"and input ({N}×{n_in}); got shape {'×'.join(map(str, np.shape(values))) or 'scalar'}")
     return np.array(a, dtype=float)
 
 
@@ -146,14 +147,14 @@ def input_rows(mech: Mechanism, inputs: ArrayLike) -> Array:
     try:
         X = np.asarray(inputs, dtype=float)
     except (TypeError, ValueError):
-        raise InputError(f"inputs must be numbers; got {inputs!r}") from None
+        raise InputError(f"inputs must be numbers; got {given(inputs)}") from None
     names = mech.driven_names
     n_in = len(names)
     if X.ndim == 1 and n_in == 1:
         X = X[:, None]
     if X.ndim != 2 or X.shape[1] != n_in or X.shape[0] == 0:
         raise InputError(f"{mech.name}: inputs must be rows of {n_in} value(s) "
-                         f"({', '.join(names)}); got shape {np.shape(X)}")
+                         f"({', '.join(names)}); got shape {'×'.join(map(str, X.shape)) or 'scalar'}")
     if not np.all(np.isfinite(X)):
         raise InputError(f"{mech.name}: inputs must be finite numbers (a NaN or inf was given)")
     return X
@@ -434,11 +435,11 @@ def with_events(mode: MechanismMode, events: list[str]) -> MechanismMode:
 
 
 def input_text(mech: Mechanism, lay: GraphLayout, x: Array) -> str:
-    parts = []
-    for name, f, v in zip(mech.inputs, lay.inputs, x, strict=True):
-        parts.append(f"{name} = {v:.6g} m" if lay.is_translation[f]
-                     else f"{name} = {np.degrees(v):.6g} deg")
-    return ", ".join(parts)
+    """One row of inputs for a message, in the spec's units (kinematics/motion.py
+    ``format_inputs``)."""
+    from screwkit.kinematics.motion import format_inputs
+
+    return format_inputs(mech, x)
 
 
 def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDArray[np.bool_],
