@@ -101,3 +101,18 @@ def test_without_numba_the_numpy_route_runs():
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
                          check=True, timeout=300)
     assert out.stdout.split() == ["False", "16", "0"]
+
+
+def test_the_endgame_stops_a_path_at_its_step_budget():
+    """The double root above takes a few hundred endgame steps per path; with a budget of 60
+    every path stops inside the endgame and is reported failed (not singular, not a mode),
+    having taken at most the budget plus one circle segment's steps there."""
+    x0, x1, a, b = (Poly.variable(i) for i in range(4))
+    system = compile_system([x0 * x0 - a, x1 * x1 + x0 * x1 - b], ["x0", "x1"], ["a", "b"])
+    start = StartSolutions.by_total_degree(system, seed=3)
+    args = (system, start.p, np.array([0.0, 1.0]), start.x)
+    full = track_parameter_homotopy(*args)
+    capped = track_parameter_homotopy(*args, TrackOptions(endgame_max_steps=60))
+    assert (full.status == PathStatus.SINGULAR).all()
+    assert (capped.status == PathStatus.FAILED).all()
+    assert (capped.steps < full.steps).all()

@@ -58,6 +58,8 @@ class TrackOptions:
     endgame_tolerance: float = 1e-10
     samples_per_loop: int = 12
     max_winding: int = 8
+    #: steps a path may take in the endgame before it is given up (failed)
+    endgame_max_steps: int = 20000
     #: an endpoint with cond(J) above this (on the patch) is treated as singular
     max_condition: float = 1e9
     #: an endpoint with |h| ≤ infinity_threshold·‖y‖∞ is at infinity (|x| ≳ 1/threshold)
