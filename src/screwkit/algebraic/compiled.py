@@ -10,8 +10,8 @@ loop, with the evaluation
 
     F_i(y; σ) = Σ_k σ^k yᵀ Q_ik y + L_i(σ)·y,   ∂F_i/∂y = Σ_k σ^k 2 Q_ik y + L_i(σ)
 
-(:mod:`.quadrics`) summed over the nonzero entries of the Q_ik only (their pattern is shared by
-every instance), and the (n+1)×(n+1) solves by Gaussian elimination with partial pivoting
+(:mod:`.quadrics`) from V = y·Qt over the columns of Qt with a nonzero entry (one contiguous
+loop per unknown), and the (n+1)×(n+1) solves by Gaussian elimination with partial pivoting
 (Golub & Van Loan, *Matrix Computations*, 4th ed., 2013, §3.4). The arithmetic is the same up
 to rounding, so both routes reach the same end points (to the Newton polish's accuracy) with the
 same statuses; tests/algebraic/test_compiled.py checks it.
@@ -51,59 +51,52 @@ LINE, CIRCLE = 0, 1
 
 
 @dataclass(frozen=True)
-class SparseQuadrics:
-    """:class:`DenseQuadrics` as a list of its nonzero entries: entry e adds
-    ``values[b, e]·y[row[e]]`` to the column ``column[e]`` (an index into
-    :attr:`DenseQuadrics.columns`, whose (k, i, l) are ``ck``, ``ci``, ``cl``)."""
+class Columns:
+    """The (k, i, l) of each column c of :attr:`DenseQuadrics.Qt` (``ck``, ``ci``, ``cl``):
+    (y·Qt[b])_c = (Q_ik y)_l of instance b."""
 
-    values: Complex  # (B, E)
-    row: Index
-    column: Index
-    start: Index  # (C + 1,): the entries of column c are start[c] .. start[c+1] − 1
     ck: Index
     ci: Index
     cl: Index
 
     @staticmethod
-    def of(dense: DenseQuadrics) -> SparseQuadrics:
-        pattern = np.any(dense.Qt != 0, axis=0)  # (m, C)
-        row, column = np.nonzero(pattern.T)[::-1]  # grouped by column
-        order = np.lexsort((row, column))
-        row, column = row[order], column[order]
-        flat = dense.columns
-        ck, rest = np.divmod(flat, dense.N * dense.m)
+    def of(dense: DenseQuadrics) -> Columns:
+        ck, rest = np.divmod(dense.columns, dense.N * dense.m)
         ci, cl = np.divmod(rest, dense.m)
-        return SparseQuadrics(np.ascontiguousarray(dense.Qt[:, row, column]),
-                              row.astype(np.int64), column.astype(np.int64),
-                              np.searchsorted(column, np.arange(len(flat) + 1)).astype(np.int64),
-                              ck.astype(np.int64), ci.astype(np.int64), cl.astype(np.int64))
+        return Columns(ck.astype(np.int64), ci.astype(np.int64), cl.astype(np.int64))
 
 
-def sparse_of(dense: DenseQuadrics) -> SparseQuadrics:
-    """The :class:`SparseQuadrics` of ``dense``, built once and kept on it."""
-    sparse = dense.__dict__.get("_sparse")
-    if sparse is None:
-        sparse = SparseQuadrics.of(dense)
-        object.__setattr__(dense, "_sparse", sparse)
-    return sparse
+def columns_of(dense: DenseQuadrics) -> Columns:
+    """The :class:`Columns` of ``dense``, built once and kept on it."""
+    cols = dense.__dict__.get("_kernel_columns")
+    if cols is None:
+        cols = Columns.of(dense)
+        object.__setattr__(dense, "_kernel_columns", cols)
+    return cols
 
 
 def _kernels() -> Any:
     """The compiled functions (built once)."""
-    njit = numba.njit(cache=True, nogil=True)
+    # fastmath without nnan/ninf: the NaN and infinity tests of the step control stay exact;
+    # the numpy error model: no zero-division checks (a zero pivot is caught before dividing)
+    njit = numba.njit(cache=True, nogil=True, error_model="numpy",
+                      fastmath={"contract", "reassoc", "nsz", "arcp"})
 
     @njit
-    def evaluate(vals: Any, row: Any, start: Any, ck: Any, ci: Any, cl: Any, K: int,
+    def evaluate(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
                  L: Any, linear: Any, patch: Any, y: Any, sigma: complex, dsigma: complex,
                  want_t: bool, V: Any, pw: Any, H: Any, J: Any, Ht: Any) -> None:
-        """H, J (and ∂H/∂τ when want_t) of one path at y, σ; vals (E,), L (K_L, N_L, m)."""
+        """H, J (and ∂H/∂τ when want_t) of one path at y, σ; vals (m, C) its instance's
+        Qt, L (K_L, N_L, m) its linear forms."""
         m = y.shape[0]
         n = m - 1
-        for c in range(V.shape[0]):  # column c: the entries start[c] .. start[c+1] − 1
-            s = 0.0j
-            for e in range(start[c], start[c + 1]):
-                s += vals[e] * y[row[e]]
-            V[c] = s
+        C = V.shape[0]
+        for c in range(C):
+            V[c] = 0.0
+        for j in range(m):  # V = y·Qt, Qt (m, C) dense: a contiguous inner loop
+            yj = y[j]
+            for c in range(C):
+                V[c] += yj * vals[j, c]
         pw[0] = 1.0
         for k in range(1, K):
             pw[k] = pw[k - 1] * sigma
@@ -185,12 +178,12 @@ def _kernels() -> Any:
         return 1.0 - turn, -1j * turn
 
     @njit
-    def velocity(vals: Any, row: Any, start: Any, ck: Any, ci: Any, cl: Any, K: int,
+    def velocity(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
                  L: Any, linear: Any, patch: Any, y: Any, kind: int, radius: float,
                  tau: float, out: Any, V: Any, pw: Any, H: Any, J: Any, Ht: Any, A: Any,
                  piv: Any, b: Any) -> None:
         sigma, dsigma = curve(kind, radius, tau)
-        evaluate(vals, row, start, ck, ci, cl, K, L, linear, patch, y, sigma, dsigma, True,
+        evaluate(vals, ck, ci, cl, K, L, linear, patch, y, sigma, dsigma, True,
                  V, pw, H, J, Ht)
         for i in range(y.shape[0]):
             b[i, 0] = Ht[i]
@@ -199,7 +192,7 @@ def _kernels() -> Any:
             out[i] = -b[i, 0]
 
     @njit
-    def track(vals: Any, row: Any, start: Any, ck: Any, ci: Any, cl: Any, K: int,
+    def track(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
               Ls: Any, linear: Any, patch: Any, instance: Any, linear_of: Any, y0: Any,
               tau0: Any, tau1: Any, kind: int, radius: Any, initial_step: float,
               max_step: float, min_step: float, max_steps: int, ptol: float, ctol: float,
@@ -237,7 +230,7 @@ def _kernels() -> Any:
             if span == 0.0:
                 reached[p] = True
                 continue
-            velocity(vp, row, start, ck, ci, cl, K, L, linear, patch, y, kind, r, tau, v,
+            velocity(vp, ck, ci, cl, K, L, linear, patch, y, kind, r, tau, v,
                      V, pw, H, J, Ht, A, piv, b)
             floor = min_step * max(span, 1.0)
             while True:
@@ -247,21 +240,21 @@ def _kernels() -> Any:
                 # RK4 predictor (k1 = v, the velocity kept from the last corrector)
                 for i in range(m):
                     z[i] = y[i] + 0.5 * hs * v[i]
-                velocity(vp, row, start, ck, ci, cl, K, L, linear, patch, z, kind, r,
+                velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
                          tau + 0.5 * hs, k2, V, pw, H, J, Ht, A, piv, b)
                 for i in range(m):
                     z[i] = y[i] + 0.5 * hs * k2[i]
-                velocity(vp, row, start, ck, ci, cl, K, L, linear, patch, z, kind, r,
+                velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
                          tau + 0.5 * hs, k3, V, pw, H, J, Ht, A, piv, b)
                 for i in range(m):
                     z[i] = y[i] + hs * k3[i]
-                velocity(vp, row, start, ck, ci, cl, K, L, linear, patch, z, kind, r,
+                velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
                          tau + hs, k4, V, pw, H, J, Ht, A, piv, b)
                 for i in range(m):
                     yp[i] = y[i] + hs / 6.0 * (v[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
                 # two Newton corrections at τ + h; the second evaluation also gives dy/dτ
                 sigma, dsigma = curve(kind, r, tau + hs)
-                evaluate(vp, row, start, ck, ci, cl, K, L, linear, patch, yp, sigma, dsigma,
+                evaluate(vp, ck, ci, cl, K, L, linear, patch, yp, sigma, dsigma,
                          False, V, pw, H, J, Ht)
                 for i in range(m):
                     b[i, 0] = H[i]
@@ -271,7 +264,7 @@ def _kernels() -> Any:
                     y1[i] = yp[i] - b[i, 0]
                     a = abs(b[i, 0])
                     first = a if (a > first or np.isnan(a)) and not np.isnan(first) else first
-                evaluate(vp, row, start, ck, ci, cl, K, L, linear, patch, y1, sigma, dsigma,
+                evaluate(vp, ck, ci, cl, K, L, linear, patch, y1, sigma, dsigma,
                          True, V, pw, H, J, Ht)
                 for i in range(m):
                     b[i, 0] = H[i]
@@ -319,7 +312,7 @@ def _kernels() -> Any:
 _TRACK: Any = None
 
 
-def track_compiled(sparse: SparseQuadrics, dense: DenseQuadrics, instance: Index,
+def track_compiled(dense: DenseQuadrics, instance: Index,
                    patch: Complex, y0: Complex, tau0: NDArray[np.float64],
                    tau1: NDArray[np.float64], kind: int, radius: NDArray[np.float64],
                    options: Any) -> tuple[Complex, NDArray[np.bool_], NDArray[np.int64]]:
@@ -332,8 +325,9 @@ def track_compiled(sparse: SparseQuadrics, dense: DenseQuadrics, instance: Index
     Ls = dense.L
     linear_of = (np.zeros(len(instance), dtype=np.int64) if len(Ls) == 1
                  else instance.astype(np.int64))
+    cols = columns_of(dense)
     y, reached, steps = _TRACK(
-        sparse.values, sparse.row, sparse.start, sparse.ck, sparse.ci, sparse.cl, dense.K,
+        dense.Qt, cols.ck, cols.ci, cols.cl, dense.K,
         np.ascontiguousarray(Ls), dense.linear.astype(np.int64), patch,
         instance.astype(np.int64), linear_of, np.ascontiguousarray(y0, dtype=complex),
         np.ascontiguousarray(tau0, dtype=float), np.ascontiguousarray(tau1, dtype=float),

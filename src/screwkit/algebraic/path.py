@@ -249,9 +249,8 @@ def track(hom: Homotopy, curve: Curve, y0: Complex, rows: Index, tau0: Real, tau
         t1 = np.broadcast_to(np.asarray(tau1, dtype=float), (m,))
         kind = compiled.LINE if curve is line else compiled.CIRCLE
         radius = curve.radius[rows] if isinstance(curve, circle) else np.zeros(m)
-        return compiled.track_compiled(compiled.sparse_of(hom.dense), hom.dense,
-                                       hom.instance[rows], hom.patch, y0, t0, t1, kind,
-                                       radius, options)
+        return compiled.track_compiled(hom.dense, hom.instance[rows], hom.patch, y0, t0, t1,
+                                       kind, radius, options)
     y = np.array(y0, dtype=complex)
     tau = np.array(tau0, dtype=float)
     span = np.abs(np.asarray(tau1, dtype=float) - tau)
