@@ -60,6 +60,10 @@ class Certificate:
     real: NDArray[np.bool_]
     not_real: NDArray[np.bool_]
     newton: Complex
+    #: F(x) (P, N) and Σ|terms| of each F_i(x) (P, N), as evaluated for the test (so that a
+    #: caller's residual needs no second evaluation)
+    value: Complex | None = None
+    terms: NDArray[np.float64] | None = None
 
 
 def bombieri_weyl_norm(system: PolynomialSystem, p: Complex) -> NDArray[np.float64]:
@@ -85,13 +89,14 @@ def term_magnitude(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[
     return np.asarray(F_abs.real, dtype=float)
 
 
-def _evaluation_error(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[np.float64]:
+def _evaluation_error(system: PolynomialSystem, magnitude: NDArray[np.float64]
+                      ) -> NDArray[np.float64]:
     """A bound on the rounding error of each F_i(x) (P, N): 8·(terms + degree + factors)·u
-    times Σ|terms| (Higham, *Accuracy and Stability of Numerical Algorithms*, 2002, §3.1, for
-    sums and products, with a factor 2 to spare)."""
+    times Σ|terms| (``magnitude``, :func:`term_magnitude`; Higham, *Accuracy and Stability of
+    Numerical Algorithms*, 2002, §3.1, for sums and products, with a factor 2 to spare)."""
     terms = np.diff(np.append(system.starts, len(system.eq)))
     factor = 8.0 * (terms + np.asarray(system.degrees) + system.sym.shape[1]) * UNIT_ROUNDOFF
-    return term_magnitude(system, x, p) * factor
+    return magnitude * factor
 
 
 def certify(system: PolynomialSystem, x: Complex, p: Complex) -> Certificate:
@@ -100,7 +105,8 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex) -> Certificate:
     P, n = x.shape
     p = np.broadcast_to(np.asarray(p, dtype=complex), (P, system.k))
     F, J, _ = system.evaluate(x, p, want_jp=False)
-    err = _evaluation_error(system, x, p)
+    magnitude = term_magnitude(system, x, p)
+    err = _evaluation_error(system, magnitude)
     with np.errstate(all="ignore"):
         finite = np.asarray(np.isfinite(J).all(axis=(1, 2)) & np.isfinite(F).all(axis=1),
                             dtype=bool)
@@ -127,7 +133,8 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex) -> Certificate:
         not_real = certified & real_system & (gap > 4.0 * beta)
     bad = ~ok
     alpha[bad], beta[bad], gamma[bad] = np.inf, np.inf, np.inf
-    return Certificate(certified, alpha, beta, gamma, 2.0 * beta, real, not_real, x - step)
+    return Certificate(certified, alpha, beta, gamma, 2.0 * beta, real, not_real, x - step, F,
+                       magnitude)
 
 
 def distinct(x: Complex, radius: NDArray[np.float64],
