@@ -30,10 +30,11 @@ rigorous under the assumption that those margins cover the rounding, but not a c
 from __future__ import annotations
 
 from dataclasses import dataclass
-from math import lgamma, sqrt
+from math import sqrt
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.special import gammaln
 
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.track import same_points
@@ -71,7 +72,9 @@ def bombieri_weyl_norm(system: PolynomialSystem, p: Complex) -> NDArray[np.float
     eq, exps, coef = system.coefficients_at(p)
     degree = np.asarray(system.degrees)[eq]
     alpha0 = degree - exps.sum(axis=1)
-    log_fact = np.vectorize(lambda v: lgamma(v + 1.0))
+    def log_fact(v: NDArray[np.intp]) -> NDArray[np.float64]:  # log v!, elementwise
+        return np.asarray(gammaln(np.asarray(v, dtype=float) + 1.0), dtype=float)
+
     log_weight = log_fact(alpha0) + log_fact(exps).sum(axis=1) - log_fact(degree)
     if not len(eq):
         return np.zeros(len(coef))
@@ -83,7 +86,10 @@ def term_magnitude(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[
     residual or a rounding error is measured."""
     from dataclasses import replace
 
-    moduli = replace(system, coef=np.abs(system.coef).astype(complex))
+    moduli = system.__dict__.get("_moduli")  # kept on the system: its evaluation plan too
+    if moduli is None:
+        moduli = replace(system, coef=np.abs(system.coef).astype(complex))
+        object.__setattr__(system, "_moduli", moduli)
     F_abs, _, _ = moduli.evaluate(np.abs(x).astype(complex), np.abs(p).astype(complex),
                                   want_jp=False)
     return np.asarray(F_abs.real, dtype=float)
