@@ -13,6 +13,9 @@ import numpy as np
 # the numpy error model: no zero-division checks (a zero pivot is caught before dividing)
 njit = numba.njit(cache=True, nogil=True, error_model="numpy",
                   fastmath={"contract", "reassoc", "nsz", "arcp"})
+#: the step, inlined into the path loop by numba (as it was before the two were split)
+njit_inline = numba.njit(cache=True, nogil=True, error_model="numpy",
+                         fastmath={"contract", "reassoc", "nsz", "arcp"}, inline="always")
 
 
 @njit
@@ -64,6 +67,7 @@ def evaluate(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
     H[n] = s
     Ht[n] = 0.0
 
+
 @njit
 def solve(J: Any, A: Any, piv: Any, b: Any) -> bool:
     """LU of J (copied into A, partial pivoting); b (m, r) overwritten by J⁻¹b. False
@@ -103,12 +107,14 @@ def solve(J: Any, A: Any, piv: Any, b: Any) -> bool:
             b[i, r] = s / A[i, i]
     return True
 
+
 @njit
 def curve(kind: int, radius: float, tau: float) -> tuple[complex, complex]:
     if kind == 0:
         return tau + 0.0j, 1.0 + 0.0j
     turn = radius * np.exp(1j * tau)
     return 1.0 - turn, -1j * turn
+
 
 @njit
 def velocity(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
@@ -123,6 +129,60 @@ def velocity(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
     solve(J, A, piv, b[:, :1])
     for i in range(y.shape[0]):
         out[i] = -b[i, 0]
+
+
+@njit_inline
+def step(vp: Any, ck: Any, ci: Any, cl: Any, K: int, L: Any, linear: Any, patch: Any,
+         kind: int, r: float, y: Any, v: Any, tau: float, hs: float, k2: Any, k3: Any,
+         k4: Any, z: Any, yp: Any, y1: Any, V: Any, pw: Any, H: Any, J: Any, Ht: Any, A: Any,
+         piv: Any, b: Any) -> tuple[float, float, bool]:
+    """One predictor–corrector step of one path from y (velocity v) at τ over hs: the
+    corrected point in z, dy/dτ there in −b[:, 1]; the ∞-norms of both Newton corrections
+    (NaN when not finite) and whether z is finite."""
+    m = y.shape[0]
+    # RK4 predictor (k1 = v, the velocity kept from the last corrector)
+    for i in range(m):
+        z[i] = y[i] + 0.5 * hs * v[i]
+    velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
+             tau + 0.5 * hs, k2, V, pw, H, J, Ht, A, piv, b)
+    for i in range(m):
+        z[i] = y[i] + 0.5 * hs * k2[i]
+    velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
+             tau + 0.5 * hs, k3, V, pw, H, J, Ht, A, piv, b)
+    for i in range(m):
+        z[i] = y[i] + hs * k3[i]
+    velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
+             tau + hs, k4, V, pw, H, J, Ht, A, piv, b)
+    for i in range(m):
+        yp[i] = y[i] + hs / 6.0 * (v[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+    # two Newton corrections at τ + h; the second evaluation also gives dy/dτ
+    sigma, dsigma = curve(kind, r, tau + hs)
+    evaluate(vp, ck, ci, cl, K, L, linear, patch, yp, sigma, dsigma,
+             False, V, pw, H, J, Ht)
+    for i in range(m):
+        b[i, 0] = H[i]
+    solve(J, A, piv, b[:, :1])
+    first = 0.0
+    for i in range(m):
+        y1[i] = yp[i] - b[i, 0]
+        a = abs(b[i, 0])
+        first = a if (a > first or np.isnan(a)) and not np.isnan(first) else first
+    evaluate(vp, ck, ci, cl, K, L, linear, patch, y1, sigma, dsigma,
+             True, V, pw, H, J, Ht)
+    for i in range(m):
+        b[i, 0] = H[i]
+        b[i, 1] = Ht[i]
+    solve(J, A, piv, b)
+    second = 0.0
+    finite = True
+    for i in range(m):
+        z[i] = y1[i] - b[i, 0]
+        a = abs(b[i, 0])
+        second = a if (a > second or np.isnan(a)) and not np.isnan(second) \
+            else second
+        finite = finite and np.isfinite(z[i].real) and np.isfinite(z[i].imag)
+    return first, second, finite
+
 
 @njit
 def track(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
@@ -170,48 +230,11 @@ def track(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
             left = tau1[p] - tau
             hs = min(h, left)
             last = hs >= left
-            # RK4 predictor (k1 = v, the velocity kept from the last corrector)
-            for i in range(m):
-                z[i] = y[i] + 0.5 * hs * v[i]
-            velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
-                     tau + 0.5 * hs, k2, V, pw, H, J, Ht, A, piv, b)
-            for i in range(m):
-                z[i] = y[i] + 0.5 * hs * k2[i]
-            velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
-                     tau + 0.5 * hs, k3, V, pw, H, J, Ht, A, piv, b)
-            for i in range(m):
-                z[i] = y[i] + hs * k3[i]
-            velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
-                     tau + hs, k4, V, pw, H, J, Ht, A, piv, b)
-            for i in range(m):
-                yp[i] = y[i] + hs / 6.0 * (v[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            # two Newton corrections at τ + h; the second evaluation also gives dy/dτ
-            sigma, dsigma = curve(kind, r, tau + hs)
-            evaluate(vp, ck, ci, cl, K, L, linear, patch, yp, sigma, dsigma,
-                     False, V, pw, H, J, Ht)
-            for i in range(m):
-                b[i, 0] = H[i]
-            solve(J, A, piv, b[:, :1])
-            first = 0.0
-            for i in range(m):
-                y1[i] = yp[i] - b[i, 0]
-                a = abs(b[i, 0])
-                first = a if (a > first or np.isnan(a)) and not np.isnan(first) else first
-            evaluate(vp, ck, ci, cl, K, L, linear, patch, y1, sigma, dsigma,
-                     True, V, pw, H, J, Ht)
-            for i in range(m):
-                b[i, 0] = H[i]
-                b[i, 1] = Ht[i]
-            solve(J, A, piv, b)
-            second = 0.0
-            finite = True
+            first, second, finite = step(vp, ck, ci, cl, K, L, linear, patch, kind, r, y, v,
+                                         tau, hs, k2, k3, k4, z, yp, y1, V, pw, H, J, Ht, A,
+                                         piv, b)
             big = 0.0
             for i in range(m):
-                z[i] = y1[i] - b[i, 0]
-                a = abs(b[i, 0])
-                second = a if (a > second or np.isnan(a)) and not np.isnan(second) \
-                    else second
-                finite = finite and np.isfinite(z[i].real) and np.isfinite(z[i].imag)
                 big = max(big, abs(y[i]))
             scale = 1.0 + big
             first /= scale
