@@ -13,9 +13,13 @@ from cProfile (on 10 instances).
 Target (issue 27's Stewart numbers scaled to 64 paths, not a peer measurement): ≥ 10 000
 paths/s in the batch.
 
-The system is a set of quadrics, so the tracker evaluates it densely (algebraic/quadrics.py);
-the row "sparse evaluation" tracks 10 of the instances with ``TrackOptions(dense=False)`` (the
-term-table evaluation used before), side by side. BLAS runs on one thread
+The system is a set of quadrics, so the tracker evaluates it densely (algebraic/quadrics.py)
+and, with numba installed (the ``fast`` extra), runs its step loop compiled
+(algebraic/compiled.py; compiled or loaded by a first call outside the timings). The row
+"numpy route" tracks the same batch with ``TrackOptions(compiled=False)`` (the vectorised numpy
+tracker, the same algorithm), the row "sparse evaluation" 10 of the instances with
+``TrackOptions(dense=False, compiled=False)`` (the term-table evaluation used before), side by
+side. BLAS runs on one thread
 (OPENBLAS_NUM_THREADS=1 unless set): extra threads only add spinning CPU time here.
 """
 
@@ -33,6 +37,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
+from screwkit.algebraic import compiled  # noqa: E402
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system  # noqa: E402
 from screwkit.algebraic.solve import StartSolutions, solve_all  # noqa: E402
 from screwkit.algebraic.track import TrackOptions, track_parameter_homotopy  # noqa: E402
@@ -78,7 +83,7 @@ def _profile_shares(fn: Any) -> str:
     shares = {}
     for (_, _, name), row in stats.stats.items():  # type: ignore[attr-defined]
         if name in ("_evaluate_columns", "evaluate", "solve", "cauchy_endgame", "certify",
-                    "_polish"):
+                    "_polish", "track_compiled"):
             shares[name] = shares.get(name, 0.0) + row[3] / total
     return ", ".join(f"{k} {100 * v:.0f}%" for k, v in sorted(shares.items(),
                                                                key=lambda kv: -kv[1]))
@@ -100,10 +105,16 @@ def run() -> list[dict[str, Any]]:
         track_parameter_homotopy(system, start.p, np.repeat(targets, m, axis=0),
                                  np.tile(start.x, (BATCH, 1)))
 
+    alone()  # the first call compiles (or loads) the step loop (numba)
     t_alone, t_batch = _best(alone), _best(batch, repeats=1)
     t0 = time.process_time()
+    track_parameter_homotopy(system, start.p, np.repeat(targets, m, axis=0),
+                             np.tile(start.x, (BATCH, 1)), TrackOptions(compiled=False))
+    numpy_rate = BATCH * m / (time.process_time() - t0)
+    t0 = time.process_time()
     track_parameter_homotopy(system, start.p, np.repeat(targets[:10], m, axis=0),
-                             np.tile(start.x, (10, 1)), TrackOptions(dense=False))
+                             np.tile(start.x, (10, 1)),
+                             TrackOptions(dense=False, compiled=False))
     sparse_rate = 10 * m / (time.process_time() - t0)
     t0 = time.process_time()
     solutions = solve_all(system, targets, start)
@@ -112,6 +123,7 @@ def run() -> list[dict[str, Any]]:
     certified = bool(solutions.certified.all())
 
     rate = BATCH * m / t_batch
+    route = "compiled, numba" if compiled.AVAILABLE else "numpy, numba absent"
     note = f"{complete}/{BATCH} instances with all {2**N}, all certified: {certified}"
     return [
         {"name": f"start: total degree, {2**N} paths", "value": t_start * 1e3, "unit": "ms",
@@ -122,8 +134,12 @@ def run() -> list[dict[str, Any]]:
          "target": f"≥ {TARGET_PATHS_PER_S}",
          "note": ("PASS" if rate >= TARGET_PATHS_PER_S else "MISS")
          + f"; {t_batch * 1e3 / BATCH:.1f} ms per instance"},
+        {"name": f"{m} paths × {BATCH} instances, numpy route", "value": numpy_rate,
+         "unit": "paths/s", "target": "",
+         "note": f"the batch above ({route}): {rate / numpy_rate:.1f}× faster"},
         {"name": f"{m} paths × 10 instances, sparse evaluation", "value": sparse_rate,
-         "unit": "paths/s", "target": "", "note": f"dense: {rate / sparse_rate:.1f}× faster"},
+         "unit": "paths/s", "target": "",
+         "note": f"dense numpy route: {numpy_rate / sparse_rate:.1f}× faster"},
         {"name": f"solve_all × {BATCH} (track + α-test + dedupe)",
          "value": t_solve * 1e3 / BATCH, "unit": "ms/instance", "target": "", "note": note},
         {"name": "where the batch's time goes", "value": None, "unit": "",

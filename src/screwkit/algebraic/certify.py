@@ -30,10 +30,11 @@ rigorous under the assumption that those margins cover the rounding, but not a c
 from __future__ import annotations
 
 from dataclasses import dataclass
-from math import lgamma, sqrt
+from math import sqrt
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.special import gammaln
 
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.track import same_points
@@ -60,6 +61,10 @@ class Certificate:
     real: NDArray[np.bool_]
     not_real: NDArray[np.bool_]
     newton: Complex
+    #: F(x) (P, N) and Σ|terms| of each F_i(x) (P, N), as evaluated for the test (so that a
+    #: caller's residual needs no second evaluation)
+    value: Complex | None = None
+    terms: NDArray[np.float64] | None = None
 
 
 def bombieri_weyl_norm(system: PolynomialSystem, p: Complex) -> NDArray[np.float64]:
@@ -67,7 +72,9 @@ def bombieri_weyl_norm(system: PolynomialSystem, p: Complex) -> NDArray[np.float
     eq, exps, coef = system.coefficients_at(p)
     degree = np.asarray(system.degrees)[eq]
     alpha0 = degree - exps.sum(axis=1)
-    log_fact = np.vectorize(lambda v: lgamma(v + 1.0))
+    def log_fact(v: NDArray[np.intp]) -> NDArray[np.float64]:  # log v!, elementwise
+        return np.asarray(gammaln(np.asarray(v, dtype=float) + 1.0), dtype=float)
+
     log_weight = log_fact(alpha0) + log_fact(exps).sum(axis=1) - log_fact(degree)
     if not len(eq):
         return np.zeros(len(coef))
@@ -79,19 +86,23 @@ def term_magnitude(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[
     residual or a rounding error is measured."""
     from dataclasses import replace
 
-    moduli = replace(system, coef=np.abs(system.coef).astype(complex))
+    moduli = system.__dict__.get("_moduli")  # kept on the system: its evaluation plan too
+    if moduli is None:
+        moduli = replace(system, coef=np.abs(system.coef).astype(complex))
+        object.__setattr__(system, "_moduli", moduli)
     F_abs, _, _ = moduli.evaluate(np.abs(x).astype(complex), np.abs(p).astype(complex),
                                   want_jp=False)
     return np.asarray(F_abs.real, dtype=float)
 
 
-def _evaluation_error(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[np.float64]:
+def _evaluation_error(system: PolynomialSystem, magnitude: NDArray[np.float64]
+                      ) -> NDArray[np.float64]:
     """A bound on the rounding error of each F_i(x) (P, N): 8·(terms + degree + factors)·u
-    times Σ|terms| (Higham, *Accuracy and Stability of Numerical Algorithms*, 2002, §3.1, for
-    sums and products, with a factor 2 to spare)."""
+    times Σ|terms| (``magnitude``, :func:`term_magnitude`; Higham, *Accuracy and Stability of
+    Numerical Algorithms*, 2002, §3.1, for sums and products, with a factor 2 to spare)."""
     terms = np.diff(np.append(system.starts, len(system.eq)))
     factor = 8.0 * (terms + np.asarray(system.degrees) + system.sym.shape[1]) * UNIT_ROUNDOFF
-    return term_magnitude(system, x, p) * factor
+    return magnitude * factor
 
 
 def certify(system: PolynomialSystem, x: Complex, p: Complex) -> Certificate:
@@ -100,7 +111,8 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex) -> Certificate:
     P, n = x.shape
     p = np.broadcast_to(np.asarray(p, dtype=complex), (P, system.k))
     F, J, _ = system.evaluate(x, p, want_jp=False)
-    err = _evaluation_error(system, x, p)
+    magnitude = term_magnitude(system, x, p)
+    err = _evaluation_error(system, magnitude)
     with np.errstate(all="ignore"):
         finite = np.asarray(np.isfinite(J).all(axis=(1, 2)) & np.isfinite(F).all(axis=1),
                             dtype=bool)
@@ -127,7 +139,8 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex) -> Certificate:
         not_real = certified & real_system & (gap > 4.0 * beta)
     bad = ~ok
     alpha[bad], beta[bad], gamma[bad] = np.inf, np.inf, np.inf
-    return Certificate(certified, alpha, beta, gamma, 2.0 * beta, real, not_real, x - step)
+    return Certificate(certified, alpha, beta, gamma, 2.0 * beta, real, not_real, x - step, F,
+                       magnitude)
 
 
 def distinct(x: Complex, radius: NDArray[np.float64],

@@ -7,7 +7,10 @@ Cauchy's integral (1/2πi)∮ y(t) dt/t = y(0), exact up to O((r/R)^(cM)) where 
 the next branch point (Morgan, Sommese & Wampler, "Computing singular solutions to nonlinear
 analytic systems", Numer. Math. 58, 1991; Sommese & Wampler 2005, §10.3.3). The loops never
 touch the singular end point, so its accuracy is not limited by the conditioning there. The
-radius shrinks by 4 between estimates until two successive ones agree.
+radius shrinks by 4 between estimates until two successive ones agree. A path stops when it
+has used ``endgame_max_steps`` steps in the endgame (it is then reported failed): without that
+bound one path could take levels × max_winding × samples_per_loop × max_steps steps (~10⁶
+with the defaults), minutes on its own.
 
 All paths run together: each loop segment between samples is one batched call of the tracker.
 """
@@ -32,10 +35,11 @@ class EndgameResult:
 
 
 def _loops(hom: Homotopy, y: Complex, rows: Index, radius: NDArray[np.float64],
-           options: TrackOptions) -> tuple[Complex, NDArray[np.int64], NDArray[np.int64]]:
+           options: TrackOptions, budget: NDArray[np.int64]
+           ) -> tuple[Complex, NDArray[np.int64], NDArray[np.int64]]:
     """Cauchy's integral around |t| = radius from y (on the circle at τ = 0): the mean of
-    the samples over the c loops until y comes back, c ≤ max_winding (c = 0: never closed
-    or the tracking failed)."""
+    the samples over the c loops until y comes back, c ≤ max_winding (c = 0: never closed,
+    the tracking failed, or the path used up its ``budget`` of steps)."""
     m = len(rows)
     M = options.samples_per_loop
     by_row = np.zeros(hom.p_start.shape[0])
@@ -56,7 +60,7 @@ def _loops(hom: Homotopy, y: Complex, rows: Index, radius: NDArray[np.float64],
                                   tau0 + 2 * np.pi / M, options)
             current[active] = end
             steps[active] += used
-            active = active[ok]
+            active = active[ok & (steps[active] < budget[active])]
             if not active.size:
                 break
         scale = 1.0 + np.abs(y[active]).max(axis=1)
@@ -82,7 +86,8 @@ def cauchy_endgame(hom: Homotopy, y: Complex, rows: Index,
     current = y.copy()
     active = np.arange(m)
     for level in range(options.endgame_levels):
-        estimate, c, used = _loops(hom, current[active], rows[active], radius[active], options)
+        estimate, c, used = _loops(hom, current[active], rows[active], radius[active], options,
+                                   options.endgame_max_steps - steps[active])
         steps[active] += used
         closed = c > 0
         scale = 1.0 + np.abs(estimate).max(axis=1)
@@ -101,5 +106,5 @@ def cauchy_endgame(hom: Homotopy, y: Complex, rows: Index,
         steps[active] += used
         current[active] = end
         radius[active] /= 4
-        active = active[ok]
+        active = active[ok & (steps[active] < options.endgame_max_steps)]
     return EndgameResult(best, winding, converged, steps)

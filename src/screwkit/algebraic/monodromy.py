@@ -29,8 +29,8 @@ from screwkit.errors import InputError
 
 @dataclass(frozen=True)
 class MonodromyOptions:
-    """``stale_loops``: loops in a row without a new solution before stopping;
-    ``expected``: stop as soon as this many are known; ``max_loops``: a hard cap;
+    """``stale_loops``: loops in a row without a new solution before stopping (when no count
+    is expected); ``expected``: stop as soon as this many are known; ``max_loops``: a hard cap;
     ``parallel_loops``: loops run together (the stale count grows by a whole batch);
     ``seed`` for the random loop points."""
 
@@ -114,7 +114,9 @@ def monodromy_solve(system: PolynomialSystem, p0: Complex, x0: Complex,
         if options.expected is not None and len(known) >= options.expected:
             stopped = "expected count"
             break
-        if stale >= options.stale_loops:
+        # with a proven count to reach, stale loops do not stop the search (only max_loops
+        # does): a few loops in a row without a new solution are common by chance
+        if stale >= options.stale_loops and options.expected is None:
             stopped = "stabilised"
             break
         batch = min(options.parallel_loops, options.max_loops - loops)

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.algebraic import compiled
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.quadrics import DenseBlock, DenseQuadrics
 
@@ -57,6 +58,8 @@ class TrackOptions:
     endgame_tolerance: float = 1e-10
     samples_per_loop: int = 12
     max_winding: int = 8
+    #: steps a path may take in the endgame before it is given up (failed)
+    endgame_max_steps: int = 20000
     #: an endpoint with cond(J) above this (on the patch) is treated as singular
     max_condition: float = 1e9
     #: an endpoint with |h| ≤ infinity_threshold·‖y‖∞ is at infinity (|x| ≳ 1/threshold)
@@ -71,6 +74,9 @@ class TrackOptions:
     chunk: int = 512
     #: evaluate a system of quadrics densely (:mod:`.quadrics`); False: the sparse term table
     dense: bool = True
+    #: run the step loop of a dense homotopy compiled (:mod:`.compiled`, numba: the ``fast``
+    #: extra) when numba is installed; False: the numpy route (the same algorithm)
+    compiled: bool = True
 
     def tighter(self) -> TrackOptions:
         """The options for a retrack after suspected path jumping: 10× smaller steps and
@@ -152,14 +158,15 @@ def line(tau: Real, rows: Index) -> tuple[Complex, Complex]:
     return sigma, np.ones(len(tau), dtype=complex)
 
 
-def circle(radius: Real) -> Curve:
+class circle:  # noqa: N801 - used like the function ``line``
     """σ = 1 − r·e^{iτ} (r per path, indexed by row): the endgame's loop around σ = 1."""
 
-    def curve(tau: Real, rows: Index) -> tuple[Complex, Complex]:
-        turn = (radius[rows] * np.exp(1j * tau)).astype(complex)
-        return (1.0 - turn).astype(complex), (-1j * turn).astype(complex)
+    def __init__(self, radius: Real) -> None:
+        self.radius = radius
 
-    return curve
+    def __call__(self, tau: Real, rows: Index) -> tuple[Complex, Complex]:
+        turn = (self.radius[rows] * np.exp(1j * tau)).astype(complex)
+        return (1.0 - turn).astype(complex), (-1j * turn).astype(complex)
 
 
 def _solve(J: Complex, b: Complex) -> Complex:
@@ -232,8 +239,18 @@ def track(hom: Homotopy, curve: Curve, y0: Complex, rows: Index, tau0: Real, tau
     """Track the paths ``rows`` (start points y0 at τ = tau0) to τ = tau1 (per path).
 
     Returns the end points, whether each path reached tau1, and the steps taken (accepted
-    and rejected)."""
+    and rejected). A dense homotopy on the line or the circle runs compiled when numba is
+    installed and ``options.compiled`` (:mod:`.compiled`: the same steps, one compiled loop
+    per path)."""
     m = len(rows)
+    if (options.compiled and compiled.AVAILABLE and hom.dense is not None
+            and hom.instance is not None and (curve is line or isinstance(curve, circle))):
+        t0 = np.broadcast_to(np.asarray(tau0, dtype=float), (m,))
+        t1 = np.broadcast_to(np.asarray(tau1, dtype=float), (m,))
+        kind = compiled.LINE if curve is line else compiled.CIRCLE
+        radius = curve.radius[rows] if isinstance(curve, circle) else np.zeros(m)
+        return compiled.track_compiled(hom.dense, hom.instance[rows], hom.patch, y0, t0, t1,
+                                       kind, radius, options)
     y = np.array(y0, dtype=complex)
     tau = np.array(tau0, dtype=float)
     span = np.abs(np.asarray(tau1, dtype=float) - tau)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.algebraic.certify import certify, distinct, term_magnitude
+from screwkit.algebraic.certify import certify, distinct
 from screwkit.algebraic.monodromy import MonodromyOptions, monodromy_solve
 from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
@@ -141,10 +141,10 @@ def solve_all(system: PolynomialSystem, p_target: ArrayLike,
                       1e-6 * (1.0 + np.abs(x).max(axis=1, initial=0.0)))
     label = distinct(x, radius, instance[finite])
     keep = label == np.arange(len(finite))
+    assert cert.value is not None and cert.terms is not None
     with np.errstate(all="ignore"):
-        F, _, _ = system.evaluate(x, p, want_jp=False)
-        residual = np.abs(F).max(axis=1, initial=0.0) / np.maximum(
-            1.0, term_magnitude(system, x, p).max(axis=1, initial=0.0))
+        residual = np.abs(cert.value).max(axis=1, initial=0.0) / np.maximum(
+            1.0, cert.terms.max(axis=1, initial=0.0))
     real = np.abs(x.imag).max(axis=1, initial=0.0) <= 1e-8 * (1.0 + np.abs(x).max(
         axis=1, initial=0.0))
     certified = cert.certified & regular

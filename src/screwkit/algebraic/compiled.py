@@ -1,0 +1,107 @@
+"""The predictor–corrector loop of :func:`.path.track`, compiled by numba, for homotopies of
+quadrics evaluated densely (:mod:`.quadrics`).
+
+The algorithm is the one of :mod:`.path`, step for step (its module docstring): a fourth-order
+Runge–Kutta predictor on dy/dτ = −J⁻¹·∂H/∂τ, two Newton corrections at the new τ, the same
+acceptance test (predictor error, corrector error, contraction) and the same step-size rule.
+Only the order of work differs: numpy runs one step for every active path at a time (~100
+numpy calls per step, each over the paths); here each path runs from τ0 to τ1 in one compiled
+loop, with the evaluation
+
+    F_i(y; σ) = Σ_k σ^k yᵀ Q_ik y + L_i(σ)·y,   ∂F_i/∂y = Σ_k σ^k 2 Q_ik y + L_i(σ)
+
+(:mod:`.quadrics`) from V = y·Qt over the columns of Qt with a nonzero entry (one contiguous
+loop per unknown), and the (n+1)×(n+1) solves by Gaussian elimination with partial pivoting
+(Golub & Van Loan, *Matrix Computations*, 4th ed., 2013, §3.4). The arithmetic is the same up
+to rounding, so both routes reach the same end points (to the Newton polish's accuracy) with the
+same statuses; tests/algebraic/test_compiled.py checks it.
+
+numba is optional (the ``fast`` extra): :data:`AVAILABLE` is False without it, and the tracker
+then runs the numpy route. The kernels are compiled on first use (a few seconds, cached on disk
+by numba next to this module when the folder is writable).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.algebraic.polynomial import Complex
+from screwkit.algebraic.quadrics import DenseQuadrics
+
+Index = NDArray[np.intp]
+
+#: numba is installed (and not turned off by SCREWKIT_NO_NUMBA); it is imported on the first
+#: compiled track only, so that importing screwkit does not pay for it
+AVAILABLE = (importlib.util.find_spec("numba") is not None
+             and not os.environ.get("SCREWKIT_NO_NUMBA"))
+
+#: the curves σ(τ) the kernel knows: the straight segment σ = τ and the endgame's circle
+#: σ = 1 − r·e^{iτ} (:func:`.path.line`, :func:`.path.circle`)
+LINE, CIRCLE = 0, 1
+
+
+@dataclass(frozen=True)
+class Columns:
+    """The (k, i, l) of each column c of :attr:`DenseQuadrics.Qt` (``ck``, ``ci``, ``cl``):
+    (y·Qt[b])_c = (Q_ik y)_l of instance b."""
+
+    ck: Index
+    ci: Index
+    cl: Index
+
+    @staticmethod
+    def of(dense: DenseQuadrics) -> Columns:
+        ck, rest = np.divmod(dense.columns, dense.N * dense.m)
+        ci, cl = np.divmod(rest, dense.m)
+        return Columns(ck.astype(np.int64), ci.astype(np.int64), cl.astype(np.int64))
+
+
+def columns_of(dense: DenseQuadrics) -> Columns:
+    """The :class:`Columns` of ``dense``, built once and kept on it."""
+    cols = dense.__dict__.get("_kernel_columns")
+    if cols is None:
+        cols = Columns.of(dense)
+        object.__setattr__(dense, "_kernel_columns", cols)
+    return cols
+
+
+def _kernels() -> Any:
+    """The compiled track function (numba imported and the kernels loaded on first use)."""
+    from screwkit.algebraic import compiled_kernels
+
+    return compiled_kernels.track
+
+
+_TRACK: Any = None
+
+
+def track_compiled(dense: DenseQuadrics, instance: Index,
+                   patch: Complex, y0: Complex, tau0: NDArray[np.float64],
+                   tau1: NDArray[np.float64], kind: int, radius: NDArray[np.float64],
+                   options: Any) -> tuple[Complex, NDArray[np.bool_], NDArray[np.int64]]:
+    """:func:`.path.track` for paths of instances ``instance`` (P,) (rows of the quadrics),
+    start points y0 (P, m) at tau0, to tau1, on the curve ``kind`` (``radius`` (P,) for the
+    circle). Returns the end points, whether each reached tau1, and the steps taken."""
+    global _TRACK
+    if _TRACK is None:
+        _TRACK = _kernels()
+    Ls = dense.L
+    linear_of = (np.zeros(len(instance), dtype=np.int64) if len(Ls) == 1
+                 else instance.astype(np.int64))
+    cols = columns_of(dense)
+    y, reached, steps = _TRACK(
+        dense.Qt, cols.ck, cols.ci, cols.cl, dense.K,
+        np.ascontiguousarray(Ls), dense.linear.astype(np.int64), patch,
+        instance.astype(np.int64), linear_of, np.ascontiguousarray(y0, dtype=complex),
+        np.ascontiguousarray(tau0, dtype=float), np.ascontiguousarray(tau1, dtype=float),
+        kind, np.ascontiguousarray(radius, dtype=float), float(options.initial_step),
+        float(options.max_step), float(options.min_step), int(options.max_steps),
+        float(options.predictor_tolerance), float(options.corrector_tolerance),
+        float(options.contraction))
+    return y, reached, steps

@@ -1,0 +1,118 @@
+"""The compiled step loop (screwkit.algebraic.compiled, numba) against the numpy route of
+screwkit.algebraic.path: the same algorithm, so the same statuses, steps and end points (to
+the Newton polish's accuracy) on random Stewart–Gough and 6R instances and through the Cauchy
+endgame; and the numpy route when numba is absent."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from screwkit.algebraic import compiled
+from screwkit.algebraic.polynomial import Poly, compile_system
+from screwkit.algebraic.solve import StartSolutions, solve_all
+from screwkit.algebraic.track import PathStatus, TrackOptions, track_parameter_homotopy
+from screwkit.kinematics.modes.loop6r import loop6r_start, loop6r_system, random_loop6r
+from screwkit.kinematics.modes.stewart import random_stewart, stewart_start, stewart_system
+
+NUMPY = TrackOptions(compiled=False)
+
+
+def test_numba_is_there_for_the_tests():
+    """numba is in the dev extra: without it every comparison below would compare the numpy
+    route with itself."""
+    assert compiled.AVAILABLE
+
+
+def _both(system, start, targets):
+    m = start.generic_count
+    args = (system, start.p, np.repeat(targets, m, axis=0), np.tile(start.x, (len(targets), 1)))
+    instance = np.repeat(np.arange(len(targets)), m)
+    return (track_parameter_homotopy(*args, TrackOptions(), instance=instance),
+            track_parameter_homotopy(*args, NUMPY, instance=instance))
+
+
+@pytest.mark.parametrize("family", ["stewart", "loop6r"])
+def test_compiled_and_numpy_routes_agree(family):
+    """Random instances (3 Stewart–Gough platforms, 40 paths each; 3 6R loops, 16 each): equal
+    statuses and step counts path by path, end points equal to 1e-10, every path regular."""
+    if family == "stewart":
+        system, start = stewart_system(), stewart_start()
+        targets = random_stewart(np.random.default_rng(11), 3)[0]
+    else:
+        system, start = loop6r_system(), loop6r_start()
+        targets = random_loop6r(np.random.default_rng(11), 3)[0].real
+    fast, slow = _both(system, start, targets)
+    assert (fast.status == slow.status).all()
+    assert (fast.steps == slow.steps).all()
+    assert fast.counts()["regular"] == 3 * start.generic_count
+    assert np.abs(fast.x - slow.x).max() <= 1e-10 * (1 + np.abs(slow.x).max())
+
+
+def test_solve_all_agrees_on_the_solutions():
+    """The front door on one Stewart instance: the same 40 solutions, certified alike."""
+    system, start = stewart_system(), stewart_start()
+    target = random_stewart(np.random.default_rng(0), 1)[0][0]
+    fast, slow = solve_all(system, target, start), solve_all(system, target, start, NUMPY)
+    assert fast.found[0] == slow.found[0] == 40
+    assert (fast.certified == slow.certified).all() and (fast.real == slow.real).all()
+    assert np.abs(fast.x - slow.x).max() <= 1e-10 * (1 + np.abs(slow.x).max())
+
+
+def test_singular_ends_through_the_endgame_agree():
+    """x0² = a, x1² + x0·x1 = b (quadrics) at a = 0, b = 1: x0 = 0 is a double root, so all
+    four paths go through the Cauchy endgame (the circle σ = 1 − r·e^{iτ} runs compiled) and
+    end singular with winding number 2 at x = (0, ±1); both routes alike."""
+
+    x0, x1, a, b = (Poly.variable(i) for i in range(4))
+    system = compile_system([x0 * x0 - a, x1 * x1 + x0 * x1 - b], ["x0", "x1"], ["a", "b"])
+    start = StartSolutions.by_total_degree(system, seed=3)
+    assert start.generic_count == 4
+    fast, slow = _both(system, start, np.array([[0.0, 1.0]]))
+    assert (fast.status == PathStatus.SINGULAR).all() and (slow.status == fast.status).all()
+    assert (fast.winding == 2).all() and (slow.winding == 2).all()
+    # near a singular end the rounding of the two routes steers the step sizes a little
+    # apart (a few steps of ~380); the Cauchy integral's end points agree all the same
+    assert np.abs(fast.steps - slow.steps).max() <= 0.05 * slow.steps.min()
+    assert np.abs(fast.x - slow.x).max() <= 1e-10
+    assert np.allclose(np.sort(fast.x[:, 1].real), [-1, -1, 1, 1], atol=1e-8)
+    assert np.abs(fast.x[:, 0]).max() <= 1e-8
+
+
+def test_without_numba_the_numpy_route_runs():
+    """SCREWKIT_NO_NUMBA stands for an install without the fast extra: the module says it is
+    not available and the tracker solves the 6R loop all the same (16 regular ends)."""
+    code = ("import numpy as np\n"
+            "from screwkit.algebraic import compiled\n"
+            "from screwkit.algebraic.solve import solve_all\n"
+            "from screwkit.kinematics.modes.loop6r import loop6r_start, loop6r_system, "
+            "random_loop6r\n"
+            "p = random_loop6r(np.random.default_rng(2), 1)[0].real\n"
+            "s = solve_all(loop6r_system(), p[0], loop6r_start())\n"
+            "print(compiled.AVAILABLE, int(s.found[0]), int(s.failed[0]))\n")
+    src = str(Path(compiled.__file__).resolve().parents[2])
+    env = {**os.environ, "SCREWKIT_NO_NUMBA": "1",
+           "PYTHONPATH": os.pathsep.join([src, os.environ.get("PYTHONPATH", "")])}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         check=True, timeout=300)
+    assert out.stdout.split() == ["False", "16", "0"]
+
+
+def test_the_endgame_stops_a_path_at_its_step_budget():
+    """The double root above takes a few hundred endgame steps per path; with a budget of 60
+    every path stops inside the endgame and is reported failed (not singular, not a mode),
+    having taken at most the budget plus one circle segment's steps there."""
+    x0, x1, a, b = (Poly.variable(i) for i in range(4))
+    system = compile_system([x0 * x0 - a, x1 * x1 + x0 * x1 - b], ["x0", "x1"], ["a", "b"])
+    start = StartSolutions.by_total_degree(system, seed=3)
+    args = (system, start.p, np.array([0.0, 1.0]), start.x)
+    full = track_parameter_homotopy(*args)
+    capped = track_parameter_homotopy(*args, TrackOptions(endgame_max_steps=60))
+    assert (full.status == PathStatus.SINGULAR).all()
+    assert (capped.status == PathStatus.FAILED).all()
+    assert (capped.steps < full.steps).all()
