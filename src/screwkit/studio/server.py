@@ -123,14 +123,13 @@ def create_app(studio: Studio) -> Any:
                         "the studio goes on — please report this with the spec"}
 
     def handle(tab: Tab, text: str) -> tuple[str, int | None]:
-        """The answer to ``text`` as JSON, and the seq of a solved state (its 3-D scene
-        follows) or None."""
+        """The answer to ``text`` as JSON — a solved state with its 3-D scene in the same
+        message (Tab.with_scene) — and the seq of a solved state or None."""
         reply = guarded(lambda: tab.handle(text))
         solved = reply["type"] == "state" and bool(reply["result"].get("ok"))
+        if solved:
+            reply = guarded(lambda: tab.with_scene(reply))
         return to_json(reply), reply["seq"] if solved else None
-
-    def scene(tab: Tab, seq: int) -> str:
-        return to_json(guarded(lambda: tab.scene(seq)))
 
     def check(tab: Tab, seq: int) -> list[str]:
         """After a warm-started answer and its scene: confirm it (``checked``) or, where the
@@ -141,7 +140,7 @@ def create_app(studio: Studio) -> Any:
             return [] if outcome["type"] == "verify" else [to_json(outcome)]
         if not outcome["replaced"]:
             return [to_json({"type": "checked", "seq": seq})]
-        return [to_json(guarded(lambda: tab.answer(seq))), scene(tab, seq)]
+        return [handle(tab, '{"type": "state", "seq": %d}' % seq)[0]]
 
     async def updates(ws: WebSocket) -> None:
         origin = ws.headers.get("origin")
@@ -152,7 +151,7 @@ def create_app(studio: Studio) -> Any:
             return
         await ws.accept()
         try:
-            await serve_tab(ws, Tab(studio.design, studio.save_as), handle, scene, check)
+            await serve_tab(ws, Tab(studio.design, studio.save_as), handle, check)
         except WebSocketDisconnect:  # the tab was closed while an answer was on its way
             return
 
@@ -161,10 +160,9 @@ def create_app(studio: Studio) -> Any:
 
 
 async def serve_tab(ws: Any, tab: Tab, handle: Callable[[Tab, str], tuple[str, int | None]],
-                    scene: Callable[[Tab, int], str],
                     check: Callable[[Tab, int], list[str]]) -> None:
-    """One tab's WebSocket: each message answered in turn (``handle``; a solved state is
-    followed by its 3-D ``scene`` and a warm start's ``check``), except a numbers table,
+    """One tab's WebSocket: each message answered in turn (``handle``; a solved state, which
+    carries its 3-D scene, is followed by a warm start's ``check``), except a numbers table,
     computed beside the messages that follow (Tab.numbers_job)."""
     import anyio
     from starlette.websockets import WebSocketDisconnect
@@ -222,8 +220,7 @@ async def serve_tab(ws: Any, tab: Tab, handle: Callable[[Tab, str], tuple[str, i
                     else:
                         answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
                         await send(answer)
-                        if solved is not None:  # the 3-D scene right after the curves
-                            await send(await anyio.to_thread.run_sync(scene, tab, solved))
+                        if solved is not None:
                             # a warm start's check, unless the page has sent another message
                             # meanwhile (a drag): that state is then past, and whatever comes
                             # next is checked on its own (Tab.pipeline, Tab.verify)

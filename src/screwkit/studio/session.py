@@ -258,6 +258,12 @@ class Tab:
 
         return {"type": "scene", "seq": seq, "scene": packed_scene(self.pipeline(checked=False))}
 
+    def with_scene(self, answer: dict[str, Any]) -> dict[str, Any]:
+        """A solved ``state`` answer with the 3-D scene of its state under ``"scene"``: one
+        message, so that the page draws the curves and hands the view its new frames in one
+        task and one frame (docs/studio.md, "Speed")."""
+        return {**answer, "scene": self.scene(answer["seq"])["scene"]}
+
     def handle(self, text: str) -> dict[str, Any]:
         """The answer to one message from the page (never raises for a page's mistake)."""
         seq = 0

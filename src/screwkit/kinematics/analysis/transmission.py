@@ -372,10 +372,12 @@ def _cones(linkage: Linkage, md: ModeMotion) -> tuple[dict[str, Array], dict[str
     return angle, axis, limit
 
 
-def transmission(motion: Motion) -> Transmission:
+def transmission(motion: Motion, *, cones: bool = True) -> Transmission:
     """Transmission index of every output, transmission angle (planar loops) and ball-joint
     cone angles over every mode of ``motion`` (module docstring). A ValueError says why a loop
-    has none (its input is not on the ground, so it has no output joint)."""
+    has none (its input is not on the ground, so it has no output joint). ``cones=False``
+    leaves out the cone angles (their smallest cones are a third of the time; the studio's
+    curves do not show them): the index and angle are the same numbers."""
     expect_instance(motion, Motion, "transmission: motion", "a solved Motion (sk.solve_motion(...))")
     linkage = motion.linkage
     lay = layout(linkage)
@@ -414,7 +416,7 @@ def transmission(motion: Motion) -> Transmission:
             cos_mu = np.einsum("ni,ni->n", ba, bo) / (np.linalg.norm(ba, axis=-1)
                                                       * np.linalg.norm(bo, axis=-1))
             angle = np.arccos(np.clip(cos_mu, -1.0, 1.0))
-        cone_angle, socket, limit = _cones(linkage, md)
+        cone_angle, socket, limit = _cones(linkage, md) if cones else ({}, {}, {})
         modes.append(ModeTransmission(md.index, index, angle, cone_angle, socket, limit))
     return Transmission(outputs, linkage.joints[out_j].name, linkage.joints[drive].name, planar,
                         modes)

@@ -70,12 +70,10 @@
   function receive(msg) {
     const timed = S.inflight && msg.seq === S.inflight.seq ? S.inflight : null;
     if (timed) { S.inflight = null; S.phases.push({ answer: performance.now() - timed.t0, parse: S.parsed }); }
-    if (msg.type === 'scene' && S.phases.length) S.phases[S.phases.length - 1].scene = performance.now() - S.stateT0;
     if (msg.type === 'state') showState(msg, timed);
     else if (msg.type === 'error') { S.errors.push(msg.message); say(msg.message, 'error'); }
     else if (msg.type === 'saved') say(`saved ${msg.path}`, 'ok');
     else if (msg.type === 'checked') { S.checked = msg.seq; document.body.dataset.checked = String(msg.seq); }
-    else if (msg.type === 'scene') { if (S.state && msg.seq === S.state.seq) loadView(msg.scene, S.stateT0); }
     else if (msg.type === 'numbers') {
       if (msg.seq > S.lastChange) { // else asked for before a later change: stale
         S.numbers = msg.numbers; drawNumbers(msg.numbers); $('numbers').classList.remove('stale'); document.body.dataset.numbers = String(msg.seq);
@@ -402,7 +400,11 @@
     if (timed && S.phases.length) S.phases[S.phases.length - 1].draw = performance.now() - t1;
     S.frame = Math.min(S.frame, r.input.values.length - 1);
     S.stateT0 = timed ? timed.t0 : performance.now();
-    S.viewReady = false; // until the scene that follows this state is loaded
+    S.viewReady = false; // until the scene of this state is loaded
+    if (msg.scene) { // the 3-D scene comes in the same message: the view takes it now
+      if (timed && S.phases.length) S.phases[S.phases.length - 1].scene = performance.now() - S.stateT0;
+      loadView(msg.scene, S.stateT0);
+    }
     setFrame(S.frame);
     document.body.dataset.solved = String(msg.seq);
     requestAnimationFrame(() => {
