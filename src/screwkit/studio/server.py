@@ -140,7 +140,7 @@ def create_app(studio: Studio) -> Any:
             return [] if outcome["type"] == "verify" else [to_json(outcome)]
         if not outcome["replaced"]:
             return [to_json({"type": "checked", "seq": seq})]
-        return [handle(tab, '{"type": "state", "seq": %d}' % seq)[0]]
+        return [handle(tab, json.dumps({"type": "state", "seq": seq}))[0]]
 
     async def updates(ws: WebSocket) -> None:
         origin = ws.headers.get("origin")
