@@ -63,6 +63,65 @@ def to_json(doc: Any) -> str:
         return json.dumps(finite(doc), separators=(",", ":"))
 
 
+#: a part of a state shorter than this (JSON characters) is always sent
+SMALL_PART = 256
+
+
+def _parts(reply: dict[str, Any]) -> list[tuple[Any, ...]]:
+    """The paths of the parts of a solved state that are compared with the ones sent before:
+    each entry of its ``result``, each entry of its ``scene`` but the modes, and each entry
+    of each of the scene's modes (so that a change of the mode alone, which moves the load
+    arrows from one mode to another, resends the arrows and not the mode's frames)."""
+    paths: list[tuple[Any, ...]] = [("result", k) for k in reply["result"]]
+    scene = reply.get("scene")
+    if isinstance(scene, dict):
+        paths += [("scene", k) for k in scene if k != "modes"]
+        for i, mode in enumerate(scene.get("modes") or []):
+            paths += [("scene", "modes", i, k) for k in mode]
+    return paths
+
+
+def state_json(reply: dict[str, Any], sent: dict[tuple[Any, ...], bytes]) -> str:
+    """A ``state`` answer as JSON without the parts the page already holds: each part
+    (:func:`_parts`) whose JSON is the one sent last on this WebSocket (``sent``, updated) is
+    left out and its path listed in ``"unchanged"``; the page takes those from the state
+    and scene it holds (docs/studio.md, "Messages"). A state that is not solved is sent
+    whole and forgets what was sent (the page then holds no solved state)."""
+    import orjson
+
+    result = reply.get("result") or {}
+    if reply.get("type") != "state" or not result.get("ok"):
+        sent.clear()
+        return to_json({**reply, "unchanged": []} if reply.get("type") == "state" else reply)
+    doc: dict[str, Any] = {**reply, "result": dict(result)}
+    if isinstance(reply.get("scene"), dict):
+        doc["scene"] = {**reply["scene"], "modes": [dict(m) for m in reply["scene"]["modes"]]}
+    unchanged: list[list[Any]] = []
+    scene_moved = False
+    paths = _parts(reply)
+    for gone in set(sent) - set(paths):  # what the page's state no longer holds
+        del sent[gone]
+    for path in paths:
+        holder: Any = doc
+        for key in path[:-1]:
+            holder = holder[key]
+        text = to_json(holder[path[-1]]).encode()
+        if sent.get(path) != text:
+            scene_moved |= path[0] == "scene"
+            sent[path] = text
+            holder[path[-1]] = orjson.Fragment(text)
+        elif len(text) >= SMALL_PART:
+            del holder[path[-1]]
+            unchanged.append(list(path))
+        else:
+            holder[path[-1]] = orjson.Fragment(text)
+    if "scene" in doc and not scene_moved:
+        del doc["scene"]  # the view shows this scene already
+        unchanged = [p for p in unchanged if p[0] != "scene"] + [["scene"]]
+    doc["unchanged"] = unchanged
+    return orjson.dumps(doc).decode()
+
+
 @dataclass
 class Studio:
     """What one studio process serves: the design, its token and the ``--save-as`` file."""
@@ -129,7 +188,9 @@ def create_app(studio: Studio) -> Any:
         solved = reply["type"] == "state" and bool(reply["result"].get("ok"))
         if solved:
             reply = guarded(lambda: tab.with_scene(reply))
-        return to_json(reply), reply["seq"] if solved else None
+        if reply["type"] != "state":
+            return to_json(reply), None
+        return state_json(reply, tab.sent), reply["seq"] if solved else None
 
     def check(tab: Tab, seq: int) -> list[str]:
         """After a warm-started answer and its scene: confirm it (``checked``) or, where the

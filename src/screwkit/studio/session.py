@@ -114,6 +114,9 @@ class Tab:
     save_as: Path | None = None
     history: list[DesignState] = field(default_factory=list)
     future: list[DesignState] = field(default_factory=list)
+    #: the JSON of each part of the last solved state sent to the page (the server leaves out
+    #: the parts that have not changed since: studio/server.py, state_json)
+    sent: dict[tuple[Any, ...], bytes] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         d = self.design
