@@ -22,7 +22,7 @@ import json
 import secrets
 from typing import Any
 
-from screwkit.report.viewer import _text_section, pack_scene, render_report_html, script_json
+from screwkit.report.viewer import text_section, pack_scene, render_report_html, script_json
 
 #: the report page's listener for the scenes the kernel posts (``%ID%``: the view's id)
 LISTENER = """<script>(function () {
@@ -74,7 +74,7 @@ class InPlaceView:
             return
         self.updates += 1
         message = {"screwkitStudio": self.id, "seq": self.updates, "scene": pack_scene(scene),
-                   "text": _text_section(scene["text"]),
+                   "text": text_section(scene["text"]),
                    "description": str(scene.get("description") or "")}
         script = ("(function () { const f = document.querySelector("
                   f"'iframe[data-screwkit-view=\"{self.id}\"]'); "
