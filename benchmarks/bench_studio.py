@@ -71,17 +71,16 @@ def _server_side(spec: Path, key: str, value: float) -> dict[str, float]:
         assert checked is not True, "a warm start was replaced"
         warm += checked is False
         # the breakdown, on a fresh pipeline of the same values (solved anew)
-        steps = [("spec", lambda: tab.design.spec_with(tab.state.as_dict, tab.state.mode))]
         c = time.thread_time()
-        pipe = Pipeline(steps[0][1]())
+        pipe = Pipeline(tab.design.spec_with(tab.state.as_dict, tab.state.mode))
         parts["spec"].append(time.thread_time() - c)
-        for name, job in (("kinematics", lambda: pipe.motion),
-                          ("transmission", lambda: shown_transmission(pipe)),
-                          ("loads", lambda: dynamics_document(pipe)),
-                          ("curves", lambda: solve_spec(pipe, numbers=False, scene=False)),
-                          ("scene", lambda: packed_scene(pipe))):
+        for name, job in (("kinematics", lambda p: p.motion),
+                          ("transmission", shown_transmission),
+                          ("loads", dynamics_document),
+                          ("curves", lambda p: solve_spec(p, numbers=False, scene=False)),
+                          ("scene", packed_scene)):
             c = time.thread_time()
-            job()
+            job(pipe)
             parts[name].append(time.thread_time() - c)
         whole = {**reply, "result": solve_spec(pipe, numbers=False, scene=False),
                  "scene": packed_scene(pipe)}
