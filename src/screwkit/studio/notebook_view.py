@@ -22,7 +22,7 @@ import json
 import secrets
 from typing import Any
 
-from screwkit.report.viewer import text_section, pack_scene, render_report_html, script_json
+from screwkit.report.viewer import pack_scene, render_report_html, script_json, text_section
 
 #: the report page's listener for the scenes the kernel posts (``%ID%``: the view's id)
 LISTENER = """<script>(function () {
