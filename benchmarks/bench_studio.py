@@ -1,8 +1,9 @@
 """``screwkit studio``: the time from a dimension change to the redrawn page for a single loop at
 360 samples (target ≤ 100 ms, issue 29), side by side for the RSSR (closed form, with loads)
 and the RRSRR joint list (the tracker, warm-started from the design before: docs/studio.md,
-"Speed"). Server side: one tab's answer to a ``set`` message (solve, curves, loads, JSON), the
-3-D scene sent after it and the warm start's check after both, wall and CPU time; in the
+"Speed"). Server side: one tab's answer to a ``set`` message as sent (solve, curves, loads,
+the 3-D scene in the same message, JSON) with its CPU breakdown, and the warm start's check
+after it, wall and CPU time; in the
 browser (headless Debian chromium, when installed): input event → curves redrawn, and → the
 frame where the 3-D view shows the new design too (the whole page redrawn: the view updates in
 place), median of 10 moves, with the page's phases; and the machine's load during the run."""
@@ -30,39 +31,65 @@ def _at_360(name: str, folder: Path) -> Path:
 
 
 def _server_side(spec: Path, key: str, value: float) -> dict[str, float]:
-    """Median wall and CPU time (ms) of a tab's answers to a ``set`` message: the ``state``
-    (solve, curves, loads, JSON), the ``scene`` that follows it and a warm start's check after
-    both (Tab.verify), and how many answers were warm starts. CPU time (this thread's)
-    is what the answer costs on an idle machine; wall time what it took here."""
+    """Median wall and CPU time (ms) of a tab's answers to a ``set`` message as the server
+    sends them — the ``state`` with its 3-D scene in one message (solve, curves, loads,
+    scene, JSON without the parts the page holds) — and of a warm start's check after it
+    (Tab.verify); how many answers were warm starts; and the CPU breakdown of one answer on a
+    fresh pipeline (kinematics, transmission, loads, the rest of the curves, the scene, the
+    JSON). CPU time (this thread's) is what the answer costs on an idle machine; wall time
+    what it took here."""
+    from screwkit.pipeline import Pipeline
     from screwkit.studio.design import Design
-    from screwkit.studio.server import to_json
+    from screwkit.studio.server import state_json
     from screwkit.studio.session import Tab
+    from screwkit.studio.solve import (
+        dynamics_document,
+        packed_scene,
+        shown_transmission,
+        solve_spec,
+    )
 
     tab = Tab(Design(spec))
     warm = 0
-    times: dict[str, list[float]] = {"state": [], "state_cpu": [], "scene": [], "scene_cpu": [],
-                                     "check": [], "check_cpu": []}
-    tab.handle(json.dumps({"type": "state", "seq": 0}))
+    times: dict[str, list[float]] = {"state": [], "state_cpu": [], "check": [], "check_cpu": []}
+    parts: dict[str, list[float]] = {k: [] for k in (
+        "spec", "kinematics", "transmission", "loads", "curves", "scene", "json")}
+    state_json(tab.with_scene(tab.handle(json.dumps({"type": "state", "seq": 0}))), tab.sent)
     tab.verify()
     for k in range(7):
         message = json.dumps({"type": "set", "seq": k + 1, "values": {key: value + 0.01 * (k + 1)}})
         t, c = time.perf_counter(), time.thread_time()
         reply = tab.handle(message)
-        to_json(reply)
+        assert reply["type"] == "state" and reply["result"]["ok"], reply
+        state_json(tab.with_scene(reply), tab.sent)
         times["state"].append(time.perf_counter() - t)
         times["state_cpu"].append(time.thread_time() - c)
-        assert reply["type"] == "state" and reply["result"]["ok"], reply
-        t, c = time.perf_counter(), time.thread_time()
-        to_json(tab.scene(k + 1))
-        times["scene"].append(time.perf_counter() - t)
-        times["scene_cpu"].append(time.thread_time() - c)
         t, c = time.perf_counter(), time.thread_time()
         checked = tab.verify()  # a warm start's confirmation (None: nothing to confirm)
         times["check"].append(time.perf_counter() - t)
         times["check_cpu"].append(time.thread_time() - c)
         assert checked is not True, "a warm start was replaced"
         warm += checked is False
-    return {**{k: statistics.median(v) * 1e3 for k, v in times.items()}, "warm": warm}
+        # the breakdown, on a fresh pipeline of the same values (solved anew)
+        c = time.thread_time()
+        pipe = Pipeline(tab.design.spec_with(tab.state.as_dict, tab.state.mode))
+        parts["spec"].append(time.thread_time() - c)
+        for name, job in (("kinematics", lambda p: p.motion),
+                          ("transmission", shown_transmission),
+                          ("loads", dynamics_document),
+                          ("curves", lambda p: solve_spec(p, numbers=False, scene=False)),
+                          ("scene", packed_scene)):
+            c = time.thread_time()
+            job(pipe)
+            parts[name].append(time.thread_time() - c)
+        whole = {**reply, "result": solve_spec(pipe, numbers=False, scene=False),
+                 "scene": packed_scene(pipe)}
+        c = time.thread_time()
+        state_json(whole, {})
+        parts["json"].append(time.thread_time() - c)
+    out = {k: statistics.median(v) * 1e3 for k, v in times.items()}
+    out.update({f"cpu_{k}": statistics.median(v) * 1e3 for k, v in parts.items()})
+    return {**out, "warm": warm}
 
 
 #: the page is idle: the last change's curves and 3-D view drawn, a warm start confirmed
@@ -133,11 +160,17 @@ def run() -> list[dict[str, Any]]:
                 ("RRSRR joint list (tracker)", loop, "joints[1].length", 111.6)):
             t = _server_side(spec, key, value)
             rows += [
-                {"name": f"server: state answer, {label}, 360 samples", "value": t["state"],
-                 "unit": "ms", "target": "≤ 100",
-                 "note": f"solve + curves + loads + JSON; CPU {t['state_cpu']:.0f} ms"},
-                {"name": f"server: 3-D scene after it, {label}", "value": t["scene"],
-                 "unit": "ms", "target": "", "note": f"CPU {t['scene_cpu']:.0f} ms"},
+                {"name": f"server: state answer with its 3-D scene, {label}, 360 samples",
+                 "value": t["state"], "unit": "ms", "target": "≤ 100",
+                 "note": f"one message: solve, curves, loads, scene, JSON; CPU "
+                         f"{t['state_cpu']:.1f} ms"},
+                {"name": f"server: CPU breakdown of an answer solved anew, {label}",
+                 "value": sum(t[f"cpu_{k}"] for k in ("spec", "kinematics", "transmission",
+                                                       "loads", "curves", "scene", "json")),
+                 "unit": "ms", "target": "",
+                 "note": "; ".join(f"{k} {t[f'cpu_{k}']:.1f}" for k in (
+                     "spec", "kinematics", "transmission", "loads", "curves", "scene", "json"))
+                         + " (curves: the rest of the state; json: without the parts sent)"},
                 {"name": f"server: the warm start's check after that, {label}",
                  "value": t["check"] if t["warm"] else None, "unit": "ms", "target": "",
                  "note": f"CPU {t['check_cpu']:.0f} ms; {t['warm']}/7 answers warm-started"

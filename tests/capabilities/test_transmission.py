@@ -189,3 +189,34 @@ def test_rssr_ball_cone_angles_are_tilts_of_the_rod():
             axis = mt.socket_axis[joint]
             np.testing.assert_allclose(mt.cone_angle[joint], np.arccos(local @ axis), atol=1e-9)
             assert mt.cone_limit[joint] == pytest.approx(np.max(mt.cone_angle[joint]), abs=1e-12)
+
+
+@pytest.mark.parametrize("name", ["rssr_spatial.toml", "rahman_cssp.toml"])
+def test_the_rod_wrench_is_the_null_space_of_the_balls(name: str, monkeypatch) -> None:
+    """An S–S rod's transmission wrench in closed form (the force along the line of the ball
+    centres) gives the index the SVD null space of the six ball freedoms gives, sample by
+    sample (to round-off) and with the same missing samples; ``cones=False`` leaves the index
+    and angle as they are and the cone angles out."""
+    import screwkit.kinematics.analysis.transmission as tr_module
+    from screwkit.pipeline import Pipeline
+
+    motion = Pipeline(load_spec(f"{EXAMPLES}/{name}")).motion
+    used: list[bool] = []
+    closed_form = tr_module.rod_wrench
+
+    def spy(*args):
+        w = closed_form(*args)
+        used.append(w is not None)
+        return w
+
+    monkeypatch.setattr(tr_module, "rod_wrench", spy)
+    fast = transmission(motion, cones=False)
+    assert used and all(used)
+    monkeypatch.setattr(tr_module, "rod_wrench", lambda *args: None)
+    general = transmission(motion)
+    for a, b in zip(fast.modes, general.modes, strict=True):
+        assert a.index.keys() == b.index.keys() and not a.cone_angle and b.cone_angle
+        for key in a.index:
+            np.testing.assert_array_equal(np.isnan(a.index[key]), np.isnan(b.index[key]))
+            np.testing.assert_allclose(a.index[key], b.index[key], rtol=0, atol=1e-12)
+        assert (a.angle is None) == (b.angle is None)

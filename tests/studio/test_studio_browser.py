@@ -90,7 +90,19 @@ def test_latency_of_a_slider_move(open_studio: Any, served: Any) -> None:
     assert statistics.median(view) < 5000
 
 
-def test_modes_play_and_undo(open_studio: Any) -> None:
+def whole_answer(spec: Path, values: dict[str, float], mode: int) -> dict[str, Any]:
+    """The whole ``state`` answer (every part, with its scene) of a fresh tab at a design."""
+    from screwkit.studio.design import Design
+    from screwkit.studio.server import state_json
+    from screwkit.studio.session import Tab
+
+    tab = Tab(Design(spec))
+    reply = tab.handle(json.dumps({"type": "set", "values": values, "mode": mode}))
+    doc: dict[str, Any] = json.loads(state_json(tab.with_scene(reply), {}))
+    return doc
+
+
+def test_modes_play_and_undo(open_studio: Any, served: Any) -> None:
     page = open_studio()
     assert page.evaluate("window.studio.mode") == 0
     page.page.select_option("#mode", "1")
@@ -98,6 +110,12 @@ def test_modes_play_and_undo(open_studio: Any) -> None:
     r = page.result()
     assert page.evaluate("window.studio.mode") == 1 and r["mode"] == 1 and r["loads"]["mode"] == 1
     assert page.evaluate("document.getElementById('view').contentWindow.screwkitViewer.mode") == 1
+    # the mode alone changed: the server left out the motion's curves and frames, and the
+    # page's merge of them is the whole answer of a fresh tab at this design
+    left_out = page.evaluate("window.studio.state.unchanged")
+    assert ["result", "modes"] in left_out and ["scene", "modes", 0, "joint_centres"] in left_out
+    whole = whole_answer(served.spec, page.evaluate("window.studio.state.values"), 1)
+    assert r == whole["result"] and page.evaluate("window.studio.scene") == whole["scene"]
     # play: the frame advances by itself, and the 3-D view follows
     page.page.click("#play")
     f0 = page.evaluate("window.studio.frame")

@@ -1,8 +1,8 @@
 """The studio's notebook controls (screwkit.studio.notebook, ipywidgets) in a real JupyterLab:
 a server started here on 127.0.0.1 (a free port, its own token and config folders), a notebook
 that makes the widget opened in headless Debian chromium, the cell run, a dimension slider
-dragged with the mouse: the kernel's design takes the new value and the report's plots in the
-output redraw with another curve. JupyterLab and ipykernel come from the dev extra."""
+dragged with the mouse: the kernel's design takes the new value and the report's page in the
+output takes the new design in place (the same iframe; its plots redraw with another curve). JupyterLab and ipykernel come from the dev extra."""
 
 from __future__ import annotations
 
@@ -141,9 +141,12 @@ def test_the_controls_in_jupyterlab(jupyter: str, playwright_driver: Any,
         page.wait_for_function("el => +el.value > 100", arg=value.element_handle(),
                                timeout=30_000)
         shown = float(value.input_value())
-        page.wait_for_function("el => !el.isConnected", arg=element, timeout=30_000)
-        element, frame = _viewer(page)  # the report of the new design
-        assert _plots(frame) != before  # another curve drawn
+        # the report shown takes the new design in place (the kernel posts its scene to the
+        # viewer): the same iframe, still connected, and no second one; another curve drawn
+        frame.wait_for_function("() => document.body.dataset.updates === '1'", timeout=30_000)
+        assert element.evaluate("el => el.isConnected")
+        assert page.locator(".jp-OutputArea iframe").count() == 1
+        assert _plots(frame) != before
         # the kernel's design holds the value the box shows
         second = page.locator(".jp-Notebook .jp-Cell").nth(1)
         second.locator(".jp-InputPrompt").click()  # selects the cell (command mode)

@@ -57,9 +57,8 @@ def test_malformed_messages_get_an_error_and_the_server_goes_on(served: Any) -> 
     with connect(served.ws_url, open_timeout=10, max_size=None) as ws:
         first = json.loads(ws.recv(timeout=60))
         assert first["type"] == "state" and first["result"]["ok"]
-        scene = json.loads(ws.recv(timeout=60))  # the 3-D scene follows a solved state
-        assert scene["type"] == "scene" and scene["seq"] == 0
-        assert len(scene["scene"]["modes"]) == len(first["result"]["modes"])
+        # a solved state carries its 3-D scene (one message: drawn in one frame)
+        assert len(first["scene"]["modes"]) == len(first["result"]["modes"])
         bad = ["garbage", "[]", "null", '{"type": "set", "values": {"dimensions.d2": "ten"}}',
                '{"type": "set", "values": {"nowhere": 1}}', '{"type": "fly"}',
                '{"type": "set", "values": {"dimensions.d2": NaN}}', '{"type": "save", "x": 1}',
@@ -204,3 +203,65 @@ def test_the_command_refuses_bad_arguments_in_one_sentence(rssr_copy: Path) -> N
     for args, words in cases:
         result = runner.invoke(app, args)
         assert result.exit_code == 2 and words in result.output, result.output
+
+
+def test_answers_leave_out_the_parts_the_page_holds(rssr_copy: Path) -> None:
+    """state_json leaves out each part of a state, and of its scene each entry and each
+    mode's entry, whose JSON is the one sent last: a dimension change resends every curve but
+    not the input values; a change of the mode alone resends the loads and the load arrows
+    (moved to that mode), not the motion's curves or frames. The page's merge (each left-out
+    path taken from the state before) is the whole answer of a fresh tab at that state; a
+    state that is not solved is sent whole, and the next solved one whole again."""
+    from screwkit.studio.server import state_json
+
+    def whole(values: dict[str, float], mode: int) -> dict[str, Any]:
+        fresh = Tab(Design(rssr_copy))
+        reply = fresh.handle(json.dumps({"type": "set", "values": values, "mode": mode}))
+        return json.loads(state_json(fresh.with_scene(reply), {}))
+
+    tab = Tab(Design(rssr_copy))
+    page: dict[str, Any] = {}
+    sizes: list[int] = []
+
+    def send(message: dict[str, Any]) -> dict[str, Any]:
+        reply = tab.handle(json.dumps(message))
+        if reply["result"]["ok"]:
+            reply = tab.with_scene(reply)
+        text = state_json(reply, tab.sent)
+        sizes.append(len(text))
+        msg = json.loads(text)
+        for path in msg["unchanged"] if msg["result"]["ok"] else []:  # the page's merge
+            if path == ["scene"]:
+                msg["scene"] = page["scene"]
+                continue
+            source, target = page, msg
+            for key in path[:-1]:
+                source, target = source[key], target[key]
+            target[path[-1]] = source[path[-1]]
+        page.update(result=msg["result"], scene=msg.get("scene"))
+        return msg
+
+    first = send({"type": "state"})
+    assert first["unchanged"] == [] and first["result"]["ok"]
+    moved = send({"type": "set", "values": {"dimensions.d2": 101.0}})
+    kept = {tuple(p) for p in moved["unchanged"]}
+    assert ("result", "input") in kept and ("scene", "input") in kept
+    assert not {p for p in kept if p[0] == "result"} - {("result", "input")}
+    assert ("scene", "modes", 0, "joint_centres") not in kept
+    picked = send({"type": "set", "values": {}, "mode": 1})
+    kept = {tuple(p) for p in picked["unchanged"]}
+    assert {("result", k) for k in ("modes", "paths", "transmission", "input")} <= kept
+    assert ("result", "loads") not in kept and ("scene", "modes", 1, "arrows") not in kept
+    assert ("scene", "modes", 0, "link_points") in kept and ("scene", "modes", 1, "joint_centres") in kept
+    assert sizes[-1] < 0.3 * sizes[-2]  # the curves and frames stay on the page
+    want = whole({"dimensions.d2": 101.0}, 1)
+    assert picked["result"] == want["result"] and picked["scene"] == want["scene"]
+    bad = send({"type": "set", "values": {"dimensions.d2": 1000.0}})
+    assert not bad["result"]["ok"] and bad["unchanged"] == [] and tab.sent == {}
+    back = send({"type": "undo"})
+    assert back["unchanged"] == [] and back["result"] == want["result"]
+    assert back["scene"] == want["scene"]
+    same = send({"type": "state"})
+    assert same["unchanged"][-1] == ["scene"] and "scene" not in json.loads(
+        state_json(tab.with_scene(tab.handle('{"type": "state"}')), dict(tab.sent)))
+    assert same["result"] == want["result"] and same["scene"] == want["scene"]

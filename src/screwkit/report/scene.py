@@ -207,6 +207,7 @@ def scene_from_motion(
     linkage: Any = None,
     initial_mode: int | None = None,
     packed: bool = False,
+    plots: bool = True,
 ) -> dict[str, Any]:
     """Build the scene (module docstring) of a solved motion.
 
@@ -221,6 +222,7 @@ def scene_from_motion(
     ``initial_mode``: the mode shown first (default: the mode with dynamics, else 0).
     ``packed``: the scene as the page gets it (:func:`~screwkit.report.viewer.pack_scene`: the
     large arrays as base64 floats), packed from the arrays without the lists between.
+    ``plots=False``: no plots and no text (empty, None), for a page drawing its own (studio).
     """
     spec_linkage = getattr(spec_or_linkage, "linkage", spec_or_linkage)
     spec = spec_or_linkage if spec_or_linkage is not spec_linkage else None
@@ -241,8 +243,8 @@ def scene_from_motion(
         traces = {name: point_trace(md, link, np.asarray(local, dtype=float))
                   for name, (link, local) in points.items()}
         mode_entries.append(_mode_entry(linkage, k, md, traces))
-    plots, groups = kinematic_plots(modes, x, input_name, kind, units, linkage.inputs,
-                                    seed_variables)
+    charts, groups = kinematic_plots(modes, x, input_name, kind, units, linkage.inputs,
+                                     seed_variables) if plots else ([], [])
     dyn_mode = None
     if dynamics_doc is not None:
         dyn_mode = dynamics_mode if dynamics_mode is not None else int(dynamics_doc.get("mode", 0))
@@ -251,17 +253,14 @@ def scene_from_motion(
                              f"{len(modes)} mode(s)")
         centres = np.asarray(modes[dyn_mode].joint_centres, dtype=float)
         mode_entries[dyn_mode]["arrows"] = dynamics_arrows(dynamics_doc, centres, linkage)
-        p, g = dynamics_plots(dynamics_doc, dyn_mode, x, input_name, kind, du)
-        plots += p
-        groups += g
-    if balance_doc is not None:
-        p, g = balancing_plots(balance_doc, dyn_mode, x, input_name, kind, du)
-        plots += p
-        groups += g
-    if synthesis_doc is not None:
-        p, g = synthesis_plots(synthesis_doc, units, synthesised=linkage is not spec_linkage)
-        plots += p
-        groups += g
+    for p, g in [] if not plots else [
+            dynamics_plots(dynamics_doc, dyn_mode or 0, x, input_name, kind, du)
+            if dynamics_doc is not None else ([], []),
+            balancing_plots(balance_doc, dyn_mode, x, input_name, kind, du)
+            if balance_doc is not None else ([], []),
+            synthesis_plots(synthesis_doc, units, synthesised=linkage is not spec_linkage)
+            if synthesis_doc is not None else ([], [])]:
+        charts, groups = charts + p, groups + g
     base_R = np.asarray(linkage.base.real, dtype=float)
     scene = {
         "format": SCENE_FORMAT,
@@ -282,12 +281,12 @@ def scene_from_motion(
                         "rotation": base_R},
         "modes": mode_entries,
         "initial_mode": initial_mode if initial_mode is not None else dyn_mode or 0,
-        "plots": plots,
+        "plots": charts,
         "plot_groups": groups,
         "text": text_sections(linkage, mode_entries, units, kind, spec_text=spec_text,
                               solver=solver, notes=notes, dynamics_doc=dynamics_doc,
                               dynamics_mode=dyn_mode, balance_doc=balance_doc,
-                              synthesis_doc=synthesis_doc),
+                              synthesis_doc=synthesis_doc) if plots else None,
     }
     out: dict[str, Any] = jsonable(pack_scene(scene) if packed else scene)
     return out

@@ -139,7 +139,9 @@ def _list(lines: list[str]) -> str:
     return "<ul>" + "".join(f"<li>{html.escape(str(x))}</li>" for x in lines) + "</ul>"
 
 
-def _text_section(text: dict[str, Any]) -> str:
+def text_section(text: dict[str, Any]) -> str:
+    """The HTML of a scene's text sections (``<section id='sk-text'>``: units, solver,
+    topology, validation, the spec file)."""
     parts = ["<section id='sk-text'>"]
     for key, title in (("units", "Units"), ("solver", "Solver"), ("topology", "Topology"),
                        ("validation", "Validation status")):
@@ -168,7 +170,7 @@ def render_report_html(scene: dict[str, Any]) -> str:
         "<main><section id='sk-viewer' aria-label='3-D view'></section>",
         "<div id='sk-side'>", f"<header><h1>{e(scene['name'])}</h1>",
         f"<p class='muted'>{e(scene.get('description') or '')}</p>", source, "</header>",
-        "<div id='sk-plots'></div>", _text_section(scene["text"]),
+        "<div id='sk-plots'></div>", text_section(scene["text"]),
         f"<footer>Made by screwkit {e(__version__)}. The viewer bundles three.js and Chart.js "
         "(MIT licences):<details><summary>third-party notices</summary><pre>",
         e(third_party_notices()), "</pre></details></footer></div></main>",

@@ -1,14 +1,15 @@
 """The studio's controls inline in Jupyter (ipywidgets): one slider and number box per
 dimension, the mode picker, undo, redo and save, driving the same tab as the web page
 (:class:`~screwkit.studio.session.Tab`: the same values, history, solve and save), with the
-report's viewer (:func:`~screwkit.report.notebook.report_iframe`: the animated 3-D view, the
-input slider with play/pause and its linked plots) and the table of the CLI's numbers.
+report's page (the animated 3-D view, the input slider with play/pause and its linked plots),
+updated in place with each design (:mod:`screwkit.studio.notebook_view`: the viewer shown
+takes the new scene, as the web page's does), and the table of the CLI's numbers.
 
 >>> from screwkit.studio.notebook import studio
 >>> studio("examples/rssr_spatial.toml")          # the last value of a cell: the controls
 
 Needs ipywidgets (the ``notebook`` extra). A slider solves the loop again when it is released
-(``continuous_update=False``): the report's page is rebuilt with each design.
+(``continuous_update=False``).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import numpy as np
 from screwkit.errors import InputError, ScrewkitError
 from screwkit.kinematics.motion import AssemblyError
 from screwkit.studio.design import Design
+from screwkit.studio.notebook_view import InPlaceView
 from screwkit.studio.session import Tab, save_design
 
 
@@ -74,10 +76,12 @@ class StudioWidget:
         buttons["save"].on_click(lambda _: self.save())
         self.buttons = buttons
         self.message = w.HTML()
-        self.view = w.HTML()
+        self.report = InPlaceView(w, height)
+        self.view = self.report.frame  # the report page's iframe (built again only for
+        self.push = self.report.push  # another mechanism; each design is pushed to it)
         self.numbers = w.HTML()
         self.widget = w.VBox([w.HBox([self.mode, *buttons.values()]), *rows, self.message,
-                              self.view, self.numbers])
+                              self.view, self.push, self.numbers])
         self.refresh()
 
     def _changed(self, values: dict[str, float], mode: int | None = None) -> None:
@@ -103,7 +107,6 @@ class StudioWidget:
     def refresh(self) -> None:
         """Solve the current state and redraw: the sliders, the modes, the 3-D report, the
         numbers; where the loop does not close, the sentence saying so."""
-        from screwkit.report.notebook import report_iframe
         from screwkit.studio.solve import (
             assembly_notes,
             design_scene,
@@ -140,7 +143,7 @@ class StudioWidget:
                         len(pipe.spec.inputs), -1)[:, 0])
                     rows = numbers_table(pipe)
                     notes = assembly_notes(pipe, np.asarray(x), units.label(kind))
-                self.view.value = report_iframe(scene, self.height)
+                self.report.show(scene)
                 self.numbers.value = _numbers_html(rows, notes)
                 self.message.value = ""
             except AssemblyError as exc:

@@ -63,6 +63,65 @@ def to_json(doc: Any) -> str:
         return json.dumps(finite(doc), separators=(",", ":"))
 
 
+#: a part of a state shorter than this (JSON characters) is always sent
+SMALL_PART = 256
+
+
+def _parts(reply: dict[str, Any]) -> list[tuple[Any, ...]]:
+    """The paths of the parts of a solved state that are compared with the ones sent before:
+    each entry of its ``result``, each entry of its ``scene`` but the modes, and each entry
+    of each of the scene's modes (so that a change of the mode alone, which moves the load
+    arrows from one mode to another, resends the arrows and not the mode's frames)."""
+    paths: list[tuple[Any, ...]] = [("result", k) for k in reply["result"]]
+    scene = reply.get("scene")
+    if isinstance(scene, dict):
+        paths += [("scene", k) for k in scene if k != "modes"]
+        for i, mode in enumerate(scene.get("modes") or []):
+            paths += [("scene", "modes", i, k) for k in mode]
+    return paths
+
+
+def state_json(reply: dict[str, Any], sent: dict[tuple[Any, ...], bytes]) -> str:
+    """A ``state`` answer as JSON without the parts the page already holds: each part
+    (:func:`_parts`) whose JSON is the one sent last on this WebSocket (``sent``, updated) is
+    left out and its path listed in ``"unchanged"``; the page takes those from the state
+    and scene it holds (docs/studio.md, "Messages"). A state that is not solved is sent
+    whole and forgets what was sent (the page then holds no solved state)."""
+    import orjson
+
+    result = reply.get("result") or {}
+    if reply.get("type") != "state" or not result.get("ok"):
+        sent.clear()
+        return to_json({**reply, "unchanged": []} if reply.get("type") == "state" else reply)
+    doc: dict[str, Any] = {**reply, "result": dict(result)}
+    if isinstance(reply.get("scene"), dict):
+        doc["scene"] = {**reply["scene"], "modes": [dict(m) for m in reply["scene"]["modes"]]}
+    unchanged: list[list[Any]] = []
+    scene_moved = False
+    paths = _parts(reply)
+    for gone in set(sent) - set(paths):  # what the page's state no longer holds
+        del sent[gone]
+    for path in paths:
+        holder: Any = doc
+        for key in path[:-1]:
+            holder = holder[key]
+        text = to_json(holder[path[-1]]).encode()
+        if sent.get(path) != text:
+            scene_moved |= path[0] == "scene"
+            sent[path] = text
+            holder[path[-1]] = orjson.Fragment(text)
+        elif len(text) >= SMALL_PART:
+            del holder[path[-1]]
+            unchanged.append(list(path))
+        else:
+            holder[path[-1]] = orjson.Fragment(text)
+    if "scene" in doc and not scene_moved:
+        del doc["scene"]  # the view shows this scene already
+        unchanged = [p for p in unchanged if p[0] != "scene"] + [["scene"]]
+    doc["unchanged"] = unchanged
+    return orjson.dumps(doc).decode()
+
+
 @dataclass
 class Studio:
     """What one studio process serves: the design, its token and the ``--save-as`` file."""
@@ -123,14 +182,15 @@ def create_app(studio: Studio) -> Any:
                         "the studio goes on — please report this with the spec"}
 
     def handle(tab: Tab, text: str) -> tuple[str, int | None]:
-        """The answer to ``text`` as JSON, and the seq of a solved state (its 3-D scene
-        follows) or None."""
+        """The answer to ``text`` as JSON — a solved state with its 3-D scene in the same
+        message (Tab.with_scene) — and the seq of a solved state or None."""
         reply = guarded(lambda: tab.handle(text))
         solved = reply["type"] == "state" and bool(reply["result"].get("ok"))
-        return to_json(reply), reply["seq"] if solved else None
-
-    def scene(tab: Tab, seq: int) -> str:
-        return to_json(guarded(lambda: tab.scene(seq)))
+        if solved:
+            reply = guarded(lambda: tab.with_scene(reply))
+        if reply["type"] != "state":
+            return to_json(reply), None
+        return state_json(reply, tab.sent), reply["seq"] if solved else None
 
     def check(tab: Tab, seq: int) -> list[str]:
         """After a warm-started answer and its scene: confirm it (``checked``) or, where the
@@ -141,7 +201,7 @@ def create_app(studio: Studio) -> Any:
             return [] if outcome["type"] == "verify" else [to_json(outcome)]
         if not outcome["replaced"]:
             return [to_json({"type": "checked", "seq": seq})]
-        return [to_json(guarded(lambda: tab.answer(seq))), scene(tab, seq)]
+        return [handle(tab, json.dumps({"type": "state", "seq": seq}))[0]]
 
     async def updates(ws: WebSocket) -> None:
         origin = ws.headers.get("origin")
@@ -152,7 +212,7 @@ def create_app(studio: Studio) -> Any:
             return
         await ws.accept()
         try:
-            await serve_tab(ws, Tab(studio.design, studio.save_as), handle, scene, check)
+            await serve_tab(ws, Tab(studio.design, studio.save_as), handle, check)
         except WebSocketDisconnect:  # the tab was closed while an answer was on its way
             return
 
@@ -161,10 +221,9 @@ def create_app(studio: Studio) -> Any:
 
 
 async def serve_tab(ws: Any, tab: Tab, handle: Callable[[Tab, str], tuple[str, int | None]],
-                    scene: Callable[[Tab, int], str],
                     check: Callable[[Tab, int], list[str]]) -> None:
-    """One tab's WebSocket: each message answered in turn (``handle``; a solved state is
-    followed by its 3-D ``scene`` and a warm start's ``check``), except a numbers table,
+    """One tab's WebSocket: each message answered in turn (``handle``; a solved state, which
+    carries its 3-D scene, is followed by a warm start's ``check``), except a numbers table,
     computed beside the messages that follow (Tab.numbers_job)."""
     import anyio
     from starlette.websockets import WebSocketDisconnect
@@ -222,8 +281,7 @@ async def serve_tab(ws: Any, tab: Tab, handle: Callable[[Tab, str], tuple[str, i
                     else:
                         answer, solved = await anyio.to_thread.run_sync(handle, tab, text)
                         await send(answer)
-                        if solved is not None:  # the 3-D scene right after the curves
-                            await send(await anyio.to_thread.run_sync(scene, tab, solved))
+                        if solved is not None:
                             # a warm start's check, unless the page has sent another message
                             # meanwhile (a drag): that state is then past, and whatever comes
                             # next is checked on its own (Tab.pipeline, Tab.verify)

@@ -114,6 +114,9 @@ class Tab:
     save_as: Path | None = None
     history: list[DesignState] = field(default_factory=list)
     future: list[DesignState] = field(default_factory=list)
+    #: the JSON of each part of the last solved state sent to the page (the server leaves out
+    #: the parts that have not changed since: studio/server.py, state_json)
+    sent: dict[tuple[Any, ...], bytes] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         d = self.design
@@ -257,6 +260,12 @@ class Tab:
         from screwkit.studio.solve import packed_scene
 
         return {"type": "scene", "seq": seq, "scene": packed_scene(self.pipeline(checked=False))}
+
+    def with_scene(self, answer: dict[str, Any]) -> dict[str, Any]:
+        """A solved ``state`` answer with the 3-D scene of its state under ``"scene"``: one
+        message, so that the page draws the curves and hands the view its new frames in one
+        task and one frame (docs/studio.md, "Speed")."""
+        return {**answer, "scene": self.scene(answer["seq"])["scene"]}
 
     def handle(self, text: str) -> dict[str, Any]:
         """The answer to one message from the page (never raises for a page's mistake)."""

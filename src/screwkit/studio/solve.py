@@ -88,9 +88,34 @@ def _paths(pipe: Pipeline, factor: float) -> dict[str, Any]:
     return {"title": "joint-centre paths", "modes": out}
 
 
+#: the transmission without cone angles of each pipeline still in use (the curves and the
+#: numbers table share it)
+_TRANSMISSION: weakref.WeakKeyDictionary[Pipeline, Any] = weakref.WeakKeyDictionary()
+
+
+def shown_transmission(pipe: Pipeline) -> Any:
+    """The pipeline's transmission index and angle (:func:`~screwkit.kinematics.analysis.
+    transmission.transmission` with ``cones=False``: the same numbers as ``screwkit analyze``,
+    without the ball joints' cone angles, which the page does not show), once per pipeline;
+    a :class:`~screwkit.errors.ScrewkitError` says why a loop has none."""
+    from screwkit.kinematics.analysis.transmission import transmission
+    from screwkit.messages import message_units
+
+    if pipe not in _TRANSMISSION:
+        try:
+            with message_units(pipe.units):
+                _TRANSMISSION[pipe] = transmission(pipe.motion, cones=False)
+        except ScrewkitError as exc:
+            _TRANSMISSION[pipe] = exc
+    tr = _TRANSMISSION[pipe]
+    if isinstance(tr, ScrewkitError):
+        raise tr
+    return tr
+
+
 def _transmission(pipe: Pipeline, units: Any) -> tuple[list[dict[str, Any]] | None, str | None]:
     try:
-        tr = pipe.transmission()
+        tr = shown_transmission(pipe)
     except ScrewkitError as exc:
         return None, str(exc)
     out = []
@@ -120,7 +145,7 @@ def _dynamics_document(pipe: Pipeline) -> tuple[dict[str, Any] | None, str | Non
     if any(link.mass is None for link in pipe.spec.linkage.links):
         return None, "no loads: the spec gives no mass properties ([links.<name>] mass)"
     try:
-        return pipe.dynamics().as_dict(), None
+        return pipe.dynamics().as_dict(arrays=True), None
     except ScrewkitError as exc:
         return None, str(exc)
 
@@ -186,7 +211,7 @@ def numbers_table(pipe: Pipeline) -> list[list[str]]:
         rows.append(["limit positions", str(exc)])
     x = np.asarray(pipe.spec.inputs, dtype=float).reshape(len(pipe.spec.inputs), -1)[:, 0]
     try:
-        summary = pipe.transmission().summary(x)
+        summary = shown_transmission(pipe).summary(x)
     except ScrewkitError:
         summary = []
     for entry in summary:
@@ -203,8 +228,8 @@ def numbers_table(pipe: Pipeline) -> list[list[str]]:
     return rows
 
 
-def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None, *, packed: bool = False
-                 ) -> dict[str, Any]:
+def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None, *, packed: bool = False,
+                 plots: bool = True) -> dict[str, Any]:
     """The report's scene (:func:`~screwkit.report.scene.scene_from_motion`) of the pipeline's
     motion with the spec's coupler points as traces (their 3-D paths) and the loads of
     ``[motion] mode`` (``dyn_doc``, from :func:`dynamics_document`; None: no loads), as
@@ -218,15 +243,14 @@ def design_scene(pipe: Pipeline, dyn_doc: dict[str, Any] | None, *, packed: bool
                              dynamics_mode=None if dyn_doc is None else int(pipe.spec.mode),
                              seed_variables=[seed_tables(md) for md in mot.modes],
                              coupler_points={p.name: (p.link, p.point)
-                                             for p in pipe.spec.coupler_points}, packed=packed)
+                                             for p in pipe.spec.coupler_points}, packed=packed,
+                             plots=plots)
 
 
 def packed_scene(pipe: Pipeline) -> dict[str, Any]:
     """The scene of :func:`design_scene` packed for the page's 3-D view (the report's plots
-    left out: the page draws its own)."""
-    packed = design_scene(pipe, dynamics_document(pipe)[0], packed=True)
-    packed["plots"], packed["plot_groups"] = [], []
-    return packed
+    and text left out: the page draws its own)."""
+    return design_scene(pipe, dynamics_document(pipe)[0], packed=True, plots=False)
 
 
 def solve_spec(spec: Spec | Pipeline, *, numbers: bool = True,

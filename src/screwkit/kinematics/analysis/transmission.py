@@ -216,6 +216,27 @@ def _wrench_nullspace(S: Array, cons: list[int], L: float, U: Array | None,
     return np.asarray(w)
 
 
+def rod_wrench(linkage: Linkage, cons_joints: set[int], centres: Array) -> Array | None:
+    """The transmission wrench (N, 6; f, m about the ground origin) in closed form where the
+    coupler chain is one S–S rod (the constraint freedoms are the six of two neighbouring ball
+    joints): a rod between two balls passes only a force along the line of their centres
+    (reciprocal to every rotation about either centre), w = (u, c × u) with u the unit vector
+    from one centre to the other — the one-dimensional null space :func:`_wrench_nullspace`
+    finds by an SVD per sample. None for any other chain, or where the centres meet (no
+    line)."""
+    if len(cons_joints) != 2:
+        return None
+    i, j = sorted(cons_joints)
+    if j != i + 1 or linkage.joints[i].kind != "S" or linkage.joints[j].kind != "S":
+        return None
+    d = centres[:, j] - centres[:, i]
+    length = np.linalg.norm(d, axis=-1)
+    if not np.all(length[np.isfinite(length)] > 1e-9 * linkage.length_scale):
+        return None
+    u = d / length[:, None]
+    return np.asarray(np.concatenate([u, np.cross(centres[:, i], u)], axis=-1))
+
+
 def _index(w: Array, twist: Array, joint_point: Array, joint_axis: Array | None,
            L: float) -> Array:
     """Sutherland–Roth transmission index of wrenches ``w`` (N, 6) on output twists (N, 6)."""
@@ -372,10 +393,12 @@ def _cones(linkage: Linkage, md: ModeMotion) -> tuple[dict[str, Array], dict[str
     return angle, axis, limit
 
 
-def transmission(motion: Motion) -> Transmission:
+def transmission(motion: Motion, *, cones: bool = True) -> Transmission:
     """Transmission index of every output, transmission angle (planar loops) and ball-joint
     cone angles over every mode of ``motion`` (module docstring). A ValueError says why a loop
-    has none (its input is not on the ground, so it has no output joint)."""
+    has none (its input is not on the ground, so it has no output joint). ``cones=False``
+    leaves out the cone angles (their smallest cones are a third of the time; the studio's
+    curves do not show them): the index and angle are the same numbers."""
     expect_instance(motion, Motion, "transmission: motion", "a solved Motion (sk.solve_motion(...))")
     linkage = motion.linkage
     lay = layout(linkage)
@@ -400,7 +423,9 @@ def transmission(motion: Motion) -> Transmission:
             f_out = lay.names.index(freedom)
             cons = [k for k, fname in enumerate(lay.names)
                     if fname.split(".")[0] not in in_joints and k != f_out]
-            w = _wrench_nullspace(S, cons, L, U, St)
+            w = rod_wrench(linkage, {lay.joint_of[k] for k in cons}, fr.centres)
+            if w is None:
+                w = _wrench_nullspace(S, cons, L, U, St)
             kind = linkage.joints[drive].kind
             axis = None if kind in ("S", "U") else fr.axes[:, drive]
             ti = _index(w, S[:, :, f_out], fr.centres[:, drive], axis, L)
@@ -414,7 +439,7 @@ def transmission(motion: Motion) -> Transmission:
             cos_mu = np.einsum("ni,ni->n", ba, bo) / (np.linalg.norm(ba, axis=-1)
                                                       * np.linalg.norm(bo, axis=-1))
             angle = np.arccos(np.clip(cos_mu, -1.0, 1.0))
-        cone_angle, socket, limit = _cones(linkage, md)
+        cone_angle, socket, limit = _cones(linkage, md) if cones else ({}, {}, {})
         modes.append(ModeTransmission(md.index, index, angle, cone_angle, socket, limit))
     return Transmission(outputs, linkage.joints[out_j].name, linkage.joints[drive].name, planar,
                         modes)

@@ -138,8 +138,9 @@ def _least_squares(A: Array, b: Array, skip: NDArray[np.bool_]) -> Array:
 
 def _sigma_ratio(Jp: Array, exact: bool, near: tuple[Array, Array] | None = None) -> Array:
     """σ_min/σ_max of each tall or square ``Jp`` (N, k, m), from the eigenvalues of JᵀJ. With
-    ``exact=False`` only the rank test's answer is kept exact: where det(JᵀJ)/tr(JᵀJ)^m, a lower
-    bound of (σ_min/σ_max)² (λ_min ≥ det/λ_max^(m−1) and λ_max ≤ tr), already clears
+    ``exact=False`` only the rank test's answer is kept exact: where det(JᵀJ)/u^m, a lower
+    bound of (σ_min/σ_max)² (λ_min ≥ det/λ_max^(m−1) and λ_max ≤ u, the smaller of tr(JᵀJ)
+    and ‖JᵀJ‖_∞), already clears
     SINGULAR_RTOL² the eigenvalues are not computed and the ratio is NaN ("well above the
     threshold"). ``near`` — a nearby sample's Jacobian (N, k, m) and its σ_min (N,) — certifies
     it without the determinant where Weyl's inequality σ_min ≥ σ_min,near − |Jp − J_near|_F
@@ -156,13 +157,17 @@ def _sigma_ratio(Jp: Array, exact: bool, near: tuple[Array, Array] | None = None
         if rest.size:
             ratio[rest] = _sigma_ratio(Jp[rest], False)
         return ratio
-    if Jp.shape[1] == Jp.shape[2]:  # square: det(JᵀJ) = det(J)², tr(JᵀJ) = |J|²_F
-        fro = np.sqrt(np.maximum(np.einsum("nij,nij->n", Jp, Jp), 1e-300))
-        bound = np.linalg.det(Jp / fro[:, None, None]) ** 2
+    # λ_max ≤ tr(JᵀJ) and λ_max ≤ ‖JᵀJ‖_∞ (any induced norm bounds the spectral radius);
+    # the smaller is the bound u, and the ratio² ≥ det(JᵀJ)/u^m (the row sums are often several
+    # times below the trace: with 7 columns that is the difference between an eigenvalue
+    # decomposition at every sample and none)
+    M = np.swapaxes(Jp, -1, -2) @ Jp
+    u = np.maximum(np.minimum(np.trace(M, axis1=-2, axis2=-1),
+                              np.abs(M).sum(axis=-1).max(axis=-1)), 1e-300)
+    if Jp.shape[1] == Jp.shape[2]:  # square: det(JᵀJ) = det(J)²
+        bound = np.linalg.det(Jp / np.sqrt(u)[:, None, None]) ** 2
     else:
-        M = np.swapaxes(Jp, -1, -2) @ Jp
-        tr = np.maximum(np.trace(M, axis1=-2, axis2=-1), 1e-300)
-        bound = np.linalg.det(M / tr[:, None, None])  # det(M)/tr^m, scaled against overflow
+        bound = np.linalg.det(M / u[:, None, None])  # det(M)/u^m, scaled against overflow
     ratio = np.full(Jp.shape[0], np.nan)
     close = ~(bound > 4.0 * SINGULAR_RTOL**2)  # a margin for the determinant's round-off
     if close.any():

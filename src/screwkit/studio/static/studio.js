@@ -70,12 +70,12 @@
   function receive(msg) {
     const timed = S.inflight && msg.seq === S.inflight.seq ? S.inflight : null;
     if (timed) { S.inflight = null; S.phases.push({ answer: performance.now() - timed.t0, parse: S.parsed }); }
-    if (msg.type === 'scene' && S.phases.length) S.phases[S.phases.length - 1].scene = performance.now() - S.stateT0;
+    if (msg.type === 'state' && msg.unchanged) mergeUnchanged(msg);
+    if (msg.type === 'state' && msg.scene) S.scene = msg.scene; // whole again (merged)
     if (msg.type === 'state') showState(msg, timed);
     else if (msg.type === 'error') { S.errors.push(msg.message); say(msg.message, 'error'); }
     else if (msg.type === 'saved') say(`saved ${msg.path}`, 'ok');
     else if (msg.type === 'checked') { S.checked = msg.seq; document.body.dataset.checked = String(msg.seq); }
-    else if (msg.type === 'scene') { if (S.state && msg.seq === S.state.seq) loadView(msg.scene, S.stateT0); }
     else if (msg.type === 'numbers') {
       if (msg.seq > S.lastChange) { // else asked for before a later change: stale
         S.numbers = msg.numbers; drawNumbers(msg.numbers); $('numbers').classList.remove('stale'); document.body.dataset.numbers = String(msg.seq);
@@ -89,6 +89,21 @@
       if (S.inflight) S.inflight.t0 = p.t0;
     } else if (S.inflight === null && msg.type === 'state' && msg.result.ok) {
       numbersAtRest(); // the slower table, once the curves are drawn and the design rests
+    }
+  }
+
+  // the parts of a state the server left out (each a path into its result or scene) are
+  // those of the state before, as the page holds them
+  function mergeUnchanged(msg) {
+    for (const path of msg.unchanged) {
+      let from = path[0] === 'result' ? S.result : S.scene;
+      let to = msg;
+      if (path.length === 1) { msg.sameScene = true; continue; } // ['scene']: the shown one
+      for (let k = 0; k < path.length - 1; k++) {
+        if (k) from = from[path[k]];
+        to = to[path[k]];
+      }
+      to[path[path.length - 1]] = from[path[path.length - 1]];
     }
   }
 
@@ -402,7 +417,15 @@
     if (timed && S.phases.length) S.phases[S.phases.length - 1].draw = performance.now() - t1;
     S.frame = Math.min(S.frame, r.input.values.length - 1);
     S.stateT0 = timed ? timed.t0 : performance.now();
-    S.viewReady = false; // until the scene that follows this state is loaded
+    if (msg.scene) { // the 3-D scene comes in the same message: the view takes it now
+      S.viewReady = false; // until it is loaded
+      if (timed && S.phases.length) S.phases[S.phases.length - 1].scene = performance.now() - S.stateT0;
+      loadView(msg.scene, S.stateT0);
+    } else if (msg.sameScene) { // the view already shows this scene
+      const t0 = S.stateT0;
+      if (timed && S.phases.length) Object.assign(S.phases[S.phases.length - 1], { scene: performance.now() - t0, update: 0 });
+      requestAnimationFrame(() => { S.viewLatencies.push(performance.now() - t0); document.body.dataset.view = String(S.viewLatencies.length); });
+    }
     setFrame(S.frame);
     document.body.dataset.solved = String(msg.seq);
     requestAnimationFrame(() => {
