@@ -519,6 +519,7 @@ def all_branches(linkage: Linkage, lay: Layout, X: Array, starts: int, seed: int
         if not (_seed_fold_partners(linkage, lay, tracker, X, partnered) or found):
             break
     tracks = _attach_turning_points(linkage, lay, _merge_duplicates(linkage, lay, tracker.tracks))
+    tracks = _without_singular_shadows(linkage, lay, tracks)
     tracks = _off_continua(tracks, engine.continuum_samples)
     tracks = _attach_lone_ends(linkage, lay, tracks)
     _pair_ends(linkage, lay, tracks)
@@ -741,6 +742,31 @@ def _attach_turning_points(linkage: Linkage, lay: Layout, tracks: list[Track]) -
         for o in ends:
             o.set_sample(s, tr.scalars[s], tr.spherical[s])
     return out
+
+
+def _without_singular_shadows(linkage: Linkage, lay: Layout, tracks: list[Track]
+                              ) -> list[Track]:
+    """Without one-sample tracks that are singular at a sample where another track is singular
+    too: at a bifurcation that falls on a sample the passive equations lose rank, and the
+    homotopy's singular end points there may include closures far out along the lost
+    direction (an RCCC's slides at hundreds of link lengths, where the dual part of its
+    input-output equation degenerates with the real part's double root). Such a point is
+    followed nowhere, so it is no assembly mode; the branches that meet there keep the sample."""
+    lone = [tr for tr in tracks if int(tr.mask.sum()) == 1]
+    if not lone:
+        return tracks
+
+    def singular_at(tr: Track, s: int) -> bool:
+        conf = Configuration(tr.scalars[[s]], tr.spherical[[s]])
+        return bool(rate_equations(linkage, lay, forward(linkage, conf, lay)).rank_deficient[0])
+
+    drop = set()
+    for tr in lone:
+        s = int(np.argmax(tr.mask))
+        if singular_at(tr, s) and any(o is not tr and o.mask[s] and o.mask.sum() > 1
+                                      and singular_at(o, s) for o in tracks):
+            drop.add(id(tr))
+    return [tr for tr in tracks if id(tr) not in drop]
 
 
 def _attach_lone_ends(linkage: Linkage, lay: Layout, tracks: list[Track]) -> list[Track]:
