@@ -9,7 +9,8 @@ import screwkit.kinematics.tracker.continuation as continuation
 from screwkit.io.spec import load_spec
 from screwkit.kinematics.solve_motion import solve_motion
 from screwkit.kinematics.tracker.branch_fill import quintic_hermite, spherical_end_conditions
-from screwkit.kinematics.tracker.generic_motion import _same_samples, all_branches, generic_motion
+from screwkit.kinematics.tracker.branch_merge import same_samples
+from screwkit.kinematics.tracker.generic_motion import all_branches, generic_motion
 from screwkit.kinematics.tracker.joint_motion import solve_joints
 from screwkit.kinematics.tracker.loop import closure_twist, forward, layout
 from screwkit.kinematics.tracker.rates import joint_rates, rate_equations, solve_rates
@@ -244,10 +245,10 @@ def test_overlapping_tracks_are_compared_sample_by_sample_where_they_meet():
     jumped.scalars[1001:1004] = a.scalars[1001:1004]
     jumped.spherical[1001:1004] = a.spherical[1001:1004]
     both = np.nonzero(a.mask & jumped.mask)[0]
-    same = _same_samples(lk, lay, a, jumped, both)
+    same = same_samples(lk, lay, a, jumped, both)
     np.testing.assert_array_equal(both[same], [1001, 1002, 1003])
-    assert _same_samples(lk, lay, a, a, both).all()
-    assert not _same_samples(lk, lay, a, b, both).any()
+    assert same_samples(lk, lay, a, a, both).all()
+    assert not same_samples(lk, lay, a, b, both).any()
 
 
 @pytest.mark.parametrize("family", ["RSSR", "RCCC"])
@@ -274,7 +275,7 @@ def test_bare_route_on_long_sweeps_of_loops_with_closed_forms(family):
 
 @pytest.mark.parametrize("name", ["RSRC", "RSSR", "RCCC", "RSHC", "RUSR"])
 def test_signature_moves_bound_how_far_the_signature_moves(name):
-    from screwkit.kinematics.tracker.generic_motion import _signature_moves
+    from screwkit.kinematics.tracker.branch_merge import signature_moves
     from screwkit.kinematics.tracker.solve import signature
 
     lk = _loops()[name]
@@ -284,7 +285,7 @@ def test_signature_moves_bound_how_far_the_signature_moves(name):
     assert tracks
     for tr in tracks:
         held = np.nonzero(tr.mask)[0]
-        bound = _signature_moves(lk, lay, tr, held)
+        bound = signature_moves(lk, lay, tr, held)
         sig = signature(lk, tr.configuration().take(held), lay)
         true = np.max(np.abs(np.diff(sig, axis=0)), axis=1)
         near = np.diff(held) == 1
@@ -365,7 +366,7 @@ def _rpscr():
 
 
 def test_signature_moves_count_the_slides_of_the_loop():
-    from screwkit.kinematics.tracker.generic_motion import _signature_moves
+    from screwkit.kinematics.tracker.branch_merge import signature_moves
     from screwkit.kinematics.tracker.solve import signature
 
     lk = _rpscr()
@@ -375,14 +376,14 @@ def test_signature_moves_count_the_slides_of_the_loop():
     assert tracks
     for tr in tracks:
         held = np.nonzero(tr.mask)[0]
-        bound = _signature_moves(lk, lay, tr, held)
+        bound = signature_moves(lk, lay, tr, held)
         true = np.abs(np.diff(signature(lk, tr.configuration().take(held), lay), axis=0))
         assert np.all(true.max(axis=1) <= bound)
     # a sample the track does not hold (NaN) in the middle does not shrink the bound
     tr = tracks[0]
     tr.mask[50], tr.scalars[50] = False, np.nan
     held = np.nonzero(tr.mask)[0]
-    bound = _signature_moves(lk, lay, tr, held)
+    bound = signature_moves(lk, lay, tr, held)
     true = np.abs(np.diff(signature(lk, tr.configuration().take(held), lay), axis=0))
     near = np.diff(held) == 1
     assert np.all(true.max(axis=1)[near] <= bound[near])

@@ -64,7 +64,7 @@ def _same_modes(closed, generic, length):
 
 @settings(max_examples=10, deadline=None, derandomize=True)
 # two branches born at one sample next to a fold: the generic solver once handed each the
-# other's root there, so its rod poses were carried 1° off (generic_motion._pair_ends)
+# other's root there, so its rod poses were carried 1° off (branch_merge.pair_ends)
 @example(d1=1.0, d2=5.0, d3=3.2475464481429612, a=2.0, b=-0.3359375, lambda0=0.1875,
          offset=0.125)
 # two full-turn branches pass within 3° of each other where σ_min/σ_max ~ 1e-3: a 7.5° step

@@ -236,6 +236,12 @@ def family(name: str) -> Family:
     return FAMILIES[key]
 
 
+def has_rsrc_quartic(linkage: Linkage) -> bool:
+    """Whether the loop's positions are the real roots of the RSRC quartic (Bagci 1969
+    eq. 3.63): the RSRC and the planar 4R, its δ0 = λ0 = b = e = 0 case."""
+    return linkage.family in ("RSRC", "4R")
+
+
 def family_of(linkage: Linkage) -> Family:
     """The family a linkage was built as (``LOOP`` for a joint list)."""
     return FAMILIES.get(linkage.family or "LOOP", FAMILIES["LOOP"])

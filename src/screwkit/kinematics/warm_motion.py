@@ -42,9 +42,9 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.kinematics.motion import Motion, as_input_array, per_sample
 from screwkit.kinematics.registry import family_of
 from screwkit.kinematics.solve_motion import with_seed_names
+from screwkit.kinematics.tracker.branch_merge import SAME_ROOT
 from screwkit.kinematics.tracker.continuation import FILL_TOL
 from screwkit.kinematics.tracker.generic_motion import (
-    SAME_ROOT,
     anchor_samples,
     root_search,
 )
@@ -64,7 +64,7 @@ CONTRACTION = 0.5
 STEP_GROWTH = 3.0
 STEP_SLACK = 1e-6
 #: signature distance below which two modes are the same configuration (the generic solver's
-#: merge test, generic_motion._same_samples)
+#: merge test, generic_motion.same_samples)
 DISTINCT = 1e-5
 
 

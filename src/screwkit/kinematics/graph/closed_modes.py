@@ -80,7 +80,7 @@ def mode_configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X:
     q = conf.scalars
     turning = [lay.scalar_col[f] for f in range(lay.m)
                if not lay.is_translation[f] and lay.scalar_col[f] >= 0]
-    for a, b in _runs(mask):
+    for a, b in assembling_runs(mask):
         run = q[a:b, turning]
         if a == 0 and start is not None:
             run = np.vstack([start[None, turning], run])
@@ -93,7 +93,7 @@ def mode_configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X:
     return conf
 
 
-def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
+def assembling_runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
     """The [start, stop) index ranges where ``mask`` holds."""
     edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
     return list(zip(np.nonzero(edges == 1)[0].tolist(), np.nonzero(edges == -1)[0].tolist(),

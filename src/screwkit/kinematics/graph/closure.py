@@ -152,7 +152,7 @@ def graph_forward(mech: Mechanism, lay: GraphLayout, conf: Configuration, exact:
         R[:, b] = R[:, a] @ Mr
         p[:, b] = np.einsum("nij,nj->ni", R[:, a], Mp) + p[:, a]
     residual = loop_residuals(mech, lay, conf, R, p, exact)
-    screws, centres, axes = _screws(mech, lay, R, p)
+    screws, centres, axes = joint_screws(mech, lay, R, p)
     return GraphFrames(R, p, screws, residual, centres, axes)
 
 
@@ -177,7 +177,7 @@ def _line_screw(u: Array, c: Array, pitch: float = 0.0) -> Array:
     return np.concatenate([u, cross(c, u) + pitch * u], -1)
 
 
-def _screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
+def joint_screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
             ) -> tuple[Array, Array, Array]:
     """World screws of every freedom (N, 6, m), joint centres and first axes (N, J, 3)."""
     N = R.shape[0]

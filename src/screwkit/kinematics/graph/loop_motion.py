@@ -20,8 +20,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, _screws
-from screwkit.kinematics.graph.loop_subchain import APPROACH_STEP, LoopChain, _is_drawing
+from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
+from screwkit.kinematics.graph.loop_subchain import APPROACH_STEP, LoopChain, is_drawing
 from screwkit.kinematics.motion import AssemblyError, Motion
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
@@ -66,7 +66,7 @@ def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
     rows = np.vstack([A, X])
     motion = solve_motion(chain.linkage, chain.loop_inputs(rows), progress=False)
     a = A.shape[0]
-    drawn = next((m for m, md in enumerate(motion.modes) if _is_drawing(mech, chain, md)), None)
+    drawn = next((m for m, md in enumerate(motion.modes) if is_drawing(mech, chain, md)), None)
     if drawn is None:
         return LoopModes(motion, np.zeros((0, X.shape[0]), dtype=bool), (), (), None)
     R0 = motion.modes[drawn].link_rotation[0]
@@ -88,7 +88,7 @@ def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         conf = _configuration(mech, lay, R, p, rows, ok, m == drawn)
         confs.append(conf.take(slice(a, None)))
         R, p = R[a:], p[a:]
-        screws, centres, axes = _screws(mech, lay, R, p)
+        screws, centres, axes = joint_screws(mech, lay, R, p)
         frames.append(GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes))
     return LoopModes(motion, np.array(masks), tuple(confs), tuple(frames), drawn)
 
@@ -117,7 +117,7 @@ def _configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Arr
     cosine), a slide along it, an H joint's turns from its slide, a U joint's two angles, an S
     joint's rotation; angles counted continuously along each run where the mode assembles
     (from the drawing, every variable 0, for the drawn mode), the inputs as given."""
-    from screwkit.kinematics.graph.closed_modes import _runs
+    from screwkit.kinematics.graph.closed_modes import assembling_runs
 
     N = R.shape[0]
     q = np.zeros((N, lay.n_scalar))
@@ -153,7 +153,7 @@ def _configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Arr
             q[:, col + 1] = pr @ u
     turning = [lay.scalar_col[f] for f in range(lay.m)
                if not lay.is_translation[f] and lay.scalar_col[f] >= 0]
-    for s, e in _runs(ok):
+    for s, e in assembling_runs(ok):
         run = q[s:e, turning]
         if s == 0 and from_drawing:
             q[s:e, turning] = np.unwrap(np.vstack([np.zeros(len(turning)), run]), axis=0)[1:]
@@ -241,7 +241,7 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
     segment X[k] → X[k+1] (all at once) where the loop's count of real solutions (its closed
     form's assembling modes at one input) leaves its value at X[k]."""
     from screwkit.kinematics.graph.motion import input_text
-    from screwkit.kinematics.registry import family_of
+    from screwkit.kinematics.registry import family_of, has_rsrc_quartic
 
     rows, ks = np.nonzero(masks[:, :-1] != masks[:, 1:])
     closed = family_of(chain.linkage).closed_form_for(chain.linkage)
@@ -251,7 +251,7 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
                 for r, k in zip(rows, ks, strict=True)]
     x0, x1 = X[ks], X[ks + 1]
     rsrc = None
-    if chain.linkage.family in ("RSRC", "4R"):  # its quartic's real roots, without the modes
+    if has_rsrc_quartic(chain.linkage):  # its quartic's real roots, without the modes
         from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
         from screwkit.kinematics.closed_forms.rsrc.positions import rsrc_positions
 

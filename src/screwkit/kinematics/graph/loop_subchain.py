@@ -475,10 +475,10 @@ def _draws(mech: Mechanism, chain: LoopChain) -> bool:
         motion = closed(chain.linkage, X, np.ones_like(X), np.zeros_like(X))
     except ValueError:
         return False
-    return any(_is_drawing(mech, chain, md) for md in motion.modes)
+    return any(is_drawing(mech, chain, md) for md in motion.modes)
 
 
-def _is_drawing(mech: Mechanism, chain: LoopChain, md: object) -> bool:
+def is_drawing(mech: Mechanism, chain: LoopChain, md: object) -> bool:
     """Whether a loop mode's joint lines at its first sample are the drawing's."""
     ok = md.assembles  # type: ignore[attr-defined]
     if not ok[0]:
