@@ -5,23 +5,18 @@ scheduler that does not answer is a clear error."""
 
 from __future__ import annotations
 
-import json
 import os
-import signal
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
-from sweep_helpers import EXAMPLES
+from sweep_helpers import EXAMPLES, real_dask
 
 from screwkit.sweep import EngineConfig, EngineError, define_sweep, run_sweep
 from screwkit.sweep.engine import start_engine
 
 SPEC = EXAMPLES / "rsrc_fig7_dynamics.toml"
 VARY = ["d2=4.2:4.8:3", "e=0.5:1.5:3", "links.output.mass=0.6kg,0.8kg"]  # 18 designs
-DASK = Path(sys.executable).with_name("dask")
 
 
 def _run(tmp_path: Path, name: str, config: EngineConfig, batch: int | None = None) -> bytes:
@@ -43,37 +38,9 @@ def test_embedded_cluster_gives_the_same_table(tmp_path, reference):
     assert time.perf_counter() - t0 < 120
 
 
-def _stop(procs: list[subprocess.Popen]) -> None:
-    for p in procs:
-        if p.poll() is None:
-            p.send_signal(signal.SIGTERM)
-    for p in procs:
-        try:
-            p.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            p.wait(timeout=10)
-
-
 def test_real_scheduler_and_two_workers_give_the_same_table(tmp_path, reference):
-    assert DASK.exists(), "the dask command comes with the [sweep] extra"
-    info = tmp_path / "scheduler.json"
-    env = {**os.environ, "PYTHONWARNINGS": "ignore"}
-    procs = [subprocess.Popen([str(DASK), "scheduler", "--host", "127.0.0.1", "--port", "0",
-                               "--no-dashboard", "--scheduler-file", str(info)],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)]
-    try:
-        deadline = time.monotonic() + 60
-        while not info.exists() and time.monotonic() < deadline:
-            time.sleep(0.2)
-        time.sleep(0.3)
-        address = json.loads(info.read_text())["address"]
+    with real_dask(tmp_path, workers=2) as address:
         assert address.startswith("tcp://127.0.0.1:")
-        for _ in range(2):
-            procs.append(subprocess.Popen(
-                [str(DASK), "worker", address, "--nthreads", "1", "--nworkers", "1",
-                 "--host", "127.0.0.1", "--no-dashboard"],
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env))
         with start_engine(EngineConfig(scheduler=address)) as engine:
             engine.client.wait_for_workers(2, timeout=90)
             assert engine.workers == 2
@@ -87,8 +54,6 @@ def test_real_scheduler_and_two_workers_give_the_same_table(tmp_path, reference)
             assert _run(tmp_path, "env.parquet", EngineConfig(), batch=5) == reference
         finally:
             del os.environ["SCREWKIT_SCHEDULER"]
-    finally:
-        _stop(procs)
 
 
 def test_a_scheduler_that_does_not_answer_is_a_clear_error():
