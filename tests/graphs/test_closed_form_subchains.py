@@ -425,3 +425,76 @@ def test_random_spatial_legs_every_mode_closes_and_the_tracker_stays_on_it(shape
                 assert np.max(np.abs(centres - md.joint_centres[k + step])) <= 1e-8 * L
                 checked += 1
     assert checked >= 20
+
+
+def _circle_meets(c1: np.ndarray, r1: float, c2: np.ndarray, r2: float) -> list[np.ndarray]:
+    """The points (2D) where two circles meet: none, or two (a tangency is not counted)."""
+    w = c2 - c1
+    f = float(np.hypot(*w))
+    if not abs(r1 - r2) < f < r1 + r2:
+        return []
+    along = (f ** 2 + r1 ** 2 - r2 ** 2) / (2 * f)
+    h = np.sqrt(r1 ** 2 - along ** 2)
+    mid, across = c1 + along * w / f, np.array([-w[1], w[0]]) / f
+    return [mid + h * across, mid - h * across]
+
+
+def test_a_re_entered_branch_combination_is_a_mode_each_time_it_assembles() -> None:
+    """Issue 27's re-entry on a dyad-built graph (two loops: no loop route): a non-Grashof
+    four-bar (crank 2, coupler 2.6, rocker 1.4, frame 3: the crank turns only within
+    15.6° … 104.5° and its mirror) with an RRR dyad from its coupler to the ground, drawn at
+    crank 90° and driven 0° … 380° from there. The drawn branches die 14.48° on, assemble again
+    within the mirror interval and again one turn on: with every mode, each sample is held by
+    as many modes as circles meet there (the four-bar's B on circles about A and D, then the
+    dyad's G on circles about E and F, counted per B), the drawn mode stops at its first fold,
+    and the drawn branches' later runs are one mode of their own, born at a fold."""
+    a, b, c, d = 2.0, 2.6, 1.4, 3.0
+    fb = _fourbar(a, b, c, d)
+    A0, B0, D0 = (fb.joints[i].at[:2] for i in (1, 2, 3))
+    E0 = 0.5 * (A0 + B0) + np.array([0.0, 0.4])
+    G0, F0 = np.array([1.0, 3.2]), np.array([-1.0, 2.0])
+    mech = Mechanism("re-entering six-bar", (*fb.bodies, Body("b3"), Body("b4")),
+                     (*fb.joints, joint("E", "R", "coupler", "b3", [*E0, 0.0]),
+                      joint("G", "R", "b3", "b4", [*G0, 0.0]),
+                      joint("F", "R", "b4", "ground", [*F0, 0.0])), ("O.theta",))
+    assert [dy.kind for dy in decompose(mech).dyads] == ["RRR", "RRR"]
+    t = np.radians(np.arange(0.0, 381.0, 5.0))
+    motion = solve_mechanism(mech, t, every_mode=True)
+    assert motion.method == "graph (closed forms)"
+
+    u0 = (B0 - A0) / b
+    local = np.array([(E0 - A0) @ u0, u0[0] * (E0 - A0)[1] - u0[1] * (E0 - A0)[0]])
+    eg, gf = float(np.hypot(*(G0 - E0))), float(np.hypot(*(F0 - G0)))
+    expected = []
+    for phi in np.pi / 2 + t:
+        A = a * np.array([np.cos(phi), np.sin(phi)])
+        count = 0
+        for B in _circle_meets(A, b, D0, c):
+            u = (B - A) / b
+            E = A + local[0] * u + local[1] * np.array([-u[1], u[0]])
+            count += len(_circle_meets(E, eg, F0, gf))
+        expected.append(count)
+    held = np.sum([md.assembles for md in motion.modes], axis=0)
+    assert held.tolist() == expected
+    assert {0, 2, 4} <= set(expected)  # dead, one four-bar branch, both
+    assert len(motion.modes) == 5
+    drawn, again = motion.modes[0], motion.modes[4]
+    stop = int(np.argmin(drawn.assembles))
+    assert stop == 3 and not drawn.assembles[stop:].any()  # dies 14.48° on (crank at 104.48°)
+    assert "the drawn branches again" in again.label and again.label.startswith(
+        "branches A–B–D +, E–G–F +")
+    assert again.assembles[stop:].any() and not again.assembles[:stop].any()
+    # the fold the drawn mode stops at is the four-bar's (|A − D| = b + c), not the dyad's
+    # placed on it
+    root = np.degrees(np.arccos((a ** 2 + d ** 2 - (b + c) ** 2) / (2 * a * d))) - 90.0
+    assert f"dies at O.theta = {root:.6g} deg: the RRR dyad A–B–D folds" in drawn.events[1]
+    assert again.events[0].startswith("is born at")
+    # one turn on, the drawn branches' pose is the drawn mode's (the same branch, no switch)
+    turn = int(np.flatnonzero(np.isclose(t, t[0] + 2 * np.pi))[0])
+    assert again.assembles[turn:turn + stop].all()
+    assert np.abs(again.link_origin[turn:turn + stop] - drawn.link_origin[:stop]).max() <= 1e-9
+    assert np.abs(again.link_rotation[turn:turn + stop] - drawn.link_rotation[:stop]).max() \
+        <= 1e-9
+    for md in motion.modes:
+        idx = np.nonzero(md.assembles)[0]
+        assert _residual(mech, md.conf.take(idx)) <= 1e-10

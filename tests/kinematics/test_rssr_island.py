@@ -70,3 +70,41 @@ def test_the_graph_routes_every_mode_finds_the_island_whole() -> None:
     # each closes
     for md in motion.modes:
         assert np.nanmax(md.closure_residual[md.assembles]) <= 1e-10
+
+
+def test_the_graph_routes_every_mode_holds_a_re_entered_island_twice(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Issue 27's re-entry: drawn at 170° and driven 5° … 365° from there (175° … 535°), the
+    island is assembled at the first sample and again at 530° and 535°. Solved by the graph's
+    closed forms (the RSS leg; the loop route, graph/loop_subchain.py, bypassed), every sample
+    is held by as many modes as the point-to-circle distance test puts configurations there
+    (2 strictly inside the island, 0 outside), the drawn mode stops at its first fold, and the
+    drawn branches' second run is a mode of its own, born at the island's start one turn on,
+    whose pose at 535° is the drawn mode's at 175° (the same branch, no switch)."""
+    monkeypatch.setattr("screwkit.kinematics.graph.loop_subchain.loop_chain", lambda mech: None)
+    closed = solve_motion(rssr(*ISLAND_RSSR), THETA, method="closed")
+    a, _ = ISLAND_SAMPLES
+    mech = mechanism_from_loop(closed, 0, a)  # drawn at 170°
+    X = np.radians(np.arange(5.0, 366.0, 5.0))
+    motion = solve_mechanism(mech, X[:, None], every_mode=True)
+    assert motion.method == "graph (closed forms)"
+    near, far = rssr_reach(ISLAND_RSSR, THETA[a] + X)
+    d2 = ISLAND_RSSR[1]
+    expected = np.where((near < d2) & (d2 < far), 2, 0)
+    assert expected.tolist() == [2] + [0] * 70 + [2, 2]  # the island at 175°, 530°, 535°
+    assert _counts(motion).tolist() == expected.tolist()
+    drawn, other, again = motion.modes
+    assert np.flatnonzero(drawn.assembles).tolist() == [0]
+    assert np.flatnonzero(again.assembles).tolist() == [71, 72]
+    assert again.index == 2 and "drawn branches again" in again.label
+    born = [float(e.split("= ")[1].split(" deg")[0]) for e in again.events
+            if e.startswith("is born at")]
+    assert np.allclose(born, [ISLAND_DEG[0] + 360.0 - np.degrees(THETA[a])], atol=0.011)
+    assert not [e for e in again.events if e.startswith("dies at")]
+    # 535° is 175° one turn on: each branch's pose there is its pose at the first sample
+    for md, first in ((again, drawn), (other, other)):
+        assert np.abs(md.link_origin[72] - first.link_origin[0]).max() <= 1e-9
+        assert np.abs(md.link_rotation[72] - first.link_rotation[0]).max() <= 1e-9
+    assert np.abs(again.link_origin[72] - other.link_origin[72]).max() > 1e-3  # two branches
+    for md in motion.modes:
+        assert np.nanmax(md.closure_residual[md.assembles]) <= 1e-10
+    assert motion.notes[-1].endswith("{0, 1, 2}")  # all meet at the island's folds

@@ -121,7 +121,8 @@ def fold_inputs(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
     """Where the modes of branches ``signs`` (T, D) are born or die between samples k and
     k+1 (T,; exactly one of the two assembles): the input rows at the folds (T, n_in), by
     bisection on each segment X[k] → X[k+1] (all at once), and the index of the dyad whose
-    discriminant crosses zero there (T,)."""
+    discriminant crosses zero there (T,): the first in placing order past the fold that does
+    not assemble (a dyad placed on a dyad that failed has no discriminant, NaN)."""
     T = k.shape[0]
     x0, x1 = X[k], X[k + 1]
     lo, hi = np.zeros(T), np.ones(T)
@@ -133,7 +134,9 @@ def fold_inputs(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
         hi = np.where(same, hi, mid)
     bad = np.where(ok_lo, hi, lo)
     disc = place(mech, lay, dec, x0 + bad[:, None] * (x1 - x0), signs).discriminant
-    folding = np.argmin(np.where(np.isnan(disc), -np.inf, disc), axis=1)
+    # the first sub-chain, in placing order, that does not assemble (negative or NaN): those
+    # placed on its bodies are NaN only because it failed
+    folding = np.argmax(~(disc >= 0.0), axis=1)
     return x0 + (0.5 * (lo + hi))[:, None] * (x1 - x0), folding
 
 

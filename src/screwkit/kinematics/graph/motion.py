@@ -296,26 +296,37 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     drawn[:stop] = True
     conf = mode_configuration(mech, lay, R[0], p[0], X, drawn, start)
     mode = build_mode(mech, lay, conf, drawn, X, Xd, Xdd)
-    rows = [0] + [m for m in range(1, M) if ok[m].any()]
-    folds, joins = _fold_events(mech, lay, dec, X, signs[rows], ok[rows])
+    rows = [0] + [m for m in range(1, M) if ok[m].any()]  # the branch combination of each mode
+    masks = [drawn, *(ok[m] for m in rows[1:])]
+    again = ok[0] & (np.arange(N) >= stop)  # the drawn branches assembling after its fold
+    if every and again.any():  # their later runs: a mode of their own, born at a fold
+        rows.append(0)
+        masks.append(again)
+    held = np.array(masks)
+    folds, joins = _fold_events(mech, lay, dec, X, signs[rows], held)
     events = folds[0][:1]  # the drawn mode ends at its first fold
     if stop < N:
         events.insert(0, f"stops assembling after input {input_text(mech, lay, X[stop - 1])} (a "
                          f"limit position or dead centre before {input_text(mech, lay, X[stop])})")
     modes = [replace(with_events(mode, [*events, *mode.events]), label="drawn")]
-    for m, events in zip(rows[1:], folds[1:], strict=True):
-        conf = mode_configuration(mech, lay, R[m], p[m], X, ok[m])
-        md = build_mode(mech, lay, conf, ok[m], X, Xd, Xdd)
-        modes.append(replace(with_events(md, [*events, *md.events]),
-                             label=f"branches {mode_label(mech, dec, signs[m])}",
+    for i, (m, events) in enumerate(zip(rows[1:], folds[1:], strict=True), start=1):
+        conf = mode_configuration(mech, lay, R[m], p[m], X, held[i])
+        md = build_mode(mech, lay, conf, held[i], X, Xd, Xdd)
+        label = f"branches {mode_label(mech, dec, signs[m])}"
+        if m == 0:
+            label += " (the drawn branches again, after the drawn mode's fold)"
+        modes.append(replace(with_events(md, [*events, *md.events]), label=label,
                              index=len(modes)))
     notes: tuple[str, ...] = (skipped,) if skipped else ()
     if every:
         notes = (f"{M} branch combination(s) of {len(dec.dyads)} sub-chain(s); {len(modes)} "
-                 "assemble over these inputs",
+                 "mode(s) assemble over these inputs (the drawn branches twice where they "
+                 "assemble again after the drawn mode's fold)" if len(modes) > len(set(rows))
+                 else f"{M} branch combination(s) of {len(dec.dyads)} sub-chain(s); "
+                 f"{len(modes)} assemble over these inputs",
                  "circuits (modes that meet at a fold, where the input must turn back to go "
                  "on): " + ", ".join("{" + ", ".join(map(str, c)) + "}"
-                                     for c in _circuits(signs[rows], joins)))
+                                     for c in _circuits(signs[rows], held, joins)))
 
     return MechanismMotion(mech, X, Xd, Xdd, tuple(modes), method="graph (closed forms)",
                            solver=CLOSED_FORM_SOLVER, notes=notes)
@@ -323,10 +334,11 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
 
 def _fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
                  signs: Array, ok: NDArray[np.bool_]
-                 ) -> tuple[list[list[str]], list[tuple[int, int]]]:
+                 ) -> tuple[list[list[str]], list[tuple[int, int, int]]]:
     """Each mode's (rows of ``signs`` (M', D) and ``ok`` (M', N)) births and deaths at folds,
     each located between samples (graph/closed_modes.py's ``fold_inputs``, all at once), and
-    every fold as (row, index of the folding sub-chain)."""
+    every fold as (row, index of the folding sub-chain, sample k: the fold lies between k and
+    k+1)."""
     from screwkit.kinematics.graph.closed_modes import fold_inputs
 
     mode, k = np.nonzero(ok[:, :-1] != ok[:, 1:])
@@ -340,7 +352,7 @@ def _fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array
         what = "dies" if ok[m, kk] else "is born"
         events[int(m)].append(f"{what} at {input_text(mech, lay, xx)}: the {dyad.kind} {dyad.word} "
                               f"{names} folds (its two branches meet)")
-    return events, [(int(m), int(d)) for m, d in zip(mode, folding, strict=True)]
+    return events, [(int(m), int(d), int(kk)) for m, d, kk in zip(mode, folding, k, strict=True)]
 
 
 def groups(n: int, joins: list[tuple[int, int]]) -> list[list[int]]:
@@ -360,14 +372,19 @@ def groups(n: int, joins: list[tuple[int, int]]) -> list[list[int]]:
     return sorted(out.values())
 
 
-def _circuits(signs: Array, joins: list[tuple[int, int]]) -> list[list[int]]:
-    """The modes (rows of ``signs``) grouped into circuits: at a fold of sub-chain d a mode
-    meets the mode whose branches differ in d alone (the same configuration there)."""
+def _circuits(signs: Array, ok: NDArray[np.bool_], joins: list[tuple[int, int, int]]
+              ) -> list[list[int]]:
+    """The modes (rows of ``signs`` (M', D), held at the samples ``ok`` (M', N)) grouped into
+    circuits: at a fold of sub-chain d between samples k and k+1 a mode meets the mode whose
+    branches differ in d alone (the same configuration there) and that is born or dies between
+    the same two samples (a branch combination may hold two modes: the drawn one and its
+    later runs)."""
     pairs = []
-    for m, d in joins:
+    turns = ok[:, :-1] != ok[:, 1:]
+    for m, d, k in joins:
         other = signs[m].copy()
         other[d] = -other[d]
-        match = np.nonzero(np.all(signs == other, axis=1))[0]
+        match = np.nonzero(np.all(signs == other, axis=1) & turns[:, k])[0]
         if match.size:
             pairs.append((int(match[0]), m))
     return groups(signs.shape[0], pairs)
