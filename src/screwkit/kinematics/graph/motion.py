@@ -255,7 +255,9 @@ CLOSED_FORM_SOLVER = ("closed-form sub-chains (driven joints, planar dyads, spat
 def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
                         Xd: Array, Xdd: Array, every: bool) -> MechanismMotion:
     """The drawn mode (and with ``every`` every other mode that assembles somewhere) from the
-    closed forms (graph/closed_modes.py)."""
+    closed forms (graph/closed_modes.py). The drawn mode stops at its first fold; with
+    ``every``, where the drawn branches assemble again after it, their later runs are one more
+    mode, last, born at a fold (issue 27: a run that re-enters is reported)."""
     from screwkit.budget import ResourceLimitError
     from screwkit.kinematics.graph.closed_modes import (
         branch_combinations,
