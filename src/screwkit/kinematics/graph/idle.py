@@ -9,6 +9,8 @@ inertia symmetric about it) are then carried exactly.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -46,15 +48,26 @@ def _spin_of(mech: Mechanism, lay: GraphLayout, lin: Linearised, q: Array,
     return out
 
 
-def hold_rod_spin(mech: Mechanism, lay: GraphLayout, lin: Linearised, q: Array,
-                  bias: Array | None = None) -> Array:
-    """Rates ``q`` (N, m) with the idle part chosen so no rod spins; with the joints'
-    velocity-product terms ``bias`` (closure.body_twists), accelerations with no spin
-    acceleration."""
+@dataclass(frozen=True)
+class IdleBasis:
+    """What :func:`hold_rod_spin` needs of a linearisation, the same for rates and
+    accelerations: the rods, the scaled idle directions ``null`` (N, d, m_p) of the passive
+    block (its right singular vectors past its rank) and each rod's spin ``C`` (N, r, d) under
+    each of them."""
+
+    found: list[tuple[str, int, int]]
+    null: Array
+    C: Array
+
+
+def idle_basis(mech: Mechanism, lay: GraphLayout, lin: Linearised) -> IdleBasis | None:
+    """The idle directions and the rods' spins under them (:class:`IdleBasis`; None: no rod, no
+    passive freedom or no idle direction). Made once per linearisation and shared by the rates
+    and the accelerations (one SVD instead of two)."""
     found = rods(mech)
     passive = list(lay.passive)
     if not found or not passive:
-        return q
+        return None
     Jp = lin.J[:, :, passive]
     _, s, Vt = np.linalg.svd(Jp)
     keep = s > RANK_CUTOFF * np.maximum(s[:, :1], 1e-300)
@@ -62,15 +75,30 @@ def hold_rod_spin(mech: Mechanism, lay: GraphLayout, lin: Linearised, q: Array,
     null = Vt[:, rank:]  # (N, d, m_p): scaled idle directions
     d = null.shape[1]
     if d == 0:
-        return q
+        return None
     cs = column_scale(lay)[passive]
-    C = np.empty((q.shape[0], len(found), d))
+    C = np.empty((Jp.shape[0], len(found), d))
     for k in range(d):
-        z = np.zeros_like(q)
+        z = np.zeros((Jp.shape[0], lay.m))
         z[:, passive] = null[:, k] * cs
         C[:, :, k] = _spin_of(mech, lay, lin, z, found)
-    spin = _spin_of(mech, lay, lin, q, found, bias)
-    coef = -np.einsum("nij,nj->ni", np.linalg.pinv(C), spin)
+    return IdleBasis(found, null, C)
+
+
+def hold_rod_spin(mech: Mechanism, lay: GraphLayout, lin: Linearised, q: Array,
+                  bias: Array | None = None, basis: IdleBasis | None = None) -> Array:
+    """Rates ``q`` (N, m) with the idle part chosen so no rod spins; with the joints'
+    velocity-product terms ``bias`` (closure.body_twists), accelerations with no spin
+    acceleration. ``basis``: :func:`idle_basis` of ``lin`` when already made, else made here
+    (``q`` is returned as it is where there is none)."""
+    if basis is None:
+        basis = idle_basis(mech, lay, lin)
+    if basis is None:
+        return q
+    passive = list(lay.passive)
+    cs = column_scale(lay)[passive]
+    spin = _spin_of(mech, lay, lin, q, basis.found, bias)
+    coef = -np.einsum("nij,nj->ni", np.linalg.pinv(basis.C), spin)
     out = q.copy()
-    out[:, passive] += np.einsum("ndi,nd->ni", null, coef) * cs
+    out[:, passive] += np.einsum("ndi,nd->ni", basis.null, coef) * cs
     return out

@@ -475,14 +475,16 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
     lin = linearise(mech, lay, conf, tracked, full_rank=rank == len(lay.passive))
     fr = lin.frames
     qd = rates(mech, lay, lin, Xd)
-    idle = rank < len(lay.passive)
-    if idle:  # rods between two balls: their spin held still (graph/idle.py)
-        from screwkit.kinematics.graph.idle import hold_rod_spin
+    from screwkit.kinematics.graph.idle import IdleBasis, hold_rod_spin, idle_basis
 
-        qd = hold_rod_spin(mech, lay, lin, qd)
+    basis: IdleBasis | None = None
+    if rank < len(lay.passive):  # rods between two balls: their spin held still (graph/idle.py)
+        basis = idle_basis(mech, lay, lin)  # one SVD for the rates and the accelerations
+    if basis is not None:
+        qd = hold_rod_spin(mech, lay, lin, qd, basis=basis)
     qdd, bias = accelerations(mech, lay, lin, qd, Xdd)
-    if idle:
-        qdd = hold_rod_spin(mech, lay, lin, qdd, bias)
+    if basis is not None:
+        qdd = hold_rod_spin(mech, lay, lin, qdd, bias, basis=basis)
     V, _ = body_twists(mech, lay, fr.screws, qd)
     A = body_accelerations(mech, lay, fr.screws, qdd, bias)
     nb = len(mech.bodies)
