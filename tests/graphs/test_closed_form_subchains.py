@@ -173,7 +173,11 @@ def test_a_fold_is_reported_where_brentq_finds_the_distance_law_root() -> None:
     # the other branch meets it there: it dies at the same input, one circuit with it
     other = motion.modes[1]
     assert any(f"O.theta = {np.degrees(root):.6g} deg" in e for e in other.events)
-    assert motion.notes[1].endswith(": {0, 1}")
+    # the drawn branches assemble again later in the sweep: a mode of their own, born at a fold
+    again = motion.modes[2]
+    assert len(motion.modes) == 3 and "drawn branches again" in again.label
+    assert not (again.assembles & drawn.assembles).any()
+    assert motion.notes[1].endswith(": {0, 1, 2}")
 
 
 def _random_dyad_graph(rng: np.random.Generator, kind: str) -> Mechanism:

@@ -108,3 +108,33 @@ def test_the_graph_routes_every_mode_holds_a_re_entered_island_twice(monkeypatch
     for md in motion.modes:
         assert np.nanmax(md.closure_residual[md.assembles]) <= 1e-10
     assert motion.notes[-1].endswith("{0, 1, 2}")  # all meet at the island's folds
+
+
+def test_the_loop_route_holds_a_re_entered_island_twice() -> None:
+    """The same re-entry through the loop engine (the whole RSSR drawn as a graph is solved by
+    its closed form, graph/loop_subchain.py): every sample is held by as many modes as the
+    distance test puts configurations there, the drawn mode stops at its first fold, and the
+    drawn loop mode's second run is a mode of its own whose pose at 535° is the drawn mode's
+    at 175°."""
+    closed = solve_motion(rssr(*ISLAND_RSSR), THETA, method="closed")
+    a, _ = ISLAND_SAMPLES
+    mech = mechanism_from_loop(closed, 0, a)
+    X = np.radians(np.arange(5.0, 366.0, 5.0))
+    motion = solve_mechanism(mech, X[:, None], every_mode=True)
+    assert motion.method == "graph (loop, closed)"
+    near, far = rssr_reach(ISLAND_RSSR, THETA[a] + X)
+    d2 = ISLAND_RSSR[1]
+    expected = np.where((near < d2) & (d2 < far), 2, 0)
+    assert _counts(motion).tolist() == expected.tolist()
+    drawn = motion.modes[0]
+    again = [md for md in motion.modes if "drawn branches again" in md.label]
+    assert len(again) == 1 and len(motion.modes) == 3
+    assert np.flatnonzero(drawn.assembles).tolist() == [0]
+    assert np.flatnonzero(again[0].assembles).tolist() == [71, 72]
+    # the same configuration (joint centres, R axes; the rod between the balls may carry
+    # another idle spin in a run of its own, so its frame is not compared)
+    assert np.abs(again[0].joint_centres[72] - drawn.joint_centres[0]).max() <= 1e-9
+    R = [0, 3]  # the R joints (a ball's reported axis turns with the rod's idle spin)
+    assert np.abs(again[0].joint_axes[72, R] - drawn.joint_axes[0, R]).max() <= 1e-9
+    for md in motion.modes:
+        assert np.nanmax(md.closure_residual[md.assembles]) <= 1e-10

@@ -37,13 +37,16 @@ class LoopModes:
     """The loop's solution as graph modes: per loop mode (in ``solve_motion``'s order) the
     samples where it assembles (M, N), the graph configurations and body frames (None for a
     mode not asked for) and which mode is the drawn one (None: none passes through the
-    drawing)."""
+    drawing). With every mode asked for, the drawn loop mode's samples after the drawn mode's
+    first fold, where it assembles again (an island entered twice), are one more entry, last:
+    ``again`` its index (None when the drawn loop mode does not come back)."""
 
     motion: Motion
     assembles: NDArray[np.bool_]
     confs: tuple[Configuration | None, ...]
     frames: tuple[GraphFrames | None, ...]
     drawn: int | None
+    again: int | None = None
 
 
 def approach(lay: GraphLayout, X: Array) -> Array:
@@ -74,23 +77,34 @@ def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
     confs: list[Configuration | None] = []
     frames: list[GraphFrames | None] = []
     masks = []
+
+    def add(md: object, ok: NDArray[np.bool_], from_drawing: bool) -> None:
+        R, p = _body_poses(mech, chain, md, R0, p0, ok)
+        conf = _configuration(mech, lay, R, p, rows, ok, from_drawing)
+        confs.append(conf.take(slice(a, None)))
+        R, p = R[a:], p[a:]
+        screws, centres, axes = joint_screws(mech, lay, R, p)
+        frames.append(GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes))
+
+    later: NDArray[np.bool_] | None = None
     for m, md in enumerate(motion.modes):
         ok = np.array(md.assembles)
         if m == drawn:  # followed from the drawing: it ends where it first stops assembling
             stop = int(np.argmin(ok)) if not ok.all() else ok.size
+            later = ok & (np.arange(ok.size) >= stop)
             ok[stop:] = False
         masks.append(ok[a:])
         if m != drawn and not every:
             confs.append(None)
             frames.append(None)
             continue
-        R, p = _body_poses(mech, chain, md, R0, p0, ok)
-        conf = _configuration(mech, lay, R, p, rows, ok, m == drawn)
-        confs.append(conf.take(slice(a, None)))
-        R, p = R[a:], p[a:]
-        screws, centres, axes = joint_screws(mech, lay, R, p)
-        frames.append(GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes))
-    return LoopModes(motion, np.array(masks), tuple(confs), tuple(frames), drawn)
+        add(md, ok, m == drawn)
+    again = None
+    if every and later is not None and later[a:].any():
+        again = len(masks)
+        masks.append(later[a:])
+        add(motion.modes[drawn], later, False)
+    return LoopModes(motion, np.array(masks), tuple(confs), tuple(frames), drawn, again)
 
 
 def _body_poses(mech: Mechanism, chain: LoopChain, md: object, R0: Array, p0: Array,
@@ -213,7 +227,9 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
                 events.insert(0, f"stops assembling after input "
                                  f"{input_text(mech, lay, X[stop - 1])} (a limit position or "
                                  f"dead centre before {input_text(mech, lay, X[stop])})")
-        label = "drawn" if m == d else f"loop mode {m}"
+        label = ("drawn" if m == d else
+                 f"loop mode {d} (the drawn branches again, after the drawn mode's fold)"
+                 if m == lm.again else f"loop mode {m}")
         modes.append(replace(with_events(md, [*events, *md.events]), label=label,
                              index=len(modes)))
     motion = lm.motion
