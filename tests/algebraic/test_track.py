@@ -92,6 +92,47 @@ def test_a_root_going_to_infinity_is_reported_at_infinity():
     assert np.isnan(result.x[result.status == PathStatus.AT_INFINITY]).all()
 
 
+def _quadratic():
+    x, a, b, c = (Poly.variable(i) for i in range(4))
+    return compile_system([a * x * x + b * x + c], ["x"], ["a", "b", "c"])
+
+
+def test_a_regular_end_at_infinity_skips_the_endgame(monkeypatch):
+    # at a = 0 the homogenised a·X² + b·X·h + c·h² is h·(b·X + c·h): its root h = 0 is
+    # nonsingular (∂/∂h = b·X ≠ 0), so Newton converges there and the endgame is not needed
+    import screwkit.algebraic.track as track_module
+
+    calls = []
+    real = track_module.cauchy_endgame
+    monkeypatch.setattr(track_module, "cauchy_endgame",
+                        lambda hom, y, rows, options: calls.append(len(rows)) or real(
+                            hom, y, rows, options))
+    p0 = np.array([1.0 + 0.5j, -0.3 + 1j, 0.7 - 0.2j])
+    result = track_parameter_homotopy(_quadratic(), p0, [0.0, 2.0, -3.0], np.roots(p0)[:, None])
+    assert calls == []
+    gone = result.status == PathStatus.AT_INFINITY
+    assert gone.sum() == 1 and result.winding[gone][0] == 1
+    h, X = result.y[gone][0]
+    assert abs(h) <= 1e-12 * abs(X)  # the point at infinity [h : X] = [0 : 1]
+    assert abs(result.x[result.regular, 0][0] - 1.5) < 1e-12
+
+
+def test_a_singular_end_at_infinity_still_goes_through_the_endgame(monkeypatch):
+    # a = b = 0: c·h² has the double root h = 0; both paths (x ~ ±√(−c/a)) go to infinity
+    # through it, which Newton cannot certify, so they are classified by the endgame
+    import screwkit.algebraic.track as track_module
+
+    calls = []
+    real = track_module.cauchy_endgame
+    monkeypatch.setattr(track_module, "cauchy_endgame",
+                        lambda hom, y, rows, options: calls.append(len(rows)) or real(
+                            hom, y, rows, options))
+    p0 = np.array([1.0 + 0.5j, -0.3 + 1j, 0.7 - 0.2j])
+    result = track_parameter_homotopy(_quadratic(), p0, [0.0, 0.0, -3.0], np.roots(p0)[:, None])
+    assert sum(calls) == 2
+    assert result.counts()["at_infinity"] == 2
+
+
 def test_two_paths_on_one_regular_solution_are_retracked_then_failed():
     # the same start solution twice: both paths end at one regular solution, which a correct
     # tracking never gives; both are tracked again and, still together, marked failed

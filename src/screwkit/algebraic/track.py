@@ -10,8 +10,11 @@ path). All paths (and a batch of targets, one per path) run in one vectorised tr
 stays finite and is reported as at infinity.
 
 Each path first runs to s = 1 − r (r = ``endgame_radius``) and then to s = 1; an end point where
-the tracker arrives with a well-conditioned Jacobian is polished by Newton and is regular. The
-others (the step collapsed, or the Jacobian is ill-conditioned, or h ≈ 0) go through the Cauchy
+the tracker arrives with a well-conditioned Jacobian is polished by Newton and is regular, or at
+infinity when the polished h ≈ 0 (a nonsingular solution at infinity of the homogenised system
+on the patch, Sommese & Wampler 2005, §3.2: Newton's convergence there is as good a certificate
+as at a finite regular end, so it skips the endgame). The
+others (the step collapsed, or the Jacobian is ill-conditioned) go through the Cauchy
 endgame (:mod:`.endgame`) from s = 1 − r, which gives their end point and winding number; they
 are then classified singular (with the number of paths that reach the same point as its
 multiplicity estimate), at infinity, or failed.
@@ -181,11 +184,16 @@ def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArra
     arrived = np.flatnonzero(ok1 & ok2)
     polished, good, cond_a = _polish(hom, y_end[arrived], rows[arrived], options)
     h = np.abs(polished[:, 0]) <= options.infinity_threshold * np.abs(polished).max(axis=1)
+    # a regular end point with h ≈ 0 is a nonsingular solution at infinity of the homogenised
+    # system on the patch: Newton has converged to it, so it needs no endgame
+    infinite = good & h
+    status[arrived[infinite]] = PathStatus.AT_INFINITY
+    y_final[arrived[infinite]] = polished[infinite]
     good &= ~h
     status[arrived[good]] = PathStatus.REGULAR
     y_final[arrived[good]] = polished[good]
     cond[arrived] = cond_a
-    late = np.flatnonzero(ok1 & (status != PathStatus.REGULAR))
+    late = np.flatnonzero(ok1 & (status == PathStatus.FAILED))
     if late.size:
         eg = cauchy_endgame(hom, y_near[late], rows[late], options)
         steps[late] += eg.steps
