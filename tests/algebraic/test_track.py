@@ -97,16 +97,22 @@ def _quadratic():
     return compile_system([a * x * x + b * x + c], ["x"], ["a", "b", "c"])
 
 
-def test_a_regular_end_at_infinity_skips_the_endgame(monkeypatch):
-    # at a = 0 the homogenised a·X² + b·X·h + c·h² is h·(b·X + c·h): its root h = 0 is
-    # nonsingular (∂/∂h = b·X ≠ 0), so Newton converges there and the endgame is not needed
+def _endgame_calls(monkeypatch) -> list[int]:
+    """The number of paths of each call of the Cauchy endgame, recorded as the tracker runs."""
     import screwkit.algebraic.track as track_module
 
-    calls = []
+    calls: list[int] = []
     real = track_module.cauchy_endgame
     monkeypatch.setattr(track_module, "cauchy_endgame",
                         lambda hom, y, rows, options: calls.append(len(rows)) or real(
                             hom, y, rows, options))
+    return calls
+
+
+def test_a_regular_end_at_infinity_skips_the_endgame(monkeypatch):
+    # at a = 0 the homogenised a·X² + b·X·h + c·h² is h·(b·X + c·h): its root h = 0 is
+    # nonsingular (∂/∂h = b·X ≠ 0), so Newton converges there and the endgame is not needed
+    calls = _endgame_calls(monkeypatch)
     p0 = np.array([1.0 + 0.5j, -0.3 + 1j, 0.7 - 0.2j])
     result = track_parameter_homotopy(_quadratic(), p0, [0.0, 2.0, -3.0], np.roots(p0)[:, None])
     assert calls == []
@@ -120,13 +126,7 @@ def test_a_regular_end_at_infinity_skips_the_endgame(monkeypatch):
 def test_a_singular_end_at_infinity_still_goes_through_the_endgame(monkeypatch):
     # a = b = 0: c·h² has the double root h = 0; both paths (x ~ ±√(−c/a)) go to infinity
     # through it, which Newton cannot certify, so they are classified by the endgame
-    import screwkit.algebraic.track as track_module
-
-    calls = []
-    real = track_module.cauchy_endgame
-    monkeypatch.setattr(track_module, "cauchy_endgame",
-                        lambda hom, y, rows, options: calls.append(len(rows)) or real(
-                            hom, y, rows, options))
+    calls = _endgame_calls(monkeypatch)
     p0 = np.array([1.0 + 0.5j, -0.3 + 1j, 0.7 - 0.2j])
     result = track_parameter_homotopy(_quadratic(), p0, [0.0, 0.0, -3.0], np.roots(p0)[:, None])
     assert sum(calls) == 2

@@ -44,18 +44,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.algebraic.polynomial import PolynomialSystem
-from screwkit.algebraic.solve import StartSolutions
 from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.graph.closure import GraphLayout, axis_rotation, graph_layout
 from screwkit.kinematics.modes.rod_loops import least_rotation
 from screwkit.kinematics.modes.stewart import (
     pose_from_study,
     stewart_parameters,
-    stewart_start,
-    stewart_system,
 )
-from screwkit.kinematics.modes.stewart_decode import joint_values
+from screwkit.kinematics.modes.stewart_decode import StudyPlatformSystem, joint_values
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import GROUND, Mechanism
 
@@ -279,7 +275,7 @@ def delta_configuration(dm: DeltaMechanism, input_values: ArrayLike, R: ArrayLik
 
 
 @dataclass(frozen=True)
-class DeltaFormulation:
+class DeltaFormulation(StudyPlatformSystem):
     """A Delta robot as a formulation of modes/every_mode.py: the Study-coordinate system of a
     6-6 platform whose base points are the elbow balls (every plate pose, rotated ones too),
     its parameters from the arm angles, and the decoding of each real pose (module
@@ -290,13 +286,6 @@ class DeltaFormulation:
     #: homotopy time per anchor and generic solution: measured ~2.4 s per row of the bundled
     #: example (40 paths, a third of them ending at infinity through the endgame)
     seconds_per_root: float = 0.06
-
-    @property
-    def system(self) -> PolynomialSystem:
-        return stewart_system()
-
-    def start(self) -> StartSolutions:
-        return stewart_start()
 
     def parameters(self, input_values: ArrayLike) -> Array:
         X = _rows(input_values)

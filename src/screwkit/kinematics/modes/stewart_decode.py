@@ -117,8 +117,21 @@ def joint_values(mech: Mechanism, lay: GraphLayout, poses: dict[str, Pose]) -> C
     return Configuration(scalars, spherical)
 
 
+class StudyPlatformSystem:
+    """The 40-solution Study-coordinate system of a 6-6 platform (modes/stewart.py) and its
+    start solutions, for the formulations that solve a platform with it: the Stewart–Gough
+    platform here and the Delta robot (modes/delta.py)."""
+
+    @property
+    def system(self) -> PolynomialSystem:
+        return stewart_system()
+
+    def start(self) -> StartSolutions:
+        return stewart_start()
+
+
 @dataclass(frozen=True)
-class StewartFormulation:
+class StewartFormulation(StudyPlatformSystem):
     """A Stewart–Gough graph spec as a formulation of modes/every_mode.py: the 40-solution
     Study system (modes/stewart.py), its parameters from the leg slides, and the decoding of
     each real pose into the graph's joint variables (module docstring)."""
@@ -128,13 +141,6 @@ class StewartFormulation:
     #: measured homotopy time per anchor and generic solution (docs/kinematics.md: ~1.4 s per
     #: instance in a batch, 40 paths), for the time budget of modes/along.py
     seconds_per_root: float = 0.035
-
-    @property
-    def system(self) -> PolynomialSystem:
-        return stewart_system()
-
-    def start(self) -> StartSolutions:
-        return stewart_start()
 
     def parameters(self, input_values: ArrayLike) -> Array:
         return self.stewart.parameters(input_values)
