@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from balancing_examples import EXAMPLE, fourbar_spec
 
-from conftest import EXAMPLE, fourbar_spec
 from screwkit.balancing import BalancingError
 from screwkit.io.balance_tables import write_balance_tables
 from screwkit.io.spec import load_spec

@@ -7,8 +7,8 @@ import json
 
 import numpy as np
 import pytest
+from balancing_examples import EXAMPLE
 
-from conftest import EXAMPLE
 from screwkit.balancing import balance, point_mass_variables
 from screwkit.balancing.measures import MEASURES, load_rows
 from screwkit.dynamics import inverse_dynamics, regressor

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import json
 
-from conftest import fourbar_spec
+from balancing_examples import fourbar_spec
+
 from screwkit.io.spec import load_spec
 from screwkit.pipeline import balance_from_spec
 

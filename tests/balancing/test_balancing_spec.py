@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import pytest
+from balancing_examples import EXAMPLE
 
-from conftest import EXAMPLE
 from screwkit.balancing import BalancingError
 from screwkit.io.balancing_table import balancing_table, blocks_from_table
 from screwkit.io.spec import load_spec

@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from studio_serving import EXAMPLES, serving
 
-from conftest import EXAMPLES, serving
 from screwkit.io.spec import load_spec
 from screwkit.kinematics.registry import default_outputs
 from screwkit.pipeline import Pipeline

@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 import pytest
+from studio_serving import EXAMPLES
 from typer.testing import CliRunner
 
-from conftest import EXAMPLES
 from screwkit.cli.main import app
 from screwkit.io.spec import load_spec
 from screwkit.kinematics import warm_motion as warm_module
