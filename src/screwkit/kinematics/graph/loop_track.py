@@ -13,14 +13,16 @@ contraction test and the step-halving test near singular configurations, fold de
 σ_min of the passive Jacobian, steps over bifurcations), seeded at the drawing (every freedom 0,
 inputs 0) and run forwards along the straight approach to the first input row and then the rows
 — a drawn-mode request: no root searches. An S–S rod's idle spin is held at zero from the
-drawing on (tracker/idle_spin.py's zero-spin frame, as the loop's own mode build holds it). The graph's build (graph/motion.py ``build_mode``)
-then gives the rates, accelerations, points, outputs and singular classes from the stacked screw
-Jacobian, as for every graph.
+drawing on (tracker/idle_spin.py's zero-spin frame, as the loop's own mode build holds it). The
+graph's build (graph/motion.py ``build_mode``) then gives the rates, accelerations, points,
+outputs and singular classes from the stacked screw Jacobian, as for every graph.
 
 Mechanisms that are not one loop in frame form (several loops, driven body freedoms, parts made
 off their drawing, a U joint whose axes are not perpendicular) are followed by graph/track.py.
-Measured (benchmarks/bench_graph.py, same loop, same run): the loop engine follows a drawn RCCC
-driven at a cylinder in ~0.7× the graph tracker's CPU time and a drawn RSSR in ~1.1×.
+Measured (benchmarks/bench_graph.py, the same loop side by side, each with the graph's build):
+an RCCC driven at a cylinder in ~0.7× the graph tracker's CPU time, an RSSR in frame form in
+~1.25× (the following alone ~1.1×; the rest is its rod's zero-spin pose, which the graph
+tracker's minimum-norm steps leave drifting).
 """
 
 from __future__ import annotations
