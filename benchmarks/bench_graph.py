@@ -123,13 +123,8 @@ def _every_mode_rows(mech: Any, theta: np.ndarray, t_drawn: float) -> list[dict[
 def _single_loop_rows(theta: np.ndarray) -> list[dict[str, Any]]:
     """A single loop drawn as a graph against the same loop as a family (issue 26): the graph
     path hands it to the loop engine (graph/loop_subchain.py), so both run the family's closed
-    form; the graph path adds the stacked-closure rates, singularity classes and body frames.
-    And the measurement behind leaving loops without a closed form on the graph tracker: the
-    generic loop solver on the loop's joint list (frame form) against the graph tracker."""
-    from screwkit.kinematics.graph.closure import graph_layout
+    form; the graph path adds the stacked-closure rates, singularity classes and body frames."""
     from screwkit.kinematics.graph.from_loop import mechanism_from_loop
-    from screwkit.kinematics.graph.loop_motion import loop_motion
-    from screwkit.kinematics.graph.loop_subchain import loop_chain
 
     rows: list[dict[str, Any]] = []
     for name, lk in (("4R", sk.fourbar(a=4.0, d1=1.0, d2=3.5, d3=3.0)),
@@ -150,26 +145,60 @@ def _single_loop_rows(theta: np.ndarray) -> list[dict[str, Any]]:
                      "note": f"both the closed form: graph {t_graph / run.size * 1e6:.3g} "
                              f"µs/sample (the drawn mode), loop {t_loop / run.size * 1e6:.3g} "
                              "µs/sample (every mode)"})
-    # the graph tracker against the generic loop solver on the same drawn RSSR
-    lk = sk.rssr(1.0, 3.0, 2.0, 2.5, 1.0, 0.3)
-    graph = mechanism_from_loop(sk.solve_motion(lk, theta[:2]))
-    chain = loop_chain(graph, generic=True)
-    assert chain is not None
-    lay = graph_layout(graph)
-    X = theta[:, None]
-    ones, zeros = np.ones_like(X), np.zeros_like(X)
+    rows += _loop_engine_rows(theta)
+    return rows
 
-    def tracked() -> Any:
-        f = follow_drawn_mode(graph, lay, X)
-        return build_mode(graph, lay, f.conf, f.mask, X, ones, zeros, f.frames)
 
-    t_track = _best(tracked, 3)
-    t_generic = _best(lambda: loop_motion(graph, lay, chain, X, ones, zeros, False), 1)
-    rows.append({"name": "RSSR drawn, 3 600 samples: generic loop solver / graph tracker",
-                 "value": t_generic / t_track, "unit": "x", "target": None,
-                 "note": f"graph tracker {t_track / SAMPLES * 1e6:.3g} µs/sample (the route of "
-                         f"loops without a closed form), generic loop solver on the joint list "
-                         f"{t_generic / SAMPLES * 1e6:.3g} µs/sample"})
+def _loop_engine_rows(theta: np.ndarray) -> list[dict[str, Any]]:
+    """The drawn mode of a single loop without a closed form: followed by the loop engine's
+    continuation (graph/loop_track.py, the route solve_mechanism takes since issue 26's one
+    solving path) against the graph tracker it replaced for single loops (graph/track.py), both
+    with the graph's build (rates, accelerations, singular classes), alternated 5 times, median
+    CPU time: an RCCC driven at a cylinder over 28° and an RSSR in frame form over a turn (the
+    loop engine also holds its rod's idle spin, which the graph tracker lets drift)."""
+    from dataclasses import replace
+
+    from screwkit.kinematics.graph.from_loop import mechanism_from_loop
+    from screwkit.kinematics.graph.loop_subchain import loop_chain
+    from screwkit.kinematics.graph.loop_track import follow_drawn_loop
+
+    rccc = replace(sk.rccc((1.0, 1.5, 1.2, 1.4), (0.3, 0.5, -0.4, 0.6)), inputs=("C2.theta",),
+                   family=None)
+    cases = (("RCCC driven at a cylinder", mechanism_from_loop(sk.solve_motion(
+                 rccc, np.radians([0.0, 2.0]))), np.linspace(0.0, np.radians(28.0), SAMPLES)),
+             ("RSSR in frame form", mechanism_from_loop(sk.solve_motion(
+                 sk.rssr(1.0, 3.0, 2.0, 2.5, 1.0, 0.3), theta[:2])), theta))
+    rows: list[dict[str, Any]] = []
+    for name, graph, x in cases:
+        lay = graph_layout(graph)
+        chain = loop_chain(graph, generic=True)
+        assert chain is not None
+        X = x[:, None]
+        ones, zeros = np.ones_like(X), np.zeros_like(X)
+
+        def engine(g: Any = graph, lay: Any = lay, c: Any = chain, X: Any = X,
+                   o: Any = ones, z: Any = zeros) -> Any:
+            f = follow_drawn_loop(g, lay, c, X)
+            return build_mode(g, lay, f.conf, f.mask, X, o, z, f.frames)
+
+        def tracker(g: Any = graph, lay: Any = lay, X: Any = X, o: Any = ones,
+                    z: Any = zeros) -> Any:
+            f = follow_drawn_mode(g, lay, X)
+            return build_mode(g, lay, f.conf, f.mask, X, o, z, f.frames)
+
+        a, b = engine(), tracker()
+        ok = a.assembles & b.assembles
+        miss = float(np.max(np.abs(a.conf.scalars - b.conf.scalars)[ok]))
+        times: dict[str, list[float]] = {"engine": [], "tracker": []}
+        for _ in range(5):
+            times["engine"].append(_best(engine, 1))
+            times["tracker"].append(_best(tracker, 1))
+        t_e, t_t = (float(np.median(times[k])) for k in ("engine", "tracker"))
+        rows.append({"name": f"{name}, drawn, {x.size} samples: loop engine / graph tracker",
+                     "value": t_e / t_t, "unit": "x", "target": 1.0,
+                     "note": f"loop engine {t_e / x.size * 1e6:.3g} µs/sample, graph tracker "
+                             f"{t_t / x.size * 1e6:.3g} µs/sample (each with the graph's build; "
+                             f"median of 5 alternated); joint variables agree to {miss:.1e}"})
     return rows
 
 

@@ -126,10 +126,11 @@ def test_a_reversed_input_joint_turns_the_loop_the_other_way() -> None:
                                atol=1e-10)
 
 
-def test_a_loop_without_a_closed_form_stays_on_the_graph_route_and_its_joint_list_agrees() -> None:
-    """An RCCC driven at a cylinder (no closed form) is followed by the graph tracker; its
-    joint list in frame form (loop_chain(generic=True)) solved by the generic loop solver gives
-    the same motion, every joint variable 0 at the drawing and equal to the loop's."""
+def test_a_loop_without_a_closed_form_takes_the_loop_engine_and_its_joint_list_agrees() -> None:
+    """An RCCC driven at a cylinder (no closed form) has its drawn mode followed by the loop
+    engine's continuation (graph/loop_track.py); its joint list in frame form
+    (loop_chain(generic=True)) solved by the generic loop solver gives the same motion, every
+    joint variable 0 at the drawing and equal to the loop's."""
     from screwkit.kinematics.graph.closure import graph_layout
     from screwkit.kinematics.graph.loop_motion import loop_motion
 
@@ -147,6 +148,7 @@ def test_a_loop_without_a_closed_form_stays_on_the_graph_route_and_its_joint_lis
     looped = loop_motion(mech, graph_layout(mech), chain, X0, ones, zeros, False)
     tracked = solve_mechanism(mech, x - x[0])
     assert tracked.method == "graph" and looped.method == "graph (loop, generic)"
+    assert "loop engine" in tracked.solver
     ok = md.assembles
     for gm in (looped.modes[0], tracked.modes[0]):
         for f in lk.freedom_names:

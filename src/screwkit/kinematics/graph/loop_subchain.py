@@ -26,13 +26,13 @@ the ground) round to the ground. Two forms:
   the same variable; a U joint's two angles swap). This is the joint list the generic loop
   solver takes.
 
-Which single loops take this path (docs/mechanisms.md, "How a single loop drawn as a graph is
-solved"): those with a closed form. Any other single loop stays on the graph's own continuation
-(graph/track.py) and every-mode homotopy (modes/), the generic solver for every topology:
-measured in benchmarks/bench_graph.py, the generic loop solver on the frame-form joint list
-takes 2.5–5 times the graph tracker's time for the drawn mode (which every analysis needs); for
-every mode it was faster on one loop (an RSRC: ~45 against 680 µs per sample) and slower on
-another (an RSSR: ~120 against 48).
+Which single loops take which path (docs/mechanisms.md, "How a single loop drawn as a graph is
+solved"): those with a closed form the family's, every mode; any other single loop the frame
+form, its drawn mode followed by the loop engine's continuation (the generic loop solver's
+tracker, seeded at the drawing: graph/loop_track.py), and every mode, where asked for, by the
+every-mode homotopy (modes/). Measured in benchmarks/bench_graph.py, the loop engine follows
+a drawn loop in the graph tracker's time or less (its RSSR rod pose, held at zero spin, costs
+more); the graph tracker (graph/track.py) is left to mechanisms of several loops.
 
 The motion itself is graph/loop_motion.py's.
 """

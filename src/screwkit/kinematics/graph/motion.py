@@ -3,7 +3,8 @@
 A mechanism built of closed-form sub-chains (driven joints, planar dyads and RSS legs,
 graph/subchains.py) gets its drawn mode, and on request every mode, from their closed forms
 (graph/dyads.py, graph/legs.py, graph/closed_modes.py); any other has its drawn assembly mode
-followed along the inputs (graph/track.py). Then, for each mode, at every sample and all at
+followed along the inputs: a single loop by the loop engine's continuation (graph/loop_track.py),
+a mechanism of several loops by graph/track.py. Then, for each mode, at every sample and all at
 once, the body poses, the freedoms' rates and accelerations from the stacked screw
 Jacobian (graph/newton.py: J_p q̇_p = −J_in ẋ, J_p q̈_p = −J_in ẍ − bias), every body's twist and
 acceleration (graph/closure.py), joint centres and axes, and the paths of the points carried by
@@ -29,6 +30,7 @@ from screwkit.kinematics.graph.closure import (
     graph_layout,
     loop_residuals,
 )
+from screwkit.kinematics.graph.loop_track import follow_drawn
 from screwkit.kinematics.graph.newton import (
     RANK_CUTOFF,
     accelerations,
@@ -38,7 +40,6 @@ from screwkit.kinematics.graph.newton import (
 )
 from screwkit.kinematics.graph.singular import SINGULAR_TOL
 from screwkit.kinematics.graph.subchains import Decomposition, decompose
-from screwkit.kinematics.graph.track import follow_drawn_mode
 from screwkit.kinematics.motion import AssemblyError, ModeMotion
 from screwkit.kinematics.tracker.loop import Configuration, rotation_vector
 from screwkit.messages import given, listing
@@ -193,8 +194,10 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     A mechanism that decomposes into closed-form sub-chains (graph/subchains.py: driven joints,
     planar dyads, RSS legs) is solved by their closed forms (graph/dyads.py, legs.py), and with
     ``every_mode`` every other assembly mode follows the drawn one (graph/closed_modes.py);
-    any other mechanism by continuation of the drawn mode (graph/track.py; ``every_mode``
-    then has nothing more to add: the motion's notes say so)."""
+    any other mechanism by continuation of the drawn mode (graph/loop_track.py for a single
+    loop, graph/track.py otherwise; ``every_mode`` then adds the homotopy's modes where a
+    formulation takes the mechanism, modes/along.py, and the motion's notes say so where none
+    does)."""
     if mech.drives:
         return _solve_driven(mech, inputs, rates, accelerations, progress, every_mode)
     X = input_rows(mech, inputs)
@@ -220,7 +223,7 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
             progress(N, N)
         return motion
     start = reassemble_drawing(mech, lay) if misfits(mech) else None
-    followed = follow_drawn_mode(mech, lay, X, progress, start)
+    followed = follow_drawn(mech, lay, X, progress, start)
     if not followed.mask.any():
         where = ""
         if followed.reached is not None:
@@ -244,8 +247,9 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
         modes, notes = every_mode_motion(mech, lay, dec, X, Xd, Xdd, mode, followed.conf)
         method = "graph (homotopy at anchors, tracking between)" if len(notes) and \
             notes[0].startswith("every mode along") else "graph"
-        return MechanismMotion(mech, X, Xd, Xdd, modes, method=method, notes=notes)
-    return MechanismMotion(mech, X, Xd, Xdd, (mode,))
+        return MechanismMotion(mech, X, Xd, Xdd, modes, method=method, solver=followed.solver,
+                               notes=notes)
+    return MechanismMotion(mech, X, Xd, Xdd, (mode,), solver=followed.solver)
 
 
 CLOSED_FORM_SOLVER = ("closed-form sub-chains (driven joints, planar dyads, spatial legs; every "

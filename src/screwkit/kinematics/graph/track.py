@@ -142,6 +142,8 @@ class Followed:
     #: where the first sample is not reached: the last input on the straight way there from
     #: the drawing that assembles (the drawing, 0, if no step does)
     reached: Array | None = None
+    #: the continuation that followed it, for the motion's solver string
+    solver: str = "continuation from the drawn configuration on the stacked loop closure"
 
 
 def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
