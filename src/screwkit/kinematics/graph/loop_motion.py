@@ -6,7 +6,9 @@ on the inputs from the drawing (every input 0) along a straight approach to the 
 then along the rows, and returns each loop mode as the graph's body poses (the link frames
 times the drawn link frames' inverse: every body frame is the world frame in the drawing) and
 joint variables, angles counted continuously from the drawing for the drawn mode (the mode whose
-joint lines are the drawing's at the first sample). :func:`loop_motion` builds the rest of each
+joint lines are the drawing's at the first sample); for the drawn mode alone, where the family
+offers its closed form's branches, only the drawn branch's positions are built
+(:func:`drawn_branch`: the same numbers). :func:`loop_motion` builds the rest of each
 mode as for every graph (graph/motion.py's ``build_mode``: rates and accelerations from the
 stacked screw Jacobian, points, outputs, singularities) and locates where modes are born and
 die: at a fold of the loop, where the count of its real closed-form solutions changes by two,
