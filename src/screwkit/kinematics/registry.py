@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from screwkit.errors import CapabilityError, InputError, UnknownNameError
 from screwkit.kinematics.closed_forms import seed_names
@@ -27,8 +27,13 @@ from screwkit.model import geometry as geometries
 from screwkit.model.geometry import LoopGeometry
 from screwkit.model.linkage import Linkage
 
+if TYPE_CHECKING:
+    from screwkit.kinematics.closed_forms.closed_form_motion import ClosedBranches
+
 Named = dict[str, Array]
 ClosedForm = Callable[[Linkage, Array, Array, Array], Motion]
+#: a closed form's modes before they are built (closed_form_motion.ClosedBranches)
+ClosedFormBranches = Callable[[Linkage, Array, Array, Array], "ClosedBranches"]
 SeedNames = Callable[[Linkage, ModeMotion], tuple[Named, Named, Named]]
 ClosedLimits = Callable[..., Any]  # (linkage, dwell_tolerance, max_order, at) -> LimitPositions
 
@@ -68,6 +73,9 @@ class Family:
     closed_form: ClosedForm | None = None
     #: whether the closed form solves a given loop of the family (None: every loop)
     closed_form_applies: Callable[[Linkage], bool] | None = None
+    #: the closed form's modes as branches before they are built (the same configurations and
+    #: numbering; None: only the whole Motion is offered)
+    closed_branches: ClosedFormBranches | None = None
     seed_names: SeedNames | None = None
     capabilities: frozenset[str] = _EVERY_LOOP
     aliases: tuple[str, ...] = ()
@@ -102,6 +110,13 @@ class Family:
             return None
         return self.closed_form
 
+    def closed_branches_for(self, linkage: Linkage) -> ClosedFormBranches | None:
+        """The closed form's branches for ``linkage`` (where :meth:`closed_form_for` applies
+        and the family offers them), or None."""
+        if self.closed_branches is None or self.closed_form_for(linkage) is None:
+            return None
+        return self.closed_branches
+
     def linkage(self, **dimensions: float) -> Linkage:
         """The family's loop from its dimensions (SI units, radians)."""
         if self.build is None:
@@ -134,6 +149,24 @@ def _rccc_closed(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
     return rccc_closed_motion(linkage, X, Xd, Xdd)
 
 
+def _rsrc_branches(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> ClosedBranches:
+    from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_branches
+
+    return rsrc_branches(linkage, X, Xd, Xdd)
+
+
+def _rssr_branches(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> ClosedBranches:
+    from screwkit.kinematics.closed_forms.closed_form_motion import rssr_branches
+
+    return rssr_branches(linkage, X, Xd, Xdd)
+
+
+def _rccc_branches(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> ClosedBranches:
+    from screwkit.kinematics.closed_forms.closed_form_motion import rccc_branches
+
+    return rccc_branches(linkage, X, Xd, Xdd)
+
+
 def _is_rccc(linkage: Linkage) -> bool:
     from screwkit.kinematics.closed_forms.rccc import rccc_applies
 
@@ -164,7 +197,8 @@ FAMILIES: dict[str, Family] = {
             "RSRC", "the RSRC", "Bagci's RSRC space mechanism (input R, S, coupler R, output C)",
             {"d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH, "a": _LENGTH, "b": _LENGTH,
              "e": _LENGTH, "delta0": _ANGLE, "lambda0": _ANGLE},
-            build=constructors.rsrc, closed_form=_rsrc_closed, seed_names=seed_names.rsrc_names,
+            build=constructors.rsrc, closed_form=_rsrc_closed, closed_branches=_rsrc_branches,
+            seed_names=seed_names.rsrc_names,
             aliases=("rsrc",), sketch=constructors.RSRC_SKETCH,
             capabilities=_EVERY_LOOP | {"closed_synthesis", "overlay"},
             seed_freedoms={"theta0": ("input.theta", 1.0), "phi0": ("output_C.theta", -1.0),
@@ -174,7 +208,7 @@ FAMILIES: dict[str, Family] = {
         Family(
             "4R", "the planar 4R", "planar four-bar (Bagci's special case of the RSRC)",
             {"a": _LENGTH, "d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH},
-            build=constructors.fourbar, closed_form=_rsrc_closed,
+            build=constructors.fourbar, closed_form=_rsrc_closed, closed_branches=_rsrc_branches,
             seed_names=seed_names.fourbar_names,
             aliases=("4r", "fourbar"), sketch=constructors.FOURBAR_SKETCH,
             capabilities=_EVERY_LOOP | {"closed_synthesis"},
@@ -200,6 +234,7 @@ FAMILIES: dict[str, Family] = {
             {"d1": _LENGTH, "d2": _LENGTH, "d3": _LENGTH, "a": _LENGTH, "b": _LENGTH,
              "lambda0": _ANGLE, "output_offset": _LENGTH},
             optional={"output_offset": 0.0}, build=constructors.rssr, closed_form=_rssr_closed,
+            closed_branches=_rssr_branches,
             seed_names=seed_names.rssr_names, aliases=("rssr",),
             why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch=constructors.RSSR_SKETCH,
@@ -212,14 +247,15 @@ FAMILIES: dict[str, Family] = {
             {"a1": _LENGTH, "a2": _LENGTH, "a3": _LENGTH, "a4": _LENGTH, "alpha1": _ANGLE,
              "alpha2": _ANGLE, "alpha3": _ANGLE, "alpha4": _ANGLE, "input_offset": _LENGTH},
             optional={"input_offset": 0.0}, build=_rccc, closed_form=_rccc_closed,
-            closed_form_applies=_is_rccc, aliases=("rccc",),
+            closed_branches=_rccc_branches, closed_form_applies=_is_rccc, aliases=("rccc",),
             why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch=constructors.RCCC_SKETCH, outputs=("C4.theta", "C4.s"), coupler_link="link2",
             geometry=geometries.rccc_geometry, max_modes=2),
         Family(
             "LOOP", "a joint-list loop", "any single loop given as a joint list (generic solver; "
             "the RCCC closed form for an R C C C list driven at its R joint)", {},
-            closed_form=_rccc_closed, closed_form_applies=_is_rccc, aliases=("loop",),
+            closed_form=_rccc_closed, closed_branches=_rccc_branches,
+            closed_form_applies=_is_rccc, aliases=("loop",),
             why_not={"closed_synthesis": _NOT_CLOSED, "overlay": _NOT_OVERLAY},
             sketch="[[joints]]: name, kind (R P C H U S), length, twist, offset, pitch, input "
                    "(Hartenberg-Denavit, Rahman eq. 2.2)"),

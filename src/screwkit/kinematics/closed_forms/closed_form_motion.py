@@ -20,7 +20,7 @@ input-output equation A cos x + B sin x = K first, then the one with −acos.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -44,7 +44,10 @@ from screwkit.kinematics.tracker.mode_frames import (
 from screwkit.model.linkage import Linkage
 
 if TYPE_CHECKING:
-    from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions
+    from screwkit.kinematics.closed_forms.rccc import RCCCDimensions, RCCCMotion
+    from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, RSRCMotion
+    from screwkit.kinematics.closed_forms.rssr import RSSRDimensions, RSSRMotion
+    from screwkit.kinematics.tracker.loop import Layout
 
 RSRC_SOLVER = "RSRC closed form: quartic in tan(φ0/2) (Bagci 1969 eqs. 3.59–3.82)"
 RSSR_SOLVER = ("RSSR closed form: A cos φ0 + B sin φ0 = K from the crank circles and the coupler "
@@ -53,6 +56,35 @@ RCCC_SOLVER = ("RCCC closed form: the dual input-output equation Â cos θ̂4 + 
                "(transference of the spherical four-bar; kinematics/closed_forms/rccc.py)")
 FOURBAR_SOLVER = "planar 4R closed form: Bagci's RSRC with δ0 = λ0 = b = e = 0 (§3.4)"
 CSSP_SOLVER = "CSSP closed form: quadratic in s4 (Rahman 1996 §1.2)"
+
+
+#: every sample of a sweep
+ALL = slice(None)
+#: a branch's joint configurations at the samples ``rows`` of the sweep: (branch, rows)
+BranchConfiguration = Callable[[int, slice], Configuration]
+
+
+@dataclass(frozen=True)
+class ClosedBranches:
+    """A closed form's modes before they are built (issue 26: the graph's drawn mode needs one
+    of them): per mode, in the adapter's mode order, the samples where it assembles, and its
+    joint configurations, built on demand (``configuration(mode, rows)``, ``rows`` a slice of
+    the sweep: ALL gives the ones the adapter hands to :func:`mode_from_configuration`)."""
+
+    assembles: tuple[NDArray[np.bool_], ...]
+    configuration: BranchConfiguration
+    solver: str
+
+
+def _branches(assembles: NDArray[np.bool_], configuration: BranchConfiguration,
+              solver: str) -> ClosedBranches:
+    """The branches (columns of ``assembles``) that assemble somewhere, as modes."""
+    cols = [j for j in range(assembles.shape[1]) if assembles[:, j].any()]
+
+    def of_mode(m: int, rows: slice) -> Configuration:
+        return configuration(cols[m], rows)
+
+    return ClosedBranches(tuple(assembles[:, j].copy() for j in cols), of_mode, solver)
 
 
 def _with_seed(mode: ModeMotion, index: int, label: str, seed: tuple[dict[str, Array], ...],
@@ -105,33 +137,18 @@ def rsrc_dimensions(linkage: Linkage) -> tuple[RSRCDimensions, bool]:
 def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
     """Every assembly mode of Bagci's RSRC (or its planar 4R case) from the quartic; the
     branches of :func:`~screwkit.kinematics.closed_forms.rsrc.rsrc_motion` become modes."""
-    from screwkit.kinematics.closed_forms.rsrc import rsrc_motion
-
-    dims, planar = rsrc_dimensions(linkage)
-    p = dict(linkage.parameters)
+    dims, planar, mot, lay, configuration = _rsrc_solution(linkage, X, Xd, Xdd)
     theta = X[:, 0]
-    mot = rsrc_motion(dims, theta, Xd[:, 0], Xdd[:, 0])
     rates = mot.rates
-    lay = layout(linkage)
     modes: list[ModeMotion] = []
     expect_modes(int(mot.assembles.any(axis=0).sum()))
     for j in range(mot.phi0.shape[1]):
         ok = mot.assembles[:, j]
         if not ok.any():
             continue
-        phi = np.where(ok, mot.phi0[:, j], 0.0)
-        chi = np.where(ok, mot.chi0[:, j], 0.0)
-        s = np.where(ok, mot.S[:, j], 0.0)
         events = [f"{e.kind} assembling at input {format_inputs(linkage, np.array([e.theta0]))} "
                   "(limit position or dead centre)" for e in mot.events if e.branch == j]
-        if planar:
-            conf = _fourbar_configuration(p, theta, phi)
-        else:
-            scalars = np.zeros((len(theta), lay.n_scalar))
-            for name, values in (("input.theta", theta), ("coupler_R.theta", chi),
-                                 ("output_C.theta", -phi), ("output_C.s", s)):
-                scalars[:, lay.scalar_col[lay.names.index(name)]] = values
-            conf = close_spherical_joint(linkage, scalars, lay)
+        conf = configuration(j, ALL)
         md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd, events)
         seed_v = {"theta0": theta, "phi0": mot.phi0[:, j], "chi0": mot.chi0[:, j]}
         seed_d = {"theta0": Xd[:, 0], "phi0": rates.phi0_dot[:, j], "chi0": rates.chi0_dot[:, j]}
@@ -151,6 +168,42 @@ def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         raise _no_modes(linkage, X, describe_intervals(assembling_intervals(dims)))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed",
                   solver=FOURBAR_SOLVER if planar else RSRC_SOLVER)
+
+
+def _rsrc_solution(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> tuple[
+        RSRCDimensions, bool, RSRCMotion, Layout, BranchConfiguration]:
+    """Bagci's dimensions, whether the loop is the planar 4R, the quartic's branches over the
+    sweep (:func:`~screwkit.kinematics.closed_forms.rsrc.rsrc_motion`), the loop's layout and
+    branch j's joint configurations (θ0, χ0, −φ0 and S on the loop's joints, the ball closing
+    the loop; the 4R's from θ0 and φ0)."""
+    from screwkit.kinematics.closed_forms.rsrc import rsrc_motion
+
+    dims, planar = rsrc_dimensions(linkage)
+    p = dict(linkage.parameters)
+    theta = X[:, 0]
+    mot = rsrc_motion(dims, theta, Xd[:, 0], Xdd[:, 0])
+    lay = layout(linkage)
+
+    def configuration(j: int, rows: slice = ALL) -> Configuration:
+        ok, th = mot.assembles[rows, j], theta[rows]
+        phi = np.where(ok, mot.phi0[rows, j], 0.0)
+        if planar:
+            return _fourbar_configuration(p, th, phi)
+        chi = np.where(ok, mot.chi0[rows, j], 0.0)
+        s = np.where(ok, mot.S[rows, j], 0.0)
+        scalars = np.zeros((len(th), lay.n_scalar))
+        for name, values in (("input.theta", th), ("coupler_R.theta", chi),
+                             ("output_C.theta", -phi), ("output_C.s", s)):
+            scalars[:, lay.scalar_col[lay.names.index(name)]] = values
+        return close_spherical_joint(linkage, scalars, lay)
+
+    return dims, planar, mot, lay, configuration
+
+
+def rsrc_branches(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> ClosedBranches:
+    """:func:`rsrc_closed_motion`'s modes as branches, before they are built."""
+    _, planar, mot, _, configuration = _rsrc_solution(linkage, X, Xd, Xdd)
+    return _branches(mot.assembles, configuration, FOURBAR_SOLVER if planar else RSRC_SOLVER)
 
 
 def _fourbar_configuration(p: dict[str, float], theta: Array, phi: Array) -> Configuration:
@@ -250,26 +303,18 @@ def _branch_events(linkage: Linkage, X: Array, ok: NDArray[np.bool_]) -> list[st
 def rssr_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Motion:
     """Both roots of the RSSR's input-output equation (:mod:`screwkit.kinematics.closed_forms.rssr`) as
     modes, with θ0, φ0 and the closed form's own rates of φ0 under the seed's names."""
-    from screwkit.kinematics.closed_forms.rssr import RSSRDimensions, rssr_motion
+    from screwkit.kinematics.closed_forms.rssr import rssr_motion
 
-    dims = RSSRDimensions(**dict(linkage.parameters))
+    dims, mot, lay, phis, configuration = _rssr_solution(linkage, X)
     theta = X[:, 0]
-    mot = rssr_motion(dims, theta)
-    lay = layout(linkage)
-    base = linkage.base.real
-    first, out = (f"{linkage.joints[k].name}.theta" for k in (0, 3))
     modes: list[ModeMotion] = []
     expect_modes(int(mot.assembles.any(axis=0).sum()))
     for j, label in ((0, "+acos root"), (1, "-acos root")):
         ok = mot.assembles[:, j]
         if not ok.any():
             continue
-        phi = unwrap_runs(np.where(ok, mot.phi0[:, j], np.nan), ok)
-        scalars = np.zeros((len(theta), lay.n_scalar))
-        scalars[:, lay.scalar_col[lay.names.index(first)]] = theta
-        scalars[:, lay.scalar_col[lay.names.index(out)]] = -np.where(ok, phi, 0.0)
-        rod = np.where(ok[:, None], mot.coupler_ball[:, j] - mot.crank_ball, [1.0, 0.0, 0.0])
-        conf = _two_ball_configuration(linkage, scalars, rod @ base)
+        phi = phis(j)
+        conf = configuration(j, ALL)
         md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd,
                                      _branch_events(linkage, X, ok))
         rate = mot.dphi[:, j]
@@ -281,6 +326,42 @@ def rssr_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         raise _no_modes(linkage, X, _where_over_a_turn(
             lambda th: np.asarray(rssr_motion(dims, th).assembles.any(axis=1))))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=RSSR_SOLVER)
+
+
+def _rssr_solution(linkage: Linkage, X: Array) -> tuple[
+        RSSRDimensions, RSSRMotion, Layout, Callable[[int], Array], BranchConfiguration]:
+    """The RSSR's dimensions, both roots of its input-output equation over the sweep, the
+    loop's layout, root j's output angle φ0 (continuous along each run) and its joint
+    configurations (θ0 and −φ0 on the R joints, the rod along the two ball centres)."""
+    from screwkit.kinematics.closed_forms.rssr import RSSRDimensions, rssr_motion
+
+    dims = RSSRDimensions(**dict(linkage.parameters))
+    theta = X[:, 0]
+    mot = rssr_motion(dims, theta)
+    lay = layout(linkage)
+    base = linkage.base.real
+    first, out = (f"{linkage.joints[k].name}.theta" for k in (0, 3))
+
+    def phis(j: int) -> Array:
+        ok = mot.assembles[:, j]
+        return unwrap_runs(np.where(ok, mot.phi0[:, j], np.nan), ok)
+
+    def configuration(j: int, rows: slice = ALL) -> Configuration:
+        ok, th = mot.assembles[rows, j], theta[rows]
+        scalars = np.zeros((len(th), lay.n_scalar))
+        scalars[:, lay.scalar_col[lay.names.index(first)]] = th
+        scalars[:, lay.scalar_col[lay.names.index(out)]] = -np.where(ok, phis(j)[rows], 0.0)
+        rod = np.where(ok[:, None], mot.coupler_ball[rows, j] - mot.crank_ball[rows],
+                       [1.0, 0.0, 0.0])
+        return _two_ball_configuration(linkage, scalars, rod @ base)
+
+    return dims, mot, lay, phis, configuration
+
+
+def rssr_branches(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> ClosedBranches:
+    """:func:`rssr_closed_motion`'s modes as branches, before they are built."""
+    _, mot, _, _, configuration = _rssr_solution(linkage, X)
+    return _branches(mot.assembles, configuration, RSSR_SOLVER)
 
 
 def _where_over_a_turn(assembles: Callable[[Array], NDArray[np.bool_]]) -> str:
@@ -320,6 +401,31 @@ def rccc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     """Both roots of the RCCC's dual input-output equation (:mod:`screwkit.kinematics.closed_forms.rccc`)
     as modes; every joint's angle and slide from the closed form, rates from the loop's rate
     equations."""
+    from screwkit.kinematics.closed_forms.rccc import rccc_motion
+
+    dims, mot, lay, configuration = _rccc_solution(linkage, X)
+    modes: list[ModeMotion] = []
+    expect_modes(int(mot.assembles.any(axis=0).sum()))
+    for j, label in ((0, "+acos root"), (1, "-acos root")):
+        ok = mot.assembles[:, j]
+        if not ok.any():
+            continue
+        conf = configuration(j, ALL)
+        md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd,
+                                     _branch_events(linkage, X, ok))
+        modes.append(_with_seed(md, len(modes), label, ({}, {}, {}),
+                                singular=mot.dead_centre[:, j]))
+    if not modes:
+        raise _no_modes(linkage, X, _where_over_a_turn(
+            lambda th: np.asarray(rccc_motion(dims, th).assembles.any(axis=1))))
+    return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=RCCC_SOLVER)
+
+
+def _rccc_solution(linkage: Linkage, X: Array) -> tuple[
+        RCCCDimensions, RCCCMotion, Layout, BranchConfiguration]:
+    """The RCCC's dimensions, both roots of its dual input-output equation over the sweep, the
+    loop's layout and root j's joint configurations (every joint's angle and slide, the angles
+    continuous along each run)."""
     from screwkit.kinematics.closed_forms.rccc import rccc_dimensions, rccc_motion
 
     dims = rccc_dimensions(linkage)
@@ -329,21 +435,19 @@ def rccc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     theta = X[:, 0]
     mot = rccc_motion(dims, theta)
     lay = layout(linkage)
-    modes: list[ModeMotion] = []
-    expect_modes(int(mot.assembles.any(axis=0).sum()))
-    for j, label in ((0, "+acos root"), (1, "-acos root")):
+
+    def configuration(j: int, rows: slice = ALL) -> Configuration:
         ok = mot.assembles[:, j]
-        if not ok.any():
-            continue
         scalars = np.where(ok[:, None], mot.scalars[:, j], 0.0)
         for c in (1, 3, 5):
             scalars[:, c] = np.where(ok, unwrap_runs(scalars[:, c], ok), 0.0)
-        conf = Configuration(scalars, np.zeros((len(theta), 0, 3, 3)))
-        md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd,
-                                     _branch_events(linkage, X, ok))
-        modes.append(_with_seed(md, len(modes), label, ({}, {}, {}),
-                                singular=mot.dead_centre[:, j]))
-    if not modes:
-        raise _no_modes(linkage, X, _where_over_a_turn(
-            lambda th: np.asarray(rccc_motion(dims, th).assembles.any(axis=1))))
-    return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed", solver=RCCC_SOLVER)
+        scalars = scalars[rows]
+        return Configuration(scalars, np.zeros((len(scalars), 0, 3, 3)))
+
+    return dims, mot, lay, configuration
+
+
+def rccc_branches(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> ClosedBranches:
+    """:func:`rccc_closed_motion`'s modes as branches, before they are built."""
+    _, mot, _, configuration = _rccc_solution(linkage, X)
+    return _branches(mot.assembles, configuration, RCCC_SOLVER)

@@ -6,7 +6,9 @@ on the inputs from the drawing (every input 0) along a straight approach to the 
 then along the rows, and returns each loop mode as the graph's body poses (the link frames
 times the drawn link frames' inverse: every body frame is the world frame in the drawing) and
 joint variables, angles counted continuously from the drawing for the drawn mode (the mode whose
-joint lines are the drawing's at the first sample). :func:`loop_motion` builds the rest of each
+joint lines are the drawing's at the first sample); for the drawn mode alone, where the family
+offers its closed form's branches, only the drawn branch's positions are built
+(:func:`drawn_branch`: the same numbers). :func:`loop_motion` builds the rest of each
 mode as for every graph (graph/motion.py's ``build_mode``: rates and accelerations from the
 stacked screw Jacobian, points, outputs, singularities) and locates where modes are born and
 die: at a fold of the loop, where the count of its real closed-form solutions changes by two,
@@ -22,8 +24,9 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
 from screwkit.kinematics.graph.loop_subchain import APPROACH_STEP, LoopChain, is_drawing
-from screwkit.kinematics.motion import AssemblyError, Motion
+from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.kinematics.tracker.mode_frames import ModePoses
 from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]
@@ -39,13 +42,17 @@ class LoopModes:
     mode not asked for) and which mode is the drawn one (None: none passes through the
     drawing). With every mode asked for, the drawn loop mode's samples after the drawn mode's
     first fold, where it assembles again (an island entered twice), are one more entry, last:
-    ``again`` its index (None when the drawn loop mode does not come back)."""
+    ``again`` its index (None when the drawn loop mode does not come back). ``motion`` is the
+    loop's every-mode Motion (None when only the drawn mode was built, from the closed form's
+    branches), ``method`` and ``solver`` its solver's."""
 
-    motion: Motion
+    motion: Motion | None
     assembles: NDArray[np.bool_]
     confs: tuple[Configuration | None, ...]
     frames: tuple[GraphFrames | None, ...]
     drawn: int | None
+    method: str
+    solver: str
     again: int | None = None
 
 
@@ -62,18 +69,35 @@ def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
                every: bool = True) -> LoopModes:
     """Every loop mode over the approach (:func:`approach`) and ``X``, as graph configurations
     and body frames over the rows of ``X`` (module docstring): of the drawn mode alone unless
-    ``every``."""
+    ``every``, and then, where the family's closed form offers its branches, only the drawn
+    one's positions are built (:func:`drawn_branch`); the loop's modes otherwise."""
     from screwkit.kinematics.solve_motion import solve_motion
 
     A = approach(lay, X)
     rows = np.vstack([A, X])
-    motion = solve_motion(chain.linkage, chain.loop_inputs(rows), progress=False)
     a = A.shape[0]
-    drawn = next((m for m, md in enumerate(motion.modes) if is_drawing(mech, chain, md)), None)
+    L = chain.loop_inputs(rows)
+    found = None if every else drawn_branch(mech, chain, L)
+    motion: Motion | None = None
+    drawn: int | None
+    if found is not None:
+        drawn, assembles, poses, solver = found
+        mds: list[ModeMotion | ModePoses | None] = [None] * len(assembles)
+        mds[drawn] = poses
+        method = "closed"
+    else:
+        motion = solve_motion(chain.linkage, L, progress=False)
+        assembles = tuple(md.assembles for md in motion.modes)
+        mds = list(motion.modes)
+        method, solver = motion.method, motion.solver or motion.method
+        drawn = next((m for m, md in enumerate(motion.modes) if is_drawing(mech, chain, md)),
+                     None)
     if drawn is None:
-        return LoopModes(motion, np.zeros((0, X.shape[0]), dtype=bool), (), (), None)
-    R0 = motion.modes[drawn].link_rotation[0]
-    p0 = motion.modes[drawn].link_origin[0]
+        return LoopModes(motion, np.zeros((0, X.shape[0]), dtype=bool), (), (), None, method,
+                         solver)
+    drawn_md = mds[drawn]
+    assert drawn_md is not None
+    R0, p0 = drawn_md.link_rotation[0], drawn_md.link_origin[0]
     confs: list[Configuration | None] = []
     frames: list[GraphFrames | None] = []
     masks = []
@@ -87,8 +111,8 @@ def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         frames.append(GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes))
 
     later: NDArray[np.bool_] | None = None
-    for m, md in enumerate(motion.modes):
-        ok = np.array(md.assembles)
+    for m, md in enumerate(mds):
+        ok = np.array(assembles[m])
         if m == drawn:  # followed from the drawing: it ends where it first stops assembling
             stop = int(np.argmin(ok)) if not ok.all() else ok.size
             later = ok & (np.arange(ok.size) >= stop)
@@ -103,8 +127,43 @@ def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
     if every and later is not None and later[a:].any():
         again = len(masks)
         masks.append(later[a:])
-        add(motion.modes[drawn], later, False)
-    return LoopModes(motion, np.array(masks), tuple(confs), tuple(frames), drawn, again)
+        add(drawn_md, later, False)
+    return LoopModes(motion, np.array(masks), tuple(confs), tuple(frames), drawn, method,
+                     solver, again)
+
+
+def drawn_branch(mech: Mechanism, chain: LoopChain, L: Array
+                 ) -> tuple[int, tuple[NDArray[np.bool_], ...], ModePoses, str] | None:
+    """The drawn mode from the closed form's branches alone (registry ``closed_branches``) at
+    the loop inputs ``L``: its index in ``solve_motion``'s mode order, where each mode
+    assembles, the drawn mode's positions (tracker/mode_frames.py's ``mode_poses``, the
+    numbers ``solve_motion`` gives) and the solver's name. The first mode whose joint lines
+    at the first sample are the drawing's (:func:`is_drawing`, as on the whole Motion), found
+    from one sample per branch; None when the family has no branches, when no branch draws
+    the drawing, or when the chosen branch over the whole sweep is not the drawing (then the
+    caller solves every mode as before)."""
+    from screwkit.kinematics.registry import family_of
+    from screwkit.kinematics.tracker.loop import layout
+    from screwkit.kinematics.tracker.mode_frames import mode_poses
+
+    lk = chain.linkage
+    branches_of = family_of(lk).closed_branches_for(lk)
+    if branches_of is None:
+        return None
+    ones, zeros = np.ones_like(L), np.zeros_like(L)  # solve_motion's default rates
+    br = branches_of(lk, L, ones, zeros)
+    loop_lay = layout(lk)
+    first = slice(0, 1)
+    drawn = next((m for m, ok in enumerate(br.assembles) if ok[0] and is_drawing(
+        mech, chain, mode_poses(lk, loop_lay, br.configuration(m, first), ok[first], L[first]))),
+        None)
+    if drawn is None:
+        return None
+    ok = br.assembles[drawn]
+    poses = mode_poses(lk, loop_lay, br.configuration(drawn, slice(None)), ok, L)
+    if not is_drawing(mech, chain, poses):
+        return None
+    return drawn, br.assembles, poses, br.solver
 
 
 def _body_poses(mech: Mechanism, chain: LoopChain, md: object, R0: Array, p0: Array,
@@ -235,6 +294,7 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
     motion = lm.motion
     notes: tuple[str, ...] = ()
     if every:
+        assert motion is not None
         meet = [(r1, r2) for i, (r1, k1, x1, _) in enumerate(folds)
                 for (r2, k2, x2, _) in folds[i + 1:]
                 if k1 == k2 and np.allclose(x1, x2, rtol=0.0, atol=1e-9)]
@@ -245,9 +305,8 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
                  "on): " + ", ".join("{" + ", ".join(map(str, c)) + "}"
                                      for c in groups(len(modes), meet)),
                  *motion.notes)
-    return MechanismMotion(mech, X, Xd, Xdd, tuple(modes), method=f"graph (loop, {motion.method})",
-                           solver=LOOP_SOLVER.format(solver=motion.solver or motion.method),
-                           notes=notes)
+    return MechanismMotion(mech, X, Xd, Xdd, tuple(modes), method=f"graph (loop, {lm.method})",
+                           solver=LOOP_SOLVER.format(solver=lm.solver), notes=notes)
 
 
 def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
@@ -261,6 +320,7 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
 
     rows, ks = np.nonzero(masks[:, :-1] != masks[:, 1:])
     closed = family_of(chain.linkage).closed_form_for(chain.linkage)
+    branches_of = family_of(chain.linkage).closed_branches_for(chain.linkage)
     if rows.size == 0 or closed is None:
         return [(int(r), int(k), X[k + 1], f"{'dies' if masks[r, k] else 'is born'} between "
                  f"{input_text(mech, lay, X[k])} and {input_text(mech, lay, X[k + 1])}")
@@ -275,11 +335,15 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
 
     def count(t: Array) -> NDArray[np.intp]:
         """Real solutions at the inputs x0 + t (x1 − x0): the RSRC's quartic roots (Bagci 1969
-        eq. 3.63, as its own limit search counts them), else the closed form's modes there, the
-        drawing appended (so that at least one input assembles)."""
+        eq. 3.63, as its own limit search counts them), else the closed form's modes there (its
+        branches, the same count, where the family offers them), the drawing appended (so that
+        at least one input assembles)."""
         L = chain.loop_inputs(np.vstack([x0 + t[:, None] * (x1 - x0), np.zeros((1, X.shape[1]))]))
         if rsrc is not None:
             return np.asarray(rsrc_positions(rsrc, L[:-1, 0]).n_assemblies)
+        if branches_of is not None:
+            zero = np.zeros_like(L)
+            return np.sum(branches_of(chain.linkage, L, zero, zero).assembles, axis=0)[:-1]
         mo = closed(chain.linkage, L, np.zeros_like(L), np.zeros_like(L))
         return np.sum([md.assembles for md in mo.modes], axis=0)[:-1]
 

@@ -465,17 +465,28 @@ def _cssp(mech: Mechanism, joints: tuple[int, ...], bodies: tuple[str, ...]
 
 def _draws(mech: Mechanism, chain: LoopChain) -> bool:
     """Whether some mode of the chain's loop at its drawn input is the drawing (closed form,
-    two samples)."""
+    two samples; only the modes' positions where the family offers its branches)."""
     from screwkit.kinematics.registry import family_of
 
-    closed = family_of(chain.linkage).closed_form_for(chain.linkage)
+    lk = chain.linkage
+    closed = family_of(lk).closed_form_for(lk)
     assert closed is not None
+    branches_of = family_of(lk).closed_branches_for(lk)
     X = chain.offset[None, :] + np.array([[0.0], [1e-3]])
     try:
-        motion = closed(chain.linkage, X, np.ones_like(X), np.zeros_like(X))
+        if branches_of is None:
+            motion = closed(lk, X, np.ones_like(X), np.zeros_like(X))
+            return any(is_drawing(mech, chain, md) for md in motion.modes)
+        # the modes' positions alone (the numbers of the modes' own: mode_poses)
+        from screwkit.kinematics.tracker.loop import layout
+        from screwkit.kinematics.tracker.mode_frames import mode_poses
+
+        br = branches_of(lk, X, np.ones_like(X), np.zeros_like(X))
+        lay = layout(lk)
+        return any(ok[0] and is_drawing(mech, chain, mode_poses(
+            lk, lay, br.configuration(m, slice(None)), ok, X)) for m, ok in enumerate(br.assembles))
     except ValueError:
         return False
-    return any(is_drawing(mech, chain, md) for md in motion.modes)
 
 
 def is_drawing(mech: Mechanism, chain: LoopChain, md: object) -> bool:

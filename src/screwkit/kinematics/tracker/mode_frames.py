@@ -17,6 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,6 +40,7 @@ from screwkit.kinematics.tracker.rates import (
     RateEquations,
     rate_equations,
     solve_rates,
+    spin_links,
 )
 from screwkit.kinematics.tracker.singularities import classify, singular_events
 from screwkit.kinematics.tracker.solve import newton
@@ -199,6 +201,13 @@ def idle_spin_held(linkage: Linkage, lay: Layout, conf: Configuration,
                    ) -> tuple[Configuration, LoopFrames, RateEquations]:
     """The configurations with every S–S rod's idle spin held at zero along the sweep
     (:func:`~screwkit.kinematics.tracker.idle_spin.hold_idle_spin`), their frames and rate equations."""
+    conf, fr = _spin_held(linkage, lay, conf, mask, X, fr, eq)
+    return conf, fr, rate_equations(linkage, lay, fr, mask, exact_sigma=False)
+
+
+def _spin_held(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArray[np.bool_],
+               X: Array, fr: LoopFrames, eq: RateEquations) -> tuple[Configuration, LoopFrames]:
+    """:func:`idle_spin_held` without the rate equations of the result."""
     conf = hold_idle_spin(linkage, lay, conf, mask, X, fr, eq)
     # the turns about the rods' axes leave round-off in the closure: one Newton step
     # (minimum-norm, so it does not turn the rods back) restores it
@@ -206,8 +215,45 @@ def idle_spin_held(linkage: Linkage, lay: Layout, conf: Configuration,
     conf = Configuration(np.where(mask[:, None], polished.scalars, conf.scalars),
                          np.where(mask[:, None, None, None], polished.spherical,
                                   conf.spherical))
+    return conf, forward(linkage, conf, lay)
+
+
+@dataclass(frozen=True)
+class ModePoses:
+    """The positions of one assembly mode without its rates: the fields of
+    :class:`~screwkit.kinematics.motion.ModeMotion` of the same names, the same numbers."""
+
+    assembles: NDArray[np.bool_]
+    link_rotation: Array
+    link_origin: Array
+    joint_centres: Array
+    joint_axes: Array
+
+
+def mode_poses(linkage: Linkage, lay: Layout, conf: Configuration, mask: NDArray[np.bool_],
+               X: Array) -> ModePoses:
+    """The link frames, joint centres and axes that :func:`mode_from_configuration` gives for
+    the same arguments (an S–S rod's idle spin held as there), without the rate equations'
+    solution: a caller that needs one mode's positions picks it from several branches at the
+    cost of their frames only (graph/loop_motion.py)."""
+    mask = np.asarray(mask, dtype=bool)
     fr = forward(linkage, conf, lay)
-    return conf, fr, rate_equations(linkage, lay, fr, mask, exact_sigma=False)
+    if spin_links(linkage):
+        eq = rate_equations(linkage, lay, fr, mask, exact_sigma=False)
+        conf, fr = _spin_held(linkage, lay, conf, mask, X, fr, eq)
+    R, p, cen, axs = _world_poses(linkage, fr)
+    for arr in (R, p, cen, axs):
+        arr[~mask] = np.nan
+    return ModePoses(mask, R, p, cen, axs)
+
+
+def _world_poses(linkage: Linkage, fr: LoopFrames) -> tuple[Array, Array, Array, Array]:
+    """Every moving link's frame (rotation, origin), the joint centres and axes in the world
+    (the loop's base frame applied to its ground-frame poses)."""
+    nl = len(linkage.joints) - 1
+    bR, bp = linkage.base.real, linkage.base.translation
+    return (np.asarray(bR @ fr.after_R[:, :nl]), np.asarray(fr.after_p[:, :nl] @ bR.T) + bp,
+            np.asarray(fr.centres @ bR.T) + bp, np.asarray(fr.axes @ bR.T))
 
 
 def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
@@ -231,7 +277,7 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
     qd, qdd, link_V, link_A = rates.qd, rates.qdd, rates.link_V, rates.link_A
     # link frames and their motion in the world, per moving link i < n
     nl = len(linkage.joints) - 1
-    bR, bp = linkage.base.real, linkage.base.translation
+    bR = linkage.base.real
     w, v0 = link_V[:, :nl, :3], link_V[:, :nl, 3:]
     al, a0 = link_A[:, :nl, :3], link_A[:, :nl, 3:]
     p_g = fr.after_p[:, :nl]
@@ -241,10 +287,9 @@ def mode_from_configuration(linkage: Linkage, lay: Layout, conf: Configuration,
     def world(x: Array) -> Array:
         return np.asarray(x @ bR.T)
 
-    frames = [np.asarray(bR @ fr.after_R[:, :nl]), world(p_g) + bp]
+    R, p, cen, axs = _world_poses(linkage, fr)
+    frames = [R, p]
     twists = [world(w), world(v_o), world(al), world(a_o)]
-    cen = world(fr.centres) + bp
-    axs = world(fr.axes)
     _built(0.85)
     variables, velocities, accelerations = _variable_tables(linkage, lay, conf, mask, X, qd, qdd)
     xi_res = closure_residual(fr.closure_R, fr.closure_p, eq.rows)
