@@ -1,0 +1,148 @@
+"""Every solution of 6R loops (6R arm inverse kinematics, 7R loops at one input): elimination
+first, the parameter homotopy where elimination cannot promise all 16.
+
+:func:`solve_loop6r` runs the eigenvalue solver of :mod:`.sixr_elimination` (Raghavan & Roth
+1993; Manocha & Canny 1994) on every instance of a batch, polishes its 16 solutions by Newton's
+method on the polynomial system of :mod:`.loop6r` (the axes z2..z5; Sommese & Wampler 2005,
+ch. 9) and certifies them by Smale's α-test (algebraic/certify.py). An instance whose 16 are
+not all certified and distinct (a special geometry: a singular leading matrix, a double root, a
+solution at a shifted half-angle of ∞, fewer than 16 finite solutions) is solved again by the
+parameter homotopy from the stored start solutions (algebraic/solve.py), which finds every
+isolated solution there is. The result is the homotopy's :class:`Solutions`, the same layout and
+checks for either route, with ``route`` naming per instance the method that ran.
+"""
+
+from __future__ import annotations
+
+from dataclasses import fields
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.algebraic.certify import Certificate, bombieri_weyl_norm, certify, distinct
+from screwkit.algebraic.path import TrackOptions
+from screwkit.algebraic.polynomial import Complex, PolynomialSystem
+from screwkit.algebraic.solve import Solutions, collect_solutions
+from screwkit.algebraic.track import PathStatus, track_parameter_homotopy
+from screwkit.errors import InputError
+from screwkit.kinematics.modes.loop6r import (
+    LOOP6R_GENERIC_COUNT,
+    PARAMETER_NAMES,
+    loop6r_start,
+    loop6r_system,
+)
+from screwkit.kinematics.modes.sixr_elimination import eliminate
+
+#: Newton steps at most on the eigen route's points before the α-test (each roughly squares the
+#: error; the points arrive within ~1e-12..1e-6 relative: one step reaches round-off for most)
+NEWTON_STEPS = 3
+#: a Newton step this small (relative) leaves the point at round-off: no further step there
+SETTLED = 1e-10
+ELIMINATION = "elimination (Raghavan & Roth; 24 × 24 eigenproblem)"
+HOMOTOPY = "parameter homotopy (elimination fell short of 16 certified)"
+
+
+def _targets(params: ArrayLike) -> Complex:
+    p = np.asarray(params, dtype=complex)
+    k = len(PARAMETER_NAMES)
+    if p.ndim not in (1, 2) or p.shape[-1] != k:
+        raise InputError(f"6R parameters must have shape ({k},) or (B, {k}); got {p.shape}")
+    if not np.isfinite(p).all():
+        raise InputError("6R parameters must be finite")
+    return p.reshape(-1, k)
+
+
+def _newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Complex:
+    """Up to ``steps`` Newton steps on F(·; p) from x (P, n), each after the first only at the
+    points whose last step exceeded :data:`SETTLED` (relative); a point whose Jacobian is
+    singular or not finite is left where it is (its certificate will fail)."""
+    x = x.copy()
+    n = x.shape[1]
+    active = np.arange(len(x))
+    for _ in range(steps):
+        if not len(active):
+            break
+        xa, pa = x[active], p[active]
+        with np.errstate(all="ignore"):
+            F, J, _ = system.evaluate(xa, pa, want_jp=False)
+            ok = np.isfinite(F).all(1) & np.isfinite(J).all((1, 2))
+            J = np.where(ok[:, None, None], J, np.eye(n))
+            try:
+                step = np.linalg.solve(J, np.where(ok[:, None], F, 0.0)[..., None])[..., 0]
+            except np.linalg.LinAlgError:  # an exactly singular Jacobian somewhere
+                step = np.einsum("pij,pj->pi", np.linalg.pinv(J), np.where(ok[:, None], F, 0.0))
+            ok &= np.isfinite(step).all(1)
+            x[active[ok]] = xa[ok] - step[ok]
+            size = np.abs(step).max(1) / (1.0 + np.abs(xa).max(1))
+        active = active[ok & (size > SETTLED)]
+    return x
+
+
+def eigen_route(params: ArrayLike) -> tuple[Complex, NDArray[np.bool_], Certificate]:
+    """The polished eigen-route solutions (B, 16, 12) of instances (B, 23), whether each
+    instance's 16 are all certified (α-test) and pairwise distinct (B,), and the α-test of
+    every point (B·16)."""
+    targets = _targets(params)
+    B, m = len(targets), LOOP6R_GENERIC_COUNT
+    system = loop6r_system()
+    x, _ = eliminate(targets)
+    p = np.repeat(targets, m, axis=0)
+    x = _newton(system, x.reshape(B * m, -1), p, NEWTON_STEPS)
+    finite = np.isfinite(x).all(1)
+    x = np.where(finite[:, None], x, 0.0)
+    cert = certify(system, x, p, fast=True,
+                   norm_f=np.repeat(bombieri_weyl_norm(system, targets), m))
+    good = cert.certified & finite
+    instance = np.repeat(np.arange(B), m)
+    label = distinct(x, np.where(good, cert.radius, np.inf), instance)
+    unique = (label == np.arange(B * m)) & good
+    ok = np.bincount(instance[unique], minlength=B) == m
+    return x.reshape(B, m, -1), ok, cert
+
+
+def _rows(cert: Certificate, rows: NDArray[np.intp]) -> Certificate:
+    """The certificate of the points ``rows``."""
+    return Certificate(**{f.name: (None if getattr(cert, f.name) is None
+                                   else getattr(cert, f.name)[rows]) for f in fields(cert)})
+
+
+def _joined(a: Certificate, b: Certificate) -> Certificate:
+    return Certificate(**{f.name: np.concatenate([getattr(a, f.name), getattr(b, f.name)])
+                          for f in fields(a)})
+
+
+def solve_loop6r(params: ArrayLike, options: TrackOptions | None = None) -> Solutions:
+    """Every isolated solution of 6R instances (23,) or (B, 23) (:mod:`.loop6r`'s parameters):
+    the eigen route, the parameter homotopy (``options``) for the instances it does not
+    settle (module docstring). ``route`` says which ran for each instance."""
+    targets = _targets(params)
+    B, m = len(targets), LOOP6R_GENERIC_COUNT
+    x_eig, ok, cert = eigen_route(targets)
+    cert = _rows(cert, np.flatnonzero(np.repeat(ok, m)))
+    xs = [x_eig[ok].reshape(-1, x_eig.shape[2])]
+    inst = [np.repeat(np.flatnonzero(ok), m)]
+    status = [np.full(len(inst[0]), PathStatus.REGULAR, dtype=np.int8)]
+    mult = [np.ones(len(inst[0]), dtype=np.int64)]
+    at_infinity, failed = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)
+    start = loop6r_start()
+    redo = np.flatnonzero(~ok)
+    if len(redo):
+        system, r = loop6r_system(), len(start.x)
+        instance = np.repeat(redo, r)
+        res = track_parameter_homotopy(system, start.p, targets[instance],
+                                       np.tile(start.x, (len(redo), 1)), options,
+                                       instance=np.repeat(np.arange(len(redo)), r))
+        end = (res.status == PathStatus.REGULAR) | (res.status == PathStatus.SINGULAR)
+        cert = _joined(cert, certify(system, res.x[end], targets[instance[end]]))
+        xs.append(res.x[end])
+        inst.append(instance[end])
+        status.append(res.status[end])
+        mult.append(res.multiplicity[end])
+        at_infinity += np.bincount(instance[res.status == PathStatus.AT_INFINITY], minlength=B)
+        failed += np.bincount(instance[res.status == PathStatus.FAILED], minlength=B)
+    route = tuple(ELIMINATION if good else HOMOTOPY for good in ok)
+    how = (f"{ELIMINATION} on {int(ok.sum())} of {B} instances; the homotopy on the others "
+           f"from the start solutions ({start.how_found})")
+    return collect_solutions(loop6r_system(), targets, np.concatenate(xs),
+                             np.concatenate(inst), np.concatenate(status), np.concatenate(mult),
+                             at_infinity, failed, m, how, route, cert)
