@@ -5,9 +5,9 @@ first, the parameter homotopy where elimination cannot promise all 16.
 1993; Manocha & Canny 1994) on every instance of a batch, polishes its 16 solutions by Newton's
 method on the polynomial system of :mod:`.loop6r` (the axes z2..z5; Sommese & Wampler 2005,
 ch. 9) and certifies them by Smale's α-test (algebraic/certify.py). An instance whose 16 are
-not all certified and distinct (a special geometry: a singular leading matrix, a double root, a
-solution at a shifted half-angle of ∞, fewer than 16 finite solutions) is solved again by the
-parameter homotopy from the stored start solutions (algebraic/solve.py), which finds every
+not all settled and distinct (a special geometry: a singular leading matrix, a double root, a
+solution at a shifted half-angle of ∞, fewer than 16 finite solutions; :func:`eigen_route`)
+is solved again by the parameter homotopy from the stored start solutions (algebraic/solve.py), which finds every
 isolated solution there is. The result is the homotopy's :class:`Solutions`, the same layout and
 checks for either route, with ``route`` naming per instance the method that ran.
 """
@@ -15,6 +15,7 @@ checks for either route, with ``route`` naming per instance the method that ran.
 from __future__ import annotations
 
 from dataclasses import fields
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -38,8 +39,12 @@ from screwkit.kinematics.modes.sixr_elimination import eliminate
 NEWTON_STEPS = 3
 #: a Newton step this small (relative) leaves the point at round-off: no further step there
 SETTLED = 1e-10
+#: an uncertified point counts as a solution when its Newton step is this small (relative)
+CONVERGED = 1e-8
+#: and as distinct from another when they are this far apart (relative)
+DISTINCT = 1e-6
 ELIMINATION = "elimination (Raghavan & Roth; 24 × 24 eigenproblem)"
-HOMOTOPY = "parameter homotopy (elimination fell short of 16 certified)"
+HOMOTOPY = "parameter homotopy (elimination did not settle 16 distinct solutions)"
 
 
 def _targets(params: ArrayLike) -> Complex:
@@ -65,12 +70,14 @@ def _newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Com
         xa, pa = x[active], p[active]
         with np.errstate(all="ignore"):
             F, J, _ = system.evaluate(xa, pa, want_jp=False)
-            ok = np.isfinite(F).all(1) & np.isfinite(J).all((1, 2))
-            J = np.where(ok[:, None, None], J, np.eye(n))
+            ok: NDArray[np.bool_] = np.asarray(np.isfinite(F).all(1) & np.isfinite(J).all((1, 2)),
+                                               dtype=bool)
+            Js: Complex = np.where(ok[:, None, None], J, np.eye(n))
+            Fs: Complex = np.where(ok[:, None], F, 0.0)
             try:
-                step = np.linalg.solve(J, np.where(ok[:, None], F, 0.0)[..., None])[..., 0]
+                step: Complex = np.asarray(np.linalg.solve(Js, Fs[..., None])[..., 0], dtype=complex)
             except np.linalg.LinAlgError:  # an exactly singular Jacobian somewhere
-                step = np.einsum("pij,pj->pi", np.linalg.pinv(J), np.where(ok[:, None], F, 0.0))
+                step = np.asarray(np.einsum("pij,pj->pi", np.linalg.pinv(Js), Fs), dtype=complex)
             ok &= np.isfinite(step).all(1)
             x[active[ok]] = xa[ok] - step[ok]
             size = np.abs(step).max(1) / (1.0 + np.abs(xa).max(1))
@@ -80,21 +87,31 @@ def _newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Com
 
 def eigen_route(params: ArrayLike) -> tuple[Complex, NDArray[np.bool_], Certificate]:
     """The polished eigen-route solutions (B, 16, 12) of instances (B, 23), whether each
-    instance's 16 are all certified (α-test) and pairwise distinct (B,), and the α-test of
-    every point (B·16)."""
+    instance's 16 are all settled and pairwise distinct (B,), and the α-test of every point
+    (B·16).
+
+    A point is settled when certified (α-test; distinct from another when their balls of
+    radius 2β are disjoint) or, where the α-test cannot decide (an ill-conditioned solution,
+    e.g. one far out near infinity, which the homotopy cannot certify either), when its
+    Newton step is below :data:`CONVERGED` (relative; distinct when apart by more than
+    :data:`DISTINCT`, the homotopy's own rule in algebraic/solve.py)."""
     targets = _targets(params)
     B, m = len(targets), LOOP6R_GENERIC_COUNT
     system = loop6r_system()
     x, _ = eliminate(targets)
     p = np.repeat(targets, m, axis=0)
     x = _newton(system, x.reshape(B * m, -1), p, NEWTON_STEPS)
-    finite = np.isfinite(x).all(1)
+    finite: NDArray[np.bool_] = np.asarray(np.isfinite(x).all(1), dtype=bool)
     x = np.where(finite[:, None], x, 0.0)
     cert = certify(system, x, p, fast=True,
                    norm_f=np.repeat(bombieri_weyl_norm(system, targets), m))
-    good = cert.certified & finite
+    scale = 1.0 + np.abs(x).max(axis=1)
+    with np.errstate(invalid="ignore"):
+        settled = np.abs(x - cert.newton).max(axis=1) <= CONVERGED * scale
+    good = (cert.certified | settled) & finite
     instance = np.repeat(np.arange(B), m)
-    label = distinct(x, np.where(good, cert.radius, np.inf), instance)
+    label = distinct(x, np.where(cert.certified, cert.radius,
+                                 np.where(good, DISTINCT * scale, np.inf)), instance)
     unique = (label == np.arange(B * m)) & good
     ok = np.bincount(instance[unique], minlength=B) == m
     return x.reshape(B, m, -1), ok, cert
@@ -102,13 +119,15 @@ def eigen_route(params: ArrayLike) -> tuple[Complex, NDArray[np.bool_], Certific
 
 def _rows(cert: Certificate, rows: NDArray[np.intp]) -> Certificate:
     """The certificate of the points ``rows``."""
-    return Certificate(**{f.name: (None if getattr(cert, f.name) is None
-                                   else getattr(cert, f.name)[rows]) for f in fields(cert)})
+    parts: dict[str, Any] = {f.name: (None if getattr(cert, f.name) is None
+                                      else getattr(cert, f.name)[rows]) for f in fields(cert)}
+    return Certificate(**parts)
 
 
 def _joined(a: Certificate, b: Certificate) -> Certificate:
-    return Certificate(**{f.name: np.concatenate([getattr(a, f.name), getattr(b, f.name)])
-                          for f in fields(a)})
+    parts: dict[str, Any] = {f.name: np.concatenate([getattr(a, f.name), getattr(b, f.name)])
+                             for f in fields(a)}
+    return Certificate(**parts)
 
 
 def solve_loop6r(params: ArrayLike, options: TrackOptions | None = None) -> Solutions:
@@ -124,9 +143,11 @@ def solve_loop6r(params: ArrayLike, options: TrackOptions | None = None) -> Solu
     status = [np.full(len(inst[0]), PathStatus.REGULAR, dtype=np.int8)]
     mult = [np.ones(len(inst[0]), dtype=np.int64)]
     at_infinity, failed = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)
-    start = loop6r_start()
     redo = np.flatnonzero(~ok)
+    how = f"{ELIMINATION} on {int(ok.sum())} of {B} instances"
     if len(redo):
+        start = loop6r_start()  # found once per process, only when needed
+        how += f"; the parameter homotopy on the others ({start.how_found})"
         system, r = loop6r_system(), len(start.x)
         instance = np.repeat(redo, r)
         res = track_parameter_homotopy(system, start.p, targets[instance],
@@ -141,8 +162,6 @@ def solve_loop6r(params: ArrayLike, options: TrackOptions | None = None) -> Solu
         at_infinity += np.bincount(instance[res.status == PathStatus.AT_INFINITY], minlength=B)
         failed += np.bincount(instance[res.status == PathStatus.FAILED], minlength=B)
     route = tuple(ELIMINATION if good else HOMOTOPY for good in ok)
-    how = (f"{ELIMINATION} on {int(ok.sum())} of {B} instances; the homotopy on the others "
-           f"from the start solutions ({start.how_found})")
     return collect_solutions(loop6r_system(), targets, np.concatenate(xs),
                              np.concatenate(inst), np.concatenate(status), np.concatenate(mult),
                              at_infinity, failed, m, how, route, cert)

@@ -32,6 +32,7 @@ ran for each instance.
 from __future__ import annotations
 
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -132,12 +133,11 @@ def _products(t_a: Array, t_b: Array) -> Array:
 
 
 @lru_cache(maxsize=2)
-def _design(samples: int) -> dict[str, Array]:
+def _design(samples: int) -> dict[str, NDArray[Any]]:
     """The fixed sample angles (``samples`` per angle) and the pseudo-inverses of the two
     bases at them."""
     grid = 2.0 * np.pi * np.arange(samples) / samples + 0.1
-    t3, t4, t5 = np.meshgrid(grid, grid, grid, indexing="ij")
-    t3, t4, t5 = t3.ravel(), t4.ravel(), t5.ravel()
+    t3, t4, t5 = (v.ravel() for v in np.meshgrid(grid, grid, grid, indexing="ij"))
     shifted = [_trig3(t - phi) for t, phi in zip((t3, t4, t5), SHIFT, strict=True)]
     left = (shifted[0][:, :, None] * _products(shifted[1], shifted[2])[:, None, :])
     left = left.reshape(len(t3), 27)  # column 9·k3 + j45
@@ -256,7 +256,7 @@ def eliminate(params: ArrayLike) -> tuple[Complex, Array]:
     L[:, :, 26] -= R[:, :, 8]  # the right side's constant moves to the left
     Q = R[:, :, :8]
     U, sv, Vh = np.linalg.svd(Q)
-    N = np.swapaxes(U[:, :, 8:], 1, 2)  # (B, 6, 14): N Q = 0
+    N = np.swapaxes(U[:, :, 8:], 1, 2).conj()  # (B, 6, 14): N Q = 0
     M = (N @ L).reshape(-1, 6, 3, 9)
     P = np.einsum("bekj,kjmn->bemn", M, _monomial_map())  # (B, 6, x3 power, 9)
     B = len(p)
@@ -271,12 +271,8 @@ def eliminate(params: ArrayLike) -> tuple[Complex, Array]:
     comp[:, :12, 12:] = np.eye(12)
     comp[:, 12:] = -solve
     lam, W = np.linalg.eig(comp)
-    # drop the spurious roots: the four nearest +i and the four nearest −i
-    drop = np.concatenate([np.argsort(np.abs(lam - 1j), 1)[:, :4],
-                           np.argsort(np.abs(lam + 1j), 1)[:, :4]], 1)
-    keep = np.ones(lam.shape, dtype=bool)
-    np.put_along_axis(keep, drop, False, 1)
-    idx = np.flatnonzero(keep.ravel()).reshape(B, 16) % 24
+    # drop the spurious roots: the eight nearest ±i
+    idx = np.argsort(np.minimum(np.abs(lam - 1j), np.abs(lam + 1j)), 1)[:, 8:]
     x3 = np.take_along_axis(lam, idx, 1)
     W = np.take_along_axis(W, idx[:, None, :], 2)  # (B, 24, 16)
     v = np.where((np.abs(x3) <= 1.0)[:, None, :], W[:, :12], W[:, 12:])
