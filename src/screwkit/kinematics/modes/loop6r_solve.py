@@ -85,42 +85,64 @@ def _newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Com
     return x
 
 
-def eigen_route(params: ArrayLike) -> tuple[Complex, NDArray[np.bool_], Certificate]:
-    """The polished eigen-route solutions (B, 16, 12) of instances (B, 23), whether each
-    instance's 16 are all settled and pairwise distinct (B,), and the α-test of every point
-    (B·16).
+def eigen_route(params: ArrayLike
+                ) -> tuple[Complex, NDArray[np.intp], NDArray[np.bool_], Certificate]:
+    """The polished eigen-route solutions (P, 12) of instances (B, 23), sorted by their
+    instance (P,); whether each instance's are 16, all settled and pairwise distinct (B,);
+    and the α-test of every point (P).
 
     A point is settled when certified (α-test; distinct from another when their balls of
     radius 2β are disjoint) or, where the α-test cannot decide (an ill-conditioned solution,
     e.g. one far out near infinity, which the homotopy cannot certify either), when its
     Newton step is below :data:`CONVERGED` (relative; distinct when apart by more than
-    :data:`DISTINCT`, the homotopy's own rule in algebraic/solve.py)."""
+    :data:`DISTINCT`, the homotopy's own rule in algebraic/solve.py). A real instance's
+    system is real, so its solutions come in conjugate pairs with equal certificates: only
+    the solutions with Im x3 ≥ 0 are polished and certified, and the others are their
+    conjugates."""
     targets = _targets(params)
     B, m = len(targets), LOOP6R_GENERIC_COUNT
     system = loop6r_system()
-    x, _ = eliminate(targets)
-    p = np.repeat(targets, m, axis=0)
-    x = _newton(system, x.reshape(B * m, -1), p, NEWTON_STEPS)
-    finite: NDArray[np.bool_] = np.asarray(np.isfinite(x).all(1), dtype=bool)
-    x = np.where(finite[:, None], x, 0.0)
-    cert = certify(system, x, p, fast=True,
-                   norm_f=np.repeat(bombieri_weyl_norm(system, targets), m))
-    scale = 1.0 + np.abs(x).max(axis=1)
+    x, x3, _ = eliminate(targets)
+    real = np.all(targets.imag == 0, axis=1)[:, None]
+    sel = np.flatnonzero((~real | (x3.imag >= 0)).ravel())
+    inst = sel // m
+    twin = np.flatnonzero((real & (x3.imag > 0)).ravel()[sel])  # their conjugates solve too
+    p = targets[inst]
+    xs = _newton(system, x.reshape(B * m, -1)[sel], p, NEWTON_STEPS)
+    finite: NDArray[np.bool_] = np.asarray(np.isfinite(xs).all(1), dtype=bool)
+    xs = np.where(finite[:, None], xs, 0.0)
+    cert = certify(system, xs, p, fast=True, norm_f=bombieri_weyl_norm(system, targets)[inst])
+    xs = np.concatenate([xs, xs[twin].conj()])
+    inst = np.concatenate([inst, inst[twin]])
+    finite = np.concatenate([finite, finite[twin]])
+    cert = _joined(cert, _conjugate(_rows(cert, twin)))
+    order = np.argsort(inst, kind="stable")
+    xs, inst, finite, cert = xs[order], inst[order], finite[order], _rows(cert, order)
+    scale = 1.0 + np.abs(xs).max(axis=1)
     with np.errstate(invalid="ignore"):
-        settled = np.abs(x - cert.newton).max(axis=1) <= CONVERGED * scale
+        settled = np.abs(xs - cert.newton).max(axis=1) <= CONVERGED * scale
     good = (cert.certified | settled) & finite
-    instance = np.repeat(np.arange(B), m)
-    label = distinct(x, np.where(cert.certified, cert.radius,
-                                 np.where(good, DISTINCT * scale, np.inf)), instance)
-    unique = (label == np.arange(B * m)) & good
-    ok = np.bincount(instance[unique], minlength=B) == m
-    return x.reshape(B, m, -1), ok, cert
+    label = distinct(xs, np.where(cert.certified, cert.radius,
+                                  np.where(good, DISTINCT * scale, np.inf)), inst)
+    unique = (label == np.arange(len(xs))) & good
+    ok = (np.bincount(inst[unique], minlength=B) == m) & (np.bincount(inst, minlength=B) == m)
+    return xs, inst, ok, cert
 
 
 def _rows(cert: Certificate, rows: NDArray[np.intp]) -> Certificate:
     """The certificate of the points ``rows``."""
     parts: dict[str, Any] = {f.name: (None if getattr(cert, f.name) is None
                                       else getattr(cert, f.name)[rows]) for f in fields(cert)}
+    return Certificate(**parts)
+
+
+def _conjugate(cert: Certificate) -> Certificate:
+    """The certificate of the conjugate points of a real system: the same bounds, the
+    conjugate Newton points and values."""
+    parts: dict[str, Any] = {f.name: getattr(cert, f.name) for f in fields(cert)}
+    for name in ("newton", "value"):
+        if parts[name] is not None:
+            parts[name] = parts[name].conj()
     return Certificate(**parts)
 
 
@@ -136,10 +158,10 @@ def solve_loop6r(params: ArrayLike, options: TrackOptions | None = None) -> Solu
     settle (module docstring). ``route`` says which ran for each instance."""
     targets = _targets(params)
     B, m = len(targets), LOOP6R_GENERIC_COUNT
-    x_eig, ok, cert = eigen_route(targets)
-    cert = _rows(cert, np.flatnonzero(np.repeat(ok, m)))
-    xs = [x_eig[ok].reshape(-1, x_eig.shape[2])]
-    inst = [np.repeat(np.flatnonzero(ok), m)]
+    x_eig, i_eig, ok, cert = eigen_route(targets)
+    rows = np.flatnonzero(ok[i_eig])
+    cert = _rows(cert, rows)
+    xs, inst = [x_eig[rows]], [i_eig[rows]]
     status = [np.full(len(inst[0]), PathStatus.REGULAR, dtype=np.int8)]
     mult = [np.ones(len(inst[0]), dtype=np.int64)]
     at_infinity, failed = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)

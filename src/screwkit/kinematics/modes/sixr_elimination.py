@@ -244,10 +244,12 @@ def _axes_from_angles(chain: tuple[Complex, ...], cs: list[tuple[Complex, Comple
     return np.concatenate(out, -1)
 
 
-def eliminate(params: ArrayLike) -> tuple[Complex, Array]:
+def eliminate(params: ArrayLike) -> tuple[Complex, Complex, Array]:
     """The 16 solutions (B, 16, 12) of 6R instances (B, 23) by the eigenproblem (module
-    docstring), unpolished, and the condition number (B,) of Σ's leading matrix (the
-    companion form divides by it)."""
+    docstring), unpolished; their x3 (B, 16) (for real parameters, exact conjugate pairs and
+    exactly real values, as LAPACK returns the eigenvalues of a real matrix, so that a
+    solution with Im x3 < 0 is the conjugate of one with Im x3 > 0); and the condition number
+    (B,) of Σ's leading matrix (the companion form divides by it)."""
     p = _as_parameters(params)
     left, right, chain = _sides(p)
     D = _design(SAMPLES)
@@ -296,4 +298,4 @@ def eliminate(params: ArrayLike) -> tuple[Complex, Array]:
         cs.append((c_ / n, s_ / n))
     cs.append(_shifted_trig(x3, SHIFT[0]))
     cs.append(_shifted_trig(x4, SHIFT[1]))
-    return _axes_from_angles(chain, cs), np.asarray(lead_cond, dtype=float)
+    return _axes_from_angles(chain, cs), x3, np.asarray(lead_cond, dtype=float)
