@@ -153,19 +153,22 @@ def collect_solutions(system: PolynomialSystem, targets: Complex, x: Complex,
                       multiplicity: NDArray[np.int64], at_infinity: NDArray[np.int64],
                       failed: NDArray[np.int64], generic_count: int, how_found: str,
                       route: tuple[str, ...] | None = None,
-                      cert: Certificate | None = None) -> Solutions:
+                      cert: Certificate | None = None,
+                      label: NDArray[np.intp] | None = None) -> Solutions:
     """:class:`Solutions` from finite points x (M, n) of instances ``instance`` (M,) with
     parameters ``targets`` (B, k), each REGULAR or SINGULAR: certified (α-test), duplicates
     dropped, sorted per instance (real, then certified, first). ``at_infinity`` and ``failed``
     count paths per instance; ``route`` names the method per instance (the parameter
-    homotopy when None); ``cert`` the points' α-test when the caller has run it."""
+    homotopy when None); ``cert`` the points' α-test and ``label`` their duplicate labels
+    (:func:`~screwkit.algebraic.certify.distinct`) when the caller has them."""
     B = len(targets)
     if cert is None:
         cert = certify(system, x, targets[instance])
     regular = status == PathStatus.REGULAR
     radius = np.where(regular & cert.certified, cert.radius,
                       1e-6 * (1.0 + np.abs(x).max(axis=1, initial=0.0)))
-    label = distinct(x, radius, instance)
+    if label is None:
+        label = distinct(x, radius, instance)
     keep = label == np.arange(len(x))
     assert cert.value is not None and cert.terms is not None
     with np.errstate(all="ignore"):

@@ -186,4 +186,5 @@ def solve_loop6r(params: ArrayLike, options: TrackOptions | None = None) -> Solu
     route = tuple(ELIMINATION if good else HOMOTOPY for good in ok)
     return collect_solutions(loop6r_system(), targets, np.concatenate(xs),
                              np.concatenate(inst), np.concatenate(status), np.concatenate(mult),
-                             at_infinity, failed, m, how, route, cert)
+                             at_infinity, failed, m, how, route, cert,
+                             None if len(redo) else np.arange(len(xs[0])))

@@ -91,24 +91,22 @@ def dh_chain(params: Complex) -> tuple[Complex, Complex, Complex, Complex, Compl
     return cos_a, sin_a, a, d, R0
 
 
-def _rot_x(c: Complex, s: Complex) -> Complex:
-    one, zero = np.ones_like(c), np.zeros_like(c)
-    return np.stack([np.stack([one, zero, zero], -1), np.stack([zero, c, -s], -1),
-                     np.stack([zero, s, c], -1)], -2)
-
-
-def _rot_z(c: Complex, s: Complex) -> Complex:
-    one, zero = np.ones_like(c), np.zeros_like(c)
-    return np.stack([np.stack([c, -s, zero], -1), np.stack([s, c, zero], -1),
-                     np.stack([zero, zero, one], -1)], -2)
+def _rz_rx(c_t: Complex, s_t: Complex, c_a: Complex, s_a: Complex) -> Complex:
+    """Rot_z(θ)·Rot_x(α) (…, 3, 3) from the cosines and sines (broadcast together)."""
+    c_t, s_t, c_a, s_a = np.broadcast_arrays(c_t, s_t, c_a, s_a)
+    R = np.zeros(c_t.shape + (3, 3), dtype=np.result_type(c_t, c_a))
+    R[..., 0, 0], R[..., 0, 1], R[..., 0, 2] = c_t, -s_t * c_a, s_t * s_a
+    R[..., 1, 0], R[..., 1, 1], R[..., 1, 2] = s_t, c_t * c_a, -c_t * s_a
+    R[..., 2, 1], R[..., 2, 2] = s_a, c_a
+    return R
 
 
 def _link(c_t: Complex, s_t: Complex, c_a: Complex, s_a: Complex, a: Complex, d: Complex
           ) -> tuple[Complex, Complex]:
     """A_i as (R, t): R = Rot_z(θ)Rot_x(α), t = Rot_z(θ)(a, 0, d)."""
-    c_t, s_t, c_a, s_a, a, d = np.broadcast_arrays(c_t, s_t, c_a, s_a, a, d)
-    R = _rot_z(c_t, s_t) @ _rot_x(c_a, s_a)
-    t = np.stack([c_t * a, s_t * a, d], -1)
+    R = _rz_rx(c_t, s_t, c_a, s_a)
+    t = np.zeros(R.shape[:-1], dtype=R.dtype)
+    t[..., 0], t[..., 1], t[..., 2] = c_t * a, s_t * a, d
     return R, t
 
 
@@ -238,8 +236,7 @@ def _axes_from_angles(chain: tuple[Complex, ...], cs: list[tuple[Complex, Comple
     R = np.broadcast_to(R0[:, None], cs[0][0].shape + (3, 3))
     out = []
     for i, (c, s) in enumerate(cs):
-        R = R @ _rot_z(c, s) @ _rot_x(*np.broadcast_arrays(cos_a[:, i, None],
-                                                           sin_a[:, i, None]))
+        R = R @ _rz_rx(c, s, cos_a[:, i, None], sin_a[:, i, None])
         out.append(R[..., :, 2])
     return np.concatenate(out, -1)
 
