@@ -8,6 +8,7 @@ arm (a closure the polynomial system does not contain) and the graph tracker's l
 from __future__ import annotations
 
 import os
+import warnings
 
 import numpy as np
 import pytest
@@ -204,3 +205,18 @@ def test_bad_parameters_are_input_errors() -> None:
         solve_loop6r(np.zeros(22))
     with pytest.raises(InputError, match="finite"):
         solve_loop6r(np.full(23, np.nan))
+
+
+def test_parameters_without_a_dh_chain_go_to_the_homotopy() -> None:
+    """Parallel ground axes (z1 = z6) or cos α1 = 1 leave no Denavit–Hartenberg chain (a zero
+    sin α): the elimination marks those instances unsettled, without an error or a warning
+    for the batch, and the homotopy solves them; the others of the batch stay by elimination."""
+    p, _ = random_loop6r(np.random.default_rng(29), 4)
+    p = p.real.copy()
+    p[1, 3:6] = p[1, 0:3]
+    p[2, 6] = 1.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sol = solve_loop6r(p)
+    assert sol.route == (ELIMINATION, HOMOTOPY, HOMOTOPY, ELIMINATION)
+    _same_as_homotopy(sol, p)

@@ -142,8 +142,10 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False
             scaled_norm = np.linalg.norm(Jinv * delta[:, None, :], axis=(1, 2))  # ≥ ‖J⁻¹Δ‖₂
         else:
             s = np.linalg.svd(Jsafe, compute_uv=False)
-            s_min = s[:, -1]
+            singular = ~(s[:, -1] > s[:, 0] * n * np.finfo(float).eps)  # no certificate there
+            s_min = np.where(singular, 0.0, s[:, -1])
             kappa = s[:, 0] / s_min
+            Jsafe = np.where(singular[:, None, None], np.eye(n), Jsafe)  # a solve would raise
             step = np.linalg.solve(Jsafe, Fsafe[..., None])[..., 0]
             scaled = np.linalg.solve(Jsafe, delta[:, :, None] * np.eye(n)[None])  # J⁻¹Δ
             scaled_norm = np.linalg.norm(scaled, ord=2, axis=(1, 2))

@@ -61,7 +61,7 @@ def _newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Com
     """Up to ``steps`` Newton steps on F(·; p) from x (P, n), each after the first only at the
     points whose last step exceeded :data:`SETTLED` (relative); a point whose Jacobian is
     singular or not finite is left where it is (its certificate will fail)."""
-    x = x.copy()
+    x = np.array(x, dtype=complex)
     n = x.shape[1]
     active = np.arange(len(x))
     for _ in range(steps):
@@ -108,7 +108,7 @@ def eigen_route(params: ArrayLike
     inst = sel // m
     twin = np.flatnonzero((real & (x3.imag > 0)).ravel()[sel])  # their conjugates solve too
     p = targets[inst]
-    xs = _newton(system, x.reshape(B * m, -1)[sel], p, NEWTON_STEPS)
+    xs = _newton(system, x.reshape(B * m, -1)[sel].astype(complex), p, NEWTON_STEPS)
     finite: NDArray[np.bool_] = np.asarray(np.isfinite(xs).all(1), dtype=bool)
     xs = np.where(finite[:, None], xs, 0.0)
     cert = certify(system, xs, p, fast=True, norm_f=bombieri_weyl_norm(system, targets)[inst])

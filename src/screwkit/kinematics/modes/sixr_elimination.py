@@ -72,6 +72,18 @@ def _as_parameters(params: ArrayLike) -> Complex:
     return np.asarray(p, dtype=complex if np.iscomplexobj(p) else float)
 
 
+def _safe_solve(A: Complex, b: Complex) -> tuple[Complex, Array]:
+    """A⁻¹b over a batch (B, n, n), (B, n, k), NaN where A is singular to working precision
+    or not finite (a batched solve would raise for the whole batch); and cond(A) (B,)."""
+    finite = np.isfinite(A).all(axis=(1, 2)) & np.isfinite(b).all(axis=(1, 2))
+    A = np.where(finite[:, None, None], A, np.eye(A.shape[1]))
+    cond = np.where(finite, np.linalg.cond(A), np.inf)
+    good = cond < 1e13
+    x = np.linalg.solve(np.where(good[:, None, None], A, np.eye(A.shape[1])),
+                        np.where(good[:, None, None], b, 0.0))
+    return np.where(good[:, None, None], x, np.nan), np.asarray(cond, dtype=float)
+
+
 def dh_chain(params: Complex) -> tuple[Complex, Complex, Complex, Complex, Complex]:
     """The Denavit–Hartenberg loop of 6R parameters (B, 23) (:mod:`.loop6r`): cos α, sin α,
     a, d (B, 6 each, joint/link 1..6, link 6 the ground from joint 6 to joint 1) and the
@@ -83,7 +95,7 @@ def dh_chain(params: Complex) -> tuple[Complex, Complex, Complex, Complex, Compl
     sin_a = np.sqrt(1.0 - cos_a * cos_a if np.iscomplexobj(params)
                     else np.maximum(1.0 - cos_a * cos_a, 0.0))
     w6 = _cross(z6, z1)
-    ground = np.linalg.solve(np.stack([w6, z1, z6], -1), params[:, 20:23, None])[..., 0]
+    ground = _safe_solve(np.stack([w6, z1, z6], -1), params[:, 20:23, None])[0][..., 0]
     a = np.concatenate([params[:, 11:16], ground[:, :1]], 1) * sin_a
     d = np.concatenate([ground[:, 1:2], params[:, 16:20], ground[:, 2:3]], 1)
     x6 = w6 / sin_a[:, 5:6]
@@ -248,7 +260,15 @@ def eliminate(params: ArrayLike) -> tuple[Complex, Complex, Array]:
     solution with Im x3 < 0 is the conjugate of one with Im x3 > 0); and the condition number
     (B,) of Σ's leading matrix (the companion form divides by it)."""
     p = _as_parameters(params)
+    with np.errstate(all="ignore"):
+        return _eliminate(p)
+
+
+def _eliminate(p: Complex) -> tuple[Complex, Complex, Array]:
     left, right, chain = _sides(p)
+    bad = ~(np.isfinite(left).all(axis=(1, 2)) & np.isfinite(right).all(axis=(1, 2)))
+    left = np.where(bad[:, None, None], 0.0, left)
+    right = np.where(bad[:, None, None], 0.0, right)
     D = _design(SAMPLES)
     L = np.einsum("ks,bsq->bqk", D["left_pinv"], left)  # (B, 14, 27)
     R = np.einsum("ks,bsq->bqk", D["right_pinv"], right)  # (B, 14, 9)
@@ -264,11 +284,11 @@ def eliminate(params: ArrayLike) -> tuple[Complex, Complex, Array]:
     S[:, :, 6:, 3:] = np.swapaxes(P, 1, 2)
     if not np.iscomplexobj(p):
         S = S.real  # type: ignore[assignment]
-    lead_cond = np.linalg.cond(S[:, 2])
-    solve = np.linalg.solve(S[:, 2], np.concatenate([S[:, 0], S[:, 1]], -1))
+    solve, lead_cond = _safe_solve(S[:, 2], np.concatenate([S[:, 0], S[:, 1]], -1))
+    bad |= ~np.isfinite(solve).all(axis=(1, 2))
     comp = np.zeros((B, 24, 24), dtype=S.dtype)
     comp[:, :12, 12:] = np.eye(12)
-    comp[:, 12:] = -solve
+    comp[:, 12:] = np.where(bad[:, None, None], 0.0, -solve)
     lam, W = np.linalg.eig(comp)
     # drop the spurious roots: the eight nearest ±i
     idx = np.argsort(np.minimum(np.abs(lam - 1j), np.abs(lam + 1j)), 1)[:, 8:]
@@ -295,4 +315,5 @@ def eliminate(params: ArrayLike) -> tuple[Complex, Complex, Array]:
         cs.append((c_ / n, s_ / n))
     cs.append(_shifted_trig(x3, SHIFT[0]))
     cs.append(_shifted_trig(x4, SHIFT[1]))
-    return _axes_from_angles(chain, cs), x3, np.asarray(lead_cond, dtype=float)
+    axes = np.where(bad[:, None, None], np.nan, _axes_from_angles(chain, cs))
+    return axes, np.where(bad[:, None], np.nan, x3), lead_cond
