@@ -17,7 +17,12 @@ from modes_helpers import random_r_loop
 from screwkit.algebraic.solve import Solutions, solve_all
 from screwkit.errors import InputError
 from screwkit.kinematics.graph.closure import graph_forward
-from screwkit.kinematics.modes.arm6r import Arm6RInstance, arm6r_instance, arm_forward
+from screwkit.kinematics.modes.arm6r import (
+    Arm6RInstance,
+    arm6r_instance,
+    arm_forward,
+    arm_inverse_kinematics,
+)
 from screwkit.kinematics.modes.every_mode import every_mode
 from screwkit.kinematics.modes.loop6r import loop6r_start, loop6r_system, random_loop6r
 from screwkit.kinematics.modes.loop6r_solve import ELIMINATION, HOMOTOPY, solve_loop6r
@@ -220,3 +225,13 @@ def test_parameters_without_a_dh_chain_go_to_the_homotopy() -> None:
         sol = solve_loop6r(p)
     assert sol.route == (ELIMINATION, HOMOTOPY, HOMOTOPY, ELIMINATION)
     _same_as_homotopy(sol, p)
+
+
+def test_arm_inverse_kinematics_gives_the_joint_values_back() -> None:
+    (C, U, home, target), _, q = _random_arm(np.random.default_rng(30))
+    values, sol = arm_inverse_kinematics(C, U, home, target)
+    assert sol.route == (ELIMINATION,) and sol.found[0] == 16 and len(values) == sol.real_count[0]
+    assert np.abs(np.mod(values - q + np.pi, 2 * np.pi) - np.pi).max(axis=1).min() <= MATCH
+    for row in values:
+        R, p = arm_forward(C, U, home, row)
+        assert np.abs(R - target[0]).max() + np.abs(p - target[1]).max() <= CLOSE

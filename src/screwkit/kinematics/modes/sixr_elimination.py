@@ -75,7 +75,8 @@ def _as_parameters(params: ArrayLike) -> Complex:
 def _safe_solve(A: Complex, b: Complex) -> tuple[Complex, Array]:
     """A⁻¹b over a batch (B, n, n), (B, n, k), NaN where A is singular to working precision
     or not finite (a batched solve would raise for the whole batch); and cond(A) (B,)."""
-    finite = np.isfinite(A).all(axis=(1, 2)) & np.isfinite(b).all(axis=(1, 2))
+    finite = np.asarray(np.isfinite(A).all(axis=(1, 2)) & np.isfinite(b).all(axis=(1, 2)),
+                        dtype=bool)
     A = np.where(finite[:, None, None], A, np.eye(A.shape[1]))
     cond = np.where(finite, np.linalg.cond(A), np.inf)
     good = cond < 1e13
@@ -266,7 +267,8 @@ def eliminate(params: ArrayLike) -> tuple[Complex, Complex, Array]:
 
 def _eliminate(p: Complex) -> tuple[Complex, Complex, Array]:
     left, right, chain = _sides(p)
-    bad = ~(np.isfinite(left).all(axis=(1, 2)) & np.isfinite(right).all(axis=(1, 2)))
+    bad = np.asarray(~(np.isfinite(left).all(axis=(1, 2)) & np.isfinite(right).all(axis=(1, 2))),
+                     dtype=bool)
     left = np.where(bad[:, None, None], 0.0, left)
     right = np.where(bad[:, None, None], 0.0, right)
     D = _design(SAMPLES)
