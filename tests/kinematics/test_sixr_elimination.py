@@ -27,7 +27,7 @@ from screwkit.kinematics.modes.every_mode import every_mode
 from screwkit.kinematics.modes.loop6r import loop6r_start, loop6r_system, random_loop6r
 from screwkit.kinematics.modes.loop6r_solve import ELIMINATION, HOMOTOPY, solve_loop6r
 from screwkit.kinematics.modes.r_loop import r_loop_instance
-from screwkit.kinematics.modes.sixr_elimination import SHIFT, fit_residual
+from screwkit.kinematics.modes.sixr_elimination import SHIFT, eliminate, fit_residual
 
 INSTANCES = int(os.environ.get("SCREWKIT_MODES_INSTANCES", "200"))
 #: solutions of the two routes agree to this, relative to 1 + the largest coordinate (the axes
@@ -235,3 +235,39 @@ def test_arm_inverse_kinematics_gives_the_joint_values_back() -> None:
     for row in values:
         R, p = arm_forward(C, U, home, row)
         assert np.abs(R - target[0]).max() + np.abs(p - target[1]).max() <= CLOSE
+
+
+def _dh_arm(alpha: np.ndarray, a: np.ndarray, d: np.ndarray) -> tuple:
+    """Joint lines at home (every θ = 0) and the home tool pose of the Denavit–Hartenberg arm
+    A_i = Trans_z(d_i)·Trans_x(a_i)·Rot_x(α_i)."""
+    T, C, U = np.eye(4), [], []
+    for al, ai, di in zip(alpha, a, d, strict=True):
+        C.append(T[:3, 3].copy())
+        U.append(T[:3, 2].copy())
+        A = np.eye(4)
+        A[:3, :3] = [[1, 0, 0], [0, np.cos(al), -np.sin(al)], [0, np.sin(al), np.cos(al)]]
+        A[:3, 3] = [ai, 0.0, di]
+        T = T @ A
+    return np.array(C), np.array(U), (T[:3, :3], T[:3, 3])
+
+
+def test_arms_with_meeting_axes_go_by_elimination_relabelled() -> None:
+    """Twists of ±90° and a_1 = a_4 = 0 (axes 1–2 and 4–5 meet, as on many industrial arms)
+    make the pencil singular in the first labelling; a cyclic relabelling settles all 16, and
+    they are the homotopy's."""
+    rng = np.random.default_rng(31)
+    arms, insts, truth = [], [], []
+    for _ in range(10):
+        C, U, home = _dh_arm(rng.choice([-1.0, 1.0], 6) * np.pi / 2,
+                             np.array([0.0, 0.8, 0.3, 0.0, 0.2, 0.1]), rng.uniform(-1, 1, 6))
+        q = rng.uniform(-np.pi, np.pi, 6)
+        target = arm_forward(C, U, home, q)
+        arms.append((C, U, home, target))
+        insts.append(arm6r_instance(C, U, home, target))
+        truth.append(q)
+    p = np.array([i.params for i in insts])
+    assert np.isnan(eliminate(p, 0)[0]).any(axis=(1, 2)).all()  # the first labelling fails
+    sol = solve_loop6r(p)
+    assert sol.route == (ELIMINATION,) * 10 and np.all(sol.found == 16)
+    _same_as_homotopy(sol, p)
+    _arm_check(arms, insts, truth, sol)

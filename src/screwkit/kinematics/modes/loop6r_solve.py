@@ -41,6 +41,8 @@ NEWTON_STEPS = 3
 SETTLED = 1e-10
 #: an uncertified point counts as a solution when its Newton step is this small (relative)
 CONVERGED = 1e-8
+#: the cyclic relabellings of the loop tried in turn on the instances still unsettled
+SHIFTS = (0, 1, 5, 2, 4, 3)
 #: and as distinct from another when they are this far apart (relative)
 DISTINCT = 1e-6
 ELIMINATION = "elimination (Raghavan & Roth; 24 × 24 eigenproblem)"
@@ -87,9 +89,9 @@ def _newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Com
 
 def eigen_route(params: ArrayLike
                 ) -> tuple[Complex, NDArray[np.intp], NDArray[np.bool_], Certificate]:
-    """The polished eigen-route solutions (P, 12) of instances (B, 23), sorted by their
-    instance (P,); whether each instance's are 16, all settled and pairwise distinct (B,);
-    and the α-test of every point (P).
+    """The polished eigen-route solutions (P, 12) of the instances (B, 23) it settles, sorted
+    by their instance (P,); whether each instance is settled: 16 solutions, all settled and
+    pairwise distinct (B,); and the α-test of every point (P).
 
     A point is settled when certified (α-test; distinct from another when their balls of
     radius 2β are disjoint) or, where the α-test cannot decide (an ill-conditioned solution,
@@ -98,11 +100,38 @@ def eigen_route(params: ArrayLike
     :data:`DISTINCT`, the homotopy's own rule in algebraic/solve.py). A real instance's
     system is real, so its solutions come in conjugate pairs with equal certificates: only
     the solutions with Im x3 ≥ 0 are polished and certified, and the others are their
-    conjugates."""
+    conjugates. An instance left unsettled is eliminated again with the loop relabelled
+    cyclically (:data:`SHIFTS`): a geometry that makes the 12 × 12 pencil singular in one
+    labelling (two consecutive axes that meet, as in most industrial arms) usually does not
+    in another."""
     targets = _targets(params)
+    B = len(targets)
+    todo = np.arange(B)
+    ok = np.zeros(B, dtype=bool)
+    parts: list[tuple[Complex, NDArray[np.intp], Certificate]] = []
+    for shift in SHIFTS:
+        xs, inst, good, cert = _eigen_pass(targets[todo], shift)
+        keep = np.flatnonzero(good[inst])
+        parts.append((xs[keep], todo[inst[keep]], _rows(cert, keep)))
+        ok[todo[good]] = True
+        todo = todo[~good]
+        if not len(todo):
+            break
+    xs = np.concatenate([x for x, _, _ in parts])
+    inst = np.concatenate([i for _, i, _ in parts])
+    cert = parts[0][2]
+    for _, _, c in parts[1:]:
+        cert = _joined(cert, c)
+    order = np.argsort(inst, kind="stable")
+    return xs[order], inst[order], ok, _rows(cert, order)
+
+
+def _eigen_pass(targets: Complex, shift: int
+                ) -> tuple[Complex, NDArray[np.intp], NDArray[np.bool_], Certificate]:
+    """:func:`eigen_route` with one labelling of the loop: every point, settled or not."""
     B, m = len(targets), LOOP6R_GENERIC_COUNT
     system = loop6r_system()
-    x, x3, _ = eliminate(targets)
+    x, x3, _ = eliminate(targets, shift)
     real = np.all(targets.imag == 0, axis=1)[:, None]
     sel = np.flatnonzero((~real | (x3.imag >= 0)).ravel())
     inst = sel // m

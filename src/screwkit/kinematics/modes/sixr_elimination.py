@@ -158,13 +158,14 @@ def _design(samples: int) -> dict[str, NDArray[Any]]:
             "left_pinv": np.linalg.pinv(left), "right_pinv": np.linalg.pinv(right)}
 
 
-def _sides(params: Complex, samples: int = SAMPLES
+def _sides(params: Complex, samples: int = SAMPLES, shift: int = 0
            ) -> tuple[Complex, Complex, tuple[Complex, ...]]:
     """The 14 quantities at the sample angles: left (B, S3, 14) over θ3, θ4, θ5 and right
     (B, S2, 14) over θ1, θ2, lengths scaled to order one; and the chain. Real parameters are
-    kept real."""
+    kept real. ``shift`` k relabels the loop cyclically (the elimination's joint i is the
+    loop's joint i + k): the product A_{k+1}⋯A_6A_1⋯A_k is the identity as well."""
     chain = dh_chain(params)
-    cos_a, sin_a, a, d, _ = chain
+    cos_a, sin_a, a, d = (np.roll(v, -shift, axis=1) for v in chain[:4])
     scale = np.sqrt(np.mean(np.abs(a) ** 2 + np.abs(d) ** 2, axis=1))
     scale = np.where(scale > 0, scale, 1.0)[:, None]
     a, d = a / scale, d / scale
@@ -254,19 +255,24 @@ def _axes_from_angles(chain: tuple[Complex, ...], cs: list[tuple[Complex, Comple
     return np.concatenate(out, -1)
 
 
-def eliminate(params: ArrayLike) -> tuple[Complex, Complex, Array]:
+def eliminate(params: ArrayLike, shift: int = 0) -> tuple[Complex, Complex, Array]:
     """The 16 solutions (B, 16, 12) of 6R instances (B, 23) by the eigenproblem (module
     docstring), unpolished; their x3 (B, 16) (for real parameters, exact conjugate pairs and
     exactly real values, as LAPACK returns the eigenvalues of a real matrix, so that a
     solution with Im x3 < 0 is the conjugate of one with Im x3 > 0); and the condition number
-    (B,) of Σ's leading matrix (the companion form divides by it)."""
+    (B,) of Σ's leading matrix (the companion form divides by it). ``shift`` k relabels the
+    loop cyclically first (joint i of the elimination is the loop's joint i + k): a geometry
+    that makes Σ singular for one labelling (two consecutive axes that meet, say) may not for
+    another."""
     p = _as_parameters(params)
+    if shift not in range(6):
+        raise InputError(f"the cyclic shift of a 6R loop is 0..5; got {shift}")
     with np.errstate(all="ignore"):
-        return _eliminate(p)
+        return _eliminate(p, shift)
 
 
-def _eliminate(p: Complex) -> tuple[Complex, Complex, Array]:
-    left, right, chain = _sides(p)
+def _eliminate(p: Complex, shift: int) -> tuple[Complex, Complex, Array]:
+    left, right, chain = _sides(p, SAMPLES, shift)
     bad = np.asarray(~(np.isfinite(left).all(axis=(1, 2)) & np.isfinite(right).all(axis=(1, 2))),
                      dtype=bool)
     left = np.where(bad[:, None, None], 0.0, left)
@@ -317,5 +323,13 @@ def _eliminate(p: Complex) -> tuple[Complex, Complex, Array]:
         cs.append((c_ / n, s_ / n))
     cs.append(_shifted_trig(x3, SHIFT[0]))
     cs.append(_shifted_trig(x4, SHIFT[1]))
+    if shift:  # θ5, θ6 too (θ6 by closure: Rot_z(θ6)Rot_x(α6) = (R1⋯R5)ᵀ), then relabel
+        cs.append(_shifted_trig(x5, SHIFT[2]))
+        cos_a, sin_a = (np.roll(v, -shift, axis=1) for v in chain[:2])
+        R = _rz_rx(*cs[0], cos_a[:, 0, None], sin_a[:, 0, None])
+        for i in range(1, 5):
+            R = R @ _rz_rx(*cs[i], cos_a[:, i, None], sin_a[:, i, None])
+        cs.append((R[..., 0, 0], R[..., 0, 1]))
+        cs = [cs[(j - shift) % 6] for j in range(4)]
     axes = np.where(bad[:, None, None], np.nan, _axes_from_angles(chain, cs))
     return axes, np.where(bad[:, None], np.nan, x3), lead_cond
