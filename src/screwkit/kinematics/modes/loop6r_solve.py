@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.algebraic.certify import Certificate, bombieri_weyl_norm, certify, distinct
+from screwkit.algebraic.certify import Certificate, bombieri_weyl_norm, certify
 from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.solve import Solutions, collect_solutions
@@ -97,7 +97,8 @@ def eigen_route(params: ArrayLike
     radius 2β are disjoint) or, where the α-test cannot decide (an ill-conditioned solution,
     e.g. one far out near infinity, which the homotopy cannot certify either), when its
     Newton step is below :data:`CONVERGED` (relative; distinct when apart by more than
-    :data:`DISTINCT`, the homotopy's own rule in algebraic/solve.py). A real instance's
+    :data:`DISTINCT`, the homotopy's own rule in algebraic/solve.py); every pair of an
+    instance's 16 is compared. A real instance's
     system is real, so its solutions come in conjugate pairs with equal certificates: only
     the solutions with Im x3 ≥ 0 are polished and certified, and the others are their
     conjugates. An instance left unsettled is eliminated again with the loop relabelled
@@ -151,10 +152,15 @@ def _eigen_pass(targets: Complex, shift: int
     with np.errstate(invalid="ignore"):
         settled = np.abs(xs - cert.newton).max(axis=1) <= CONVERGED * scale
     good = (cert.certified | settled) & finite
-    label = distinct(xs, np.where(cert.certified, cert.radius,
-                                  np.where(good, DISTINCT * scale, np.inf)), inst)
-    unique = (label == np.arange(len(xs))) & good
-    ok = (np.bincount(inst[unique], minlength=B) == m) & (np.bincount(inst, minlength=B) == m)
+    radius = np.where(cert.certified, cert.radius, DISTINCT * scale)
+    ok = np.bincount(inst, minlength=B) == m
+    full = np.flatnonzero(ok[inst])  # the instances with 16 points: contiguous, sorted
+    x16, r16 = xs[full].reshape(-1, m, xs.shape[1]), radius[full].reshape(-1, m)
+    apart = good[full].reshape(-1, m).all(axis=1)
+    for k in range(1, m // 2 + 1):  # point i against i + k (mod 16): every pair once or twice
+        gap = np.linalg.norm(x16 - np.roll(x16, k, axis=1), axis=-1)
+        apart &= (gap > r16 + np.roll(r16, k, axis=1)).all(axis=1)
+    ok[ok] = apart
     return xs, inst, ok, cert
 
 
