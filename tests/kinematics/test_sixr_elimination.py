@@ -27,7 +27,7 @@ from screwkit.kinematics.modes.every_mode import every_mode
 from screwkit.kinematics.modes.loop6r import loop6r_start, loop6r_system, random_loop6r
 from screwkit.kinematics.modes.loop6r_solve import ELIMINATION, HOMOTOPY, solve_loop6r
 from screwkit.kinematics.modes.r_loop import r_loop_instance
-from screwkit.kinematics.modes.sixr_elimination import SHIFT, eliminate, fit_residual
+from screwkit.kinematics.modes.sixr_elimination import OFFSETS, eliminate, fit_residual
 
 INSTANCES = int(os.environ.get("SCREWKIT_MODES_INSTANCES", "200"))
 #: solutions of the two routes agree to this, relative to 1 + the largest coordinate (the axes
@@ -162,7 +162,7 @@ def test_a_solution_at_the_shifted_infinity_falls_back_or_is_found() -> None:
     certifies 16 or the homotopy runs; the answer is the homotopy's either way."""
     rng = np.random.default_rng(26)
     for _ in range(3):
-        arm, inst, q = _arm_with_theta3(rng, np.pi + SHIFT[0])
+        arm, inst, q = _arm_with_theta3(rng, np.pi + OFFSETS[0])
         sol = solve_loop6r(inst.params)
         _same_as_homotopy(sol, inst.params[None])
         _arm_check([arm], [inst], [q], sol)

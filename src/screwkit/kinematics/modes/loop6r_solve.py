@@ -7,9 +7,11 @@ method on the polynomial system of :mod:`.loop6r` (the axes z2..z5; Sommese & Wa
 ch. 9) and certifies them by Smale's α-test (algebraic/certify.py). An instance whose 16 are
 not all settled and distinct (a special geometry: a singular leading matrix, a double root, a
 solution at a shifted half-angle of ∞, fewer than 16 finite solutions; :func:`eigen_route`)
-is solved again by the parameter homotopy from the stored start solutions (algebraic/solve.py), which finds every
-isolated solution there is. The result is the homotopy's :class:`Solutions`, the same layout and
-checks for either route, with ``route`` naming per instance the method that ran.
+is eliminated again with the loop relabelled cyclically, and what is still unsettled is
+solved by the parameter homotopy from the stored start solutions (algebraic/solve.py), which
+finds every isolated solution there is. The result is the homotopy's :class:`Solutions`, the
+same layout and checks for either route, with ``route`` naming per instance the method that
+ran.
 """
 
 from __future__ import annotations

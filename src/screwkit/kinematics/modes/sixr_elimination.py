@@ -23,10 +23,11 @@ kinematics for general 6R manipulators", IEEE T-RA 10(5), 1994), on the loop of
   eigenproblem gives x3, and each eigenvector x4, x5; a least-squares solve of the 14
   equations gives (c1, s1, c2, s2), and the axes z2..z5 follow from θ1..θ4.
 
-:func:`solve_loop6r` polishes every solution by Newton's method on the polynomial system of
-:mod:`.loop6r` and certifies it (α-test, algebraic/certify.py); an instance without 16 distinct
-certified solutions is solved again by the parameter homotopy, and the result says which route
-ran for each instance.
+``shift`` relabels the loop cyclically first (joint i + k plays joint i), for geometries that
+make Σ singular in one labelling. :func:`.loop6r_solve.solve_loop6r` polishes every solution
+by Newton's method on the polynomial system of :mod:`.loop6r`, certifies it (α-test,
+algebraic/certify.py), tries the other labellings on the instances not settled, solves what is
+still unsettled by the parameter homotopy, and says which route ran for each instance.
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ SAMPLES = 3
 CHECK_SAMPLES = 5
 #: the fixed offsets of θ3, θ4, θ5 behind the half-angle tangents (x = tan((θ − φ)/2)): any
 #: values not special to a geometry
-SHIFT = (0.6180339887, 1.2247448714, -0.7071067812)
+OFFSETS = (0.6180339887, 1.2247448714, -0.7071067812)
 
 
 def _cross(a: Complex, b: Complex) -> Complex:
@@ -149,7 +150,7 @@ def _design(samples: int) -> dict[str, NDArray[Any]]:
     bases at them."""
     grid = 2.0 * np.pi * np.arange(samples) / samples + 0.1
     t3, t4, t5 = (v.ravel() for v in np.meshgrid(grid, grid, grid, indexing="ij"))
-    shifted = [_trig3(t - phi) for t, phi in zip((t3, t4, t5), SHIFT, strict=True)]
+    shifted = [_trig3(t - phi) for t, phi in zip((t3, t4, t5), OFFSETS, strict=True)]
     left = (shifted[0][:, :, None] * _products(shifted[1], shifted[2])[:, None, :])
     left = left.reshape(len(t3), 27)  # column 9·k3 + j45
     t1, t2 = (v.ravel() for v in np.meshgrid(grid, grid, indexing="ij"))
@@ -321,10 +322,10 @@ def _eliminate(p: Complex, shift: int) -> tuple[Complex, Complex, Array]:
     for s_, c_ in ((m12[..., 4], m12[..., 5]), (m12[..., 6], m12[..., 7])):
         n = np.sqrt(c_ * c_ + s_ * s_)
         cs.append((c_ / n, s_ / n))
-    cs.append(_shifted_trig(x3, SHIFT[0]))
-    cs.append(_shifted_trig(x4, SHIFT[1]))
+    cs.append(_shifted_trig(x3, OFFSETS[0]))
+    cs.append(_shifted_trig(x4, OFFSETS[1]))
     if shift:  # θ5, θ6 too (θ6 by closure: Rot_z(θ6)Rot_x(α6) = (R1⋯R5)ᵀ), then relabel
-        cs.append(_shifted_trig(x5, SHIFT[2]))
+        cs.append(_shifted_trig(x5, OFFSETS[2]))
         cos_a, sin_a = (np.roll(v, -shift, axis=1) for v in chain[:2])
         R = _rz_rx(*cs[0], cos_a[:, 0, None], sin_a[:, 0, None])
         for i in range(1, 5):
