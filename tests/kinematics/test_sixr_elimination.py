@@ -252,7 +252,7 @@ def _dh_arm(alpha: np.ndarray, a: np.ndarray, d: np.ndarray) -> tuple:
 
 
 def test_arms_with_meeting_axes_go_by_elimination_relabelled() -> None:
-    """Twists of ±90° and a_1 = a_4 = 0 (axes 1–2 and 4–5 meet, as on many industrial arms)
+    """Twists of ±90° and a_1 = a_4 = 0 (axes 1–2 and 4–5 meet)
     make the pencil singular in the first labelling; a cyclic relabelling settles all 16, and
     they are the homotopy's."""
     rng = np.random.default_rng(31)

@@ -105,8 +105,7 @@ def eigen_route(params: ArrayLike
     the solutions with Im x3 ≥ 0 are polished and certified, and the others are their
     conjugates. An instance left unsettled is eliminated again with the loop relabelled
     cyclically (:data:`SHIFTS`): a geometry that makes the 12 × 12 pencil singular in one
-    labelling (two consecutive axes that meet, as in most industrial arms) usually does not
-    in another."""
+    labelling (two consecutive axes that meet, say) may not make it singular in another."""
     targets = _targets(params)
     B = len(targets)
     todo = np.arange(B)
