@@ -107,8 +107,8 @@ def dh_chain(params: Complex) -> tuple[Complex, Complex, Complex, Complex, Compl
 
 def _rz_rx(c_t: Complex, s_t: Complex, c_a: Complex, s_a: Complex) -> Complex:
     """Rot_z(θ)·Rot_x(α) (…, 3, 3) from the cosines and sines (broadcast together)."""
-    c_t, s_t, c_a, s_a = np.broadcast_arrays(c_t, s_t, c_a, s_a)
-    R = np.zeros(c_t.shape + (3, 3), dtype=np.result_type(c_t, c_a))
+    shape = np.broadcast_shapes(np.shape(c_t), np.shape(c_a))
+    R = np.zeros(shape + (3, 3), dtype=np.result_type(c_t, c_a))
     R[..., 0, 0], R[..., 0, 1], R[..., 0, 2] = c_t, -s_t * c_a, s_t * s_a
     R[..., 1, 0], R[..., 1, 1], R[..., 1, 2] = s_t, c_t * c_a, -c_t * s_a
     R[..., 2, 1], R[..., 2, 2] = s_a, c_a
