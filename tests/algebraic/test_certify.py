@@ -66,3 +66,21 @@ def test_overlapping_certified_balls_count_once():
     # in different groups (instances) the same point is not a duplicate
     groups = np.array([0, 0, 0, 0, 1, 1])
     assert distinct(points, cert.radius, groups).tolist() == [0, 1, 2, 3, 4, 5]
+
+
+def test_the_fast_bounds_are_on_the_safe_side_of_the_svd_ones():
+    """``fast=True`` bounds 2-norms by Frobenius norms: α, β and γ are never smaller than the
+    SVD route's (and at most √n · (1 + round-off) larger in γ), so it certifies no point the
+    SVD route refuses; near the roots both certify."""
+    system, roots = _circle_parabola()
+    rng = np.random.default_rng(3)
+    points = np.concatenate([roots + 1e-6 * rng.normal(size=roots.shape),
+                             roots + 0.2 * rng.normal(size=roots.shape)])
+    exact, fast = certify(system, points, np.zeros(0)), certify(system, points, np.zeros(0),
+                                                                 fast=True)
+    for name in ("alpha", "beta", "gamma"):
+        assert (getattr(fast, name) >= getattr(exact, name) * (1 - 1e-12)).all(), name
+    assert (fast.gamma <= exact.gamma * np.sqrt(2) * (1 + 1e-9)).all()
+    assert not (fast.certified & ~exact.certified).any()
+    assert fast.certified[:4].all() and exact.certified[:4].all()
+    assert np.allclose(fast.newton, exact.newton, rtol=1e-12, atol=1e-14)

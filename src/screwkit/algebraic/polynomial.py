@@ -240,19 +240,25 @@ class PolynomialSystem:
         equation (G,) and exponent vector (G, n) of each distinct monomial in x, and its
         coefficient (B, G), the sum over the terms with that monomial of coef·Π p^pw."""
         p = np.atleast_2d(np.asarray(p, dtype=complex))
-        unknown = self.sym < self.n
-        exps = np.zeros((len(self.eq), self.n), dtype=np.intp)
-        rows = np.nonzero(unknown)
-        np.add.at(exps, (rows[0], self.sym[rows]), self.pw[rows])
-        keys, group = np.unique(np.column_stack([self.eq, exps]), axis=0, return_inverse=True)
+        plan = self.__dict__.get("_coefficient_plan")  # parameter-free: kept on the system
+        if plan is None:
+            unknown = self.sym < self.n
+            exps = np.zeros((len(self.eq), self.n), dtype=np.intp)
+            rows = np.nonzero(unknown)
+            np.add.at(exps, (rows[0], self.sym[rows]), self.pw[rows])
+            keys, group = np.unique(np.column_stack([self.eq, exps]), axis=0,
+                                    return_inverse=True)
+            order = np.argsort(group.reshape(-1), kind="stable")
+            heads = np.flatnonzero(np.r_[True, np.diff(group.reshape(-1)[order]) != 0])
+            plan = (keys[:, 0].astype(np.intp), keys[:, 1:].astype(np.intp), order, heads)
+            object.__setattr__(self, "_coefficient_plan", plan)
+        eq, exps_out, order, heads = plan
         z = self._columns(np.ones((len(p), self.n), dtype=complex), p)
         values = (self.coef[:, None] * np.prod(self._power_table(z)[self.pw, self.sym],
                                                axis=1)).T
-        out = np.zeros((len(p), len(keys)), dtype=complex)
-        order = np.argsort(group.reshape(-1), kind="stable")
-        heads = np.flatnonzero(np.r_[True, np.diff(group.reshape(-1)[order]) != 0])
+        out = np.zeros((len(p), len(eq)), dtype=complex)
         out[:] = np.add.reduceat(values[:, order], heads, axis=1)
-        return keys[:, 0].astype(np.intp), keys[:, 1:].astype(np.intp), out
+        return eq, exps_out, out
 
     def _power_table(self, z: Complex) -> Complex:
         """z^0..z^D (D+1, S, B) for z (S, B)."""

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.algebraic.certify import certify, distinct
+from screwkit.algebraic.certify import Certificate, certify, distinct
 from screwkit.algebraic.monodromy import MonodromyOptions, monodromy_solve
 from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
@@ -81,7 +81,9 @@ class Solutions:
     lies within it), ``residual`` (‖F(x)‖∞ relative to the largest Σ|terms| of an equation at x,
     or to 1), ``multiplicity`` (paths ending there). Per instance (B,): ``found`` (distinct
     complex solutions), ``real_count``, ``certified_real_count``, ``at_infinity``, ``failed``
-    (paths). ``generic_count`` and ``how_found`` come from the start solutions."""
+    (paths). ``generic_count`` and ``how_found`` come from the start solutions; ``route`` names,
+    per instance, the method that ran (the parameter homotopy, or an elimination solver that
+    falls back to it)."""
 
     x: Complex
     instance: NDArray[np.intp]
@@ -102,6 +104,8 @@ class Solutions:
     failed: NDArray[np.int64]
     generic_count: int
     how_found: str
+    #: per instance, the method that found its solutions
+    route: tuple[str, ...] = ()
 
     def of(self, b: int) -> Complex:
         """The solutions (m_b, n) of instance b, in the sorted order."""
@@ -134,13 +138,38 @@ def solve_all(system: PolynomialSystem, p_target: ArrayLike,
                                       np.tile(start.x, (B, 1)), options, instance=instance)
     finite = np.flatnonzero((result.status == PathStatus.REGULAR)
                             | (result.status == PathStatus.SINGULAR))
-    x, p = result.x[finite], targets[instance[finite]]
-    cert = certify(system, x, p)
-    regular = result.status[finite] == PathStatus.REGULAR
+
+    def paths(status: PathStatus) -> NDArray[np.int64]:
+        return np.bincount(instance[result.status == status], minlength=B).astype(np.int64)
+
+    return collect_solutions(system, targets, result.x[finite], instance[finite],
+                             result.status[finite], result.multiplicity[finite],
+                             paths(PathStatus.AT_INFINITY), paths(PathStatus.FAILED),
+                             start.generic_count, start.how_found)
+
+
+def collect_solutions(system: PolynomialSystem, targets: Complex, x: Complex,
+                      instance: NDArray[np.intp], status: NDArray[np.int8],
+                      multiplicity: NDArray[np.int64], at_infinity: NDArray[np.int64],
+                      failed: NDArray[np.int64], generic_count: int, how_found: str,
+                      route: tuple[str, ...] | None = None,
+                      cert: Certificate | None = None,
+                      label: NDArray[np.intp] | None = None) -> Solutions:
+    """:class:`Solutions` from finite points x (M, n) of instances ``instance`` (M,) with
+    parameters ``targets`` (B, k), each REGULAR or SINGULAR: certified (α-test), duplicates
+    dropped, sorted per instance (real, then certified, first). ``at_infinity`` and ``failed``
+    count paths per instance; ``route`` names the method per instance (the parameter
+    homotopy when None); ``cert`` the points' α-test and ``label`` their duplicate labels
+    (:func:`~screwkit.algebraic.certify.distinct`) when the caller has them."""
+    B = len(targets)
+    if cert is None:
+        cert = certify(system, x, targets[instance])
+    regular = status == PathStatus.REGULAR
     radius = np.where(regular & cert.certified, cert.radius,
                       1e-6 * (1.0 + np.abs(x).max(axis=1, initial=0.0)))
-    label = distinct(x, radius, instance[finite])
-    keep = label == np.arange(len(finite))
+    if label is None:
+        label = distinct(x, radius, instance)
+    keep = label == np.arange(len(x))
     assert cert.value is not None and cert.terms is not None
     with np.errstate(all="ignore"):
         residual = np.abs(cert.value).max(axis=1, initial=0.0) / np.maximum(
@@ -148,21 +177,18 @@ def solve_all(system: PolynomialSystem, p_target: ArrayLike,
     real = np.abs(x.imag).max(axis=1, initial=0.0) <= 1e-8 * (1.0 + np.abs(x).max(
         axis=1, initial=0.0))
     certified = cert.certified & regular
-    order = np.lexsort((~certified, ~(real | cert.real), instance[finite]))
+    order = np.lexsort((~certified, ~(real | cert.real), instance))
     order = order[keep[order]]
-    inst = instance[finite][order]
+    inst = instance[order]
 
     def per_instance(mask: NDArray[np.bool_]) -> NDArray[np.int64]:
         return np.bincount(inst[mask], minlength=B).astype(np.int64)
 
-    def paths(status: PathStatus) -> NDArray[np.int64]:
-        return np.bincount(instance[result.status == status], minlength=B).astype(np.int64)
-
     cert_real = (cert.real & certified)[order]
-    return Solutions(x[order], inst, result.status[finite][order], certified[order], cert_real,
+    return Solutions(x[order], inst, status[order], certified[order], cert_real,
                      real[order], cert.alpha[order], cert.beta[order], cert.gamma[order],
-                     cert.radius[order], residual[order], result.multiplicity[finite][order],
+                     cert.radius[order], residual[order], multiplicity[order],
                      np.bincount(inst, minlength=B).astype(np.int64),
-                     per_instance(real[order]), per_instance(cert_real),
-                     paths(PathStatus.AT_INFINITY), paths(PathStatus.FAILED),
-                     start.generic_count, start.how_found)
+                     per_instance(real[order]), per_instance(cert_real), at_infinity, failed,
+                     generic_count, how_found,
+                     route if route is not None else ("parameter homotopy",) * B)

@@ -8,6 +8,10 @@ placed at T·T_home⁻¹: the ground carries joint 1 as drawn and joint 6 moved 
 links 1..5 keep their home geometry. The joint values then come from the axes: q_i is the change,
 from home, of the angle about z_i from a direction fixed in the link before (the base's for
 joint 1) to one fixed in the link after (the tool's for joint 6).
+
+:func:`arm_inverse_kinematics` solves it: by elimination (a 24 × 24 eigenproblem, Raghavan &
+Roth 1993), with the parameter homotopy where elimination cannot settle all 16
+(modes/loop6r_solve.py).
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.algebraic.solve import Solutions
 from screwkit.errors import InputError
 from screwkit.kinematics.modes.loop6r import PlacedLink, loop6r_axes, loop6r_parameters
 
@@ -97,3 +102,16 @@ def arm6r_instance(centres: ArrayLike, axes: ArrayLike, tool_home: tuple[ArrayLi
     tool_home_ref = np.cross(U[5], [1.0, 0.0, 0.0] if abs(U[5][0]) < 0.9 else [0.0, 1.0, 0.0])
     home = _joint_angles(U, base_ref, tool_home_ref)
     return Arm6RInstance(params, base_ref, move @ tool_home_ref, home)
+
+
+def arm_inverse_kinematics(centres: ArrayLike, axes: ArrayLike,
+                           tool_home: tuple[ArrayLike, ArrayLike],
+                           target: tuple[ArrayLike, ArrayLike]) -> tuple[Array, Solutions]:
+    """Every real inverse-kinematics solution of the 6R arm (joint lines at home, base to
+    tool; the home tool pose) at ``target`` (R, p): joint values from home (N, 6), and the
+    loop's :class:`Solutions` (all 16 complex solutions, certificates, the route that ran)."""
+    from screwkit.kinematics.modes.loop6r_solve import solve_loop6r
+
+    inst = arm6r_instance(centres, axes, tool_home, target)
+    sol = solve_loop6r(inst.params)
+    return inst.joint_values(sol.x[sol.real]), sol

@@ -22,12 +22,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import PolynomialSystem
-from screwkit.algebraic.solve import StartSolutions, solve_all
+from screwkit.algebraic.solve import Solutions, StartSolutions, solve_all
 from screwkit.algebraic.track import PathStatus
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
 from screwkit.kinematics.modes.continuum import on_a_continuum
 from screwkit.kinematics.modes.loop6r import loop6r_start, loop6r_system
+from screwkit.kinematics.modes.loop6r_solve import solve_loop6r
 from screwkit.kinematics.modes.planar import planar_formulation
 from screwkit.kinematics.modes.r_loop import r_loop_instance
 from screwkit.kinematics.modes.rccc import rccc_loop
@@ -68,6 +69,11 @@ class _RLoopFormulation:
                       ) -> tuple[Configuration, GraphLayout]:
         row = np.atleast_1d(np.asarray(input_values, dtype=float)).reshape(-1)
         return r_loop_instance(self.mechanism, row).configuration(solutions)
+
+    def solve(self, p: Array) -> Solutions:
+        """Every solution at the rows of parameters p: elimination, the homotopy where it
+        falls short (modes/loop6r_solve.py)."""
+        return solve_loop6r(p)
 
 
 def closure_formulation(mech: Mechanism) -> Formulation:
@@ -139,6 +145,16 @@ def formulation_start(form: Formulation) -> StartSolutions:
     return start_solutions(form.system, grouping=getattr(form, "grouping", None))
 
 
+def solve_formulation(form: Formulation, p: ArrayLike) -> Solutions:
+    """Every isolated solution of ``form``'s system at the parameter rows p: its own exact
+    solver where it has one (a single R loop: elimination, modes/loop6r_solve.py), else the
+    parameter homotopy from the topology's start solutions."""
+    own_solve = getattr(form, "solve", None)
+    if callable(own_solve):
+        return own_solve(p)  # type: ignore[no-any-return]
+    return solve_all(form.system, p, formulation_start(form))
+
+
 def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:
     """Every real assembly mode of ``mech`` at each row of ``inputs`` (B, n_inputs), radians
     and metres from the drawing (module docstring). Equal rows are solved once (a closed
@@ -159,9 +175,8 @@ def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:
 def _every_mode_rows(mech: Mechanism, X: Array) -> MechanismModes:
     """:func:`every_mode` at rows ``X`` (B, n_inputs), each solved (one batched solve)."""
     form = closure_formulation(mech)
-    start = formulation_start(form)
     p = form.parameters(X)  # (B, n_in); the one-input loops read it as (B,)
-    sol = solve_all(form.system, p, start)
+    sol = solve_formulation(form, p)
     confs, certs, continuum, worst = [], [], np.zeros(len(X), dtype=bool), 0.0
     for b in range(len(X)):
         rows = np.flatnonzero((sol.instance == b) & sol.real)
@@ -180,4 +195,4 @@ def _every_mode_rows(mech: Mechanism, X: Array) -> MechanismModes:
         confs.append(conf.take(np.flatnonzero(keep)))
         certs.append(sol.certified_real[rows][keep])
     return MechanismModes(mech, X, tuple(confs), tuple(certs), sol.found, continuum,
-                          start.generic_count, start.how_found, worst)
+                          sol.generic_count, sol.how_found, worst)

@@ -14,8 +14,9 @@ rows searched, instead of Newton from random starts, which cannot promise every 
    sweep's inputs find nothing (an RCCC with a small twist whose roots lie at slides of many
    link lengths). The formulations' parameters are invariants of the links, so any closed
    configuration will do; of those found, the best-conditioned is kept.
-2. **The solve.** One :func:`~screwkit.algebraic.solve.solve_all` over every row (inputs
-   measured from the drawing), each real regular solution turned into the graph tracker's
+2. **The solve.** One batched solve over every row (inputs measured from the drawing):
+   :func:`~screwkit.kinematics.modes.every_mode.solve_formulation`, the parameter homotopy, or
+   for a single R loop the elimination solver that falls back to it; each real regular solution turned into the graph tracker's
    configuration by the formulation (with the nearly real singular end points off a continuum:
    double roots, where two modes meet at a fold) and kept only if the graph closure (exact SE(3) logarithm)
    is within :data:`~screwkit.kinematics.modes.every_mode.CLOSURE_TOLERANCE`. A row whose
@@ -40,7 +41,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.algebraic.solve import solve_all
 from screwkit.algebraic.track import PathStatus
 from screwkit.errors import ScrewkitError
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
@@ -50,7 +50,7 @@ from screwkit.kinematics.modes.every_mode import (
     CLOSURE_TOLERANCE,
     Formulation,
     closure_formulation,
-    formulation_start,
+    solve_formulation,
 )
 from screwkit.kinematics.modes.planar import PlanarFormulation
 from screwkit.kinematics.tracker.loop import (
@@ -226,9 +226,8 @@ def algebraic_roots(lf: LoopFormulation, linkage: Linkage, lay: Layout, X: Array
     form = lf.form
     B = X.shape[0]
     rel = X - lf.drawn_inputs
-    start = formulation_start(form)
     p = form.parameters(_form_inputs(form, rel))
-    sol = solve_all(form.system, p, start)
+    sol = solve_formulation(form, p)
     continuum = np.zeros(B, dtype=bool)
     singular = np.flatnonzero(sol.status == PathStatus.SINGULAR)
     if singular.size:
