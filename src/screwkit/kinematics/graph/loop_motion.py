@@ -80,7 +80,7 @@ def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
 
     def add(md: object, ok: NDArray[np.bool_], from_drawing: bool) -> None:
         R, p = _body_poses(mech, chain, md, R0, p0, ok)
-        conf = _configuration(mech, lay, R, p, rows, ok, from_drawing)
+        conf = configuration_from_poses(mech, lay, R, p, rows, ok, from_drawing)
         confs.append(conf.take(slice(a, None)))
         R, p = R[a:], p[a:]
         screws, centres, axes = joint_screws(mech, lay, R, p)
@@ -124,7 +124,7 @@ def _body_poses(mech: Mechanism, chain: LoopChain, md: object, R0: Array, p0: Ar
     return R, p
 
 
-def _configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Array,
+def configuration_from_poses(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Array,
                    ok: NDArray[np.bool_], from_drawing: bool) -> Configuration:
     """Every joint variable from the body poses (the inverse of graph/closure.py's joint
     motions M_j(q) on T_a⁻¹T_b): a rotation angle about the axis (atan2 of its sine and
@@ -257,7 +257,7 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
     segment X[k] → X[k+1] (all at once) where the loop's count of real solutions (its closed
     form's assembling modes at one input) leaves its value at X[k]."""
     from screwkit.kinematics.graph.motion import input_text
-    from screwkit.kinematics.registry import family_of, has_rsrc_quartic
+    from screwkit.kinematics.registry import family_of
 
     rows, ks = np.nonzero(masks[:, :-1] != masks[:, 1:])
     closed = family_of(chain.linkage).closed_form_for(chain.linkage)
@@ -266,22 +266,9 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
                  f"{input_text(mech, lay, X[k])} and {input_text(mech, lay, X[k + 1])}")
                 for r, k in zip(rows, ks, strict=True)]
     x0, x1 = X[ks], X[ks + 1]
-    rsrc = None
-    if has_rsrc_quartic(chain.linkage):  # its quartic's real roots, without the modes
-        from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
-        from screwkit.kinematics.closed_forms.rsrc.positions import rsrc_positions
-
-        rsrc = rsrc_dimensions(chain.linkage)[0]
 
     def count(t: Array) -> NDArray[np.intp]:
-        """Real solutions at the inputs x0 + t (x1 − x0): the RSRC's quartic roots (Bagci 1969
-        eq. 3.63, as its own limit search counts them), else the closed form's modes there, the
-        drawing appended (so that at least one input assembles)."""
-        L = chain.loop_inputs(np.vstack([x0 + t[:, None] * (x1 - x0), np.zeros((1, X.shape[1]))]))
-        if rsrc is not None:
-            return np.asarray(rsrc_positions(rsrc, L[:-1, 0]).n_assemblies)
-        mo = closed(chain.linkage, L, np.zeros_like(L), np.zeros_like(L))
-        return np.sum([md.assembles for md in mo.modes], axis=0)[:-1]
+        return real_count(chain, chain.loop_inputs(x0 + t[:, None] * (x1 - x0)))
 
     lo, hi = np.zeros(ks.size), np.ones(ks.size)
     c_lo = count(lo)
@@ -297,3 +284,22 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         out.append((int(r), int(k), x, f"{what} at {input_text(mech, lay, x)}: the loop folds "
                                        "(two of its assembly modes meet)"))
     return out
+
+
+def real_count(chain: LoopChain, L: Array) -> NDArray[np.intp]:
+    """The loop's real closed-form solutions at each row of loop inputs ``L`` (K, 1): the
+    RSRC's quartic roots (Bagci 1969 eq. 3.63, as its own limit search counts them), else the
+    closed form's modes there, the drawing appended (so that at least one input assembles)."""
+    from screwkit.kinematics.registry import family_of, has_rsrc_quartic
+
+    if has_rsrc_quartic(chain.linkage):  # its quartic's real roots, without the modes
+        from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
+        from screwkit.kinematics.closed_forms.rsrc.positions import rsrc_positions
+
+        return np.asarray(rsrc_positions(rsrc_dimensions(chain.linkage)[0],
+                                         L[:, 0]).n_assemblies)
+    closed = family_of(chain.linkage).closed_form_for(chain.linkage)
+    assert closed is not None
+    L = np.vstack([L, chain.offset[None, :]])
+    mo = closed(chain.linkage, L, np.zeros_like(L), np.zeros_like(L))
+    return np.asarray(np.sum([md.assembles for md in mo.modes], axis=0)[:-1])

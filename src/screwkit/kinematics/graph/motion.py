@@ -269,6 +269,10 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     )
     from screwkit.kinematics.graph.dyads import place
 
+    if dec.loops:  # a family loop among the sub-chains (graph/loop_stage.py)
+        from screwkit.kinematics.graph.loop_stage import loop_stage_motion
+
+        return loop_stage_motion(mech, lay, dec, X, Xd, Xdd, every)  # type: ignore[return-value]
     N = X.shape[0]
     skipped = ""
     if every:  # 2^D modes, each costing a drawn mode's time: only the drawn one when too many

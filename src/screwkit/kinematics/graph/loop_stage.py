@@ -1,0 +1,389 @@
+"""Every mode of a mechanism whose decomposition holds a family loop as a sub-chain stage
+(graph/subchains.py's :class:`LoopStage`; issue 27, "closed-form sub-chains first").
+
+A loop stage is solved once over the rows (the straight approach from the drawing, then the
+inputs) by its family's closed form (graph/loop_subchain.py reads the family off the drawing:
+Bagci 1969 eqs. 3.59–3.82 for the RSRC and its 4R case, A cos φ + B sin φ = C for the RSSR and
+the RCCC, Rahman 1996 §1.2's quadratic for the CSSP), every loop mode at once. Each loop mode
+gives the loop bodies' poses relative to the body the loop hangs on, T_rel = T_link ·
+T_link(drawing)⁻¹ (every body frame is the world frame in the drawing), and their world poses
+are the parent's pose times T_rel. The dyads and legs after it are placed on each loop mode by
+their closed forms (graph/dyads.py, graph/legs.py), so a mode of the mechanism is one loop mode
+× one branch of each dyad and leg; the drawn mode is the combination whose loop mode draws the
+drawing and whose dyad branches are the drawing's, followed from the drawing until it first
+stops assembling (its later runs, where it assembles again, are a mode of their own, as in
+graph/closed_modes.py).
+
+A mode is born or dies between two samples where one of its stages folds: the loop (its count
+of real closed-form solutions changes, graph/loop_motion.py's ``real_count``) or a dyad or leg
+(its discriminant crosses zero). Either is located by bisection of the input segment between
+the samples; for a dyad's fold the loop is carried along the segment on its branch (at each
+bisection point, the loop mode nearest the one at the bisection's last point). Rates and
+accelerations come from the stacked closure Jacobian (graph/motion.py's ``build_mode``).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.graph.dyads import Placement, driven_pose, dyad_poses
+from screwkit.kinematics.graph.loop_motion import (
+    FOLD_STEPS,
+    approach,
+    configuration_from_poses,
+    real_count,
+)
+from screwkit.kinematics.graph.loop_subchain import is_drawing
+from screwkit.kinematics.graph.subchains import Decomposition, Driven, Dyad, LoopStage
+from screwkit.kinematics.motion import AssemblyError
+from screwkit.model.mechanism import GROUND, Mechanism
+
+Array = NDArray[np.float64]
+Pose = tuple[Array, Array]
+#: one loop stage's bodies relative to its parent at K rows: R (K, n, 3, 3), p (K, n, 3), and
+#: where the loop mode assembles (K,)
+Relative = tuple[Array, Array, NDArray[np.bool_]]
+
+LOOP_STAGE_SOLVER = ("closed-form sub-chains (driven joints, family loops with every loop mode, "
+                     "planar dyads, spatial legs; every branch), rates and accelerations from "
+                     "the stacked loop closure")
+
+
+@dataclass(frozen=True)
+class StageModes:
+    """Every mode of one loop stage over K rows: ``R`` (M, K, n, 3, 3) and ``p`` (M, K, n, 3)
+    the loop bodies' poses relative to the parent (``stage.loop_bodies`` order; NaN where the
+    mode does not assemble), ``ok`` (M, K), the drawn mode's link frames at the drawing
+    (``R0``, ``p0``) and its index ``drawn`` (in the closed form's mode order)."""
+
+    R: Array
+    p: Array
+    ok: NDArray[np.bool_]
+    R0: Array
+    p0: Array
+    drawn: int
+
+
+def _column(lay: GraphLayout, stage: LoopStage) -> int:
+    """The graph input column of the loop's driven joint."""
+    return lay.inputs.index(lay.first_freedom[stage.joints[0]])
+
+
+def _solve(stage: LoopStage, x: Array) -> tuple[object, ...]:
+    """The loop's closed-form modes at the driven joint's values ``x`` (K,) and the drawing
+    appended (one row more: at least one row assembles)."""
+    from screwkit.kinematics.registry import family_of
+
+    lk = stage.chain.linkage
+    closed = family_of(lk).closed_form_for(lk)
+    assert closed is not None  # loop_chain keeps families with a closed form only
+    L = stage.chain.loop_inputs(np.append(x, 0.0)[:, None])
+    return tuple(closed(lk, L, np.zeros_like(L), np.zeros_like(L)).modes)
+
+
+def _relative(modes: tuple[object, ...], R0: Array, p0: Array) -> Relative:
+    """Every mode's loop bodies relative to the parent (the appended drawing row dropped):
+    (M, K, n, 3, 3), (M, K, n, 3), (M, K)."""
+    ok = np.array([md.assembles[:-1] for md in modes])  # type: ignore[attr-defined]
+    LR = np.array([md.link_rotation[:-1] for md in modes])  # type: ignore[attr-defined]
+    Lp = np.array([md.link_origin[:-1] for md in modes])  # type: ignore[attr-defined]
+    R = LR @ np.swapaxes(R0, -1, -2)
+    p = Lp - np.einsum("mknij,nj->mkni", R, p0)
+    R[~ok], p[~ok] = np.nan, np.nan
+    return R, p, ok
+
+
+def stage_modes(mech: Mechanism, lay: GraphLayout, stage: LoopStage, rows: Array
+                ) -> StageModes:
+    """Every mode of ``stage`` over the graph input ``rows`` (K, n_in), the first the drawing."""
+    modes = _solve(stage, rows[:, _column(lay, stage)])
+    drawn = next((m for m, md in enumerate(modes) if is_drawing(stage.sub, stage.chain, md)),
+                 None)
+    if drawn is None:  # loop_chain checked that the closed form draws the drawing
+        raise AssemblyError(f"{mech.name}: no mode of the {stage.describe(mech)} passes "
+                            "through the drawing")
+    R0 = modes[drawn].link_rotation[0]  # type: ignore[attr-defined]
+    p0 = modes[drawn].link_origin[0]  # type: ignore[attr-defined]
+    R, p, ok = _relative(modes, R0, p0)
+    return StageModes(R, p, ok, R0, p0, drawn)
+
+
+def carried(mech: Mechanism, lay: GraphLayout, stage: LoopStage, sm: StageModes, X: Array,
+            ref: Relative) -> Relative:
+    """The loop at input rows ``X`` (T, n_in) on the branch of ``ref`` (its relative poses at
+    nearby inputs, T rows): of the loop's modes there, the nearest to ``ref`` (rotation
+    entries and positions over the length scale)."""
+    R, p, ok = _relative(_solve(stage, X[:, _column(lay, stage)]), sm.R0, sm.p0)
+    L = mech.length_scale
+    gap = np.maximum(np.abs(R - ref[0]).max(axis=(2, 3, 4)), np.abs(p - ref[1]).max(axis=(2, 3)) / L)
+    gap = np.where(ok, gap, np.inf)
+    best = np.argmin(gap, axis=0)
+    t = np.arange(X.shape[0])
+    return R[best, t], p[best, t], ok[best, t]
+
+
+def place_rows(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array, signs: Array,
+               loops: list[Relative]) -> Placement:
+    """Every body's pose at input rows ``X`` (K, n_in): the stages' branches ``signs`` (K, S)
+    (a dyad's ±1; a loop's column unused here), each loop stage's relative poses ``loops``
+    (in placing order); the discriminant of a loop stage is 1 where it assembles (NaN where
+    not), a dyad's its own (graph/dyads.py)."""
+    K = X.shape[0]
+    poses: dict[str, Pose] = {GROUND: (np.broadcast_to(np.eye(3), (K, 3, 3)), np.zeros((K, 3)))}
+    disc = np.empty((K, len(dec.stages)))
+    d = li = 0
+    for step in dec.steps:
+        if isinstance(step, Driven):
+            poses[step.body] = driven_pose(mech, lay, step, X, poses[step.parent])
+            continue
+        if isinstance(step, LoopStage):
+            Rr, pr, ok = loops[li]
+            Rp, pp = poses[step.parent]
+            for i, body in enumerate(step.loop_bodies):
+                if body in step.bodies:
+                    poses[body] = (Rp @ Rr[:, i], np.einsum("kij,kj->ki", Rp, pr[:, i]) + pp)
+            disc[:, d] = np.where(ok, 1.0, np.nan)
+            li += 1
+        else:
+            b1, b2, disc[:, d] = dyad_poses(mech, step, signs[:, d], poses[step.placed[0]],
+                                            poses[step.placed[1]])
+            poses[step.bodies[0]], poses[step.bodies[1]] = b1, b2
+        d += 1
+    B = len(mech.bodies) + 1
+    R = np.empty((K, B, 3, 3))
+    p = np.empty((K, B, 3))
+    for name, (Rb, pb) in poses.items():
+        R[:, lay.body_of[name]], p[:, lay.body_of[name]] = Rb, pb
+    return Placement(R, p, disc)
+
+
+def combinations(dec: Decomposition, loops: list[StageModes]) -> Array:
+    """Every combination of stage branches (M, S): a loop's mode index (the drawn one first,
+    then those that assemble somewhere), a dyad's ±1 (the drawing's first); row 0 the
+    drawing's."""
+    choices: list[list[float]] = []
+    li = 0
+    for st in dec.stages:
+        if isinstance(st, LoopStage):
+            sm = loops[li]
+            li += 1
+            choices.append([float(sm.drawn)] + [float(m) for m in range(sm.ok.shape[0])
+                                                if m != sm.drawn and sm.ok[m].any()])
+        else:
+            choices.append([float(st.drawn_branch), -float(st.drawn_branch)][:st.branches])
+    return np.array(list(itertools.product(*choices)), dtype=float).reshape(-1, len(choices))
+
+
+def _loop_rows(dec: Decomposition, loops: list[StageModes], combos: Array, k: NDArray[np.intp]
+               ) -> list[Relative]:
+    """Each loop stage's relative poses for combination rows ``combos`` (T, S) at row
+    indices ``k`` (T,) of the solved rows."""
+    out = []
+    cols = [d for d, st in enumerate(dec.stages) if isinstance(st, LoopStage)]
+    for sm, d in zip(loops, cols, strict=True):
+        m = combos[:, d].astype(int)
+        out.append((sm.R[m, k], sm.p[m, k], sm.ok[m, k]))
+    return out
+
+
+def stage_names(mech: Mechanism, st: Dyad | LoopStage) -> str:
+    return "–".join(mech.joints[k].name for k in st.joints)
+
+
+def combination_label(mech: Mechanism, dec: Decomposition, loops: list[StageModes],
+                      signs: Array) -> str:
+    """Each stage's branch: a loop's mode (its closed form's index; "drawn" for the drawing's),
+    a two-branch dyad's sign (+: the drawing's)."""
+    parts, li = [], 0
+    for st, s in zip(dec.stages, signs, strict=True):
+        if isinstance(st, LoopStage):
+            drawn = loops[li].drawn
+            li += 1
+            parts.append(f"{st.kind} loop {stage_names(mech, st)} mode {int(s)}"
+                         + (" (drawn)" if int(s) == drawn else ""))
+        elif st.branches == 2:
+            parts.append(f"{stage_names(mech, st)} {'+' if s == st.drawn_branch else '−'}")
+    return ", ".join(parts)
+
+
+def _bisect(T: int, assembles: Callable[[Array], NDArray[np.bool_]],
+            moved: Callable[[Array, NDArray[np.bool_]], None] | None = None) -> Array:
+    """The parameters t in [0, 1] (T,) where ``assembles(t)`` leaves its value at t = 0,
+    by FOLD_STEPS bisections (``moved(mid, same)`` told of each step)."""
+    lo, hi = np.zeros(T), np.ones(T)
+    at_lo = assembles(lo)
+    for _ in range(FOLD_STEPS):
+        mid = 0.5 * (lo + hi)
+        same = assembles(mid) == at_lo
+        if moved is not None:
+            moved(mid, same)
+        lo = np.where(same, mid, lo)
+        hi = np.where(same, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: list[StageModes],
+                X: Array, a: int, combos: Array, held: NDArray[np.bool_], disc: Array
+                ) -> tuple[list[list[str]], list[tuple[int, int, int]]]:
+    """Each mode's births and deaths (modes: rows of ``combos`` (M', S), held at ``held``
+    (M', N); ``disc`` (M', a + N, S) their stages' discriminants over the solved rows, the
+    approach's ``a`` first), each located between its two samples (module docstring), and
+    every fold as (mode, folding stage, sample k before it)."""
+    from screwkit.kinematics.graph.motion import input_text
+
+    i, k = np.nonzero(held[:, :-1] != held[:, 1:])
+    events: list[list[str]] = [[] for _ in range(held.shape[0])]
+    if k.size == 0:
+        return events, []
+    bad = np.where(held[i, k], k + 1, k)  # the sample of the two where it does not assemble
+    folding = np.argmax(~(disc[i, a + bad] >= 0.0), axis=1)  # the first stage that fails
+    stages = dec.stages
+    x0, x1 = X[k], X[k + 1]
+    t = np.empty(k.size)
+    is_loop = np.array([isinstance(stages[f], LoopStage) for f in folding])
+    for d, st in enumerate(stages):
+        sel = np.flatnonzero(is_loop & (folding == d))
+        if sel.size == 0 or not isinstance(st, LoopStage):
+            continue
+        col = _column(lay, st)
+        s0, s1 = x0[sel, col], x1[sel, col]
+        t[sel] = _bisect(sel.size, lambda tt, st=st, s0=s0, s1=s1: real_count(
+            st.chain, st.chain.loop_inputs((s0 + tt * (s1 - s0))[:, None])))
+    sel = np.flatnonzero(~is_loop)
+    if sel.size:
+        t[sel] = _dyad_folds(mech, lay, dec, loops, x0[sel], x1[sel], combos[i[sel]],
+                             a + k[sel])
+    at = x0 + t[:, None] * (x1 - x0)
+    for m, kk, x, d in zip(i, k, at, folding, strict=True):
+        st = stages[int(d)]
+        what = "dies" if held[m, kk] else "is born"
+        how = ("two of its assembly modes meet" if isinstance(st, LoopStage)
+               else "its two branches meet")
+        events[int(m)].append(f"{what} at {input_text(mech, lay, x)}: the {st.kind} {st.word} "
+                              f"{stage_names(mech, st)} folds ({how})")
+    return events, [(int(m), int(d), int(kk)) for m, d, kk in zip(i, folding, k, strict=True)]
+
+
+def _dyad_folds(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: list[StageModes],
+                x0: Array, x1: Array, combos: Array, k: NDArray[np.intp]) -> Array:
+    """Where a dyad or leg of each mode (``combos`` (T, S)) folds on the segment x0 → x1
+    (T, n_in), the loops carried on their branches from the solved row ``k`` (T,)."""
+    ref = _loop_rows(dec, loops, combos, k)
+    last: list[list[Relative]] = [ref]
+
+    def assembles(tt: Array) -> NDArray[np.bool_]:
+        xm = x0 + tt[:, None] * (x1 - x0)
+        rel = [carried(mech, lay, st, sm, xm, r)
+               for st, sm, r in zip(dec.loops, loops, ref, strict=True)]
+        last[0] = rel
+        return place_rows(mech, lay, dec, xm, combos, rel).assembles
+
+    def moved(mid: Array, same: NDArray[np.bool_]) -> None:
+        for n, (new, old) in enumerate(zip(last[0], ref, strict=True)):
+            keep = new[2]
+            ref[n] = (np.where(keep[:, None, None, None], new[0], old[0]),
+                      np.where(keep[:, None, None], new[1], old[1]), old[2] | keep)
+
+    return _bisect(k.size, assembles, moved)
+
+
+def _circuits(combos: Array, held: NDArray[np.bool_], joins: list[tuple[int, int, int]]
+              ) -> list[tuple[int, int]]:
+    """Pairs of modes that meet at a fold: at a fold of stage d between samples k and k+1, a
+    mode meets a mode whose branches differ in d alone and that is born or dies there."""
+    turns = held[:, :-1] != held[:, 1:]
+    pairs = []
+    for m, d, k in joins:
+        others = np.delete(np.arange(combos.shape[1]), d)
+        match = np.flatnonzero(np.all(combos[:, others] == combos[m, others], axis=1)
+                               & (combos[:, d] != combos[m, d]) & turns[:, k])
+        if match.size:
+            pairs.append((int(match[0]), m))
+    return pairs
+
+
+def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
+                      Xd: Array, Xdd: Array, every: bool) -> object:
+    """The :class:`~screwkit.kinematics.graph.motion.MechanismMotion` of a mechanism whose
+    decomposition holds family loops (module docstring): mode 0 the drawn mode, then with
+    ``every`` every other combination of loop modes and dyad branches that assembles
+    somewhere, and the drawn combination's later runs (a mode of their own)."""
+    from screwkit.budget import ResourceLimitError
+    from screwkit.kinematics.graph.motion import (
+        MechanismMotion,
+        build_mode,
+        check_cost,
+        groups,
+        input_text,
+        with_events,
+    )
+
+    N = X.shape[0]
+    A = approach(lay, X)
+    a = A.shape[0]
+    rows = np.vstack([A, X])
+    K = a + N
+    loops = [stage_modes(mech, lay, st, rows) for st in dec.loops]
+    combos = combinations(dec, loops)
+    skipped = ""
+    if every:  # each combination costs a drawn mode's time: only the drawn one when too many
+        try:
+            check_cost(mech, N * combos.shape[0])
+        except ResourceLimitError as err:
+            every, skipped = False, (f"every mode: only the drawn mode is solved; the "
+                                     f"{combos.shape[0]} branch combinations would be over a "
+                                     f"limit ({err})")
+    if not every:
+        combos = combos[:1]
+    M = combos.shape[0]
+    signs = np.repeat(combos, K, axis=0)
+    pl = place_rows(mech, lay, dec, np.tile(rows, (M, 1)), signs,
+                    _loop_rows(dec, loops, signs, np.tile(np.arange(K), M)))
+    ok = pl.assembles.reshape(M, K)
+    R = pl.R.reshape(M, K, *pl.R.shape[1:])
+    p = pl.p.reshape(M, K, *pl.p.shape[1:])
+    disc = pl.discriminant.reshape(M, K, -1)
+    if not ok[0, :a + 1].all():
+        raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
+                            f"first input row {input_text(mech, lay, X[0])}: the mechanism stops "
+                            "assembling before it")
+    stop = int(np.argmin(ok[0, a:])) if not ok[0, a:].all() else N
+    drawn = np.arange(N) < stop
+    conf = configuration_from_poses(mech, lay, R[0], p[0], rows,
+                                    np.concatenate([np.ones(a, dtype=bool), drawn]), True)
+    mode = build_mode(mech, lay, conf.take(slice(a, None)), drawn, X, Xd, Xdd)
+    picked = [0] + [m for m in range(1, M) if ok[m, a:].any()]
+    masks = [drawn, *(ok[m, a:] for m in picked[1:])]
+    again = ok[0, a:] & (np.arange(N) >= stop)  # the drawn combination after its first fold
+    if every and again.any():
+        picked.append(0)
+        masks.append(again)
+    held = np.array(masks)
+    folds, joins = fold_events(mech, lay, dec, loops, X, a, combos[picked], held, disc[picked])
+    events = folds[0][:1]  # the drawn mode ends at its first fold
+    if stop < N:
+        events.insert(0, f"stops assembling after input {input_text(mech, lay, X[stop - 1])} (a "
+                         f"limit position or dead centre before {input_text(mech, lay, X[stop])})")
+    modes = [replace(with_events(mode, [*events, *mode.events]), label="drawn")]
+    for n, (m, ev) in enumerate(zip(picked[1:], folds[1:], strict=True), start=1):
+        conf = configuration_from_poses(mech, lay, R[m, a:], p[m, a:], X, held[n], False)
+        md = build_mode(mech, lay, conf, held[n], X, Xd, Xdd)
+        label = f"branches {combination_label(mech, dec, loops, combos[m])}"
+        if m == 0:
+            label += " (the drawn branches again, after the drawn mode's fold)"
+        modes.append(replace(with_events(md, [*ev, *md.events]), label=label, index=len(modes)))
+    notes: tuple[str, ...] = (skipped,) if skipped else ()
+    if every:
+        circuits = groups(len(modes), _circuits(combos[picked], held, joins))
+        notes = (f"{M} branch combination(s) of {len(dec.stages)} sub-chain(s) (loop modes × "
+                 f"dyad and leg branches); {len(modes)} mode(s) assemble over these inputs",
+                 "circuits (modes that meet at a fold, where the input must turn back to go "
+                 "on): " + ", ".join("{" + ", ".join(map(str, c)) + "}" for c in circuits))
+    return MechanismMotion(mech, X, Xd, Xdd, tuple(modes), method="graph (closed forms)",
+                           solver=LOOP_STAGE_SOLVER, notes=notes)
