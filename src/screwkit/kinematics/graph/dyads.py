@@ -98,6 +98,7 @@ def place(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array, signs
         if isinstance(step, Driven):
             poses[step.body] = driven_pose(mech, lay, step, X, poses[step.parent])
         else:
+            assert isinstance(step, Dyad), "a loop stage is placed by graph/loop_stage.py"
             b1, b2, disc[:, d] = dyad_poses(mech, step, signs[:, d], poses[step.placed[0]],
                                        poses[step.placed[1]])
             poses[step.bodies[0]], poses[step.bodies[1]] = b1, b2
@@ -122,6 +123,7 @@ def place_every(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array)
             poses[step.body] = driven_pose(mech, lay, step, np.tile(X, (c, 1)), poses[step.parent])
             count[step.body] = c
             continue
+        assert isinstance(step, Dyad), "a loop stage is placed by graph/loop_stage.py"
         m_new = m * step.branches
         branch = [step.drawn_branch, -step.drawn_branch][:step.branches]
         sigma = np.repeat(np.tile(np.array(branch, dtype=float), m), N)

@@ -27,6 +27,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -212,7 +213,7 @@ def combination_label(mech: Mechanism, dec: Decomposition, loops: list[StageMode
     return ", ".join(parts)
 
 
-def _bisect(T: int, assembles: Callable[[Array], NDArray[np.bool_]],
+def _bisect(T: int, assembles: Callable[[Array], NDArray[Any]],
             moved: Callable[[Array, NDArray[np.bool_]], None] | None = None) -> Array:
     """The parameters t in [0, 1] (T,) where ``assembles(t)`` leaves its value at t = 0,
     by FOLD_STEPS bisections (``moved(mid, same)`` told of each step)."""
@@ -253,8 +254,12 @@ def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: li
             continue
         col = _column(lay, st)
         s0, s1 = x0[sel, col], x1[sel, col]
-        t[sel] = _bisect(sel.size, lambda tt, st=st, s0=s0, s1=s1: real_count(
-            st.chain, st.chain.loop_inputs((s0 + tt * (s1 - s0))[:, None])))
+
+        def count(tt: Array, st: LoopStage = st, s0: Array = s0, s1: Array = s1
+                  ) -> NDArray[np.intp]:
+            return real_count(st.chain, st.chain.loop_inputs((s0 + tt * (s1 - s0))[:, None]))
+
+        t[sel] = _bisect(sel.size, count)
     sel = np.flatnonzero(~is_loop)
     if sel.size:
         t[sel] = _dyad_folds(mech, lay, dec, loops, x0[sel], x1[sel], combos[i[sel]],

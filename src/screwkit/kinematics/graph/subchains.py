@@ -375,9 +375,9 @@ def _loop_alone(mech: Mechanism, loop: tuple[int, ...], bodies: tuple[str, ...],
     from screwkit.model.mechanism import Body
 
     rename = {parent: GROUND, GROUND: parent}  # the parent may itself be the ground
-    joints = tuple(replace(mech.joints[k], bodies=tuple(rename.get(b, b) for b in
-                                                        mech.joints[k].bodies))
-                   for k in loop)
+    joints = tuple(replace(j, bodies=(rename.get(j.bodies[0], j.bodies[0]),
+                                      rename.get(j.bodies[1], j.bodies[1])))
+                   for j in (mech.joints[k] for k in loop))
     return Mechanism(f"{mech.name}: loop", tuple(Body(b) for b in bodies), joints,
                      (f"{mech.joints[loop[0]].name}.theta",), length_scale=mech.length_scale)
 
