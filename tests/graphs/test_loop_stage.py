@@ -63,7 +63,7 @@ def _pose_vector(R: np.ndarray, p: np.ndarray, L: float) -> np.ndarray:
     return np.concatenate([np.ravel(R[:4]), np.ravel(p[:4]) / L])
 
 
-def _independent(mech: Mechanism) -> list[np.ndarray]:
+def _independent(mech: Mechanism, X: np.ndarray = X) -> list[np.ndarray]:
     """Every configuration at every input row, without the loop stage: the RSRC's modes from
     the homotopy, then every arm angle φ where |T(φ) − G| is the rod's length (a sign change
     on a 0.1° grid refined by brentq)."""
@@ -150,6 +150,22 @@ def test_every_mode_closes_and_the_folds_are_named(
         assert "the drawn branches again" in motion.modes[-1].label
     else:
         assert [int(md.assembles.sum()) for md in motion.modes[:2]] == [X.shape[0]] * 2
+
+
+def test_each_fold_is_where_the_independent_count_changes_by_two() -> None:
+    """The births and deaths the loop stage reports (bisected between samples): just before
+    and just after each, the independent count of configurations differs by two (a fold:
+    two configurations meet)."""
+    mech = _with_leg("folding")
+    motion = solve_mechanism(mech, X, every_mode=True)
+    folds = {float(e.split(" deg")[0].split("= ")[1]) for md in motion.modes for e in md.events
+             if e.startswith(("dies at", "is born at"))}
+    assert len(folds) == 6  # two on the drawn loop mode, four on the other
+    eps = 2e-4  # the event's six digits place it within 1e-5 rad
+    x = np.radians(np.array(sorted(folds)))
+    around = _independent(mech, np.stack([x - eps, x + eps], axis=1).reshape(-1, 1))
+    counts = np.array([len(c) for c in around]).reshape(-1, 2)
+    assert np.all(np.abs(counts[:, 0] - counts[:, 1]) == 2), counts
 
 
 def test_the_drawn_mode_is_the_graph_tracker_s(case: tuple[Mechanism, MechanismMotion]) -> None:

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
 from screwkit.kinematics.graph.dyads import Placement, driven_pose, dyad_poses
 from screwkit.kinematics.graph.loop_motion import (
     FOLD_STEPS,
@@ -50,6 +50,9 @@ Pose = tuple[Array, Array]
 #: one loop stage's bodies relative to its parent at K rows: R (K, n, 3, 3), p (K, n, 3), and
 #: where the loop mode assembles (K,)
 Relative = tuple[Array, Array, NDArray[np.bool_]]
+#: points per round of the fold search (graph/loop_stage.py's ``_bisect``): 2⁵ sections, so
+#: a round gains five bits of the fold's place
+SECTIONS = 32
 
 LOOP_STAGE_SOLVER = ("closed-form sub-chains (driven joints, family loops with every loop mode, "
                      "planar dyads, spatial legs; every branch), rates and accelerations from "
@@ -214,18 +217,26 @@ def combination_label(mech: Mechanism, dec: Decomposition, loops: list[StageMode
 
 
 def _bisect(T: int, assembles: Callable[[Array], NDArray[Any]],
-            moved: Callable[[Array, NDArray[np.bool_]], None] | None = None) -> Array:
-    """The parameters t in [0, 1] (T,) where ``assembles(t)`` leaves its value at t = 0,
-    by FOLD_STEPS bisections (``moved(mid, same)`` told of each step)."""
+            moved: Callable[[NDArray[np.intp]], None] | None = None) -> Array:
+    """The parameters t in [0, 1] (T,) where ``assembles`` first leaves its value at t = 0:
+    each round evaluates SECTIONS − 1 points of every interval at once (``assembles`` takes
+    t (T, n) and gives (T, n)) and keeps the section where the value first changes, until the
+    interval is 2⁻FOLD_STEPS long (a closed-form call per round, not per halving);
+    ``moved(j)`` is told the column j of the points the interval's start moved to (−1: it
+    did not move)."""
     lo, hi = np.zeros(T), np.ones(T)
-    at_lo = assembles(lo)
-    for _ in range(FOLD_STEPS):
-        mid = 0.5 * (lo + hi)
-        same = assembles(mid) == at_lo
+    at_lo = assembles(lo[:, None])[:, 0]
+    r = np.arange(T)
+    frac = np.arange(1, SECTIONS) / SECTIONS
+    for _ in range(int(np.ceil(FOLD_STEPS / np.log2(SECTIONS)))):
+        ts = lo[:, None] + (hi - lo)[:, None] * frac
+        changed = assembles(ts) != at_lo[:, None]
+        first = np.where(changed.any(axis=1), np.argmax(changed, axis=1), SECTIONS - 1)
+        j = first - 1  # the last point before the change (−1: the interval's start)
         if moved is not None:
-            moved(mid, same)
-        lo = np.where(same, mid, lo)
-        hi = np.where(same, hi, mid)
+            moved(j)
+        hi = np.where(first < SECTIONS - 1, ts[r, np.minimum(first, SECTIONS - 2)], hi)
+        lo = np.where(j >= 0, ts[r, np.maximum(j, 0)], lo)
     return 0.5 * (lo + hi)
 
 
@@ -255,9 +266,10 @@ def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: li
         col = _column(lay, st)
         s0, s1 = x0[sel, col], x1[sel, col]
 
-        def count(tt: Array, st: LoopStage = st, s0: Array = s0, s1: Array = s1
+        def count(ts: Array, st: LoopStage = st, s0: Array = s0, s1: Array = s1
                   ) -> NDArray[np.intp]:
-            return real_count(st.chain, st.chain.loop_inputs((s0 + tt * (s1 - s0))[:, None]))
+            x = (s0[:, None] + ts * (s1 - s0)[:, None]).reshape(-1, 1)
+            return real_count(st.chain, st.chain.loop_inputs(x)).reshape(ts.shape)
 
         t[sel] = _bisect(sel.size, count)
     sel = np.flatnonzero(~is_loop)
@@ -278,24 +290,33 @@ def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: li
 def _dyad_folds(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: list[StageModes],
                 x0: Array, x1: Array, combos: Array, k: NDArray[np.intp]) -> Array:
     """Where a dyad or leg of each mode (``combos`` (T, S)) folds on the segment x0 → x1
-    (T, n_in), the loops carried on their branches from the solved row ``k`` (T,)."""
+    (T, n_in), the loops carried on their branches from the solved row ``k`` (T,): at each
+    round's points, the loop mode nearest the one at the interval's start."""
     ref = _loop_rows(dec, loops, combos, k)
+    T = k.size
     last: list[list[Relative]] = [ref]
 
-    def assembles(tt: Array) -> NDArray[np.bool_]:
-        xm = x0 + tt[:, None] * (x1 - x0)
-        rel = [carried(mech, lay, st, sm, xm, r)
+    def assembles(ts: Array) -> NDArray[np.bool_]:
+        n = ts.shape[1]
+        xm = (x0[:, None] + ts[:, :, None] * (x1 - x0)[:, None]).reshape(T * n, -1)
+        rel = [carried(mech, lay, st, sm, xm, (np.repeat(r[0], n, axis=0),
+                                               np.repeat(r[1], n, axis=0),
+                                               np.repeat(r[2], n, axis=0)))
                for st, sm, r in zip(dec.loops, loops, ref, strict=True)]
         last[0] = rel
-        return place_rows(mech, lay, dec, xm, combos, rel).assembles
+        return place_rows(mech, lay, dec, xm, np.repeat(combos, n, axis=0),
+                          rel).assembles.reshape(T, n)
 
-    def moved(mid: Array, same: NDArray[np.bool_]) -> None:
-        for n, (new, old) in enumerate(zip(last[0], ref, strict=True)):
-            keep = new[2]
-            ref[n] = (np.where(keep[:, None, None, None], new[0], old[0]),
-                      np.where(keep[:, None, None], new[1], old[1]), old[2] | keep)
+    def moved(j: NDArray[np.intp]) -> None:
+        go = np.flatnonzero(j >= 0)
+        n = len(last[0][0][2]) // T
+        for li, new in enumerate(last[0]):
+            R, p, ok = ref[li][0].copy(), ref[li][1].copy(), ref[li][2].copy()
+            at = go * n + j[go]
+            R[go], p[go], ok[go] = new[0][at], new[1][at], new[2][at]
+            ref[li] = (R, p, ok)
 
-    return _bisect(k.size, assembles, moved)
+    return _bisect(T, assembles, moved)
 
 
 def _circuits(combos: Array, held: NDArray[np.bool_], joins: list[tuple[int, int, int]]
@@ -311,6 +332,16 @@ def _circuits(combos: Array, held: NDArray[np.bool_], joins: list[tuple[int, int
         if match.size:
             pairs.append((int(match[0]), m))
     return pairs
+
+
+def _frames(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, ok: NDArray[np.bool_]
+            ) -> GraphFrames:
+    """A mode's body poses as the tracker's frames (the identity where it does not assemble),
+    with its joints' world screws, centres and axes, for ``build_mode`` to reuse."""
+    R = np.where(ok[:, None, None, None], R, np.eye(3))
+    p = np.where(ok[:, None, None], p, 0.0)
+    screws, centres, axes = joint_screws(mech, lay, R, p)
+    return GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes)
 
 
 def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
@@ -362,7 +393,8 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     drawn = np.arange(N) < stop
     conf = configuration_from_poses(mech, lay, R[0], p[0], rows,
                                     np.concatenate([np.ones(a, dtype=bool), drawn]), True)
-    mode = build_mode(mech, lay, conf.take(slice(a, None)), drawn, X, Xd, Xdd)
+    mode = build_mode(mech, lay, conf.take(slice(a, None)), drawn, X, Xd, Xdd,
+                      _frames(mech, lay, R[0, a:], p[0, a:], drawn))
     picked = [0] + [m for m in range(1, M) if ok[m, a:].any()]
     masks = [drawn, *(ok[m, a:] for m in picked[1:])]
     again = ok[0, a:] & (np.arange(N) >= stop)  # the drawn combination after its first fold
@@ -378,7 +410,8 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     modes = [replace(with_events(mode, [*events, *mode.events]), label="drawn")]
     for n, (m, ev) in enumerate(zip(picked[1:], folds[1:], strict=True), start=1):
         conf = configuration_from_poses(mech, lay, R[m, a:], p[m, a:], X, held[n], False)
-        md = build_mode(mech, lay, conf, held[n], X, Xd, Xdd)
+        md = build_mode(mech, lay, conf, held[n], X, Xd, Xdd,
+                        _frames(mech, lay, R[m, a:], p[m, a:], held[n]))
         label = f"branches {combination_label(mech, dec, loops, combos[m])}"
         if m == 0:
             label += " (the drawn branches again, after the drawn mode's fold)"
