@@ -8,6 +8,8 @@ tracker; rates against finite differences; every mode's loops close."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -204,3 +206,51 @@ def test_rates_and_accelerations_are_the_finite_differences_of_the_positions() -
         # the tie rod's: its spin about its own axis is idle, its pose there a convention)
         v = (md.link_origin[3, :4] - md.link_origin[1, :4]) / (2 * h)
         assert np.max(np.abs(md.link_origin_velocity[2, :4] - v)) <= 1e-7 * mech.length_scale
+
+
+def _knee() -> Mechanism:
+    """The RSRC hung on a thigh that a hip joint turns: the loop's ground is the thigh, its
+    crank driven from the thigh by a second input (a four-bar knee inside a serial chain)."""
+    loop = _loop()
+    on_thigh = tuple(replace(j, bodies=tuple("thigh" if b == "ground" else b for b in j.bodies))
+                     for j in loop.joints)
+    hip = MechanismJoint("hip", "R", ("ground", "thigh"), np.array([0.5, -2.0, 1.0]),
+                         np.array([0.2, 0.3, 1.0]))
+    return Mechanism("knee", (Body("thigh"), *loop.bodies), (hip, *on_thigh),
+                     ("hip.theta", "input.theta"))
+
+
+def test_a_loop_hung_on_a_driven_body_is_the_loop_alone_in_that_body_s_frame() -> None:
+    mech = _knee()
+    dec = decompose(mech)
+    assert dec.complete and dec.loops[0].parent == "thigh"
+    t = np.linspace(0.0, 1.0, 41)
+    rows = np.stack([0.8 * np.sin(2 * np.pi * t), 2 * np.pi * t], axis=1)
+    motion = solve_mechanism(mech, rows, every_mode=True)
+    assert motion.method == "graph (closed forms)"
+    # the loop alone at the knee's inputs, from the homotopy
+    loop = _loop()
+    lay_loop = graph_layout(loop)
+    found = every_mode(loop, rows[:, 1:])
+    for n, conf in enumerate(found.configurations):
+        fr = graph_forward(loop, lay_loop, conf)
+        want = np.concatenate([fr.R[:, :3].reshape(len(conf.scalars), -1),
+                               fr.p[:, :3].reshape(len(conf.scalars), -1)], axis=1)
+        mine = []
+        for md in motion.modes:
+            if not md.assembles[n]:
+                continue
+            Rt, pt = md.link_rotation[n, 0], md.link_origin[n, 0]  # the thigh
+            R = Rt.T @ md.link_rotation[n, 1:4]
+            p = (md.link_origin[n, 1:4] - pt) @ Rt
+            mine.append(np.concatenate([R.ravel(), p.ravel()]))
+        assert len(mine) == len(want) == 2, n
+        gap = np.abs(np.array(mine)[:, None] - want[None]).max(axis=2)
+        assert np.all(gap.min(axis=1) <= 1e-9) and np.all(gap.min(axis=0) <= 1e-9), n
+    lay = graph_layout(mech)
+    followed = follow_drawn_mode(mech, lay, rows)
+    assert followed.mask.all() and motion.modes[0].assembles.all()
+    assert np.max(np.abs(motion.modes[0].conf.scalars - followed.conf.scalars)) <= 1e-10
+    for md in motion.modes:
+        res = graph_forward(mech, lay, md.conf.take(np.flatnonzero(md.assembles))).residual
+        assert np.abs(res).max() <= 1e-10 * mech.length_scale
