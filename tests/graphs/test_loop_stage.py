@@ -25,23 +25,29 @@ from screwkit.kinematics.graph.track import follow_drawn_mode
 from screwkit.kinematics.modes.every_mode import every_mode
 from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
 
+#: Bagci's RSRC dimensions (d1, d2, d3, a, b, e, δ0, λ0): two modes over every turn, and four,
+#: two of which fold (tests/graphs/test_loop_subchain.py)
+RSRC2 = (1.0, 3.5, 2.0, 3.0, 0.5, 0.2, 0.3, 0.4)
+RSRC4 = (0.681, 2.147, 0.633, 1.955, 0.248, 0.174, 1.177, 0.273)
 #: the legs hung on the RSRC's coupler: (arm pivot K, arm axis, ball T on the arm, ground ball G)
 LEGS = {"full": ([-0.17, 4.581, -1.036], [-0.378, 2.043, 0.647], [-0.705, 3.766, 0.092],
                  [-0.609, 1.462, 0.833]),
         "folding": ([-1.797, 4.77, -0.752], [0.914, -0.02, -1.249], [-1.108, 4.03, -0.026],
-                    [-2.96, 1.52, 2.105])}
+                    [-2.96, 1.52, 2.105]),
+        "loop folding": ([-1.86, 1.262, 0.175], [0.648, -0.121, -0.23], [-1.756, 1.077, 0.469],
+                         [-1.017, 2.443, -0.149])}
 X = np.radians(np.arange(0.0, 360.0, 6.0))[:, None]
 
 
-def _loop() -> Mechanism:
-    """Bagci's RSRC (crank 1, coupler 3.5, …) drawn where its first mode is at input 0."""
-    lk = sk.rsrc(1.0, 3.5, 2.0, 3.0, 0.5, 0.2, 0.3, 0.4)
+def _loop(dims: tuple[float, ...] = RSRC2) -> Mechanism:
+    """Bagci's RSRC drawn where its first mode is at input 0."""
+    lk = sk.rsrc(*dims)
     return mechanism_from_loop(sk.solve_motion(lk, np.radians([0.0, 2.0])), 0, 0)
 
 
 def _with_leg(which: str) -> Mechanism:
     K, u, T, G = (np.asarray(v, dtype=float) for v in LEGS[which])
-    loop = _loop()
+    loop = _loop(RSRC4 if which == "loop folding" else RSRC2)
     joints = (MechanismJoint("K", "R", ("coupler", "arm"), K, u),
               MechanismJoint("T", "S", ("arm", "tie"), T, np.array([0.0, 0.0, 1.0])),
               MechanismJoint("G", "S", ("tie", "ground"), G, np.array([0.0, 0.0, 1.0])))
@@ -69,7 +75,7 @@ def _independent(mech: Mechanism, X: np.ndarray = X) -> list[np.ndarray]:
     """Every configuration at every input row, without the loop stage: the RSRC's modes from
     the homotopy, then every arm angle φ where |T(φ) − G| is the rod's length (a sign change
     on a 0.1° grid refined by brentq)."""
-    loop = _loop()
+    loop = _loop(RSRC4 if mech.name.endswith("loop folding leg") else RSRC2)
     lay = graph_layout(loop)
     K0, u0 = mech.joints[4].at, mech.joints[4].axis
     T0, G = mech.joints[5].at, mech.joints[6].at
@@ -132,7 +138,9 @@ def test_every_mode_is_every_configuration_at_every_sample(
             assert np.all(gap.min(axis=1) <= 1e-9) and np.all(gap.min(axis=0) <= 1e-9), n
         counts.append(len(want))
     assert max(counts) == 4  # two loop modes, each with both leg branches
-    assert motion.notes[0].startswith("4 branch combination(s) of 2 sub-chain(s)")
+    four = mech.name.endswith("loop folding leg")  # four loop modes: 8 combinations
+    assert motion.notes[0].startswith(f"{8 if four else 4} branch combination(s) of 2 "
+                                      "sub-chain(s)")
 
 
 def test_every_mode_closes_and_the_folds_are_named(
@@ -147,27 +155,35 @@ def test_every_mode_closes_and_the_folds_are_named(
             if e.startswith(("dies", "is born")):
                 assert "the RSS leg K–T–G folds" in e or "the RSRC loop" in e, e
     births = sum(e.startswith(("dies", "is born")) for md in motion.modes for e in md.events)
-    if mech.name.endswith("folding leg"):
+    if mech.name.endswith("loop folding leg"):  # the loop's folds and the leg's
+        assert len(motion.modes) == 5 and births >= 4
+        assert any("the RSRC loop input–sphere–coupler_R–output_C folds (two of its assembly "
+                   "modes meet)" in e for md in motion.modes for e in md.events)
+    elif mech.name.endswith("folding leg"):
         assert births >= 4 and len(motion.modes) == 5
         assert "the drawn branches again" in motion.modes[-1].label
     else:
         assert [int(md.assembles.sum()) for md in motion.modes[:2]] == [X.shape[0]] * 2
 
 
-def test_each_fold_is_where_the_independent_count_changes_by_two() -> None:
-    """The births and deaths the loop stage reports (bisected between samples): just before
-    and just after each, the independent count of configurations differs by two (a fold:
-    two configurations meet)."""
-    mech = _with_leg("folding")
+@pytest.mark.parametrize("which", ["folding", "loop folding"])
+def test_each_fold_is_where_the_independent_count_changes_by_two(which: str) -> None:
+    """The births and deaths the loop stage reports (located between samples): just before
+    and just after each, the independent count of configurations changes (a fold: pairs of
+    configurations meet), the leg's folds and the loop's."""
+    mech = _with_leg(which)
     motion = solve_mechanism(mech, X, every_mode=True)
     folds = {float(e.split(" deg")[0].split("= ")[1]) for md in motion.modes for e in md.events
              if e.startswith(("dies at", "is born at"))}
-    assert len(folds) == 6  # two on the drawn loop mode, four on the other
+    assert len(folds) == 6
     eps = 2e-4  # the event's six digits place it within 1e-5 rad
     x = np.radians(np.array(sorted(folds)))
     around = _independent(mech, np.stack([x - eps, x + eps], axis=1).reshape(-1, 1))
     counts = np.array([len(c) for c in around]).reshape(-1, 2)
-    assert np.all(np.abs(counts[:, 0] - counts[:, 1]) == 2), counts
+    change = np.abs(counts[:, 0] - counts[:, 1])
+    # two configurations meet at a leg's fold; at the loop's, two loop modes with whatever
+    # assembles on them (both leg branches on each: four)
+    assert np.all((change > 0) & (change % 2 == 0)), counts
 
 
 def test_the_drawn_mode_is_the_graph_tracker_s(case: tuple[Mechanism, MechanismMotion]) -> None:

@@ -53,6 +53,9 @@ Relative = tuple[Array, Array, NDArray[np.bool_]]
 #: points per round of the fold search (graph/loop_stage.py's ``_bisect``): 2⁵ sections, so
 #: a round gains five bits of the fold's place
 SECTIONS = 32
+#: a mode's end found within this fraction of the segment from a loop's fold bounding it is
+#: that fold
+BOUND_GAP = 1e-6
 
 LOOP_STAGE_SOLVER = ("closed-form sub-chains (driven joints, family loops with every loop mode, "
                      "planar dyads, spatial legs; every branch), rates and accelerations from "
@@ -217,11 +220,12 @@ def combination_label(mech: Mechanism, dec: Decomposition, loops: list[StageMode
 
 
 def _bisect(T: int, assembles: Callable[[Array], NDArray[Any]],
-            moved: Callable[[NDArray[np.intp]], None] | None = None) -> Array:
+            moved: Callable[[NDArray[np.intp]], None] | None = None) -> tuple[Array, Array]:
     """The parameters t in [0, 1] (T,) where ``assembles`` first leaves its value at t = 0:
     each round evaluates SECTIONS − 1 points of every interval at once (``assembles`` takes
     t (T, n) and gives (T, n)) and keeps the section where the value first changes, until the
-    interval is 2⁻FOLD_STEPS long (a closed-form call per round, not per halving);
+    interval is 2⁻FOLD_STEPS long (a closed-form call per round, not per halving): its middle
+    and its end (1 where nothing changed);
     ``moved(j)`` is told the column j of the points the interval's start moved to (−1: it
     did not move)."""
     lo, hi = np.zeros(T), np.ones(T)
@@ -237,7 +241,7 @@ def _bisect(T: int, assembles: Callable[[Array], NDArray[Any]],
             moved(j)
         hi = np.where(first < SECTIONS - 1, ts[r, np.minimum(first, SECTIONS - 2)], hi)
         lo = np.where(j >= 0, ts[r, np.maximum(j, 0)], lo)
-    return 0.5 * (lo + hi)
+    return 0.5 * (lo + hi), hi
 
 
 def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: list[StageModes],
@@ -245,67 +249,73 @@ def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: li
                 ) -> tuple[list[list[str]], list[tuple[int, int, int]]]:
     """Each mode's births and deaths (modes: rows of ``combos`` (M', S), held at ``held``
     (M', N); ``disc`` (M', a + N, S) their stages' discriminants over the solved rows, the
-    approach's ``a`` first), each located between its two samples (module docstring), and
-    every fold as (mode, folding stage, sample k before it)."""
+    approach's ``a`` first), each located between its two samples, and every fold as (mode,
+    folding stage, sample k before it). Where a loop stage does not assemble at the far
+    sample, its fold (where its count of real solutions changes) bounds the search; the mode's
+    own end is then the first place, from the sample where it assembles, where any of its
+    stages stops assembling (a leg on a loop mode just born may assemble only later)."""
     from screwkit.kinematics.graph.motion import input_text
 
     i, k = np.nonzero(held[:, :-1] != held[:, 1:])
     events: list[list[str]] = [[] for _ in range(held.shape[0])]
     if k.size == 0:
         return events, []
-    bad = np.where(held[i, k], k + 1, k)  # the sample of the two where it does not assemble
-    folding = np.argmax(~(disc[i, a + bad] >= 0.0), axis=1)  # the first stage that fails
+    ka = np.where(held[i, k], k, k + 1)  # the sample of the two where it assembles
+    kb = 2 * k + 1 - ka
+    folding = np.argmax(~(disc[i, a + kb] >= 0.0), axis=1)  # the first stage that fails
     stages = dec.stages
-    x0, x1 = X[k], X[k + 1]
-    t = np.empty(k.size)
-    is_loop = np.array([isinstance(stages[f], LoopStage) for f in folding])
+    xa, xb = X[ka], X[kb].copy()
     for d, st in enumerate(stages):
-        sel = np.flatnonzero(is_loop & (folding == d))
+        sel = np.flatnonzero(folding == d)
         if sel.size == 0 or not isinstance(st, LoopStage):
             continue
         col = _column(lay, st)
-        s0, s1 = x0[sel, col], x1[sel, col]
+        s0, s1 = xa[sel, col], xb[sel, col]
 
         def count(ts: Array, st: LoopStage = st, s0: Array = s0, s1: Array = s1
                   ) -> NDArray[np.intp]:
             x = (s0[:, None] + ts * (s1 - s0)[:, None]).reshape(-1, 1)
             return real_count(st.chain, st.chain.loop_inputs(x)).reshape(ts.shape)
 
-        t[sel] = _bisect(sel.size, count)
-    sel = np.flatnonzero(~is_loop)
-    if sel.size:
-        t[sel] = _dyad_folds(mech, lay, dec, loops, x0[sel], x1[sel], combos[i[sel]],
-                             a + k[sel])
-    at = x0 + t[:, None] * (x1 - x0)
-    for m, kk, x, d in zip(i, k, at, folding, strict=True):
+        t, _ = _bisect(sel.size, count)
+        xb[sel] = xa[sel] + t[:, None] * (xb[sel] - xa[sel])
+    t, failing = _first_failure(mech, lay, dec, loops, xa, xb, combos[i], a + ka)
+    named = np.where(failing >= 0, failing, folding)
+    at = xa + t[:, None] * (xb - xa)
+    for m, kk, x, d in zip(i, k, at, named, strict=True):
         st = stages[int(d)]
         what = "dies" if held[m, kk] else "is born"
         how = ("two of its assembly modes meet" if isinstance(st, LoopStage)
                else "its two branches meet")
         events[int(m)].append(f"{what} at {input_text(mech, lay, x)}: the {st.kind} {st.word} "
                               f"{stage_names(mech, st)} folds ({how})")
-    return events, [(int(m), int(d), int(kk)) for m, d, kk in zip(i, folding, k, strict=True)]
+    return events, [(int(m), int(d), int(kk)) for m, d, kk in zip(i, named, k, strict=True)]
 
 
-def _dyad_folds(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: list[StageModes],
-                x0: Array, x1: Array, combos: Array, k: NDArray[np.intp]) -> Array:
-    """Where a dyad or leg of each mode (``combos`` (T, S)) folds on the segment x0 → x1
-    (T, n_in), the loops carried on their branches from the solved row ``k`` (T,): at each
-    round's points, the loop mode nearest the one at the interval's start."""
+def _first_failure(mech: Mechanism, lay: GraphLayout, dec: Decomposition,
+                   loops: list[StageModes], xa: Array, xb: Array, combos: Array,
+                   k: NDArray[np.intp]) -> tuple[Array, NDArray[np.intp]]:
+    """Where each mode (``combos`` (T, S)), assembling at ``xa`` (T, n_in; the solved row
+    ``k``), first stops assembling on the segment xa → xb, as the fraction t along it (T,),
+    and the stage that fails just past it (−1: none fails before xb). The loops are carried
+    on their branches from row k: at each round's points, the loop mode nearest the one at the
+    interval's start."""
     ref = _loop_rows(dec, loops, combos, k)
     T = k.size
     last: list[list[Relative]] = [ref]
 
-    def assembles(ts: Array) -> NDArray[np.bool_]:
+    def placed(ts: Array) -> Placement:
         n = ts.shape[1]
-        xm = (x0[:, None] + ts[:, :, None] * (x1 - x0)[:, None]).reshape(T * n, -1)
+        xm = (xa[:, None] + ts[:, :, None] * (xb - xa)[:, None]).reshape(T * n, -1)
         rel = [carried(mech, lay, st, sm, xm, (np.repeat(r[0], n, axis=0),
                                                np.repeat(r[1], n, axis=0),
                                                np.repeat(r[2], n, axis=0)))
                for st, sm, r in zip(dec.loops, loops, ref, strict=True)]
         last[0] = rel
-        return place_rows(mech, lay, dec, xm, np.repeat(combos, n, axis=0),
-                          rel).assembles.reshape(T, n)
+        return place_rows(mech, lay, dec, xm, np.repeat(combos, n, axis=0), rel)
+
+    def assembles(ts: Array) -> NDArray[np.bool_]:
+        return placed(ts).assembles.reshape(ts.shape)
 
     def moved(j: NDArray[np.intp]) -> None:
         go = np.flatnonzero(j >= 0)
@@ -316,7 +326,13 @@ def _dyad_folds(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: li
             R[go], p[go], ok[go] = new[0][at], new[1][at], new[2][at]
             ref[li] = (R, p, ok)
 
-    return _bisect(T, assembles, moved)
+    t, hi = _bisect(T, assembles, moved)
+    past = placed(hi[:, None])
+    fails = ~(past.discriminant >= 0.0)
+    # a failure within BOUND_GAP of xb is xb's own (a loop's fold there: next to it the loop's
+    # two meeting modes are too close to tell apart by pose)
+    failing = np.where(fails.any(axis=1) & (hi < 1.0 - BOUND_GAP), np.argmax(fails, axis=1), -1)
+    return t, failing
 
 
 def _circuits(combos: Array, held: NDArray[np.bool_], joins: list[tuple[int, int, int]]

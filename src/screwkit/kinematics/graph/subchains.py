@@ -23,11 +23,14 @@ Two kinds of step place bodies:
 
 - a **family loop**: when nothing above applies, a loop of four joints through a driven R joint
   (its body already placed by a driven step on a placed body p) and two unplaced bodies back to
-  p, whose drawing graph/loop_subchain.py reads as a family with a closed form (RSRC, RSSR,
-  RCCC, CSSP, planar 4R; p standing for the ground): the family's closed form gives every loop
-  mode relative to p, and the steps above then place what hangs on its bodies
-  (graph/loop_stage.py). An RSSR or slider-crank whose rod is a bare S–S rod is an RSS/PSS leg
-  above; the loop step takes the RSRC and RCCC, and an RSSR or CSSP whose coupler carries more.
+  p, whose drawing graph/loop_subchain.py reads as a family with a closed form that fixes
+  every loop body (RSRC, RCCC, planar 4R; p standing for the ground): the family's closed form
+  gives every loop mode relative to p, and the steps above then place what hangs on its bodies
+  (graph/loop_stage.py). An RSSR or slider-crank is an RSS/PSS leg above where its rod is a
+  bare S–S rod; where its rod carries more, the rod's spin (idle in the loop alone) is fixed
+  by what hangs on it, jointly, so it is no sub-chain: that stays with the tracker. A planar
+  4R is two steps above (a crank, an RRR dyad) unless the body it hangs on moves out of its
+  plane.
 
 What is left (a Stephenson III triad, a platform, a spatial loop) is reported as needing the
 homotopy; the graph tracker (graph/track.py) keeps handling those. The closed forms of the steps
@@ -327,8 +330,11 @@ def _find_legs(mech: Mechanism, planes: dict[str, set[int]], used: set[int],
     return ()
 
 
-#: the family of a loop by its joint kinds read from the driven joint
-LOOP_FAMILIES = {"RRRR": "4R", "RSRC": "RSRC", "RSSR": "RSSR", "RCCC": "RCCC", "RSSP": "CSSP"}
+#: the family of a loop by its joint kinds read from the driven joint. Not the RSSR nor the
+#: CSSP: their coupler is a rod between two balls whose spin the loop leaves idle, so a loop
+#: body whose pose the loop alone does not fix; with nothing more on the rod they are RSS and
+#: PSS legs, and with more on it the rod's spin is fixed by what hangs on it, jointly
+LOOP_FAMILIES = {"RRRR": "4R", "RSRC": "RSRC", "RCCC": "RCCC"}
 
 
 def _find_loop(mech: Mechanism, planes: dict[str, set[int]], used: set[int], driven: set[int],
