@@ -224,28 +224,38 @@ def test_rates_and_accelerations_are_the_finite_differences_of_the_positions() -
         assert np.max(np.abs(md.link_origin_velocity[2, :4] - v)) <= 1e-7 * mech.length_scale
 
 
-def _knee() -> Mechanism:
-    """The RSRC hung on a thigh that a hip joint turns: the loop's ground is the thigh, its
-    crank driven from the thigh by a second input (a four-bar knee inside a serial chain)."""
-    loop = _loop()
+def _fourbar() -> Mechanism:
+    """A crank–rocker four-bar (frame 4, crank 1, coupler 3.5, rocker 3) in the x–y plane."""
+    lk = sk.fourbar(a=4.0, d1=1.0, d2=3.5, d3=3.0)
+    return mechanism_from_loop(sk.solve_motion(lk, np.radians([30.0, 32.0])), 0, 0)
+
+
+def _knee(loop: Mechanism) -> Mechanism:
+    """The loop hung on a thigh that a hip joint turns (about an axis across the four-bar's
+    normal, so the thigh moves out of its plane): the loop's ground is the thigh, its crank
+    driven from the thigh by a second input (a knee inside a serial chain)."""
     on_thigh = tuple(replace(j, bodies=tuple("thigh" if b == "ground" else b for b in j.bodies))
                      for j in loop.joints)
     hip = MechanismJoint("hip", "R", ("ground", "thigh"), np.array([0.5, -2.0, 1.0]),
                          np.array([0.2, 0.3, 1.0]))
     return Mechanism("knee", (Body("thigh"), *loop.bodies), (hip, *on_thigh),
-                     ("hip.theta", "input.theta"))
+                     ("hip.theta", f"{loop.joints[0].name}.theta"))
 
 
-def test_a_loop_hung_on_a_driven_body_is_the_loop_alone_in_that_body_s_frame() -> None:
-    mech = _knee()
+@pytest.mark.parametrize("family", ["RSRC", "4R"])
+def test_a_loop_hung_on_a_driven_body_is_the_loop_alone_in_that_body_s_frame(family: str
+                                                                             ) -> None:
+    loop = _loop() if family == "RSRC" else _fourbar()
+    mech = _knee(loop)
     dec = decompose(mech)
-    assert dec.complete and dec.loops[0].parent == "thigh"
+    assert dec.complete and dec.loops[0].parent == "thigh" and dec.loops[0].kind == family
+    # the same four-bar on the ground is a crank and an RRR dyad, not a loop stage
+    assert family == "RSRC" or [s.kind for s in decompose(_fourbar()).stages] == ["RRR"]
     t = np.linspace(0.0, 1.0, 41)
     rows = np.stack([0.8 * np.sin(2 * np.pi * t), 2 * np.pi * t], axis=1)
     motion = solve_mechanism(mech, rows, every_mode=True)
     assert motion.method == "graph (closed forms)"
     # the loop alone at the knee's inputs, from the homotopy
-    loop = _loop()
     lay_loop = graph_layout(loop)
     found = every_mode(loop, rows[:, 1:])
     for n, conf in enumerate(found.configurations):

@@ -242,7 +242,7 @@ def decompose(mech: Mechanism) -> Decomposition:
                 planes[body] = planar if step.kind in DYAD_KINDS else set()
             progress = True
         if not progress:
-            loop = _find_loop(mech, planes, used, driven, steps, joints_of)
+            loop = _find_loop(mech, planes, used, driven, steps, joints_of, normals)
             if loop is not None:
                 steps.append(loop)
                 used.update(loop.joints)
@@ -338,10 +338,13 @@ LOOP_FAMILIES = {"RRRR": "4R", "RSRC": "RSRC", "RCCC": "RCCC"}
 
 
 def _find_loop(mech: Mechanism, planes: dict[str, set[int]], used: set[int], driven: set[int],
-               steps: list[Step], joints_of: dict[str, list[int]]) -> LoopStage | None:
+               steps: list[Step], joints_of: dict[str, list[int]], normals: list[Array]
+               ) -> LoopStage | None:
     """The first family loop (module docstring) through a body a driven R joint placed, or
     None: the loop P –k– c –j2– b2 –j3– b3 –j4– P with b2, b3 unplaced and j2, j3, j4 unused
-    and not driven, read by graph/loop_subchain.py's ``loop_chain`` on the loop alone."""
+    and not driven, read by graph/loop_subchain.py's ``loop_chain`` on the loop alone. A planar
+    4R only where P moves out of its plane (else it is a crank and an RRR dyad, or a dyad
+    refused for a reason that holds for the loop too, such as a drawing on its fold)."""
     from screwkit.kinematics.graph.loop_subchain import loop_chain
 
     for step in steps:
@@ -363,7 +366,8 @@ def _find_loop(mech: Mechanism, planes: dict[str, set[int]], used: set[int], dri
                         continue
                     loop = (k, j2, j3, j4)
                     kinds = "".join(mech.joints[i].kind for i in loop)
-                    if kinds not in LOOP_FAMILIES:
+                    if kinds not in LOOP_FAMILIES or (kinds == "RRRR" and any(
+                            _parallel(mech.joints[k].axis, normals[n]) for n in planes[P])):
                         continue
                     sub = _loop_alone(mech, loop, (c, b2, b3), P)
                     chain = loop_chain(sub)
