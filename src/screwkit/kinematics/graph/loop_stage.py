@@ -187,7 +187,7 @@ def combinations(dec: Decomposition, loops: list[StageModes]) -> Array:
     return np.array(list(itertools.product(*choices)), dtype=float).reshape(-1, len(choices))
 
 
-def _loop_rows(dec: Decomposition, loops: list[StageModes], combos: Array, k: NDArray[np.intp]
+def loop_rows(dec: Decomposition, loops: list[StageModes], combos: Array, k: NDArray[np.intp]
                ) -> list[Relative]:
     """Each loop stage's relative poses for combination rows ``combos`` (T, S) at row
     indices ``k`` (T,) of the solved rows."""
@@ -300,7 +300,7 @@ def _first_failure(mech: Mechanism, lay: GraphLayout, dec: Decomposition,
     and the stage that fails just past it (−1: none fails before xb). The loops are carried
     on their branches from row k: at each round's points, the loop mode nearest the one at the
     interval's start."""
-    ref = _loop_rows(dec, loops, combos, k)
+    ref = loop_rows(dec, loops, combos, k)
     T = k.size
     last: list[list[Relative]] = [ref]
 
@@ -396,7 +396,7 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     M = combos.shape[0]
     signs = np.repeat(combos, K, axis=0)
     pl = place_rows(mech, lay, dec, np.tile(rows, (M, 1)), signs,
-                    _loop_rows(dec, loops, signs, np.tile(np.arange(K), M)))
+                    loop_rows(dec, loops, signs, np.tile(np.arange(K), M)))
     ok = pl.assembles.reshape(M, K)
     R = pl.R.reshape(M, K, *pl.R.shape[1:])
     p = pl.p.reshape(M, K, *pl.p.shape[1:])
