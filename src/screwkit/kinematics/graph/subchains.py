@@ -116,9 +116,11 @@ class LoopStage:
 
     @property
     def branches(self) -> int:
-        """The family's largest count of assembly modes at one input (RSRC: the roots of a
-        quartic, Bagci 1969 eq. 3.63; RCCC: four; the others two)."""
-        return 4 if self.kind in ("RSRC", "RCCC") else 2
+        """The family's largest count of assembly modes at one input (the RSRC's: the roots of
+        a quartic, Bagci 1969 eq. 3.63), from the family registry (four where it has none)."""
+        from screwkit.kinematics.registry import family_of
+
+        return family_of(self.chain.linkage).max_modes or 4
 
     word = "loop"
 
@@ -330,11 +332,12 @@ def _find_legs(mech: Mechanism, planes: dict[str, set[int]], used: set[int],
     return ()
 
 
-#: the family of a loop by its joint kinds read from the driven joint. Not the RSSR nor the
+#: the joint kinds, read from the driven joint, of loops whose family fixes every loop body
+#: (the planar 4R, the RSRC, the RCCC; loop_subchain.py reads the family). Not the RSSR nor the
 #: CSSP: their coupler is a rod between two balls whose spin the loop leaves idle, so a loop
 #: body whose pose the loop alone does not fix; with nothing more on the rod they are RSS and
 #: PSS legs, and with more on it the rod's spin is fixed by what hangs on it, jointly
-LOOP_FAMILIES = {"RRRR": "4R", "RSRC": "RSRC", "RCCC": "RCCC"}
+LOOP_KINDS = ("RRRR", "RSRC", "RCCC")
 
 
 def _find_loop(mech: Mechanism, planes: dict[str, set[int]], used: set[int], driven: set[int],
@@ -346,6 +349,7 @@ def _find_loop(mech: Mechanism, planes: dict[str, set[int]], used: set[int], dri
     4R only where P moves out of its plane (else it is a crank and an RRR dyad, or a dyad
     refused for a reason that holds for the loop too, such as a drawing on its fold)."""
     from screwkit.kinematics.graph.loop_subchain import loop_chain
+    from screwkit.kinematics.registry import family_of
 
     for step in steps:
         if not isinstance(step, Driven) or mech.joints[step.joint].kind != "R":
@@ -366,13 +370,14 @@ def _find_loop(mech: Mechanism, planes: dict[str, set[int]], used: set[int], dri
                         continue
                     loop = (k, j2, j3, j4)
                     kinds = "".join(mech.joints[i].kind for i in loop)
-                    if kinds not in LOOP_FAMILIES or (kinds == "RRRR" and any(
+                    if kinds not in LOOP_KINDS or (kinds == "RRRR" and any(
                             _parallel(mech.joints[k].axis, normals[n]) for n in planes[P])):
                         continue
                     sub = _loop_alone(mech, loop, (c, b2, b3), P)
                     chain = loop_chain(sub)
                     if chain is not None:
-                        return LoopStage(LOOP_FAMILIES[kinds], loop, (b2, b3), P, chain, sub)
+                        return LoopStage(family_of(chain.linkage).name, loop, (b2, b3), P,
+                                         chain, sub)
     return None
 
 
