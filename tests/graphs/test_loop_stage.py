@@ -81,6 +81,7 @@ def _independent(mech: Mechanism, X: np.ndarray = X) -> list[np.ndarray]:
     T0, G = mech.joints[5].at, mech.joints[6].at
     rod2 = float(np.sum((T0 - G) ** 2))
     grid = np.radians(np.arange(0.0137, 360.0, 0.1))  # no root (φ = 0 is one) on the grid
+    on_arm = K0 + np.array([_rotation(u0, f) @ (T0 - K0) for f in grid])  # T(φ) on the coupler
     found = every_mode(loop, X)
     out = []
     for conf in found.configurations:
@@ -93,7 +94,7 @@ def _independent(mech: Mechanism, X: np.ndarray = X) -> list[np.ndarray]:
                 T = Rc @ (K0 + _rotation(u0, phi) @ (T0 - K0)) + pc
                 return float(np.sum((T - G) ** 2)) - rod2
 
-            values = np.array([gap(f) for f in grid])
+            values = np.sum((on_arm @ Rc.T + pc - G) ** 2, axis=1) - rod2  # gap on the grid
             change = np.flatnonzero(np.sign(values) != np.sign(np.roll(values, -1)))
             for i in change:
                 phi = brentq(gap, grid[i], grid[i] + np.radians(0.1), xtol=1e-15)
