@@ -125,7 +125,7 @@ def _body_poses(mech: Mechanism, chain: LoopChain, md: object, R0: Array, p0: Ar
 
 
 def configuration_from_poses(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Array,
-                   ok: NDArray[np.bool_], from_drawing: bool) -> Configuration:
+                             ok: NDArray[np.bool_], from_drawing: bool) -> Configuration:
     """Every joint variable from the body poses (the inverse of graph/closure.py's joint
     motions M_j(q) on T_a⁻¹T_b): a rotation angle about the axis (atan2 of its sine and
     cosine), a slide along it, an H joint's turns from its slide, a U joint's two angles, an S
@@ -257,7 +257,7 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
     segment X[k] → X[k+1] (all at once) where the loop's count of real solutions (its closed
     form's assembling modes at one input) leaves its value at X[k]."""
     from screwkit.kinematics.graph.motion import input_text
-    from screwkit.kinematics.registry import family_of
+    from screwkit.kinematics.registry import family_of, has_rsrc_quartic
 
     rows, ks = np.nonzero(masks[:, :-1] != masks[:, 1:])
     closed = family_of(chain.linkage).closed_form_for(chain.linkage)
@@ -266,9 +266,22 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
                  f"{input_text(mech, lay, X[k])} and {input_text(mech, lay, X[k + 1])}")
                 for r, k in zip(rows, ks, strict=True)]
     x0, x1 = X[ks], X[ks + 1]
+    rsrc = None
+    if has_rsrc_quartic(chain.linkage):  # its quartic's real roots, without the modes
+        from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
+        from screwkit.kinematics.closed_forms.rsrc.positions import rsrc_positions
+
+        rsrc = rsrc_dimensions(chain.linkage)[0]
 
     def count(t: Array) -> NDArray[np.intp]:
-        return real_count(chain, chain.loop_inputs(x0 + t[:, None] * (x1 - x0)))
+        """Real solutions at the inputs x0 + t (x1 − x0): the RSRC's quartic roots (Bagci 1969
+        eq. 3.63, as its own limit search counts them), else the closed form's modes there, the
+        drawing appended (so that at least one input assembles)."""
+        L = chain.loop_inputs(np.vstack([x0 + t[:, None] * (x1 - x0), np.zeros((1, X.shape[1]))]))
+        if rsrc is not None:
+            return np.asarray(rsrc_positions(rsrc, L[:-1, 0]).n_assemblies)
+        mo = closed(chain.linkage, L, np.zeros_like(L), np.zeros_like(L))
+        return np.sum([md.assembles for md in mo.modes], axis=0)[:-1]
 
     lo, hi = np.zeros(ks.size), np.ones(ks.size)
     c_lo = count(lo)
