@@ -27,7 +27,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,6 +44,9 @@ from screwkit.kinematics.graph.loop_subchain import is_drawing
 from screwkit.kinematics.graph.subchains import Decomposition, Driven, Dyad, LoopStage
 from screwkit.kinematics.motion import AssemblyError
 from screwkit.model.mechanism import GROUND, Mechanism
+
+if TYPE_CHECKING:
+    from screwkit.kinematics.graph.motion import MechanismMotion
 
 Array = NDArray[np.float64]
 Pose = tuple[Array, Array]
@@ -361,7 +364,7 @@ def _frames(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, ok: NDArray[n
 
 
 def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
-                      Xd: Array, Xdd: Array, every: bool) -> object:
+                      Xd: Array, Xdd: Array, every: bool) -> MechanismMotion:
     """The :class:`~screwkit.kinematics.graph.motion.MechanismMotion` of a mechanism whose
     decomposition holds family loops (module docstring): mode 0 the drawn mode, then with
     ``every`` every other combination of loop modes and dyad branches that assembles

@@ -29,6 +29,7 @@ from screwkit.kinematics.graph.closure import (
     graph_layout,
     loop_residuals,
 )
+from screwkit.kinematics.graph.loop_stage import loop_stage_motion
 from screwkit.kinematics.graph.newton import (
     RANK_CUTOFF,
     accelerations,
@@ -190,9 +191,8 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     one per sample and input). The inputs are the joint inputs, then the driven body freedoms
     (``mech.driven_names``; graph/drives.py).
 
-    A mechanism that decomposes into closed-form sub-chains (graph/subchains.py: driven joints,
-    planar dyads, RSS legs, family loops) is solved by their closed forms (loop_stage.py), and with
-    ``every_mode`` every other assembly mode follows the drawn one (graph/closed_modes.py);
+    A mechanism that decomposes into closed-form sub-chains (graph/subchains.py) is solved by
+    their closed forms, and with ``every_mode`` every other mode follows the drawn one;
     any other mechanism by continuation of the drawn mode (graph/track.py; ``every_mode``
     then has nothing more to add: the motion's notes say so)."""
     if mech.drives:
@@ -215,7 +215,8 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
             return looped  # type: ignore[return-value]
     dec = decompose(mech)
     if dec.complete and not misfits(mech):  # seat offsets (tolerances): re-assembled below
-        motion = _closed_form_motion(mech, lay, dec, X, Xd, Xdd, every_mode)
+        solve = loop_stage_motion if dec.loops else _closed_form_motion  # a family loop in it?
+        motion = solve(mech, lay, dec, X, Xd, Xdd, every_mode)
         if callable(progress):
             progress(N, N)
         return motion
@@ -269,10 +270,6 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     )
     from screwkit.kinematics.graph.dyads import place
 
-    if dec.loops:  # a family loop among the sub-chains (graph/loop_stage.py)
-        from screwkit.kinematics.graph.loop_stage import loop_stage_motion
-
-        return loop_stage_motion(mech, lay, dec, X, Xd, Xdd, every)  # type: ignore[return-value]
     N = X.shape[0]
     skipped = ""
     if every:  # 2^D modes, each costing a drawn mode's time: only the drawn one when too many
