@@ -29,7 +29,6 @@ from screwkit.kinematics.graph.closure import (
     graph_layout,
     loop_residuals,
 )
-from screwkit.kinematics.graph.loop_stage import loop_stage_motion
 from screwkit.kinematics.graph.newton import (
     RANK_CUTOFF,
     accelerations,
@@ -191,8 +190,9 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     one per sample and input). The inputs are the joint inputs, then the driven body freedoms
     (``mech.driven_names``; graph/drives.py).
 
-    A mechanism that decomposes into closed-form sub-chains (graph/subchains.py) is solved by
-    their closed forms, and with ``every_mode`` every other mode follows the drawn one;
+    A mechanism that decomposes into closed-form sub-chains (graph/subchains.py: driven joints,
+    planar dyads, RSS legs) is solved by their closed forms (graph/dyads.py, legs.py), and with
+    ``every_mode`` every other assembly mode follows the drawn one (graph/closed_modes.py);
     any other mechanism by continuation of the drawn mode (graph/track.py; ``every_mode``
     then has nothing more to add: the motion's notes say so)."""
     if mech.drives:
@@ -204,6 +204,7 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     Xdd = _per_sample(accelerations, N, n_in, "accelerations")
     lay = graph_layout(mech)
     from screwkit.kinematics.graph.loop_motion import loop_motion
+    from screwkit.kinematics.graph.loop_stage import loop_stage_motion
     from screwkit.kinematics.graph.loop_subchain import loop_chain
 
     chain = loop_chain(mech)
@@ -419,8 +420,7 @@ def _solve_driven(mech: Mechanism, inputs: ArrayLike, rates_: ArrayLike | None,
 
 
 def misfits(mech: Mechanism) -> bool:
-    """Whether any joint of ``mech`` is made off its drawing (a ``seat_offset``), so that the
-    drawing does not close."""
+    """Whether any joint of ``mech`` is made off its drawing (a ``seat_offset``): no closure."""
     return any(j.seat_offset is not None for j in mech.joints)
 
 
