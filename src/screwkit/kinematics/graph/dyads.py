@@ -96,9 +96,10 @@ def place(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array, signs
     d = 0
     for step in dec.steps:
         if isinstance(step, Driven):
-            poses[step.body] = _driven(mech, lay, step, X, poses[step.parent])
+            poses[step.body] = driven_pose(mech, lay, step, X, poses[step.parent])
         else:
-            b1, b2, disc[:, d] = _dyad(mech, step, signs[:, d], poses[step.placed[0]],
+            assert isinstance(step, Dyad), "a loop stage is placed by graph/loop_stage.py"
+            b1, b2, disc[:, d] = dyad_poses(mech, step, signs[:, d], poses[step.placed[0]],
                                        poses[step.placed[1]])
             poses[step.bodies[0]], poses[step.bodies[1]] = b1, b2
             d += 1
@@ -119,16 +120,17 @@ def place_every(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array)
     for step in dec.steps:
         if isinstance(step, Driven):
             c = count[step.parent]
-            poses[step.body] = _driven(mech, lay, step, np.tile(X, (c, 1)), poses[step.parent])
+            poses[step.body] = driven_pose(mech, lay, step, np.tile(X, (c, 1)), poses[step.parent])
             count[step.body] = c
             continue
+        assert isinstance(step, Dyad), "a loop stage is placed by graph/loop_stage.py"
         m_new = m * step.branches
         branch = [step.drawn_branch, -step.drawn_branch][:step.branches]
         sigma = np.repeat(np.tile(np.array(branch, dtype=float), m), N)
         ends = [_widened(poses[b], count[b], m, N) for b in step.placed]
         if step.branches == 2:  # every prefix on both branches
             ends = [_widened(e, m, m_new, N) for e in ends]
-        b1, b2, dsc = _dyad(mech, step, sigma, ends[0], ends[1])
+        b1, b2, dsc = dyad_poses(mech, step, sigma, ends[0], ends[1])
         poses[step.bodies[0]], poses[step.bodies[1]] = b1, b2
         count[step.bodies[0]] = count[step.bodies[1]] = m_new
         discs.append((dsc, m_new))
@@ -176,7 +178,7 @@ def _gathered(mech: Mechanism, lay: GraphLayout, poses: dict[str, Pose], disc: A
     return Placement(R.transpose(1, 0, 2, 3), p.transpose(1, 0, 2), disc)
 
 
-def _driven(mech: Mechanism, lay: GraphLayout, step: Driven, X: Array, parent: Pose) -> Pose:
+def driven_pose(mech: Mechanism, lay: GraphLayout, step: Driven, X: Array, parent: Pose) -> Pose:
     j = mech.joints[step.joint]
     x = X[:, lay.inputs.index(lay.first_freedom[step.joint])]
     if j.kind == "R":
@@ -196,7 +198,7 @@ def _world(pose: Pose, x0: Array) -> Array:
     return pose[0] @ x0 + pose[1]
 
 
-def _dyad(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose
+def dyad_poses(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose
           ) -> tuple[Pose, Pose, Array]:
     """The poses of the dyad's two bodies from those of the placed bodies it joins (p1, p2)
     on branches ``sigma`` (K,), and its discriminant over L² (K,)."""

@@ -104,7 +104,7 @@ def loop_modes(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
 
     def add(md: object, ok: NDArray[np.bool_], from_drawing: bool) -> None:
         R, p = _body_poses(mech, chain, md, R0, p0, ok)
-        conf = _configuration(mech, lay, R, p, rows, ok, from_drawing)
+        conf = configuration_from_poses(mech, lay, R, p, rows, ok, from_drawing)
         confs.append(conf.take(slice(a, None)))
         R, p = R[a:], p[a:]
         screws, centres, axes = joint_screws(mech, lay, R, p)
@@ -183,8 +183,8 @@ def _body_poses(mech: Mechanism, chain: LoopChain, md: object, R0: Array, p0: Ar
     return R, p
 
 
-def _configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Array,
-                   ok: NDArray[np.bool_], from_drawing: bool) -> Configuration:
+def configuration_from_poses(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X: Array,
+                             ok: NDArray[np.bool_], from_drawing: bool) -> Configuration:
     """Every joint variable from the body poses (the inverse of graph/closure.py's joint
     motions M_j(q) on T_a⁻¹T_b): a rotation angle about the axis (atan2 of its sine and
     cosine), a slide along it, an H joint's turns from its slide, a U joint's two angles, an S
@@ -361,3 +361,22 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         out.append((int(r), int(k), x, f"{what} at {input_text(mech, lay, x)}: the loop folds "
                                        "(two of its assembly modes meet)"))
     return out
+
+
+def real_count(chain: LoopChain, L: Array) -> NDArray[np.intp]:
+    """The loop's real closed-form solutions at each row of loop inputs ``L`` (K, 1): the
+    RSRC's quartic roots (Bagci 1969 eq. 3.63, as its own limit search counts them), else the
+    closed form's modes there, the drawing appended (so that at least one input assembles)."""
+    from screwkit.kinematics.registry import family_of, has_rsrc_quartic
+
+    if has_rsrc_quartic(chain.linkage):  # its quartic's real roots, without the modes
+        from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
+        from screwkit.kinematics.closed_forms.rsrc.positions import rsrc_positions
+
+        return np.asarray(rsrc_positions(rsrc_dimensions(chain.linkage)[0],
+                                         L[:, 0]).n_assemblies)
+    closed = family_of(chain.linkage).closed_form_for(chain.linkage)
+    assert closed is not None
+    L = np.vstack([L, chain.offset[None, :]])
+    mo = closed(chain.linkage, L, np.zeros_like(L), np.zeros_like(L))
+    return np.asarray(np.sum([md.assembles for md in mo.modes], axis=0)[:-1])

@@ -207,6 +207,7 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     Xdd = _per_sample(accelerations, N, n_in, "accelerations")
     lay = graph_layout(mech)
     from screwkit.kinematics.graph.loop_motion import loop_motion
+    from screwkit.kinematics.graph.loop_stage import loop_stage_motion
     from screwkit.kinematics.graph.loop_subchain import loop_chain
 
     chain = loop_chain(mech)
@@ -218,7 +219,8 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
             return looped  # type: ignore[return-value]
     dec = decompose(mech)
     if dec.complete and not misfits(mech):  # seat offsets (tolerances): re-assembled below
-        motion = _closed_form_motion(mech, lay, dec, X, Xd, Xdd, every_mode)
+        solve = loop_stage_motion if dec.loops else _closed_form_motion  # a family loop in it?
+        motion = solve(mech, lay, dec, X, Xd, Xdd, every_mode)
         if callable(progress):
             progress(N, N)
         return motion
@@ -422,8 +424,7 @@ def _solve_driven(mech: Mechanism, inputs: ArrayLike, rates_: ArrayLike | None,
 
 
 def misfits(mech: Mechanism) -> bool:
-    """Whether any joint of ``mech`` is made off its drawing (a ``seat_offset``), so that the
-    drawing does not close."""
+    """Whether any joint of ``mech`` is made off its drawing (a ``seat_offset``): no closure."""
     return any(j.seat_offset is not None for j in mech.joints)
 
 

@@ -21,6 +21,17 @@ Two kinds of step place bodies:
   ball on an S–S rod anchored on a placed body (a suspension upright and its tie rod): an "SS"
   step then turns it about its first two balls until the tie rod fits, two branches.
 
+- a **family loop**: when nothing above applies, a loop of four joints through a driven R joint
+  (its body already placed by a driven step on a placed body p) and two unplaced bodies back to
+  p, whose drawing graph/loop_subchain.py reads as a family with a closed form that fixes
+  every loop body (RSRC, RCCC, planar 4R; p standing for the ground): the family's closed form
+  gives every loop mode relative to p, and the steps above then place what hangs on its bodies
+  (graph/loop_stage.py). An RSSR or slider-crank is an RSS/PSS leg above where its rod is a
+  bare S–S rod; where its rod carries more, the rod's spin (idle in the loop alone) is fixed
+  by what hangs on it, jointly, so it is no sub-chain: that stays with the tracker. A planar
+  4R is two steps above (a crank, an RRR dyad) unless the body it hangs on moves out of its
+  plane.
+
 What is left (a Stephenson III triad, a platform, a spatial loop) is reported as needing the
 homotopy; the graph tracker (graph/track.py) keeps handling those. The closed forms of the steps
 are in graph/dyads.py.
@@ -33,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.kinematics.graph.loop_subchain import LoopChain
 from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]
@@ -88,7 +100,42 @@ class Dyad:
                 f"{self.bodies[1]!r}")
 
 
-Step = Driven | Dyad
+@dataclass(frozen=True, eq=False)
+class LoopStage:
+    """The bodies of a family loop (module docstring) placed together: ``joints`` the loop's
+    joints in loop order from ``parent`` through the driven joint ``joints[0]`` (whose body
+    a driven step placed), ``bodies`` the two bodies it places, ``chain`` the loop read as a
+    family on ``sub``, the loop alone with ``parent`` as its ground (graph/loop_subchain.py)."""
+
+    kind: str
+    joints: tuple[int, ...]
+    bodies: tuple[str, ...]
+    parent: str
+    chain: LoopChain
+    sub: Mechanism
+
+    @property
+    def branches(self) -> int:
+        """The family's largest count of assembly modes at one input (the RSRC's: the roots of
+        a quartic, Bagci 1969 eq. 3.63), from the family registry (four where it has none)."""
+        from screwkit.kinematics.registry import family_of
+
+        return family_of(self.chain.linkage).max_modes or 4
+
+    word = "loop"
+
+    @property
+    def loop_bodies(self) -> tuple[str, ...]:
+        """The loop's moving bodies in loop order (the chain's links: the driven one first)."""
+        return self.chain.bodies[1:-1]
+
+    def describe(self, mech: Mechanism) -> str:
+        names = "–".join(mech.joints[k].name for k in self.joints)
+        return (f"{self.kind} loop {names} (closed form, every mode) placing "
+                + " and ".join(repr(b) for b in self.bodies))
+
+
+Step = Driven | Dyad | LoopStage
 
 
 @dataclass(frozen=True)
@@ -110,9 +157,18 @@ class Decomposition:
         return tuple(s for s in self.steps if isinstance(s, Dyad))
 
     @property
+    def loops(self) -> tuple[LoopStage, ...]:
+        return tuple(s for s in self.steps if isinstance(s, LoopStage))
+
+    @property
+    def stages(self) -> tuple[Dyad | LoopStage, ...]:
+        """The steps with branches (dyads, legs, loops), in placing order."""
+        return tuple(s for s in self.steps if not isinstance(s, Driven))
+
+    @property
     def mode_count(self) -> int:
-        """Branch combinations: 2 per two-branch dyad."""
-        return int(2 ** sum(d.branches == 2 for d in self.dyads))
+        """Branch combinations: 2 per two-branch dyad, times each loop's largest mode count."""
+        return int(np.prod([s.branches for s in self.stages], dtype=float))
 
     def describe(self, mech: Mechanism) -> list[str]:
         lines = [s.describe(mech) for s in self.steps]
@@ -187,6 +243,13 @@ def decompose(mech: Mechanism) -> Decomposition:
             for body in step.bodies:
                 planes[body] = planar if step.kind in DYAD_KINDS else set()
             progress = True
+        if not progress:
+            loop = _find_loop(mech, planes, used, driven, steps, joints_of, normals)
+            if loop is not None:
+                steps.append(loop)
+                used.update(loop.joints)
+                planes.update({b: set() for b in loop.bodies})
+                progress = True
     unplaced = tuple(b for b in mech.body_names if b not in planes)
     unused = tuple(k for k in range(len(mech.joints)) if k not in used)
     return Decomposition(tuple(steps), unplaced, unused)
@@ -267,6 +330,71 @@ def _find_legs(mech: Mechanism, planes: dict[str, set[int]], used: set[int],
                        mech.joints[hold[0]].axis, branch)
             return (leg,) if spin is None else (leg, spin)
     return ()
+
+
+#: the joint kinds, read from the driven joint, of loops whose family fixes every loop body
+#: (the planar 4R, the RSRC, the RCCC; loop_subchain.py reads the family). Not the RSSR nor the
+#: CSSP: their coupler is a rod between two balls whose spin the loop leaves idle, so a loop
+#: body whose pose the loop alone does not fix; with nothing more on the rod they are RSS and
+#: PSS legs, and with more on it the rod's spin is fixed by what hangs on it, jointly
+LOOP_KINDS = ("RRRR", "RSRC", "RCCC")
+
+
+def _find_loop(mech: Mechanism, planes: dict[str, set[int]], used: set[int], driven: set[int],
+               steps: list[Step], joints_of: dict[str, list[int]], normals: list[Array]
+               ) -> LoopStage | None:
+    """The first family loop (module docstring) through a body a driven R joint placed, or
+    None: the loop P –k– c –j2– b2 –j3– b3 –j4– P with b2, b3 unplaced and j2, j3, j4 unused
+    and not driven, read by graph/loop_subchain.py's ``loop_chain`` on the loop alone. A planar
+    4R only where P moves out of its plane (else it is a crank and an RRR dyad, or a dyad
+    refused for a reason that holds for the loop too, such as a drawing on its fold)."""
+    from screwkit.kinematics.graph.loop_subchain import loop_chain
+    from screwkit.kinematics.registry import family_of
+
+    for step in steps:
+        if not isinstance(step, Driven) or mech.joints[step.joint].kind != "R":
+            continue
+        k, P, c = step.joint, step.parent, step.body
+        free = [j for j in joints_of[c] if j not in used and j not in driven]
+        for j2 in free:
+            b2 = _other(mech, j2, c)
+            if b2 in planes:
+                continue
+            for j3 in joints_of[b2]:
+                b3 = _other(mech, j3, b2)
+                if j3 == j2 or j3 in used or j3 in driven or b3 in planes or b3 == c:
+                    continue
+                for j4 in joints_of[b3]:
+                    if j4 in (j3, j2) or j4 in used or j4 in driven \
+                            or _other(mech, j4, b3) != P:
+                        continue
+                    loop = (k, j2, j3, j4)
+                    kinds = "".join(mech.joints[i].kind for i in loop)
+                    if kinds not in LOOP_KINDS or (kinds == "RRRR" and any(
+                            _parallel(mech.joints[k].axis, normals[n]) for n in planes[P])):
+                        continue
+                    sub = _loop_alone(mech, loop, (c, b2, b3), P)
+                    chain = loop_chain(sub)
+                    if chain is not None:
+                        return LoopStage(family_of(chain.linkage).name, loop, (b2, b3), P,
+                                         chain, sub)
+    return None
+
+
+def _loop_alone(mech: Mechanism, loop: tuple[int, ...], bodies: tuple[str, ...], parent: str
+                ) -> Mechanism:
+    """The loop's joints and bodies as a mechanism of their own, ``parent`` as its ground,
+    driven by ``loop[0]``'s angle, at the whole mechanism's length scale."""
+    from dataclasses import replace
+
+    from screwkit.model.mechanism import Body
+
+    rename = {parent: GROUND, GROUND: parent}  # the parent may itself be the ground
+    joints = tuple(replace(j, bodies=(rename.get(j.bodies[0], j.bodies[0]),
+                                      rename.get(j.bodies[1], j.bodies[1])))
+                   for j in (mech.joints[k] for k in loop))
+    return Mechanism(f"{mech.name}: loop", tuple(Body(b) for b in bodies), joints,
+                     (f"{mech.joints[loop[0]].name}.theta",), length_scale=mech.length_scale)
 
 
 def _spin_step(mech: Mechanism, planes: dict[str, set[int]], joints_of: dict[str, list[int]],
