@@ -48,18 +48,20 @@ LINE, CIRCLE = 0, 1
 
 @dataclass(frozen=True)
 class Columns:
-    """The (k, i, l) of each column c of :attr:`DenseQuadrics.Qt` (``ck``, ``ci``, ``cl``):
-    (y·Qt[b])_c = (Q_ik y)_l of instance b."""
+    """The (k, i, l) of each column c of :attr:`DenseQuadrics.Qt` (``ck`` and the cell
+    ``cu`` = i·m + l): (y·Qt[b])_c = (Q_ik y)_l of instance b; and Qt's real and imaginary
+    parts apart (``qr``, ``qi``, (B, m, C)), as the kernel reads them."""
 
     ck: Index
-    ci: Index
-    cl: Index
+    cu: Index
+    qr: NDArray[np.float64]
+    qi: NDArray[np.float64]
 
     @staticmethod
     def of(dense: DenseQuadrics) -> Columns:
         ck, rest = np.divmod(dense.columns, dense.N * dense.m)
-        ci, cl = np.divmod(rest, dense.m)
-        return Columns(ck.astype(np.int64), ci.astype(np.int64), cl.astype(np.int64))
+        return Columns(ck.astype(np.int64), rest.astype(np.int64),
+                       np.ascontiguousarray(dense.Qt.real), np.ascontiguousarray(dense.Qt.imag))
 
 
 def columns_of(dense: DenseQuadrics) -> Columns:
@@ -69,6 +71,23 @@ def columns_of(dense: DenseQuadrics) -> Columns:
         cols = Columns.of(dense)
         object.__setattr__(dense, "_kernel_columns", cols)
     return cols
+
+
+def evaluate_terms(coef: Complex, sym: Index, pw: Index, eq: Index, N: int, x: Complex,
+                   p: Complex) -> tuple[Complex, Complex]:
+    """F (B, N) and ∂F/∂x (B, N, n) of a term table (:class:`.polynomial.PolynomialSystem`'s
+    ``coef``, ``sym``, ``pw``, ``eq``) at x (B, n), p (B, k) or (k,), compiled: the same sums
+    as its numpy evaluation, one point and one term at a time, with no temporaries."""
+    from screwkit.algebraic import compiled_kernels
+
+    x = np.ascontiguousarray(x, dtype=complex)
+    B, n = x.shape
+    pb = np.ascontiguousarray(np.broadcast_to(np.asarray(p, dtype=complex), (B, p.shape[-1])))
+    F = np.zeros((B, N), dtype=complex)
+    J = np.zeros((B, N, n), dtype=complex)
+    compiled_kernels.term_values(coef, sym.astype(np.int64), pw.astype(np.int64),
+                                 eq.astype(np.int64), n, x, pb, F, J)
+    return F, J
 
 
 def _kernels() -> Any:
@@ -96,7 +115,7 @@ def track_compiled(dense: DenseQuadrics, instance: Index,
                  else instance.astype(np.int64))
     cols = columns_of(dense)
     y, reached, steps = _TRACK(
-        dense.Qt, cols.ck, cols.ci, cols.cl, dense.K,
+        cols.qr, cols.qi, cols.ck, cols.cu, dense.K,
         np.ascontiguousarray(Ls), dense.linear.astype(np.int64), patch,
         instance.astype(np.int64), linear_of, np.ascontiguousarray(y0, dtype=complex),
         np.ascontiguousarray(tau0, dtype=float), np.ascontiguousarray(tau1, dtype=float),

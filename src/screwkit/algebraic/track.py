@@ -293,13 +293,26 @@ def _homotopy(hsys: PolynomialSystem, patch: Complex, ps: Complex, pt: Complex,
               options: TrackOptions) -> tuple[Homotopy, NDArray[np.intp]]:
     """The homotopy of the segments ps → pt (one row per path), evaluated densely when the
     system is made of quadrics, and each path's instance (index of its distinct segment)."""
-    first, instance = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_index=True,
-                                return_inverse=True)[1:]
-    instance = instance.reshape(-1).astype(np.intp)
+    first, instance = _segments(ps, pt)
     dense = (DenseQuadrics.build(hsys, ps[first], pt[first] - ps[first])
              if options.dense and dense_quadrics_apply(hsys) else None)
     return (Homotopy(hsys, patch, ps, pt - ps, dense, instance if dense is not None else None),
             instance)
+
+
+def _segments(ps: Complex, pt: Complex) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """``np.unique(rows, axis=0, return_index=True, return_inverse=True)[1:]`` of the rows
+    (ps, pt), the same arrays, with the sort run over the first row of each run of equal
+    rows only (a batch repeats each target once per path, so there are few)."""
+    rows = np.concatenate([ps, pt], axis=1)
+    head = np.ones(len(rows), dtype=bool)
+    head[1:] = (rows[1:] != rows[:-1]).any(axis=1)
+    heads = np.flatnonzero(head)
+    if len(heads) == 1:  # one segment (one instance alone)
+        return np.zeros(1, dtype=np.intp), np.zeros(len(rows), dtype=np.intp)
+    first, inverse = np.unique(rows[heads], axis=0, return_index=True, return_inverse=True)[1:]
+    return (heads[first].astype(np.intp),
+            inverse.reshape(-1)[np.cumsum(head) - 1].astype(np.intp))
 
 
 def _detour(system: PolynomialSystem, hsys: PolynomialSystem, patch: Complex, ps: Complex,
