@@ -175,7 +175,8 @@ def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArra
     y0 = hom.to_patch(x_start)
     near = 1.0 - options.endgame_radius
     y_near, ok1, steps = track(hom, line, y0, rows, np.zeros(m), np.full(m, near), options)
-    y_end, ok2, used = track(hom, line, y_near, rows, np.full(m, near), np.ones(m), options)
+    end = options.near_end()
+    y_end, ok2, used = track(hom, line, y_near, rows, np.full(m, near), np.ones(m), end)
     steps = steps + used
     status = np.full(m, PathStatus.FAILED, dtype=np.int8)
     winding = np.ones(m, dtype=np.int64)
@@ -195,7 +196,7 @@ def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArra
     cond[arrived] = cond_a
     late = np.flatnonzero(ok1 & (status == PathStatus.FAILED))
     if late.size:
-        eg = cauchy_endgame(hom, y_near[late], rows[late], options)
+        eg = cauchy_endgame(hom, y_near[late], rows[late], end)
         steps[late] += eg.steps
         winding[late] = eg.winding
         estimate = eg.y
