@@ -11,8 +11,13 @@ loop, with the evaluation
     F_i(y; σ) = Σ_k σ^k yᵀ Q_ik y + L_i(σ)·y,   ∂F_i/∂y = Σ_k σ^k 2 Q_ik y + L_i(σ)
 
 (:mod:`.quadrics`) from V = y·Qt over the columns of Qt with a nonzero entry (one contiguous
-loop per unknown), and the (n+1)×(n+1) solves by Gaussian elimination with partial pivoting
-(Golub & Van Loan, *Matrix Computations*, 4th ed., 2013, §3.4). The arithmetic is the same up
+loop per unknown, in real arithmetic on Qt's real and imaginary parts apart, which the compiler
+vectorises), then W_il = Σ_k σ^k (Q_ik y)_l per cell, so F_i = Σ_l W_il y_l and
+∂F_i/∂y_l = 2 W_il; and the (n+1)×(n+1) solves by Gaussian elimination in place with partial
+pivoting on |re| + |im| (Golub & Van Loan, *Matrix Computations*, 4th ed., 2013, §3.4; the
+pivot LAPACK's zgetrf picks). Measured on the Stewart system (9 × 128 columns): ~1 µs per
+evaluation, ~0.7 µs per solve, ~8 µs per step (5 of each), against ~11 µs before (complex V,
+a scatter per column into F and J, |·| by hypot in the pivot search). The arithmetic is the same up
 to rounding, so both routes reach the same end points (to the Newton polish's accuracy) with the
 same statuses; tests/algebraic/test_compiled.py checks it.
 
