@@ -175,3 +175,66 @@ def test_a_segment_through_a_double_root_fails_straight_and_is_detoured():
     assert result.counts()["regular"] == 4 and result.retracked.all()
     expected = np.roots(np.r_[1.0, target[::-1]])
     assert _matches(result.x[:, 0], expected, 1e-10)
+
+
+def _lose_path_zero(monkeypatch, first_end=None):
+    """Make the first tracking pass report path 0 lost on its main leg (its step collapsed);
+    with ``first_end`` the next pass (the retrack alone) ends path 0 there. Returns the
+    list of the detour's calls."""
+    import screwkit.algebraic.track as track_module
+
+    run, detour, calls = track_module._run, track_module._detour, {"run": 0, "detour": 0}
+
+    def lossy(system, hom, x, rows, options):
+        out = run(system, hom, x, rows, options)
+        calls["run"] += 1
+        if calls["run"] == 1:
+            out["status"][0], out["main_leg"][0] = PathStatus.FAILED, False
+            out["y"][0] = np.nan
+        elif calls["run"] == 2 and first_end is not None:
+            out["y"][0] = first_end
+        return out
+
+    def counted(*args, **kwargs):
+        calls["detour"] += 1
+        return detour(*args, **kwargs)
+
+    monkeypatch.setattr(track_module, "_run", lossy)
+    monkeypatch.setattr(track_module, "_detour", counted)
+    return calls
+
+
+def test_a_path_lost_on_its_main_leg_is_tracked_again_alone(monkeypatch):
+    """x⁴ + … from the roots ±1, ±2 to a random complex quartic (a generic segment): with
+    path 0 reported lost on its main leg, it alone is tracked again (10× smaller steps) and
+    ends where the untouched run ends it (1e-10); no detour; only it is marked retracked."""
+    system = univariate(4)
+    roots = np.array([1.0, -1.0, 2.0, -2.0])
+    start = np.poly(roots)[::-1][:4]
+    target = np.random.default_rng(4).normal(size=4) + 1j * np.random.default_rng(5).normal(
+        size=4)
+    clean = track_parameter_homotopy(system, start, target, roots[:, None])
+    assert clean.counts()["regular"] == 4 and not clean.retracked.any()
+    calls = _lose_path_zero(monkeypatch)
+    result = track_parameter_homotopy(system, start, target, roots[:, None])
+    assert calls == {"run": 2, "detour": 0}
+    assert result.counts()["regular"] == 4
+    assert result.retracked.tolist() == [True, False, False, False]
+    assert np.abs(result.x - clean.x).max() <= 1e-10
+
+
+def test_a_lost_path_retracked_onto_another_paths_end_sends_its_instance_round(monkeypatch):
+    """The same, but the retrack alone ends path 0 where path 1 ends (a jump): that end is not
+    kept, and the detour tracks all four again; every root once, against numpy.roots."""
+    system = univariate(4)
+    roots = np.array([1.0, -1.0, 2.0, -2.0])
+    start = np.poly(roots)[::-1][:4]
+    target = np.random.default_rng(4).normal(size=4) + 1j * np.random.default_rng(5).normal(
+        size=4)
+    clean = track_parameter_homotopy(system, start, target, roots[:, None])
+    calls = _lose_path_zero(monkeypatch, first_end=clean.y[1])
+    result = track_parameter_homotopy(system, start, target, roots[:, None])
+    assert calls["detour"] == 1
+    assert result.counts()["regular"] == 4 and result.retracked.all()
+    expected = np.roots(np.r_[1.0, target[::-1]])
+    assert _matches(result.x[:, 0], expected, 1e-10)

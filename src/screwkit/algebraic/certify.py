@@ -81,6 +81,15 @@ def bombieri_weyl_norm(system: PolynomialSystem, p: Complex) -> NDArray[np.float
     return np.sqrt((np.abs(coef) ** 2 * np.exp(log_weight)).sum(axis=1))
 
 
+def _norms(system: PolynomialSystem, p: Complex) -> NDArray[np.float64]:
+    """:func:`bombieri_weyl_norm` per row of p (P, k), computed once per distinct row (the
+    points of one instance share their parameters)."""
+    if len(p) and bool((p == p[:1]).all()):
+        return np.repeat(bombieri_weyl_norm(system, p[:1]), len(p))
+    rows, inverse = np.unique(p, axis=0, return_inverse=True)
+    return bombieri_weyl_norm(system, rows)[inverse.reshape(-1)]
+
+
 def term_magnitude(system: PolynomialSystem, x: Complex, p: Complex) -> NDArray[np.float64]:
     """Σ_t |c_t·x^α·p^β| per equation (P, N): the scale of each F_i(x), against which a
     residual or a rounding error is measured."""
@@ -154,7 +163,7 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False
             * solve_margin
         norm_scaled = scaled_norm * solve_margin
         if norm_f is None:
-            norm_f = bombieri_weyl_norm(system, p)
+            norm_f = _norms(system, p)
         mu = np.maximum(1.0, norm_f * norm_scaled)
         gamma = mu * d.max(initial=1.0) ** 1.5 / (2.0 * norm1)
         alpha = beta * gamma

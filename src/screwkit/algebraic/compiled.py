@@ -11,8 +11,13 @@ loop, with the evaluation
     F_i(y; σ) = Σ_k σ^k yᵀ Q_ik y + L_i(σ)·y,   ∂F_i/∂y = Σ_k σ^k 2 Q_ik y + L_i(σ)
 
 (:mod:`.quadrics`) from V = y·Qt over the columns of Qt with a nonzero entry (one contiguous
-loop per unknown), and the (n+1)×(n+1) solves by Gaussian elimination with partial pivoting
-(Golub & Van Loan, *Matrix Computations*, 4th ed., 2013, §3.4). The arithmetic is the same up
+loop per unknown, in real arithmetic on Qt's real and imaginary parts apart, which the compiler
+vectorises), then W_il = Σ_k σ^k (Q_ik y)_l per cell, so F_i = Σ_l W_il y_l and
+∂F_i/∂y_l = 2 W_il; and the (n+1)×(n+1) solves by Gaussian elimination in place with partial
+pivoting on |re| + |im| (Golub & Van Loan, *Matrix Computations*, 4th ed., 2013, §3.4; the
+pivot LAPACK's zgetrf picks). Measured on the Stewart system (9 × 128 columns): ~1 µs per
+evaluation, ~0.7 µs per solve, ~8 µs per step (5 of each), against ~11 µs before (complex V,
+a scatter per column into F and J, |·| by hypot in the pivot search). The arithmetic is the same up
 to rounding, so both routes reach the same end points (to the Newton polish's accuracy) with the
 same statuses; tests/algebraic/test_compiled.py checks it.
 
@@ -48,18 +53,20 @@ LINE, CIRCLE = 0, 1
 
 @dataclass(frozen=True)
 class Columns:
-    """The (k, i, l) of each column c of :attr:`DenseQuadrics.Qt` (``ck``, ``ci``, ``cl``):
-    (y·Qt[b])_c = (Q_ik y)_l of instance b."""
+    """The (k, i, l) of each column c of :attr:`DenseQuadrics.Qt` (``ck`` and the cell
+    ``cu`` = i·m + l): (y·Qt[b])_c = (Q_ik y)_l of instance b; and Qt's real and imaginary
+    parts apart (``qr``, ``qi``, (B, m, C)), as the kernel reads them."""
 
     ck: Index
-    ci: Index
-    cl: Index
+    cu: Index
+    qr: NDArray[np.float64]
+    qi: NDArray[np.float64]
 
     @staticmethod
     def of(dense: DenseQuadrics) -> Columns:
         ck, rest = np.divmod(dense.columns, dense.N * dense.m)
-        ci, cl = np.divmod(rest, dense.m)
-        return Columns(ck.astype(np.int64), ci.astype(np.int64), cl.astype(np.int64))
+        return Columns(ck.astype(np.int64), rest.astype(np.int64),
+                       np.ascontiguousarray(dense.Qt.real), np.ascontiguousarray(dense.Qt.imag))
 
 
 def columns_of(dense: DenseQuadrics) -> Columns:
@@ -69,6 +76,23 @@ def columns_of(dense: DenseQuadrics) -> Columns:
         cols = Columns.of(dense)
         object.__setattr__(dense, "_kernel_columns", cols)
     return cols
+
+
+def evaluate_terms(coef: Complex, sym: Index, pw: Index, eq: Index, N: int, x: Complex,
+                   p: Complex) -> tuple[Complex, Complex]:
+    """F (B, N) and ∂F/∂x (B, N, n) of a term table (:class:`.polynomial.PolynomialSystem`'s
+    ``coef``, ``sym``, ``pw``, ``eq``) at x (B, n), p (B, k) or (k,), compiled: the same sums
+    as its numpy evaluation, one point and one term at a time, with no temporaries."""
+    from screwkit.algebraic import compiled_kernels
+
+    x = np.ascontiguousarray(x, dtype=complex)
+    B, n = x.shape
+    pb = np.ascontiguousarray(np.broadcast_to(np.asarray(p, dtype=complex), (B, p.shape[-1])))
+    F = np.zeros((B, N), dtype=complex)
+    J = np.zeros((B, N, n), dtype=complex)
+    compiled_kernels.term_values(coef, sym.astype(np.int64), pw.astype(np.int64),
+                                 eq.astype(np.int64), n, x, pb, F, J)
+    return F, J
 
 
 def _kernels() -> Any:
@@ -96,7 +120,7 @@ def track_compiled(dense: DenseQuadrics, instance: Index,
                  else instance.astype(np.int64))
     cols = columns_of(dense)
     y, reached, steps = _TRACK(
-        dense.Qt, cols.ck, cols.ci, cols.cl, dense.K,
+        cols.qr, cols.qi, cols.ck, cols.cu, dense.K,
         np.ascontiguousarray(Ls), dense.linear.astype(np.int64), patch,
         instance.astype(np.int64), linear_of, np.ascontiguousarray(y0, dtype=complex),
         np.ascontiguousarray(tau0, dtype=float), np.ascontiguousarray(tau1, dtype=float),

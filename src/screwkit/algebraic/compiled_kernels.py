@@ -19,35 +19,52 @@ njit_inline = numba.njit(cache=True, nogil=True, error_model="numpy",
 
 
 @njit
-def evaluate(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
+def evaluate(qr: Any, qi: Any, ck: Any, cu: Any, K: int,
              L: Any, linear: Any, patch: Any, y: Any, sigma: complex, dsigma: complex,
-             want_t: bool, V: Any, pw: Any, H: Any, J: Any, Ht: Any) -> None:
-    """H, J (and ∂H/∂τ when want_t) of one path at y, σ; vals (m, C) its instance's
-    Qt, L (K_L, N_L, m) its linear forms."""
+             want_t: bool, Vr: Any, Vi: Any, pw: Any, W: Any, T: Any, H: Any, J: Any,
+             Ht: Any) -> None:
+    """H, J (and ∂H/∂τ when want_t) of one path at y, σ; qr + i·qi (m, C) its instance's
+    Qt, L (K_L, N_L, m) its linear forms. V = y·Qt in real arithmetic (the real and imaginary
+    parts apart: a contiguous loop the compiler vectorises), then W_il = Σ_k σ^k (Q_ik y)_l
+    (column c adds to the cell cu[c] = i·m + l), so ∂F_i/∂y_l = 2 W_il and F_i = Σ_l W_il y_l;
+    likewise T_il = Σ_k k σ^(k−1) (Q_ik y)_l and ∂F_i/∂σ = Σ_l T_il y_l."""
     m = y.shape[0]
     n = m - 1
-    C = V.shape[0]
+    C = Vr.shape[0]
     for c in range(C):
-        V[c] = 0.0
+        Vr[c] = 0.0
+        Vi[c] = 0.0
     for j in range(m):  # V = y·Qt, Qt (m, C) dense: a contiguous inner loop
-        yj = y[j]
+        yr = y[j].real
+        yi = y[j].imag
         for c in range(C):
-            V[c] += yj * vals[j, c]
+            a = qr[j, c]
+            b = qi[j, c]
+            Vr[c] += yr * a - yi * b
+            Vi[c] += yr * b + yi * a
     pw[0] = 1.0
     for k in range(1, K):
         pw[k] = pw[k - 1] * sigma
-    for i in range(n):
-        H[i] = 0.0
-        Ht[i] = 0.0
-        for j in range(m):
-            J[i, j] = 0.0
-    for c in range(V.shape[0]):
-        k, i, l_ = ck[c], ci[c], cl[c]
-        v = V[c]
-        H[i] += pw[k] * y[l_] * v
-        J[i, l_] += 2.0 * pw[k] * v
+    for u in range(n * m):
+        W[u] = 0.0
+        T[u] = 0.0
+    for c in range(C):
+        k = ck[c]
+        v = complex(Vr[c], Vi[c])
+        W[cu[c]] += pw[k] * v
         if want_t and k > 0:
-            Ht[i] += k * pw[k - 1] * dsigma * y[l_] * v
+            T[cu[c]] += k * pw[k - 1] * v
+    for i in range(n):
+        f = 0.0j
+        t = 0.0j
+        for j in range(m):
+            w = W[i * m + j]
+            f += w * y[j]
+            J[i, j] = 2.0 * w
+            if want_t:
+                t += T[i * m + j] * y[j]
+        H[i] = f
+        Ht[i] = t * dsigma
     KL = L.shape[0]
     for e in range(linear.shape[0]):
         r = linear[e]
@@ -69,36 +86,31 @@ def evaluate(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
 
 
 @njit
-def solve(J: Any, A: Any, piv: Any, b: Any) -> bool:
-    """LU of J (copied into A, partial pivoting); b (m, r) overwritten by J⁻¹b. False
-    (b filled with NaN) when a pivot is zero or not finite."""
-    m = J.shape[0]
-    for i in range(m):
-        for j in range(m):
-            A[i, j] = J[i, j]
+def solve(A: Any, b: Any) -> bool:
+    """LU of A in place (partial pivoting on |re| + |im|, LAPACK's choice in zgetrf); b (m, r)
+    overwritten by A⁻¹b. False (b filled with NaN) when a pivot is zero or not finite."""
+    m = A.shape[0]
     for col in range(m):
         best, p = -1.0, col
         for i in range(col, m):
-            a = abs(A[i, col])
+            a = abs(A[i, col].real) + abs(A[i, col].imag)
             if a > best:
                 best, p = a, i
         if not (best > 0.0) or not np.isfinite(best):
             b[:, :] = np.nan
             return False
-        piv[col] = p
         if p != col:
-            for j in range(m):
+            for j in range(col, m):
                 A[col, j], A[p, j] = A[p, j], A[col, j]
             for r in range(b.shape[1]):
                 b[col, r], b[p, r] = b[p, r], b[col, r]
         inv = 1.0 / A[col, col]
         for i in range(col + 1, m):
             f = A[i, col] * inv
-            if f != 0:
-                for j in range(col + 1, m):
-                    A[i, j] -= f * A[col, j]
-                for r in range(b.shape[1]):
-                    b[i, r] -= f * b[col, r]
+            for j in range(col + 1, m):
+                A[i, j] -= f * A[col, j]
+            for r in range(b.shape[1]):
+                b[i, r] -= f * b[col, r]
     for r in range(b.shape[1]):
         for i in range(m - 1, -1, -1):
             s = b[i, r]
@@ -117,25 +129,24 @@ def curve(kind: int, radius: float, tau: float) -> tuple[complex, complex]:
 
 
 @njit
-def velocity(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
+def velocity(qr: Any, qi: Any, ck: Any, cu: Any, K: int,
              L: Any, linear: Any, patch: Any, y: Any, kind: int, radius: float,
-             tau: float, out: Any, V: Any, pw: Any, H: Any, J: Any, Ht: Any, A: Any,
-             piv: Any, b: Any) -> None:
+             tau: float, out: Any, ws: Any, b: Any) -> None:
+    Vr, Vi, pw, W, T, H, J, Ht = ws
     sigma, dsigma = curve(kind, radius, tau)
-    evaluate(vals, ck, ci, cl, K, L, linear, patch, y, sigma, dsigma, True,
-             V, pw, H, J, Ht)
+    evaluate(qr, qi, ck, cu, K, L, linear, patch, y, sigma, dsigma, True,
+             Vr, Vi, pw, W, T, H, J, Ht)
     for i in range(y.shape[0]):
         b[i, 0] = Ht[i]
-    solve(J, A, piv, b[:, :1])
+    solve(J, b[:, :1])
     for i in range(y.shape[0]):
         out[i] = -b[i, 0]
 
 
 @njit_inline
-def step(vp: Any, ck: Any, ci: Any, cl: Any, K: int, L: Any, linear: Any, patch: Any,
+def step(qr: Any, qi: Any, ck: Any, cu: Any, K: int, L: Any, linear: Any, patch: Any,
          kind: int, r: float, y: Any, v: Any, tau: float, hs: float, k2: Any, k3: Any,
-         k4: Any, z: Any, yp: Any, y1: Any, V: Any, pw: Any, H: Any, J: Any, Ht: Any, A: Any,
-         piv: Any, b: Any) -> tuple[float, float, bool]:
+         k4: Any, z: Any, yp: Any, y1: Any, ws: Any, b: Any) -> tuple[float, float, bool]:
     """One predictor–corrector step of one path from y (velocity v) at τ over hs: the
     corrected point in z, dy/dτ there in −b[:, 1]; the ∞-norms of both Newton corrections
     (NaN when not finite) and whether z is finite."""
@@ -143,36 +154,34 @@ def step(vp: Any, ck: Any, ci: Any, cl: Any, K: int, L: Any, linear: Any, patch:
     # RK4 predictor (k1 = v, the velocity kept from the last corrector)
     for i in range(m):
         z[i] = y[i] + 0.5 * hs * v[i]
-    velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
-             tau + 0.5 * hs, k2, V, pw, H, J, Ht, A, piv, b)
+    velocity(qr, qi, ck, cu, K, L, linear, patch, z, kind, r, tau + 0.5 * hs, k2, ws, b)
     for i in range(m):
         z[i] = y[i] + 0.5 * hs * k2[i]
-    velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
-             tau + 0.5 * hs, k3, V, pw, H, J, Ht, A, piv, b)
+    velocity(qr, qi, ck, cu, K, L, linear, patch, z, kind, r, tau + 0.5 * hs, k3, ws, b)
     for i in range(m):
         z[i] = y[i] + hs * k3[i]
-    velocity(vp, ck, ci, cl, K, L, linear, patch, z, kind, r,
-             tau + hs, k4, V, pw, H, J, Ht, A, piv, b)
+    velocity(qr, qi, ck, cu, K, L, linear, patch, z, kind, r, tau + hs, k4, ws, b)
     for i in range(m):
         yp[i] = y[i] + hs / 6.0 * (v[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
     # two Newton corrections at τ + h; the second evaluation also gives dy/dτ
+    Vr, Vi, pw, W, T, H, J, Ht = ws
     sigma, dsigma = curve(kind, r, tau + hs)
-    evaluate(vp, ck, ci, cl, K, L, linear, patch, yp, sigma, dsigma,
-             False, V, pw, H, J, Ht)
+    evaluate(qr, qi, ck, cu, K, L, linear, patch, yp, sigma, dsigma,
+             False, Vr, Vi, pw, W, T, H, J, Ht)
     for i in range(m):
         b[i, 0] = H[i]
-    solve(J, A, piv, b[:, :1])
+    solve(J, b[:, :1])
     first = 0.0
     for i in range(m):
         y1[i] = yp[i] - b[i, 0]
         a = abs(b[i, 0])
         first = a if (a > first or np.isnan(a)) and not np.isnan(first) else first
-    evaluate(vp, ck, ci, cl, K, L, linear, patch, y1, sigma, dsigma,
-             True, V, pw, H, J, Ht)
+    evaluate(qr, qi, ck, cu, K, L, linear, patch, y1, sigma, dsigma,
+             True, Vr, Vi, pw, W, T, H, J, Ht)
     for i in range(m):
         b[i, 0] = H[i]
         b[i, 1] = Ht[i]
-    solve(J, A, piv, b)
+    solve(J, b)
     second = 0.0
     finite = True
     for i in range(m):
@@ -185,7 +194,7 @@ def step(vp: Any, ck: Any, ci: Any, cl: Any, K: int, L: Any, linear: Any, patch:
 
 
 @njit
-def track(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
+def track(qrs: Any, qis: Any, ck: Any, cu: Any, K: int,
           Ls: Any, linear: Any, patch: Any, instance: Any, linear_of: Any, y0: Any,
           tau0: Any, tau1: Any, kind: int, radius: Any, initial_step: float,
           max_step: float, min_step: float, max_steps: int, ptol: float, ctol: float,
@@ -195,13 +204,10 @@ def track(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
     y_out = y0.copy()
     reached = np.zeros(P, dtype=np.bool_)
     steps = np.zeros(P, dtype=np.int64)
-    V = np.empty(C, dtype=np.complex128)
-    pw = np.empty(max(K, Ls.shape[1]), dtype=np.complex128)
-    H = np.empty(m, dtype=np.complex128)
-    Ht = np.empty(m, dtype=np.complex128)
-    J = np.empty((m, m), dtype=np.complex128)
-    A = np.empty((m, m), dtype=np.complex128)
-    piv = np.empty(m, dtype=np.int64)
+    ws = (np.empty(C), np.empty(C), np.empty(max(K, Ls.shape[1]), dtype=np.complex128),
+          np.empty(m * m, dtype=np.complex128), np.empty(m * m, dtype=np.complex128),
+          np.empty(m, dtype=np.complex128), np.empty((m, m), dtype=np.complex128),
+          np.empty(m, dtype=np.complex128))
     b = np.empty((m, 2), dtype=np.complex128)
     y = np.empty(m, dtype=np.complex128)
     v = np.empty(m, dtype=np.complex128)
@@ -212,7 +218,8 @@ def track(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
     yp = np.empty(m, dtype=np.complex128)
     y1 = np.empty(m, dtype=np.complex128)
     for p in range(P):
-        vp = vals[instance[p]]
+        qr = qrs[instance[p]]
+        qi = qis[instance[p]]
         L = Ls[linear_of[p]]
         r = radius[p]
         for i in range(m):
@@ -223,16 +230,14 @@ def track(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
         if span == 0.0:
             reached[p] = True
             continue
-        velocity(vp, ck, ci, cl, K, L, linear, patch, y, kind, r, tau, v,
-                 V, pw, H, J, Ht, A, piv, b)
+        velocity(qr, qi, ck, cu, K, L, linear, patch, y, kind, r, tau, v, ws, b)
         floor = min_step * max(span, 1.0)
         while True:
             left = tau1[p] - tau
             hs = min(h, left)
             last = hs >= left
-            first, second, finite = step(vp, ck, ci, cl, K, L, linear, patch, kind, r, y, v,
-                                         tau, hs, k2, k3, k4, z, yp, y1, V, pw, H, J, Ht, A,
-                                         piv, b)
+            first, second, finite = step(qr, qi, ck, cu, K, L, linear, patch, kind, r, y, v,
+                                         tau, hs, k2, k3, k4, z, yp, y1, ws, b)
             big = 0.0
             for i in range(m):
                 big = max(big, abs(y[i]))
@@ -261,3 +266,42 @@ def track(vals: Any, ck: Any, ci: Any, cl: Any, K: int,
         for i in range(m):
             y_out[p, i] = y[i]
     return y_out, reached, steps
+
+
+@njit
+def term_values(coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any, F: Any,
+                J: Any) -> None:
+    """F (B, N) and ∂F/∂x (B, N, n) of the term table at the points x (B, n), parameters
+    p (B, k), added into the zeroed F and J: per term its factors' powers, their prefix and
+    suffix products, and the derivative by each unknown factor (the sums of
+    :meth:`.polynomial.PolynomialSystem.evaluate`, one point at a time)."""
+    B = x.shape[0]
+    T, w = sym.shape
+    vals = np.empty(w, dtype=np.complex128)
+    pre = np.empty(w + 1, dtype=np.complex128)
+    suf = np.empty(w + 1, dtype=np.complex128)
+    for b in range(B):
+        for t in range(T):
+            for f in range(w):
+                s = sym[t, f]
+                z = x[b, s] if s < n else p[b, s - n]
+                v = 1.0 + 0.0j
+                for _ in range(pw[t, f]):
+                    v *= z
+                vals[f] = v
+            pre[0] = 1.0
+            suf[w] = 1.0
+            for f in range(w):
+                pre[f + 1] = pre[f] * vals[f]
+                suf[w - 1 - f] = suf[w - f] * vals[w - 1 - f]
+            c = coef[t]
+            i = eq[t]
+            F[b, i] += c * pre[w]
+            for f in range(w):
+                s = sym[t, f]
+                e = pw[t, f]
+                if e > 0 and s < n:
+                    zp = 1.0 + 0.0j
+                    for _ in range(e - 1):
+                        zp *= x[b, s]
+                    J[b, i, s] += (c * e) * zp * pre[f] * suf[f + 1]

@@ -13,7 +13,9 @@ then two Newton corrections at the new τ; the step is accepted when the first c
 predictor's error) is within ``predictor_tolerance`` and the second is within
 ``corrector_tolerance`` and at most ``contraction`` times the first (Newton converging fast,
 the guard against landing on a neighbouring path); the next step is sized from the error as
-(tolerance / error)^(1/5), between ½× and 2×, a rejected one at most ½×.
+(tolerance / error)^(1/5), between ½× and 2×, a rejected one at most ½×. The main leg
+(s up to 1 − ``endgame_radius``) runs with the looser pair of tolerances (1e-2, 1e-4), the rest
+and the Cauchy endgame with the tighter one (1e-3, 1e-5) (:meth:`TrackOptions.near_end`).
 Every step is a handful of batched numpy calls over the active paths (one ``np.linalg.solve``
 over (B, n+1, n+1) per stage); no Python loop runs over the paths.
 """
@@ -46,10 +48,18 @@ class TrackOptions:
     max_step: float = 0.2
     min_step: float = 1e-13
     max_steps: int = 2000
-    predictor_tolerance: float = 1e-3
+    #: the first Newton correction (the predictor's error) must be within this, on the main
+    #: leg s ∈ [0, 1 − endgame_radius] (1e-3 before issue 27's tuning: 1e-2 with the corrector
+    #: tolerance below takes ~23 % fewer steps on the Stewart and 6R systems, with every one
+    #: of 200 seeded instances complete, measured)
+    predictor_tolerance: float = 1e-2
     #: the second Newton correction must end within this: when Newton converges
     #: quadratically, the point's remaining error is of the order of its square
-    corrector_tolerance: float = 1e-5
+    corrector_tolerance: float = 1e-4
+    #: the two tolerances from s = 1 − endgame_radius on (the last leg and the Cauchy
+    #: endgame, whose estimates must agree to ``endgame_tolerance``)
+    end_predictor_tolerance: float = 1e-3
+    end_corrector_tolerance: float = 1e-5
     #: the second Newton correction must be at most this fraction of the first
     contraction: float = 0.1
     #: the endgame starts on the circle |1 − σ| = endgame_radius and shrinks it by 4 a level
@@ -79,12 +89,20 @@ class TrackOptions:
     compiled: bool = True
 
     def tighter(self) -> TrackOptions:
-        """The options for a retrack after suspected path jumping: 10× smaller steps and
-        100× tighter predictor tolerance."""
+        """The options for a retrack after suspected path jumping: 10× smaller steps, 100×
+        tighter predictor tolerance and 10× tighter corrector tolerance on the main leg."""
         from dataclasses import replace
 
         return replace(self, max_step=self.max_step / 10, initial_step=self.initial_step / 10,
-                       predictor_tolerance=self.predictor_tolerance / 100, retrack=False)
+                       predictor_tolerance=self.predictor_tolerance / 100,
+                       corrector_tolerance=self.corrector_tolerance / 10, retrack=False)
+
+    def near_end(self) -> TrackOptions:
+        """The options from s = 1 − endgame_radius on: the end tolerances."""
+        from dataclasses import replace
+
+        return replace(self, predictor_tolerance=self.end_predictor_tolerance,
+                       corrector_tolerance=self.end_corrector_tolerance)
 
 
 @dataclass(frozen=True)

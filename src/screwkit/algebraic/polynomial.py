@@ -31,6 +31,14 @@ BLOCK = 64
 Monomial = tuple[tuple[int, int], ...]  # ((symbol index, power > 0), ...) sorted by index
 
 
+def _compiled_terms() -> bool:
+    """Whether :meth:`PolynomialSystem.evaluate` (F and ∂F/∂x) runs compiled: numba is
+    installed and not turned off (:data:`.compiled.AVAILABLE`)."""
+    from screwkit.algebraic import compiled
+
+    return compiled.AVAILABLE
+
+
 class Poly:
     """A polynomial in named symbols with complex coefficients: {monomial: coefficient}.
 
@@ -138,6 +146,12 @@ class PolynomialSystem:
                  want_jp: bool = True) -> tuple[Complex, Complex, Complex | None]:
         """F (B, N), ∂F/∂x (B, N, n) and ∂F/∂p (B, N, k) (None unless ``want_jp``) at the
         points x (B, n) with parameters p (B, k) or (k,)."""
+        if not want_jp and _compiled_terms():
+            from screwkit.algebraic.compiled import evaluate_terms
+
+            F, J = evaluate_terms(self.coef, self.sym, self.pw, self.eq, self.size,
+                                  np.asarray(x, dtype=complex), np.asarray(p, dtype=complex))
+            return F, J, None
         dims = self.n + self.k if want_jp else self.n
         F, J, _ = self._blocks(self._columns(x, p), dims, None)
         return F.T, J[:, :, : self.n], (J[:, :, self.n:] if want_jp else None)
@@ -223,7 +237,15 @@ class PolynomialSystem:
         """The system in n+1 homogeneous unknowns (h, x·h): each term of equation i times
         h^(d_i − its degree), so F_i^h(h, y) = h^(d_i)·F_i(y/h) (Sommese & Wampler 2005,
         §3.2). The new unknown ``h`` comes first; parameters are unchanged and N = n
-        equations remain (a patch equation closes the system)."""
+        equations remain (a patch equation closes the system). Built once and kept on the
+        system, so that the plans cached on it (evaluation, monomials) serve every call."""
+        kept = self.__dict__.get("_homogenized")
+        if kept is None:
+            kept = self._homogenize()
+            object.__setattr__(self, "_homogenized", kept)
+        return kept  # type: ignore[no-any-return]
+
+    def _homogenize(self) -> PolynomialSystem:
         unknown = self.sym < self.n
         term_degree = np.where(unknown, self.pw, 0).sum(axis=1)
         lift = np.asarray(self.degrees, dtype=np.intp)[self.eq] - term_degree
@@ -240,25 +262,29 @@ class PolynomialSystem:
         equation (G,) and exponent vector (G, n) of each distinct monomial in x, and its
         coefficient (B, G), the sum over the terms with that monomial of coef·Π p^pw."""
         p = np.atleast_2d(np.asarray(p, dtype=complex))
-        plan = self.__dict__.get("_coefficient_plan")  # parameter-free: kept on the system
+        keys, order, heads = self._monomials()
+        z = self._columns(np.ones((len(p), self.n), dtype=complex), p)
+        values = (self.coef[:, None] * np.prod(self._power_table(z)[self.pw, self.sym],
+                                               axis=1)).T
+        out = np.add.reduceat(values[:, order], heads, axis=1)
+        return keys[:, 0].astype(np.intp), keys[:, 1:].astype(np.intp), out
+
+    def _monomials(self) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.intp]]:
+        """The (equation, exponents in x) of each distinct monomial in x, the terms in the
+        order of their monomials and the first of each (for reduceat): fixed by the system,
+        so kept on it."""
+        plan = self.__dict__.get("_monomial_plan")
         if plan is None:
-            unknown = self.sym < self.n
             exps = np.zeros((len(self.eq), self.n), dtype=np.intp)
-            rows = np.nonzero(unknown)
+            rows = np.nonzero(self.sym < self.n)
             np.add.at(exps, (rows[0], self.sym[rows]), self.pw[rows])
             keys, group = np.unique(np.column_stack([self.eq, exps]), axis=0,
                                     return_inverse=True)
             order = np.argsort(group.reshape(-1), kind="stable")
             heads = np.flatnonzero(np.r_[True, np.diff(group.reshape(-1)[order]) != 0])
-            plan = (keys[:, 0].astype(np.intp), keys[:, 1:].astype(np.intp), order, heads)
-            object.__setattr__(self, "_coefficient_plan", plan)
-        eq, exps_out, order, heads = plan
-        z = self._columns(np.ones((len(p), self.n), dtype=complex), p)
-        values = (self.coef[:, None] * np.prod(self._power_table(z)[self.pw, self.sym],
-                                               axis=1)).T
-        out = np.zeros((len(p), len(eq)), dtype=complex)
-        out[:] = np.add.reduceat(values[:, order], heads, axis=1)
-        return eq, exps_out, out
+            plan = (keys, order, heads)
+            object.__setattr__(self, "_monomial_plan", plan)
+        return plan  # type: ignore[no-any-return]
 
     def _power_table(self, z: Complex) -> Complex:
         """z^0..z^D (D+1, S, B) for z (S, B)."""

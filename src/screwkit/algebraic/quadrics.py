@@ -22,6 +22,7 @@ contractions with the powers of σ, in place of the sparse term-by-term sums of
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -38,6 +39,63 @@ def dense_quadrics_apply(hsys: PolynomialSystem) -> bool:
     unknown = hsys.sym < hsys.n
     degree = np.where(unknown, hsys.pw, 0).sum(axis=1)
     return bool(len(degree)) and bool(((degree >= 1) & (degree <= 2)).all())
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """What :meth:`DenseQuadrics.build` needs of a system apart from its parameter values:
+    the σ-degree K − 1 and the K roots of unity; ``above`` (K, G) the σ^k above each
+    monomial's parameter degree; the quadratic monomials ``quad`` and the sparse map
+    ``cells`` (N·m·m × quad) of half of each coefficient onto its cells (j, l) and (l, j);
+    the linear monomials ``lin``, their equations ``linear`` and the map ``forms``
+    (N_L·m × lin)."""
+
+    K: int
+    roots: Complex
+    above: NDArray[np.bool_]
+    quad: Index
+    cells: Any
+    lin: Index
+    linear: Index
+    forms: Any
+
+
+def _plan(hsys: PolynomialSystem) -> _Plan:
+    """The :class:`_Plan` of ``hsys``, built once and kept on it."""
+    plan = hsys.__dict__.get("_dense_plan")
+    if plan is not None:
+        return plan  # type: ignore[no-any-return]
+    from scipy import sparse
+
+    m, N = hsys.n, hsys.size
+    param = hsys.sym >= hsys.n
+    K = int(np.where(param, hsys.pw, 0).sum(axis=1).max(initial=0)) + 1
+    eq, exps, _ = hsys.coefficients_at(np.zeros((1, hsys.k), dtype=complex))
+    unknown_exps = np.zeros((len(hsys.eq), m), dtype=np.intp)
+    rows = np.nonzero(~param)
+    np.add.at(unknown_exps, (rows[0], hsys.sym[rows]), hsys.pw[rows])
+    group = np.unique(np.column_stack([hsys.eq, unknown_exps]), axis=0,
+                      return_inverse=True)[1].reshape(-1)
+    top = np.zeros(len(eq), dtype=np.intp)
+    np.maximum.at(top, group, np.where(param, hsys.pw, 0).sum(axis=1))
+    degree = exps.sum(axis=1)
+    quad = np.flatnonzero(degree == 2)
+    # the two unknowns of each quadratic monomial (the same one twice for a square)
+    pair = np.repeat(np.tile(np.arange(m), len(quad)), exps[quad].ravel()).reshape(-1, 2)
+    where = np.concatenate([(eq[quad] * m + pair[:, 0]) * m + pair[:, 1],
+                            (eq[quad] * m + pair[:, 1]) * m + pair[:, 0]])
+    cells = sparse.csr_matrix((np.full(2 * len(quad), 0.5 + 0j),
+                               (where, np.tile(np.arange(len(quad)), 2))),
+                              shape=(N * m * m, len(quad)))
+    lin = np.flatnonzero(degree == 1)
+    linear = np.unique(eq[lin]).astype(np.intp)
+    forms = sparse.csr_matrix((np.ones(len(lin), dtype=complex),
+                               (np.searchsorted(linear, eq[lin]) * m + exps[lin].argmax(axis=1),
+                                np.arange(len(lin)))), shape=(len(linear) * m, len(lin)))
+    plan = _Plan(K, np.exp(2j * np.pi * np.arange(K) / K),
+                 np.arange(K)[:, None] > top[None, :], quad, cells, lin, linear, forms)
+    object.__setattr__(hsys, "_dense_plan", plan)
+    return plan
 
 
 @dataclass(frozen=True)
@@ -63,39 +121,20 @@ class DenseQuadrics:
         """The coefficients of the instances whose segments start at the rows of ``p_start``
         (B, k) and move along the rows of ``direction`` (B, k)."""
         B, m, N = len(p_start), hsys.n, hsys.size
-        param = hsys.sym >= hsys.n
-        K = int(np.where(param, hsys.pw, 0).sum(axis=1).max(initial=0)) + 1
-        roots = np.exp(2j * np.pi * np.arange(K) / K)
-        p = (p_start[:, None, :] + roots[None, :, None] * direction[:, None, :])
-        eq, exps, values = hsys.coefficients_at(p.reshape(B * K, -1))
+        plan = _plan(hsys)
+        K = plan.K
+        p = (p_start[:, None, :] + plan.roots[None, :, None] * direction[:, None, :])
+        _, _, values = hsys.coefficients_at(p.reshape(B * K, -1))
         coef = np.fft.fft(values.reshape(B, K, -1), axis=1) / K  # (B, K, G): σ^k coefficients
         # a monomial's coefficient has σ-degree at most the largest parameter degree of its
         # terms: the higher σ^k (rounding noise of the transform) are exactly zero
-        unknown_exps = np.zeros((len(hsys.eq), m), dtype=np.intp)
-        rows = np.nonzero(~param)
-        np.add.at(unknown_exps, (rows[0], hsys.sym[rows]), hsys.pw[rows])
-        group = np.unique(np.column_stack([hsys.eq, unknown_exps]), axis=0,
-                          return_inverse=True)[1].reshape(-1)
-        top = np.zeros(len(eq), dtype=np.intp)
-        np.maximum.at(top, group, np.where(param, hsys.pw, 0).sum(axis=1))
-        coef[:, np.arange(K)[:, None] > top[None, :]] = 0.0
-        degree = exps.sum(axis=1)
-        quad = np.flatnonzero(degree == 2)
-        # the two unknowns of each quadratic monomial (the same one twice for a square), its
-        # coefficient split in halves over the cells (j, l) and (l, j)
-        pair = np.repeat(np.tile(np.arange(m), len(quad)), exps[quad].ravel()).reshape(-1, 2)
-        half = 0.5 * coef[:, :, quad].reshape(B * K, -1).T  # (G_quad, B·K)
-        cells = np.zeros((N * m * m, B * K), dtype=complex)
-        np.add.at(cells, (eq[quad] * m + pair[:, 0]) * m + pair[:, 1], half)
-        np.add.at(cells, (eq[quad] * m + pair[:, 1]) * m + pair[:, 0], half)
+        coef[:, plan.above] = 0.0
+        # each quadratic monomial's coefficient split in halves over the cells (j, l), (l, j)
+        cells = plan.cells @ coef[:, :, plan.quad].reshape(B * K, -1).T  # (N·m·m, B·K)
         Q = cells.T.reshape(B, K, N, m, m)
-        lin = np.flatnonzero(degree == 1)
-        linear = np.unique(eq[lin]).astype(np.intp)
-        forms = np.zeros((len(linear) * m, B * K), dtype=complex)
-        np.add.at(forms, np.searchsorted(linear, eq[lin]) * m + exps[lin].argmax(axis=1),
-                  coef[:, :, lin].reshape(B * K, -1).T)
-        L = forms.T.reshape(B, K, len(linear), m)
-        if lin.size:
+        forms = plan.forms @ coef[:, :, plan.lin].reshape(B * K, -1).T
+        L = forms.T.reshape(B, K, len(plan.linear), m)
+        if plan.lin.size:
             if not np.any(L[:, 1:]):
                 L = L[:, :1]
             if np.all(L == L[:1]):
@@ -103,8 +142,8 @@ class DenseQuadrics:
         Qt = Q.transpose(0, 4, 1, 2, 3).reshape(B, m, K * N * m)
         # only the columns (k, i, l) with a nonzero entry take part in the product
         columns = np.flatnonzero(np.any(Qt != 0, axis=(0, 1))).astype(np.intp)
-        return DenseQuadrics(np.ascontiguousarray(Qt[:, :, columns]), columns, L, linear, K,
-                             N, m)
+        return DenseQuadrics(np.ascontiguousarray(Qt[:, :, columns]), columns, L,
+                             plan.linear, K, N, m)
 
     def matrices(self, b: int) -> Complex:
         """The symmetric Q_ik of instance b, (K, N, m, m)."""

@@ -20,8 +20,10 @@ are then classified singular (with the number of paths that reach the same point
 multiplicity estimate), at infinity, or failed.
 
 A path whose tracking fails (its step collapses where the segment passes close to the
-discriminant and Newton stops contracting) is not given up at once: every path of its instance
-is tracked again through a random complex parameter point (p_start → p_mid → p_target, both legs
+discriminant and Newton stops contracting) is not given up at once: it is first tracked again
+alone on the same segment with 10× smaller steps (the same path, so its end is its own); if it
+still fails, or ends where another path of its instance ends, every path of its instance is
+tracked again through a random complex parameter point (p_start → p_mid → p_target, both legs
 generic), and that instance's new ends are kept when fewer of its paths fail.
 
 Path jumping: two paths of one instance ending at the same regular solution cannot both be
@@ -66,8 +68,9 @@ class TrackResult:
     ``residual`` (P,) ‖F(x; p_target)‖∞ at finite end points; ``winding`` (P,) the cycle
     number from the endgame (1 for paths that did not need it); ``multiplicity`` (P,) the number
     of paths of the same instance ending at the same point (1 for a regular end); ``steps`` (P,)
-    predictor–corrector steps taken; ``retracked`` (P,) paths tracked again (after a suspected
-    jump, or through the detour of an instance with a failed path); ``instance`` (P,) the index of each path's homotopy (its pair p_start, p_target)
+    predictor–corrector steps taken; ``retracked`` (P,) paths tracked again (alone after
+    their main leg failed, after a suspected jump, or through the detour of an instance with a
+    failed path); ``instance`` (P,) the index of each path's homotopy (its pair p_start, p_target)
     among the distinct pairs: paths of one instance are one homotopy, whose regular ends must
     differ."""
 
@@ -175,7 +178,8 @@ def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArra
     y0 = hom.to_patch(x_start)
     near = 1.0 - options.endgame_radius
     y_near, ok1, steps = track(hom, line, y0, rows, np.zeros(m), np.full(m, near), options)
-    y_end, ok2, used = track(hom, line, y_near, rows, np.full(m, near), np.ones(m), options)
+    end = options.near_end()
+    y_end, ok2, used = track(hom, line, y_near, rows, np.full(m, near), np.ones(m), end)
     steps = steps + used
     status = np.full(m, PathStatus.FAILED, dtype=np.int8)
     winding = np.ones(m, dtype=np.int64)
@@ -195,7 +199,7 @@ def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArra
     cond[arrived] = cond_a
     late = np.flatnonzero(ok1 & (status == PathStatus.FAILED))
     if late.size:
-        eg = cauchy_endgame(hom, y_near[late], rows[late], options)
+        eg = cauchy_endgame(hom, y_near[late], rows[late], end)
         steps[late] += eg.steps
         winding[late] = eg.winding
         estimate = eg.y
@@ -212,7 +216,7 @@ def _run(system: PolynomialSystem, hom: Homotopy, x_start: Complex, rows: NDArra
         y_final[late[finite[regular]]] = pol[regular]
         status[late[finite[~regular]]] = PathStatus.SINGULAR
     return {"y": y_final, "status": status, "condition": cond, "winding": winding,
-            "steps": steps}
+            "steps": steps, "main_leg": ok1.copy()}
 
 
 def _run_in_chunks(system: PolynomialSystem, hom: Homotopy, x: Complex,
@@ -261,6 +265,8 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
     rows = np.arange(P)
     out = _run_in_chunks(system, hom, x, rows, options)
     retracked = np.zeros(P, dtype=bool)
+    if options.retrack:
+        _retrack_lost(system, hom, x, rows, group, out, retracked, options)
     failed = out["status"] == PathStatus.FAILED
     if failed.any() and options.detour:
         # every path of an instance with a failed path, through the detour (all of them: a
@@ -293,13 +299,49 @@ def _homotopy(hsys: PolynomialSystem, patch: Complex, ps: Complex, pt: Complex,
               options: TrackOptions) -> tuple[Homotopy, NDArray[np.intp]]:
     """The homotopy of the segments ps → pt (one row per path), evaluated densely when the
     system is made of quadrics, and each path's instance (index of its distinct segment)."""
-    first, instance = np.unique(np.concatenate([ps, pt], axis=1), axis=0, return_index=True,
-                                return_inverse=True)[1:]
-    instance = instance.reshape(-1).astype(np.intp)
+    first, instance = _segments(ps, pt)
     dense = (DenseQuadrics.build(hsys, ps[first], pt[first] - ps[first])
              if options.dense and dense_quadrics_apply(hsys) else None)
     return (Homotopy(hsys, patch, ps, pt - ps, dense, instance if dense is not None else None),
             instance)
+
+
+def _retrack_lost(system: PolynomialSystem, hom: Homotopy, x: Complex, rows: NDArray[np.intp],
+                  group: NDArray[np.intp], out: dict[str, np.ndarray],
+                  retracked: NDArray[np.bool_], options: TrackOptions) -> None:
+    """The paths whose main leg failed (the step collapsed), tracked again alone on the same
+    segment with :meth:`TrackOptions.tighter` steps. Each is the same path of the same
+    homotopy, so its end is its own (no permutation of the ends, unlike a detour of some paths
+    only); an end that is still failed, or that another path of its instance also reaches,
+    is left failed, and the detour then takes its whole instance. Updates ``out`` and
+    ``retracked`` in place."""
+    lost = np.flatnonzero((out["status"] == PathStatus.FAILED) & ~out["main_leg"])
+    if not lost.size:
+        return
+    again = _run_in_chunks(system, hom, x[lost], rows[lost], options.tighter())
+    mine = {key: value[lost].copy() for key, value in out.items()}
+    for key, value in again.items():
+        out[key][lost] = value
+    shared = np.isin(lost, _jumps(out["y"], out["status"], group, options))
+    undo = shared | (again["status"] == PathStatus.FAILED)
+    for key, value in mine.items():
+        out[key][lost[undo]] = value[undo]
+    retracked[lost[~undo]] = True
+
+
+def _segments(ps: Complex, pt: Complex) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """``np.unique(rows, axis=0, return_index=True, return_inverse=True)[1:]`` of the rows
+    (ps, pt), the same arrays, with the sort run over the first row of each run of equal
+    rows only (a batch repeats each target once per path, so there are few)."""
+    rows = np.concatenate([ps, pt], axis=1)
+    head = np.ones(len(rows), dtype=bool)
+    head[1:] = (rows[1:] != rows[:-1]).any(axis=1)
+    heads = np.flatnonzero(head)
+    if len(heads) == 1:  # one segment (one instance alone)
+        return np.zeros(1, dtype=np.intp), np.zeros(len(rows), dtype=np.intp)
+    first, inverse = np.unique(rows[heads], axis=0, return_index=True, return_inverse=True)[1:]
+    return (heads[first].astype(np.intp),
+            inverse.reshape(-1)[np.cumsum(head) - 1].astype(np.intp))
 
 
 def _detour(system: PolynomialSystem, hsys: PolynomialSystem, patch: Complex, ps: Complex,
@@ -322,7 +364,7 @@ def _detour(system: PolynomialSystem, hsys: PolynomialSystem, patch: Complex, ps
     out = {"y": np.full_like(leg["y"], np.nan),
            "status": np.full(len(x), PathStatus.FAILED, dtype=np.int8),
            "condition": np.full(len(x), np.inf), "winding": np.ones(len(x), dtype=np.int64),
-           "steps": leg["steps"].copy()}
+           "steps": leg["steps"].copy(), "main_leg": np.zeros(len(x), dtype=bool)}
     through = np.flatnonzero(leg["status"] == PathStatus.REGULAR)
     if through.size:
         y = leg["y"][through]
