@@ -76,6 +76,9 @@ def test_solve_motion_shares_what_is_the_same(a2: float) -> None:
         np.testing.assert_array_equal(md.conf.scalars[:, 0], THETA)  # not masked
     for md in motion.modes:  # every mode's fields read back unchanged by the other's masking
         np.testing.assert_array_equal(md.velocities["theta1"][md.assembles], 7.0)
+    # the crank rate as an array: one for both modes where nothing is masked, else each its own
+    same = motion.modes[0].velocities["theta1"] is motion.modes[1].velocities["theta1"]
+    assert same == bool(motion.modes[0].assembles.all())
 
 
 def test_constant_rows_are_read_as_numbers() -> None:

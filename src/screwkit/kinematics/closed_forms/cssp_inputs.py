@@ -10,7 +10,7 @@ sweep from the same inputs without computing them again (issue 30: the two modes
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -80,6 +80,8 @@ class CSSPSweep:
     discriminant: Array
     assembles: NDArray[np.bool_]
     rod_turn: Array  # (N,) φ turning Rahman's rod frame {3} about u to the zero-spin frame
+    #: the constant inputs as arrays (:meth:`full`), kept for the other root's sweep
+    shared: dict[str, Array] = field(default_factory=dict, compare=False, repr=False)
 
     def block(self, name: str, sel: slice | NDArray[np.intp]) -> float | Array:
         """An input over some samples (a float if it is constant)."""
@@ -87,11 +89,19 @@ class CSSPSweep:
         return value if isinstance(value, float) else value[sel]
 
     def full(self, name: str) -> Array:
-        """An input as a new (N,) array."""
+        """An input as an (N,) array: where the CSSP assembles at every sample, one array for
+        every caller (both roots' modes read the same values; none writes them), else a new
+        one (a mode masks its own where it does not assemble)."""
         value = self.given[name]
+        if not self.assembles.all():
+            if not isinstance(value, float):
+                return value.copy()
+            return np.zeros(self.n) if value == 0.0 else np.full(self.n, value)
         if not isinstance(value, float):
-            return value.copy()
-        return np.zeros(self.n) if value == 0.0 else np.full(self.n, value)
+            return value  # already the sweep's own checked copy
+        if name not in self.shared:
+            self.shared[name] = np.zeros(self.n) if value == 0.0 else np.full(self.n, value)
+        return self.shared[name]
 
 
 def _given(value: ArrayLike | None, n: int, name: str, default: float) -> float | Array:
