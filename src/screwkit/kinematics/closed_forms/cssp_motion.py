@@ -27,6 +27,12 @@ Rates follow the generic solver's rule for an S–S link: zero absolute spin, ω
 rule carries along the branch (path dependent: after a full turn of the crank it comes back
 turned about u by the holonomy). The fused inverse dynamics reads the same block rows.
 
+The checked inputs, the crank angles' cosines and sines and where the loop assembles
+(:class:`~screwkit.kinematics.closed_forms.cssp_inputs.CSSPSweep`) do not depend on the root of
+the quadratic: ``solve_motion`` prepares them once for both modes (:func:`sweep_mode_motion`).
+For a crank on an R joint the link origins are the first three joint centres and are stored
+with them (one storage, ``link_origin`` a view of ``joint_centres``'s).
+
 Spherical-joint rates use the generic solver's convention: the three freedoms ``<joint>.wx|wy|wz``
 are the relative angular velocity in the child frame, and their "accelerations" the time
 derivatives of those components, with the child frame turning at the link's ω.
