@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from screwkit.dynamics import component_arrays as soa
 from screwkit.kinematics.closed_forms.cssp_inputs import cssp_sweep, sweep_for_root
 from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion, sweep_mode_motion
 from screwkit.kinematics.solve_motion import solve_motion
@@ -80,23 +79,3 @@ def test_solve_motion_shares_what_is_the_same(a2: float) -> None:
     same = motion.modes[0].velocities["theta1"] is motion.modes[1].velocities["theta1"]
     assert same == bool(motion.modes[0].assembles.all())
 
-
-def test_constant_rows_are_read_as_numbers() -> None:
-    n = 40
-    t = np.linspace(0.0, 1.0, n)
-    odd = np.full(n, 3.0)
-    odd[1] = 4.0  # between the probed samples (every 2nd of 40)
-    block = np.stack([t, np.zeros(n), np.full(n, 2.5), np.full(n, -0.0), t * 0 + 1.0, odd], 0)
-    storage = np.ascontiguousarray(block)
-    rows = soa.rows(storage.T)
-    assert rows[0] is not None and isinstance(rows[0], np.ndarray)
-    assert rows[1:5] == [0.0, 2.5, 0.0, 1.0] and all(type(r) is float for r in rows[1:5])
-    assert isinstance(rows[5], np.ndarray)  # the probes agree, the full scan does not
-    finite: list[bool] = []
-    storage[2, 7] = np.nan
-    rows = soa.rows(storage.T, finite)
-    assert finite == [False] and isinstance(rows[2], np.ndarray)
-    # products with the numbers are the arrays' products bit for bit
-    a = np.random.default_rng(1).normal(size=n)
-    for row, full in zip(soa.rows(block.T), block, strict=True):
-        np.testing.assert_array_equal(np.broadcast_to(soa.mul(row, a), (n,)), full * a)

@@ -5,11 +5,9 @@ Python float when it is the same for every sample of the block: the arithmetic t
 contiguous arrays instead of numpy's slow loops over short trailing axes (``einsum`` on
 ``(n, 3)``, stacked cross products).
 
-Exact zeros and constants are tracked: a component that holds one value in every sample of a
-block (read with :func:`rows`, which checks each input row) is that value as a float, a zero
-entry of a constant (mass properties) is the float 0.0; products with 0.0 or 1.0 and sums with
-0.0 are skipped, and products of constants are Python float arithmetic (the same IEEE double
-operations the arrays would do). The results are bit for bit what
+Exact zeros are tracked: a component that is 0.0 in every sample of a block (read with
+:func:`rows`, which checks each input row), or a zero entry of a constant (mass properties), is
+the float 0.0, and products with it, sums with it, are skipped. The results are bit for bit what
 the full arithmetic gives (up to the sign of a zero), but a link that does not turn (a slider),
 turns about a world axis (a crank on a vertical shaft), or has a diagonal inertia tensor costs
 only the arithmetic it needs.
@@ -109,8 +107,8 @@ def rotate_back(R: Rotation, v: Vec) -> Vec:
 
 
 def rows(a: Array, finite: list[bool] | None = None) -> list[Scalar]:
-    """The components of an (n, k…) block as k (n,) rows, rows that hold one value throughout
-    the block as that float (0.0 for a zero row). Component-major input (each component contiguous over the samples, as
+    """The components of an (n, k…) block as k (n,) rows, rows that are zero throughout the
+    block as 0.0. Component-major input (each component contiguous over the samples, as
     :func:`screwkit.kinematics.closed_forms.cssp_motion.cssp_mode_motion` stores it) gives views; other
     layouts are copied once, transposed (the fast paths read each row several times).
     With a ``finite`` list, appends whether every entry of the block is finite (a NaN or an
@@ -123,21 +121,10 @@ def rows(a: Array, finite: list[bool] | None = None) -> list[Scalar]:
     if finite is not None:
         with np.errstate(over="ignore", invalid="ignore"):
             finite.append(bool(np.isfinite(np.ones(comp.shape[0]) @ comp).all()))
-    # a row with two different entries among a few probed samples is not constant; only the
-    # others are scanned in full (they are few: the zero and constant components of the motion)
-    probes = comp[:, :: max(1, n // 16)]
-    flat: list[bool] = np.asarray((probes == probes[:, :1]).all(axis=1)).tolist()
-    return [_constant(row) if maybe else row for row, maybe in zip(comp, flat, strict=True)]
-
-
-def _constant(row: Array) -> Scalar:
-    """A row as its value (a float) when every entry holds it; the row itself otherwise."""
-    if row.size == 0:
-        return 0.0
-    value = float(row[0])
-    if value == 0.0:
-        return 0.0 if not row.any() else row
-    return value if bool((row == value).all()) else row
+    # a row with a non-zero entry among a few probed samples is not zero; only the others are
+    # scanned in full (they are few: the zero components of the motion)
+    probed: list[bool] = np.asarray(comp[:, :: max(1, n // 16)].any(axis=1)).tolist()
+    return [row if hit or row.any() else 0.0 for row, hit in zip(comp, probed, strict=True)]
 
 
 def component_major(*shape: int) -> Array:
