@@ -104,9 +104,10 @@ def _setup(
     finiteness (:class:`_NonFiniteMotion` if it fails); only the samples read here are."""
     N = mode.assembles.shape[0]
     if inputs is None:
-        input_arr = np.stack(
-            [mode.variables.get(name, np.full(N, np.nan)) for name in linkage.inputs], -1
-        )
+        columns = [mode.variables.get(name, np.full(N, np.nan)) for name in linkage.inputs]
+        # one input: a view of the mode's variable (no copy, as for given ``inputs``)
+        input_arr = (np.asarray(columns[0], dtype=float)[:, None] if len(columns) == 1
+                     else np.stack(columns, -1))
     else:
         try:
             input_arr = np.asarray(inputs, dtype=float).reshape(N, -1)

@@ -186,6 +186,8 @@ def per_sample(linkage: Linkage, values: ArrayLike, name: str, X: Array) -> Arra
     if a.shape[0] not in (1, X.shape[0]):
         raise InputError(f"{name}: give one value for every sample or one per sample "
                          f"({X.shape[0]} samples); got {a.shape[0]}")
+    if a.shape[0] == 1 and not np.any(a) and not np.any(np.signbit(a)):
+        return np.zeros(X.shape)  # untouched zero pages until written (issue 30)
     return np.array(np.broadcast_to(a, X.shape))
 
 

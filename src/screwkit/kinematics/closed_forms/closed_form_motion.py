@@ -224,7 +224,8 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     (rod) and θ3, η3 (slider ball) and their exact rates. The two roots stay separate: they meet
     only at a branch point, where the mode stops."""
     from screwkit.kinematics.closed_forms.cssp import CSSPDimensions
-    from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
+    from screwkit.kinematics.closed_forms.cssp_inputs import cssp_sweep, sweep_for_root
+    from screwkit.kinematics.closed_forms.cssp_motion import sweep_mode_motion
 
     p = dict(linkage.parameters)
     dims = CSSPDimensions(p["a1"], p["a2"], p["a4"], p["alpha4"], p.get("s1", 0.0))
@@ -235,27 +236,29 @@ def cssp_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     # a rate the same at every sample goes in as a number: the closed form then does scalar
     # arithmetic (same values)
     w, wd = (_constant_or(Xd[:, 0]), _constant_or(Xdd[:, 0]))
-    slider = linkage.joints[3].name
+    crank, slider = linkage.joints[0].name, linkage.joints[3].name
+    # the inputs checked, their trigonometry and where the loop assembles: once for both roots
+    inputs = cssp_sweep(linkage, theta, w, wd, 1, allow_partial=True,
+                        s1=X[:, 1] if driven else None, s1_dot=Xd[:, 1] if driven else 0.0,
+                        s1_ddot=Xdd[:, 1] if driven else 0.0)
     for root, label in ((1, "s4 = -b + sqrt(b^2 - c)"), (-1, "s4 = -b - sqrt(b^2 - c)")):
         # the seed's angles with their closed-form rates, block by block, for a fixed crank
         # offset (with a driven one the registry's names from the link frames are used)
-        md = cssp_mode_motion(linkage, theta, w, wd, root=root, allow_partial=True,
-                              s1=X[:, 1] if driven else None, s1_dot=Xd[:, 1] if driven else 0.0,
-                              s1_ddot=Xdd[:, 1] if driven else 0.0, seed_angles=not driven,
-                              lazy=True)
+        md = sweep_mode_motion(linkage, sweep_for_root(inputs, root), seed_angles=not driven,
+                               lazy=True)
         ok = np.asarray(md.assembles)
         if not ok.any():
             continue
-        full = ok.all()
+        # the seed's θ1 and s4 are the crank's and the slider's joint variables (the same
+        # arrays: NaN where the mode does not assemble already), as the generic solver's seed
+        # names are (seed_names.py)
         seed: tuple[dict[str, Array], ...] = tuple(
-            {"theta1": x.copy() if full else np.where(ok, x, np.nan)}
-            for x in (Xd[:, 0], Xdd[:, 0]))
-        seed = ({"theta1": theta.copy() if full else np.where(ok, theta, np.nan)}, *seed)
+            {"theta1": table[f"{crank}.theta"]}
+            for table in (md.variables, md.velocities, md.accelerations))
         if not driven:
-            # the tables' s4 and angles are NaN where the mode does not assemble already
             for table, named in zip((md.variables, md.velocities, md.accelerations), seed,
                                     strict=True):
-                named["s4"] = table[f"{slider}.s"].copy()
+                named["s4"] = table[f"{slider}.s"]
         # the seed's names first, then the joints' (the seed's angles move from the joint
         # tables to the seed's, θ2 … unwrapped along each run); the angles stay lazy
         unwrap = {key: (lambda a, ok=ok: unwrap_runs(a, ok)) for key in angles}

@@ -27,6 +27,12 @@ Rates follow the generic solver's rule for an S–S link: zero absolute spin, ω
 rule carries along the branch (path dependent: after a full turn of the crank it comes back
 turned about u by the holonomy). The fused inverse dynamics reads the same block rows.
 
+The checked inputs, the crank angles' cosines and sines and where the loop assembles
+(:class:`~screwkit.kinematics.closed_forms.cssp_inputs.CSSPSweep`) do not depend on the root of
+the quadratic: ``solve_motion`` prepares them once for both modes (:func:`sweep_mode_motion`).
+For a crank on an R joint the link origins are the first three joint centres and are stored
+with them (one storage, ``link_origin`` a view of ``joint_centres``'s).
+
 Spherical-joint rates use the generic solver's convention: the three freedoms ``<joint>.wx|wy|wz``
 are the relative angular velocity in the child frame, and their "accelerations" the time
 derivatives of those components, with the child frame turning at the link's ω.
@@ -41,14 +47,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dual.spatial import GIMBAL_TOL, rot_x
-from screwkit.errors import InputError
-from screwkit.kinematics.closed_forms.cssp import (
-    SEED_ROOT,
-    CSSPAssemblyError,
-    CSSPDimensions,
-    as_sample_array,
-    assembly_message,
-    check_root,
+from screwkit.kinematics.closed_forms.cssp import SEED_ROOT, CSSPDimensions
+from screwkit.kinematics.closed_forms.cssp_inputs import (
+    CSSPSweep,
+    NotACSSPError,
+    cssp_dimensions,
+    cssp_sweep,
+    sweep_for_root,
 )
 from screwkit.kinematics.closed_forms.cssp_joint_rows import (
     SEED_ANGLES,
@@ -59,37 +64,9 @@ from screwkit.kinematics.closed_forms.cssp_joint_rows import (
 )
 from screwkit.kinematics.motion import ModeMotion
 from screwkit.kinematics.tracker.loop import Configuration
-from screwkit.messages import shown
 from screwkit.model.linkage import Linkage
 
 Array = NDArray[np.float64]
-
-_JOINTS = (("R", "C"), ("S",), ("S",), ("P",))
-
-
-class NotACSSPError(InputError):
-    """The linkage given to :func:`cssp_mode_motion` is not a CSSP of the family constructor."""
-
-
-def cssp_dimensions(linkage: Linkage) -> CSSPDimensions:
-    """The :class:`CSSPDimensions` of a linkage built by :func:`screwkit.model.families.cssp`
-    (read from ``linkage.parameters``); raises :class:`NotACSSPError` for any other linkage."""
-    kinds = tuple(j.kind for j in linkage.joints)
-    ok = (
-        len(kinds) == 4
-        and all(k in allowed for k, allowed in zip(kinds, _JOINTS, strict=True))
-        and all(key in linkage.parameters for key in ("a1", "a2", "a4", "alpha4", "s1"))
-    )
-    if not ok:
-        raise NotACSSPError(
-            f"cssp_mode_motion needs a CSSP built by screwkit.model.families.cssp (joints "
-            f"R|C, S, S, P and parameters a1, a2, a4, alpha4, s1); got {linkage.name!r} "
-            f"(family {linkage.family!r}, joints {''.join(kinds)}). Use "
-            "screwkit.solve_motion for other loops."
-        )
-    p = linkage.parameters
-    return CSSPDimensions(p["a1"], p["a2"], p["a4"], p["alpha4"], p["s1"])
-
 
 BLOCK_SAMPLES = 16384
 """Samples per block of :func:`cssp_mode_motion` (its temporaries stay in the CPU caches)."""
@@ -269,14 +246,16 @@ def cssp_block_rows(
     )
 
 
-def _write_rows(stores: tuple[Array, ...], rows: CSSPBlockRows, sl: slice) -> None:
+def _write_rows(stores: tuple[Array | None, ...], rows: CSSPBlockRows, sl: slice) -> None:
     """Store a block's link rows (rotation, origin, velocity, acceleration, angular velocity
-    and acceleration, joint centres, axes) into their component-major storage."""
+    and acceleration, joint centres, axes) into their component-major storage (``None``:
+    stored with another)."""
     for storage, component_rows in zip(stores, (
             rows.rotation, rows.origin, rows.velocity, rows.acceleration,
             rows.angular_velocity, rows.angular_acceleration, rows.centres, rows.axes),
             strict=True):
-        _write(storage, component_rows, sl)
+        if storage is not None:
+            _write(storage, component_rows, sl)
 
 
 def _write(storage: Array, rows: Rows, sl: slice) -> None:
@@ -285,115 +264,6 @@ def _write(storage: Array, rows: Rows, sl: slice) -> None:
     for r, value in enumerate(rows):
         if not (type(value) is float and value == 0.0):
             flat[r, sl] = value
-
-
-_RATES = ("theta1_dot", "theta1_ddot", "s1", "s1_dot", "s1_ddot")
-
-
-@dataclass(frozen=True)
-class CSSPSweep:
-    """The checked inputs of a CSSP sweep of N samples and where it assembles.
-
-    ``theta1``, ``cos``, ``sin`` (N,); ``given`` holds θ̇1, θ̈1, s1, ṡ1, s̈1 by name, each a
-    float where it is the same for every sample (the closed form then does scalar arithmetic
-    and leaves zero rows unwritten) or an (N,) array; ``discriminant`` is b² − c, 1 where the
-    CSSP does not assemble (a placeholder: those samples are NaN in the results).
-    """
-
-    dims: CSSPDimensions
-    root: int
-    driven_offset: bool
-    n: int
-    theta1: Array
-    cos: Array
-    sin: Array
-    given: dict[str, float | Array]
-    discriminant: Array
-    assembles: NDArray[np.bool_]
-    rod_turn: Array  # (N,) φ turning Rahman's rod frame {3} about u to the zero-spin frame
-
-    def block(self, name: str, sel: slice | NDArray[np.intp]) -> float | Array:
-        """An input over some samples (a float if it is constant)."""
-        value = self.given[name]
-        return value if isinstance(value, float) else value[sel]
-
-    def full(self, name: str) -> Array:
-        """An input as a new (N,) array."""
-        value = self.given[name]
-        if not isinstance(value, float):
-            return value.copy()
-        return np.zeros(self.n) if value == 0.0 else np.full(self.n, value)
-
-
-def _given(value: ArrayLike | None, n: int, name: str, default: float) -> float | Array:
-    """A scalar input as a float, an (N,) one as a checked array."""
-    arr = np.asarray(default if value is None else value, dtype=float)
-    if arr.ndim == 0:
-        if not np.isfinite(arr):
-            raise InputError(f"{name} must be finite, got {float(arr)!r}")
-        return float(arr)
-    return as_sample_array(arr, n, name, default)
-
-
-def cssp_sweep(
-    linkage: Linkage,
-    theta1: ArrayLike,
-    theta1_dot: ArrayLike = 0.0,
-    theta1_ddot: ArrayLike = 0.0,
-    root: int = SEED_ROOT,
-    *,
-    s1: ArrayLike | None = None,
-    s1_dot: ArrayLike = 0.0,
-    s1_ddot: ArrayLike = 0.0,
-    allow_partial: bool = False,
-) -> CSSPSweep:
-    """The inputs of :func:`cssp_mode_motion` checked and broadcast over the samples; raises
-    ``CSSPAssemblyError`` (naming the crank angles) where the CSSP does not assemble, unless
-    ``allow_partial``."""
-    dims = cssp_dimensions(linkage)
-    driven_offset = linkage.joints[0].kind == "C"
-    if not driven_offset and (
-        s1 is not None or np.any(np.asarray(s1_dot) != 0) or np.any(np.asarray(s1_ddot) != 0)
-    ):
-        raise InputError(
-            f"{linkage.name}: the crank offset s1 is a constant of this CSSP "
-            f"(s1 = {shown(dims.s1, 'length')}); build it with cssp(..., s1_is_input=True) to drive s1"
-        )
-    root = check_root(root)
-    th = np.atleast_1d(np.asarray(theta1, dtype=float))
-    if th.ndim != 1:
-        raise InputError(f"theta1 must be a scalar or a 1-D array (N,), got shape {th.shape}")
-    n = th.shape[0]
-    th = as_sample_array(th, n, "theta1", 0.0)
-    given = {
-        name: _given(value, n, name, default)
-        for name, value, default in zip(
-            _RATES, (theta1_dot, theta1_ddot, s1, s1_dot, s1_ddot),
-            (0.0, 0.0, dims.s1, 0.0, 0.0), strict=True)
-    }
-    ct, st = np.cos(th), np.sin(th)
-    # the s4 quadratic's b² − c (SPEC §1.2; assembly_discriminant, with cos θ1 and sin θ1 kept
-    # for the closed form)
-    s1v = given["s1"]
-    sa, ca = np.sin(dims.alpha4), np.cos(dims.alpha4)
-    b = (dims.a1 * sa) * st + ca * s1v
-    c = (dims.a4**2 + dims.a1**2 - dims.a2**2) + (2 * dims.a1 * dims.a4) * ct + s1v * s1v
-    disc = b * b - c
-    # b² = c is a branch point of the two modes: s4 + b = 0 and the rates are unbounded
-    ok = disc > 0.0
-    if not ok.all():
-        if not allow_partial:
-            msg = assembly_message(dims, th, ok)
-            if np.any(disc == 0.0):
-                msg += (" (b² = c exactly at some samples: a branch point where the rates are "
-                        "unbounded.)")
-            raise CSSPAssemblyError(msg + " Pass allow_partial=True to get NaN there instead.",
-                                    ok)
-        disc = np.where(ok, disc, 1.0)
-    from screwkit.kinematics.closed_forms.cssp_rod_pose import rod_turn
-
-    turn = rod_turn(dims, root, th, ct, st, given, disc, ok)
-    return CSSPSweep(dims, root, driven_offset, n, th, ct, st, given, disc, ok, turn)
 
 
 def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
@@ -405,7 +275,10 @@ def _joint_tables(linkage: Linkage, sw: CSSPSweep, s4_st: Array,
     Rahman's angles with their rates (rows of ``seed`` (12, N), when given)."""
     first = linkage.joints[0].name
     pin, ball, slider = (j.name for j in linkage.joints[1:])
-    variables: dict[str, Array] = {f"{first}.theta": sw.theta1}
+    # the sweep's θ1 is shared by both roots' modes: a mode that is masked (NaN where it does
+    # not assemble, _mask_unassembled) gets its own
+    theta1 = sw.theta1 if sw.assembles.all() else sw.theta1.copy()
+    variables: dict[str, Array] = {f"{first}.theta": theta1}
     velocities: dict[str, Array] = {f"{first}.theta": sw.full("theta1_dot")}
     accelerations: dict[str, Array] = {f"{first}.theta": sw.full("theta1_ddot")}
     if sw.driven_offset:
@@ -478,6 +351,16 @@ def cssp_mode_motion(
     """
     sw = cssp_sweep(linkage, theta1, theta1_dot, theta1_ddot, root, s1=s1, s1_dot=s1_dot,
                     s1_ddot=s1_ddot, allow_partial=allow_partial)
+    return sweep_mode_motion(linkage, sw, joint_rotations=joint_rotations,
+                             ball_joints=ball_joints, seed_angles=seed_angles, lazy=lazy)
+
+
+def sweep_mode_motion(linkage: Linkage, sw: CSSPSweep, *, joint_rotations: bool = True,
+                      ball_joints: bool = True, seed_angles: bool = False,
+                      lazy: bool = False) -> ModeMotion:
+    """:func:`cssp_mode_motion` of a prepared sweep (:func:`cssp_sweep`, or
+    :func:`~screwkit.kinematics.closed_forms.cssp_inputs.sweep_for_root` for the other root
+    of the same inputs), with the same options."""
     joint_rotations = joint_rotations and ball_joints
     if lazy and (ball_joints or seed_angles):
         return _lazy_mode_motion(linkage, sw, joint_rotations, ball_joints, seed_angles)
@@ -491,12 +374,18 @@ def _mode_motion(linkage: Linkage, sw: CSSPSweep, joint_rotations: bool, ball_jo
     th = sw.theta1
 
     R_st, link_rotation = component_major(n, 3, 3, 3)
-    O_st, link_origin = component_major(n, 3, 3)
+    C_st, joint_centres = component_major(n, 4, 3)
+    O_st: Array | None = None
+    if driven_offset:  # a C joint's centre is on z1 at 0, the crank frame's origin at s1
+        O_st, link_origin = component_major(n, 3, 3)
+    else:
+        # the crank frame's origin is the R joint's centre, the rod's the pin's and the
+        # slider's the ball's: the link origins are the first three joint centres, stored once
+        link_origin = np.moveaxis(C_st[:3], -1, 0)
     V_st, link_origin_velocity = component_major(n, 3, 3)
     A_st, link_origin_acceleration = component_major(n, 3, 3)
     W_st, link_angular_velocity = component_major(n, 3, 3)
     AL_st, link_angular_acceleration = component_major(n, 3, 3)
-    C_st, joint_centres = component_major(n, 4, 3)
     X_st, joint_axes = component_major(n, 4, 3)
     RV_st: Array | None = None
     if ball_joints:
@@ -592,4 +481,6 @@ __all__ = [
     "cssp_dimensions",
     "cssp_mode_motion",
     "cssp_sweep",
+    "sweep_for_root",
+    "sweep_mode_motion",
 ]
