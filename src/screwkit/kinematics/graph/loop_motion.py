@@ -316,36 +316,19 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
     segment X[k] → X[k+1] (all at once) where the loop's count of real solutions (its closed
     form's assembling modes at one input) leaves its value at X[k]."""
     from screwkit.kinematics.graph.motion import input_text
-    from screwkit.kinematics.registry import family_of, has_rsrc_quartic
+    from screwkit.kinematics.registry import family_of
 
     rows, ks = np.nonzero(masks[:, :-1] != masks[:, 1:])
     closed = family_of(chain.linkage).closed_form_for(chain.linkage)
-    branches_of = family_of(chain.linkage).closed_branches_for(chain.linkage)
     if rows.size == 0 or closed is None:
         return [(int(r), int(k), X[k + 1], f"{'dies' if masks[r, k] else 'is born'} between "
                  f"{input_text(mech, lay, X[k])} and {input_text(mech, lay, X[k + 1])}")
                 for r, k in zip(rows, ks, strict=True)]
     x0, x1 = X[ks], X[ks + 1]
-    rsrc = None
-    if has_rsrc_quartic(chain.linkage):  # its quartic's real roots, without the modes
-        from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
-        from screwkit.kinematics.closed_forms.rsrc.positions import rsrc_positions
-
-        rsrc = rsrc_dimensions(chain.linkage)[0]
 
     def count(t: Array) -> NDArray[np.intp]:
-        """Real solutions at the inputs x0 + t (x1 − x0): the RSRC's quartic roots (Bagci 1969
-        eq. 3.63, as its own limit search counts them), else the closed form's modes there (its
-        branches, the same count, where the family offers them), the drawing appended (so that
-        at least one input assembles)."""
-        L = chain.loop_inputs(np.vstack([x0 + t[:, None] * (x1 - x0), np.zeros((1, X.shape[1]))]))
-        if rsrc is not None:
-            return np.asarray(rsrc_positions(rsrc, L[:-1, 0]).n_assemblies)
-        if branches_of is not None:
-            zero = np.zeros_like(L)
-            return np.sum(branches_of(chain.linkage, L, zero, zero).assembles, axis=0)[:-1]
-        mo = closed(chain.linkage, L, np.zeros_like(L), np.zeros_like(L))
-        return np.sum([md.assembles for md in mo.modes], axis=0)[:-1]
+        """Real solutions at the inputs x0 + t (x1 − x0) (:func:`real_count`)."""
+        return real_count(chain, chain.loop_inputs(x0 + t[:, None] * (x1 - x0)))
 
     lo, hi = np.zeros(ks.size), np.ones(ks.size)
     c_lo = count(lo)
@@ -366,7 +349,8 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
 def real_count(chain: LoopChain, L: Array) -> NDArray[np.intp]:
     """The loop's real closed-form solutions at each row of loop inputs ``L`` (K, 1): the
     RSRC's quartic roots (Bagci 1969 eq. 3.63, as its own limit search counts them), else the
-    closed form's modes there, the drawing appended (so that at least one input assembles)."""
+    closed form's modes there (its branches, the same count, where the family offers them),
+    the drawing appended (so that at least one input assembles)."""
     from screwkit.kinematics.registry import family_of, has_rsrc_quartic
 
     if has_rsrc_quartic(chain.linkage):  # its quartic's real roots, without the modes
@@ -375,8 +359,14 @@ def real_count(chain: LoopChain, L: Array) -> NDArray[np.intp]:
 
         return np.asarray(rsrc_positions(rsrc_dimensions(chain.linkage)[0],
                                          L[:, 0]).n_assemblies)
-    closed = family_of(chain.linkage).closed_form_for(chain.linkage)
-    assert closed is not None
+    family = family_of(chain.linkage)
     L = np.vstack([L, chain.offset[None, :]])
-    mo = closed(chain.linkage, L, np.zeros_like(L), np.zeros_like(L))
+    zero = np.zeros_like(L)
+    branches_of = family.closed_branches_for(chain.linkage)
+    if branches_of is not None:
+        return np.asarray(np.sum(branches_of(chain.linkage, L, zero, zero).assembles,
+                                 axis=0)[:-1])
+    closed = family.closed_form_for(chain.linkage)
+    assert closed is not None
+    mo = closed(chain.linkage, L, zero, zero)
     return np.asarray(np.sum([md.assembles for md in mo.modes], axis=0)[:-1])
