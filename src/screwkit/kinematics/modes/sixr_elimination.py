@@ -32,6 +32,7 @@ still unsettled by the parameter homotopy, and says which route ran for each ins
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 from typing import Any
 
@@ -155,8 +156,11 @@ def _design(samples: int) -> dict[str, NDArray[Any]]:
     left = left.reshape(len(t3), 27)  # column 9·k3 + j45
     t1, t2 = (v.ravel() for v in np.meshgrid(grid, grid, indexing="ij"))
     right = _products(_trig3(t1), _trig3(t2))
-    return {"t3": t3, "t4": t4, "t5": t5, "t1": t1, "t2": t2, "left": left, "right": right,
-            "left_pinv": np.linalg.pinv(left), "right_pinv": np.linalg.pinv(right)}
+    D = {"t3": t3, "t4": t4, "t5": t5, "t1": t1, "t2": t2, "left": left, "right": right,
+         "left_pinv": np.linalg.pinv(left), "right_pinv": np.linalg.pinv(right)}
+    for key in ("t1", "t2", "t3", "t4", "t5"):  # (1, S): the cosines and sines, once
+        D["cos" + key], D["sin" + key] = np.cos(D[key])[None], np.sin(D[key])[None]
+    return D
 
 
 def _sides(params: Complex, samples: int = SAMPLES, shift: int = 0
@@ -166,20 +170,19 @@ def _sides(params: Complex, samples: int = SAMPLES, shift: int = 0
     kept real. ``shift`` k relabels the loop cyclically (the elimination's joint i is the
     loop's joint i + k): the product A_{k+1}⋯A_6A_1⋯A_k is the identity as well."""
     chain = dh_chain(params)
-    cos_a, sin_a, a, d = (np.roll(v, -shift, axis=1) for v in chain[:4])
+    cos_a, sin_a, a, d = (np.roll(v, -shift, axis=1) if shift else v for v in chain[:4])
     scale = np.sqrt(np.mean(np.abs(a) ** 2 + np.abs(d) ** 2, axis=1))
     scale = np.where(scale > 0, scale, 1.0)[:, None]
     a, d = a / scale, d / scale
     D = _design(samples)
 
-    def link(i: int, theta: Array) -> tuple[Complex, Complex]:
-        c, s = np.cos(theta)[None], np.sin(theta)[None]
-        return _link(c, s, cos_a[:, i - 1, None], sin_a[:, i - 1, None], a[:, i - 1, None],
-                     d[:, i - 1, None])
+    def link(i: int) -> tuple[Complex, Complex]:
+        return _link(D[f"cost{i}"], D[f"sint{i}"], cos_a[:, i - 1, None], sin_a[:, i - 1, None],
+                     a[:, i - 1, None], d[:, i - 1, None])
 
-    R3, t3 = link(3, D["t3"])
-    R4, t4 = link(4, D["t4"])
-    R5, t5 = link(5, D["t5"])
+    R3, t3 = link(3)
+    R4, t4 = link(4)
+    R5, t5 = link(5)
     # A3A4A5: l = R3R4R5 e_z, p = t3 + R3(t4 + R4 t5)
     R34 = R3 @ R4
     l_left = np.einsum("bsij,bsj->bsi", R34, R5[..., :, 2])
@@ -189,8 +192,8 @@ def _sides(params: Complex, samples: int = SAMPLES, shift: int = 0
                    sin_a[:, 5], a[:, 5], d[:, 5])  # θ6 = 0: e_z and the origin do not see it
     l6 = np.swapaxes(R6, -1, -2)[..., :, 2]
     p6 = -np.einsum("bji,bj->bi", R6, t6)
-    R1, t1 = link(1, D["t1"])
-    R2, t2 = link(2, D["t2"])
+    R1, t1 = link(1)
+    R2, t2 = link(2)
     l1 = np.einsum("bsji,bj->bsi", R1, l6)
     p1 = np.einsum("bsji,bsj->bsi", R1, p6[:, None] - t1)
     l_right = np.einsum("bsji,bsj->bsi", R2, l1)
@@ -241,7 +244,8 @@ def _shifted_trig(x: Complex, phi: float) -> tuple[Complex, Complex]:
     """(cos θ, sin θ) of θ = ψ + φ, x = tan(ψ/2)."""
     den = 1.0 + x * x
     s, c = 2.0 * x / den, (1.0 - x * x) / den
-    return c * np.cos(phi) - s * np.sin(phi), s * np.cos(phi) + c * np.sin(phi)
+    cp, sp = math.cos(phi), math.sin(phi)
+    return c * cp - s * sp, s * cp + c * sp
 
 
 def _axes_from_angles(chain: tuple[Complex, ...], cs: list[tuple[Complex, Complex]]
