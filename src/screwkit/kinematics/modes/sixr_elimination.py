@@ -158,8 +158,11 @@ def _design(samples: int) -> dict[str, NDArray[Any]]:
     right = _products(_trig3(t1), _trig3(t2))
     D = {"t3": t3, "t4": t4, "t5": t5, "t1": t1, "t2": t2, "left": left, "right": right,
          "left_pinv": np.linalg.pinv(left), "right_pinv": np.linalg.pinv(right)}
-    for key in ("t1", "t2", "t3", "t4", "t5"):  # (1, S): the cosines and sines, once
-        D["cos" + key], D["sin" + key] = np.cos(D[key])[None], np.sin(D[key])[None]
+    # the angles of links 1..6 (6, S3) for one vectorised pass: θ1, θ2 (padded with zeros
+    # beyond their S2 samples), θ3, θ4, θ5, and θ6 = 0 (e_z and the origin do not see it)
+    angles = np.zeros((6, len(t3)))
+    angles[0, :len(t1)], angles[1, :len(t2)], angles[2:5] = t1, t2, (t3, t4, t5)
+    D["cos"], D["sin"] = np.cos(angles), np.sin(angles)
     return D
 
 
@@ -175,30 +178,26 @@ def _sides(params: Complex, samples: int = SAMPLES, shift: int = 0
     scale = np.where(scale > 0, scale, 1.0)[:, None]
     a, d = a / scale, d / scale
     D = _design(samples)
-
-    def link(i: int) -> tuple[Complex, Complex]:
-        return _link(D[f"cost{i}"], D[f"sint{i}"], cos_a[:, i - 1, None], sin_a[:, i - 1, None],
-                     a[:, i - 1, None], d[:, i - 1, None])
-
-    R3, t3 = link(3)
-    R4, t4 = link(4)
-    R5, t5 = link(5)
+    S2 = len(D["t1"])
+    # every link at once: R (B, 6, S3, 3, 3), t (B, 6, S3, 3)
+    R, t = _link(D["cos"], D["sin"], cos_a[:, :, None], sin_a[:, :, None], a[:, :, None],
+                 d[:, :, None])
+    R1, R2, R3, R4, R5 = (R[:, i, :S2] if i < 2 else R[:, i] for i in range(5))
+    t1, t2, t3, t4, t5 = (t[:, i, :S2] if i < 2 else t[:, i] for i in range(5))
+    R6, t6 = R[:, 5, 0], t[:, 5, 0]
     # A3A4A5: l = R3R4R5 e_z, p = t3 + R3(t4 + R4 t5)
     R34 = R3 @ R4
     l_left = np.einsum("bsij,bsj->bsi", R34, R5[..., :, 2])
     p_left = t3 + np.einsum("bsij,bsj->bsi", R3, t4) + np.einsum("bsij,bsj->bsi", R34, t5)
     # A2⁻¹A1⁻¹A6⁻¹ applied to e_z and the origin; A_i⁻¹ x = Rᵀ(x − t)
-    R6, t6 = _link(np.ones_like(cos_a[:, 5]), np.zeros_like(cos_a[:, 5]), cos_a[:, 5],
-                   sin_a[:, 5], a[:, 5], d[:, 5])  # θ6 = 0: e_z and the origin do not see it
-    l6 = np.swapaxes(R6, -1, -2)[..., :, 2]
+    l6 = R6[..., 2, :]
     p6 = -np.einsum("bji,bj->bi", R6, t6)
-    R1, t1 = link(1)
-    R2, t2 = link(2)
     l1 = np.einsum("bsji,bj->bsi", R1, l6)
     p1 = np.einsum("bsji,bsj->bsi", R1, p6[:, None] - t1)
     l_right = np.einsum("bsji,bsj->bsi", R2, l1)
     p_right = np.einsum("bsji,bsj->bsi", R2, p1 - t2)
-    return _quantities(p_left, l_left), _quantities(p_right, l_right), chain
+    q = _quantities(np.concatenate([p_left, p_right], 1), np.concatenate([l_left, l_right], 1))
+    return q[:, :-S2], q[:, -S2:], chain
 
 
 def fitted_coefficients(params: ArrayLike) -> tuple[Complex, Complex]:
