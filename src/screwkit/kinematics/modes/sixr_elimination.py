@@ -32,7 +32,6 @@ still unsettled by the parameter homotopy, and says which route ran for each ins
 
 from __future__ import annotations
 
-import math
 from functools import lru_cache
 from typing import Any
 
@@ -239,22 +238,23 @@ def _monomial_map() -> Array:
     return np.einsum("km,jn->kjmn", _HALF, T45)
 
 
-def _shifted_trig(x: Complex, phi: float) -> tuple[Complex, Complex]:
-    """(cos θ, sin θ) of θ = ψ + φ, x = tan(ψ/2)."""
+def _shifted_trig(x: Complex, phi: ArrayLike) -> tuple[Complex, Complex]:
+    """(cos θ, sin θ) of θ = ψ + φ, x = tan(ψ/2); φ (scalar, or one per leading row of x)."""
     den = 1.0 + x * x
     s, c = 2.0 * x / den, (1.0 - x * x) / den
-    cp, sp = math.cos(phi), math.sin(phi)
+    phi = np.asarray(phi, dtype=float).reshape(np.shape(phi) + (1,) * (x.ndim - np.ndim(phi)))
+    cp, sp = np.cos(phi), np.sin(phi)
     return c * cp - s * sp, s * cp + c * sp
 
 
-def _axes_from_angles(chain: tuple[Complex, ...], cs: list[tuple[Complex, Complex]]
-                      ) -> Complex:
-    """z2..z5 (B, M, 12) in the world from (cos θ_i, sin θ_i) (B, M) of joints 1..4."""
+def _axes_from_angles(chain: tuple[Complex, ...], c: Complex, s: Complex) -> Complex:
+    """z2..z5 (B, M, 12) in the world from cos θ_i, sin θ_i (4, B, M) of joints 1..4."""
     cos_a, sin_a, _, _, R0 = chain
-    R = np.broadcast_to(R0[:, None], cs[0][0].shape + (3, 3))
+    A = _rz_rx(c, s, cos_a[:, :4].T[:, :, None], sin_a[:, :4].T[:, :, None])  # (4, B, M, 3, 3)
+    R = np.broadcast_to(R0[:, None], c.shape[1:] + (3, 3))
     out = []
-    for i, (c, s) in enumerate(cs):
-        R = R @ _rz_rx(c, s, cos_a[:, i, None], sin_a[:, i, None])
+    for i in range(4):
+        R = R @ A[i]
         out.append(R[..., :, 2])
     return np.concatenate(out, -1)
 
@@ -312,28 +312,27 @@ def _eliminate(p: Complex, shift: int) -> tuple[Complex, Complex, Array]:
           / np.sum(np.abs(v[..., :3, :]) ** 2, (-2, -1)))
     x5 = (np.sum(v[..., :, :2].conj() * v[..., :, 1:], (-2, -1))
           / np.sum(np.abs(v[..., :, :2]) ** 2, (-2, -1)))
-    c3, s3 = _shifted_trig(x3, 0.0)
-    c4, s4 = _shifted_trig(x4, 0.0)
-    c5, s5 = _shifted_trig(x5, 0.0)
-    m45 = _products(np.stack([s4, c4, np.ones_like(c4)], -1),
-                    np.stack([s5, c5, np.ones_like(c5)], -1))  # (B, 16, 9)
-    t3 = np.stack([s3, c3, np.ones_like(c3)], -1)
+    # cos, sin of ψ3, ψ4, ψ5 (φ = 0) and of θ3, θ4, θ5 = ψ + φ: rows of (6, B, 16)
+    x345 = np.stack([x3, x4, x5])
+    c, s = _shifted_trig(np.concatenate([x345, x345]), (0.0, 0.0, 0.0) + OFFSETS)
+    one = np.ones_like(c[0])
+    m45 = _products(np.stack([s[1], c[1], one], -1), np.stack([s[2], c[2], one], -1))
+    t3 = np.stack([s[0], c[0], one], -1)  # (B, 16, 3), (B, 16, 9)
     rhs = np.einsum("bqkj,bmk,bmj->bmq", L.reshape(B, 14, 3, 9), t3, m45)
     pinv = np.einsum("bji,bj,bkj->bik", Vh.conj(), 1.0 / sv, U[:, :, :8].conj())  # (B, 8, 14)
-    m12 = np.einsum("bik,bmk->bmi", pinv, rhs)
-    cs = []
-    for s_, c_ in ((m12[..., 4], m12[..., 5]), (m12[..., 6], m12[..., 7])):
-        n = np.sqrt(c_ * c_ + s_ * s_)
-        cs.append((c_ / n, s_ / n))
-    cs.append(_shifted_trig(x3, OFFSETS[0]))
-    cs.append(_shifted_trig(x4, OFFSETS[1]))
-    if shift:  # θ5, θ6 too (θ6 by closure: Rot_z(θ6)Rot_x(α6) = (R1⋯R5)ᵀ), then relabel
-        cs.append(_shifted_trig(x5, OFFSETS[2]))
+    m12 = np.moveaxis(np.einsum("bik,bmk->ibm", pinv, rhs)[4:].reshape(2, 2, B, 16), 1, 0)
+    n = np.sqrt(m12[1] * m12[1] + m12[0] * m12[0])  # m12: [s1, s2], [c1, c2] (2, 2, B, 16)
+    cos_t = np.concatenate([m12[1] / n, c[3:]])  # θ1..θ5 (5, B, 16)
+    sin_t = np.concatenate([m12[0] / n, s[3:]])
+    if shift:  # θ6 too (by closure: Rot_z(θ6)Rot_x(α6) = (R1⋯R5)ᵀ), then relabel
         cos_a, sin_a = (np.roll(v, -shift, axis=1) for v in chain[:2])
-        R = _rz_rx(*cs[0], cos_a[:, 0, None], sin_a[:, 0, None])
+        A = _rz_rx(cos_t, sin_t, cos_a[:, :5].T[:, :, None], sin_a[:, :5].T[:, :, None])
+        R = A[0]
         for i in range(1, 5):
-            R = R @ _rz_rx(*cs[i], cos_a[:, i, None], sin_a[:, i, None])
-        cs.append((R[..., 0, 0], R[..., 0, 1]))
-        cs = [cs[(j - shift) % 6] for j in range(4)]
-    axes = np.where(bad[:, None, None], np.nan, _axes_from_angles(chain, cs))
+            R = R @ A[i]
+        cos_t = np.concatenate([cos_t, R[None, ..., 0, 0]])
+        sin_t = np.concatenate([sin_t, R[None, ..., 0, 1]])
+        order = [(j - shift) % 6 for j in range(4)]
+        cos_t, sin_t = cos_t[order], sin_t[order]
+    axes = np.where(bad[:, None, None], np.nan, _axes_from_angles(chain, cos_t[:4], sin_t[:4]))
     return axes, np.where(bad[:, None], np.nan, x3), lead_cond
