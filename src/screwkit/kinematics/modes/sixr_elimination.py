@@ -79,7 +79,10 @@ def _safe_solve(A: Complex, b: Complex) -> tuple[Complex, Array]:
     finite = np.asarray(np.isfinite(A).all(axis=(1, 2)) & np.isfinite(b).all(axis=(1, 2)),
                         dtype=bool)
     A = np.where(finite[:, None, None], A, np.eye(A.shape[1]))
-    cond = np.where(finite, np.linalg.cond(A), np.inf)
+    sv = np.linalg.svd(A, compute_uv=False)  # cond(A) = σ_max/σ_min (∞ for A = 0)
+    with np.errstate(all="ignore"):
+        cond = np.where(finite, sv[:, 0] / sv[:, -1], np.inf)
+    cond = np.where(np.isnan(cond), np.inf, cond)
     good = cond < 1e13
     x = np.linalg.solve(np.where(good[:, None, None], A, np.eye(A.shape[1])),
                         np.where(good[:, None, None], b, 0.0))
@@ -279,8 +282,9 @@ def _eliminate(p: Complex, shift: int) -> tuple[Complex, Complex, Array]:
     left, right, chain = _sides(p, SAMPLES, shift)
     bad = np.asarray(~(np.isfinite(left).all(axis=(1, 2)) & np.isfinite(right).all(axis=(1, 2))),
                      dtype=bool)
-    left = np.where(bad[:, None, None], 0.0, left)
-    right = np.where(bad[:, None, None], 0.0, right)
+    if bad.any():
+        left = np.where(bad[:, None, None], 0.0, left)
+        right = np.where(bad[:, None, None], 0.0, right)
     D = _design(SAMPLES)
     L = np.einsum("ks,bsq->bqk", D["left_pinv"], left)  # (B, 14, 27)
     R = np.einsum("ks,bsq->bqk", D["right_pinv"], right)  # (B, 14, 9)
