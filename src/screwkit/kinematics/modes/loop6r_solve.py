@@ -123,6 +123,8 @@ def eigen_route(params: ArrayLike
         todo = todo[~good]
         if not len(todo):
             break
+    if len(parts) == 1:  # one labelling settled them all: already sorted by instance
+        return parts[0][0], parts[0][1], ok, parts[0][2]
     xs = np.concatenate([x for x, _, _ in parts])
     inst = np.concatenate([i for _, i, _ in parts])
     cert = parts[0][2]
