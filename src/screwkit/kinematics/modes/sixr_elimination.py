@@ -143,8 +143,11 @@ def _products(t_a: Array, t_b: Array) -> Array:
     """The nine products [sa·sb, sa·cb, ca·sb, ca·cb, sa, ca, sb, cb, 1] (…, 9) of two
     [sin, cos, 1] rows: the outer product in the order of the module docstring."""
     o = t_a[..., :, None] * t_b[..., None, :]  # (…, 3, 3): [s, c, 1] × [s, c, 1]
-    return np.stack([o[..., 0, 0], o[..., 0, 1], o[..., 1, 0], o[..., 1, 1], o[..., 0, 2],
-                     o[..., 1, 2], o[..., 2, 0], o[..., 2, 1], o[..., 2, 2]], -1)
+    return o.reshape(o.shape[:-2] + (9,))[..., _PRODUCT_ORDER]
+
+
+#: the entries (3·row + column of the outer product) in the order of :func:`_products`
+_PRODUCT_ORDER = np.array([0, 1, 3, 4, 2, 5, 6, 7, 8])
 
 
 @lru_cache(maxsize=2)
