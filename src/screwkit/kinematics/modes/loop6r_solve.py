@@ -48,8 +48,8 @@ SHIFTS = (0, 1, 5, 2, 4, 3)
 #: and as distinct from another when they are this far apart (relative)
 DISTINCT = 1e-6
 ELIMINATION = "elimination (Raghavan & Roth; 24 × 24 eigenproblem)"
-#: the diagonal of the 16 × 16 pairwise comparison (a point against itself)
-_EYE16 = np.eye(LOOP6R_GENERIC_COUNT, dtype=bool)
+#: the pairs i < j of an instance's 16 points
+_PAIR_I, _PAIR_J = np.triu_indices(LOOP6R_GENERIC_COUNT, 1)
 #: the fields of a certificate, in order
 _FIELDS = tuple(f.name for f in fields(Certificate))
 HOMOTOPY = "parameter homotopy (elimination did not settle 16 distinct solutions)"
@@ -163,10 +163,10 @@ def _eigen_pass(targets: Complex, shift: int
     ok = np.bincount(inst, minlength=B) == m
     full = np.flatnonzero(ok[inst])  # the instances with 16 points: contiguous, sorted
     x16, r16 = xs[full].reshape(-1, m, xs.shape[1]), radius[full].reshape(-1, m)
-    # every pair (i, j), i ≠ j, at once: ‖x_i − x_j‖ > r_i + r_j (the diagonal is excluded)
-    gap = np.linalg.norm(x16[:, :, None] - x16[:, None], axis=-1)
+    # every pair i < j at once (120 per instance): ‖x_i − x_j‖ > r_i + r_j
+    gap = np.linalg.norm(x16[:, _PAIR_I] - x16[:, _PAIR_J], axis=-1)
     ok[ok] = good[full].reshape(-1, m).all(axis=1) & (
-        (gap > r16[:, :, None] + r16[:, None]) | _EYE16).all(axis=(1, 2))
+        gap > r16[:, _PAIR_I] + r16[:, _PAIR_J]).all(axis=1)
     return xs, inst, ok, cert
 
 
