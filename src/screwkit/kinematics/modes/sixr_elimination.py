@@ -163,11 +163,11 @@ def _design(samples: int) -> dict[str, NDArray[Any]]:
     right = _products(_trig3(t1), _trig3(t2))
     D = {"t3": t3, "t4": t4, "t5": t5, "t1": t1, "t2": t2, "left": left, "right": right,
          "left_pinv": np.linalg.pinv(left), "right_pinv": np.linalg.pinv(right)}
-    # the angles of links 1..6 (6, S3) for one vectorised pass: θ1, θ2 (padded with zeros
-    # beyond their S2 samples), θ3, θ4, θ5, and θ6 = 0 (e_z and the origin do not see it)
-    angles = np.zeros((6, len(t3)))
-    angles[0, :len(t1)], angles[1, :len(t2)], angles[2:5] = t1, t2, (t3, t4, t5)
-    D["cos"], D["sin"] = np.cos(angles), np.sin(angles)
+    # the angles of links 3, 4, 5 (3, S3) and of links 1, 2, 6 (3, S2) for two vectorised
+    # passes; θ6 = 0 (e_z and the origin do not see it)
+    left_angles, right_angles = np.stack([t3, t4, t5]), np.stack([t1, t2, 0.0 * t1])
+    D["cos_left"], D["sin_left"] = np.cos(left_angles), np.sin(left_angles)
+    D["cos_right"], D["sin_right"] = np.cos(right_angles), np.sin(right_angles)
     return D
 
 
@@ -184,12 +184,15 @@ def _sides(params: Complex, samples: int = SAMPLES, shift: int = 0
     a, d = a / scale, d / scale
     D = _design(samples)
     S2 = len(D["t1"])
-    # every link at once: R (B, 6, S3, 3, 3), t (B, 6, S3, 3)
-    R, t = _link(D["cos"], D["sin"], cos_a[:, :, None], sin_a[:, :, None], a[:, :, None],
-                 d[:, :, None])
-    R1, R2, R3, R4, R5 = (R[:, i, :S2] if i < 2 else R[:, i] for i in range(5))
-    t1, t2, t3, t4, t5 = (t[:, i, :S2] if i < 2 else t[:, i] for i in range(5))
-    R6, t6 = R[:, 5, 0], t[:, 5, 0]
+    # links 3, 4, 5 at once, R (3, B, S3, 3, 3), t (3, B, S3, 3) (the link first, so that
+    # each link's block is contiguous); links 1, 2, 6 likewise
+    ca, sa, a, d = (v.T[:, :, None] for v in (cos_a, sin_a, a, d))  # (6, B, 1)
+    c, s = D["cos_left"][:, None], D["sin_left"][:, None]  # (3, 1, S3)
+    (R3, R4, R5), (t3, t4, t5) = _link(c, s, ca[2:5], sa[2:5], a[2:5], d[2:5])
+    right = [0, 1, 5]
+    c, s = D["cos_right"][:, None], D["sin_right"][:, None]  # (3, 1, S2)
+    (R1, R2, R6), (t1, t2, t6) = _link(c, s, ca[right], sa[right], a[right], d[right])
+    R6, t6 = R6[:, 0], t6[:, 0]
     # A3A4A5: l = R3R4R5 e_z, p = t3 + R3(t4 + R4 t5)
     R34 = R3 @ R4
     l_left = np.einsum("bsij,bsj->bsi", R34, R5[..., :, 2])
