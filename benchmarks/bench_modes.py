@@ -65,6 +65,8 @@ from screwkit.kinematics.modes.stewart import (  # noqa: E402
 
 BATCH = int(os.environ.get("SCREWKIT_BENCH_MODES_BATCH", "1000"))
 BATCH_6R = 100
+#: the single-instance calls behind one 6R 'alone' time (the mean per call)
+ALONE_6R = 10
 #: instances of the side-by-side run with the sparse evaluation
 SPARSE_BATCH = 20
 SPARSE = TrackOptions(dense=False, compiled=False)
@@ -215,8 +217,13 @@ def _loop6r_rows() -> list[dict[str, Any]]:
     start = loop6r_start()
     t_start = time.process_time() - t0
     solve_all(system, p[0], start)  # compile (or load) the step loop for this layout
-    alone = _median_of_alternating({"elim": lambda: solve_loop6r(p[0]),
-                                    "hom": lambda: solve_all(system, p[0], start)}, 5)
+    # alone: one instance per call, ALONE_6R calls on as many instances, the mean per call
+    # (a single call right after the other route's is the cold-cache worst case, not the
+    # per-call cost of a caller solving instances one at a time)
+    alone = _median_of_alternating(
+        {"elim": lambda: [solve_loop6r(p[i]) for i in range(ALONE_6R)],
+         "hom": lambda: [solve_all(system, p[i], start) for i in range(ALONE_6R)]}, 5)
+    alone = {name: t / ALONE_6R for name, t in alone.items()}
     batch = _median_of_alternating({"elim": lambda: solve_loop6r(p),
                                     "hom": lambda: solve_all(system, p, start)}, 3)
     t_alone, t_batch = alone["elim"], batch["elim"] / BATCH_6R
@@ -240,7 +247,8 @@ def _loop6r_rows() -> list[dict[str, Any]]:
     return [
         {"name": "6R IK by elimination, 16 solutions, alone", "value": t_alone * 1e3,
          "unit": "ms", "target": "≤ 1", "note": ("PASS" if t_alone <= 1e-3 else "MISS")
-         + "; median of 5, alternating with the homotopy"},
+         + f"; one instance per call, mean of {ALONE_6R} calls; median of 5, alternating "
+         "with the homotopy"},
         {"name": f"6R IK by elimination, 16 solutions, batch of {BATCH_6R}",
          "value": t_batch * 1e3, "unit": "ms/instance", "target": "≤ 1",
          "note": ("PASS" if t_batch <= 1e-3 else "MISS")

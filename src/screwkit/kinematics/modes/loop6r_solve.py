@@ -48,6 +48,10 @@ SHIFTS = (0, 1, 5, 2, 4, 3)
 #: and as distinct from another when they are this far apart (relative)
 DISTINCT = 1e-6
 ELIMINATION = "elimination (Raghavan & Roth; 24 × 24 eigenproblem)"
+#: the pairs i < j of an instance's 16 points
+_PAIR_I, _PAIR_J = np.triu_indices(LOOP6R_GENERIC_COUNT, 1)
+#: the fields of a certificate, in order
+_FIELDS = tuple(f.name for f in fields(Certificate))
 HOMOTOPY = "parameter homotopy (elimination did not settle 16 distinct solutions)"
 
 
@@ -119,6 +123,8 @@ def eigen_route(params: ArrayLike
         todo = todo[~good]
         if not len(todo):
             break
+    if len(parts) == 1:  # one labelling settled them all: already sorted by instance
+        return parts[0][0], parts[0][1], ok, parts[0][2]
     xs = np.concatenate([x for x, _, _ in parts])
     inst = np.concatenate([i for _, i, _ in parts])
     cert = parts[0][2]
@@ -157,25 +163,24 @@ def _eigen_pass(targets: Complex, shift: int
     ok = np.bincount(inst, minlength=B) == m
     full = np.flatnonzero(ok[inst])  # the instances with 16 points: contiguous, sorted
     x16, r16 = xs[full].reshape(-1, m, xs.shape[1]), radius[full].reshape(-1, m)
-    apart = good[full].reshape(-1, m).all(axis=1)
-    for k in range(1, m // 2 + 1):  # point i against i + k (mod 16): every pair once or twice
-        gap = np.linalg.norm(x16 - np.roll(x16, k, axis=1), axis=-1)
-        apart &= (gap > r16 + np.roll(r16, k, axis=1)).all(axis=1)
-    ok[ok] = apart
+    # every pair i < j at once (120 per instance): ‖x_i − x_j‖ > r_i + r_j
+    gap = np.linalg.norm(x16[:, _PAIR_I] - x16[:, _PAIR_J], axis=-1)
+    ok[ok] = good[full].reshape(-1, m).all(axis=1) & (
+        gap > r16[:, _PAIR_I] + r16[:, _PAIR_J]).all(axis=1)
     return xs, inst, ok, cert
 
 
 def _rows(cert: Certificate, rows: NDArray[np.intp]) -> Certificate:
     """The certificate of the points ``rows``."""
-    parts: dict[str, Any] = {f.name: (None if getattr(cert, f.name) is None
-                                      else getattr(cert, f.name)[rows]) for f in fields(cert)}
+    parts: dict[str, Any] = {name: (None if getattr(cert, name) is None
+                                    else getattr(cert, name)[rows]) for name in _FIELDS}
     return Certificate(**parts)
 
 
 def _conjugate(cert: Certificate) -> Certificate:
     """The certificate of the conjugate points of a real system: the same bounds, the
     conjugate Newton points and values."""
-    parts: dict[str, Any] = {f.name: getattr(cert, f.name) for f in fields(cert)}
+    parts: dict[str, Any] = {name: getattr(cert, name) for name in _FIELDS}
     for name in ("newton", "value"):
         if parts[name] is not None:
             parts[name] = parts[name].conj()
@@ -183,8 +188,8 @@ def _conjugate(cert: Certificate) -> Certificate:
 
 
 def _joined(a: Certificate, b: Certificate) -> Certificate:
-    parts: dict[str, Any] = {f.name: np.concatenate([getattr(a, f.name), getattr(b, f.name)])
-                             for f in fields(a)}
+    parts: dict[str, Any] = {name: np.concatenate([getattr(a, name), getattr(b, name)])
+                             for name in _FIELDS}
     return Certificate(**parts)
 
 

@@ -79,7 +79,10 @@ def _safe_solve(A: Complex, b: Complex) -> tuple[Complex, Array]:
     finite = np.asarray(np.isfinite(A).all(axis=(1, 2)) & np.isfinite(b).all(axis=(1, 2)),
                         dtype=bool)
     A = np.where(finite[:, None, None], A, np.eye(A.shape[1]))
-    cond = np.where(finite, np.linalg.cond(A), np.inf)
+    sv = np.linalg.svd(A, compute_uv=False)  # cond(A) = σ_max/σ_min (∞ for A = 0)
+    with np.errstate(all="ignore"):
+        cond = np.where(finite, sv[:, 0] / sv[:, -1], np.inf)
+    cond = np.where(np.isnan(cond), np.inf, cond)
     good = cond < 1e13
     x = np.linalg.solve(np.where(good[:, None, None], A, np.eye(A.shape[1])),
                         np.where(good[:, None, None], b, 0.0))
@@ -140,8 +143,11 @@ def _products(t_a: Array, t_b: Array) -> Array:
     """The nine products [sa·sb, sa·cb, ca·sb, ca·cb, sa, ca, sb, cb, 1] (…, 9) of two
     [sin, cos, 1] rows: the outer product in the order of the module docstring."""
     o = t_a[..., :, None] * t_b[..., None, :]  # (…, 3, 3): [s, c, 1] × [s, c, 1]
-    return np.stack([o[..., 0, 0], o[..., 0, 1], o[..., 1, 0], o[..., 1, 1], o[..., 0, 2],
-                     o[..., 1, 2], o[..., 2, 0], o[..., 2, 1], o[..., 2, 2]], -1)
+    return o.reshape(o.shape[:-2] + (9,))[..., _PRODUCT_ORDER]
+
+
+#: the entries (3·row + column of the outer product) in the order of :func:`_products`
+_PRODUCT_ORDER = np.array([0, 1, 3, 4, 2, 5, 6, 7, 8])
 
 
 @lru_cache(maxsize=2)
@@ -155,8 +161,14 @@ def _design(samples: int) -> dict[str, NDArray[Any]]:
     left = left.reshape(len(t3), 27)  # column 9·k3 + j45
     t1, t2 = (v.ravel() for v in np.meshgrid(grid, grid, indexing="ij"))
     right = _products(_trig3(t1), _trig3(t2))
-    return {"t3": t3, "t4": t4, "t5": t5, "t1": t1, "t2": t2, "left": left, "right": right,
-            "left_pinv": np.linalg.pinv(left), "right_pinv": np.linalg.pinv(right)}
+    D = {"t3": t3, "t4": t4, "t5": t5, "t1": t1, "t2": t2, "left": left, "right": right,
+         "left_pinv": np.linalg.pinv(left), "right_pinv": np.linalg.pinv(right)}
+    # the angles of links 3, 4, 5 (3, S3) and of links 1, 2, 6 (3, S2) for two vectorised
+    # passes; θ6 = 0 (e_z and the origin do not see it)
+    left_angles, right_angles = np.stack([t3, t4, t5]), np.stack([t1, t2, 0.0 * t1])
+    D["cos_left"], D["sin_left"] = np.cos(left_angles), np.sin(left_angles)
+    D["cos_right"], D["sin_right"] = np.cos(right_angles), np.sin(right_angles)
+    return D
 
 
 def _sides(params: Complex, samples: int = SAMPLES, shift: int = 0
@@ -166,36 +178,34 @@ def _sides(params: Complex, samples: int = SAMPLES, shift: int = 0
     kept real. ``shift`` k relabels the loop cyclically (the elimination's joint i is the
     loop's joint i + k): the product A_{k+1}⋯A_6A_1⋯A_k is the identity as well."""
     chain = dh_chain(params)
-    cos_a, sin_a, a, d = (np.roll(v, -shift, axis=1) for v in chain[:4])
+    cos_a, sin_a, a, d = (np.roll(v, -shift, axis=1) if shift else v for v in chain[:4])
     scale = np.sqrt(np.mean(np.abs(a) ** 2 + np.abs(d) ** 2, axis=1))
     scale = np.where(scale > 0, scale, 1.0)[:, None]
     a, d = a / scale, d / scale
     D = _design(samples)
-
-    def link(i: int, theta: Array) -> tuple[Complex, Complex]:
-        c, s = np.cos(theta)[None], np.sin(theta)[None]
-        return _link(c, s, cos_a[:, i - 1, None], sin_a[:, i - 1, None], a[:, i - 1, None],
-                     d[:, i - 1, None])
-
-    R3, t3 = link(3, D["t3"])
-    R4, t4 = link(4, D["t4"])
-    R5, t5 = link(5, D["t5"])
+    S2 = len(D["t1"])
+    # links 3, 4, 5 at once, R (3, B, S3, 3, 3), t (3, B, S3, 3) (the link first, so that
+    # each link's block is contiguous); links 1, 2, 6 likewise
+    ca, sa, a, d = (v.T[:, :, None] for v in (cos_a, sin_a, a, d))  # (6, B, 1)
+    c, s = D["cos_left"][:, None], D["sin_left"][:, None]  # (3, 1, S3)
+    (R3, R4, R5), (t3, t4, t5) = _link(c, s, ca[2:5], sa[2:5], a[2:5], d[2:5])
+    right = [0, 1, 5]
+    c, s = D["cos_right"][:, None], D["sin_right"][:, None]  # (3, 1, S2)
+    (R1, R2, R6), (t1, t2, t6) = _link(c, s, ca[right], sa[right], a[right], d[right])
+    R6, t6 = R6[:, 0], t6[:, 0]
     # A3A4A5: l = R3R4R5 e_z, p = t3 + R3(t4 + R4 t5)
     R34 = R3 @ R4
     l_left = np.einsum("bsij,bsj->bsi", R34, R5[..., :, 2])
     p_left = t3 + np.einsum("bsij,bsj->bsi", R3, t4) + np.einsum("bsij,bsj->bsi", R34, t5)
     # A2⁻¹A1⁻¹A6⁻¹ applied to e_z and the origin; A_i⁻¹ x = Rᵀ(x − t)
-    R6, t6 = _link(np.ones_like(cos_a[:, 5]), np.zeros_like(cos_a[:, 5]), cos_a[:, 5],
-                   sin_a[:, 5], a[:, 5], d[:, 5])  # θ6 = 0: e_z and the origin do not see it
-    l6 = np.swapaxes(R6, -1, -2)[..., :, 2]
+    l6 = R6[..., 2, :]
     p6 = -np.einsum("bji,bj->bi", R6, t6)
-    R1, t1 = link(1, D["t1"])
-    R2, t2 = link(2, D["t2"])
     l1 = np.einsum("bsji,bj->bsi", R1, l6)
     p1 = np.einsum("bsji,bsj->bsi", R1, p6[:, None] - t1)
     l_right = np.einsum("bsji,bsj->bsi", R2, l1)
     p_right = np.einsum("bsji,bsj->bsi", R2, p1 - t2)
-    return _quantities(p_left, l_left), _quantities(p_right, l_right), chain
+    q = _quantities(np.concatenate([p_left, p_right], 1), np.concatenate([l_left, l_right], 1))
+    return q[:, :-S2], q[:, -S2:], chain
 
 
 def fitted_coefficients(params: ArrayLike) -> tuple[Complex, Complex]:
@@ -237,21 +247,23 @@ def _monomial_map() -> Array:
     return np.einsum("km,jn->kjmn", _HALF, T45)
 
 
-def _shifted_trig(x: Complex, phi: float) -> tuple[Complex, Complex]:
-    """(cos θ, sin θ) of θ = ψ + φ, x = tan(ψ/2)."""
+def _shifted_trig(x: Complex, phi: ArrayLike) -> tuple[Complex, Complex]:
+    """(cos θ, sin θ) of θ = ψ + φ, x = tan(ψ/2); φ (scalar, or one per leading row of x)."""
     den = 1.0 + x * x
     s, c = 2.0 * x / den, (1.0 - x * x) / den
-    return c * np.cos(phi) - s * np.sin(phi), s * np.cos(phi) + c * np.sin(phi)
+    phi = np.asarray(phi, dtype=float).reshape(np.shape(phi) + (1,) * (x.ndim - np.ndim(phi)))
+    cp, sp = np.cos(phi), np.sin(phi)
+    return c * cp - s * sp, s * cp + c * sp
 
 
-def _axes_from_angles(chain: tuple[Complex, ...], cs: list[tuple[Complex, Complex]]
-                      ) -> Complex:
-    """z2..z5 (B, M, 12) in the world from (cos θ_i, sin θ_i) (B, M) of joints 1..4."""
+def _axes_from_angles(chain: tuple[Complex, ...], c: Complex, s: Complex) -> Complex:
+    """z2..z5 (B, M, 12) in the world from cos θ_i, sin θ_i (4, B, M) of joints 1..4."""
     cos_a, sin_a, _, _, R0 = chain
-    R = np.broadcast_to(R0[:, None], cs[0][0].shape + (3, 3))
+    A = _rz_rx(c, s, cos_a[:, :4].T[:, :, None], sin_a[:, :4].T[:, :, None])  # (4, B, M, 3, 3)
+    R = np.broadcast_to(R0[:, None], c.shape[1:] + (3, 3))
     out = []
-    for i, (c, s) in enumerate(cs):
-        R = R @ _rz_rx(c, s, cos_a[:, i, None], sin_a[:, i, None])
+    for i in range(4):
+        R = R @ A[i]
         out.append(R[..., :, 2])
     return np.concatenate(out, -1)
 
@@ -276,8 +288,9 @@ def _eliminate(p: Complex, shift: int) -> tuple[Complex, Complex, Array]:
     left, right, chain = _sides(p, SAMPLES, shift)
     bad = np.asarray(~(np.isfinite(left).all(axis=(1, 2)) & np.isfinite(right).all(axis=(1, 2))),
                      dtype=bool)
-    left = np.where(bad[:, None, None], 0.0, left)
-    right = np.where(bad[:, None, None], 0.0, right)
+    if bad.any():
+        left = np.where(bad[:, None, None], 0.0, left)
+        right = np.where(bad[:, None, None], 0.0, right)
     D = _design(SAMPLES)
     L = np.einsum("ks,bsq->bqk", D["left_pinv"], left)  # (B, 14, 27)
     R = np.einsum("ks,bsq->bqk", D["right_pinv"], right)  # (B, 14, 9)
@@ -309,28 +322,27 @@ def _eliminate(p: Complex, shift: int) -> tuple[Complex, Complex, Array]:
           / np.sum(np.abs(v[..., :3, :]) ** 2, (-2, -1)))
     x5 = (np.sum(v[..., :, :2].conj() * v[..., :, 1:], (-2, -1))
           / np.sum(np.abs(v[..., :, :2]) ** 2, (-2, -1)))
-    c3, s3 = _shifted_trig(x3, 0.0)
-    c4, s4 = _shifted_trig(x4, 0.0)
-    c5, s5 = _shifted_trig(x5, 0.0)
-    m45 = _products(np.stack([s4, c4, np.ones_like(c4)], -1),
-                    np.stack([s5, c5, np.ones_like(c5)], -1))  # (B, 16, 9)
-    t3 = np.stack([s3, c3, np.ones_like(c3)], -1)
+    # cos, sin of ψ3, ψ4, ψ5 (φ = 0) and of θ3, θ4, θ5 = ψ + φ: rows of (6, B, 16)
+    x345 = np.stack([x3, x4, x5])
+    c, s = _shifted_trig(np.concatenate([x345, x345]), (0.0, 0.0, 0.0) + OFFSETS)
+    one = np.ones_like(c[0])
+    m45 = _products(np.stack([s[1], c[1], one], -1), np.stack([s[2], c[2], one], -1))
+    t3 = np.stack([s[0], c[0], one], -1)  # (B, 16, 3), (B, 16, 9)
     rhs = np.einsum("bqkj,bmk,bmj->bmq", L.reshape(B, 14, 3, 9), t3, m45)
     pinv = np.einsum("bji,bj,bkj->bik", Vh.conj(), 1.0 / sv, U[:, :, :8].conj())  # (B, 8, 14)
-    m12 = np.einsum("bik,bmk->bmi", pinv, rhs)
-    cs = []
-    for s_, c_ in ((m12[..., 4], m12[..., 5]), (m12[..., 6], m12[..., 7])):
-        n = np.sqrt(c_ * c_ + s_ * s_)
-        cs.append((c_ / n, s_ / n))
-    cs.append(_shifted_trig(x3, OFFSETS[0]))
-    cs.append(_shifted_trig(x4, OFFSETS[1]))
-    if shift:  # θ5, θ6 too (θ6 by closure: Rot_z(θ6)Rot_x(α6) = (R1⋯R5)ᵀ), then relabel
-        cs.append(_shifted_trig(x5, OFFSETS[2]))
+    m12 = np.moveaxis(np.einsum("bik,bmk->ibm", pinv, rhs)[4:].reshape(2, 2, B, 16), 1, 0)
+    n = np.sqrt(m12[1] * m12[1] + m12[0] * m12[0])  # m12: [s1, s2], [c1, c2] (2, 2, B, 16)
+    cos_t = np.concatenate([m12[1] / n, c[3:]])  # θ1..θ5 (5, B, 16)
+    sin_t = np.concatenate([m12[0] / n, s[3:]])
+    if shift:  # θ6 too (by closure: Rot_z(θ6)Rot_x(α6) = (R1⋯R5)ᵀ), then relabel
         cos_a, sin_a = (np.roll(v, -shift, axis=1) for v in chain[:2])
-        R = _rz_rx(*cs[0], cos_a[:, 0, None], sin_a[:, 0, None])
+        A = _rz_rx(cos_t, sin_t, cos_a[:, :5].T[:, :, None], sin_a[:, :5].T[:, :, None])
+        R = A[0]
         for i in range(1, 5):
-            R = R @ _rz_rx(*cs[i], cos_a[:, i, None], sin_a[:, i, None])
-        cs.append((R[..., 0, 0], R[..., 0, 1]))
-        cs = [cs[(j - shift) % 6] for j in range(4)]
-    axes = np.where(bad[:, None, None], np.nan, _axes_from_angles(chain, cs))
+            R = R @ A[i]
+        cos_t = np.concatenate([cos_t, R[None, ..., 0, 0]])
+        sin_t = np.concatenate([sin_t, R[None, ..., 0, 1]])
+        order = [(j - shift) % 6 for j in range(4)]
+        cos_t, sin_t = cos_t[order], sin_t[order]
+    axes = np.where(bad[:, None, None], np.nan, _axes_from_angles(chain, cos_t[:4], sin_t[:4]))
     return axes, np.where(bad[:, None], np.nan, x3), lead_cond
