@@ -5,8 +5,9 @@ closed-form dyads; a single loop through the graph path against the joint-list p
 screwkit: ``solve_mechanism`` on examples/mechanisms/watt_sixbar.toml — every body's pose, every
 freedom with exact rates and accelerations, every joint centre and the coupler point's path. The
 six-bar decomposes into a driven crank and two RRR dyads, so its positions come from the closed
-forms (kinematics/graph/dyads.py); the continuation the other graphs use (graph/track.py) is timed
-beside it on the same six-bar. Every mode: the body poses of all 4 branch combinations at every
+forms (kinematics/graph/dyads.py); the continuation the other graphs use (the loop engine's
+Tracker on the stacked closure, graph/follow.py) is timed beside it on the same six-bar, and on
+the bundled several-loop examples (six-bars, Jansen's leg, Delta robot, 3-UPU, Stewart platform). Every mode: the body poses of all 4 branch combinations at every
 sample (``closed_modes.every_mode``, target ≤ 10 ms, issue 27), and the whole motion of every mode
 with rates and accelerations (``every_mode=True``).
 pylinkage: ``Linkage.step_fast`` (numba-compiled when numba is installed) on the same six-bar
@@ -30,9 +31,9 @@ import screwkit as sk
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closed_modes import every_mode
 from screwkit.kinematics.graph.closure import graph_layout
+from screwkit.kinematics.graph.follow import follow_drawn_mode
 from screwkit.kinematics.graph.motion import build_mode
 from screwkit.kinematics.graph.subchains import decompose
-from screwkit.kinematics.graph.track import follow_drawn_mode
 
 ROOT = Path(__file__).resolve().parents[1]
 WATT = ROOT / "examples" / "mechanisms" / "watt_sixbar.toml"
@@ -163,11 +164,11 @@ def _single_loop_rows(theta: np.ndarray) -> list[dict[str, Any]]:
 
 def _loop_engine_rows(theta: np.ndarray) -> list[dict[str, Any]]:
     """The drawn mode of a single loop without a closed form: followed by the loop engine's
-    continuation (graph/loop_track.py, the route solve_mechanism takes since issue 26's one
-    solving path) against the graph tracker it replaced for single loops (graph/track.py), both
-    with the graph's build (rates, accelerations, singular classes), alternated 5 times, median
-    CPU time: an RCCC driven at a cylinder over 28° and an RSSR in frame form over a turn (the
-    loop engine also holds its rod's idle spin, which the graph tracker lets drift)."""
+    continuation on the loop in frame form (graph/loop_track.py, the route solve_mechanism takes)
+    against the same engine on the graph's stacked closure (graph/follow.py), both with the
+    graph's build (rates, accelerations, singular classes), alternated 5 times, median CPU time:
+    an RCCC driven at a cylinder over 28° and an RSSR in frame form over a turn (the frame form
+    also holds its rod's idle spin, which minimum-norm steps on the stacked closure let drift)."""
     from dataclasses import replace
 
     from screwkit.kinematics.graph.from_loop import mechanism_from_loop
@@ -206,9 +207,9 @@ def _loop_engine_rows(theta: np.ndarray) -> list[dict[str, Any]]:
             times["engine"].append(_best(engine, 1))
             times["tracker"].append(_best(tracker, 1))
         t_e, t_t = (float(np.median(times[k])) for k in ("engine", "tracker"))
-        rows.append({"name": f"{name}, drawn, {x.size} samples: loop engine / graph tracker",
+        rows.append({"name": f"{name}, drawn, {x.size} samples: frame form / stacked closure",
                      "value": t_e / t_t, "unit": "x", "target": 1.0,
-                     "note": f"loop engine {t_e / x.size * 1e6:.3g} µs/sample, graph tracker "
+                     "note": f"frame form {t_e / x.size * 1e6:.3g} µs/sample, stacked closure "
                              f"{t_t / x.size * 1e6:.3g} µs/sample (each with the graph's build; "
                              f"median of 5 alternated); joint variables agree to {miss:.1e}"})
     return rows
@@ -305,6 +306,36 @@ def _loop_stage_rows(theta: np.ndarray) -> list[dict[str, Any]]:
     ]
 
 
+def _stacked_rows() -> list[dict[str, Any]]:
+    """The drawn modes of the bundled several-loop examples followed by the continuation on the
+    stacked closure (graph/follow.py) over a straight sweep from the spec's first row to its
+    farthest: CPU time per sample (best of 3), checked by the largest closure residual of the
+    samples held (graph_forward's, scaled) and that the whole sweep assembles."""
+    from screwkit.kinematics.graph.closure import graph_forward
+    from screwkit.kinematics.graph.newton import scaled_residual
+
+    rows: list[dict[str, Any]] = []
+    for name, n in (("watt_sixbar", 3600), ("stephenson3_sixbar", 3600), ("jansen_leg", 3600),
+                    ("delta_robot", 400), ("three_upu", 400), ("stewart_platform", 400)):
+        spec = sk.load_spec(ROOT / "examples" / "mechanisms" / f"{name}.toml")
+        Xs = np.asarray(spec.inputs, dtype=float)
+        Xs = Xs[:, None] if Xs.ndim == 1 else Xs
+        far = int(np.argmax(np.abs(Xs - Xs[0]).max(axis=1)))
+        X = Xs[0] + np.linspace(0.0, 1.0, n)[:, None] * (Xs[far] - Xs[0])
+        mech = spec.mechanism
+        lay = graph_layout(mech)
+        f = follow_drawn_mode(mech, lay, X)
+        assert f.mask.all(), name
+        res = float(np.max(np.abs(scaled_residual(mech, lay, graph_forward(mech, lay, f.conf)))))
+        assert res < 1e-9, (name, res)
+        t = _best(lambda m=mech, lay=lay, X=X: follow_drawn_mode(m, lay, X), 3)
+        rows.append({"name": f"{name}, drawn mode, {n} samples, {X.shape[1]} input(s): "
+                             "continuation on the stacked closure",
+                     "value": t / n * 1e6, "unit": "µs/sample", "target": None,
+                     "note": f"largest closure residual {res:.1e}"})
+    return rows
+
+
 def run() -> list[dict[str, Any]]:
     spec = sk.load_spec(WATT)
     mech = spec.mechanism
@@ -333,6 +364,7 @@ def run() -> list[dict[str, Any]]:
                              f"positions only); paths of G agree to {miss:.1e} of the length"})
     rows += _single_loop_rows(theta)
     rows += _loop_stage_rows(theta)
+    rows += _stacked_rows()
     return rows
 
 

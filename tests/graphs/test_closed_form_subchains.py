@@ -17,11 +17,11 @@ import screwkit as sk
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closed_modes import every_mode
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout, loop_residuals
+from screwkit.kinematics.graph.follow import follow_drawn_mode, reach
 from screwkit.kinematics.graph.from_loop import mechanism_from_loop
 from screwkit.kinematics.graph.idle import rods
 from screwkit.kinematics.graph.motion import build_mode
 from screwkit.kinematics.graph.subchains import decompose
-from screwkit.kinematics.graph.track import follow_drawn_mode, reach
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Body, BodyPoint, Mechanism, MechanismJoint
 

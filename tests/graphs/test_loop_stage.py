@@ -17,11 +17,11 @@ from scipy.optimize import brentq
 import screwkit as sk
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
+from screwkit.kinematics.graph.follow import follow_drawn_mode
 from screwkit.kinematics.graph.from_loop import mechanism_from_loop
 from screwkit.kinematics.graph.idle import rods
 from screwkit.kinematics.graph.motion import MechanismMotion
 from screwkit.kinematics.graph.subchains import LoopStage, decompose
-from screwkit.kinematics.graph.track import follow_drawn_mode
 from screwkit.kinematics.modes.every_mode import every_mode
 from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
 

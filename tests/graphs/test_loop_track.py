@@ -1,7 +1,8 @@
 """A single loop without a closed form, drawn as a graph, has its drawn mode followed by the loop
 engine (graph/loop_track.py: the generic loop solver's continuation, issue 26's one solving
-path), checked against the graph's own tracker (graph/track.py, an independent continuation on
-the stacked closure), the closed form where there is one, finite differences and the closure."""
+path), checked against the same engine on the graph's stacked closure (graph/follow.py: another
+closure system, other variables and equations), the closed form where there is one, finite
+differences and the closure."""
 
 from __future__ import annotations
 
@@ -11,12 +12,12 @@ import pytest
 import screwkit as sk
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
+from screwkit.kinematics.graph.follow import follow_drawn_mode
 from screwkit.kinematics.graph.from_loop import mechanism_from_loop
 from screwkit.kinematics.graph.loop_subchain import loop_chain
 from screwkit.kinematics.graph.loop_track import follow_drawn_loop
 from screwkit.kinematics.graph.motion import build_mode
 from screwkit.kinematics.graph.newton import scaled_residual
-from screwkit.kinematics.graph.track import follow_drawn_mode
 from screwkit.kinematics.tracker.loop import rotation_vector
 from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
 

@@ -18,8 +18,8 @@ from typer.testing import CliRunner
 import screwkit as sk
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
+from screwkit.kinematics.graph.follow import follow_drawn_mode
 from screwkit.kinematics.graph.motion import build_mode, solve_mechanism
-from screwkit.kinematics.graph.track import follow_drawn_mode
 from screwkit.kinematics.modes.along import pose_vectors
 from screwkit.kinematics.modes.delta import (
     DeltaFormulation,

@@ -13,7 +13,7 @@ import screwkit as sk
 from modes_helpers import random_r_loop
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import graph_layout
-from screwkit.kinematics.graph.track import follow_drawn_mode
+from screwkit.kinematics.graph.follow import follow_drawn_mode
 from screwkit.kinematics.modes.every_mode import CLOSURE_TOLERANCE, every_mode
 from screwkit.model.mechanism import Mechanism, MechanismJoint
 

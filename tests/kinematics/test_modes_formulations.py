@@ -14,7 +14,7 @@ import screwkit as sk
 from modes_helpers import check_jacobians, random_r_loop, relative_residual
 from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout, zero_configuration
-from screwkit.kinematics.graph.track import follow_drawn_mode
+from screwkit.kinematics.graph.follow import follow_drawn_mode
 from screwkit.kinematics.modes.loop6r import loop6r_system, random_loop6r
 from screwkit.kinematics.modes.planar import planar_formulation
 from screwkit.kinematics.modes.r_loop import r_loop_instance

@@ -11,7 +11,7 @@ import numpy as np
 
 import screwkit as sk
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
-from screwkit.kinematics.graph.track import follow_drawn_mode
+from screwkit.kinematics.graph.follow import follow_drawn_mode
 from screwkit.kinematics.modes.every_mode import closure_formulation, every_mode
 from screwkit.kinematics.modes.stewart_decode import StewartFormulation, decode_poses
 

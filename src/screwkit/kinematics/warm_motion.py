@@ -43,7 +43,6 @@ from screwkit.kinematics.motion import Motion, as_input_array, per_sample
 from screwkit.kinematics.registry import family_of
 from screwkit.kinematics.solve_motion import with_seed_names
 from screwkit.kinematics.tracker.branch_merge import SAME_ROOT
-from screwkit.kinematics.tracker.continuation import FILL_TOL
 from screwkit.kinematics.tracker.generic_motion import (
     anchor_samples,
     root_search,
@@ -52,6 +51,7 @@ from screwkit.kinematics.tracker.loop import Array, Configuration, Layout, layou
 from screwkit.kinematics.tracker.mode_frames import mode_from_configuration
 from screwkit.kinematics.tracker.rates import spin_links
 from screwkit.kinematics.tracker.solve import correct, signature
+from screwkit.kinematics.tracker.system import FILL_TOL
 from screwkit.model.linkage import Linkage
 
 #: largest first Newton step from an old configuration (scaled freedoms: rad, and lengths / the

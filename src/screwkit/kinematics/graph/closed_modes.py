@@ -6,7 +6,7 @@ dyads. Each is a continuous branch over the inputs wherever every discriminant o
 positive; it is born or dies where one crosses zero (a fold: that dyad's links in line), which
 is located between the two samples around it by bisection along the segment joining their
 inputs (:func:`fold_inputs`). The drawn mode is the combination of the drawing's branches; as
-with the tracker (graph/track.py) it is followed from the drawing and stops at its first fold;
+with the continuation (graph/follow.py) it is followed from the drawing and stops at its first fold;
 where the drawn combination assembles again later over the inputs, those later runs are one more
 mode (graph/motion.py's ``_closed_form_motion``), so that every run of every combination is
 held by a mode and none switches branch.

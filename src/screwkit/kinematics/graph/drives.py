@@ -12,7 +12,7 @@ its six closure rows, with the chain's undriven freedoms passive, say "the body'
 coordinates equal the chain's driven freedoms" — the constraint rows "pose coordinate − driven
 value" of the task, eliminated of the chain's other freedoms. The undriven freedoms carry no
 constraint (a free six-freedom chain), so the mechanism's mobility is unchanged and each drive
-fixes one freedom. The augmented mechanism is solved by the graph tracker (graph/track.py) with
+fixes one freedom. The augmented mechanism is solved by the continuation on the stacked closure (graph/follow.py) with
 the chain's driven freedoms as its inputs; rates and accelerations come from its stacked
 Jacobian (graph/newton.py) with the driven rates given; the chain (massless, carrying no load)
 is then removed from the result.

@@ -3,7 +3,7 @@
 Sign changes of the exact rate (graph/newton.py) between solved samples bracket each limit;
 Newton's method on the rate, with the exact second derivative (the acceleration at unit input
 rate and zero input acceleration), finds it to round-off, following the mode by continuation
-(graph/track.py:reach). The dwell order counts the vanishing derivatives: the first two are exact;
+(graph/follow.py:reach). The dwell order counts the vanishing derivatives: the first two are exact;
 the third and fourth come from central differences of the exact second derivative (step 1e-3 rad
 or 1e-3 of the length scale), good to about 1e-6 relative.
 """
@@ -16,9 +16,9 @@ from numpy.typing import NDArray
 from screwkit.errors import CapabilityError, UnknownNameError
 from screwkit.kinematics.analysis.limit_results import LimitPosition, LimitPositions
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout
+from screwkit.kinematics.graph.follow import reach
 from screwkit.kinematics.graph.motion import MechanismMotion
 from screwkit.kinematics.graph.newton import accelerations, linearise, rates
-from screwkit.kinematics.graph.track import reach
 from screwkit.kinematics.tracker.loop import Configuration
 
 Array = NDArray[np.float64]

@@ -31,8 +31,8 @@ solved"): those with a closed form the family's, every mode; any other single lo
 form, its drawn mode followed by the loop engine's continuation (the generic loop solver's
 tracker, seeded at the drawing: graph/loop_track.py), and every mode, where asked for, by the
 every-mode homotopy (modes/). Measured in benchmarks/bench_graph.py, the loop engine follows
-a drawn loop in the graph tracker's time or less (its RSSR rod pose, held at zero spin, costs
-more); the graph tracker (graph/track.py) is left to mechanisms of several loops.
+a drawn loop in the stacked closure's time or less (its RSSR rod pose, held at zero spin, costs
+more); the same engine on the stacked closure (graph/follow.py) takes mechanisms of several loops.
 
 The motion itself is graph/loop_motion.py's.
 """

@@ -18,9 +18,9 @@ graph's build (graph/motion.py ``build_mode``) then gives the rates, acceleratio
 outputs and singular classes from the stacked screw Jacobian, as for every graph.
 
 Mechanisms that are not one loop in frame form (several loops, driven body freedoms, parts made
-off their drawing, a U joint whose axes are not perpendicular) are followed by graph/track.py.
+off their drawing, a U joint whose axes are not perpendicular) are followed by the same engine on the stacked closure (graph/follow.py).
 Measured (benchmarks/bench_graph.py, the same loop side by side, each with the graph's build):
-an RCCC driven at a cylinder in ~0.7× the graph tracker's CPU time, an RSSR in frame form in
+an RCCC driven at a cylinder in ~0.7× the CPU time of the graph tracker this replaced, an RSSR in frame form in
 ~1.25× (the following alone ~1.1×; the rest is its rod's zero-spin pose, which the graph
 tracker's minimum-norm steps leave drifting).
 """
@@ -32,9 +32,9 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, graph_forward
+from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.graph.follow import Followed, follow_drawn_mode, held_frames
 from screwkit.kinematics.graph.loop_subchain import LoopChain, loop_chain
-from screwkit.kinematics.graph.track import Followed, follow_drawn_mode
 from screwkit.kinematics.tracker.continuation import Tracker
 from screwkit.kinematics.tracker.idle_spin import hold_idle_spin
 from screwkit.kinematics.tracker.loop import Configuration, Layout, forward, layout
@@ -53,7 +53,7 @@ def follow_drawn(mech: Mechanism, lay: GraphLayout, X: Array,
                  progress: Callable[[int, int], None] | None = None,
                  start: Configuration | None = None) -> Followed:
     """The drawn mode over the rows ``X``: by the loop engine for a single loop in frame form
-    (:func:`follow_drawn_loop`), else by graph/track.py (also from a ``start`` other than the
+    (:func:`follow_drawn_loop`), else on the stacked closure, graph/follow.py (also from a ``start`` other than the
     drawing: a mechanism re-assembled near its drawing)."""
     chain = loop_chain(mech, generic=True) if start is None else None
     if chain is not None:
@@ -64,7 +64,7 @@ def follow_drawn(mech: Mechanism, lay: GraphLayout, X: Array,
 def follow_drawn_loop(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
                       progress: Callable[[int, int], None] | None = None) -> Followed:
     """The drawn mode of the single loop ``chain`` (frame form) over the rows ``X``, followed by
-    the loop engine's continuation from the drawing (module docstring), as graph/track.py's
+    the loop engine's continuation from the drawing (module docstring), as graph/follow.py's
     :class:`Followed`: configurations in the graph's layout, where they hold (the first run
     from the drawing: the mode ends where it first stops assembling), the sample after which it
     stops, and where the first row is not reached the last approach row that is."""
@@ -108,24 +108,7 @@ def follow_drawn_loop(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Ar
     if stop <= a:  # the first row is not reached: where the approach ends
         return Followed(conf, mask, -1, reached=rows[max(stop - 1, 0)].copy(), solver=SOLVER)
     return Followed(conf, mask, stop - a - 1 if stop < rows.shape[0] else None,
-                    _held_frames(mech, lay, conf, mask), solver=SOLVER)
-
-
-def _held_frames(mech: Mechanism, lay: GraphLayout, conf: Configuration,
-                 mask: NDArray[np.bool_]) -> GraphFrames:
-    """The body poses, screws, joint centres and axes at the samples ``mask`` holds (the
-    identity and zeros elsewhere, which the build marks as not assembling), for the build to
-    reuse: the graph's forward map evaluated where the mode holds only."""
-    idx = np.flatnonzero(mask)
-    part = graph_forward(mech, lay, conf.take(idx), exact=False)
-    out = []
-    for a in (part.R, part.p, part.screws, part.residual, part.centres, part.axes):
-        full = np.zeros((mask.size, *a.shape[1:]))
-        if a is part.R:
-            full[:] = np.eye(3)
-        full[idx] = a
-        out.append(full)
-    return GraphFrames(*out)
+                    held_frames(mech, lay, conf, mask), solver=SOLVER)
 
 
 def _graph_configuration(mech: Mechanism, lay: GraphLayout, chain: LoopChain, llay: Layout,

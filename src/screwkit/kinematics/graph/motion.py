@@ -4,11 +4,11 @@ A mechanism built of closed-form sub-chains (driven joints, planar dyads and RSS
 graph/subchains.py) gets its drawn mode, and on request every mode, from their closed forms
 (graph/dyads.py, graph/legs.py, graph/closed_modes.py); any other has its drawn assembly mode
 followed along the inputs: a single loop by the loop engine's continuation (graph/loop_track.py),
-a mechanism of several loops by graph/track.py. Then, for each mode, at every sample and all at
-once, the body poses, the freedoms' rates and accelerations from the stacked screw
-Jacobian (graph/newton.py: J_p q̇_p = −J_in ẋ, J_p q̈_p = −J_in ẍ − bias), every body's twist and
-acceleration (graph/closure.py), joint centres and axes, and the paths of the points carried by
-bodies. Per mode the fields are those of a single loop's :class:`ModeMotion` with "link" read as
+a mechanism of several loops by the same engine on the stacked closure (graph/follow.py).
+Then, for each mode, at every sample and all at once, the body poses, the freedoms' rates and
+accelerations from the stacked screw Jacobian (graph/newton.py: J_p q̇_p = −J_in ẋ,
+J_p q̈_p = −J_in ẍ − bias), every body's twist and acceleration (graph/closure.py), joint centres
+and axes, and the paths of the points carried by bodies. Per mode the fields are those of a single loop's :class:`ModeMotion` with "link" read as
 "body" (``link_rotation[:, k]`` is body k's pose, in ``mechanism.bodies`` order), plus the points.
 """
 
@@ -195,7 +195,7 @@ def solve_mechanism(mech: Mechanism, inputs: ArrayLike, *, rates: ArrayLike | No
     planar dyads, RSS legs) is solved by their closed forms (graph/dyads.py, legs.py), and with
     ``every_mode`` every other assembly mode follows the drawn one (graph/closed_modes.py);
     any other mechanism by continuation of the drawn mode (graph/loop_track.py for a single
-    loop, graph/track.py otherwise; ``every_mode`` then adds the homotopy's modes where a
+    loop, graph/follow.py otherwise; ``every_mode`` then adds the homotopy's modes where a
     formulation takes the mechanism, modes/along.py, and the motion's notes say so where none
     does)."""
     if mech.drives:

@@ -33,7 +33,7 @@ Two kinds of step place bodies:
   plane.
 
 What is left (a Stephenson III triad, a platform, a spatial loop) is reported as needing the
-homotopy; the graph tracker (graph/track.py) keeps handling those. The closed forms of the steps
+homotopy; the continuation on the stacked closure (graph/follow.py) keeps handling those. The closed forms of the steps
 are in graph/dyads.py.
 """
 

@@ -3,8 +3,9 @@ does not decompose into closed-form sub-chains (issue 27, "Along the motion").
 
 The homotopy (:func:`~screwkit.kinematics.modes.every_mode.every_mode`) solves the closure at
 *anchor* samples only (the first, the last and every K-th, K from the time budget); between two
-anchors each mode found at the first is followed sample by sample with the graph tracker
-(graph/track.py, whose own steps are checked against the rates by the trapezoid rule). Identities
+anchors each mode found at the first is followed sample by sample by the loop engine's
+continuation on the stacked closure (graph/follow.py: Deuflhard's contraction test and the
+step-halving test near singular configurations reject a jump onto another branch). Identities
 are kept by matching the tracked end to the next anchor's modes by body poses
 (:data:`MATCH_TOLERANCE`, relative to the length scale). A tracked end that meets no anchor mode,
 or two that meet the same one, is a path jump: the segment is tracked again with
@@ -30,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
+from screwkit.kinematics.graph.follow import SMALLEST_STEP, follow_drawn_mode, reach
 from screwkit.kinematics.graph.motion import (
     MechanismMode,
     build_mode,
@@ -40,7 +42,6 @@ from screwkit.kinematics.graph.motion import (
     with_events,
 )
 from screwkit.kinematics.graph.subchains import Decomposition
-from screwkit.kinematics.graph.track import SMALLEST_STEP, follow_drawn_mode, reach
 from screwkit.kinematics.modes.every_mode import MechanismModes, every_mode
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
@@ -159,7 +160,7 @@ def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
                  x_to: Array) -> tuple[Array, Configuration]:
     """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the way
     to ``x_to`` (which it does not reach): bisection of the segment, :data:`FOLD_STEPS`
-    halvings, each half reached by continuation (graph/track.py ``reach``, in steps down to
+    halvings, each half reached by continuation (graph/follow.py ``reach``, in steps down to
     the tracker's smallest while a half is longer than :data:`FINE_HALF`, then to
     1/:data:`FOLD_SPLIT` of the half); the input there and the last configuration reached."""
     lo, hi = np.asarray(x_from, dtype=float), np.asarray(x_to, dtype=float)

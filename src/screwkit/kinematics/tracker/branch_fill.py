@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual.spatial import cross
-from screwkit.kinematics.tracker.loop import Array, Layout
+from screwkit.kinematics.tracker.loop import Array
 
 
 def quintic_hermite(u: Array) -> Array:
@@ -76,16 +76,16 @@ def spherical_end_conditions(d1: Array, w: Array, al: Array) -> tuple[Array, Arr
     return v, jr_inv(al - jdot_v)
 
 
-def hermite_increments(lay: Layout, d1: Array, v0: Array, a0: Array, v1: Array, a1: Array,
-                       interval: NDArray[np.intp], u: Array) -> Array:
+def hermite_increments(balls: list[list[int]], d1: Array, v0: Array, a0: Array, v1: Array,
+                       a1: Array, interval: NDArray[np.intp], u: Array) -> Array:
     """Increments δ(u) (T, m) from A of the interpolation (module docstring) at targets in
     ``interval`` (T,) at positions ``u`` (T,) in it, from each interval's end data (I, m):
     ``d1`` = B ⊖ A, ``v0``/``a0`` the first and second derivatives along the interval at A,
-    ``v1``/``a1`` at B (rates; a ball joint's are its body rates, converted here)."""
+    ``v1``/``a1`` at B (rates; a ball joint's are its body rates, converted here; ``balls``:
+    each ball joint's three freedoms)."""
     v1 = v1.copy()
     a1 = a1.copy()
-    for j in lay.spherical_of_joint:
-        idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
+    for idx in balls:
         v1[:, idx], a1[:, idx] = spherical_end_conditions(d1[:, idx], v1[:, idx], a1[:, idx])
     H = quintic_hermite(u)
     return np.asarray(H[:, 1:2] * v0[interval] + H[:, 2:3] * a0[interval]

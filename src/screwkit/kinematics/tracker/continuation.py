@@ -27,7 +27,7 @@ sample, the branch ends at once.
 On a fine sweep a chunk is corrected only at every few samples (at most FILL_STRIDE samples
 and FILL_SPAN of input apart); the samples in between are filled by quintic Hermite
 interpolation between neighbouring corrected samples (:mod:`screwkit.kinematics.tracker.branch_fill`)
-and kept where the loop closes there to round-off (FILL_TOL), else corrected by Newton
+and kept where the loop closes there to round-off (the system's fill_tol), else corrected by Newton
 with the same tests. Asked for rates, the tracker also solves the rate equations of those
 samples from the screws of that closure check (:class:`~screwkit.kinematics.tracker.tracks.TrackRates`).
 """
@@ -40,33 +40,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.tracker.branch_fill import hermite_increments
-from screwkit.kinematics.tracker.loop import (
-    Array,
-    Configuration,
-    Layout,
-    apply_increment,
-    configuration_difference,
-    forward,
-)
-from screwkit.kinematics.tracker.rates import joint_rates, rate_equations, spin_links
-from screwkit.kinematics.tracker.solve import (
-    CLOSURE_TOL,
-    Correction,
-    correct,
-    set_inputs,
-    signature,
-)
+from screwkit.kinematics.tracker.loop import Array, Configuration, Layout
+from screwkit.kinematics.tracker.meeting import joins_another
+from screwkit.kinematics.tracker.solve import CLOSURE_TOL, Correction
+from screwkit.kinematics.tracker.system import ClosureSystem, LoopSystem
 from screwkit.kinematics.tracker.tracks import (
     Front,
     Track,
     TrackRates,
-    closure_residual,
     coarse_targets,
     input_at,
-    polished,
     sample_writer,
-    taylor,
-    taylor_increment,
 )
 from screwkit.model.linkage import Linkage
 
@@ -78,35 +62,37 @@ FIRST_STEP = 0.2  # largest Newton correction, relative to the predicted step
 CONTRACTION = 0.5  # largest ratio of the second Newton step to the first
 FILL_SPAN = 0.01  # rad (or length scale) of input between two corrected samples of a chunk
 FILL_STRIDE = 128  # samples between two corrected samples of a chunk, at most
-#: closure residual at which an interpolated sample is kept as it is (else Newton corrects
-#: it), or 8× the round-off of the corrected samples on either side where that is more (a loop
-#: with S–S rods: the corrector's tolerance, its build polishes every sample afterwards)
-FILL_TOL = 1e-14
 
 
 class Tracker:
     """Follows seeds along the sweep ``X`` (module docstring); ``tracks`` grows as seeds are
     added and followed."""
 
-    def __init__(self, linkage: Linkage, lay: Layout, X: Array,
+    def __init__(self, linkage: Linkage | None, lay: Layout | None, X: Array,
                  progress: Callable[[int], None] | None = None,
-                 rates: tuple[Array, Array] | None = None) -> None:
-        self.linkage, self.lay, self.X = linkage, lay, X
+                 rates: tuple[Array, Array] | None = None,
+                 system: ClosureSystem | None = None, smallest: float | None = None) -> None:
+        """Follows a loop (``linkage`` in the layout ``lay``) or any closure ``system``
+        (tracker/system.py: the stacked closure of a mechanism's loops, graph/system.py).
+        ``smallest`` (scaled input distance): sub-steps go down to it, not MIN_SUBSTEP of the
+        spacing, and a failed step does not end the branch on σ's extrapolation (a front that
+        must get as near a fold as that: graph/follow.py ``reach``)."""
+        if system is None:
+            assert linkage is not None and lay is not None
+            system = LoopSystem(linkage, lay)
+        self.system, self.X = system, X
         # the inputs' rates and accelerations (N, n_in): then the rates of the samples filled
         # by interpolation are found from the closure check's screws (a loop without S–S
         # rods, whose poses a Motion's build turns)
-        self.rates = rates if rates is not None and not spin_links(linkage) else None
-        # the fill keeps a sample at round-off closure, as polished as a corrected one; with
-        # S–S rods the Motion's build turns the rods and polishes every sample afterwards
-        self.fill_tol = CLOSURE_TOL if spin_links(linkage) else FILL_TOL
+        self.rates = rates if rates is not None and not system.idle_spin else None
+        self.fill_tol = system.fill_tol
         self.N = X.shape[0]
         self.tracks: list[Track] = []
         self._met: dict[int, bool] = {}
         self.progress = progress
-        L = linkage.length_scale
-        self.col_scale = np.array([1.0 / L if t else 1.0 for t in lay.is_translation])
-        in_scale = np.array([1.0 / L if n.endswith(".s") else 1.0 for n in linkage.inputs])
-        self.in_scale = in_scale
+        self.smallest = smallest
+        self.col_scale = system.col_scale
+        self.in_scale = in_scale = system.in_scale
         steps = np.abs(np.diff(X, axis=0)) * in_scale if self.N > 1 else np.zeros((0, 1))
         self.span = np.concatenate([[0.0], np.cumsum(steps.max(axis=1))]) if self.N > 1 \
             else np.zeros(1)
@@ -115,13 +101,14 @@ class Tracker:
         """New tracks from closed configurations at one sample (polished by Newton to
         round-off, as every corrected sample is); returns their indices."""
         ids = []
-        conf = polished(self.linkage, self.lay, conf)
+        sys = self.system
+        conf = sys.polished(conf)
         for k in range(conf.size):
-            tr = Track(np.full((self.N, self.lay.n_scalar), np.nan),
-                       np.tile(np.eye(3), (self.N, self.lay.n_spherical, 1, 1)),
+            tr = Track(np.full((self.N, sys.n_scalar), np.nan),
+                       np.tile(np.eye(3), (self.N, sys.n_spherical, 1, 1)),
                        np.zeros(self.N, dtype=bool), sample)
             if self.rates is not None:
-                m = len(self.lay.names)
+                m = sys.m
                 tr.rates = TrackRates(np.full((self.N, m), np.nan), np.full((self.N, m), np.nan),
                                       np.zeros(self.N, dtype=bool), np.zeros(self.N, dtype=bool))
             tr.set_sample(sample, conf.scalars[k], conf.spherical[k])
@@ -140,8 +127,7 @@ class Tracker:
         seeds = Configuration(np.stack([self.tracks[i].scalars[self.tracks[i].seed] for i in ids]),
                               np.stack([self.tracks[i].spherical[self.tracks[i].seed]
                                         for i in ids]))
-        sigma = rate_equations(self.linkage, self.lay,
-                               forward(self.linkage, seeds, self.lay)).sigma_ratio
+        sigma = self.system.sigma(seeds)
         for r, i in enumerate(ids):
             tr = self.tracks[i]
             row = seeds.take(np.array([r]))
@@ -189,20 +175,40 @@ class Tracker:
         n = int(np.argmin(within)) if not within.all() else len(idx)
         return idx[:n].astype(float)
 
+    def _along(self, conf: Configuration, v: Array, a: Array, u: Array, d: Array,
+               ) -> tuple[Array, Array]:
+        """Jets along the input moves ``d`` (T, n_in) at ``conf`` from the jets ``v``, ``a``
+        along ``u`` there: s v and s² a where d = s u (a straight sweep: always), else formed
+        afresh (a sweep that turns between samples)."""
+        w = self.in_scale
+        s = np.einsum("ti,ti->t", d * w, u * w) / np.maximum(
+            np.einsum("ti,ti->t", u * w, u * w), 1e-300)
+        off = np.linalg.norm((d - s[:, None] * u) * w, axis=1)
+        v, a = s[:, None] * v, (s**2)[:, None] * a
+        fresh = np.nonzero(~(off <= 1e-12 * np.linalg.norm(d * w, axis=1)))[0]
+        if fresh.size:
+            v[fresh], a[fresh], _, _ = self.system.jets(conf.take(fresh), d[fresh],
+                                                        exact_sigma=False)
+        return v, a
+
     def _predict(self, fronts: list[Front], owner: NDArray[np.intp], t: Array) -> Configuration:
-        lay, X = self.lay, self.X
+        """Each front's targets by its Taylor series along the sweep: one directional jet per
+        front, along its move to its furthest target (tracker/system.py)."""
+        sys, X = self.system, self.X
         here = Configuration(np.concatenate([f.conf.scalars for f in fronts]),
                              np.concatenate([f.conf.spherical for f in fronts]))
-        Q1, Q2, sigma, Jp = taylor(self.linkage, lay, here)
+        t_front = np.array([f.t for f in fronts])
+        d = input_at(X, t) - input_at(X, t_front)[owner]
+        u = d[np.cumsum(np.bincount(owner, minlength=len(fronts))) - 1]
+        v, a, sigma, Jp = sys.jets(here, u)
         for k, (f, sg) in enumerate(zip(fronts, sigma.tolist(), strict=True)):
-            f.derivatives = (Q1[k], Q2[k])
+            f.derivatives = (v[k], a[k], u[k])
             f.passive = Jp[k]
             at = self._position(f.t)
             if at != f.sigma[1]:
                 f.sigma_before, f.sigma = f.sigma, (sg, at)
-        t_front = np.array([f.t for f in fronts])
-        delta = taylor_increment(Q1[owner], Q2[owner],
-                                 input_at(X, t) - input_at(X, t_front)[owner])
+        dv, da = self._along(here.take(owner), v[owner], a[owner], u[owner], d)
+        delta = dv + 0.5 * da
         bad = ~np.all(np.isfinite(delta), axis=1)
         if bad.any():  # singular front: the secant through its last two points
             for r in np.nonzero(bad)[0]:
@@ -210,23 +216,20 @@ class Tracker:
                 if f.prev is None or f.t == f.prev_t:
                     delta[r] = 0.0
                 else:
-                    sec = configuration_difference(f.conf, f.prev, lay)[0]
+                    sec = sys.difference(f.conf, f.prev)[0]
                     delta[r] = sec * (t[r] - f.t) / (f.t - f.prev_t)
-        moved = apply_increment(here.take(owner), delta, lay)
-        return set_inputs(moved, lay, self.linkage.inputs, input_at(X, t))
+        return sys.set_inputs(sys.increment(here.take(owner), delta), input_at(X, t))
 
     def _step(self, here: Configuration, t_here: Array, t_to: Array) -> Correction:
         """Predict from closed configurations ``here`` (at positions ``t_here``) to ``t_to``
         and correct (the acceptance tests of a front's step)."""
-        lay, X = self.lay, self.X
-        Q1, Q2, _, _ = taylor(self.linkage, lay, here)
-        delta = taylor_increment(Q1, Q2, input_at(X, t_to) - input_at(X, t_here))
+        sys, X = self.system, self.X
+        v, a, _, _ = sys.jets(here, input_at(X, t_to) - input_at(X, t_here))
+        delta = v + 0.5 * a
         delta = np.where(np.isfinite(delta), delta, 0.0)
-        pred = set_inputs(apply_increment(here, delta, lay), lay, self.linkage.inputs,
-                          input_at(X, t_to))
-        step = np.linalg.norm(configuration_difference(pred, here, lay) * self.col_scale,
-                              axis=1)
-        return correct(self.linkage, pred, lay, FIRST_STEP * step + 1e-9, CONTRACTION)
+        pred = sys.set_inputs(sys.increment(here, delta), input_at(X, t_to))
+        step = np.linalg.norm(sys.difference(pred, here) * self.col_scale, axis=1)
+        return sys.correct(pred, FIRST_STEP * step + 1e-9, CONTRACTION)
 
     def _halves_agree(self, start: Configuration, t_start: Array, reached: Configuration,
                       t_reached: Array, sigma: Array) -> NDArray[np.bool_]:
@@ -249,8 +252,8 @@ class Tracker:
             end.scalars[rows] = second.conf.scalars
             end.spherical[rows] = second.conf.spherical
         # compared by signature (joint centres and axes): an S–S rod's idle spin is free
-        miss = np.max(np.abs(signature(self.linkage, end, self.lay)
-                             - signature(self.linkage, reached, self.lay)), axis=1)
+        miss = np.max(np.abs(self.system.signature(end) - self.system.signature(reached)),
+                      axis=1)
         return np.asarray(conclusive & (miss <= np.maximum(1e-6, 1e-10 / np.maximum(
             sigma, 1e-300))))
 
@@ -267,15 +270,14 @@ class Tracker:
         pred = self._predict(fronts, owner, t)
         here = Configuration(np.concatenate([f.conf.scalars for f in fronts]),
                              np.concatenate([f.conf.spherical for f in fronts])).take(owner)
-        step = np.linalg.norm(configuration_difference(pred, here, self.lay) * self.col_scale,
-                              axis=1)
+        step = np.linalg.norm(self.system.difference(pred, here) * self.col_scale, axis=1)
         # a jump's near target is the singular sample itself: Newton converges there only
         # linearly; it is accepted if it converges and the sample after it passes the test
         near = np.zeros(len(t), dtype=bool)
         near[np.cumsum([len(tg) for tg in targets]) - 2] = [f.jump for f in fronts]
         reach = np.where(near, np.inf, FIRST_STEP * step + 1e-9)
-        res = correct(self.linkage, pred, self.lay, reach, np.where(near, 1.0, CONTRACTION),
-                      max_iter=40 if near.any() else 7)
+        res = self.system.correct(pred, reach, np.where(near, 1.0, CONTRACTION),
+                                  max_iter=40 if near.any() else 7)
         ok = self._halving_test(fronts, targets, res.conf, res.accepted)
         alive = []
         fills: list[tuple[Front, Array, Array, Configuration, bool]] = []
@@ -320,7 +322,7 @@ class Tracker:
         """Every how many samples a front's chunk is corrected (1: every sample): so that each
         interval between corrected samples spans at most FILL_SPAN of input and FILL_STRIDE
         samples; only for chunks of plain samples (not sub-steps or jumps)."""
-        if f.jump or f.substep or f.plain or len(targets) < 4:
+        if f.jump or f.substep or f.plain or not f.fill or len(targets) < 4:
             return 1
         k = int(round(f.t))
         idx = targets.astype(int)
@@ -334,19 +336,18 @@ class Tracker:
         """The samples between a front and its accepted coarse targets, all fronts at once:
         predicted by quintic Hermite interpolation between neighbouring corrected samples of the
         branch (:mod:`screwkit.kinematics.tracker.branch_fill`, with the derivatives from the rate
-        equations at both), accepted where the loop closes there to round-off (FILL_TOL)
+        equations at both), accepted where the loop closes there to round-off (fill_tol)
         (the interpolation error is of sixth order in the interval); elsewhere corrected by
         Newton with the usual acceptance tests. A front keeps its samples up to the first one
         that fails. Returns, per front, the samples reached, their configurations, whether the
         whole chunk was, and (when the tracker was asked for them) their rates where found."""
         if not fills:
             return []
-        lay, X = self.lay, self.X
+        sys, X = self.system, self.X
         starts = Configuration(np.concatenate([f.conf.scalars for f, *_ in fills]),
                                np.concatenate([f.conf.spherical for f, *_ in fills]))
         nodes = Configuration(np.concatenate([c.scalars for *_, c, _ in fills]),
                               np.concatenate([c.spherical for *_, c, _ in fills]))
-        QB1, QB2, _, JB = taylor(self.linkage, lay, nodes, exact_sigma=False)
         counts = [len(tc) for _, _, tc, _, _ in fills]
         first = np.cumsum([0, *counts[:-1]])  # each front's first node
         # interval j runs from node j − 1 (the front, for a front's first interval) to node j
@@ -364,18 +365,17 @@ class Tracker:
             return np.asarray(np.where(is_first.reshape(-1, *[1] * (front.ndim - 1)), front,
                                        of_nodes[np.maximum(prev, 0)]))
 
-        # the front's derivatives and Jacobian are this wave's (set by _predict)
-        QA1 = at_starts([f.derivatives[0] for f, *_ in fills], QB1)  # type: ignore[index]
-        QA2 = at_starts([f.derivatives[1] for f, *_ in fills], QB2)  # type: ignore[index]
-        JA = at_starts([f.passive for f, *_ in fills], JB)  # type: ignore[misc]
         tB = np.concatenate([tc for _, _, tc, _, _ in fills])
         tA = np.where(is_first, np.array([f.t for f, *_ in fills])[which], np.roll(tB, 1))
         dX = input_at(X, tB) - input_at(X, tA)
-        v0 = np.einsum("jmi,ji->jm", QA1, dX)
-        a0 = np.einsum("jmik,ji,jk->jm", QA2, dX, dX)
-        v1 = np.einsum("jmi,ji->jm", QB1, dX)
-        a1 = np.einsum("jmik,ji,jk->jm", QB2, dX, dX)
-        d1 = configuration_difference(nodes, A, lay)
+        # the jets along each interval: at its end directly, at its start from the front's
+        # (this wave's, set by _predict) or the node before's, and the Jacobians there
+        v1, a1, _, JB = sys.jets(nodes, dX, exact_sigma=False)
+        v0, a0 = self._along(A, at_starts([f.derivatives[0] for f, *_ in fills], v1),  # type: ignore[index]
+                             at_starts([f.derivatives[1] for f, *_ in fills], a1),  # type: ignore[index]
+                             at_starts([f.derivatives[2] for f, *_ in fills], dX), dX)  # type: ignore[index]
+        JA = at_starts([f.passive for f, *_ in fills], JB)  # type: ignore[misc]
+        d1 = sys.difference(nodes, A)
         # the samples strictly inside each interval
         gap = np.abs(tB - tA).astype(int) - 1
         interval = np.repeat(np.arange(nodes.size), gap)
@@ -388,24 +388,16 @@ class Tracker:
         chord = dX[interval] * scale
         u = np.einsum("ti,ti->t", (input_at(X, t) - input_at(X, tA)[interval]) * scale, chord) \
             / np.maximum(np.einsum("ti,ti->t", chord, chord), 1e-300)
-        delta = hermite_increments(lay, d1, v0, a0, v1, a1, interval, u)
+        delta = hermite_increments(sys.balls, d1, v0, a0, v1, a1, interval, u)
         line = ~np.all(np.isfinite(delta), axis=1)  # a singular end: the chord
         delta[line] = u[line, None] * d1[interval[line]]
         start_conf = A.take(interval)
-        pred = set_inputs(apply_increment(start_conf, delta, lay), lay, self.linkage.inputs,
-                          input_at(X, t))
+        pred = sys.set_inputs(sys.increment(start_conf, delta), input_at(X, t))
         near = (JA[interval], np.asarray(np.linalg.svd(JA, compute_uv=False)[:, -1],
                                          dtype=float)[interval]) \
             if JA.shape[1] >= JA.shape[2] > 0 else None
-        # an interpolated sample is kept as it is only where the loop closes there to about the
-        # round-off of the corrected samples on either side (each polished by Newton)
-        ends = forward(self.linkage, Configuration(
-            np.concatenate([starts.scalars, nodes.scalars]),
-            np.concatenate([starts.spherical, nodes.spherical])), lay, frames=False)
-        res = closure_residual(self.linkage, ends.closure_R, ends.closure_p)
-        res_a = np.where(is_first, res[:len(fills)][which], res[len(fills):][np.maximum(prev, 0)])
-        tol = np.clip(8.0 * np.maximum(res_a, res[len(fills):]), self.fill_tol, CLOSURE_TOL)
-        conf, closed, rates = self._closed_or_corrected(pred, start_conf, t, near,
+        tol = self._fill_closure(starts, nodes, is_first, which, prev)
+        conf, closed, rates, as_is = self._closed_or_corrected(pred, start_conf, t, near,
                                                         tol[interval])
         out = []
         for k, (f, _, tc, reached, full) in enumerate(fills):
@@ -413,6 +405,8 @@ class Tracker:
             t_all = np.concatenate([t[mine], tc])
             order = np.argsort(t_all * f.direction, kind="stable")
             ok = np.concatenate([closed[mine], np.ones(len(tc), dtype=bool)])[order]
+            # most interpolated samples needed Newton: the front corrects every sample on
+            f.fill = f.fill and not (len(mine) and 2 * int(as_is[mine].sum()) < len(mine))
             p = len(order) if ok.all() else int(np.argmin(ok))
             f.plain = p < len(order)
             keep = order[:p]
@@ -429,35 +423,48 @@ class Tracker:
             out.append((f, t_all[keep], here, full and p == len(order), found))
         return out
 
+    def _fill_closure(self, starts: Configuration, nodes: Configuration,
+                      is_first: NDArray[np.bool_], which: NDArray[np.intp],
+                      prev: NDArray[np.intp]) -> Array:
+        """The closure residual at which an interval's interpolated samples are kept as they
+        are: about the round-off of the corrected samples on either side (each polished by
+        Newton), at most the corrector's tolerance (which the stacked closure's fill_tol is)."""
+        if self.fill_tol >= CLOSURE_TOL:
+            return np.full(nodes.size, CLOSURE_TOL)
+        res = self.system.residual(Configuration(
+            np.concatenate([starts.scalars, nodes.scalars]),
+            np.concatenate([starts.spherical, nodes.spherical])))[0]
+        res_a = np.where(is_first, res[:starts.size][which], res[starts.size:][np.maximum(prev, 0)])
+        return np.asarray(np.clip(8.0 * np.maximum(res_a, res[starts.size:]), self.fill_tol,
+                                  CLOSURE_TOL))
+
     def _closed_or_corrected(self, pred: Configuration, start: Configuration, t: Array,
                              near: tuple[Array, Array] | None, tol: Array,
-                             ) -> tuple[Configuration, NDArray[np.bool_], TrackRates | None]:
+                             ) -> tuple[Configuration, NDArray[np.bool_], TrackRates | None,
+                                        NDArray[np.bool_]]:
         """Interpolated samples (at positions ``t``) as they are where the loop closes to the
         corrector's tolerance, else corrected by Newton from them (accepted by the corrector's
         tests, the reach measured from the interval's start); with the rates of the samples
         kept as they are, from the same screws, when the tracker was asked for rates (their
         rank test helped by ``near``: each interval start's passive Jacobian and σ_min)."""
-        fr = forward(self.linkage, pred, self.lay, frames=False)
-        closed = closure_residual(self.linkage, fr.closure_R, fr.closure_p) <= tol
+        sys = self.system
+        residual, checked = sys.residual(pred)
+        closed = residual <= tol
         rates = None
         if self.rates is not None:
-            eq = rate_equations(self.linkage, self.lay, fr, closed, exact_sigma=False,
-                                near=near)
             k = np.round(t).astype(int)
-            jr = joint_rates(self.linkage, self.lay, eq, closed, self.rates[0][k],
-                             self.rates[1][k])
-            rates = TrackRates(jr.qd, jr.qdd, jr.singular, closed.copy())
+            rates = sys.sample_rates(checked, closed, near, self.rates[0][k], self.rates[1][k])
         if closed.all():
-            return pred, closed, rates
+            return pred, closed, rates, closed
+        as_is = closed.copy()
         bad = np.nonzero(~closed)[0]
         sub = pred.take(bad)
-        step = np.linalg.norm(configuration_difference(sub, start.take(bad), self.lay)
-                              * self.col_scale, axis=1)
-        fixed = correct(self.linkage, sub, self.lay, FIRST_STEP * step + 1e-9, CONTRACTION)
+        step = np.linalg.norm(sys.difference(sub, start.take(bad)) * self.col_scale, axis=1)
+        fixed = sys.correct(sub, FIRST_STEP * step + 1e-9, CONTRACTION)
         scalars, spherical = pred.scalars.copy(), pred.spherical.copy()
         scalars[bad], spherical[bad] = fixed.conf.scalars, fixed.conf.spherical
         closed[bad] = fixed.accepted
-        return Configuration(scalars, spherical), closed, rates
+        return Configuration(scalars, spherical), closed, rates, as_is
 
     def _halving_test(self, fronts: list[Front], targets: list[Array], conf: Configuration,
                     accepted: NDArray[np.bool_]) -> NDArray[np.bool_]:
@@ -493,8 +500,8 @@ class Tracker:
         sig = np.concatenate(sigma)
         # only steps longer than σ (scaled freedoms): a root as close as the step lies within
         # ~σ of the branch only where the Jacobian is that near singular
-        step = np.linalg.norm(configuration_difference(reached, start_conf, self.lay)
-                              * self.col_scale, axis=1)
+        step = np.linalg.norm(self.system.difference(reached, start_conf) * self.col_scale,
+                              axis=1)
         long = np.nonzero(step > sig)[0]
         if long.size:
             ok[idx[long]] = self._halves_agree(start_conf.take(long),
@@ -523,7 +530,8 @@ class Tracker:
                         put(getattr(tr.rates, name), getattr(rates, name))
             if self.progress is not None and len(idx):
                 self.progress(len(idx))
-            if len(self.tracks) > 1 and self._joins_another(f.track, idx, conf.take(whole)):
+            if len(self.tracks) > 1 and joins_another(self.system, self.tracks, self._met, f.track, idx,
+                                                         conf.take(whole)):
                 return False
             last = len(t) - 1
             if len(t) > 1:
@@ -539,45 +547,23 @@ class Tracker:
             else:
                 f.chunk = min(2 * f.chunk, MAX_CHUNK) if full else max(len(t), 1)
                 f.jumped = False
-        elif self._fold_ahead(f):
+        elif self.smallest is None and self._fold_ahead(f):
             return self._jump_or_end(f)
         elif f.substep:
             f.substep /= 4
-            if f.substep < MIN_SUBSTEP:
+            if f.substep < self._min_substep(f):
                 return self._jump_or_end(f)
         else:
             f.substep = 0.25
         at_end = f.t == round(f.t) and not (0 <= round(f.t) + f.direction < self.N)
         return not at_end
 
-    def _joins_another(self, track: int, idx: NDArray[np.intp], conf: Configuration) -> bool:
-        """Whether the newly reached samples ``idx`` of ``track`` are, at two of them or more,
-        the configurations another track already holds: the front has run onto a known branch
-        (a seed found again next to where a branch ended) and stops there; the two tracks are
-        merged afterwards. Branches that cross meet at one sample only. A long chunk is
-        compared at its first two and last two samples: a front that runs onto a branch
-        stays on it to the chunk's end (where it left the branch again within the chunk, the
-        merge removes the shared samples afterwards)."""
-        if len(idx) < 2:
-            idx, conf = idx[-1:], conf.take(np.arange(len(idx))[-1:])
-        elif len(idx) > 4:
-            ends = np.array([0, 1, len(idx) - 2, len(idx) - 1])
-            idx, conf = idx[ends], conf.take(ends)
-        others = [k for k, tr in enumerate(self.tracks) if k != track and tr.mask[idx].any()]
-        if not others or len(idx) == 0:
-            return False
-        mine = signature(self.linkage, conf, self.lay)
-        for k in others:
-            tr = self.tracks[k]
-            held = np.nonzero(tr.mask[idx])[0]
-            theirs = signature(self.linkage, Configuration(tr.scalars[idx[held]],
-                                                           tr.spherical[idx[held]]), self.lay)
-            same = np.max(np.abs(mine[held] - theirs), axis=1) < 1e-6
-            if same.sum() >= min(2, len(idx)) and (same.sum() >= 2 or self._met[track]):
-                return True
-            if same.any():
-                self._met[track] = True
-        return False
+    def _min_substep(self, f: Front) -> float:
+        """The shortest sub-step (a fraction of the spacing to the next sample)."""
+        if self.smallest is None:
+            return MIN_SUBSTEP
+        k = int(np.clip(np.floor(f.t) if f.direction > 0 else np.ceil(f.t) - 1, 0, self.N - 2))
+        return self.smallest / max(float(self.span[k + 1] - self.span[k]), 1e-300)
 
     def _jump_or_end(self, f: Front) -> bool:
         """A front that cannot reach the next sample may be at a bifurcation (branches that

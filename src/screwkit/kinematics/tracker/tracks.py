@@ -1,7 +1,8 @@
 """What the continuation keeps and computes per branch (:mod:`screwkit.kinematics.tracker.continuation`):
 a :class:`Track` (one branch over the sweep, with the rates found on the way), a
 :class:`Front` (a branch end moving along the sweep), and the branch's Taylor series from the
-rate equations — the predictor's q(X + d) ≈ q + q_X d + ½ q_XX(d, d)."""
+rate equations — the predictor's q(X + d) ≈ q + q_X d + ½ q_XX(d, d), whose directional jets a
+closure system gives (tracker/system.py)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.tracker.loop import Array, Configuration, Layout, closure_error, forward
-from screwkit.kinematics.tracker.rates import freedom_rates, rate_equations, spin_links
 from screwkit.kinematics.tracker.solve import newton
 from screwkit.model.linkage import Linkage
 
@@ -68,9 +68,10 @@ class Front:
     sigma_before: tuple[float, float] = (np.inf, np.nan)
     jump: bool = False  # this wave steps over a singular sample to the one after it
     jumped: bool = False  # a jump was tried since the front last advanced normally
-    derivatives: tuple[Array, Array] | None = None  # q_X, q_XX at the front (this wave)
+    derivatives: tuple[Array, Array, Array] | None = None  # jets q', q'' along u, and u (this wave)
     passive: Array | None = None  # the scaled passive Jacobian there
     plain: bool = False  # an interpolated sample failed: correct the next chunk sample by sample
+    fill: bool = True  # interpolate between corrected samples (off: most fills needed Newton)
 
 
 def input_at(X: Array, t: Array) -> Array:
@@ -79,40 +80,6 @@ def input_at(X: Array, t: Array) -> Array:
     i1 = np.minimum(i0 + 1, X.shape[0] - 1)
     frac = (t - i0)[:, None]
     return np.asarray(X[i0] + frac * (X[i1] - X[i0]))
-
-
-def taylor(linkage: Linkage, lay: Layout, conf: Configuration, exact_sigma: bool = True,
-           ) -> tuple[Array, Array, Array, Array]:
-    """First and second derivatives of every freedom with respect to the inputs, q_X (B, m,
-    n_in) and q_XX (B, m, n_in, n_in), at each configuration; where the rate equations are
-    singular, their minimum-norm solution (on a continuum: the least motion that follows the
-    input; elsewhere the acceptance test judges the prediction). Also returns the σ ratio of
-    the passive Jacobian (B,) (with ``exact_sigma=False`` NaN where well above the singular
-    threshold) and the scaled passive Jacobian itself (B, k, m_p)."""
-    B, n_in = conf.size, len(linkage.inputs)
-    m = len(lay.names)
-    eq = rate_equations(linkage, lay, forward(linkage, conf, lay, frames=bool(spin_links(linkage))),
-                        exact_sigma=exact_sigma)
-    Q1 = np.empty((B, m, n_in))
-    Q2 = np.empty((B, m, n_in, n_in))
-    zero = np.zeros((B, n_in))
-    eye = np.eye(n_in)
-    for i in range(n_in):
-        Q1[:, :, i], Q2[:, :, i, i], _ = freedom_rates(
-            linkage, lay, eq, np.broadcast_to(eye[i], (B, n_in)), zero, True)
-    for i in range(n_in):
-        for j in range(i + 1, n_in):
-            _, both, _ = freedom_rates(linkage, lay, eq, np.broadcast_to(eye[i] + eye[j],
-                                                                         (B, n_in)), zero, True)
-            Q2[:, :, i, j] = Q2[:, :, j, i] = 0.5 * (both - Q2[:, :, i, i] - Q2[:, :, j, j])
-    return Q1, Q2, eq.sigma_ratio, eq.passive
-
-
-def taylor_increment(Q1: Array, Q2: Array, d: Array) -> Array:
-    """The predictor's increment q_X d + ½ q_XX(d, d) (B, m) for input moves ``d`` (B, n_in)
-    from the derivatives of :func:`taylor`."""
-    return np.asarray(np.einsum("tmi,ti->tm", Q1, d)
-                      + 0.5 * np.einsum("tmij,ti,tj->tm", Q2, d, d))
 
 
 def closure_residual(linkage: Linkage, R: Array, p: Array) -> Array:
@@ -162,4 +129,4 @@ def coarse_targets(n: int, stride: int) -> NDArray[np.intp]:
 
 
 __all__ = ["Front", "Track", "TrackRates", "closure_residual", "coarse_targets", "input_at",
-           "polished", "sample_writer", "taylor", "taylor_increment"]
+           "polished", "sample_writer"]
