@@ -175,3 +175,28 @@ def test_ctrl_c_leaves_no_file_and_no_traceback(tmp_path: Path) -> None:
     else:  # typer exits with 130 (128 + SIGINT) and says nothing
         assert proc.returncode in (1, 130) and not out.exists(), (proc.returncode, stderr)
     assert sorted(p.name for p in tmp_path.iterdir()) in (["long.toml"], ["long.toml", "out.json"])
+
+
+def test_ctrl_c_inside_a_c_callback_stops_the_run_without_a_traceback() -> None:
+    """Ctrl-C that lands in a ctypes callback (where numba's compile cache notifies llvmlite)
+    is dropped by Python with an "Exception ignored" traceback; the CLI's hook
+    (cli/interrupts.py) prints nothing and delivers it to ordinary code, where it stops."""
+    code = (
+        "import ctypes, sys\n"
+        "from screwkit.cli.interrupts import deliver_interrupts_from_callbacks\n"
+        "if sys.argv[1] == 'hook': deliver_interrupts_from_callbacks()\n"
+        "def cb(): raise KeyboardInterrupt\n"
+        "f = ctypes.CFUNCTYPE(None)(cb)\n"
+        "try:\n"
+        "    f()\n"
+        "    for _ in range(10**8): pass\n"
+        "    print('ran on')\n"
+        "except KeyboardInterrupt:\n"
+        "    print('stopped')\n")
+    runs = {how: subprocess.run([sys.executable, "-c", code, how], capture_output=True,
+                                text=True, timeout=120) for how in ("hook", "bare")}
+    assert runs["hook"].stdout.strip() == "stopped"
+    assert runs["hook"].stderr == ""
+    # without the hook Python drops the interrupt with a traceback: what the hook is for
+    assert runs["bare"].stdout.strip() == "ran on"
+    assert "Traceback" in runs["bare"].stderr

@@ -37,7 +37,9 @@ def main(
     max_time: Annotated[str | None, typer.Option("--max-time", help="Refuse a solve estimated to need more computing time than this (e.g. 10min; default 60 s; also SCREWKIT_MAX_TIME).")] = None,
 ) -> None:
     from screwkit.budget import set_memory_limit, set_time_limit
+    from screwkit.cli.interrupts import deliver_interrupts_from_callbacks
 
+    deliver_interrupts_from_callbacks()  # Ctrl-C inside numba's compile stops the run too
     guard(lambda: set_memory_limit(max_memory))  # None: the default (or SCREWKIT_MAX_MEMORY)
     guard(lambda: set_time_limit(max_time))  # None: the default (or SCREWKIT_MAX_TIME)
     if version:
