@@ -35,7 +35,12 @@ from screwkit.kinematics.graph.newton import (
     set_inputs,
 )
 from screwkit.kinematics.tracker.loop import Array, Configuration
-from screwkit.kinematics.tracker.solve import CLOSURE_TOL, POLISHED, Correction
+from screwkit.kinematics.tracker.solve import (
+    CLOSURE_TOL,
+    Correction,
+    polish_verdict,
+    step_verdict,
+)
 from screwkit.kinematics.tracker.system import ball_freedoms
 from screwkit.kinematics.tracker.tracks import TrackRates
 from screwkit.model.mechanism import Mechanism
@@ -130,24 +135,13 @@ class GraphSystem:
             lin = linearise(mech, lay, Configuration(q[todo], sph[todo]), exact=False)
             xi = scaled_residual(mech, lay, lin.frames)
             r = np.max(np.abs(xi), axis=-1)
-            fine = (r <= POLISHED) | ((r <= CLOSURE_TOL) & (r > 0.1 * last[todo]))
-            last[todo] = r
-            done[todo[r <= CLOSURE_TOL]] = True
-            keep = ~fine & np.isfinite(r)
+            keep = polish_verdict(r, todo, last, done, CLOSURE_TOL)
             if it == max_iter or not keep.any():
                 break
             done[todo[keep]] = False  # a polishing step must succeed too
             todo = todo[keep]
             step = -lin.take(np.flatnonzero(keep)).solve(xi[keep])
-            size = np.linalg.norm(step, axis=-1)
-            total[todo] += step
-            if it == 0:
-                first[todo] = size
-                hopeful = size <= reach[todo]
-            else:
-                hopeful = np.linalg.norm(total[todo], axis=-1) <= 1.5 * reach[todo]
-                if it == 1:
-                    hopeful &= size <= limit[todo] * np.maximum(first[todo], 1e-12)
+            hopeful = step_verdict(it, step, todo, total, first, reach, limit)
             if not hopeful.all():
                 todo, step = todo[hopeful], step[hopeful]
                 if todo.size == 0:

@@ -119,6 +119,35 @@ class Correction:
     accepted: NDArray[np.bool_]  # converged and passed the contraction test
 
 
+def polish_verdict(r: Array, todo: NDArray[np.intp], last: Array, done: NDArray[np.bool_],
+                   tol: float) -> NDArray[np.bool_]:
+    """One corrector iteration's residuals ``r`` of the predictions ``todo``: marks those within
+    ``tol`` in ``done``, keeps ``r`` in ``last``, and says which take another Newton step (within
+    tolerance, one more quadratically converging step polishes to round-off; stop when that no
+    longer gains a digit)."""
+    fine = (r <= POLISHED) | ((r <= tol) & (r > 0.1 * last[todo]))
+    last[todo] = r
+    done[todo[r <= tol]] = True
+    return np.asarray(~fine & np.isfinite(r))
+
+
+def step_verdict(it: int, step: Array, todo: NDArray[np.intp], total: Array, first: Array,
+                 reach: Array, limit: Array) -> NDArray[np.bool_]:
+    """Which Newton steps ``step`` of iteration ``it`` keep their predictions hopeful (adding
+    them to ``total``, the first one's size to ``first``): the first within ``reach``, all
+    together within 1.5 ``reach``, the second at most ``limit`` times the first (Deuflhard's
+    contraction test)."""
+    size = np.linalg.norm(step, axis=-1)
+    total[todo] += step
+    if it == 0:
+        first[todo] = size
+        return np.asarray(size <= reach[todo])
+    hopeful = np.linalg.norm(total[todo], axis=-1) <= 1.5 * reach[todo]
+    if it == 1:
+        hopeful &= size <= limit[todo] * np.maximum(first[todo], 1e-12)
+    return np.asarray(hopeful)
+
+
 def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
             contraction: float | Array = 0.5, max_iter: int = 7, tol: float = CLOSURE_TOL,
             ) -> Correction:
@@ -148,12 +177,7 @@ def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
         fr = forward(linkage, Configuration(q[todo], sph[todo]), lay, frames=False)
         xi = closure_error(fr.closure_R, fr.closure_p) * rows
         r = np.max(np.abs(xi), axis=-1)
-        # within tolerance, one more (quadratically converging) step polishes to round-off;
-        # stop when that no longer gains a digit
-        fine = (r <= POLISHED) | ((r <= tol) & (r > 0.1 * last[todo]))
-        last[todo] = r
-        done[todo[r <= tol]] = True
-        keep = ~fine & np.isfinite(r)
+        keep = polish_verdict(r, todo, last, done, tol)
         if it == max_iter or not keep.any():
             break
         done[todo[keep]] = False  # a polishing step must succeed too
@@ -163,15 +187,7 @@ def correct(linkage: Linkage, conf: Configuration, lay: Layout, reach: Array,
         mu = 1e-13 * np.maximum(np.trace(JJt, axis1=-2, axis2=-1), 1e-300)
         y = np.linalg.solve(JJt + mu[:, None, None] * np.eye(6), xi[..., None])[..., 0]
         step = -np.einsum("nji,nj->ni", J, y)
-        size = np.linalg.norm(step, axis=-1)
-        total[todo] += step
-        if it == 0:
-            first[todo] = size
-            hopeful = size <= reach[todo]
-        else:
-            hopeful = np.linalg.norm(total[todo], axis=-1) <= 1.5 * reach[todo]
-            if it == 1:
-                hopeful &= size <= limit[todo] * np.maximum(first[todo], 1e-12)
+        hopeful = step_verdict(it, step, todo, total, first, reach, limit)
         if not hopeful.all():
             todo, step = todo[hopeful], step[hopeful]
             if todo.size == 0:
