@@ -39,7 +39,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout
-from screwkit.kinematics.graph.newton import RANK_CUTOFF, Linearised, column_scale, linearise
+from screwkit.kinematics.graph.newton import (
+    RANK_CUTOFF,
+    Linearised,
+    column_scale,
+    drawn_linearisation,
+    gram_sigma,
+    linearise,
+)
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import GROUND, Mechanism
 
@@ -105,10 +112,10 @@ class Singularities:
     text: list[str]
 
 
-def _ranks(mech: Mechanism, lay: GraphLayout, platform: str | None) -> tuple[int, int, int]:
-    """The ranks of J_p, J and M at the drawing."""
-    lin = linearise(mech, lay, Configuration(np.zeros((1, lay.n_scalar)), np.broadcast_to(
-        np.eye(3), (1, lay.n_spherical, 3, 3)).copy()))
+def _ranks(mech: Mechanism, lay: GraphLayout, platform: str | None,
+           drawn: Linearised | None) -> tuple[int, int, int]:
+    """The ranks of J_p, J and M at the drawing (``drawn``: its linearisation, if made)."""
+    lin = drawn if drawn is not None else drawn_linearisation(mech, lay)
     out = []
     mats = [lin.Jp, lin.J]
     if platform is not None:
@@ -132,8 +139,8 @@ def _gram_sigma(A: Array) -> Array:
     """Singular values (N, k) of A (N, …), largest first, from the eigenvalues of its smaller
     Gram matrix (twice as fast as the SVD; relative accuracy ~ε·condition², ample for the
     condition numbers reported at regular samples; the SVD is used where a rank is tested)."""
-    G = np.einsum("nki,nkj->nij", A, A) if A.shape[1] >= A.shape[2] else \
-        np.einsum("nik,njk->nij", A, A)
+    At = np.swapaxes(A, 1, 2)
+    G = At @ A if A.shape[1] >= A.shape[2] else A @ At
     lam = np.linalg.eigvalsh(G)[:, ::-1]
     return np.sqrt(np.maximum(lam, 0.0))
 
@@ -146,14 +153,16 @@ def _null(A: Array, r: int) -> Array:
 
 
 def singularities(mech: Mechanism, lay: GraphLayout, conf: Configuration,
-                  mask: NDArray[np.bool_], lin: Linearised | None = None) -> Singularities:
+                  mask: NDArray[np.bool_], lin: Linearised | None = None,
+                  drawn: Linearised | None = None) -> Singularities:
     """The condition numbers and singular classes of ``conf`` (N) where ``mask`` holds
     (``lin``: its exact linearisation at every sample, when already made: its passive
-    singular values are reused). Singular values at every sample, singular vectors only at
+    singular values are reused; ``drawn``: newton.drawn_linearisation, when already made).
+    Singular values at every sample, singular vectors only at
     the singular ones."""
     N = conf.size
     platform = platform_body(mech)
-    rp, rJ, rM = _ranks(mech, lay, platform)
+    rp, rJ, rM = _ranks(mech, lay, platform, drawn)
     kind = np.full(N, "", dtype=object)
     text = [""] * N
     names = ["passive", "closure"] + (["platform_held"] if platform else [])
@@ -161,11 +170,12 @@ def singularities(mech: Mechanism, lay: GraphLayout, conf: Configuration,
     idx = np.flatnonzero(mask)
     if idx.size == 0:
         return Singularities(condition, kind.astype(str), text)
+    idx_in: slice | NDArray[np.intp]
     if lin is None:
         lin = linearise(mech, lay, conf.take(idx))
-        idx_in = np.arange(idx.size)
-    else:
-        idx_in = idx
+        idx_in = slice(None)
+    else:  # every sample assembled: views, not copies
+        idx_in = slice(None) if idx.size == N else idx
     J, Jp = lin.J[idx_in], lin.Jp[idx_in]
     passive, inputs = list(lay.passive), list(lay.inputs)
     sp = lin.sigma[idx_in] if lin.sigma.shape[1] == min(Jp.shape[1:]) else \
@@ -182,10 +192,10 @@ def singularities(mech: Mechanism, lay: GraphLayout, conf: Configuration,
     if platform is not None:
         fr = lin.frames
         K = platform_jacobian(mech, lay, GraphFrames(
-            fr.R[idx_in], fr.p[idx_in], fr.screws[idx_in], fr.residual[idx_in],
-            fr.centres[idx_in], fr.axes[idx_in]), platform)
+            fr.R, fr.p, fr.screws[idx_in], fr.residual, fr.centres[idx_in], fr.axes),
+            platform)
         M = np.concatenate([J, K], axis=1)
-        cM = _condition(np.asarray(np.linalg.svd(M, compute_uv=False)), rM)
+        cM = _condition(gram_sigma(M, rM), rM)  # the SVD's values near singular
         condition["platform_held"][idx] = cM
     J_sing = ~(1.0 / cJ > SINGULAR_TOL)
     M_sing = ~(1.0 / cM > SINGULAR_TOL) if K is not None else np.zeros(idx.size, bool)
