@@ -193,9 +193,9 @@ def gram_sigma(A: Array, rank: int | None = None) -> Array:
     the eigenvalues of the smaller Gram matrix AᵀA or AAᵀ (Golub & Van Loan, Matrix
     Computations, 4th ed., §8.6: σᵢ² = λᵢ(AᵀA)), nearly twice as fast as the SVD for these
     small shapes. Its error in σᵢ is ~ε·σ₁²/σᵢ, so at the samples where σ_r/σ₁ (r = ``rank``,
-    default k) is below :data:`GRAM_REFINE` (or not finite) the SVD's values are taken
-    instead: rank tests and singular flags see the SVD's values and condition numbers change
-    at round-off level."""
+    default k) is below :data:`GRAM_REFINE` the SVD's values are taken instead: rank tests and
+    singular flags see the SVD's values and condition numbers change at round-off level. A
+    sample with a non-finite entry gets NaN."""
     if A.shape[0] == 0 or min(A.shape[1:]) == 0:
         return np.zeros((A.shape[0], min(A.shape[1:])))
     At = np.swapaxes(A, 1, 2)
@@ -203,8 +203,9 @@ def gram_sigma(A: Array, rank: int | None = None) -> Array:
     ok = np.all(np.isfinite(G), axis=(1, 2))
     G[~ok] = np.eye(G.shape[-1])
     s = np.sqrt(np.maximum(np.linalg.eigvalsh(G)[:, ::-1], 0.0))
+    s[~ok] = np.nan
     r = s.shape[1] if rank is None else rank
-    redo = ~ok if r == 0 else ~(s[:, r - 1] > GRAM_REFINE * s[:, 0]) | ~ok
+    redo = ok & ~(s[:, r - 1] > GRAM_REFINE * s[:, 0]) if r else np.zeros(len(s), bool)
     if redo.any():
         s[redo] = np.linalg.svd(A[redo], compute_uv=False)
     return s

@@ -135,16 +135,6 @@ def _condition(s: Array, r: int) -> Array:
     return np.asarray(s[:, 0] / np.maximum(s[:, r - 1], tiny))
 
 
-def _gram_sigma(A: Array) -> Array:
-    """Singular values (N, k) of A (N, …), largest first, from the eigenvalues of its smaller
-    Gram matrix (twice as fast as the SVD; relative accuracy ~ε·condition², ample for the
-    condition numbers reported at regular samples; the SVD is used where a rank is tested)."""
-    At = np.swapaxes(A, 1, 2)
-    G = At @ A if A.shape[1] >= A.shape[2] else A @ At
-    lam = np.linalg.eigvalsh(G)[:, ::-1]
-    return np.sqrt(np.maximum(lam, 0.0))
-
-
 def _null(A: Array, r: int) -> Array:
     """The right singular vectors (n, cols) of σ_r of A (n, …): the motion a rank loss frees."""
     if A.shape[0] == 0:
@@ -181,7 +171,7 @@ def singularities(mech: Mechanism, lay: GraphLayout, conf: Configuration,
     sp = lin.sigma[idx_in] if lin.sigma.shape[1] == min(Jp.shape[1:]) else \
         np.linalg.svd(Jp, compute_uv=False)
     cp = _condition(np.asarray(sp, dtype=float), rp)
-    cJ = _condition(_gram_sigma(J), rJ)
+    cJ = _condition(gram_sigma(J, rJ), rJ)  # the SVD's values near singular
     p_sing = ~(1.0 / cp > SINGULAR_TOL)
     at = np.flatnonzero(p_sing)  # exact singular values where the rank is in question
     if at.size:
