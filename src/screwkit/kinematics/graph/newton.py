@@ -200,8 +200,9 @@ def gram_sigma(A: Array, rank: int | None = None) -> Array:
         return np.zeros((A.shape[0], min(A.shape[1:])))
     At = np.swapaxes(A, 1, 2)
     G = At @ A if A.shape[1] >= A.shape[2] else A @ At
-    ok = np.all(np.isfinite(G), axis=(1, 2))
-    G[~ok] = np.eye(G.shape[-1])
+    ok = np.isfinite(np.einsum("nii->n", G))  # Σ of A's squared entries
+    if not ok.all():
+        G[~ok] = np.eye(G.shape[-1])
     s = np.sqrt(np.maximum(np.linalg.eigvalsh(G)[:, ::-1], 0.0))
     s[~ok] = np.nan
     r = s.shape[1] if rank is None else rank
