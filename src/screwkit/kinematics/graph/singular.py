@@ -96,10 +96,14 @@ def platform_jacobian(mech: Mechanism, lay: GraphLayout, fr: GraphFrames, body: 
         K[:, :, f0:f0 + n] += sign * fr.screws[:, :, f0:f0 + n]
         b = par
     mine = [i for i, j in enumerate(mech.joints) if body in j.bodies]
-    c = fr.centres[:, mine].mean(axis=1)
+    c = fr.centres[:, mine].mean(axis=1)[:, :, None]
     w = K[:, :3]
-    v = K[:, 3:] + np.cross(w, c[:, :, None], axisa=1, axisb=1, axisc=1)  # v_c = v₀ + ω × c
-    return np.concatenate([w, v / lay.length], axis=1) * column_scale(lay)[None, None, :]
+    K[:, 3:] += np.stack([w[:, 1] * c[:, 2] - w[:, 2] * c[:, 1],  # v_c = v₀ + ω × c
+                          w[:, 2] * c[:, 0] - w[:, 0] * c[:, 2],
+                          w[:, 0] * c[:, 1] - w[:, 1] * c[:, 0]], axis=1)
+    K[:, 3:] /= lay.length
+    K *= column_scale(lay)[None, None, :]
+    return K
 
 
 @dataclass(frozen=True)
