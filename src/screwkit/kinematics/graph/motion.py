@@ -26,14 +26,15 @@ from screwkit.kinematics.graph.closure import (
     GraphFrames,
     GraphLayout,
     body_accelerations,
-    body_twists,
     graph_layout,
     loop_residuals,
 )
 from screwkit.kinematics.graph.loop_track import follow_drawn
 from screwkit.kinematics.graph.newton import (
     RANK_CUTOFF,
-    accelerations,
+    Linearised,
+    accelerations_twists,
+    drawn_linearisation,
     linearise,
     rates,
     scaled_residual,
@@ -472,7 +473,8 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
     """Everything about one mode from its configurations (module docstring); ``tracked``, the
     tracker's body poses and screws at those configurations, are reused when given (only the
     loops' exact closure twists are evaluated anew)."""
-    rank = expected_rank(mech, lay)
+    drawn = drawn_linearisation(mech, lay)  # one for the ranks here and in singularities
+    rank = expected_rank(mech, lay, drawn)
     if tracked is not None:
         tracked = GraphFrames(tracked.R, tracked.p, tracked.screws,
                               loop_residuals(mech, lay, conf, tracked.R, tracked.p),
@@ -487,10 +489,9 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
         basis = idle_basis(mech, lay, lin)  # one SVD for the rates and the accelerations
     if basis is not None:
         qd = hold_rod_spin(mech, lay, lin, qd, basis=basis)
-    qdd, bias = accelerations(mech, lay, lin, qd, Xdd)
+    qdd, bias, V = accelerations_twists(mech, lay, lin, qd, Xdd)  # V: the body twists
     if basis is not None:
         qdd = hold_rod_spin(mech, lay, lin, qdd, bias, basis=basis)
-    V, _ = body_twists(mech, lay, fr.screws, qd)
     A = body_accelerations(mech, lay, fr.screws, qdd, bias)
     nb = len(mech.bodies)
     singular = mask & _singular(rank, lin.sigma)
@@ -525,7 +526,7 @@ def build_mode(mech: Mechanism, lay: GraphLayout, conf: Configuration, mask: NDA
     residual[bad] = np.nan
     from screwkit.kinematics.graph.singular import singular_events, singularities
 
-    sing = singularities(mech, lay, conf, mask, lin)
+    sing = singularities(mech, lay, conf, mask, lin, drawn)
     idx = np.flatnonzero(sing.kind != "")
     events = singular_events({int(k): input_text(mech, lay, X[k]) for k in idx}, sing) \
         if idx.size else []
@@ -561,11 +562,10 @@ def _outputs(mech: Mechanism, lay: GraphLayout, R: Array, V: Array, A: Array,
     return values, rates_, accs
 
 
-def expected_rank(mech: Mechanism, lay: GraphLayout) -> int:
+def expected_rank(mech: Mechanism, lay: GraphLayout, drawn: Linearised | None = None) -> int:
     """Rank of the passive block at the drawing (idle freedoms and redundant constraints
-    excluded): what a regular sample keeps."""
-    lin = linearise(mech, lay, Configuration(np.zeros((1, lay.n_scalar)), np.broadcast_to(
-        np.eye(3), (1, lay.n_spherical, 3, 3)).copy()))
+    excluded): what a regular sample keeps (``drawn``: the drawing's linearisation if made)."""
+    lin = drawn if drawn is not None else drawn_linearisation(mech, lay)
     s = lin.sigma[0]
     return int(np.sum(s > RANK_CUTOFF * max(float(s[0]) if s.size else 0.0, 1e-300)))
 

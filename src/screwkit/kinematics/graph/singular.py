@@ -39,7 +39,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout
-from screwkit.kinematics.graph.newton import RANK_CUTOFF, Linearised, column_scale, linearise
+from screwkit.kinematics.graph.newton import (
+    RANK_CUTOFF,
+    Linearised,
+    column_scale,
+    drawn_linearisation,
+    gram_sigma,
+    linearise,
+)
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import GROUND, Mechanism
 
@@ -89,10 +96,14 @@ def platform_jacobian(mech: Mechanism, lay: GraphLayout, fr: GraphFrames, body: 
         K[:, :, f0:f0 + n] += sign * fr.screws[:, :, f0:f0 + n]
         b = par
     mine = [i for i, j in enumerate(mech.joints) if body in j.bodies]
-    c = fr.centres[:, mine].mean(axis=1)
+    c = fr.centres[:, mine].mean(axis=1)[:, :, None]
     w = K[:, :3]
-    v = K[:, 3:] + np.cross(w, c[:, :, None], axisa=1, axisb=1, axisc=1)  # v_c = v₀ + ω × c
-    return np.concatenate([w, v / lay.length], axis=1) * column_scale(lay)[None, None, :]
+    K[:, 3:] += np.stack([w[:, 1] * c[:, 2] - w[:, 2] * c[:, 1],  # v_c = v₀ + ω × c
+                          w[:, 2] * c[:, 0] - w[:, 0] * c[:, 2],
+                          w[:, 0] * c[:, 1] - w[:, 1] * c[:, 0]], axis=1)
+    K[:, 3:] /= lay.length
+    K *= column_scale(lay)[None, None, :]
+    return K
 
 
 @dataclass(frozen=True)
@@ -105,10 +116,10 @@ class Singularities:
     text: list[str]
 
 
-def _ranks(mech: Mechanism, lay: GraphLayout, platform: str | None) -> tuple[int, int, int]:
-    """The ranks of J_p, J and M at the drawing."""
-    lin = linearise(mech, lay, Configuration(np.zeros((1, lay.n_scalar)), np.broadcast_to(
-        np.eye(3), (1, lay.n_spherical, 3, 3)).copy()))
+def _ranks(mech: Mechanism, lay: GraphLayout, platform: str | None,
+           drawn: Linearised | None) -> tuple[int, int, int]:
+    """The ranks of J_p, J and M at the drawing (``drawn``: its linearisation, if made)."""
+    lin = drawn if drawn is not None else drawn_linearisation(mech, lay)
     out = []
     mats = [lin.Jp, lin.J]
     if platform is not None:
@@ -128,16 +139,6 @@ def _condition(s: Array, r: int) -> Array:
     return np.asarray(s[:, 0] / np.maximum(s[:, r - 1], tiny))
 
 
-def _gram_sigma(A: Array) -> Array:
-    """Singular values (N, k) of A (N, …), largest first, from the eigenvalues of its smaller
-    Gram matrix (twice as fast as the SVD; relative accuracy ~ε·condition², ample for the
-    condition numbers reported at regular samples; the SVD is used where a rank is tested)."""
-    G = np.einsum("nki,nkj->nij", A, A) if A.shape[1] >= A.shape[2] else \
-        np.einsum("nik,njk->nij", A, A)
-    lam = np.linalg.eigvalsh(G)[:, ::-1]
-    return np.sqrt(np.maximum(lam, 0.0))
-
-
 def _null(A: Array, r: int) -> Array:
     """The right singular vectors (n, cols) of σ_r of A (n, …): the motion a rank loss frees."""
     if A.shape[0] == 0:
@@ -146,14 +147,16 @@ def _null(A: Array, r: int) -> Array:
 
 
 def singularities(mech: Mechanism, lay: GraphLayout, conf: Configuration,
-                  mask: NDArray[np.bool_], lin: Linearised | None = None) -> Singularities:
+                  mask: NDArray[np.bool_], lin: Linearised | None = None,
+                  drawn: Linearised | None = None) -> Singularities:
     """The condition numbers and singular classes of ``conf`` (N) where ``mask`` holds
     (``lin``: its exact linearisation at every sample, when already made: its passive
-    singular values are reused). Singular values at every sample, singular vectors only at
+    singular values are reused; ``drawn``: newton.drawn_linearisation, when already made).
+    Singular values at every sample, singular vectors only at
     the singular ones."""
     N = conf.size
     platform = platform_body(mech)
-    rp, rJ, rM = _ranks(mech, lay, platform)
+    rp, rJ, rM = _ranks(mech, lay, platform, drawn)
     kind = np.full(N, "", dtype=object)
     text = [""] * N
     names = ["passive", "closure"] + (["platform_held"] if platform else [])
@@ -161,17 +164,18 @@ def singularities(mech: Mechanism, lay: GraphLayout, conf: Configuration,
     idx = np.flatnonzero(mask)
     if idx.size == 0:
         return Singularities(condition, kind.astype(str), text)
+    idx_in: slice | NDArray[np.intp]
     if lin is None:
         lin = linearise(mech, lay, conf.take(idx))
-        idx_in = np.arange(idx.size)
-    else:
-        idx_in = idx
+        idx_in = slice(None)
+    else:  # every sample assembled: views, not copies
+        idx_in = slice(None) if idx.size == N else idx
     J, Jp = lin.J[idx_in], lin.Jp[idx_in]
     passive, inputs = list(lay.passive), list(lay.inputs)
     sp = lin.sigma[idx_in] if lin.sigma.shape[1] == min(Jp.shape[1:]) else \
         np.linalg.svd(Jp, compute_uv=False)
     cp = _condition(np.asarray(sp, dtype=float), rp)
-    cJ = _condition(_gram_sigma(J), rJ)
+    cJ = _condition(gram_sigma(J, rJ), rJ)  # the SVD's values near singular
     p_sing = ~(1.0 / cp > SINGULAR_TOL)
     at = np.flatnonzero(p_sing)  # exact singular values where the rank is in question
     if at.size:
@@ -182,10 +186,10 @@ def singularities(mech: Mechanism, lay: GraphLayout, conf: Configuration,
     if platform is not None:
         fr = lin.frames
         K = platform_jacobian(mech, lay, GraphFrames(
-            fr.R[idx_in], fr.p[idx_in], fr.screws[idx_in], fr.residual[idx_in],
-            fr.centres[idx_in], fr.axes[idx_in]), platform)
+            fr.R, fr.p, fr.screws[idx_in], fr.residual, fr.centres[idx_in], fr.axes),
+            platform)
         M = np.concatenate([J, K], axis=1)
-        cM = _condition(np.asarray(np.linalg.svd(M, compute_uv=False)), rM)
+        cM = _condition(gram_sigma(M, rM), rM)  # the SVD's values near singular
         condition["platform_held"][idx] = cM
     J_sing = ~(1.0 / cJ > SINGULAR_TOL)
     M_sing = ~(1.0 / cM > SINGULAR_TOL) if K is not None else np.zeros(idx.size, bool)
