@@ -16,7 +16,8 @@ Rates and accelerations come from the closure Jacobian (graph/motion.py's ``buil
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,6 +27,9 @@ from screwkit.kinematics.graph.dyads import Placement, configuration, place, pla
 from screwkit.kinematics.graph.subchains import Decomposition
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
+
+if TYPE_CHECKING:
+    from screwkit.kinematics.graph.motion import MechanismMode
 
 Array = NDArray[np.float64]
 
@@ -152,3 +156,15 @@ def mode_label(mech: Mechanism, dec: Decomposition, signs: Array) -> str:
             parts.append(f"{names} {'+' if s == d.drawn_branch else '−'}")
     return ", ".join(parts)
 
+
+def drawn_with_events(mech: Mechanism, lay: GraphLayout, mode: MechanismMode, X: Array,
+                      stop: int, folds: list[str]) -> MechanismMode:
+    """The drawn mode labelled, with its end: where it stops assembling (``stop`` < N) and its
+    first fold (the drawn mode ends there), before its own events."""
+    from screwkit.kinematics.graph.motion import input_text, with_events
+
+    events = folds[:1]
+    if stop < X.shape[0]:
+        events.insert(0, f"stops assembling after input {input_text(mech, lay, X[stop - 1])} (a "
+                         f"limit position or dead centre before {input_text(mech, lay, X[stop])})")
+    return replace(with_events(mode, [*events, *mode.events]), label="drawn")

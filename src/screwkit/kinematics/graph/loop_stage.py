@@ -370,6 +370,7 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     ``every`` every other combination of loop modes and dyad branches that assembles
     somewhere, and the drawn combination's later runs (a mode of their own)."""
     from screwkit.budget import ResourceLimitError
+    from screwkit.kinematics.graph.closed_modes import drawn_with_events
     from screwkit.kinematics.graph.motion import (
         MechanismMotion,
         build_mode,
@@ -422,11 +423,7 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
         masks.append(again)
     held = np.array(masks)
     folds, joins = fold_events(mech, lay, dec, loops, X, a, combos[picked], held, disc[picked])
-    events = folds[0][:1]  # the drawn mode ends at its first fold
-    if stop < N:
-        events.insert(0, f"stops assembling after input {input_text(mech, lay, X[stop - 1])} (a "
-                         f"limit position or dead centre before {input_text(mech, lay, X[stop])})")
-    modes = [replace(with_events(mode, [*events, *mode.events]), label="drawn")]
+    modes = [drawn_with_events(mech, lay, mode, X, stop, folds[0])]
     for n, (m, ev) in enumerate(zip(picked[1:], folds[1:], strict=True), start=1):
         conf = configuration_from_poses(mech, lay, R[m, a:], p[m, a:], X, held[n], False)
         md = build_mode(mech, lay, conf, held[n], X, Xd, Xdd,

@@ -270,6 +270,7 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
         branch_combinations,
         drawn_combination,
         drawn_start,
+        drawn_with_events,
         every_mode,
         mode_configuration,
         mode_label,
@@ -313,11 +314,7 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
         masks.append(again)
     held = np.array(masks)
     folds, joins = _fold_events(mech, lay, dec, X, signs[rows], held)
-    events = folds[0][:1]  # the drawn mode ends at its first fold
-    if stop < N:
-        events.insert(0, f"stops assembling after input {input_text(mech, lay, X[stop - 1])} (a "
-                         f"limit position or dead centre before {input_text(mech, lay, X[stop])})")
-    modes = [replace(with_events(mode, [*events, *mode.events]), label="drawn")]
+    modes = [drawn_with_events(mech, lay, mode, X, stop, folds[0])]
     for i, (m, events) in enumerate(zip(rows[1:], folds[1:], strict=True), start=1):
         conf = mode_configuration(mech, lay, R[m], p[m], X, held[i])
         md = build_mode(mech, lay, conf, held[i], X, Xd, Xdd)
