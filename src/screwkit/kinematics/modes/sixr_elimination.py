@@ -151,7 +151,7 @@ _PRODUCT_ORDER = np.array([0, 1, 3, 4, 2, 5, 6, 7, 8])
 
 
 @lru_cache(maxsize=2)
-def _design(samples: int) -> dict[str, NDArray[Any]]:
+def sample_design(samples: int) -> dict[str, NDArray[Any]]:
     """The fixed sample angles (``samples`` per angle) and the pseudo-inverses of the two
     bases at them."""
     grid = 2.0 * np.pi * np.arange(samples) / samples + 0.1
@@ -182,7 +182,7 @@ def _sides(params: Complex, samples: int = SAMPLES, shift: int = 0
     scale = np.sqrt(np.mean(np.abs(a) ** 2 + np.abs(d) ** 2, axis=1))
     scale = np.where(scale > 0, scale, 1.0)[:, None]
     a, d = a / scale, d / scale
-    D = _design(samples)
+    D = sample_design(samples)
     S2 = len(D["t1"])
     # links 3, 4, 5 at once, R (3, B, S3, 3, 3), t (3, B, S3, 3) (the link first, so that
     # each link's block is contiguous); links 1, 2, 6 likewise
@@ -214,7 +214,7 @@ def fitted_coefficients(params: ArrayLike) -> tuple[Complex, Complex]:
     θ5 − φ5) and right (B, 14, 9) (the nine products of θ1, θ2)."""
     p = _as_parameters(params)
     left, right, _ = _sides(p, CHECK_SAMPLES)
-    D = _design(CHECK_SAMPLES)
+    D = sample_design(CHECK_SAMPLES)
     return (np.einsum("ks,bsq->bqk", D["left_pinv"], left),
             np.einsum("ks,bsq->bqk", D["right_pinv"], right))
 
@@ -225,7 +225,7 @@ def fit_residual(params: ArrayLike) -> Array:
     p = _as_parameters(params)
     left, right, _ = _sides(p, CHECK_SAMPLES)
     L, R = fitted_coefficients(p)
-    D = _design(CHECK_SAMPLES)
+    D = sample_design(CHECK_SAMPLES)
     rl = np.abs(np.einsum("sk,bqk->bsq", D["left"], L) - left).max(axis=(1, 2))
     rr = np.abs(np.einsum("sk,bqk->bsq", D["right"], R) - right).max(axis=(1, 2))
     big = np.maximum(np.abs(left).max(axis=(1, 2)), np.abs(right).max(axis=(1, 2)))
@@ -240,7 +240,7 @@ _PAIRS = ((0, 0), (0, 1), (1, 0), (1, 1), (0, 2), (1, 2), (2, 0), (2, 1), (2, 2)
 
 
 @lru_cache(maxsize=1)
-def _monomial_map() -> Array:
+def monomial_map() -> Array:
     """(3, 9, 3, 9): from the coefficients over [s3, c3, 1] × products of θ4, θ5 to those over
     x3^k × x4^i x5^j (column 3i + j), all three factors (1 + x²) multiplied out."""
     T45 = np.array([np.outer(_HALF[f4], _HALF[f5]).ravel() for f4, f5 in _PAIRS])
@@ -268,7 +268,8 @@ def _axes_from_angles(chain: tuple[Complex, ...], c: Complex, s: Complex) -> Com
     return np.concatenate(out, -1)
 
 
-def eliminate(params: ArrayLike, shift: int = 0) -> tuple[Complex, Complex, Array]:
+def eliminate(params: ArrayLike, shift: int = 0, compiled: bool = True
+              ) -> tuple[Complex, Complex, Array]:
     """The 16 solutions (B, 16, 12) of 6R instances (B, 23) by the eigenproblem (module
     docstring), unpolished; their x3 (B, 16) (for real parameters, exact conjugate pairs and
     exactly real values, as LAPACK returns the eigenvalues of a real matrix, so that a
@@ -276,10 +277,17 @@ def eliminate(params: ArrayLike, shift: int = 0) -> tuple[Complex, Complex, Arra
     (B,) of Σ's leading matrix (the companion form divides by it). ``shift`` k relabels the
     loop cyclically first (joint i of the elimination is the loop's joint i + k): a geometry
     that makes Σ singular for one labelling (two consecutive axes that meet, say) may not for
-    another."""
+    another. ``compiled``: real parameters go through the numba kernels of
+    :mod:`.sixr_compiled` when numba is there (the same steps, one instance at a time; the
+    results equal this module's numpy route to round-off), else through the numpy route."""
     p = _as_parameters(params)
     if shift not in range(6):
         raise InputError(f"the cyclic shift of a 6R loop is 0..5; got {shift}")
+    if compiled and not np.iscomplexobj(p):
+        from screwkit.kinematics.modes import sixr_compiled
+
+        if sixr_compiled.AVAILABLE:
+            return sixr_compiled.eliminate_real(p.real, shift)
     with np.errstate(all="ignore"):
         return _eliminate(p, shift)
 
@@ -291,7 +299,7 @@ def _eliminate(p: Complex, shift: int) -> tuple[Complex, Complex, Array]:
     if bad.any():
         left = np.where(bad[:, None, None], 0.0, left)
         right = np.where(bad[:, None, None], 0.0, right)
-    D = _design(SAMPLES)
+    D = sample_design(SAMPLES)
     L = np.einsum("ks,bsq->bqk", D["left_pinv"], left)  # (B, 14, 27)
     R = np.einsum("ks,bsq->bqk", D["right_pinv"], right)  # (B, 14, 9)
     L[:, :, 26] -= R[:, :, 8]  # the right side's constant moves to the left
@@ -299,7 +307,7 @@ def _eliminate(p: Complex, shift: int) -> tuple[Complex, Complex, Array]:
     U, sv, Vh = np.linalg.svd(Q)
     N = np.swapaxes(U[:, :, 8:], 1, 2).conj()  # (B, 6, 14): N Q = 0
     M = (N @ L).reshape(-1, 6, 3, 9)
-    P = np.einsum("bekj,kjmn->bemn", M, _monomial_map())  # (B, 6, x3 power, 9)
+    P = np.einsum("bekj,kjmn->bemn", M, monomial_map())  # (B, 6, x3 power, 9)
     B = len(p)
     S = np.zeros((B, 3, 12, 12), dtype=complex)
     S[:, :, :6, :9] = np.swapaxes(P, 1, 2)
