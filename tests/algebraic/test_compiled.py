@@ -153,3 +153,53 @@ def test_compiled_term_evaluation_matches_numpy(family, monkeypatch):
         Fp, _, _ = system.evaluate(x + e, p, want_jp=False)
         Fm, _, _ = system.evaluate(x - e, p, want_jp=False)
         assert np.abs((Fp - Fm) / (2 * step) - J[:, :, j]).max() <= 1e-6 * np.abs(J).max()
+
+
+def _moved_6r_points(rng: np.random.Generator):
+    """Points near the 16 solutions of random real 6R loops (the eigen route's, moved by
+    1e-6..1e-3), a non-finite point and one where ∂F/∂x is exactly singular (the origin: every
+    term of every equation's Jacobian row vanishes but the parameters')."""
+    from screwkit.kinematics.modes.sixr_elimination import eliminate
+
+    p, _ = random_loop6r(rng, 6)
+    x = eliminate(p.real)[0].reshape(-1, 12)
+    x = x + 10.0 ** rng.uniform(-6, -3, (len(x), 1)) * rng.standard_normal(x.shape)
+    x = np.concatenate([x, np.full((1, 12), np.nan), np.zeros((1, 12))])
+    return x, np.repeat(p, 16, axis=0)[np.r_[np.arange(len(x) - 2), 0, 0]]
+
+
+def test_the_compiled_polish_and_alpha_test_equal_the_numpy_route(monkeypatch):
+    """compiled.newton_terms and compiled.alpha_terms (the fast α-test's per-point work)
+    against the numpy route: the same polished points, the same certificates."""
+    from screwkit.algebraic.certify import certify
+    from screwkit.kinematics.modes import loop6r_solve
+
+    system = loop6r_system()
+    x, p = _moved_6r_points(np.random.default_rng(7))
+
+    def both(fn):
+        new = fn()
+        with monkeypatch.context() as m:
+            m.setattr(compiled, "AVAILABLE", False)
+            return new, fn()
+
+    new_x, old_x = both(lambda: loop6r_solve._newton(system, x, p, 3))
+    # a singular ∂F/∂x (the last point): the compiled polish leaves the point where it is
+    # (the numpy route takes a pseudo-inverse step there)
+    assert np.array_equal(new_x[-1], x[-1])
+    ok = np.isfinite(old_x[:-1]).all(axis=1)
+    assert np.array_equal(ok, np.isfinite(new_x[:-1]).all(axis=1)) and not ok[-1]
+    scale = 1.0 + np.abs(old_x[:-1][ok]).max(axis=1)
+    assert (np.abs(new_x[:-1][ok] - old_x[:-1][ok]).max(axis=1) <= 1e-12 * scale).all()
+    assert not certify(system, new_x[-1:], p[-1:], fast=True).certified[0]
+    new, old = both(lambda: certify(system, new_x[:-1], p[:-1], fast=True))
+    assert np.array_equal(new.certified, old.certified) and new.certified[:-1].mean() > 0.9
+    assert not new.certified[-1]
+    assert np.array_equal(new.real, old.real) and np.array_equal(new.not_real, old.not_real)
+    good = old.certified
+    for name in ("alpha", "beta", "gamma"):
+        a, b = getattr(new, name), getattr(old, name)
+        assert np.allclose(a[good], b[good], rtol=1e-6, atol=1e-300), name
+        assert np.array_equal(np.isinf(a), np.isinf(b)), name
+    assert np.allclose(new.terms, old.terms, rtol=1e-12, equal_nan=True)
+    assert np.allclose(new.newton[good], old.newton[good], rtol=0, atol=1e-12)

@@ -1,5 +1,6 @@
-"""The compiled 6R elimination (modes/sixr_compiled.py, numba) against the numpy route of
-modes/sixr_elimination.py: the same method, so the same 16 solutions after the polish, the
+"""The compiled 6R elimination (modes/sixr_compiled.py, numba), Newton polish and fast α-test
+(algebraic/compiled.py) against the numpy route (modes/sixr_elimination.py,
+modes/loop6r_solve.py, algebraic/certify.py): the same method, so the same 16 solutions after the polish, the
 same routes, counts and certificates, on random loops and arms (every real solution closing by
 the arm's product-of-exponentials forward kinematics, a check outside both routes).
 
@@ -40,6 +41,7 @@ def test_numba_is_there_for_the_tests() -> None:
 def _numpy_route(monkeypatch: pytest.MonkeyPatch, params: np.ndarray):  # type: ignore[no-untyped-def]
     with monkeypatch.context() as m:
         m.setattr(sixr_compiled, "AVAILABLE", False)
+        m.setattr(compiled, "AVAILABLE", False)  # the polish and the α-test too
         return solve_loop6r(params)
 
 

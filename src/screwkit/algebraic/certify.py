@@ -70,15 +70,26 @@ class Certificate:
 def bombieri_weyl_norm(system: PolynomialSystem, p: Complex) -> NDArray[np.float64]:
     """‖f‖ (B,) of the system at each parameter vector of p (B, k)."""
     eq, exps, coef = system.coefficients_at(p)
-    degree = np.asarray(system.degrees)[eq]
-    alpha0 = degree - exps.sum(axis=1)
-    def log_fact(v: NDArray[np.intp]) -> NDArray[np.float64]:  # log v!, elementwise
-        return np.asarray(gammaln(np.asarray(v, dtype=float) + 1.0), dtype=float)
-
-    log_weight = log_fact(alpha0) + log_fact(exps).sum(axis=1) - log_fact(degree)
     if not len(eq):
         return np.zeros(len(coef))
-    return np.sqrt((np.abs(coef) ** 2 * np.exp(log_weight)).sum(axis=1))
+    return np.sqrt((np.abs(coef) ** 2 * _weights(system, eq, exps)).sum(axis=1))
+
+
+def _weights(system: PolynomialSystem, eq: NDArray[np.intp], exps: NDArray[np.intp]
+             ) -> NDArray[np.float64]:
+    """The Bombieri–Weyl weights α₀!α₁!…α_n!/d_i! of the monomials (eq, exps) of
+    :meth:`.PolynomialSystem.coefficients_at`: fixed by the system, so kept on it."""
+    kept = system.__dict__.get("_bw_weights")
+    if kept is None:
+        degree = np.asarray(system.degrees)[eq]
+        alpha0 = degree - exps.sum(axis=1)
+
+        def log_fact(v: NDArray[np.intp]) -> NDArray[np.float64]:  # log v!, elementwise
+            return np.asarray(gammaln(np.asarray(v, dtype=float) + 1.0), dtype=float)
+
+        kept = np.exp(log_fact(alpha0) + log_fact(exps).sum(axis=1) - log_fact(degree))
+        object.__setattr__(system, "_bw_weights", kept)
+    return kept  # type: ignore[no-any-return]
 
 
 def _norms(system: PolynomialSystem, p: Complex) -> NDArray[np.float64]:
@@ -123,20 +134,26 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False
     κ and ‖Df⁻¹Δ‖ are bounded on the safe side: the test is as rigorous, only more
     conservative, by at most √n in γ). ``norm_f``: ‖f‖ (P,) when the caller has it (one per
     parameter vector, repeated), else computed here."""
+    from screwkit.algebraic import compiled
+
     x = np.asarray(x, dtype=complex)
     P, n = x.shape
     p = np.broadcast_to(np.asarray(p, dtype=complex), (P, system.k))
+    d = np.asarray(system.degrees, dtype=float)
+    norm1 = np.sqrt(1.0 + np.linalg.norm(x, axis=1) ** 2)
+    delta = np.sqrt(d)[None, :] * norm1[:, None] ** (d - 1.0)[None, :]
+    if fast and compiled.AVAILABLE:  # the same quantities, one compiled pass per point
+        t = compiled.alpha_terms(system, x, p, delta)
+        with np.errstate(all="ignore"):
+            return _alpha_test(system, x, p, t.F, t.magnitude, t.finite, 1.0 / t.inv_norm,
+                               t.norm * t.inv_norm, t.step, t.scaled_norm, norm1, d, norm_f)
     F, J, _ = system.evaluate(x, p, want_jp=False)
     magnitude = term_magnitude(system, x, p)
-    err = _evaluation_error(system, magnitude)
     with np.errstate(all="ignore"):
         finite = np.asarray(np.isfinite(J).all(axis=(1, 2)) & np.isfinite(F).all(axis=1),
                             dtype=bool)
         Jsafe = np.where(finite[:, None, None], J, np.eye(n))
         Fsafe = np.where(finite[:, None], F, 0.0)
-        d = np.asarray(system.degrees, dtype=float)
-        norm1 = np.sqrt(1.0 + np.linalg.norm(x, axis=1) ** 2)
-        delta = np.sqrt(d)[None, :] * norm1[:, None] ** (d - 1.0)[None, :]
         Jinv = None
         if fast:
             try:
@@ -158,6 +175,20 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False
             step = np.linalg.solve(Jsafe, Fsafe[..., None])[..., 0]
             scaled = np.linalg.solve(Jsafe, delta[:, :, None] * np.eye(n)[None])  # J⁻¹Δ
             scaled_norm = np.linalg.norm(scaled, ord=2, axis=(1, 2))
+    return _alpha_test(system, x, p, F, magnitude, finite, s_min, kappa, step, scaled_norm,
+                       norm1, d, norm_f)
+
+
+def _alpha_test(system: PolynomialSystem, x: Complex, p: Complex, F: Complex,
+                magnitude: NDArray[np.float64], finite: NDArray[np.bool_],
+                s_min: NDArray[np.float64], kappa: NDArray[np.float64], step: Complex,
+                scaled_norm: NDArray[np.float64], norm1: NDArray[np.float64],
+                d: NDArray[np.float64], norm_f: NDArray[np.float64] | None) -> Certificate:
+    """The α-test (module docstring) from F, Σ|terms|, σ_min and κ of Df (or bounds on the
+    safe side), the Newton step and ‖Df⁻¹Δ‖ of the points x at p."""
+    n = x.shape[1]
+    err = _evaluation_error(system, magnitude)
+    with np.errstate(all="ignore"):
         solve_margin = 1.0 + 10.0 * n * kappa * UNIT_ROUNDOFF
         beta = (np.linalg.norm(step, axis=1) + np.linalg.norm(err, axis=1) / s_min) \
             * solve_margin

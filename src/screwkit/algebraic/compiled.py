@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.algebraic.polynomial import Complex
+from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.quadrics import DenseQuadrics
 
 Index = NDArray[np.intp]
@@ -129,3 +129,56 @@ def track_compiled(dense: DenseQuadrics, instance: Index,
         float(options.predictor_tolerance), float(options.corrector_tolerance),
         float(options.contraction))
     return y, reached, steps
+
+
+def newton_terms(system: PolynomialSystem, x: Complex, p: Complex, steps: int,
+                 settled: float) -> Complex:
+    """Up to ``steps`` Newton steps on F(·; p) from the points x (P, n), p (P, k), compiled
+    (:func:`.compiled_kernels.newton`: a point stops once its step is at most ``settled``
+    relative to 1 + max|x|, or where F, ∂F/∂x or the step is not finite or ∂F/∂x singular)."""
+    from screwkit.algebraic import compiled_kernels
+
+    x = np.array(x, dtype=complex, order="C")
+    pb = np.ascontiguousarray(np.broadcast_to(np.asarray(p, dtype=complex),
+                                              (len(x), system.k)))
+    compiled_kernels.newton(system.coef, system.sym.astype(np.int64),
+                            system.pw.astype(np.int64), system.eq.astype(np.int64), system.n,
+                            x, pb, int(steps), float(settled))
+    return x
+
+
+@dataclass(frozen=True)
+class AlphaTerms:
+    """Per point, what the fast α-test needs (:func:`alpha_terms`): F (P, N), Σ|terms|
+    (P, N), the Newton step J⁻¹F (P, n), whether F and J are finite, ‖J⁻¹‖_F, ‖J‖_F and
+    ‖J⁻¹Δ‖_F (P,)."""
+
+    F: Complex
+    magnitude: NDArray[np.float64]
+    step: Complex
+    finite: NDArray[np.bool_]
+    inv_norm: NDArray[np.float64]
+    norm: NDArray[np.float64]
+    scaled_norm: NDArray[np.float64]
+
+
+def alpha_terms(system: PolynomialSystem, x: Complex, p: Complex,
+                delta: NDArray[np.float64]) -> AlphaTerms:
+    """:class:`AlphaTerms` of the points x (P, n) at p (P, k), Δ = diag(delta) (P, n),
+    compiled (:func:`.compiled_kernels.alpha_terms`: one LU per point for J⁻¹)."""
+    from screwkit.algebraic import compiled_kernels
+
+    x = np.ascontiguousarray(x, dtype=complex)
+    P = len(x)
+    pb = np.ascontiguousarray(np.broadcast_to(np.asarray(p, dtype=complex), (P, system.k)))
+    F = np.empty((P, system.size), dtype=complex)
+    magnitude = np.empty((P, system.size), dtype=complex)
+    step = np.empty((P, system.n), dtype=complex)
+    stats = np.empty((P, 4))
+    compiled_kernels.alpha_terms(system.coef, np.abs(system.coef).astype(complex),
+                                 system.sym.astype(np.int64), system.pw.astype(np.int64),
+                                 system.eq.astype(np.int64), system.n, x, pb,
+                                 np.ascontiguousarray(delta, dtype=float), F, magnitude, step,
+                                 stats)
+    return AlphaTerms(F, magnitude.real.copy(), step, stats[:, 0] > 0, stats[:, 1],
+                      stats[:, 2], stats[:, 3])

@@ -305,3 +305,94 @@ def term_values(coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any, F
                     for _ in range(e - 1):
                         zp *= x[b, s]
                     J[b, i, s] += (c * e) * zp * pre[f] * suf[f + 1]
+
+
+@njit
+def newton(coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any, steps: int,
+           settled: float) -> None:
+    """Up to ``steps`` Newton steps on the term table's F(·; p) from each point x (P, n) in
+    place (p (P, k)), a point's steps ending once one is at most ``settled`` relative to
+    1 + max|x|, or its F, ∂F/∂x or step is not finite, or ∂F/∂x is singular (the point is
+    then left where it is): :func:`.loop6r_solve`'s polish, one point at a time."""
+    P = x.shape[0]
+    N = n
+    F = np.empty((1, N), dtype=np.complex128)
+    J = np.empty((1, N, n), dtype=np.complex128)
+    r = np.empty((N, 1), dtype=np.complex128)
+    for b in range(P):
+        for _ in range(steps):
+            F[:] = 0.0
+            J[:] = 0.0
+            term_values(coef, sym, pw, eq, n, x[b:b + 1], p[b:b + 1], F, J)
+            if not (np.isfinite(F).all() and np.isfinite(J).all()):
+                break
+            for i in range(N):
+                r[i, 0] = F[0, i]
+            if not solve(J[0], r) or not np.isfinite(r).all():
+                break
+            big, top = 0.0, 0.0
+            for i in range(n):
+                big = max(big, abs(r[i, 0]))
+                top = max(top, abs(x[b, i]))
+                x[b, i] -= r[i, 0]
+            if big / (1.0 + top) <= settled:
+                break
+
+
+@njit
+def alpha_terms(coef: Any, abs_coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any,
+                delta: Any, F: Any, magnitude: Any, step: Any, stats: Any) -> None:
+    """What the fast α-test (:func:`.certify.certify`, ``fast``) needs per point of x (P, n),
+    p (P, k): F (P, N), Σ|terms| (P, N) (the table with |coef| at |x|, |p|; complex, real
+    valued), the Newton step
+    J⁻¹F (P, n), and ``stats`` (P, 4): finite (1/0), ‖J⁻¹‖_F, ‖J‖_F, ‖J⁻¹Δ‖_F (Δ = diag
+    ``delta`` (P, n)), with J⁻¹ by one LU per point. A point with F or J not finite has
+    finite 0 and J taken as I (and F as 0); an exactly singular J has ‖J⁻¹‖_F = ∞ and the
+    step F (the numpy route's SVD fallback)."""
+    P = x.shape[0]
+    N = F.shape[1]
+    J = np.empty((1, N, n), dtype=np.complex128)
+    dummy = np.empty((1, N, n), dtype=np.complex128)
+    inv = np.empty((n, n), dtype=np.complex128)
+    ax = np.empty((1, n), dtype=np.complex128)
+    ap = np.empty((1, p.shape[1]), dtype=np.complex128)
+    for b in range(P):
+        F[b] = 0.0
+        J[:] = 0.0
+        term_values(coef, sym, pw, eq, n, x[b:b + 1], p[b:b + 1], F[b:b + 1], J)
+        for i in range(n):
+            ax[0, i] = abs(x[b, i])
+        for i in range(p.shape[1]):
+            ap[0, i] = abs(p[b, i])
+        magnitude[b] = 0.0
+        dummy[:] = 0.0
+        term_values(abs_coef, sym, pw, eq, n, ax, ap, magnitude[b:b + 1], dummy)
+        finite = np.isfinite(F[b]).all() and np.isfinite(J).all()
+        A = J[0].copy()
+        if not finite:
+            A[:] = 0.0
+            for i in range(n):
+                A[i, i] = 1.0
+        norm_j = np.sqrt(np.sum(np.abs(A) ** 2))
+        inv[:] = 0.0
+        for i in range(n):
+            inv[i, i] = 1.0
+        ok = solve(A, inv)
+        if not ok:
+            for i in range(n):
+                step[b, i] = F[b, i] if finite else 0.0
+            stats[b, 0], stats[b, 1], stats[b, 2] = 1.0 if finite else 0.0, np.inf, norm_j
+            stats[b, 3] = np.inf
+            continue
+        for i in range(n):
+            s = 0j
+            if finite:
+                for j in range(n):
+                    s += inv[i, j] * F[b, j]
+            step[b, i] = s
+        scaled = 0.0
+        for i in range(n):
+            for j in range(n):
+                scaled += abs(inv[i, j] * delta[b, j]) ** 2
+        stats[b, 0], stats[b, 1] = 1.0 if finite else 0.0, np.sqrt(np.sum(np.abs(inv) ** 2))
+        stats[b, 2], stats[b, 3] = norm_j, np.sqrt(scaled)

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.algebraic import compiled
 from screwkit.algebraic.certify import Certificate, bombieri_weyl_norm, certify
 from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
@@ -68,7 +69,10 @@ def _targets(params: ArrayLike) -> Complex:
 def _newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Complex:
     """Up to ``steps`` Newton steps on F(·; p) from x (P, n), each after the first only at the
     points whose last step exceeded :data:`SETTLED` (relative); a point whose Jacobian is
-    singular or not finite is left where it is (its certificate will fail)."""
+    singular or not finite is left where it is (its certificate will fail). Compiled, one
+    point at a time, when numba is there (:func:`.compiled.newton_terms`)."""
+    if compiled.AVAILABLE:
+        return compiled.newton_terms(system, x, p, steps, SETTLED)
     x = np.array(x, dtype=complex)
     n = x.shape[1]
     active = np.arange(len(x))
@@ -203,7 +207,7 @@ def solve_loop6r(params: ArrayLike, options: TrackOptions | None = None) -> Solu
     rows = np.flatnonzero(ok[i_eig])
     cert = _rows(cert, rows)
     xs, inst = [x_eig[rows]], [i_eig[rows]]
-    status = [np.full(len(inst[0]), PathStatus.REGULAR, dtype=np.int8)]
+    status = [np.full(len(inst[0]), int(PathStatus.REGULAR), dtype=np.int8)]
     mult = [np.ones(len(inst[0]), dtype=np.int64)]
     at_infinity, failed = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)
     redo = np.flatnonzero(~ok)
