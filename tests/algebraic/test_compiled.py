@@ -169,8 +169,8 @@ def _moved_6r_points(rng: np.random.Generator):
 
 
 def test_the_compiled_polish_and_alpha_test_equal_the_numpy_route(monkeypatch):
-    """compiled.newton_terms and compiled.alpha_terms (the fast α-test's per-point work)
-    against the numpy route: the same polished points, the same certificates."""
+    """compiled.newton_terms and compiled.alpha_test (the fast α-test) against the numpy
+    route: the same polished points, the same certificates."""
     from screwkit.algebraic.certify import certify
     from screwkit.kinematics.modes import loop6r_solve
 

@@ -120,9 +120,18 @@ def _evaluation_error(system: PolynomialSystem, magnitude: NDArray[np.float64]
     """A bound on the rounding error of each F_i(x) (P, N): 8·(terms + degree + factors)·u
     times Σ|terms| (``magnitude``, :func:`term_magnitude`; Higham, *Accuracy and Stability of
     Numerical Algorithms*, 2002, §3.1, for sums and products, with a factor 2 to spare)."""
-    terms = np.diff(np.append(system.starts, len(system.eq)))
-    factor = 8.0 * (terms + np.asarray(system.degrees) + system.sym.shape[1]) * UNIT_ROUNDOFF
-    return magnitude * factor
+    return magnitude * _error_factor(system)
+
+
+def _error_factor(system: PolynomialSystem) -> NDArray[np.float64]:
+    """8·(terms + degree + factors)·u per equation (:func:`_evaluation_error`), kept on the
+    system."""
+    factor = system.__dict__.get("_error_factor")
+    if factor is None:
+        terms = np.diff(np.append(system.starts, len(system.eq)))
+        factor = 8.0 * (terms + np.asarray(system.degrees) + system.sym.shape[1]) * UNIT_ROUNDOFF
+        object.__setattr__(system, "_error_factor", factor)
+    return factor  # type: ignore[no-any-return]
 
 
 def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False,
@@ -139,14 +148,14 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False
     x = np.asarray(x, dtype=complex)
     P, n = x.shape
     p = np.broadcast_to(np.asarray(p, dtype=complex), (P, system.k))
+    if fast and compiled.AVAILABLE:  # the same test, one compiled pass per point
+        real_p = np.all(p.imag == 0, axis=1) & bool(np.all(system.coef.imag == 0))
+        return Certificate(*compiled.alpha_test(
+            system, x, p, _error_factor(system), _norms(system, p) if norm_f is None else norm_f,
+            real_p, ALPHA_0, ALPHA_REAL, UNIT_ROUNDOFF))
     d = np.asarray(system.degrees, dtype=float)
     norm1 = np.sqrt(1.0 + np.linalg.norm(x, axis=1) ** 2)
     delta = np.sqrt(d)[None, :] * norm1[:, None] ** (d - 1.0)[None, :]
-    if fast and compiled.AVAILABLE:  # the same quantities, one compiled pass per point
-        t = compiled.alpha_terms(system, x, p, delta)
-        with np.errstate(all="ignore"):
-            return _alpha_test(system, x, p, t.F, t.magnitude, t.finite, 1.0 / t.inv_norm,
-                               t.norm * t.inv_norm, t.step, t.scaled_norm, norm1, d, norm_f)
     F, J, _ = system.evaluate(x, p, want_jp=False)
     magnitude = term_magnitude(system, x, p)
     with np.errstate(all="ignore"):

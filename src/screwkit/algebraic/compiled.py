@@ -141,31 +141,19 @@ def newton_terms(system: PolynomialSystem, x: Complex, p: Complex, steps: int,
     x = np.array(x, dtype=complex, order="C")
     pb = np.ascontiguousarray(np.broadcast_to(np.asarray(p, dtype=complex),
                                               (len(x), system.k)))
-    compiled_kernels.newton(system.coef, system.sym.astype(np.int64),
-                            system.pw.astype(np.int64), system.eq.astype(np.int64), system.n,
-                            x, pb, int(steps), float(settled))
+    coef, _, sym, pw, eq = _term_table(system)
+    compiled_kernels.newton(coef, sym, pw, eq, system.n, x, pb, int(steps), float(settled))
     return x
 
 
-@dataclass(frozen=True)
-class AlphaTerms:
-    """Per point, what the fast α-test needs (:func:`alpha_terms`): F (P, N), Σ|terms|
-    (P, N), the Newton step J⁻¹F (P, n), whether F and J are finite, ‖J⁻¹‖_F, ‖J‖_F and
-    ‖J⁻¹Δ‖_F (P,)."""
-
-    F: Complex
-    magnitude: NDArray[np.float64]
-    step: Complex
-    finite: NDArray[np.bool_]
-    inv_norm: NDArray[np.float64]
-    norm: NDArray[np.float64]
-    scaled_norm: NDArray[np.float64]
-
-
-def alpha_terms(system: PolynomialSystem, x: Complex, p: Complex,
-                delta: NDArray[np.float64]) -> AlphaTerms:
-    """:class:`AlphaTerms` of the points x (P, n) at p (P, k), Δ = diag(delta) (P, n),
-    compiled (:func:`.compiled_kernels.alpha_terms`: one LU per point for J⁻¹)."""
+def alpha_test(system: PolynomialSystem, x: Complex, p: Complex, factor: NDArray[np.float64],
+               norm_f: NDArray[np.float64], real_p: NDArray[np.bool_], alpha0: float,
+               alpha_real: float, unit: float) -> tuple[Any, ...]:
+    """The fast α-test of the points x (P, n) at p (P, k), compiled
+    (:func:`.compiled_kernels.alpha_test`; ``factor`` (N,) the rounding allowance per
+    Σ|terms|, ``norm_f`` (P,) ‖f‖, ``real_p`` (P,) whether the system is real at p, and the
+    constants α₀, the real test's α and the unit round-off): the fields of a
+    :class:`.certify.Certificate` in order."""
     from screwkit.algebraic import compiled_kernels
 
     x = np.ascontiguousarray(x, dtype=complex)
@@ -173,12 +161,24 @@ def alpha_terms(system: PolynomialSystem, x: Complex, p: Complex,
     pb = np.ascontiguousarray(np.broadcast_to(np.asarray(p, dtype=complex), (P, system.k)))
     F = np.empty((P, system.size), dtype=complex)
     magnitude = np.empty((P, system.size), dtype=complex)
-    step = np.empty((P, system.n), dtype=complex)
-    stats = np.empty((P, 4))
-    compiled_kernels.alpha_terms(system.coef, np.abs(system.coef).astype(complex),
-                                 system.sym.astype(np.int64), system.pw.astype(np.int64),
-                                 system.eq.astype(np.int64), system.n, x, pb,
-                                 np.ascontiguousarray(delta, dtype=float), F, magnitude, step,
-                                 stats)
-    return AlphaTerms(F, magnitude.real.copy(), step, stats[:, 0] > 0, stats[:, 1],
-                      stats[:, 2], stats[:, 3])
+    newton = np.empty((P, system.n), dtype=complex)
+    bounds = np.empty((P, 3))
+    flags = np.empty((P, 3), dtype=np.bool_)
+    coef, abs_coef, sym, pw, eq = _term_table(system)
+    compiled_kernels.alpha_test(coef, abs_coef, sym, pw, eq, system.n, x, pb,
+                                np.asarray(system.degrees, dtype=float), factor,
+                                np.ascontiguousarray(norm_f, dtype=float),
+                                np.ascontiguousarray(real_p, dtype=np.bool_), alpha0,
+                                alpha_real, unit, F, magnitude, newton, bounds, flags)
+    return (flags[:, 0], bounds[:, 0], bounds[:, 1], bounds[:, 2], 2.0 * bounds[:, 1],
+            flags[:, 1], flags[:, 2], newton, F, magnitude.real.copy())
+
+
+def _term_table(system: PolynomialSystem) -> tuple[Any, ...]:
+    """coef, |coef|, sym, pw, eq of the system as the kernels read them, kept on it."""
+    table = system.__dict__.get("_kernel_table")
+    if table is None:
+        table = (system.coef, np.abs(system.coef).astype(complex), system.sym.astype(np.int64),
+                 system.pw.astype(np.int64), system.eq.astype(np.int64))
+        object.__setattr__(system, "_kernel_table", table)
+    return table  # type: ignore[no-any-return]

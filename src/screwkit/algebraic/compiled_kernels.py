@@ -396,3 +396,59 @@ def alpha_terms(coef: Any, abs_coef: Any, sym: Any, pw: Any, eq: Any, n: int, x:
                 scaled += abs(inv[i, j] * delta[b, j]) ** 2
         stats[b, 0], stats[b, 1] = 1.0 if finite else 0.0, np.sqrt(np.sum(np.abs(inv) ** 2))
         stats[b, 2], stats[b, 3] = norm_j, np.sqrt(scaled)
+
+
+@njit
+def alpha_test(coef: Any, abs_coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any,
+               degrees: Any, factor: Any, norm_f: Any, real_p: Any, alpha0: float,
+               alpha_real: float, unit: float, F: Any, magnitude: Any, newton: Any,
+               bounds: Any, flags: Any) -> None:
+    """The fast α-test (:func:`.certify.certify`, ``fast``; its module docstring for the
+    bounds) of the points x (P, n) at p (P, k), each through :func:`alpha_terms`: F and
+    Σ|terms| (P, N), the Newton points (P, n), ``bounds`` (P, 3) α, β, γ (∞ where the test
+    cannot run) and ``flags`` (P, 3) certified, real, not real. ``degrees`` (N,) of the
+    equations, ``factor`` (N,) the rounding allowance per Σ|terms|, ``norm_f`` (P,) ‖f‖,
+    ``real_p`` (P,) whether the system is real at p."""
+    P = x.shape[0]
+    dmax = 1.0
+    for i in range(degrees.shape[0]):
+        dmax = max(dmax, degrees[i])
+    delta = np.empty((P, n))
+    norm1 = np.empty(P)
+    for b in range(P):
+        sq = 0.0
+        for i in range(n):
+            sq += abs(x[b, i]) ** 2
+        norm1[b] = np.sqrt(1.0 + sq)
+        for i in range(n):
+            delta[b, i] = np.sqrt(degrees[i]) * norm1[b] ** (degrees[i] - 1.0)
+    step = np.empty((P, n), dtype=np.complex128)
+    stats = np.empty((P, 4))
+    alpha_terms(coef, abs_coef, sym, pw, eq, n, x, p, delta, F, magnitude, step, stats)
+    for b in range(P):
+        err, st, gap = 0.0, 0.0, 0.0
+        for i in range(F.shape[1]):
+            err += (magnitude[b, i].real * factor[i]) ** 2
+        for i in range(n):
+            st += abs(step[b, i]) ** 2
+            gap += (2.0 * x[b, i].imag) ** 2
+            newton[b, i] = x[b, i] - step[b, i]
+        finite, inv_norm, norm_j, scaled = stats[b, 0] > 0, stats[b, 1], stats[b, 2], stats[b, 3]
+        s_min = 1.0 / inv_norm
+        margin = 1.0 + 10.0 * n * (norm_j * inv_norm) * unit
+        beta = (np.sqrt(st) + np.sqrt(err) / s_min) * margin
+        mu = norm_f[b] * scaled * margin
+        if not (mu > 1.0 or np.isnan(mu)):
+            mu = 1.0
+        gamma = mu * dmax ** 1.5 / (2.0 * norm1[b])
+        alpha = beta * gamma
+        ok = finite and np.isfinite(alpha) and s_min > 0
+        certified = ok and alpha < alpha0
+        gap = np.sqrt(gap)
+        flags[b, 0] = certified
+        flags[b, 1] = certified and real_p[b] and alpha < alpha_real and gap < 1.0 / (20.0 * gamma)
+        flags[b, 2] = certified and real_p[b] and gap > 4.0 * beta
+        if ok:
+            bounds[b, 0], bounds[b, 1], bounds[b, 2] = alpha, beta, gamma
+        else:
+            bounds[b, 0], bounds[b, 1], bounds[b, 2] = np.inf, np.inf, np.inf

@@ -29,6 +29,7 @@ from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.solve import Solutions, collect_solutions
 from screwkit.algebraic.track import PathStatus, track_parameter_homotopy
 from screwkit.errors import InputError
+from screwkit.kinematics.modes import sixr_compiled
 from screwkit.kinematics.modes.loop6r import (
     LOOP6R_GENERIC_COUNT,
     PARAMETER_NAMES,
@@ -122,7 +123,9 @@ def eigen_route(params: ArrayLike
     for shift in SHIFTS:
         xs, inst, good, cert = _eigen_pass(targets[todo], shift)
         keep = np.flatnonzero(good[inst])
-        parts.append((xs[keep], todo[inst[keep]], _rows(cert, keep)))
+        if len(keep) < len(inst):  # (else keep is every row: nothing to take)
+            xs, inst, cert = xs[keep], inst[keep], _rows(cert, keep)
+        parts.append((xs, todo[inst], cert))
         ok[todo[good]] = True
         todo = todo[~good]
         if not len(todo):
@@ -153,12 +156,27 @@ def _eigen_pass(targets: Complex, shift: int
     finite: NDArray[np.bool_] = np.asarray(np.isfinite(xs).all(1), dtype=bool)
     xs = np.where(finite[:, None], xs, 0.0)
     cert = certify(system, xs, p, fast=True, norm_f=bombieri_weyl_norm(system, targets)[inst])
-    xs = np.concatenate([xs, xs[twin].conj()])
-    inst = np.concatenate([inst, inst[twin]])
-    finite = np.concatenate([finite, finite[twin]])
-    cert = _joined(cert, _conjugate(_rows(cert, twin)))
-    order = np.argsort(inst, kind="stable")
-    xs, inst, finite, cert = xs[order], inst[order], finite[order], _rows(cert, order)
+    # every point: the polished ones, then their twins (conjugated), sorted by instance (one
+    # instance: already in order), in one take
+    rows = np.concatenate([np.arange(len(sel)), twin])
+    flip = np.arange(len(rows)) >= len(sel)
+    if B > 1:
+        order = np.argsort(inst[rows], kind="stable")
+        rows, flip = rows[order], flip[order]
+    xs, inst, finite = np.where(flip[:, None], xs[rows].conj(), xs[rows]), inst[rows], finite[rows]
+    cert = _rows(cert, rows, flip)
+    return xs, inst, _settled(xs, inst, finite, cert, B), cert
+
+
+def _settled(xs: Complex, inst: NDArray[np.intp], finite: NDArray[np.bool_], cert: Certificate,
+             B: int) -> NDArray[np.bool_]:
+    """Whether each of the B instances is settled by its points xs (sorted by ``inst``):
+    16 of them, each certified or converged, pairwise distinct (:func:`eigen_route`);
+    compiled when numba is there (:func:`.sixr_compiled.settled`)."""
+    if sixr_compiled.AVAILABLE:
+        return sixr_compiled.settled(xs, inst, finite, cert.newton, cert.certified, cert.radius,
+                                     B, LOOP6R_GENERIC_COUNT, CONVERGED, DISTINCT)
+    m = LOOP6R_GENERIC_COUNT
     scale = 1.0 + np.abs(xs).max(axis=1)
     with np.errstate(invalid="ignore"):
         settled = np.abs(xs - cert.newton).max(axis=1) <= CONVERGED * scale
@@ -171,23 +189,19 @@ def _eigen_pass(targets: Complex, shift: int
     gap = np.linalg.norm(x16[:, _PAIR_I] - x16[:, _PAIR_J], axis=-1)
     ok[ok] = good[full].reshape(-1, m).all(axis=1) & (
         gap > r16[:, _PAIR_I] + r16[:, _PAIR_J]).all(axis=1)
-    return xs, inst, ok, cert
+    return ok
 
 
-def _rows(cert: Certificate, rows: NDArray[np.intp]) -> Certificate:
-    """The certificate of the points ``rows``."""
+def _rows(cert: Certificate, rows: NDArray[np.intp],
+          flip: NDArray[np.bool_] | None = None) -> Certificate:
+    """The certificate of the points ``rows``; where ``flip``, of their conjugates (a real
+    system's: the same bounds, the conjugate Newton points and values)."""
     parts: dict[str, Any] = {name: (None if getattr(cert, name) is None
                                     else getattr(cert, name)[rows]) for name in _FIELDS}
-    return Certificate(**parts)
-
-
-def _conjugate(cert: Certificate) -> Certificate:
-    """The certificate of the conjugate points of a real system: the same bounds, the
-    conjugate Newton points and values."""
-    parts: dict[str, Any] = {name: getattr(cert, name) for name in _FIELDS}
-    for name in ("newton", "value"):
-        if parts[name] is not None:
-            parts[name] = parts[name].conj()
+    if flip is not None:
+        for name in ("newton", "value"):
+            if parts[name] is not None:
+                parts[name] = np.where(flip[:, None], parts[name].conj(), parts[name])
     return Certificate(**parts)
 
 
@@ -205,8 +219,9 @@ def solve_loop6r(params: ArrayLike, options: TrackOptions | None = None) -> Solu
     B, m = len(targets), LOOP6R_GENERIC_COUNT
     x_eig, i_eig, ok, cert = eigen_route(targets)
     rows = np.flatnonzero(ok[i_eig])
-    cert = _rows(cert, rows)
-    xs, inst = [x_eig[rows]], [i_eig[rows]]
+    if len(rows) < len(i_eig):  # (else every row)
+        cert, x_eig, i_eig = _rows(cert, rows), x_eig[rows], i_eig[rows]
+    xs, inst = [x_eig], [i_eig]
     status = [np.full(len(inst[0]), int(PathStatus.REGULAR), dtype=np.int8)]
     mult = [np.ones(len(inst[0]), dtype=np.int64)]
     at_infinity, failed = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)

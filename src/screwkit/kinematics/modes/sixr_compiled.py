@@ -82,3 +82,19 @@ def eliminate_real(p: Array, shift: int) -> tuple[Complex, Complex, Array]:
     sixr_kernels.solutions(lam, W, idx, L, pinv, cos_a, sin_a, R0, bad, shift, offsets, axes,
                            x3)
     return axes, x3, cond
+
+
+def settled(xs: Complex, inst: NDArray[np.intp], finite: NDArray[np.bool_], newton: Complex,
+            certified: NDArray[np.bool_], radius: Array, B: int, m: int, converged: float,
+            distinct: float) -> NDArray[np.bool_]:
+    """loop6r_solve's verdict per instance (B,) on its points xs (P, n) sorted by ``inst``,
+    compiled (:func:`.sixr_kernels.settled`)."""
+    from screwkit.kinematics.modes import sixr_kernels
+
+    ok = np.zeros(B, dtype=np.bool_)
+    if len(xs):
+        sixr_kernels.settled(np.ascontiguousarray(xs), np.ascontiguousarray(newton),
+                             np.ascontiguousarray(certified), np.ascontiguousarray(radius),
+                             np.ascontiguousarray(finite), np.ascontiguousarray(inst), m,
+                             converged, distinct, ok)
+    return ok

@@ -307,3 +307,44 @@ def solutions(lam: Any, W: Any, idx: Any, L: Any, pinv: Any, cos_a: Any, sin_a: 
                 R = R @ _rz_rx(cos_t[j], sin_t[j], cos_a[b, i], sin_a[b, i])
                 for r in range(3):
                     axes[b, m, 3 * i + r] = R[r, 2]
+
+
+@njit
+def settled(xs: Any, newton: Any, certified: Any, radius: Any, finite: Any, inst: Any,
+            m: int, converged: float, distinct: float, ok: Any) -> None:
+    """Whether each instance's points (xs (P, n), sorted by ``inst``) settle it
+    (loop6r_solve._eigen_pass): exactly m points, each certified or converged (its Newton
+    point within ``converged`` relative to 1 + max|x|) and finite, every pair apart by more
+    than the sum of their radii (2β when certified, else ``distinct`` relative); ``ok`` (B,)
+    filled."""
+    P, n = xs.shape
+    ok[:] = False
+    start = 0
+    while start < P:
+        b = inst[start]
+        stop = start
+        while stop < P and inst[stop] == b:
+            stop += 1
+        good = stop - start == m
+        r = np.empty(stop - start)
+        for j in range(start, stop):
+            scale, step = 0.0, 0.0
+            for i in range(n):
+                scale = max(scale, abs(xs[j, i]))
+                step = max(step, abs(xs[j, i] - newton[j, i]))
+            scale += 1.0
+            near = step <= converged * scale
+            good = good and (certified[j] or near) and finite[j]
+            r[j - start] = radius[j] if certified[j] else distinct * scale
+        for j in range(start, stop):
+            if not good:
+                break
+            for k in range(j + 1, stop):
+                d = 0.0
+                for i in range(n):
+                    d += abs(xs[j, i] - xs[k, i]) ** 2
+                if not np.sqrt(d) > r[j - start] + r[k - start]:
+                    good = False
+                    break
+        ok[b] = good
+        start = stop
