@@ -203,3 +203,18 @@ def test_the_compiled_polish_and_alpha_test_equal_the_numpy_route(monkeypatch):
         assert np.array_equal(np.isinf(a), np.isinf(b)), name
     assert np.allclose(new.terms, old.terms, rtol=1e-12, equal_nan=True)
     assert np.allclose(new.newton[good], old.newton[good], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("family", ["stewart", "loop6r"])
+def test_the_compiled_bombieri_weyl_norm_equals_the_numpy_one(monkeypatch, family):
+    from screwkit.algebraic.certify import bombieri_weyl_norm
+
+    system = stewart_system() if family == "stewart" else loop6r_system()
+    rng = np.random.default_rng(8)
+    p = rng.standard_normal((5, system.k)) + 1j * rng.standard_normal((5, system.k))
+    p[0] = p[0].real
+    new = bombieri_weyl_norm(system, p)
+    with monkeypatch.context() as m:
+        m.setattr(compiled, "AVAILABLE", False)
+        old = bombieri_weyl_norm(system, p)
+    assert np.allclose(new, old, rtol=1e-13, atol=0) and (old > 0).all()

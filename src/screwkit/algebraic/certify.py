@@ -68,7 +68,21 @@ class Certificate:
 
 
 def bombieri_weyl_norm(system: PolynomialSystem, p: Complex) -> NDArray[np.float64]:
-    """‖f‖ (B,) of the system at each parameter vector of p (B, k)."""
+    """‖f‖ (B,) of the system at each parameter vector of p (B, k); compiled when numba is
+    there (:func:`.compiled.bombieri_weyl`: the same sums, one parameter row at a time)."""
+    from screwkit.algebraic import compiled
+
+    if compiled.AVAILABLE and len(system.eq):
+        plan = system.__dict__.get("_bw_plan")
+        if plan is None:
+            eq, exps, _ = system.coefficients_at(np.zeros(system.k, dtype=complex))
+            _, order, heads = system.monomial_plan()
+            group = np.repeat(np.arange(len(heads)), np.diff(np.append(heads, len(order))))
+            term_group = np.empty(len(order), dtype=np.int64)
+            term_group[order] = group
+            plan = (order.astype(np.int64), term_group, _weights(system, eq, exps))
+            object.__setattr__(system, "_bw_plan", plan)
+        return compiled.bombieri_weyl(system, p, *plan)
     eq, exps, coef = system.coefficients_at(p)
     if not len(eq):
         return np.zeros(len(coef))

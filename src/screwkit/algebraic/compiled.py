@@ -182,3 +182,17 @@ def _term_table(system: PolynomialSystem) -> tuple[Any, ...]:
                  system.pw.astype(np.int64), system.eq.astype(np.int64))
         object.__setattr__(system, "_kernel_table", table)
     return table  # type: ignore[no-any-return]
+
+
+def bombieri_weyl(system: PolynomialSystem, p: Complex, order: NDArray[np.intp],
+                  group: NDArray[np.intp], weights: NDArray[np.float64]) -> NDArray[np.float64]:
+    """‖f‖ (B,) of the system at each row of p (B, k), compiled
+    (:func:`.compiled_kernels.bombieri_weyl`; ``order``, ``group`` and ``weights`` the
+    monomials of :meth:`.PolynomialSystem.coefficients_at` and their weights)."""
+    from screwkit.algebraic import compiled_kernels
+
+    coef, _, sym, pw, _ = _term_table(system)
+    pb = np.ascontiguousarray(np.atleast_2d(np.asarray(p, dtype=complex)))
+    out = np.empty(len(pb))
+    compiled_kernels.bombieri_weyl(coef, sym, pw, system.n, order, group, weights, pb, out)
+    return out

@@ -452,3 +452,28 @@ def alpha_test(coef: Any, abs_coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: 
             bounds[b, 0], bounds[b, 1], bounds[b, 2] = alpha, beta, gamma
         else:
             bounds[b, 0], bounds[b, 1], bounds[b, 2] = np.inf, np.inf, np.inf
+
+
+@njit
+def bombieri_weyl(coef: Any, sym: Any, pw: Any, n: int, order: Any, group: Any, weights: Any,
+                  p: Any, out: Any) -> None:
+    """‖f‖ (B,) at each parameter row of p (B, k) (:func:`.certify.bombieri_weyl_norm`): each
+    term's coefficient times its parameters' powers, summed per monomial in x (the terms
+    ``order``-ed by monomial, ``group`` (T,) the monomial of each term), then
+    √(Σ |c|²·weight) over the monomials."""
+    G = weights.shape[0]
+    acc = np.empty(G, dtype=np.complex128)
+    for b in range(p.shape[0]):
+        acc[:] = 0.0
+        for t in order:
+            v = 1.0 + 0.0j
+            for f in range(sym.shape[1]):
+                s = sym[t, f]
+                if s >= n:
+                    for _ in range(pw[t, f]):
+                        v *= p[b, s - n]
+            acc[group[t]] += coef[t] * v
+        total = 0.0
+        for g in range(G):
+            total += (acc[g].real ** 2 + acc[g].imag ** 2) * weights[g]
+        out[b] = np.sqrt(total)

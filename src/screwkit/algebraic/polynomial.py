@@ -262,14 +262,14 @@ class PolynomialSystem:
         equation (G,) and exponent vector (G, n) of each distinct monomial in x, and its
         coefficient (B, G), the sum over the terms with that monomial of coef·Π p^pw."""
         p = np.atleast_2d(np.asarray(p, dtype=complex))
-        keys, order, heads = self._monomials()
+        keys, order, heads = self.monomial_plan()
         z = self._columns(np.ones((len(p), self.n), dtype=complex), p)
         values = (self.coef[:, None] * np.prod(self._power_table(z)[self.pw, self.sym],
                                                axis=1)).T
         out = np.add.reduceat(values[:, order], heads, axis=1)
         return keys[:, 0].astype(np.intp), keys[:, 1:].astype(np.intp), out
 
-    def _monomials(self) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.intp]]:
+    def monomial_plan(self) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.intp]]:
         """The (equation, exponents in x) of each distinct monomial in x, the terms in the
         order of their monomials and the first of each (for reduceat): fixed by the system,
         so kept on it."""
