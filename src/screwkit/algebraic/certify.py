@@ -155,7 +155,8 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False
     ``fast``: one inverse of Df(x) per point instead of two singular value decompositions,
     with every 2-norm replaced by the Frobenius norm, which bounds it from above (so σ_min,
     κ and ‖Df⁻¹Δ‖ are bounded on the safe side: the test is as rigorous, only more
-    conservative, by at most √n in γ). ``norm_f``: ‖f‖ (P,) when the caller has it (one per
+    conservative, by at most √n in γ; compiled when numba is there, :func:`.compiled.alpha_test`,
+    the same arithmetic point by point). ``norm_f``: ‖f‖ (P,) when the caller has it (one per
     parameter vector, repeated), else computed here."""
     from screwkit.algebraic import compiled
 

@@ -21,6 +21,13 @@ a scatter per column into F and J, |·| by hypot in the pivot search). The arith
 to rounding, so both routes reach the same end points (to the Newton polish's accuracy) with the
 same statuses; tests/algebraic/test_compiled.py checks it.
 
+The same module compiles three per-point passes over a term table
+(:class:`.polynomial.PolynomialSystem`), each the numpy route's arithmetic one point at a time
+(issue 27, the 6R eigen route alone): the Newton polish (:func:`newton_terms`), the fast α-test
+of :func:`.certify.certify` (:func:`alpha_test`: F, Σ|terms|, J⁻¹ by one LU per point, the
+Frobenius bounds and the verdicts) and the Bombieri–Weyl norm (:func:`bombieri_weyl`);
+tests/algebraic/test_compiled.py checks them against the numpy route.
+
 numba is optional (the ``fast`` extra): :data:`AVAILABLE` is False without it, and the tracker
 then runs the numpy route. The kernels are compiled on first use (a few seconds, cached on disk
 by numba next to this module when the folder is writable).
