@@ -11,7 +11,8 @@ their wall time varies with the load (as in bench_fourbar.py). Memory is the tra
 * closed-form kinematics: ``cssp_mode_motion`` on ``SAMPLES`` crank angles — as it is by
   default, without the ball joints' rotation vectors (``joint_rotations=False``) and lean
   (``ball_joints=False``: only what the dynamics reads);
-* dynamics: ``inverse_dynamics`` on that ModeMotion (the CSSP closed-form statics, blocked), and
+* dynamics: ``inverse_dynamics`` on that ModeMotion (the CSSP closed-form statics, blocked;
+  compiled by numba where it is installed, dynamics/cssp_compiled.py), and
   the chain kinematics + dynamics, the issue's target (≤ 1 µs per sample, ≤ 2 GiB);
 * fused: ``cssp_inverse_dynamics`` — the same loads, kinematics and dynamics block by block
   without building the ModeMotion;
@@ -547,6 +548,14 @@ def _dynamics_on_modes(lk: Any, theta: np.ndarray, omega: float) -> tuple[float,
     return dyn, peak, dyn_full
 
 
+def _route() -> str:
+    """Which route ran the CSSP's blocked statics on 10⁶ samples."""
+    from screwkit.dynamics import cssp_compiled
+
+    return ("compiled (numba)" if cssp_compiled.use_compiled(SAMPLES)
+            else "numpy route (numba not installed)")
+
+
 def run(samples: int = SAMPLES, families: bool = True) -> list[dict[str, Any]]:
     from screwkit.dynamics import cssp_inverse_dynamics, inverse_dynamics
     from screwkit.kinematics.closed_forms.cssp_motion import cssp_mode_motion
@@ -619,7 +628,8 @@ def run(samples: int = SAMPLES, families: bool = True) -> list[dict[str, Any]]:
         rows.append({"name": "CSSP inverse_dynamics (closed-form statics, blocked) / pinocchio rnea, per "
                              "sample", "value": dyn / rnea["value"], "unit": "ratio",
                      "target": 0.34, "note": f"rnea {rnea['value']:.2f} us/call (issue 30: "
-                                             "the dynamics step alone stays at 0.34x)"})
+                                             "the dynamics step alone stays at 0.34x); "
+                                             f"{_route()}"})
     constraint = _pinocchio("constraint")
     rows += [constraint, *solve_motion_rows(lk, theta, omega, dyn, constraint)]
     if families:

@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from screwkit.dual.spatial import cross
+from screwkit.dynamics import cssp_compiled as compiled
 from screwkit.dynamics.checks import (
     DynamicsInputError,
     ExternalLoad,
@@ -339,6 +340,11 @@ def _run(
     plan = _closed_form_plan(linkage, s) if closed_form else None
     N = s.valid.shape[0]
     out = Outputs.allocate(linkage, N, fill=not s.valid.all())
+    if plan is not None and not external and compiled.use_compiled(N):  # same loads, compiled
+        if not compiled.mode_loads(linkage, plan, masses, s, mode_motion, out, block_size,
+                                   check_finite=not check_finite):
+            raise _NonFiniteMotion
+        return as_dynamics(linkage, mode_motion.joint_centres, s, out)
     for sel in blocks(s.valid, block_size):
         part = _subset(mode_motion, sel)
         dest = out.block(sel)
