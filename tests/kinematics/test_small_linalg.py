@@ -5,6 +5,8 @@ samples; and the Watt six-bar's drawn mode the same by both routes."""
 
 from __future__ import annotations
 
+import importlib
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +26,26 @@ def _built(rng: np.random.Generator, sigma: np.ndarray, rows: int) -> np.ndarray
     return np.asarray(U * sigma[:, None, :] @ np.swapaxes(V, 1, 2))
 
 
+def _route(monkeypatch: pytest.MonkeyPatch, compiled: bool) -> None:
+    """The compiled route for every batch, however small, or numpy's."""
+    monkeypatch.setattr(small_linalg, "AVAILABLE", compiled)
+    monkeypatch.setattr(small_linalg, "LOAD_FROM", 0)
+
+
+def test_loaded_only_for_a_large_batch_or_once_loaded(monkeypatch: pytest.MonkeyPatch) -> None:
+    name = "screwkit.kinematics.graph.small_kernels"
+    kernels = importlib.import_module(name)
+    monkeypatch.setattr(small_linalg, "AVAILABLE", True)
+    monkeypatch.delitem(sys.modules, name)  # not loaded yet
+    assert not small_linalg.compiled(small_linalg.LOAD_FROM - 1)
+    assert not small_linalg.compiled(0)
+    assert small_linalg.compiled(small_linalg.LOAD_FROM)
+    monkeypatch.setitem(sys.modules, name, kernels)  # loaded
+    assert small_linalg.compiled(1)
+    monkeypatch.setattr(small_linalg, "AVAILABLE", False)
+    assert not small_linalg.compiled(small_linalg.LOAD_FROM)
+
+
 def test_numba_is_there_for_the_tests() -> None:
     """numba is in the dev extra: without it the comparisons below would compare the numpy
     route with itself."""
@@ -33,7 +55,7 @@ def test_numba_is_there_for_the_tests() -> None:
 @pytest.mark.parametrize("compiled", [True, False])
 def test_gram_eigenvalues_are_the_squared_singular_values(monkeypatch: pytest.MonkeyPatch,
                                                           compiled: bool) -> None:
-    monkeypatch.setattr(small_linalg, "AVAILABLE", compiled)
+    _route(monkeypatch, compiled)
     rng = np.random.default_rng(11)
     for k, rows in ((1, 1), (1, 4), (3, 3), (6, 12), (7, 7), (7, 18), (9, 12)):
         sigma = np.sort(rng.uniform(0.05, 3.0, (100, k)), axis=1)[:, ::-1]
@@ -54,9 +76,9 @@ def test_gram_eigenvalues_compiled_as_lapack(monkeypatch: pytest.MonkeyPatch) ->
     J[60, 2, 1] = np.nan
     J[61, 0, 2] = np.inf
     for A in (J, J[:, :, [1, 2, 3, 4, 5, 6]], J[:, :6, :]):
-        monkeypatch.setattr(small_linalg, "AVAILABLE", True)
+        _route(monkeypatch, True)
         got = gram_eigenvalues(A)
-        monkeypatch.setattr(small_linalg, "AVAILABLE", False)
+        _route(monkeypatch, False)
         ref = gram_eigenvalues(A)
         bad = np.isnan(ref[:, 0])
         assert bad[[60, 61]].all() and bad.sum() == 2
@@ -72,7 +94,7 @@ def test_qr_inverse_is_the_least_squares_solution(monkeypatch: pytest.MonkeyPatc
     """R⁻¹Q₁ᵀ against the SVD's pseudo-inverse (to round-off times the condition number) and
     R's diagonal against |R| from numpy's QR; a matrix with a zero column has no finite
     inverse."""
-    monkeypatch.setattr(small_linalg, "AVAILABLE", compiled)
+    _route(monkeypatch, compiled)
     rng = np.random.default_rng(13)
     for k, rows in ((1, 3), (6, 6), (6, 12), (7, 18)):
         sigma = np.sort(rng.uniform(0.1, 3.0, (80, k)), axis=1)[:, ::-1]
@@ -102,7 +124,7 @@ def test_watt_drawn_mode_the_same_by_both_routes(monkeypatch: pytest.MonkeyPatch
     theta = np.radians(np.arange(0.0, 360.0, 0.5))
     motion = {}
     for compiled in (True, False):
-        monkeypatch.setattr(small_linalg, "AVAILABLE", compiled)
+        _route(monkeypatch, compiled)
         motion[compiled] = solve_mechanism(mech, theta, rates=2.0, accelerations=0.5).modes[0]
     a, b = motion[True], motion[False]
     for name in a.velocities:

@@ -13,14 +13,18 @@ Both routes are backward stable and agree to round-off (tests/kinematics/test_sm
 For 6×6 and 7×7 matrices LAPACK's cost per matrix is mostly its calling overhead (workspace
 queries, copies to column order); the compiled loops run ~3× faster here. numba is optional
 (the ``fast`` extra): :data:`AVAILABLE` is False without it or with SCREWKIT_NO_NUMBA set, and
-numpy then does the work. The kernels compile on first use (a few seconds, cached on disk next
-to graph/small_kernels.py when the folder is writable).
+numpy then does the work. Loading them costs once per process what they save on some 10⁵
+matrices (numba's import and the kernels' disk cache, ~0.5–1 s; compiling them the first time,
+a few seconds, cached next to graph/small_kernels.py when the folder is writable), so a call
+loads them only for a batch of at least :data:`LOAD_FROM` matrices (a motion of that many
+samples), and every later call, large or small, uses them.
 """
 
 from __future__ import annotations
 
 import importlib.util
 import os
+import sys
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,6 +34,15 @@ Array = NDArray[np.float64]
 #: numba is installed and not turned off by SCREWKIT_NO_NUMBA (imported on first use only)
 AVAILABLE = (importlib.util.find_spec("numba") is not None
              and not os.environ.get("SCREWKIT_NO_NUMBA"))
+#: matrices in one call from which the kernels are loaded (module docstring)
+LOAD_FROM = 2000
+
+
+def compiled(count: int) -> bool:
+    """Whether a batch of ``count`` matrices runs compiled: numba is there and the kernels are
+    loaded already or worth loading for it."""
+    return AVAILABLE and count > 0 and (
+        count >= LOAD_FROM or "screwkit.kinematics.graph.small_kernels" in sys.modules)
 
 
 def gram_eigenvalues(A: Array) -> Array:
@@ -40,7 +53,7 @@ def gram_eigenvalues(A: Array) -> Array:
     k = min(a, b)
     if N == 0 or k == 0:
         return np.zeros((N, k))
-    if AVAILABLE:
+    if compiled(N):
         from screwkit.kinematics.graph import small_kernels
 
         out = np.empty((N, k))
@@ -61,7 +74,7 @@ def qr_inverse(A: Array) -> tuple[Array, Array]:
     the least-squares sense where A has full column rank; and R's diagonal (N, b). Where R is
     singular the inverse is not finite (the caller takes another route there)."""
     N, a, b = A.shape
-    if AVAILABLE and N:
+    if compiled(N):
         from screwkit.kinematics.graph import small_kernels
 
         P = np.empty((N, b, a))
