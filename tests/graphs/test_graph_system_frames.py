@@ -41,6 +41,8 @@ def test_kept_frames_are_the_forward_maps() -> None:
         got = system.frames(c)  # partly kept (conf), then not at all (moved)
         for name in FIELDS:
             assert np.array_equal(getattr(got, name), getattr(expect, name)), name
+    empty = system.frames(conf.take(np.arange(0)))  # no rows: as the forward map
+    assert empty.R.shape[0] == 0 and system.residual(conf.take(np.arange(0)))[0].shape == (0,)
     again = system.frames(conf)  # every row kept now
     for name in FIELDS:
         assert np.array_equal(getattr(again, name), getattr(ref, name)), name

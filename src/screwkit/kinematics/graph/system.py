@@ -95,7 +95,8 @@ class GraphSystem:
         self.memo.clear()
 
     def _keys(self, conf: Configuration) -> list[bytes]:
-        rows = np.concatenate([conf.scalars, conf.spherical.reshape(conf.size, -1)], axis=1)
+        rows = np.concatenate([conf.scalars,
+                               conf.spherical.reshape(conf.size, 9 * self.n_spherical)], axis=1)
         return [r.tobytes() for r in np.ascontiguousarray(rows)]
 
     def _keep(self, conf: Configuration, fr: GraphFrames) -> None:
