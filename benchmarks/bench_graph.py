@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 import screwkit as sk
-from screwkit.kinematics.graph import solve_mechanism
+from screwkit.kinematics.graph import small_linalg, solve_mechanism
 from screwkit.kinematics.graph.closed_modes import every_mode
 from screwkit.kinematics.graph.closure import graph_layout
 from screwkit.kinematics.graph.follow import follow_drawn_mode
@@ -346,7 +346,9 @@ def run() -> list[dict[str, Any]]:
     rows: list[dict[str, Any]] = [{
         "name": "Watt six-bar, 3 600 samples, drawn mode (closed-form dyads)",
         "value": t_ours / SAMPLES * 1e6, "unit": "µs/sample", "target": 20.0,
-        "note": f"every body, exact rates and accelerations; best of {REPEATS}, CPU time"}]
+        "note": f"every body, exact rates and accelerations; best of {REPEATS}, CPU time; "
+                f"small matrices {'compiled' if small_linalg.AVAILABLE else 'by LAPACK'} "
+                "(graph/small_linalg.py)"}]
     rows += _every_mode_rows(mech, theta, t_ours)
     t_py, path, note = _pylinkage(mech, theta)
     if t_py is None or path is None:

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
 from screwkit.kinematics.graph.dyads import Placement, configuration, place, place_every
 from screwkit.kinematics.graph.subchains import Decomposition
 from screwkit.kinematics.tracker.loop import Configuration
@@ -98,6 +98,19 @@ def mode_configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X:
     for k, f in enumerate(lay.inputs):
         q[:, lay.scalar_col[f]] = X[:, k]
     return conf
+
+
+def mode_frames(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, ok: NDArray[np.bool_]
+                ) -> GraphFrames:
+    """A mode's closed-form body poses as the frames ``build_mode`` reuses (graph/motion.py),
+    so that they are not computed a second time from the joint variables along the spanning
+    tree: the identity (the drawing) where the mode does not assemble, as its configuration
+    (every freedom 0) there; its joints' world screws, centres and axes from them. The loop
+    residuals are left to ``build_mode``, which evaluates them anew from the configuration."""
+    R = np.where(ok[:, None, None, None], R, np.eye(3))
+    p = np.where(ok[:, None, None], p, 0.0)
+    screws, centres, axes = joint_screws(mech, lay, R, p)
+    return GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes)
 
 
 def assembling_runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:

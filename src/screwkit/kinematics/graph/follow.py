@@ -86,7 +86,9 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
         if progress is not None:
             progress(int(np.clip(done[0] - a, 0, N)), N)
 
-    tracker = Tracker(None, None, rows, count, system=graph_system(mech, lay))
+    system = graph_system(mech, lay)
+    system.forget()  # the poses kept from another sweep: not this one's
+    tracker = Tracker(None, None, rows, count, system=system)
     tracker.follow(tracker.add_seeds(0, conf0))
     if progress is not None:
         progress(N, N)
@@ -100,8 +102,9 @@ def follow_drawn_mode(mech: Mechanism, lay: GraphLayout, X: Array,
         at = Configuration(tr.scalars[last:stop], tr.spherical[last:stop])
         return Followed(conf, held, -1, reached=_furthest(mech, lay, at, rows[last],
                                                           rows[stop]))
-    return Followed(conf, held, stop - a - 1 if stop < rows.shape[0] else None,
-                    held_frames(mech, lay, conf, held))
+    frames = held_frames(mech, lay, conf, held, system.frames)
+    system.forget()
+    return Followed(conf, held, stop - a - 1 if stop < rows.shape[0] else None, frames)
 
 
 def _furthest(mech: Mechanism, lay: GraphLayout, at: Configuration, good: Array, bad: Array,
@@ -147,12 +150,15 @@ def reach(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from: Array,
 
 
 def held_frames(mech: Mechanism, lay: GraphLayout, conf: Configuration,
-                mask: NDArray[np.bool_]) -> GraphFrames:
+                mask: NDArray[np.bool_],
+                forward: Callable[[Configuration], GraphFrames] | None = None) -> GraphFrames:
     """The body poses, screws, joint centres and axes at the samples ``mask`` holds (the
     identity and zeros elsewhere, which the build marks as not assembling), for the build to
-    reuse: the graph's forward map evaluated where the mode holds only."""
+    reuse: the graph's forward map evaluated where the mode holds only (by ``forward`` when
+    given: the tracker's system, which kept those of the samples it closed)."""
     idx = np.flatnonzero(mask)
-    part = graph_forward(mech, lay, conf.take(idx), exact=False)
+    part = forward(conf.take(idx)) if forward is not None else \
+        graph_forward(mech, lay, conf.take(idx), exact=False)
     out = []
     for arr in (part.R, part.p, part.screws, part.residual, part.centres, part.axes):
         full = np.zeros((mask.size, *arr.shape[1:]))

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
+from screwkit.kinematics.graph.closure import GraphLayout
 from screwkit.kinematics.graph.dyads import Placement, driven_pose, dyad_poses
 from screwkit.kinematics.graph.loop_motion import (
     FOLD_STEPS,
@@ -353,16 +353,6 @@ def _circuits(combos: Array, held: NDArray[np.bool_], joins: list[tuple[int, int
     return pairs
 
 
-def _frames(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, ok: NDArray[np.bool_]
-            ) -> GraphFrames:
-    """A mode's body poses as the tracker's frames (the identity where it does not assemble),
-    with its joints' world screws, centres and axes, for ``build_mode`` to reuse."""
-    R = np.where(ok[:, None, None, None], R, np.eye(3))
-    p = np.where(ok[:, None, None], p, 0.0)
-    screws, centres, axes = joint_screws(mech, lay, R, p)
-    return GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes)
-
-
 def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
                       Xd: Array, Xdd: Array, every: bool) -> MechanismMotion:
     """The :class:`~screwkit.kinematics.graph.motion.MechanismMotion` of a mechanism whose
@@ -370,7 +360,7 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     ``every`` every other combination of loop modes and dyad branches that assembles
     somewhere, and the drawn combination's later runs (a mode of their own)."""
     from screwkit.budget import ResourceLimitError
-    from screwkit.kinematics.graph.closed_modes import drawn_with_events
+    from screwkit.kinematics.graph.closed_modes import drawn_with_events, mode_frames
     from screwkit.kinematics.graph.motion import (
         MechanismMotion,
         build_mode,
@@ -414,7 +404,7 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     conf = configuration_from_poses(mech, lay, R[0], p[0], rows,
                                     np.concatenate([np.ones(a, dtype=bool), drawn]), True)
     mode = build_mode(mech, lay, conf.take(slice(a, None)), drawn, X, Xd, Xdd,
-                      _frames(mech, lay, R[0, a:], p[0, a:], drawn))
+                      mode_frames(mech, lay, R[0, a:], p[0, a:], drawn))
     picked = [0] + [m for m in range(1, M) if ok[m, a:].any()]
     masks = [drawn, *(ok[m, a:] for m in picked[1:])]
     again = ok[0, a:] & (np.arange(N) >= stop)  # the drawn combination after its first fold
@@ -427,7 +417,7 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     for n, (m, ev) in enumerate(zip(picked[1:], folds[1:], strict=True), start=1):
         conf = configuration_from_poses(mech, lay, R[m, a:], p[m, a:], X, held[n], False)
         md = build_mode(mech, lay, conf, held[n], X, Xd, Xdd,
-                        _frames(mech, lay, R[m, a:], p[m, a:], held[n]))
+                        mode_frames(mech, lay, R[m, a:], p[m, a:], held[n]))
         label = f"branches {combination_label(mech, dec, loops, combos[m])}"
         if m == 0:
             label += " (the drawn branches again, after the drawn mode's fold)"

@@ -273,6 +273,7 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
         drawn_with_events,
         every_mode,
         mode_configuration,
+        mode_frames,
         mode_label,
     )
     from screwkit.kinematics.graph.dyads import place
@@ -305,7 +306,8 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     drawn = np.zeros(N, dtype=bool)
     drawn[:stop] = True
     conf = mode_configuration(mech, lay, R[0], p[0], X, drawn, start)
-    mode = build_mode(mech, lay, conf, drawn, X, Xd, Xdd)
+    mode = build_mode(mech, lay, conf, drawn, X, Xd, Xdd,
+                      mode_frames(mech, lay, R[0], p[0], drawn))  # the poses reused
     rows = [0] + [m for m in range(1, M) if ok[m].any()]  # the branch combination of each mode
     masks = [drawn, *(ok[m] for m in rows[1:])]
     again = ok[0] & (np.arange(N) >= stop)  # the drawn branches assembling after its fold
@@ -317,7 +319,8 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
     modes = [drawn_with_events(mech, lay, mode, X, stop, folds[0])]
     for i, (m, events) in enumerate(zip(rows[1:], folds[1:], strict=True), start=1):
         conf = mode_configuration(mech, lay, R[m], p[m], X, held[i])
-        md = build_mode(mech, lay, conf, held[i], X, Xd, Xdd)
+        md = build_mode(mech, lay, conf, held[i], X, Xd, Xdd,
+                        mode_frames(mech, lay, R[m], p[m], held[i]))
         label = f"branches {mode_label(mech, dec, signs[m])}"
         if m == 0:
             label += " (the drawn branches again, after the drawn mode's fold)"

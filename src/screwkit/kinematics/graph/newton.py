@@ -26,6 +26,7 @@ from screwkit.kinematics.graph.closure import (
     loop_bias,
     loop_jacobian,
 )
+from screwkit.kinematics.graph.small_linalg import gram_eigenvalues, qr_inverse
 from screwkit.kinematics.tracker.loop import (
     Configuration,
     apply_increment,
@@ -155,7 +156,8 @@ def linearise(mech: Mechanism, lay: GraphLayout, conf: Configuration,
     solution up to that relative size; idle freedoms stay still). ``full_rank`` (a mechanism
     with no idle freedom) takes the exact route by a QR factorisation J_p = QR (the least-squares
     solution R⁻¹Qᵀ, exact for the consistent closure equations, with R's singular values, which
-    are J_p's), and the SVD only where R is singular to working precision."""
+    are J_p's: those of J_pᵀJ_p = RᵀR, graph/small_linalg.py), and the SVD only where R is
+    singular to working precision."""
     fr = frames if frames is not None else graph_forward(mech, lay, conf, exact)
     L = len(mech.topology.loops)
     J = (loop_jacobian(mech, lay, fr.screws) * row_scale(lay, L)[:, None]
@@ -171,11 +173,9 @@ def linearise(mech: Mechanism, lay: GraphLayout, conf: Configuration,
         return Linearised(fr, J, Jp, np.zeros((conf.size, 0)),
                           normal=JtJ + mu * np.eye(Jp.shape[2]))
     if full_rank and Jp.shape[1] >= Jp.shape[2]:
-        Q, R = np.linalg.qr(Jp)
-        s = gram_sigma(R)
+        s = gram_sigma(Jp)  # J_pᵀJ_p = RᵀR
+        pinv = qr_inverse(Jp)[0]
         bad = ~(s[:, -1] > RANK_CUTOFF * s[:, 0])
-        R[bad] = np.eye(R.shape[-1])
-        pinv = np.linalg.solve(R, np.swapaxes(Q, 1, 2))
         if bad.any():
             pinv[bad] = _svd_pinv(Jp[bad])[0]
         return Linearised(fr, J, Jp, s, pinv)
@@ -191,20 +191,16 @@ GRAM_REFINE = 1e-2
 def gram_sigma(A: Array, rank: int | None = None) -> Array:
     """Singular values (N, k) of A (N, a, b), largest first, k = min(a, b): the square roots of
     the eigenvalues of the smaller Gram matrix AᵀA or AAᵀ (Golub & Van Loan, Matrix
-    Computations, 4th ed., §8.6: σᵢ² = λᵢ(AᵀA)), nearly twice as fast as the SVD for these
-    small shapes. Its error in σᵢ is ~ε·σ₁²/σᵢ, so at the samples where σ_r/σ₁ (r = ``rank``,
+    Computations, 4th ed., §8.6: σᵢ² = λᵢ(AᵀA); graph/small_linalg.py), several times faster
+    than the SVD for these small shapes. Its error in σᵢ is ~ε·σ₁²/σᵢ, so at the samples where σ_r/σ₁ (r = ``rank``,
     default k) is below :data:`GRAM_REFINE` the SVD's values are taken instead: rank tests and
     singular flags see the SVD's values and condition numbers change at round-off level. A
     sample with a non-finite entry gets NaN."""
     if A.shape[0] == 0 or min(A.shape[1:]) == 0:
         return np.zeros((A.shape[0], min(A.shape[1:])))
-    At = np.swapaxes(A, 1, 2)
-    G = At @ A if A.shape[1] >= A.shape[2] else A @ At
-    ok = np.isfinite(np.einsum("nii->n", G))  # Σ of A's squared entries
-    if not ok.all():
-        G[~ok] = np.eye(G.shape[-1])
-    s = np.sqrt(np.maximum(np.linalg.eigvalsh(G)[:, ::-1], 0.0))
-    s[~ok] = np.nan
+    lam = gram_eigenvalues(A)  # NaN at a sample with a non-finite entry
+    s = np.sqrt(np.maximum(lam, 0.0))
+    ok = ~np.isnan(lam[:, 0])
     r = s.shape[1] if rank is None else rank
     redo = ok & ~(s[:, r - 1] > GRAM_REFINE * s[:, 0]) if r else np.zeros(len(s), bool)
     if redo.any():

@@ -12,6 +12,11 @@ minimum-norm Gauss–Newton on the passive freedoms, Deuflhard's contraction tes
 residual; the σ ratio σ_r/σ_1 is the passive block's at its regular rank r (the drawing's,
 idle freedoms and redundant constraints excluded), relative to its value at the drawing: the
 tracker's fold and step-halving tests read it as nearness to a singular configuration.
+
+The body poses and joint screws of every configuration the corrector linearised or the fill
+checked are kept (by the configuration's exact values, the last MEMO_ROWS): the fronts' jets,
+the step-halving signatures and the build's frames at those configurations reuse them instead
+of evaluating the forward map again (the same numbers: it is a function of the configuration).
 """
 
 from __future__ import annotations
@@ -21,7 +26,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.graph.closure import GraphLayout, graph_forward, zero_configuration
+from screwkit.kinematics.graph.closure import (
+    GraphFrames,
+    GraphLayout,
+    graph_forward,
+    zero_configuration,
+)
 from screwkit.kinematics.graph.newton import (
     RANK_CUTOFF,
     Linearised,
@@ -47,6 +57,8 @@ from screwkit.model.mechanism import Mechanism
 
 #: a drawing whose σ ratio is below this is (nearly) singular: not the reference of the others
 SIGMA_REFERENCE = 1e-4
+#: configurations whose poses and screws are kept for reuse (module docstring), at most
+MEMO_ROWS = 1 << 14
 
 
 class GraphSystem:
@@ -76,6 +88,51 @@ class GraphSystem:
         drawn = float(self._ratio_of(s[None, :])[0]) if s.size else 1.0
         if SIGMA_REFERENCE < drawn < 1.0:
             self.sigma_unit = drawn
+        self.memo: dict[bytes, tuple[GraphFrames, int]] = {}
+
+    def forget(self) -> None:
+        """Drop the kept poses and screws (a new sweep starts)."""
+        self.memo.clear()
+
+    def _keys(self, conf: Configuration) -> list[bytes]:
+        rows = np.concatenate([conf.scalars,
+                               conf.spherical.reshape(conf.size, 9 * self.n_spherical)], axis=1)
+        return [r.tobytes() for r in np.ascontiguousarray(rows)]
+
+    def _keep(self, conf: Configuration, fr: GraphFrames) -> None:
+        """Keep the poses and screws ``fr`` of ``conf`` (module docstring)."""
+        if len(self.memo) + conf.size > MEMO_ROWS:
+            self.memo.clear()
+        for k, key in enumerate(self._keys(conf)):
+            self.memo[key] = (fr, k)
+
+    def frames(self, conf: Configuration) -> GraphFrames:
+        """graph_forward's body poses and screws at ``conf`` (its first-order residual),
+        reused where kept."""
+        found = [self.memo.get(key) for key in self._keys(conf)]
+        miss = np.array([i for i, f in enumerate(found) if f is None], dtype=np.intp)
+        if miss.size == conf.size:
+            fr = graph_forward(self.mech, self.lay, conf, exact=False)
+            self._keep(conf, fr)
+            return fr
+        fields = ("R", "p", "screws", "residual", "centres", "axes")
+        first = next(f for f in found if f is not None)[0]
+        out = {n: np.empty((conf.size, *getattr(first, n).shape[1:])) for n in fields}
+        if miss.size:
+            fresh = graph_forward(self.mech, self.lay, conf.take(miss), exact=False)
+            self._keep(conf.take(miss), fresh)
+            for n in fields:
+                out[n][miss] = getattr(fresh, n)
+        sources: dict[int, tuple[GraphFrames, list[int], list[int]]] = {}
+        for i, f in enumerate(found):
+            if f is not None:
+                entry = sources.setdefault(id(f[0]), (f[0], [], []))
+                entry[1].append(i)
+                entry[2].append(f[1])
+        for kept, rows, at in sources.values():
+            for n in fields:
+                out[n][rows] = getattr(kept, n)[at]
+        return GraphFrames(**out)
 
     def _ratio_of(self, s: Array) -> Array:
         if self.rank == 0 or s.shape[1] == 0:
@@ -92,6 +149,7 @@ class GraphSystem:
 
     def residual(self, conf: Configuration) -> tuple[Array, Any]:
         fr = graph_forward(self.mech, self.lay, conf, exact=False)
+        self._keep(conf, fr)
         return np.max(np.abs(scaled_residual(self.mech, self.lay, fr)), axis=-1), fr
 
     def sigma(self, conf: Configuration) -> Array:
@@ -100,7 +158,8 @@ class GraphSystem:
     def jets(self, conf: Configuration, D: Array, exact_sigma: bool = True,
              ) -> tuple[Array, Array, Array, Array]:
         """q' and q'' along ``D`` (module docstring): one rate and one acceleration solve."""
-        lin = linearise(self.mech, self.lay, conf, exact=exact_sigma or self.redundant)
+        lin = linearise(self.mech, self.lay, conf, self.frames(conf),
+                        exact=exact_sigma or self.redundant)
         qd = rates(self.mech, self.lay, lin, D)
         qdd = accelerations(self.mech, self.lay, lin, qd, np.zeros_like(D))[0]
         sigma = self._ratio(lin) if exact_sigma else np.full(conf.size, np.nan)
@@ -132,7 +191,9 @@ class GraphSystem:
         last = np.full(N, np.inf)
         todo = np.arange(N)
         for it in range(max_iter + 1):
-            lin = linearise(mech, lay, Configuration(q[todo], sph[todo]), exact=False)
+            at = Configuration(q[todo], sph[todo])
+            lin = linearise(mech, lay, at, exact=False)
+            self._keep(at, lin.frames)
             xi = scaled_residual(mech, lay, lin.frames)
             r = np.max(np.abs(xi), axis=-1)
             keep = polish_verdict(r, todo, last, done, CLOSURE_TOL)
@@ -154,7 +215,7 @@ class GraphSystem:
 
     def signature(self, conf: Configuration) -> Array:
         """Joint centres (/ length scale) and non-spherical axes: one per assembly."""
-        fr = graph_forward(self.mech, self.lay, conf, exact=False)
+        fr = self.frames(conf)
         ax = [fr.axes[:, i] for i, j in enumerate(self.mech.joints) if j.kind != "S"]
         return np.concatenate([fr.centres.reshape(conf.size, -1) / self.lay.length, *ax], -1)
 
