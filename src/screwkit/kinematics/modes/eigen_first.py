@@ -38,6 +38,8 @@ NEWTON_STEPS = 3
 SETTLED = 1e-10
 #: an uncertified point counts as a solution when its Newton step is this small (relative)
 CONVERGED = 1e-8
+#: rounds of Newton steps more for the points still moving after the first
+POLISH_ROUNDS = 3
 #: and as distinct from another when they are this far apart (relative)
 DISTINCT = 1e-6
 #: the fields of a certificate, in order
@@ -146,12 +148,14 @@ def _eigen_pass(route: EigenRoute, targets: Complex, label: int
     xs = np.where(finite[:, None], xs, 0.0)
     norm_f = bombieri_weyl_norm(system, targets)[inst]
     cert = certify(system, xs, p, fast=True, norm_f=norm_f)
-    # a point still moving after its steps (it arrived far off, in Newton's slow phase) gets
-    # another round where its last step was contracting (it is converging)
-    with np.errstate(invalid="ignore"):
-        again = np.flatnonzero(finite & (np.abs(xs - cert.newton).max(axis=1)
-                                         > SETTLED * (1.0 + np.abs(xs).max(axis=1))))
-    if len(again):
+    # a point still moving after its steps (it arrived far off and wandered before Newton's
+    # fast phase) gets more rounds, at most POLISH_ROUNDS
+    for _ in range(POLISH_ROUNDS):
+        with np.errstate(invalid="ignore"):
+            again = np.flatnonzero(finite & (np.abs(xs - cert.newton).max(axis=1)
+                                             > SETTLED * (1.0 + np.abs(xs).max(axis=1))))
+        if not len(again):
+            break
         xs[again] = newton(system, xs[again], p[again], route.newton_steps)
         cert = _replaced(cert, again, certify(system, xs[again], p[again], fast=True,
                                               norm_f=norm_f[again]))
