@@ -13,7 +13,8 @@ determine R in terms of B after eliminating the other monomials E: rank [M_E M_R
 rank M_E + |R| (Kukelova, Bujnak & Pajdla 2008, "Automatic generator of minimal problem
 solvers", ECCV; Larsson, Åström & Oskarsson 2017). A column basis of M_E is kept (the others are
 combinations of it at a generic instance), and the rows are then exactly as many as the kept
-columns: the template is square.
+columns: the template is square; of the bases pivoted QR gives at a few random instances, the
+one whose square matrix has the smallest largest block in its block triangular form.
 """
 
 from __future__ import annotations
@@ -24,11 +25,13 @@ from pathlib import Path
 
 import numpy as np
 import scipy.linalg as sla
+from scipy.sparse import csr_matrix
 
 from screwkit.algebraic.solve import solve_all
 from screwkit.kinematics.modes.stewart import random_stewart, stewart_start, stewart_system
 from screwkit.kinematics.modes.stewart_template import (
     UNKNOWNS,
+    block_triangular,
     chart,
     coefficients,
     monomials,
@@ -151,10 +154,21 @@ def main() -> None:
         rows = prune(rows, by_degree[i:i + 24])
         print(f"{i}: {len(rows)} rows", flush=True)
     Ec = e_cols(rows)
-    ME = Mr[rows][:, Ec]
-    kept = rank(ME)
-    piv = sla.qr(ME, mode="economic", pivoting=True)[2]
-    square = list(np.asarray(Ec)[np.sort(piv[:kept])]) + list(Ri)
+    kept = rank(Mr[rows][:, Ec])
+    # a column basis of M_E by pivoted QR at a few random instances: the one whose square
+    # matrix splits into the smallest blocks (block triangular form) is kept
+    best: tuple[int, list[int]] | None = None
+    for seed in range(24):
+        q, _ = random_stewart(np.random.default_rng(100 + seed), 1)
+        Mq = macaulay(coefficients(q.real)[0], mults, mono)
+        piv = sla.qr(Mq[rows][:, Ec], mode="economic", pivoting=True)[2]
+        cand = list(np.asarray(Ec)[np.sort(piv[:kept])]) + list(Ri)
+        largest = max(len(r) for r, _ in block_triangular(csr_matrix(Mr[rows][:, cand] != 0)))
+        print(f"column basis {seed}: largest block {largest}", flush=True)
+        if best is None or largest < best[0]:
+            best = (largest, cand)
+    assert best is not None
+    square = best[1]
     if len(square) != len(rows):
         sys.exit(f"{len(rows)} rows for {len(square)} columns: not square")
     write(rows=[v for r in rows for v in mults[r]], square=square, kept=kept,

@@ -172,26 +172,31 @@ def _layout() -> dict[str, Any]:
 
 
 def _blocks(n: int, dst: Index, src: Index) -> list[tuple[Index, Index]]:
-    """The square matrix's block triangular form (Duff & Reid 1978, "An implementation of
-    Tarjan's algorithm for the block triangularization of a matrix", ACM TOMS 4(2)): its rows
-    matched to columns (a structural transversal), the strongly connected components of the
-    matched graph, in the order they can be solved (every block's rows touch only its own
-    columns and those of blocks before it), as (rows, columns) per block. The pattern is read
-    at a random instance (a structural zero, such as y·y in the differences, is exactly zero
-    there): 526 unknowns fall into blocks of 313, 206, 6 and 1, so the solve costs about a
-    quarter of one dense LU."""
+    """:func:`block_triangular` of the square matrix, its pattern read at a random instance (a
+    structural zero, such as y·y in the differences, is exactly zero there)."""
     from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
 
     rng = np.random.default_rng(0)
     c = coefficients(rng.normal(size=(1, 42)).astype(complex)).reshape(-1)
     nz = c[src] != 0
-    pattern = csr_matrix((np.ones(int(nz.sum())), divmod(dst[nz], n)), shape=(n, n))
+    return block_triangular(csr_matrix((np.ones(int(nz.sum())), divmod(dst[nz], n)),
+                                       shape=(n, n)))
+
+
+def block_triangular(pattern: Any) -> list[tuple[Index, Index]]:
+    """The block triangular form of a square sparsity pattern (scipy CSR; Duff & Reid 1978,
+    "An implementation of Tarjan's algorithm for the block triangularization of a matrix",
+    ACM TOMS 4(2)): its rows matched to columns (a structural transversal), the strongly
+    connected components of the matched graph, in the order they can be solved (every
+    block's rows touch only its own columns and those of blocks before it), as (rows,
+    columns) per block. The template's 526 unknowns fall into blocks of 313, 206, 6 and 1,
+    so its solve costs about a quarter of one dense LU."""
+    from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
+
+    n = pattern.shape[0]
     match = maximum_bipartite_matching(pattern, perm_type="column")  # row i ↔ column match[i]
     if (match < 0).any():
         raise RuntimeError("the Stewart template is structurally singular")
-    col_row = np.empty(n, dtype=np.intp)
-    col_row[match] = np.arange(n)
     graph = pattern[:, match]  # row i → row j when row i touches row j's matched column
     count, label = connected_components(graph, directed=True, connection="strong")
     # a block is solved after every block it touches: a depth-first order of the condensation
@@ -213,6 +218,7 @@ def _blocks(n: int, dst: Index, src: Index) -> list[tuple[Index, Index]]:
     for k in range(count):
         if not seen[k]:
             visit(k)
+    assert sum(int((label == k).sum()) for k in order) == n
     return [(np.flatnonzero(label == k), match[label == k]) for k in order]
 
 
