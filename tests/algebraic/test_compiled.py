@@ -172,7 +172,7 @@ def test_the_compiled_polish_and_alpha_test_equal_the_numpy_route(monkeypatch):
     """compiled.newton_terms and compiled.alpha_test (the fast α-test) against the numpy
     route: the same polished points, the same certificates."""
     from screwkit.algebraic.certify import certify
-    from screwkit.kinematics.modes import loop6r_solve
+    from screwkit.kinematics.modes import eigen_first
 
     system = loop6r_system()
     x, p = _moved_6r_points(np.random.default_rng(7))
@@ -183,7 +183,7 @@ def test_the_compiled_polish_and_alpha_test_equal_the_numpy_route(monkeypatch):
             m.setattr(compiled, "AVAILABLE", False)
             return new, fn()
 
-    new_x, old_x = both(lambda: loop6r_solve._newton(system, x, p, 3))
+    new_x, old_x = both(lambda: eigen_first.newton(system, x, p, 3))
     # a singular ∂F/∂x (the last point): the compiled polish leaves the point where it is
     # (the numpy route takes a pseudo-inverse step there)
     assert np.array_equal(new_x[-1], x[-1])

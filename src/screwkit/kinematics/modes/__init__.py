@@ -9,11 +9,14 @@ value is an instance with the same number of isolated solutions), which is what 
 homotopy started at a random complex instance needs to find every solution.
 
 - :mod:`.stewart`: 6-6 Stewart–Gough forward kinematics in Study coordinates (40 solutions);
+  solved by an elimination template (:mod:`.stewart_template`, a 526 × 526 block-triangular
+  solve and a 40 × 40 action matrix) with the homotopy as the fallback (:mod:`.stewart_solve`);
 - :mod:`.delta`: a Delta robot read from its graph: plate positions (three spheres), leg
   branches, every plate pose by the Stewart system with the elbow balls as base points;
 - :mod:`.loop6r`: a 6R loop, the inverse kinematics of a 6R arm (:mod:`.arm6r`), a 7R loop at
   one input (16); solved by elimination (:mod:`.sixr_elimination`, a 24 × 24 eigenproblem)
-  with the homotopy as the fallback (:mod:`.loop6r_solve`);
+  with the homotopy as the fallback (:mod:`.loop6r_solve`); :mod:`.eigen_first`: the polish,
+  α-test, relabelling and fallback that both eigen routes share;
 - :mod:`.planar`: planar R-joint mechanisms as graphs (distance equations; 4R: 2, Stephenson III: 6);
 - :mod:`.rod_loops`: the RSSR (2) and RSRC (4) loops at one input;
 - :mod:`.rccc`: the RCCC loop at one input, in Plücker coordinates (2);

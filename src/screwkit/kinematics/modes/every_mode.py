@@ -147,7 +147,8 @@ def formulation_start(form: Formulation) -> StartSolutions:
 
 def solve_formulation(form: Formulation, p: ArrayLike) -> Solutions:
     """Every isolated solution of ``form``'s system at the parameter rows p: its own exact
-    solver where it has one (a single R loop: elimination, modes/loop6r_solve.py), else the
+    solver where it has one (a single R loop: elimination, modes/loop6r_solve.py; a
+    Stewart–Gough platform: the elimination template, modes/stewart_solve.py), else the
     parameter homotopy from the topology's start solutions."""
     own_solve = getattr(form, "solve", None)
     if callable(own_solve):

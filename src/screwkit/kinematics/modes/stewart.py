@@ -40,7 +40,7 @@ STEWART_GENERIC_COUNT = 40
 #: the affine patch r·x = 1: fixed, so that one compiled system serves every instance, and real,
 #: so that a real pose has real Study coordinates (the solver's real and certified-real tests
 #: then apply to poses directly)
-_PATCH = np.random.default_rng(20260627).normal(size=4)
+PATCH = np.random.default_rng(20260627).normal(size=4)
 STUDY_NAMES = ("x0", "x1", "x2", "x3", "y0", "y1", "y2", "y3")
 
 
@@ -90,7 +90,7 @@ def stewart_system() -> PolynomialSystem:
             for s in range(3):
                 leg = leg - 2 * a[i][r] * Rn[r][s] * b[i][s]
         eqs.append(leg)
-    eqs.append(sum((complex(_PATCH[k]) * x[k] for k in range(4)), Poly()) - 1.0)
+    eqs.append(sum((complex(PATCH[k]) * x[k] for k in range(4)), Poly()) - 1.0)
     params = ([f"a{i}_{c}" for i in range(6) for c in "xyz"]
               + [f"b{i}_{c}" for i in range(6) for c in "xyz"] + [f"L2_{i}" for i in range(6)])
     return compile_system(eqs, STUDY_NAMES, params)
@@ -133,7 +133,7 @@ def study_from_pose(R: ArrayLike, t: ArrayLike) -> Complex:
     y = np.stack(quaternion_product(list(np.moveaxis(tq, -1, 0)),
                                     list(np.moveaxis(x, -1, 0))), -1) / 2
     z = np.concatenate([x, y], -1)
-    return np.asarray(z / (z[..., :4] @ _PATCH)[..., None], dtype=complex)
+    return np.asarray(z / (z[..., :4] @ PATCH)[..., None], dtype=complex)
 
 
 def pose_from_study(z: ArrayLike) -> tuple[Complex, Complex]:

@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import PolynomialSystem
-from screwkit.algebraic.solve import StartSolutions
+from screwkit.algebraic.solve import Solutions, StartSolutions
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout, axis_rotation, graph_layout
 from screwkit.kinematics.modes.rod_loops import least_rotation
@@ -42,6 +42,7 @@ from screwkit.kinematics.modes.stewart import (
     stewart_start,
     stewart_system,
 )
+from screwkit.kinematics.modes.stewart_solve import solve_stewart
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import GROUND, Mechanism
 
@@ -144,6 +145,11 @@ class StewartFormulation(StudyPlatformSystem):
 
     def parameters(self, input_values: ArrayLike) -> Array:
         return self.stewart.parameters(input_values)
+
+    def solve(self, p: ArrayLike) -> Solutions:
+        """Every pose at the parameter rows p: the elimination template, the homotopy where it
+        falls short (modes/stewart_solve.py)."""
+        return solve_stewart(p)
 
     def configuration(self, solutions: ArrayLike, input_values: ArrayLike
                       ) -> tuple[Configuration, GraphLayout]:

@@ -1,0 +1,275 @@
+"""Every solution by an eigenvalue method first, the parameter homotopy where it falls short.
+
+A formulation with an eigenvalue (elimination) solver — the 6R loop (modes/sixr_elimination.py:
+Raghavan & Roth 1993), the Stewart–Gough platform (modes/stewart_template.py: an elimination
+template and its action matrix) — describes it as an :class:`EigenRoute`: the polynomial system,
+its generic count m, the eigen solver (every instance's m points, unpolished, and a key per point
+whose imaginary part tells a conjugate pair apart), the labellings to try in turn and the stored
+start solutions of its homotopy. :func:`solve_eigen_first` polishes the eigen solver's points by
+Newton's method on the polynomial system (Sommese & Wampler 2005, ch. 9), certifies them by
+Smale's α-test (algebraic/certify.py) and keeps an instance when its m points are all settled and
+pairwise distinct; an instance left unsettled (a special geometry: a singular leading matrix, a
+double root, an ill-conditioned elimination, a solution far out) is solved again with the next
+labelling, and what is still unsettled by the parameter homotopy from the stored start solutions
+(algebraic/solve.py), which finds every isolated solution there is. The result is the homotopy's
+:class:`Solutions`, the same layout and checks for either route, with ``route`` naming per
+instance the method that ran.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.algebraic import compiled
+from screwkit.algebraic.certify import Certificate, bombieri_weyl_norm, certify
+from screwkit.algebraic.path import TrackOptions
+from screwkit.algebraic.polynomial import Complex, PolynomialSystem
+from screwkit.algebraic.solve import Solutions, StartSolutions, collect_solutions
+from screwkit.algebraic.track import PathStatus, track_parameter_homotopy
+from screwkit.kinematics.modes import sixr_compiled
+
+#: Newton steps at most on the eigen route's points before the α-test (each roughly squares the
+#: error; the points arrive within ~1e-12..1e-6 relative: one step reaches round-off for most)
+NEWTON_STEPS = 3
+#: a Newton step this small (relative) leaves the point at round-off: no further step there
+SETTLED = 1e-10
+#: an uncertified point counts as a solution when its Newton step is this small (relative)
+CONVERGED = 1e-8
+#: rounds of Newton steps more for the points still moving after the first
+POLISH_ROUNDS = 3
+#: and as distinct from another when they are this far apart (relative)
+DISTINCT = 1e-6
+#: the fields of a certificate, in order
+_FIELDS = tuple(f.name for f in fields(Certificate))
+
+
+@dataclass(frozen=True)
+class EigenRoute:
+    """An eigenvalue solver and what the homotopy needs where it falls short (module
+    docstring). ``eliminate(targets, label)`` returns every instance's ``count`` points
+    (B, count, n) and a key per point (B, count): for real parameters the points come in
+    exact conjugate pairs with conjugate keys and the real ones have real keys (LAPACK's
+    eigenvalues of a real matrix), so that a point with Im key < 0 is the conjugate of one
+    with Im key > 0."""
+
+    system: PolynomialSystem
+    count: int
+    eliminate: Callable[[Complex, int], tuple[Complex, Complex]]
+    labels: tuple[int, ...]
+    start: Callable[[], StartSolutions]
+    elimination: str
+    homotopy: str
+    #: Newton steps at most per point (a point stops once its step is below SETTLED)
+    newton_steps: int = NEWTON_STEPS
+
+
+def newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Complex:
+    """Up to ``steps`` Newton steps on F(·; p) from x (P, n), each after the first only at the
+    points whose last step exceeded :data:`SETTLED` (relative); a point whose Jacobian is
+    singular or not finite is left where it is (its certificate will fail). Compiled, one
+    point at a time, when numba is there (:func:`.compiled.newton_terms`)."""
+    if compiled.AVAILABLE:
+        return compiled.newton_terms(system, x, p, steps, SETTLED)
+    x = np.array(x, dtype=complex)
+    n = x.shape[1]
+    active = np.arange(len(x))
+    for _ in range(steps):
+        if not len(active):
+            break
+        xa, pa = x[active], p[active]
+        with np.errstate(all="ignore"):
+            F, J, _ = system.evaluate(xa, pa, want_jp=False)
+            ok: NDArray[np.bool_] = np.asarray(np.isfinite(F).all(1) & np.isfinite(J).all((1, 2)),
+                                               dtype=bool)
+            Js: Complex = np.where(ok[:, None, None], J, np.eye(n))
+            Fs: Complex = np.where(ok[:, None], F, 0.0)
+            try:
+                step: Complex = np.asarray(np.linalg.solve(Js, Fs[..., None])[..., 0], dtype=complex)
+            except np.linalg.LinAlgError:  # an exactly singular Jacobian somewhere
+                step = np.asarray(np.einsum("pij,pj->pi", np.linalg.pinv(Js), Fs), dtype=complex)
+            ok &= np.isfinite(step).all(1)
+            x[active[ok]] = xa[ok] - step[ok]
+            size = np.abs(step).max(1) / (1.0 + np.abs(xa).max(1))
+        active = active[ok & (size > SETTLED)]
+    return x
+
+
+def eigen_route(route: EigenRoute, targets: Complex
+                ) -> tuple[Complex, NDArray[np.intp], NDArray[np.bool_], Certificate]:
+    """The polished eigen-route solutions (P, n) of the instances (B, k) it settles, sorted
+    by their instance (P,); whether each instance is settled: ``count`` solutions, all
+    settled and pairwise distinct (B,); and the α-test of every point (P).
+
+    A point is settled when certified (α-test; distinct from another when their balls of
+    radius 2β are disjoint) or, where the α-test cannot decide (an ill-conditioned solution,
+    e.g. one far out near infinity, which the homotopy cannot certify either), when its
+    Newton step is below :data:`CONVERGED` (relative; distinct when apart by more than
+    :data:`DISTINCT`, the homotopy's own rule in algebraic/solve.py); every pair of an
+    instance's points is compared. A real instance's system is real, so its solutions come in
+    conjugate pairs with equal certificates: only the solutions with Im key ≥ 0 are polished
+    and certified, and the others are their conjugates. An instance left unsettled is
+    eliminated again with the route's next labelling."""
+    B = len(targets)
+    todo = np.arange(B)
+    ok = np.zeros(B, dtype=bool)
+    parts: list[tuple[Complex, NDArray[np.intp], Certificate]] = []
+    for label in route.labels:
+        xs, inst, good, cert = _eigen_pass(route, targets[todo], label)
+        keep = np.flatnonzero(good[inst])
+        if len(keep) < len(inst):  # (else keep is every row: nothing to take)
+            xs, inst, cert = xs[keep], inst[keep], rows_of(cert, keep)
+        parts.append((xs, todo[inst], cert))
+        ok[todo[good]] = True
+        todo = todo[~good]
+        if not len(todo):
+            break
+    if len(parts) == 1:  # one labelling settled them all: already sorted by instance
+        return parts[0][0], parts[0][1], ok, parts[0][2]
+    xs = np.concatenate([x for x, _, _ in parts])
+    inst = np.concatenate([i for _, i, _ in parts])
+    cert = parts[0][2]
+    for _, _, c in parts[1:]:
+        cert = joined(cert, c)
+    order = np.argsort(inst, kind="stable")
+    return xs[order], inst[order], ok, rows_of(cert, order)
+
+
+def _eigen_pass(route: EigenRoute, targets: Complex, label: int
+                ) -> tuple[Complex, NDArray[np.intp], NDArray[np.bool_], Certificate]:
+    """:func:`eigen_route` with one labelling: every point, settled or not."""
+    B, m = len(targets), route.count
+    system = route.system
+    x, key = route.eliminate(targets, label)
+    real = np.all(targets.imag == 0, axis=1)[:, None]
+    sel = np.flatnonzero((~real | (key.imag >= 0)).ravel())
+    inst = sel // m
+    twin = np.flatnonzero((real & (key.imag > 0)).ravel()[sel])  # their conjugates solve too
+    p = targets[inst]
+    xs = newton(system, x.reshape(B * m, -1)[sel].astype(complex), p, route.newton_steps)
+    finite: NDArray[np.bool_] = np.asarray(np.isfinite(xs).all(1), dtype=bool)
+    xs = np.where(finite[:, None], xs, 0.0)
+    norm_f = bombieri_weyl_norm(system, targets)[inst]
+    cert = certify(system, xs, p, fast=True, norm_f=norm_f)
+    # a point still moving after its steps (it arrived far off and wandered before Newton's
+    # fast phase) gets more rounds, at most POLISH_ROUNDS
+    for _ in range(POLISH_ROUNDS):
+        with np.errstate(invalid="ignore"):
+            again = np.flatnonzero(finite & (np.abs(xs - cert.newton).max(axis=1)
+                                             > SETTLED * (1.0 + np.abs(xs).max(axis=1))))
+        if not len(again):
+            break
+        xs[again] = newton(system, xs[again], p[again], route.newton_steps)
+        cert = _replaced(cert, again, certify(system, xs[again], p[again], fast=True,
+                                              norm_f=norm_f[again]))
+    # the fast test's Frobenius bounds are up to √n looser: where it does not decide (not
+    # certified, or real or not real on a real instance), the exact test (two SVDs) decides
+    unsure = np.flatnonzero(~cert.certified | (real[inst, 0] & ~(cert.real | cert.not_real)))
+    if len(unsure):
+        cert = _replaced(cert, unsure, certify(system, xs[unsure], p[unsure],
+                                               norm_f=norm_f[unsure]))
+    xs = np.concatenate([xs, xs[twin].conj()])
+    inst = np.concatenate([inst, inst[twin]])
+    finite = np.concatenate([finite, finite[twin]])
+    cert = joined(cert, _conjugate(rows_of(cert, twin)))
+    order = np.argsort(inst, kind="stable")
+    xs, inst, finite, cert = xs[order], inst[order], finite[order], rows_of(cert, order)
+    if sixr_compiled.AVAILABLE:  # the same verdict, compiled (sixr_kernels.settled)
+        return xs, inst, sixr_compiled.settled(xs, inst, finite, cert.newton, cert.certified,
+                                               cert.radius, B, m, CONVERGED, DISTINCT), cert
+    scale = 1.0 + np.abs(xs).max(axis=1)
+    with np.errstate(invalid="ignore"):
+        settled = np.abs(xs - cert.newton).max(axis=1) <= CONVERGED * scale
+    good = (cert.certified | settled) & finite
+    radius = np.where(cert.certified, cert.radius, DISTINCT * scale)
+    ok = np.bincount(inst, minlength=B) == m
+    full = np.flatnonzero(ok[inst])  # the instances with m points: contiguous, sorted
+    xm, rm = xs[full].reshape(-1, m, xs.shape[1]), radius[full].reshape(-1, m)
+    pi, pj = np.triu_indices(m, 1)
+    # every pair i < j at once: ‖x_i − x_j‖ > r_i + r_j (in blocks of instances: the pairs of
+    # 40 points are 780 per instance)
+    apart = np.ones(len(xm), dtype=bool)
+    for s in range(0, len(xm), 256):
+        gap = np.linalg.norm(xm[s:s + 256, pi] - xm[s:s + 256, pj], axis=-1)
+        apart[s:s + 256] = (gap > rm[s:s + 256, pi] + rm[s:s + 256, pj]).all(axis=1)
+    ok[ok] = good[full].reshape(-1, m).all(axis=1) & apart
+    return xs, inst, ok, cert
+
+
+def rows_of(cert: Certificate, rows: NDArray[np.intp]) -> Certificate:
+    """The certificate of the points ``rows``."""
+    parts: dict[str, Any] = {name: (None if getattr(cert, name) is None
+                                    else getattr(cert, name)[rows]) for name in _FIELDS}
+    return Certificate(**parts)
+
+
+def _replaced(cert: Certificate, rows: NDArray[np.intp], other: Certificate) -> Certificate:
+    """``cert`` with the points ``rows`` certified by ``other`` (in their order)."""
+    parts: dict[str, Any] = {}
+    for name in _FIELDS:
+        mine, theirs = getattr(cert, name), getattr(other, name)
+        if mine is not None and theirs is not None:
+            mine = mine.copy()
+            mine[rows] = theirs
+        parts[name] = mine
+    return Certificate(**parts)
+
+
+def _conjugate(cert: Certificate) -> Certificate:
+    """The certificate of the conjugate points of a real system: the same bounds, the
+    conjugate Newton points and values."""
+    parts: dict[str, Any] = {name: getattr(cert, name) for name in _FIELDS}
+    for name in ("newton", "value"):
+        if parts[name] is not None:
+            parts[name] = parts[name].conj()
+    return Certificate(**parts)
+
+
+def joined(a: Certificate, b: Certificate) -> Certificate:
+    """The certificates of a's points then b's."""
+    parts: dict[str, Any] = {name: np.concatenate([getattr(a, name), getattr(b, name)])
+                             for name in _FIELDS}
+    return Certificate(**parts)
+
+
+def solve_eigen_first(route: EigenRoute, targets: Complex,
+                      options: TrackOptions | None = None) -> Solutions:
+    """Every isolated solution of the instances ``targets`` (B, k): the eigen route, the
+    parameter homotopy (``options``) for the instances it does not settle (module docstring).
+    ``route`` of the result says which ran for each instance."""
+    B, m = len(targets), route.count
+    x_eig, i_eig, ok, cert = eigen_route(route, targets)
+    rows = np.flatnonzero(ok[i_eig])
+    if len(rows) < len(i_eig):  # (else every row)
+        cert, x_eig, i_eig = rows_of(cert, rows), x_eig[rows], i_eig[rows]
+    xs, inst = [x_eig], [i_eig]
+    status = [np.full(len(inst[0]), PathStatus.REGULAR, dtype=np.int8)]
+    mult = [np.ones(len(inst[0]), dtype=np.int64)]
+    at_infinity, failed = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)
+    redo = np.flatnonzero(~ok)
+    how = f"{route.elimination} on {int(ok.sum())} of {B} instances"
+    system = route.system
+    if len(redo):
+        start = route.start()  # found once per process, only when needed
+        how += f"; the parameter homotopy on the others ({start.how_found})"
+        r = len(start.x)
+        instance = np.repeat(redo, r)
+        res = track_parameter_homotopy(system, start.p, targets[instance],
+                                       np.tile(start.x, (len(redo), 1)), options,
+                                       instance=np.repeat(np.arange(len(redo)), r))
+        end = (res.status == PathStatus.REGULAR) | (res.status == PathStatus.SINGULAR)
+        cert = joined(cert, certify(system, res.x[end], targets[instance[end]]))
+        xs.append(res.x[end])
+        inst.append(instance[end])
+        status.append(res.status[end])
+        mult.append(res.multiplicity[end])
+        at_infinity += np.bincount(instance[res.status == PathStatus.AT_INFINITY], minlength=B)
+        failed += np.bincount(instance[res.status == PathStatus.FAILED], minlength=B)
+    names = tuple(route.elimination if good else route.homotopy for good in ok)
+    return collect_solutions(system, targets, np.concatenate(xs), np.concatenate(inst),
+                             np.concatenate(status), np.concatenate(mult), at_infinity, failed,
+                             m, how, names, cert, None if len(redo) else np.arange(len(xs[0])))

@@ -1,0 +1,63 @@
+"""Every pose of 6-6 Stewart–Gough platforms: the elimination template first, the parameter
+homotopy where it cannot promise all 40 (issue 27).
+
+:func:`solve_stewart` runs the template of :mod:`.stewart_template` (one block-triangular
+solve of a 526 × 526 matrix and a 40 × 40 eigenproblem per instance) on every instance of a
+batch, polishes its 40 points by Newton's method on modes/stewart.py's system and certifies
+them by Smale's α-test (:mod:`.eigen_first`). An instance whose 40 are not all settled and
+distinct (an ill-conditioned template, a double root, a pose far out, fewer than 40 finite
+poses) is eliminated again in another affine chart of the Study coordinates (a pose far out
+in one chart, ill-conditioned there, is near the middle of another), and what is still unsettled is solved by the parameter homotopy
+from the stored start solutions (algebraic/solve.py), which finds every isolated solution
+there is. The result is the homotopy's :class:`Solutions`, the same layout and checks for either
+route, with ``route`` naming per instance the method that ran.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from screwkit.algebraic.path import TrackOptions
+from screwkit.algebraic.polynomial import Complex
+from screwkit.algebraic.solve import Solutions
+from screwkit.errors import InputError
+from screwkit.kinematics.modes import eigen_first
+from screwkit.kinematics.modes.stewart import STEWART_GENERIC_COUNT, stewart_start, stewart_system
+from screwkit.kinematics.modes.stewart_template import template_solve
+
+#: the charts of the template tried in turn on the instances still unsettled
+CHARTS = (0, 1, 2)
+#: Newton steps at most per point: the template's points arrive within ~1e-8 (relative) at
+#: the median, a few percent 1e-3..0.2 off (the block-triangular solve pivots within blocks
+#: only); a point stops once its step is at round-off
+NEWTON_STEPS = 6
+TEMPLATE = "elimination template (526 × 526, block triangular; 40 × 40 eigenproblem)"
+HOMOTOPY = "parameter homotopy (the template did not settle 40 distinct solutions)"
+
+
+def _targets(params: ArrayLike) -> Complex:
+    p = np.asarray(params, dtype=complex)
+    if p.ndim not in (1, 2) or p.shape[-1] != 42:
+        raise InputError(f"Stewart–Gough parameters must have shape (42,) or (B, 42); got "
+                         f"{p.shape}")
+    if not np.isfinite(p).all():
+        raise InputError("Stewart–Gough parameters must be finite")
+    return p.reshape(-1, 42)
+
+
+@lru_cache(maxsize=1)
+def stewart_route() -> eigen_first.EigenRoute:
+    """The Stewart–Gough platform's eigen route (module docstring), keyed by ξ1."""
+    return eigen_first.EigenRoute(stewart_system(), STEWART_GENERIC_COUNT, template_solve, CHARTS,
+                                  stewart_start, TEMPLATE, HOMOTOPY, NEWTON_STEPS)
+
+
+def solve_stewart(params: ArrayLike, options: TrackOptions | None = None) -> Solutions:
+    """Every isolated solution (Study coordinates, modes/stewart.py) of the instances (42,) or
+    (B, 42) (:func:`.stewart.stewart_parameters`): the template, the parameter homotopy
+    (``options``) for the instances it does not settle (module docstring). ``route`` says
+    which ran for each instance."""
+    return eigen_first.solve_eigen_first(stewart_route(), _targets(params), options)

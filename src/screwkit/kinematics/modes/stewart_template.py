@@ -1,0 +1,302 @@
+"""Stewart–Gough forward kinematics by an elimination template: all 40 poses from one linear
+solve and a 40 × 40 eigenproblem per instance (issue 27).
+
+The system is modes/stewart.py's (Husty 1996: the Study quadric and six leg quadrics in the
+Study coordinates (x; y) on the patch r·x = 1), written in the affine chart x = P·(1, ξ),
+ξ ∈ C³ (P's first column r/‖r‖², the others an orthonormal basis of r⊥), with the unknowns
+w = (ξ1, ξ2, ξ3, y0, …, y3). Subtracting leg 0 from legs 1..5 cancels 4 y·y, so the Study
+quadric and these five differences are linear in y (Husty 1996, §3), and leg 0 is the only
+equation with y·y. A Macaulay matrix of these seven quadrics times monomials (the y-linear six
+times the monomials of degree ≤ 4 with at most one y, leg 0 times those in ξ only: degree ≤ 6,
+at most two y's) has the 40 solutions' monomial vectors in its null space, and on the
+monomials of degree ≤ 6 with at most one y it has no other null vectors (Telen, Mourrain &
+Van Barel 2018, "Solving polynomial systems via truncated normal forms", SIAM J. Matrix Anal.
+Appl. 39(3), checked numerically when the template was made). Its rows that matter were kept
+by tools/stewart_template.py (Kukelova et al. 2008's automatic generator, pruned greedily;
+the indices are in :mod:`.stewart_template_data`): a square matrix [M_E M_R] (526 × 526) over
+the other monomials E and the monomials R = ξ1·B ∖ B, times the values at the 40 basis
+monomials B on the right, so that one solve gives every R in terms of B. The action matrix of
+ξ1 on B (a row of the identity where ξ1·b is in B, a row of that solve where it is in R) has
+the 40 values of ξ1 as its eigenvalues and the basis monomials' values as its eigenvectors
+(Stetter 2004, *Numerical Polynomial Algebra*, ch. 2; Cox, Little & O'Shea, *Using Algebraic
+Geometry*, ch. 2 §4); B contains 1 and the seven unknowns, which are read off them.
+
+Dropped E columns are combinations of the kept ones at a generic instance: only the column
+space of M_E takes part in the elimination, so they change nothing. The points are unpolished;
+modes/stewart_solve.py polishes, certifies and falls back to the homotopy.
+"""
+
+from __future__ import annotations
+
+import itertools
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from screwkit.algebraic.polynomial import Complex
+from screwkit.kinematics.modes import stewart_template_data as data
+from screwkit.kinematics.modes.stewart import PATCH, quaternion_product, rotation_numerator
+
+Index = NDArray[np.intp]
+#: affine unknowns w = (ξ1, ξ2, ξ3, y0, y1, y2, y3)
+UNKNOWNS = 7
+#: instances eliminated together (the template is 526 × 526: 2.2 MB each in float64; more
+#: at once gains nothing, the solves are LAPACK's one by one)
+CHUNK = 8
+
+
+def monomials(degree: int) -> list[tuple[int, ...]]:
+    """The exponents of the monomials in the 7 affine unknowns of degree ≤ ``degree``,
+    graded, each degree in the order of itertools.combinations_with_replacement: the
+    numbering of :mod:`.stewart_template_data`."""
+    out = []
+    for d in range(degree + 1):
+        for combo in itertools.combinations_with_replacement(range(UNKNOWNS), d):
+            e = [0] * UNKNOWNS
+            for k in combo:
+                e[k] += 1
+            out.append(tuple(e))
+    return out
+
+
+@lru_cache(maxsize=8)
+def chart(label: int = 0) -> NDArray[np.float64]:
+    """T (8, 8): the Study coordinates z = T·(1, w), x = P·(1, ξ) on the patch r·x = 1
+    (module docstring), y = y; label 0 on the system's patch (r = modes/stewart.py's), the
+    others on random real patches (a pose with r·x ≈ 0 is far out in one chart, ill-conditioned
+    there, and near the middle of another)."""
+    r = PATCH if label == 0 else np.random.default_rng(label).normal(size=4)
+    q, _ = np.linalg.qr(np.column_stack([r, np.eye(4)[:, :3]]))
+    T = np.eye(8)
+    T[:4, 0] = r / (r @ r)
+    T[:4, 1:4] = q[:, 1:4]
+    return T
+
+
+@lru_cache(maxsize=1)
+def _forms() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The constant tensors of the leg quadrics: G[r, k, l] and H[r, k, l], the coefficients
+    of x_k y_l in vec(x̄ y)_r and vec(y x̄)_r; S[k, l] the symmetric bilinear form of R'(x)
+    (3 × 3 each)."""
+    E = np.eye(4)
+
+    def conj(q: list) -> list:
+        return [q[0], -q[1], -q[2], -q[3]]
+
+    G, H, S = np.zeros((3, 4, 4)), np.zeros((3, 4, 4)), np.zeros((4, 4, 3, 3))
+    for k in range(4):
+        for m in range(4):
+            G[:, k, m] = quaternion_product(conj(list(E[k])), list(E[m]))[1:]
+            H[:, k, m] = quaternion_product(list(E[m]), conj(list(E[k])))[1:]
+            both = np.array(rotation_numerator(list(E[k] + E[m])), dtype=float)
+            S[k, m] = (both - np.array(rotation_numerator(list(E[k])), dtype=float)
+                       - np.array(rotation_numerator(list(E[m])), dtype=float)) / 2
+            if k == m:
+                S[k, m] = np.array(rotation_numerator(list(E[k])), dtype=float)
+    return G, H, S
+
+
+def quadrics(params: Complex) -> Complex:
+    """The symmetric matrices (B, 7, 8, 8) of modes/stewart.py's Study quadric and six leg
+    quadrics (its module docstring) at the parameter rows (B, 42): zᵀ Q z is the equation."""
+    G, H, S = _forms()
+    A = params[:, :18].reshape(-1, 6, 3)
+    Bp = params[:, 18:36].reshape(-1, 6, 3)
+    c = np.sum(A * A, -1) + np.sum(Bp * Bp, -1) - params[:, 36:]
+    Q = np.zeros((len(params), 7, 8, 8), dtype=params.dtype)
+    Q[:, 0, :4, 4:] = Q[:, 0, 4:, :4] = 0.5 * np.eye(4)
+    Q[:, 1:, :4, :4] = c[..., None, None] * np.eye(4) - 2 * np.einsum(
+        "bir,klrs,bis->bikl", A, S, Bp, optimize=True)
+    Q[:, 1:, 4:, 4:] = 4 * np.eye(4)
+    xy = 2 * (np.einsum("bir,rkl->bikl", Bp, G) - np.einsum("bir,rkl->bikl", A, H))
+    Q[:, 1:, :4, 4:] = xy
+    Q[:, 1:, 4:, :4] = np.swapaxes(xy, -1, -2)
+    return Q
+
+
+@lru_cache(maxsize=1)
+def _layout() -> dict[str, Any]:
+    """Where each coefficient goes (module docstring): for each template row and each of the
+    36 products w_i w_k (i ≤ k, w_0 = 1) of its equation, the flat index into the square
+    matrix or into the right-hand side (-1: nowhere, a dropped E column), and the source of
+    each; the basis positions of the action matrix's rows."""
+    mono = monomials(data.DEGREE)
+    rows = np.asarray(data.ROWS, dtype=np.intp).reshape(-1, 2)
+    square = [mono[i] for i in data.SQUARE]
+    basis = [mono[i] for i in data.BASIS]
+    n = len(square)
+    col_sq = {e: c for c, e in enumerate(square)}
+    col_b = {e: c for c, e in enumerate(basis)}
+    pairs = [(i, k) for i in range(8) for k in range(i, 8)]
+
+    def exponent(i: int, k: int) -> tuple[int, ...]:
+        e = [0] * UNKNOWNS
+        for v in (i, k):
+            if v > 0:
+                e[v - 1] += 1
+        return tuple(e)
+
+    sq_dst, sq_src, b_dst, b_src = [], [], [], []
+    for r, (eq, mult) in enumerate(rows):
+        m = mono[mult]
+        for t, (i, k) in enumerate(pairs):
+            e = tuple(a + b for a, b in zip(exponent(i, k), m, strict=True))
+            if e in col_sq:
+                sq_dst.append(r * n + col_sq[e])
+                sq_src.append(eq * len(pairs) + t)
+            elif e in col_b:
+                b_dst.append(r * len(basis) + col_b[e])
+                b_src.append(eq * len(pairs) + t)
+    g = data.ACTION
+    action = np.empty(len(basis), dtype=np.intp)  # ≥ 0: a basis column; < 0: −1 − R row
+    r_of = {e: c for c, e in enumerate(square[data.KEPT:])}
+    for i, e in enumerate(basis):
+        ge = tuple(a + (j == g) for j, a in enumerate(e))
+        action[i] = col_b[ge] if ge in col_b else -1 - r_of[ge]
+    unit = np.array([col_b[tuple(int(j == k) for j in range(UNKNOWNS))]
+                     for k in range(-1, UNKNOWNS)], dtype=np.intp)  # 1, then the unknowns
+    blocks = _blocks(n, np.array(sq_dst), np.array(sq_src))
+    # rows and columns renumbered block by block, so that each block is a contiguous slice
+    new_row, new_col = np.empty(n, dtype=np.intp), np.empty(n, dtype=np.intp)
+    new_row[np.concatenate([r for r, _ in blocks])] = np.arange(n)
+    new_col[np.concatenate([c for _, c in blocks])] = np.arange(n)
+    row, col = np.divmod(np.array(sq_dst), n)
+    brow, bcol = np.divmod(np.array(b_dst), len(basis))
+    bounds = np.cumsum([0] + [len(r) for r, _ in blocks])
+    return {"bounds": bounds, "sq_dst": new_row[row] * n + new_col[col],
+            "sq_src": np.array(sq_src), "b_dst": new_row[brow] * len(basis) + bcol,
+            "b_src": np.array(b_src), "action": action, "unit": unit,
+            "r_pos": new_col[data.KEPT:]}
+
+
+def _blocks(n: int, dst: Index, src: Index) -> list[tuple[Index, Index]]:
+    """:func:`block_triangular` of the square matrix, its pattern read at a random instance (a
+    structural zero, such as y·y in the differences, is exactly zero there)."""
+    from scipy.sparse import csr_matrix
+
+    rng = np.random.default_rng(0)
+    c = coefficients(rng.normal(size=(1, 42)).astype(complex)).reshape(-1)
+    nz = c[src] != 0
+    return block_triangular(csr_matrix((np.ones(int(nz.sum())), divmod(dst[nz], n)),
+                                       shape=(n, n)))
+
+
+def block_triangular(pattern: Any) -> list[tuple[Index, Index]]:
+    """The block triangular form of a square sparsity pattern (scipy CSR; Duff & Reid 1978,
+    "An implementation of Tarjan's algorithm for the block triangularization of a matrix",
+    ACM TOMS 4(2)): its rows matched to columns (a structural transversal), the strongly
+    connected components of the matched graph, in the order they can be solved (every
+    block's rows touch only its own columns and those of blocks before it), as (rows,
+    columns) per block. The template's 526 unknowns fall into blocks of 313, 206, 6 and 1,
+    so its solve costs about a quarter of one dense LU."""
+    from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
+
+    n = pattern.shape[0]
+    match = maximum_bipartite_matching(pattern, perm_type="column")  # row i ↔ column match[i]
+    if (match < 0).any():
+        raise RuntimeError("the Stewart template is structurally singular")
+    graph = pattern[:, match]  # row i → row j when row i touches row j's matched column
+    count, label = connected_components(graph, directed=True, connection="strong")
+    # a block is solved after every block it touches: a depth-first order of the condensation
+    coo = graph.tocoo()
+    after: list[set[int]] = [set() for _ in range(count)]
+    for i, j in zip(label[coo.row], label[coo.col], strict=True):
+        if i != j:
+            after[i].add(int(j))
+    order: list[int] = []
+    seen = np.zeros(count, dtype=bool)
+
+    def visit(k: int) -> None:
+        seen[k] = True
+        for j in after[k]:
+            if not seen[j]:
+                visit(j)
+        order.append(k)
+
+    for k in range(count):
+        if not seen[k]:
+            visit(k)
+    assert sum(int((label == k).sum()) for k in order) == n
+    return [(np.flatnonzero(label == k), match[label == k]) for k in order]
+
+
+def coefficients(params: Complex, label: int = 0) -> Complex:
+    """The coefficients (B, 7, 36) of the template's equations at the products w_i w_k
+    (i ≤ k, w_0 = 1) in the chart ``label``: the Study quadric, legs 1..5 minus leg 0 (free of
+    y·y), leg 0."""
+    T = chart(label)
+    i, k = np.triu_indices(8)  # the products w_i w_k, i ≤ k, in the layout's order
+    Q = np.einsum("ai,njab,bk->njik", T, quadrics(params), T, optimize=True)
+    c = Q[:, :, i, k] * np.where(i == k, 1.0, 2.0)
+    out = np.empty_like(c)
+    out[:, 0] = c[:, 0]
+    out[:, 1:6] = c[:, 2:7] - c[:, 1:2]
+    out[:, 6] = c[:, 1]
+    return out
+
+
+def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
+    """The 40 points (B, 40, 8) of the instances (B, 42) in Study coordinates on the patch,
+    unpolished, eliminated in the chart ``label``, and their ξ1 (B, 40): the action matrix's
+    eigenvalues (for real parameters the template and the action matrix are real, so the
+    points come in exact conjugate pairs with conjugate ξ1 and the real ones have real ξ1). An instance whose template is singular or
+    not finite gets NaN points."""
+    lay = _layout()
+    B = len(params)
+    real = bool(np.all(params.imag == 0))
+    dtype = np.float64 if real else np.complex128
+    n, m = len(data.SQUARE), len(data.BASIS)
+    points = np.full((B, m, 8), np.nan, dtype=complex)
+    keys = np.full((B, m), np.nan, dtype=complex)
+    with np.errstate(all="ignore"):
+        for s in range(0, B, CHUNK):
+            p = params[s:s + CHUNK]
+            c: Any = coefficients(p, label).reshape(len(p), -1)
+            c = c.real if real else c
+            flat: Any = np.zeros((len(p), n * n), dtype=dtype)
+            flat[:, lay["sq_dst"]] = c[:, lay["sq_src"]]
+            right: Any = np.zeros((len(p), n * m), dtype=dtype)
+            right[:, lay["b_dst"]] = -c[:, lay["b_src"]]
+            S, rhs = flat.reshape(-1, n, n), right.reshape(-1, n, m)
+            good: NDArray[np.bool_] = np.asarray(np.isfinite(c).all(axis=1), dtype=bool)
+            if not good.all():
+                S[~good] = np.eye(n)
+            X: Any = np.empty((len(p), n, m), dtype=dtype)
+            bounds = lay["bounds"]
+            for a, b in zip(bounds[:-1], bounds[1:], strict=True):  # block triangular
+                known = rhs[:, a:b] - S[:, a:b, :a] @ X[:, :a] if a else rhs[:, a:b]
+                X[:, a:b] = _solve(S[:, a:b, a:b], known, good)
+            R = X[:, lay["r_pos"]]
+            act = lay["action"]
+            Am: Any = np.zeros((len(p), m, m), dtype=dtype)
+            inside = np.flatnonzero(act >= 0)
+            Am[:, inside, act[inside]] = 1.0
+            Am[:, act < 0] = R[:, -1 - act[act < 0]]
+            good &= np.isfinite(Am).all(axis=(1, 2))
+            if not good.all():
+                Am[~good] = np.eye(m)
+            vals, vecs = np.linalg.eig(Am)
+            w = vecs[:, lay["unit"][1:], :] / vecs[:, lay["unit"][:1], :]  # (b, 7, 40)
+            one = np.ones((len(p), 1, m))
+            z = np.einsum("ij,bjm->bmi", chart(label), np.concatenate([one, w], axis=1))
+            z /= (z[..., :4] @ PATCH)[..., None]  # on the system's patch
+            points[s:s + CHUNK] = np.where(good[:, None, None], z, np.nan)
+            keys[s:s + CHUNK] = np.where(good[:, None], vals, np.nan)
+    return points, keys
+
+
+def _solve(S: Any, rhs: Any, good: NDArray[np.bool_]) -> Any:
+    """S⁻¹·rhs for the stacked systems; one exactly singular system (LAPACK raises for the
+    whole stack) is solved alone and left NaN (``good`` cleared)."""
+    try:
+        return np.linalg.solve(S, rhs)
+    except np.linalg.LinAlgError:
+        out = np.full(rhs.shape, np.nan, dtype=rhs.dtype)
+        for b in range(len(S)):
+            try:
+                out[b] = np.linalg.solve(S[b], rhs[b])
+            except np.linalg.LinAlgError:
+                good[b] = False
+        return out
