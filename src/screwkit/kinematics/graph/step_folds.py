@@ -10,10 +10,11 @@ below, a hump above it (an island: the mode is born and dies inside the step, no
 Such a pair is bracketed by the discriminant's values and slopes at the two samples: of one
 sign at both ends, with slopes that point to an extremum inside (g > 0 with g'(0) < 0 < g'(1):
 a minimum; g < 0 with g'(0) > 0 > g'(1): a maximum). The extremum t* is located by bisection on
-the sign of g' (central differences of :data:`SLOPE_STEP` of the step), and where the mode's
-assembling at t* differs from the samples', its two folds are located by bisection of its
-assembling on [0, t*] and [t*, 1] (:data:`FOLD_STEPS` halvings each, as graph/closed_modes.py's
-``fold_inputs`` does between samples that differ). The folding sub-chain at each is the first,
+its least (greatest) value on a grid of :data:`EXTREMUM_SECTIONS` points narrowed round by round
+(one batched evaluation per round), and where the mode's assembling at t* differs from the
+samples', its two folds are located by sectioning its assembling on [0, t*] and [t*, 1] to
+2⁻⁵⁰ of the step (as graph/closed_modes.py's ``fold_inputs`` bisects between samples that
+differ). Slopes are one-sided differences over :data:`SLOPE_STEP` of the step. The folding sub-chain at each is the first,
 in placing order, that does not assemble just past it.
 
 Seen: one dip or hump of each discriminant per step, of any depth (the slopes at the samples
@@ -34,10 +35,16 @@ Array = NDArray[np.float64]
 
 #: slopes by differences over this fraction of the step
 SLOPE_STEP = 1e-7
-#: bisection steps locating the extremum between two samples (on the sign of the slope)
-EXTREMUM_STEPS = 40
-#: bisection steps locating each of the two folds (2⁻⁵⁰ of the step)
-FOLD_STEPS = 50
+#: points per round of the extremum's search (one batched evaluation per round): its bracket
+#: shrinks EXTREMUM_SECTIONS/2 times a round
+EXTREMUM_SECTIONS = 64
+#: rounds locating the extremum (to 32⁻⁴ ≈ 1e-6 of the step: the discriminant there is its
+#: extremum's to ~1e-12 of its second derivative over the step)
+EXTREMUM_ROUNDS = 4
+#: points per round of a fold's search: its bracket shrinks SECTIONS times a round
+SECTIONS = 32
+#: rounds locating each of the two folds (to 2⁻⁵⁰ of the step)
+FOLD_ROUNDS = 10
 #: two pairs found from different discriminants are one where their folds agree to this
 #: fraction of the step
 SAME_PAIR = 1e-9
@@ -69,8 +76,10 @@ def hidden_pairs(evaluate: Evaluate, ok: NDArray[np.bool_], disc: Array) -> list
         return []
     g0, g1 = disc[rows, ks], disc[rows, ks + 1]  # (T, S)
     h = SLOPE_STEP
-    s0 = (evaluate(rows, ks, np.full(rows.size, h))[0] - g0) / h
-    s1 = (g1 - evaluate(rows, ks, np.full(rows.size, 1.0 - h))[0]) / h
+    T0 = rows.size
+    near = evaluate(np.concatenate([rows, rows]), np.concatenate([ks, ks]),
+                    np.concatenate([np.full(T0, h), np.full(T0, 1.0 - h)]))[0]
+    s0, s1 = (near[:T0] - g0) / h, (g1 - near[T0:]) / h
     with np.errstate(invalid="ignore"):
         dip = ok[rows, ks][:, None] & (g0 > 0) & (g1 > 0) & (s0 < 0) & (s1 > 0)
         # a mode assembling at neither sample: the first sub-chain that fails there (the
@@ -78,22 +87,15 @@ def hidden_pairs(evaluate: Evaluate, ok: NDArray[np.bool_], disc: Array) -> list
         first0 = np.argmax(~(g0 >= 0), axis=1)
         first1 = np.argmax(~(g1 >= 0), axis=1)
         hump = np.zeros_like(dip)
-        r = np.arange(rows.size)
+        r = np.arange(T0)
         hump[r, first0] = (~ok[rows, ks]) & (first0 == first1) & (g0[r, first0] < 0) & \
             (g1[r, first0] < 0) & (s0[r, first0] > 0) & (s1[r, first0] < 0)
     c, stage = np.nonzero(dip | hump)
     if c.size == 0:
         return []
-    sign = np.where(dip[c, stage], 1.0, -1.0)  # +1: a minimum (g' from − to +)
+    sign = np.where(dip[c, stage], 1.0, -1.0)  # +1: a minimum
     cr, ck = rows[c], ks[c]
-    lo, hi = np.zeros(c.size), np.ones(c.size)
-    for _ in range(EXTREMUM_STEPS):
-        mid = 0.5 * (lo + hi)
-        slope = (evaluate(cr, ck, mid + 0.5 * h)[0] - evaluate(cr, ck, mid - 0.5 * h)[0]) / h
-        down = sign * slope[np.arange(c.size), stage] < 0  # still before the extremum
-        lo, hi = np.where(down, mid, lo), np.where(down, hi, mid)
-    t_star = 0.5 * (lo + hi)
-    at_star = evaluate(cr, ck, t_star)[1]
+    t_star, at_star = _extremum(evaluate, cr, ck, stage, sign)
     hidden = np.flatnonzero(at_star != ok[cr, ck])
     if hidden.size == 0:
         return []
@@ -101,13 +103,9 @@ def hidden_pairs(evaluate: Evaluate, ok: NDArray[np.bool_], disc: Array) -> list
     # the two folds: the assembling changes once on [0, t*] and once on [t*, 1]
     T = hidden.size
     rr, kk = np.concatenate([cr, cr]), np.concatenate([ck, ck])
-    lo = np.concatenate([np.zeros(T), t_star])
-    hi = np.concatenate([t_star, np.ones(T)])
     at_lo = np.concatenate([ok[cr, ck], ~ok[cr, ck]])
-    for _ in range(FOLD_STEPS):
-        mid = 0.5 * (lo + hi)
-        same = evaluate(rr, kk, mid)[1] == at_lo
-        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+    lo, hi = _change(evaluate, rr, kk, np.concatenate([np.zeros(T), t_star]),
+                     np.concatenate([t_star, np.ones(T)]), at_lo)
     t = 0.5 * (lo + hi)
     # the side that does not assemble: past the first fold for a gap, before it for an island
     bad = np.where(np.concatenate([ok[cr, ck], ok[cr, ck]]),
@@ -121,3 +119,44 @@ def hidden_pairs(evaluate: Evaluate, ok: NDArray[np.bool_], disc: Array) -> list
                    for p in out):
             out.append(pair)
     return out
+
+
+def _extremum(evaluate: Evaluate, rows: NDArray[np.intp], ks: NDArray[np.intp],
+              stage: NDArray[np.intp], sign: Array) -> tuple[Array, NDArray[np.bool_]]:
+    """Where ``sign`` × the discriminant of ``stage`` is least on each step (T,), bracketed
+    by the slopes (one extremum): the grid's least point, its bracket narrowed to its two
+    neighbours each round; that point and whether the mode assembles there."""
+    T = rows.size
+    lo, hi = np.zeros(T), np.ones(T)
+    n = EXTREMUM_SECTIONS
+    frac = np.arange(n + 1) / n
+    r = np.arange(T)
+    for _ in range(EXTREMUM_ROUNDS):
+        ts = lo[:, None] + (hi - lo)[:, None] * frac  # (T, n+1)
+        g, ok = evaluate(np.repeat(rows, n + 1), np.repeat(ks, n + 1), ts.reshape(-1))
+        v = sign[:, None] * g[np.arange(g.shape[0]), np.repeat(stage, n + 1)].reshape(T, -1)
+        i = np.argmin(np.where(np.isnan(v), np.inf, v), axis=1)
+        best, at = ts[r, i], ok.reshape(T, -1)[r, i]
+        lo = ts[r, np.maximum(i - 1, 0)]
+        hi = ts[r, np.minimum(i + 1, n)]
+    return best, at
+
+
+def _change(evaluate: Evaluate, rows: NDArray[np.intp], ks: NDArray[np.intp], lo: Array,
+            hi: Array, at_lo: NDArray[np.bool_]) -> tuple[Array, Array]:
+    """The bracket [lo, hi] (to 2⁻⁵⁰ of the step) where the mode's assembling first leaves
+    ``at_lo``, its value at ``lo``: the first of :data:`SECTIONS` points where it differs, each
+    round."""
+    T = rows.size
+    frac = np.arange(1, SECTIONS) / SECTIONS
+    r = np.arange(T)
+    for _ in range(FOLD_ROUNDS):
+        ts = lo[:, None] + (hi - lo)[:, None] * frac  # (T, S−1)
+        ok = evaluate(np.repeat(rows, SECTIONS - 1), np.repeat(ks, SECTIONS - 1),
+                      ts.reshape(-1))[1].reshape(T, -1)
+        changed = ok != at_lo[:, None]
+        first = np.where(changed.any(axis=1), np.argmax(changed, axis=1), SECTIONS - 1)
+        new_lo = np.where(first > 0, ts[r, np.maximum(first - 1, 0)], lo)
+        hi = np.where(first < SECTIONS - 1, ts[r, np.minimum(first, SECTIONS - 2)], hi)
+        lo = new_lo
+    return lo, hi
