@@ -230,3 +230,51 @@ def test_the_cli_lists_the_island_modes_with_their_folds(tmp_path: Path) -> None
     islands = [m for m in doc["modes"] if "island" in m["label"]]
     assert len(islands) == 4
     assert all(m["events"][1].startswith("dies at O.theta = 187 deg") for m in islands)
+
+
+def _fourbar(a: float, b: float, c: float, d: float, drawn: float) -> Mechanism:
+    """The four-bar of :func:`_sixbar` alone: one loop, solved by the loop engine (its family's
+    closed form, graph/loop_motion.py)."""
+    six = _sixbar(a, b, c, d, drawn)
+    return Mechanism("four-bar", six.bodies[:3], six.joints[:4], ("O.theta",))
+
+
+def test_the_single_loop_route_ends_the_drawn_mode_at_a_gap_inside_one_step() -> None:
+    """The same gap on the four-bar alone (the loop route): the drawn mode stops at the first
+    fold, both loop modes are cut there and come back at the second (four modes), the pieces
+    that die together and those born together are circuits."""
+    a, b, c, d = GAP
+    mech = _fourbar(*GAP, GAP_DRAWN)
+    X = GAP_INPUTS[:, None]
+    first = _crank_at(a, d, b + c) - GAP_DRAWN
+    second = 360.0 - _crank_at(a, d, b + c) - GAP_DRAWN
+    k = int(np.flatnonzero(np.degrees(GAP_INPUTS) < first)[-1])
+    drawn = solve_mechanism(mech, X).modes
+    assert len(drawn) == 1 and np.flatnonzero(drawn[0].assembles).tolist() == list(range(k + 1))
+    motion = solve_mechanism(mech, X, every_mode=True)
+    assert motion.method == "graph (loop, closed)" and len(motion.modes) == 4
+    for md in motion.modes:
+        before = md.assembles[:k + 1].all() and not md.assembles[k + 1:].any()
+        after = md.assembles[k + 1:].all() and not md.assembles[:k + 1].any()
+        assert before or after
+        fold = md.events[1] if md.label == "drawn" else md.events[0]
+        assert fold.startswith(f"dies at O.theta = {first:.6g} deg: the loop folds" if before
+                               else f"is born at O.theta = {second:.6g} deg: the loop folds")
+    assert motion.notes[1].endswith(": {0, 2}, {1, 3}")
+    assert np.sum([md.assembles for md in motion.modes], axis=0).tolist() == [2] * X.shape[0]
+    _closes(mech, motion)
+
+
+def test_the_single_loop_route_finds_an_island_inside_one_step() -> None:
+    a, b, c, d = _island_dims()
+    mech = _fourbar(a, b, c, d, ISLAND_DRAWN)
+    motion = solve_mechanism(mech, ISLAND_INPUTS[:, None], every_mode=True)
+    born = 360.0 - _crank_at(a, d, b + c) - ISLAND_DRAWN
+    dies = 360.0 - _crank_at(a, d, abs(b - c)) - ISLAND_DRAWN
+    islands = [md for md in motion.modes if "island inside one sample step" in md.label]
+    assert len(motion.modes) == 4 and len(islands) == 2
+    for md in islands:
+        assert not md.assembles.any()
+        assert md.events[0].startswith(f"is born at O.theta = {born:.6g} deg: the loop folds")
+        assert md.events[1].startswith(f"dies at O.theta = {dies:.6g} deg: the loop folds")
+    assert motion.notes[1].endswith(": {0, 1}, {2, 3}")

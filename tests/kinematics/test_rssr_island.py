@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.from_loop import mechanism_from_loop
@@ -140,22 +141,27 @@ def test_the_loop_route_holds_a_re_entered_island_twice() -> None:
         assert np.nanmax(md.closure_residual[md.assembles]) <= 1e-10
 
 
-def test_the_graph_routes_every_mode_finds_an_island_inside_one_step(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+@pytest.mark.parametrize("route", ["closed forms", "loop"])
+def test_every_mode_finds_an_island_inside_one_step(monkeypatch, route: str) -> None:  # type: ignore[no-untyped-def]
     """Drawn at 170° and driven 0°, 7°, 17°, … , 367° from there, the island comes back one
     turn on strictly inside the step from 357° to 367° (527° … 537°): no sample lies on it.
-    The graph's closed forms (the RSS leg; the loop route bypassed) find it from the leg's
+    The graph's closed forms (the RSS leg; the loop route bypassed) and the loop route (the
+    RSSR's closed form, its two modes the leg's two branches) find it from the leg's
     discriminant (graph/step_folds.py): both branches as modes on no sample, each born and
     dying where the point-to-circle distance test (brentq on ``rssr_reach``) puts the island's
     ends, one circuit; the drawn mode and the other branch hold the first sample only."""
     from scipy.optimize import brentq
 
-    monkeypatch.setattr("screwkit.kinematics.graph.loop_subchain.loop_chain", lambda mech: None)
+    if route == "closed forms":
+        monkeypatch.setattr("screwkit.kinematics.graph.loop_subchain.loop_chain",
+                            lambda mech: None)
     closed = solve_motion(rssr(*ISLAND_RSSR), THETA, method="closed")
     a, _ = ISLAND_SAMPLES
     mech = mechanism_from_loop(closed, 0, a)  # drawn at 170°
     X = np.radians(np.array([0.0, *np.arange(7.0, 368.0, 10.0)]))
     motion = solve_mechanism(mech, X[:, None], every_mode=True)
-    assert motion.method == "graph (closed forms)"
+    assert motion.method == ("graph (closed forms)" if route == "closed forms"
+                             else "graph (loop, closed)")
     d2 = ISLAND_RSSR[1]
 
     def inside(x: float) -> float:  # > 0 where the loop closes, x from the drawing (rad)
@@ -173,4 +179,5 @@ def test_the_graph_routes_every_mode_finds_an_island_inside_one_step(monkeypatch
         assert not md.assembles.any()
         assert md.events[0].startswith(f"is born at input.theta = {start:.6g} deg")
         assert md.events[1].startswith(f"dies at input.theta = {end:.6g} deg")
-    assert motion.notes[-1].endswith("{0, 1}, {2, 3}")
+    circuits = [n for n in motion.notes if n.startswith("circuits")]
+    assert circuits[0].endswith("{0, 1}, {2, 3}")
