@@ -9,18 +9,21 @@ runs before and after are two modes, the input must turn back at the first fold)
 below, a hump above it (an island: the mode is born and dies inside the step, no sample on it).
 Such a pair is bracketed by the discriminant's values and slopes at the two samples: of one
 sign at both ends, with slopes that point to an extremum inside (g > 0 with g'(0) < 0 < g'(1):
-a minimum; g < 0 with g'(0) > 0 > g'(1): a maximum). The extremum t* is located by bisection on
-its least (greatest) value on a grid of :data:`EXTREMUM_SECTIONS` points narrowed round by round
-(one batched evaluation per round), and where the mode's assembling at t* differs from the
-samples', its two folds are located by sectioning its assembling on [0, t*] and [t*, 1] to
-2⁻⁵⁰ of the step (as graph/closed_modes.py's ``fold_inputs`` bisects between samples that
-differ). Slopes are one-sided differences over :data:`SLOPE_STEP` of the step. The folding sub-chain at each is the first,
-in placing order, that does not assemble just past it.
+a minimum; g < 0 with g'(0) > 0 > g'(1): a maximum; by Rolle's theorem a single dip or hump
+between samples of one sign has such slopes). The extremum t* is located as the least
+(greatest) value on a grid of :data:`EXTREMUM_SECTIONS` points narrowed round by round to its
+neighbours (one batched evaluation per round), and where the mode's assembling at t* differs
+from the samples', its two folds are located by sectioning its assembling on [0, t*] and
+[t*, 1] to 2⁻⁵⁰ of the step (as graph/closed_modes.py's ``fold_inputs`` bisects between samples
+that differ). Slopes are one-sided differences over :data:`SLOPE_STEP` of the step. The folding
+sub-chain at each fold is the first, in placing order, that does not assemble just past it.
 
-Seen: one dip or hump of each discriminant per step, of any depth (the slopes at the samples
-bracket it). Not seen: a discriminant with two or more extrema inside one step whose slopes at
-the samples do not point inside (a wiggle shorter than a step), and an island of a sub-chain
-placed on one that does not assemble at either sample (its discriminant is not defined there).
+Seen: a dip or hump of a discriminant inside one step whose slopes at the samples point inside,
+down to a depth of ~1e-12 of the discriminant's second derivative over the step (the extremum
+is located to ~1e-6 of the step). Not seen: a discriminant with two or more extrema inside one
+step whose slopes at the samples do not point inside (a wiggle shorter than the step), and an
+island of a sub-chain placed on one that does not assemble at either sample (its discriminant
+is not defined there).
 """
 
 from __future__ import annotations
