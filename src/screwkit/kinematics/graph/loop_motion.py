@@ -406,12 +406,7 @@ def step_pieces(mech: Mechanism, lay: GraphLayout, X: Array, masks: NDArray[np.b
     fold together), cut where the sub-chain's discriminant dips below zero inside one step, and
     with ``every`` its islands inside one step as modes on no sample (graph/step_folds.py; the
     drawn mode, row 0, ends at its first fold); any other loop's modes as they are."""
-    from screwkit.kinematics.graph.closed_modes import (
-        ISLAND,
-        SAME_AGAIN,
-        branch_combinations,
-        every_mode,
-    )
+    from screwkit.kinematics.graph.closed_modes import ISLAND, SAME_AGAIN, drawn_combination
     from screwkit.kinematics.graph.dyads import place
     from screwkit.kinematics.graph.motion import input_text
     from screwkit.kinematics.graph.step_folds import hidden_pairs
@@ -423,16 +418,18 @@ def step_pieces(mech: Mechanism, lay: GraphLayout, X: Array, masks: NDArray[np.b
     if N < 2 or not dec.complete or dec.loops or len(dec.dyads) != 1 or \
             dec.dyads[0].branches != 2:
         return StepPieces(masks, rows, masks, labels, [])
-    signs = branch_combinations(dec)
-    em = every_mode(mech, lay, dec, X)
+    # the two branches share the discriminant (they fold together): the drawing's alone, over
+    # the drawn mode's samples unless every mode is asked for
+    n = N if every else int(np.flatnonzero(masks[0])[-1]) + 1
+    signs = drawn_combination(dec)
+    pl = place(mech, lay, dec, X[:n], np.repeat(signs, n, axis=0))
 
     def evaluate(r: NDArray[np.intp], ks: NDArray[np.intp], t: Array
                  ) -> tuple[Array, NDArray[np.bool_]]:
         pl = place(mech, lay, dec, X[ks] + t[:, None] * (X[ks + 1] - X[ks]), signs[r])
         return pl.discriminant, pl.assembles
 
-    found = hidden_pairs(evaluate, em.assembles(N), em.placement.discriminant.reshape(2, N, -1))
-    pairs = {(p.k, p.gap): p for p in found}.values()  # both branches fold together
+    pairs = hidden_pairs(evaluate, pl.assembles[None, :], pl.discriminant[None]) if n > 1 else []
     idx = np.arange(N)
     rows, pieces, labels = [], [], []
     for r in range(M):
