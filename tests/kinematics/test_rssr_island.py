@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.from_loop import mechanism_from_loop
@@ -138,3 +139,45 @@ def test_the_loop_route_holds_a_re_entered_island_twice() -> None:
     assert np.abs(again[0].joint_axes[72, R] - drawn.joint_axes[0, R]).max() <= 1e-9
     for md in motion.modes:
         assert np.nanmax(md.closure_residual[md.assembles]) <= 1e-10
+
+
+@pytest.mark.parametrize("route", ["closed forms", "loop"])
+def test_every_mode_finds_an_island_inside_one_step(monkeypatch, route: str) -> None:  # type: ignore[no-untyped-def]
+    """Drawn at 170° and driven 0°, 7°, 17°, … , 367° from there, the island comes back one
+    turn on strictly inside the step from 357° to 367° (527° … 537°): no sample lies on it.
+    The graph's closed forms (the RSS leg; the loop route bypassed) and the loop route (the
+    RSSR's closed form, its two modes the leg's two branches) find it from the leg's
+    discriminant (graph/step_folds.py): both branches as modes on no sample, each born and
+    dying where the point-to-circle distance test (brentq on ``rssr_reach``) puts the island's
+    ends, one circuit; the drawn mode and the other branch hold the first sample only."""
+    from scipy.optimize import brentq
+
+    if route == "closed forms":
+        monkeypatch.setattr("screwkit.kinematics.graph.loop_subchain.loop_chain",
+                            lambda mech: None)
+    closed = solve_motion(rssr(*ISLAND_RSSR), THETA, method="closed")
+    a, _ = ISLAND_SAMPLES
+    mech = mechanism_from_loop(closed, 0, a)  # drawn at 170°
+    X = np.radians(np.array([0.0, *np.arange(7.0, 368.0, 10.0)]))
+    motion = solve_mechanism(mech, X[:, None], every_mode=True)
+    assert motion.method == ("graph (closed forms)" if route == "closed forms"
+                             else "graph (loop, closed)")
+    d2 = ISLAND_RSSR[1]
+
+    def inside(x: float) -> float:  # > 0 where the loop closes, x from the drawing (rad)
+        near, far = rssr_reach(ISLAND_RSSR, np.array([THETA[a] + x]))
+        return float(min(d2 - near[0], far[0] - d2))
+
+    start = np.degrees(brentq(inside, X[-2], np.radians(362.0), xtol=1e-14))
+    end = np.degrees(brentq(inside, np.radians(362.0), X[-1], xtol=1e-14))
+    assert 357.0 < start < end < 367.0
+    near, far = rssr_reach(ISLAND_RSSR, THETA[a] + X)
+    assert not ((near < d2) & (d2 < far))[1:].any()  # no sample on it
+    islands = [md for md in motion.modes if "island inside one sample step" in md.label]
+    assert len(motion.modes) == 4 and len(islands) == 2
+    for md in islands:
+        assert not md.assembles.any()
+        assert md.events[0].startswith(f"is born at input.theta = {start:.6g} deg")
+        assert md.events[1].startswith(f"dies at input.theta = {end:.6g} deg")
+    circuits = [n for n in motion.notes if n.startswith("circuits")]
+    assert circuits[0].endswith("{0, 1}, {2, 3}")

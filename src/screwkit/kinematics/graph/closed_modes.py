@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
 from screwkit.kinematics.graph.dyads import Placement, configuration, place, place_every
+from screwkit.kinematics.graph.step_folds import HiddenPair
 from screwkit.kinematics.graph.subchains import Decomposition
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
@@ -181,3 +182,137 @@ def drawn_with_events(mech: Mechanism, lay: GraphLayout, mode: MechanismMode, X:
         events.insert(0, f"stops assembling after input {input_text(mech, lay, X[stop - 1])} (a "
                          f"limit position or dead centre before {input_text(mech, lay, X[stop])})")
     return replace(with_events(mode, [*events, *mode.events]), label="drawn")
+
+
+#: labels of the modes a branch combination holds after its first run
+DRAWN_AGAIN = " (the drawn branches again, after the drawn mode's fold)"
+SAME_AGAIN = " (the same branches again, after two folds inside one sample step)"
+ISLAND = " (an island inside one sample step: no sample on it)"
+
+
+@dataclass(frozen=True)
+class HeldModes:
+    """The modes of a closed-form motion: each one's branch combination (``rows``, into the
+    combinations' ``ok`` (M, N)), samples (``masks`` (M', N)) and label tail; the drawn
+    mode's end ``stop`` (its first sample past its first fold); the fold pairs hidden inside
+    one step (graph/step_folds.py), and which modes are islands on no sample (mode → pair)."""
+
+    rows: list[int]
+    masks: NDArray[np.bool_]
+    labels: list[str]
+    stop: int
+    ok: NDArray[np.bool_]
+    pairs: list[HiddenPair]
+    islands: dict[int, HiddenPair]
+
+
+def held_modes(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array, signs: Array,
+               ok: NDArray[np.bool_], disc: Array, every: bool) -> HeldModes:
+    """The modes of the branch combinations ``signs`` (M, D), assembling at ``ok`` (M, N) with
+    discriminants ``disc`` (M, N, D): the drawn mode (row 0) up to its first fold, a fold
+    hidden inside one step included; with ``every`` each other combination's samples, cut
+    where it dies and is born again inside one step (two modes: the input must turn back at
+    the first fold), the drawn combination's later samples cut the same way, and each island
+    inside one step (graph/step_folds.py) as a mode on no sample."""
+    from screwkit.kinematics.graph.step_folds import hidden_pairs
+
+    N = X.shape[0]
+
+    def evaluate(rows: NDArray[np.intp], ks: NDArray[np.intp], t: Array
+                 ) -> tuple[Array, NDArray[np.bool_]]:
+        pl = place(mech, lay, dec, X[ks] + t[:, None] * (X[ks + 1] - X[ks]), signs[rows])
+        return pl.discriminant, pl.assembles
+
+    pairs = hidden_pairs(evaluate, ok, disc) if N > 1 else []
+    gaps: dict[int, list[int]] = {}
+    for pr in pairs:
+        if pr.gap:
+            gaps.setdefault(pr.row, []).append(pr.k)
+    stop = int(np.argmin(ok[0])) if not ok[0].all() else N
+    stop = min([stop, *(k + 1 for k in gaps.get(0, []))])
+    idx = np.arange(N)
+    rows, masks, labels = [0], [idx < stop], [""]
+
+    def pieces(m: int, mask: NDArray[np.bool_], first: str, later: str) -> None:
+        cuts = [k + 1 for k in sorted(gaps.get(m, [])) if mask[k] and mask[k + 1]]
+        for j, (a, b) in enumerate(zip([0, *cuts], [*cuts, N], strict=True)):
+            piece = mask & (idx >= a) & (idx < b)
+            if piece.any():
+                rows.append(m)
+                masks.append(piece)
+                labels.append(first if j == 0 else later)
+
+    islands: dict[int, HiddenPair] = {}
+    if every:
+        for m in range(1, ok.shape[0]):
+            pieces(m, ok[m], "", SAME_AGAIN)
+        pieces(0, ok[0] & (idx >= stop), DRAWN_AGAIN, DRAWN_AGAIN)
+        for pr in pairs:
+            if not pr.gap:
+                islands[len(rows)] = pr
+                rows.append(pr.row)
+                masks.append(np.zeros(N, dtype=bool))
+                labels.append(ISLAND)
+    return HeldModes(rows, np.array(masks), labels, stop, ok, pairs, islands)
+
+
+def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array, signs: Array,
+                held: HeldModes) -> tuple[list[list[str]], list[tuple[int, int]]]:
+    """Each mode's births and deaths at folds, in input order: between samples where its
+    combination's assembling changes (located by :func:`fold_inputs`, all at once), at a fold
+    pair hidden inside one step and at an island's two ends (graph/step_folds.py); and the
+    pairs of modes that meet at a fold (the same sub-chain folding between the same samples,
+    their branches differing in that sub-chain alone; a hidden fold at the same place too)."""
+    from screwkit.kinematics.graph.motion import input_text
+
+    masks, rows = held.masks, np.array(held.rows, dtype=np.intp)
+    i, k = np.nonzero(masks[:, :-1] != masks[:, 1:])
+    m = rows[i]
+    regular = held.ok[m, k] != held.ok[m, k + 1]
+    #: (mode, sub-chain, sample k, fraction of the step or NaN for a regular fold, dies, text)
+    points: list[tuple[int, int, int, float, bool, str]] = []
+    if regular.any():
+        x, folding = fold_inputs(mech, lay, dec, X, signs[m[regular]], k[regular])
+        for ii, kk, xx, d in zip(i[regular], k[regular], x, folding, strict=True):
+            points.append((int(ii), int(d), int(kk), np.nan, bool(masks[ii, kk]),
+                           f"at {input_text(mech, lay, xx)}: the {_folding(mech, dec, int(d))} "
+                           "folds (its two branches meet)"))
+
+    def hidden(ii: int, pr: HiddenPair, end: int) -> None:
+        t = pr.t[end]
+        x = X[pr.k] + t * (X[pr.k + 1] - X[pr.k])
+        where = (f"{'the first' if end == 0 else 'the second'} of two folds between the "
+                 f"samples at {input_text(mech, lay, X[pr.k])} and "
+                 f"{input_text(mech, lay, X[pr.k + 1])}, where it "
+                 f"{'assembles' if pr.gap else 'does not assemble'}")
+        points.append((ii, pr.stages[end], pr.k, t, (end == 0) == pr.gap,
+                       f"at {input_text(mech, lay, x)}: the "
+                       f"{_folding(mech, dec, pr.stages[end])} folds (its two branches meet; "
+                       f"{where})"))
+
+    for ii, kk in zip(i[~regular], k[~regular], strict=True):
+        pr = next(p for p in held.pairs if p.gap and p.row == rows[ii] and p.k == kk)
+        hidden(int(ii), pr, 0 if masks[ii, kk] else 1)
+    for ii, pr in held.islands.items():
+        hidden(ii, pr, 0)
+        hidden(ii, pr, 1)
+    points.sort(key=lambda q: (q[2], 0.0 if np.isnan(q[3]) else q[3]))
+    events: list[list[str]] = [[] for _ in range(masks.shape[0])]
+    for ii, _, _, _, dies, text in points:
+        events[ii].append(("dies " if dies else "is born ") + text)
+    joins = []
+    for ii, d, kk, t, _, _ in points:
+        other = signs[rows[ii]].copy()
+        other[d] = -other[d]
+        match = [jj for jj, dd, k2, t2, _, _ in points
+                 if jj != ii and dd == d and k2 == kk and np.all(signs[rows[jj]] == other)
+                 and (np.isnan(t) and np.isnan(t2) or abs(t - t2) <= 1e-9)]
+        if match:
+            joins.append((match[0], ii))
+    return events, joins
+
+
+def _folding(mech: Mechanism, dec: Decomposition, d: int) -> str:
+    """The sub-chain ``d`` for a fold event, e.g. "RRR dyad A–B–D"."""
+    dyad = dec.dyads[d]
+    return f"{dyad.kind} {dyad.word} " + "–".join(mech.joints[i].name for i in dyad.joints)

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
 from screwkit.kinematics.graph.loop_subchain import APPROACH_STEP, LoopChain, is_drawing
+from screwkit.kinematics.graph.step_folds import HiddenPair as HiddenPairT
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.kinematics.tracker.mode_frames import ModePoses
@@ -270,15 +271,21 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
                             "assembling before it")
     order = [d] + ([m for m in range(len(lm.confs)) if m != d and lm.assembles[m].any()]
                    if every else [])
-    masks = lm.assembles[order]
-    folds = _folds(mech, lay, chain, X, masks)
+    cut = step_pieces(mech, lay, X, lm.assembles[order], every)
+    masks = cut.masks
+    order = [order[r] for r in cut.rows]
+    folds = [(cut.piece(r, k, bool(cut.source[r, k])), k, x, text)
+             for r, k, x, text in _folds(mech, lay, chain, X, cut.source)]
+    # in input order: a fold between samples k and k+1 at k + ½, one inside a step at k + t
+    at = [k + 0.5 for _, k, _, _ in folds] + [p for p, _ in cut.events]
+    folds += [f for _, f in cut.events]
     modes: list[MechanismMode] = []
     for row, m in enumerate(order):
         ok = masks[row]
         conf = lm.confs[m]
         assert conf is not None
-        md = build_mode(mech, lay, conf, ok, X, Xd, Xdd, lm.frames[m])
-        events = [text for r, _, _, text in folds if r == row]
+        md = build_mode(mech, lay, conf, ok, X, Xd, Xdd, lm.frames[m] if ok.any() else None)
+        events = [folds[i][3] for i in np.argsort(at, kind="stable") if folds[i][0] == row]
         if row == 0:  # the drawn mode ends at its first fold
             events = events[:1]
             stop = int(np.argmin(ok)) if not ok.all() else ok.size
@@ -286,9 +293,9 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
                 events.insert(0, f"stops assembling after input "
                                  f"{input_text(mech, lay, X[stop - 1])} (a limit position or "
                                  f"dead centre before {input_text(mech, lay, X[stop])})")
-        label = ("drawn" if m == d else
-                 f"loop mode {d} (the drawn branches again, after the drawn mode's fold)"
-                 if m == lm.again else f"loop mode {m}")
+        label = ("drawn" if row == 0 else "one of the loop's two modes" if row in cut.islands
+                 else f"loop mode {d} (the drawn branches again, after the drawn mode's fold)"
+                 if m == lm.again else f"loop mode {m}") + cut.labels[row]
         modes.append(replace(with_events(md, [*events, *md.events]), label=label,
                              index=len(modes)))
     motion = lm.motion
@@ -297,7 +304,7 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
         assert motion is not None
         meet = [(r1, r2) for i, (r1, k1, x1, _) in enumerate(folds)
                 for (r2, k2, x2, _) in folds[i + 1:]
-                if k1 == k2 and np.allclose(x1, x2, rtol=0.0, atol=1e-9)]
+                if r1 != r2 and k1 == k2 and np.allclose(x1, x2, rtol=0.0, atol=1e-9)]
         notes = (f"{len(motion.modes)} assembly mode(s) of the loop ({motion.method} solver); "
                  f"{len(modes)} assemble over these inputs; mode 0 is the drawn one (the loop's "
                  f"mode {d})",
@@ -370,3 +377,95 @@ def real_count(chain: LoopChain, L: Array) -> NDArray[np.intp]:
     assert closed is not None
     mo = closed(chain.linkage, L, zero, zero)
     return np.asarray(np.sum([md.assembles for md in mo.modes], axis=0)[:-1])
+
+
+@dataclass(frozen=True)
+class StepPieces:
+    """The loop's modes (``source`` (M, N)) cut where two folds lie inside one step: each
+    piece's mode row (``rows``), samples (``masks``) and label tail; the pieces' fold events
+    inside steps as (place k + t, (piece, k, input row, text)), islands on no sample included."""
+
+    source: NDArray[np.bool_]
+    rows: list[int]
+    masks: NDArray[np.bool_]
+    labels: list[str]
+    events: list[tuple[float, tuple[int, int, Array, str]]]
+    islands: frozenset[int] = frozenset()
+
+    def piece(self, row: int, k: int, dies: bool) -> int:
+        """The piece of mode ``row`` that dies after sample k (``dies``) or is born before k+1."""
+        n = k if dies else k + 1
+        return next(i for i, (r, m) in enumerate(zip(self.rows, self.masks, strict=True))
+                    if r == row and m[n])
+
+
+def step_pieces(mech: Mechanism, lay: GraphLayout, X: Array, masks: NDArray[np.bool_],
+                every: bool) -> StepPieces:
+    """The modes ``masks`` (M, N) of a loop that is one two-branch dyad or leg on its driven
+    joint (graph/subchains.py: its two loop modes are that sub-chain's two branches, and they
+    fold together), cut where the sub-chain's discriminant dips below zero inside one step, and
+    with ``every`` its islands inside one step as modes on no sample (graph/step_folds.py; the
+    drawn mode, row 0, ends at its first fold); any other loop's modes as they are."""
+    from screwkit.kinematics.graph.closed_modes import ISLAND, SAME_AGAIN, drawn_combination
+    from screwkit.kinematics.graph.dyads import place
+    from screwkit.kinematics.graph.motion import input_text
+    from screwkit.kinematics.graph.step_folds import hidden_pairs
+    from screwkit.kinematics.graph.subchains import decompose
+
+    M, N = masks.shape
+    rows, pieces, labels = list(range(M)), list(masks), [""] * M
+    dec = decompose(mech)
+    if N < 2 or not dec.complete or dec.loops or len(dec.dyads) != 1 or \
+            dec.dyads[0].branches != 2:
+        return StepPieces(masks, rows, masks, labels, [])
+    # the two branches share the discriminant (they fold together): the drawing's alone, over
+    # the drawn mode's samples unless every mode is asked for
+    n = N if every else int(np.flatnonzero(masks[0])[-1]) + 1
+    signs = drawn_combination(dec)
+    pl = place(mech, lay, dec, X[:n], np.repeat(signs, n, axis=0))
+
+    def evaluate(r: NDArray[np.intp], ks: NDArray[np.intp], t: Array
+                 ) -> tuple[Array, NDArray[np.bool_]]:
+        pl = place(mech, lay, dec, X[ks] + t[:, None] * (X[ks + 1] - X[ks]), signs[r])
+        return pl.discriminant, pl.assembles
+
+    pairs = hidden_pairs(evaluate, pl.assembles[None, :], pl.discriminant[None]) if n > 1 else []
+    idx = np.arange(N)
+    rows, pieces, labels = [], [], []
+    for r in range(M):
+        cuts = sorted(p.k + 1 for p in pairs if p.gap and masks[r, p.k] and masks[r, p.k + 1])
+        for j, (a, b) in enumerate(zip([0, *cuts], [*cuts, N], strict=True)):
+            part = masks[r] & (idx >= a) & (idx < b)
+            # the drawn mode ends at its first fold: its later pieces only with every mode
+            if part.any() and (r or j == 0 or every):
+                rows.append(r)
+                pieces.append(part)
+                labels.append("" if j == 0 else SAME_AGAIN)
+    events: list[tuple[float, tuple[int, int, Array, str]]] = []
+
+    def event(i: int, p: HiddenPairT, end: int) -> None:
+        x = X[p.k] + p.t[end] * (X[p.k + 1] - X[p.k])
+        what = "dies" if (end == 0) == p.gap else "is born"
+        events.append((p.k + p.t[end], (i, p.k, x, (
+            f"{what} at {input_text(mech, lay, x)}: the loop folds (two of its assembly modes "
+            f"meet; {'the first' if end == 0 else 'the second'} of two folds between the "
+            f"samples at {input_text(mech, lay, X[p.k])} and "
+            f"{input_text(mech, lay, X[p.k + 1])}, where it "
+            f"{'assembles' if p.gap else 'does not assemble'})"))))
+
+    for i, (r, part) in enumerate(zip(rows, pieces, strict=True)):
+        for p in pairs:
+            if p.gap and part[p.k] and not part[p.k + 1] and masks[r][p.k + 1]:
+                event(i, p, 0)
+            elif p.gap and part[p.k + 1] and not part[p.k] and masks[r][p.k]:
+                event(i, p, 1)
+    for p in pairs if every else ():
+        if not p.gap:
+            for _ in range(2):  # the loop's two modes, born and dying together
+                rows.append(0)
+                pieces.append(np.zeros(N, dtype=bool))
+                labels.append(ISLAND)
+                event(len(rows) - 1, p, 0)
+                event(len(rows) - 1, p, 1)
+    return StepPieces(masks, rows, np.array(pieces), labels, events,
+                      frozenset(i for i, t in enumerate(labels) if t == ISLAND))

@@ -272,6 +272,8 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
         drawn_start,
         drawn_with_events,
         every_mode,
+        fold_events,
+        held_modes,
         mode_configuration,
         mode_frames,
         mode_label,
@@ -302,66 +304,34 @@ def _closed_form_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X
         raise AssemblyError(f"{mech.name}: the drawn configuration cannot be followed to the "
                             f"first input row {input_text(mech, lay, X[0])}: the mechanism stops "
                             "assembling before it")
-    stop = int(np.argmin(ok[0])) if not ok[0].all() else N
-    drawn = np.zeros(N, dtype=bool)
-    drawn[:stop] = True
+    held = held_modes(mech, lay, dec, X, signs, ok, pl.discriminant.reshape(M, N, -1), every)
+    drawn = held.masks[0]
     conf = mode_configuration(mech, lay, R[0], p[0], X, drawn, start)
     mode = build_mode(mech, lay, conf, drawn, X, Xd, Xdd,
                       mode_frames(mech, lay, R[0], p[0], drawn))  # the poses reused
-    rows = [0] + [m for m in range(1, M) if ok[m].any()]  # the branch combination of each mode
-    masks = [drawn, *(ok[m] for m in rows[1:])]
-    again = ok[0] & (np.arange(N) >= stop)  # the drawn branches assembling after its fold
-    if every and again.any():  # their later runs: a mode of their own, born at a fold
-        rows.append(0)
-        masks.append(again)
-    held = np.array(masks)
-    folds, joins = _fold_events(mech, lay, dec, X, signs[rows], held)
-    modes = [drawn_with_events(mech, lay, mode, X, stop, folds[0])]
-    for i, (m, events) in enumerate(zip(rows[1:], folds[1:], strict=True), start=1):
-        conf = mode_configuration(mech, lay, R[m], p[m], X, held[i])
-        md = build_mode(mech, lay, conf, held[i], X, Xd, Xdd,
-                        mode_frames(mech, lay, R[m], p[m], held[i]))
-        label = f"branches {mode_label(mech, dec, signs[m])}"
-        if m == 0:
-            label += " (the drawn branches again, after the drawn mode's fold)"
+    folds, joins = fold_events(mech, lay, dec, X, signs, held)
+    modes = [drawn_with_events(mech, lay, mode, X, held.stop, folds[0])]
+    for i, (m, events) in enumerate(zip(held.rows[1:], folds[1:], strict=True), start=1):
+        conf = mode_configuration(mech, lay, R[m], p[m], X, held.masks[i])
+        md = build_mode(mech, lay, conf, held.masks[i], X, Xd, Xdd,
+                        mode_frames(mech, lay, R[m], p[m], held.masks[i]))
+        label = f"branches {mode_label(mech, dec, signs[m])}{held.labels[i]}"
         modes.append(replace(with_events(md, [*events, *md.events]), label=label,
                              index=len(modes)))
     notes: tuple[str, ...] = (skipped,) if skipped else ()
     if every:
         notes = (f"{M} branch combination(s) of {len(dec.dyads)} sub-chain(s); {len(modes)} "
-                 "mode(s) assemble over these inputs (the drawn branches twice where they "
-                 "assemble again after the drawn mode's fold)" if len(modes) > len(set(rows))
+                 "mode(s) assemble over these inputs (the same branches again where they "
+                 "assemble again after a fold, and islands inside one sample step as modes of "
+                 "their own)" if len(modes) > len(set(held.rows))
                  else f"{M} branch combination(s) of {len(dec.dyads)} sub-chain(s); "
                  f"{len(modes)} assemble over these inputs",
                  "circuits (modes that meet at a fold, where the input must turn back to go "
                  "on): " + ", ".join("{" + ", ".join(map(str, c)) + "}"
-                                     for c in _circuits(signs[rows], held, joins)))
+                                     for c in groups(len(modes), joins)))
 
     return MechanismMotion(mech, X, Xd, Xdd, tuple(modes), method="graph (closed forms)",
                            solver=CLOSED_FORM_SOLVER, notes=notes)
-
-
-def _fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
-                 signs: Array, ok: NDArray[np.bool_]
-                 ) -> tuple[list[list[str]], list[tuple[int, int, int]]]:
-    """Each mode's (rows of ``signs`` (M', D) and ``ok`` (M', N)) births and deaths at folds,
-    each located between samples (graph/closed_modes.py's ``fold_inputs``, all at once), and
-    every fold as (row, index of the folding sub-chain, sample k: the fold lies between k and
-    k+1)."""
-    from screwkit.kinematics.graph.closed_modes import fold_inputs
-
-    mode, k = np.nonzero(ok[:, :-1] != ok[:, 1:])
-    events: list[list[str]] = [[] for _ in range(ok.shape[0])]
-    if k.size == 0:
-        return events, []
-    x, folding = fold_inputs(mech, lay, dec, X, signs[mode], k)
-    for m, kk, xx, d in zip(mode, k, x, folding, strict=True):
-        dyad = dec.dyads[int(d)]
-        names = "–".join(mech.joints[i].name for i in dyad.joints)
-        what = "dies" if ok[m, kk] else "is born"
-        events[int(m)].append(f"{what} at {input_text(mech, lay, xx)}: the {dyad.kind} {dyad.word} "
-                              f"{names} folds (its two branches meet)")
-    return events, [(int(m), int(d), int(kk)) for m, d, kk in zip(mode, folding, k, strict=True)]
 
 
 def groups(n: int, joins: list[tuple[int, int]]) -> list[list[int]]:
@@ -379,24 +349,6 @@ def groups(n: int, joins: list[tuple[int, int]]) -> list[list[int]]:
     for i in range(n):
         out.setdefault(root(i), []).append(i)
     return sorted(out.values())
-
-
-def _circuits(signs: Array, ok: NDArray[np.bool_], joins: list[tuple[int, int, int]]
-              ) -> list[list[int]]:
-    """The modes (rows of ``signs`` (M', D), held at the samples ``ok`` (M', N)) grouped into
-    circuits: at a fold of sub-chain d between samples k and k+1 a mode meets the mode whose
-    branches differ in d alone (the same configuration there) and that is born or dies between
-    the same two samples (a branch combination may hold two modes: the drawn one and its
-    later runs)."""
-    pairs = []
-    turns = ok[:, :-1] != ok[:, 1:]
-    for m, d, k in joins:
-        other = signs[m].copy()
-        other[d] = -other[d]
-        match = np.nonzero(np.all(signs == other, axis=1) & turns[:, k])[0]
-        if match.size:
-            pairs.append((int(match[0]), m))
-    return groups(signs.shape[0], pairs)
 
 
 def _solve_driven(mech: Mechanism, inputs: ArrayLike, rates_: ArrayLike | None,
