@@ -345,7 +345,9 @@ def cssp_mode_motion(
     :class:`~screwkit.kinematics.lazy_fields.LazyConfiguration` and the tables
     :class:`~screwkit.kinematics.lazy_fields.LazyTable` s.
 
-    Computed in blocks of :data:`BLOCK_SAMPLES` samples in structure-of-arrays form. The (N, …)
+    Computed in blocks of :data:`BLOCK_SAMPLES` samples in structure-of-arrays form (the lean
+    pass — ``ball_joints=False`` or ``lazy=True`` — by the compiled loop of
+    :mod:`~screwkit.kinematics.closed_forms.cssp_compiled` where it applies: the same rows). The (N, …)
     arrays are views of component-major storage (every component contiguous over the samples;
     not C-contiguous): the values are those of the (N, …) layout, and the blocked inverse
     dynamics reads them without a transposing copy.
