@@ -10,7 +10,8 @@ their wall time varies with the load (as in bench_fourbar.py). Memory is the tra
 * generic kinematics: ``motion`` (Newton + continuation) on a 72-sample sweep, per sample;
 * closed-form kinematics: ``cssp_mode_motion`` on ``SAMPLES`` crank angles — as it is by
   default, without the ball joints' rotation vectors (``joint_rotations=False``) and lean
-  (``ball_joints=False``: only what the dynamics reads);
+  (``ball_joints=False``: only what the dynamics reads; its lean pass and the rod's zero-spin
+  turn compiled by numba where it is installed, kinematics/closed_forms/cssp_compiled.py);
 * dynamics: ``inverse_dynamics`` on that ModeMotion (the CSSP closed-form statics, blocked;
   compiled by numba where it is installed, dynamics/cssp_compiled.py), and
   the chain kinematics + dynamics, the issue's target (≤ 1 µs per sample, ≤ 2 GiB);
@@ -426,7 +427,8 @@ def solve_motion_rows(lk: Any, theta: np.ndarray, omega: float, dyn: float,
                              f"{med['chain']:.2f} us/sample against the peer's "
                              f"{med['peer']:.2f} us/call; median of {SIDE_BY_SIDE} side-by-side "
                              f"rounds, each in its own processes, warm "
-                             f"({', '.join(f'{r:.2f}' for r in ratios)})"})
+                             f"({', '.join(f'{r:.2f}' for r in ratios)}); kinematics "
+                             f"{_kinematics_route()}"})
     return rows
 
 
@@ -546,6 +548,15 @@ def _dynamics_on_modes(lk: Any, theta: np.ndarray, omega: float) -> tuple[float,
     full = cssp_mode_motion(lk, theta, omega, 0.0, joint_rotations=False)
     dyn_full = _best_time(lambda: inverse_dynamics(lk, full, GRAVITY)) / theta.size * 1e6
     return dyn, peak, dyn_full
+
+
+def _kinematics_route() -> str:
+    """Which route ran the CSSP's closed-form kinematics (lean pass, rod turn) on 10⁶
+    samples."""
+    from screwkit.kinematics.closed_forms import cssp_compiled
+
+    return ("compiled (numba)" if cssp_compiled.use_compiled(SAMPLES)
+            else "numpy route (numba not installed)")
 
 
 def _route() -> str:

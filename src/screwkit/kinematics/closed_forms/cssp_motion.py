@@ -47,6 +47,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.dual.spatial import GIMBAL_TOL, rot_x
+from screwkit.kinematics.closed_forms import cssp_compiled
 from screwkit.kinematics.closed_forms.cssp import SEED_ROOT, CSSPDimensions
 from screwkit.kinematics.closed_forms.cssp_inputs import (
     CSSPSweep,
@@ -344,7 +345,9 @@ def cssp_mode_motion(
     :class:`~screwkit.kinematics.lazy_fields.LazyConfiguration` and the tables
     :class:`~screwkit.kinematics.lazy_fields.LazyTable` s.
 
-    Computed in blocks of :data:`BLOCK_SAMPLES` samples in structure-of-arrays form. The (N, …)
+    Computed in blocks of :data:`BLOCK_SAMPLES` samples in structure-of-arrays form (the lean
+    pass — ``ball_joints=False`` or ``lazy=True`` — by the compiled loop of
+    :mod:`~screwkit.kinematics.closed_forms.cssp_compiled` where it applies: the same rows). The (N, …)
     arrays are views of component-major storage (every component contiguous over the samples;
     not C-contiguous): the values are those of the (N, …) layout, and the blocked inverse
     dynamics reads them without a transposing copy.
@@ -400,7 +403,20 @@ def _mode_motion(linkage: Linkage, sw: CSSPSweep, joint_rotations: bool, ball_jo
     s4_st = np.empty((3, n))  # s4, ṡ4, s̈4
     closure = np.empty(n)
     base_R, base_p = linkage.base.real, linkage.base.translation
-    for start in range(0, n, BLOCK_SAMPLES):
+    if (not ball_joints and SEED_st is None and cssp_compiled.use_compiled(n)
+            and np.array_equal(base_R, np.eye(3)) and not np.any(base_p)):
+        # the same rows, written by the compiled loop (cssp_compiled); the rows the numpy
+        # route leaves unwritten (a constant zero) are those of one sample's block rows
+        one = cssp_block_rows(sw, slice(0, 1), base_R, base_p)
+        write = [not (type(v) is float and v == 0.0) for rows in (
+            one.rotation, one.origin, one.velocity, one.acceleration, one.angular_velocity,
+            one.angular_acceleration, one.centres, one.axes) for v in rows] + [True] * 4
+        cssp_compiled.lean_rows(sw, [R_st, O_st, V_st, A_st, W_st, AL_st, C_st, X_st, s4_st,
+                                     closure], write)
+        n_blocks = 0
+    else:
+        n_blocks = n
+    for start in range(0, n_blocks, BLOCK_SAMPLES):
         sl = slice(start, min(start + BLOCK_SAMPLES, n))
         rows = cssp_block_rows(sw, sl, base_R, base_p)
         _write_rows((R_st, O_st, V_st, A_st, W_st, AL_st, C_st, X_st), rows, sl)

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.closed_forms.cssp import CSSPDimensions
+from screwkit.kinematics.closed_forms.cssp_compiled import rod_steps, use_compiled
 from screwkit.kinematics.tracker.idle_spin import (
     minimal_rotation_apply,
     perpendicular,
@@ -131,22 +132,11 @@ def rod_turn(dims: CSSPDimensions, root: int, theta1: Array, ct: Array, st: Arra
     starts = np.flatnonzero(ok & ~continues)
     frame_start = np.empty((starts.size, 3))
     u_start = np.empty((starts.size, 3))
-    with np.errstate(divide="ignore", invalid="ignore"):  # placeholders off the runs
-        for a in range(0, n, BLOCK):
-            b = min(a + BLOCK, n)
-            lo = max(a - 1, 0)  # with the sample before the block
-            k = closed(slice(lo, b))
-            u, ud, udd = k["u"], k["u_dot"], k["u_ddot"]
-            x = _frame_x(k, e_body)
-            here = [s - lo for s in starts[(starts >= a) & (starts < b)].tolist()]
-            if here:
-                j = np.searchsorted(starts, a)
-                frame_start[j:j + len(here)] = np.stack([c[here] for c in x], -1)
-                u_start[j:j + len(here)] = np.stack([c[here] for c in u], -1)
-            if b - lo < 2:
-                continue
-            cont = continues[lo + 1:b]
-            phi_step[lo + 1:b] = np.where(cont, _steps(u, ud, udd, x, cont), 0.0)
+    if use_compiled(n):
+        _compiled_steps(dims, root, ct, st, steps, s1, s1_steps, disc, continues, e_body,
+                        starts, closed, phi_step, frame_start, u_start)
+    else:
+        _blocked_steps(n, closed, e_body, starts, continues, phi_step, frame_start, u_start)
     # the wanted frame at a run's start: the proximal ball is a pure swing from rest
     start_phi = np.zeros(n)
     if starts.size:
@@ -169,3 +159,47 @@ def rod_turn(dims: CSSPDimensions, root: int, theta1: Array, ct: Array, st: Arra
     base = (start_phi[starts] - total[starts]) if starts.size else np.zeros(1)
     phi = total + base[run_id]
     return np.where(ok, phi, 0.0)
+
+
+def _blocked_steps(n: int, closed: Any, e_body: Array, starts: NDArray[np.intp],
+                   continues: NDArray[np.bool_], phi_step: Array, frame_start: Array,
+                   u_start: Array) -> None:
+    """The steps of :func:`rod_turn` block by block (numpy), into ``phi_step``; the rod's
+    body vector x and u at the runs' starts into ``frame_start``, ``u_start``."""
+    with np.errstate(divide="ignore", invalid="ignore"):  # placeholders off the runs
+        for a in range(0, n, BLOCK):
+            b = min(a + BLOCK, n)
+            lo = max(a - 1, 0)  # with the sample before the block
+            k = closed(slice(lo, b))
+            u, ud, udd = k["u"], k["u_dot"], k["u_ddot"]
+            x = _frame_x(k, e_body)
+            here = [s - lo for s in starts[(starts >= a) & (starts < b)].tolist()]
+            if here:
+                j = np.searchsorted(starts, a)
+                frame_start[j:j + len(here)] = np.stack([c[here] for c in x], -1)
+                u_start[j:j + len(here)] = np.stack([c[here] for c in u], -1)
+            if b - lo < 2:
+                continue
+            cont = continues[lo + 1:b]
+            phi_step[lo + 1:b] = np.where(cont, _steps(u, ud, udd, x, cont), 0.0)
+
+
+def _compiled_steps(dims: CSSPDimensions, root: int, ct: Array, st: Array, steps: Array,
+                    s1: Any, s1_steps: Any, disc: Array, continues: NDArray[np.bool_],
+                    e_body: Array, starts: NDArray[np.intp], closed: Any, phi_step: Array,
+                    frame_start: Array, u_start: Array) -> None:
+    """The steps of :func:`rod_turn` by the compiled loop (the same formulas: cssp_compiled),
+    x and u at the runs' starts and the half-turn steps by the numpy functions."""
+    opposite = rod_steps(dims, root, ct, st, steps, s1, s1_steps, disc, continues, e_body,
+                         phi_step)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if starts.size:
+            k = closed(starts)
+            frame_start[:] = np.stack(_frame_x(k, e_body), -1)
+            u_start[:] = np.stack(k["u"], -1)
+        if opposite.size:  # u turned by a half turn in one step: as _steps finishes them
+            kp, kq = closed(opposite - 1), closed(opposite)
+            a, b = np.stack(kp["u"], -1), np.stack(kq["u"], -1)
+            moved = minimal_rotation_apply(a, b, np.stack(_frame_x(kp, e_body), -1))
+            phi_step[opposite] = phi_step[opposite] - signed_angle(
+                moved, np.stack(_frame_x(kq, e_body), -1), b)
