@@ -26,7 +26,11 @@ The same module compiles three per-point passes over a term table
 (issue 27, the 6R eigen route alone): the Newton polish (:func:`newton_terms`), the fast α-test
 of :func:`.certify.certify` (:func:`alpha_test`: F, Σ|terms|, J⁻¹ by one LU per point, the
 Frobenius bounds and the verdicts) and the Bombieri–Weyl norm (:func:`bombieri_weyl`);
-tests/algebraic/test_compiled.py checks them against the numpy route.
+tests/algebraic/test_compiled.py checks them against the numpy route. For a system of quadrics
+given as dense symmetric matrices (F_i = zᵀ Q_i z, z = (x, 1)), the polish and the α-test also
+run from those (:func:`newton_quadrics`, :func:`alpha_test_quadrics`: the Stewart route's 9 × 9
+matrices instead of its 489-term table in 42 parameters; tests/kinematics/test_stewart_dense.py
+checks them against the term table's).
 
 numba is optional (the ``fast`` extra): :data:`AVAILABLE` is False without it, and the tracker
 then runs the numpy route. The kernels are compiled on first use (a few seconds, cached on disk
