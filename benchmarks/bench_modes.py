@@ -18,6 +18,9 @@ Checked: the count per instance (40, 16); for Stewart, the leg lengths of every 
 largest distance between the two routes' solutions. Times are CPU seconds (best of 3 alone, one run for a batch), start solutions
 excluded (found once per process: their time is its own row).
 
+The template route's Newton polish and fast α-test evaluate the Stewart system from its 9 × 9
+quadric matrices (modes/stewart_solve.py's ``dense_quadrics``), not the 489-term table.
+
 Targets (issue 27): Stewart ≤ 5 ms alone, ≤ 0.5 ms per instance in the batch of 1,000 (fkSGP
 12–14 ms per instance); 6R ≤ 1 ms per instance.
 

@@ -149,7 +149,8 @@ def _error_factor(system: PolynomialSystem) -> NDArray[np.float64]:
 
 
 def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False,
-            norm_f: NDArray[np.float64] | None = None) -> Certificate:
+            norm_f: NDArray[np.float64] | None = None,
+            dense: tuple[Complex, Complex, NDArray[np.intp]] | None = None) -> Certificate:
     """The α-test of the points x (P, n) for F(·; p) = 0, p (k,) or (P, k).
 
     ``fast``: one inverse of Df(x) per point instead of two singular value decompositions,
@@ -157,7 +158,11 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False
     κ and ‖Df⁻¹Δ‖ are bounded on the safe side: the test is as rigorous, only more
     conservative, by at most √n in γ; compiled when numba is there, :func:`.compiled.alpha_test`,
     the same arithmetic point by point). ``norm_f``: ‖f‖ (P,) when the caller has it (one per
-    parameter vector, repeated), else computed here."""
+    parameter vector, repeated), else computed here. ``dense``: for a system of quadrics, its
+    symmetric matrices (Q, |Q|, inst) (:func:`.compiled.alpha_test_quadrics`): with ``fast``
+    and numba, F, Df and Σ|terms| are evaluated from them (the same values to rounding: the
+    rounding allowance per Σ|terms|, sized for the term table's longer sums, covers the dense
+    sums of ≤ (n + 1)² products too) and the rest of the test is unchanged."""
     from screwkit.algebraic import compiled
 
     x = np.asarray(x, dtype=complex)
@@ -165,6 +170,11 @@ def certify(system: PolynomialSystem, x: Complex, p: Complex, fast: bool = False
     p = np.broadcast_to(np.asarray(p, dtype=complex), (P, system.k))
     if fast and compiled.AVAILABLE:  # the same test, one compiled pass per point
         real_p = np.all(p.imag == 0, axis=1) & bool(np.all(system.coef.imag == 0))
+        if dense is not None:
+            return Certificate(*compiled.alpha_test_quadrics(
+                system, dense, x, _error_factor(system),
+                _norms(system, p) if norm_f is None else norm_f, real_p, ALPHA_0, ALPHA_REAL,
+                UNIT_ROUNDOFF))
         return Certificate(*compiled.alpha_test(
             system, x, p, _error_factor(system), _norms(system, p) if norm_f is None else norm_f,
             real_p, ALPHA_0, ALPHA_REAL, UNIT_ROUNDOFF))

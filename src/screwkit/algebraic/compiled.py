@@ -26,7 +26,11 @@ The same module compiles three per-point passes over a term table
 (issue 27, the 6R eigen route alone): the Newton polish (:func:`newton_terms`), the fast α-test
 of :func:`.certify.certify` (:func:`alpha_test`: F, Σ|terms|, J⁻¹ by one LU per point, the
 Frobenius bounds and the verdicts) and the Bombieri–Weyl norm (:func:`bombieri_weyl`);
-tests/algebraic/test_compiled.py checks them against the numpy route.
+tests/algebraic/test_compiled.py checks them against the numpy route. For a system of quadrics
+given as dense symmetric matrices (F_i = zᵀ Q_i z, z = (x, 1)), the polish and the α-test also
+run from those (:func:`newton_quadrics`, :func:`alpha_test_quadrics`: the Stewart route's 9 × 9
+matrices instead of its 489-term table in 42 parameters; tests/kinematics/test_stewart_dense.py
+checks them against the term table's).
 
 numba is optional (the ``fast`` extra): :data:`AVAILABLE` is False without it, and the tracker
 then runs the numpy route. The kernels are compiled on first use (a few seconds, cached on disk
@@ -153,6 +157,20 @@ def newton_terms(system: PolynomialSystem, x: Complex, p: Complex, steps: int,
     return x
 
 
+def newton_quadrics(Q: Complex, inst: Index, x: Complex, steps: int, settled: float
+                    ) -> Complex:
+    """:func:`newton_terms` on the symmetric quadrics Q (B, N, n + 1, n + 1) of the instances
+    ``inst`` (P,) of the points x (P, n): F_i = zᵀ Q_i z, z = (x, 1), compiled
+    (:func:`.compiled_kernels.newton_quadrics`)."""
+    from screwkit.algebraic import compiled_kernels
+
+    x = np.array(x, dtype=complex, order="C")
+    compiled_kernels.newton_quadrics(np.ascontiguousarray(Q, dtype=complex),
+                                     np.ascontiguousarray(inst, dtype=np.int64), x, int(steps),
+                                     float(settled))
+    return x
+
+
 def alpha_test(system: PolynomialSystem, x: Complex, p: Complex, factor: NDArray[np.float64],
                norm_f: NDArray[np.float64], real_p: NDArray[np.bool_], alpha0: float,
                alpha_real: float, unit: float) -> tuple[Any, ...]:
@@ -177,6 +195,34 @@ def alpha_test(system: PolynomialSystem, x: Complex, p: Complex, factor: NDArray
                                 np.ascontiguousarray(norm_f, dtype=float),
                                 np.ascontiguousarray(real_p, dtype=np.bool_), alpha0,
                                 alpha_real, unit, F, magnitude, newton, bounds, flags)
+    return (flags[:, 0], bounds[:, 0], bounds[:, 1], bounds[:, 2], 2.0 * bounds[:, 1],
+            flags[:, 1], flags[:, 2], newton, F, magnitude.real.copy())
+
+
+def alpha_test_quadrics(system: PolynomialSystem, dense: tuple[Complex, Complex, Index],
+                        x: Complex, factor: NDArray[np.float64], norm_f: NDArray[np.float64],
+                        real_p: NDArray[np.bool_], alpha0: float, alpha_real: float,
+                        unit: float) -> tuple[Any, ...]:
+    """:func:`alpha_test` with F, ∂F/∂x and Σ|terms| from the system's quadrics ``dense`` =
+    (Q, |Q|, inst): Q (B, N, n + 1, n + 1) symmetric, F_i = zᵀ Q_i z with z = (x, 1), |Q| the
+    term-wise moduli (|z|ᵀ |Q|_i |z| = Σ|terms| of F_i), inst (P,) each point's instance
+    (:func:`.compiled_kernels.alpha_test_quadrics`)."""
+    from screwkit.algebraic import compiled_kernels
+
+    x = np.ascontiguousarray(x, dtype=complex)
+    P = len(x)
+    F = np.empty((P, system.size), dtype=complex)
+    magnitude = np.empty((P, system.size), dtype=complex)
+    newton = np.empty((P, system.n), dtype=complex)
+    bounds = np.empty((P, 3))
+    flags = np.empty((P, 3), dtype=np.bool_)
+    Q, Qabs, inst = dense
+    compiled_kernels.alpha_test_quadrics(
+        np.ascontiguousarray(Q, dtype=complex), np.ascontiguousarray(Qabs, dtype=complex),
+        np.ascontiguousarray(inst, dtype=np.int64), x, np.asarray(system.degrees, dtype=float),
+        factor, np.ascontiguousarray(norm_f, dtype=float),
+        np.ascontiguousarray(real_p, dtype=np.bool_), alpha0, alpha_real, unit, F, magnitude,
+        newton, bounds, flags)
     return (flags[:, 0], bounds[:, 0], bounds[:, 1], bounds[:, 2], 2.0 * bounds[:, 1],
             flags[:, 1], flags[:, 2], newton, F, magnitude.real.copy())
 

@@ -340,6 +340,47 @@ def newton(coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any, steps:
 
 
 @njit
+def newton_quadrics(Q: Any, inst: Any, x: Any, steps: int, settled: float) -> None:
+    """:func:`newton` on symmetric quadrics Q (B, N, n + 1, n + 1) (point b's are
+    Q[inst[b]]): F_i = zᵀ Q_i z, ∂F_i/∂x = 2 (Q_i z)[:n], z = (x, 1), the same stopping
+    rules, x (P, n) in place."""
+    P, n = x.shape
+    N = Q.shape[1]
+    z = np.empty(n + 1, dtype=np.complex128)
+    J = np.empty((N, n), dtype=np.complex128)
+    r = np.empty((N, 1), dtype=np.complex128)
+    for b in range(P):
+        q = Q[inst[b]]
+        for _ in range(steps):
+            for k in range(n):
+                z[k] = x[b, k]
+            z[n] = 1.0
+            finite = True
+            for i in range(N):
+                f = 0j
+                for j in range(n + 1):
+                    s = 0j
+                    for k in range(n + 1):
+                        s += q[i, j, k] * z[k]
+                    f += s * z[j]
+                    if j < n:
+                        J[i, j] = 2.0 * s
+                r[i, 0] = f
+                finite = finite and np.isfinite(f)
+            if not (finite and np.isfinite(J).all()):
+                break
+            if not solve(J, r) or not np.isfinite(r).all():
+                break
+            big, top = 0.0, 0.0
+            for i in range(n):
+                big = max(big, abs(r[i, 0]))
+                top = max(top, abs(x[b, i]))
+                x[b, i] -= r[i, 0]
+            if big / (1.0 + top) <= settled:
+                break
+
+
+@njit
 def alpha_terms(coef: Any, abs_coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any,
                 delta: Any, F: Any, magnitude: Any, step: Any, stats: Any) -> None:
     """What the fast α-test (:func:`.certify.certify`, ``fast``) needs per point of x (P, n),
@@ -367,35 +408,93 @@ def alpha_terms(coef: Any, abs_coef: Any, sym: Any, pw: Any, eq: Any, n: int, x:
         magnitude[b] = 0.0
         dummy[:] = 0.0
         term_values(abs_coef, sym, pw, eq, n, ax, ap, magnitude[b:b + 1], dummy)
-        finite = np.isfinite(F[b]).all() and np.isfinite(J).all()
-        A = J[0].copy()
-        if not finite:
-            A[:] = 0.0
-            for i in range(n):
-                A[i, i] = 1.0
-        norm_j = np.sqrt(np.sum(np.abs(A) ** 2))
-        inv[:] = 0.0
+        point_stats(b, J[0], F, delta, inv, step, stats)
+
+
+@njit
+def point_stats(b: int, J: Any, F: Any, delta: Any, inv: Any, step: Any, stats: Any) -> None:
+    """:func:`alpha_terms`' step and ``stats`` of point b from its F[b] and J (N, n), with
+    ``inv`` (n, n) as workspace."""
+    n = J.shape[1]
+    finite = np.isfinite(F[b]).all() and np.isfinite(J).all()
+    A = J.copy()
+    if not finite:
+        A[:] = 0.0
         for i in range(n):
-            inv[i, i] = 1.0
-        ok = solve(A, inv)
-        if not ok:
-            for i in range(n):
-                step[b, i] = F[b, i] if finite else 0.0
-            stats[b, 0], stats[b, 1], stats[b, 2] = 1.0 if finite else 0.0, np.inf, norm_j
-            stats[b, 3] = np.inf
-            continue
+            A[i, i] = 1.0
+    norm_j = np.sqrt(np.sum(np.abs(A) ** 2))
+    inv[:] = 0.0
+    for i in range(n):
+        inv[i, i] = 1.0
+    ok = solve(A, inv)
+    if not ok:
         for i in range(n):
-            s = 0j
-            if finite:
-                for j in range(n):
-                    s += inv[i, j] * F[b, j]
-            step[b, i] = s
-        scaled = 0.0
-        for i in range(n):
+            step[b, i] = F[b, i] if finite else 0.0
+        stats[b, 0], stats[b, 1], stats[b, 2] = 1.0 if finite else 0.0, np.inf, norm_j
+        stats[b, 3] = np.inf
+        return
+    for i in range(n):
+        s = 0j
+        if finite:
             for j in range(n):
-                scaled += abs(inv[i, j] * delta[b, j]) ** 2
-        stats[b, 0], stats[b, 1] = 1.0 if finite else 0.0, np.sqrt(np.sum(np.abs(inv) ** 2))
-        stats[b, 2], stats[b, 3] = norm_j, np.sqrt(scaled)
+                s += inv[i, j] * F[b, j]
+        step[b, i] = s
+    scaled = 0.0
+    for i in range(n):
+        for j in range(n):
+            scaled += abs(inv[i, j] * delta[b, j]) ** 2
+    stats[b, 0], stats[b, 1] = 1.0 if finite else 0.0, np.sqrt(np.sum(np.abs(inv) ** 2))
+    stats[b, 2], stats[b, 3] = norm_j, np.sqrt(scaled)
+
+
+@njit
+def alpha_quadrics(Q: Any, Qabs: Any, inst: Any, x: Any, delta: Any, F: Any, magnitude: Any,
+                   step: Any, stats: Any) -> None:
+    """:func:`alpha_terms` for symmetric quadrics Q (B, N, n + 1, n + 1) of the instances
+    ``inst`` (P,): F_i = zᵀ Q_i z, ∂F_i/∂x = 2 (Q_i z)[:n], Σ|terms| = |z|ᵀ Qabs_i |z|
+    (z = (x, 1); Qabs the term-wise moduli, real valued)."""
+    P, n = x.shape
+    N = F.shape[1]
+    J = np.empty((N, n), dtype=np.complex128)
+    inv = np.empty((n, n), dtype=np.complex128)
+    z = np.empty(n + 1, dtype=np.complex128)
+    az = np.empty(n + 1)
+    for b in range(P):
+        q, qa = Q[inst[b]], Qabs[inst[b]]
+        for k in range(n):
+            z[k] = x[b, k]
+            az[k] = abs(x[b, k])
+        z[n], az[n] = 1.0, 1.0
+        for i in range(N):
+            f, m = 0j, 0.0
+            for j in range(n + 1):
+                s, t = 0j, 0.0
+                for k in range(n + 1):
+                    s += q[i, j, k] * z[k]
+                    t += qa[i, j, k].real * az[k]
+                f += s * z[j]
+                m += t * az[j]
+                if j < n:
+                    J[i, j] = 2.0 * s
+            F[b, i] = f
+            magnitude[b, i] = m
+        point_stats(b, J, F, delta, inv, step, stats)
+
+
+@njit
+def deltas(x: Any, degrees: Any) -> tuple[Any, Any]:
+    """Δ (P, n) = √d_i·‖x‖₁^(d_i − 1) and ‖x‖₁ = √(1 + ‖x‖²) (P,) of the points x (P, n)."""
+    P, n = x.shape
+    delta = np.empty((P, n))
+    norm1 = np.empty(P)
+    for b in range(P):
+        sq = 0.0
+        for i in range(n):
+            sq += abs(x[b, i]) ** 2
+        norm1[b] = np.sqrt(1.0 + sq)
+        for i in range(n):
+            delta[b, i] = np.sqrt(degrees[i]) * norm1[b] ** (degrees[i] - 1.0)
+    return delta, norm1
 
 
 @njit
@@ -409,22 +508,37 @@ def alpha_test(coef: Any, abs_coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: 
     cannot run) and ``flags`` (P, 3) certified, real, not real. ``degrees`` (N,) of the
     equations, ``factor`` (N,) the rounding allowance per Σ|terms|, ``norm_f`` (P,) ‖f‖,
     ``real_p`` (P,) whether the system is real at p."""
-    P = x.shape[0]
+    delta, norm1 = deltas(x, degrees)
+    step = np.empty((x.shape[0], n), dtype=np.complex128)
+    stats = np.empty((x.shape[0], 4))
+    alpha_terms(coef, abs_coef, sym, pw, eq, n, x, p, delta, F, magnitude, step, stats)
+    verdicts(x, degrees, factor, norm_f, real_p, alpha0, alpha_real, unit, F, magnitude, step,
+             stats, norm1, newton, bounds, flags)
+
+
+@njit
+def alpha_test_quadrics(Q: Any, Qabs: Any, inst: Any, x: Any, degrees: Any, factor: Any,
+                        norm_f: Any, real_p: Any, alpha0: float, alpha_real: float,
+                        unit: float, F: Any, magnitude: Any, newton: Any, bounds: Any,
+                        flags: Any) -> None:
+    """:func:`alpha_test` with F, ∂F/∂x and Σ|terms| from quadrics (:func:`alpha_quadrics`)."""
+    delta, norm1 = deltas(x, degrees)
+    step = np.empty(x.shape, dtype=np.complex128)
+    stats = np.empty((x.shape[0], 4))
+    alpha_quadrics(Q, Qabs, inst, x, delta, F, magnitude, step, stats)
+    verdicts(x, degrees, factor, norm_f, real_p, alpha0, alpha_real, unit, F, magnitude, step,
+             stats, norm1, newton, bounds, flags)
+
+
+@njit
+def verdicts(x: Any, degrees: Any, factor: Any, norm_f: Any, real_p: Any, alpha0: float,
+             alpha_real: float, unit: float, F: Any, magnitude: Any, step: Any, stats: Any,
+             norm1: Any, newton: Any, bounds: Any, flags: Any) -> None:
+    """:func:`alpha_test`'s bounds and flags from F, Σ|terms|, the steps and ``stats``."""
+    P, n = x.shape
     dmax = 1.0
     for i in range(degrees.shape[0]):
         dmax = max(dmax, degrees[i])
-    delta = np.empty((P, n))
-    norm1 = np.empty(P)
-    for b in range(P):
-        sq = 0.0
-        for i in range(n):
-            sq += abs(x[b, i]) ** 2
-        norm1[b] = np.sqrt(1.0 + sq)
-        for i in range(n):
-            delta[b, i] = np.sqrt(degrees[i]) * norm1[b] ** (degrees[i] - 1.0)
-    step = np.empty((P, n), dtype=np.complex128)
-    stats = np.empty((P, 4))
-    alpha_terms(coef, abs_coef, sym, pw, eq, n, x, p, delta, F, magnitude, step, stats)
     for b in range(P):
         err, st, gap = 0.0, 0.0, 0.0
         for i in range(F.shape[1]):

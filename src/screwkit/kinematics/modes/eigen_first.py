@@ -66,6 +66,12 @@ class EigenRoute:
     homotopy: str
     #: Newton steps at most per point (a point stops once its step is below SETTLED)
     newton_steps: int = NEWTON_STEPS
+    #: for a system of quadrics (and linear equations), its symmetric matrices at the
+    #: instances (B, N, n + 1, n + 1), F_i(x) = zᵀ Q_i z with z = (x, 1), and their term-wise
+    #: moduli (|z|ᵀ |Q|_i |z| = Σ|terms| of F_i): Newton's method (:func:`newton_dense`) and the
+    #: fast α-test (:func:`.certify.certify`, ``dense``) then evaluate them instead of the term
+    #: table (the same values to rounding; ‖f‖, the γ bound and the verdicts are unchanged)
+    quadrics: Callable[[Complex], tuple[Complex, Complex]] | None = None
 
 
 def newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Complex:
@@ -84,6 +90,41 @@ def newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Comp
         xa, pa = x[active], p[active]
         with np.errstate(all="ignore"):
             F, J, _ = system.evaluate(xa, pa, want_jp=False)
+            ok: NDArray[np.bool_] = np.asarray(np.isfinite(F).all(1) & np.isfinite(J).all((1, 2)),
+                                               dtype=bool)
+            Js: Complex = np.where(ok[:, None, None], J, np.eye(n))
+            Fs: Complex = np.where(ok[:, None], F, 0.0)
+            try:
+                step: Complex = np.asarray(np.linalg.solve(Js, Fs[..., None])[..., 0], dtype=complex)
+            except np.linalg.LinAlgError:  # an exactly singular Jacobian somewhere
+                step = np.asarray(np.einsum("pij,pj->pi", np.linalg.pinv(Js), Fs), dtype=complex)
+            ok &= np.isfinite(step).all(1)
+            x[active[ok]] = xa[ok] - step[ok]
+            size = np.abs(step).max(1) / (1.0 + np.abs(xa).max(1))
+        active = active[ok & (size > SETTLED)]
+    return x
+
+
+def newton_dense(Q: Complex, inst: NDArray[np.intp], x: Complex, steps: int) -> Complex:
+    """:func:`newton` on the symmetric quadrics Q (B, N, n + 1, n + 1) of the instances
+    ``inst`` (P,) of the points x (P, n): F_i = zᵀ Q_i z and ∂F_i/∂x = 2 (Q_i z)[:n] with
+    z = (x, 1) (the gradient of a quadratic form; Sommese & Wampler 2005, ch. 9, for Newton's
+    method), the same steps as the term table's evaluation to rounding. Compiled, one point
+    at a time, when numba is there (:func:`.compiled.newton_quadrics`)."""
+    if compiled.AVAILABLE:
+        return compiled.newton_quadrics(Q, inst, x, steps, SETTLED)
+    x = np.array(x, dtype=complex)
+    P, n = x.shape
+    active = np.arange(P)
+    for _ in range(steps):
+        if not len(active):
+            break
+        xa = x[active]
+        z = np.concatenate([xa, np.ones((len(active), 1))], axis=1)
+        with np.errstate(all="ignore"):
+            Qz = (Q[inst[active]] @ z[:, None, :, None])[..., 0]  # (P, N, n + 1)
+            F = (Qz @ z[:, :, None])[..., 0]
+            J = 2.0 * Qz[:, :, :n]
             ok: NDArray[np.bool_] = np.asarray(np.isfinite(F).all(1) & np.isfinite(J).all((1, 2)),
                                                dtype=bool)
             Js: Complex = np.where(ok[:, None, None], J, np.eye(n))
@@ -150,11 +191,22 @@ def _eigen_pass(route: EigenRoute, targets: Complex, label: int
     inst = sel // m
     twin = np.flatnonzero((real & (key.imag > 0)).ravel()[sel])  # their conjugates solve too
     p = targets[inst]
-    xs = newton(system, x.reshape(B * m, -1)[sel].astype(complex), p, route.newton_steps)
+    Q, Qabs = (None, None) if route.quadrics is None else route.quadrics(targets)
+
+    def polish(x: Complex, rows: NDArray[np.intp] | slice) -> Complex:
+        if Q is None:
+            return newton(system, x, p[rows], route.newton_steps)
+        return newton_dense(Q, inst[rows], x, route.newton_steps)
+
+    def fast_test(x: Complex, rows: NDArray[np.intp] | slice) -> Certificate:
+        dense = None if Q is None or Qabs is None else (Q, Qabs, inst[rows])
+        return certify(system, x, p[rows], fast=True, norm_f=norm_f[rows], dense=dense)
+
+    xs = polish(x.reshape(B * m, -1)[sel].astype(complex), slice(None))
     finite: NDArray[np.bool_] = np.asarray(np.isfinite(xs).all(1), dtype=bool)
     xs = np.where(finite[:, None], xs, 0.0)
     norm_f = bombieri_weyl_norm(system, targets)[inst]
-    cert = certify(system, xs, p, fast=True, norm_f=norm_f)
+    cert = fast_test(xs, slice(None))
     # a point still moving after its steps (it arrived far off and wandered before Newton's
     # fast phase) gets more rounds, at most POLISH_ROUNDS
     for _ in range(POLISH_ROUNDS):
@@ -163,9 +215,8 @@ def _eigen_pass(route: EigenRoute, targets: Complex, label: int
                                              > SETTLED * (1.0 + np.abs(xs).max(axis=1))))
         if not len(again):
             break
-        xs[again] = newton(system, xs[again], p[again], route.newton_steps)
-        cert = _replaced(cert, again, certify(system, xs[again], p[again], fast=True,
-                                              norm_f=norm_f[again]))
+        xs[again] = polish(xs[again], again)
+        cert = _replaced(cert, again, fast_test(xs[again], again))
     # the fast test's Frobenius bounds are up to √n looser: where it does not decide (not
     # certified, or real or not real on a real instance), the exact test (two SVDs) decides
     unsure = np.flatnonzero(~cert.certified | (real[inst, 0] & ~(cert.real | cert.not_real)))

@@ -25,8 +25,13 @@ from screwkit.algebraic.polynomial import Complex
 from screwkit.algebraic.solve import Solutions
 from screwkit.errors import InputError
 from screwkit.kinematics.modes import eigen_first
-from screwkit.kinematics.modes.stewart import STEWART_GENERIC_COUNT, stewart_start, stewart_system
-from screwkit.kinematics.modes.stewart_template import template_solve
+from screwkit.kinematics.modes.stewart import (
+    PATCH,
+    STEWART_GENERIC_COUNT,
+    stewart_start,
+    stewart_system,
+)
+from screwkit.kinematics.modes.stewart_template import quadrics, template_solve
 
 #: the charts of the template tried in turn on the instances still unsettled
 CHARTS = (0, 1, 2)
@@ -48,11 +53,27 @@ def _targets(params: ArrayLike) -> Complex:
     return p.reshape(-1, 42)
 
 
+def dense_quadrics(targets: Complex) -> tuple[Complex, Complex]:
+    """The system's symmetric matrices (B, 8, 9, 9) at the instances (B, 42), F_i = zᵀ Q_i z
+    with z = (x, y, 1): the Study quadric and the six legs (:func:`.stewart_template.quadrics`,
+    Husty 1996) and the patch r·x − 1; and their term-wise moduli, |z|ᵀ |Q|_i |z| = Σ|terms|
+    of F_i (the α-test's rounding scale): for the polish's dense Newton steps and α-test."""
+    out = []
+    for absolute in (False, True):
+        Q = np.zeros((len(targets), 8, 9, 9), dtype=complex)
+        Q[:, :7, :8, :8] = quadrics(targets, absolute)
+        Q[:, 7, :4, 8] = Q[:, 7, 8, :4] = 0.5 * (np.abs(PATCH) if absolute else PATCH)
+        Q[:, 7, 8, 8] = 1.0 if absolute else -1.0
+        out.append(Q)
+    return out[0], out[1]
+
+
 @lru_cache(maxsize=1)
 def stewart_route() -> eigen_first.EigenRoute:
     """The Stewart–Gough platform's eigen route (module docstring), keyed by ξ1."""
     return eigen_first.EigenRoute(stewart_system(), STEWART_GENERIC_COUNT, template_solve, CHARTS,
-                                  stewart_start, TEMPLATE, HOMOTOPY, NEWTON_STEPS)
+                                  stewart_start, TEMPLATE, HOMOTOPY, NEWTON_STEPS,
+                                  dense_quadrics)
 
 
 def solve_stewart(params: ArrayLike, options: TrackOptions | None = None) -> Solutions:

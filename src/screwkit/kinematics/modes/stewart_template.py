@@ -98,19 +98,27 @@ def _forms() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float
     return G, H, S
 
 
-def quadrics(params: Complex) -> Complex:
+def quadrics(params: Complex, absolute: bool = False) -> Complex:
     """The symmetric matrices (B, 7, 8, 8) of modes/stewart.py's Study quadric and six leg
-    quadrics (its module docstring) at the parameter rows (B, 42): zᵀ Q z is the equation."""
+    quadrics (its module docstring) at the parameter rows (B, 42): zᵀ Q z is the equation.
+    ``absolute``: the same sums with every product replaced by its modulus (|A|, |B|, |L²| and
+    the forms' |entries|, every − a +), so that |z|ᵀ Q |z| is Σ|terms| of the expanded
+    equation (the rounding scale of the α-test, algebraic/certify.py)."""
     G, H, S = _forms()
+    sign = 1.0
+    if absolute:
+        params, G, H, S, sign = np.abs(params).astype(complex), abs(G), abs(H), abs(S), -1.0
     A = params[:, :18].reshape(-1, 6, 3)
     Bp = params[:, 18:36].reshape(-1, 6, 3)
-    c = np.sum(A * A, -1) + np.sum(Bp * Bp, -1) - params[:, 36:]
+    c = np.sum(A * A, -1) + np.sum(Bp * Bp, -1) - sign * params[:, 36:]
     Q = np.zeros((len(params), 7, 8, 8), dtype=params.dtype)
     Q[:, 0, :4, 4:] = Q[:, 0, 4:, :4] = 0.5 * np.eye(4)
-    Q[:, 1:, :4, :4] = c[..., None, None] * np.eye(4) - 2 * np.einsum(
-        "bir,klrs,bis->bikl", A, S, Bp, optimize=True)
+    # Σ_rs A_ir S_klrs B_is and Σ_r (B_ir G_rkl − A_ir H_rkl) as matrix products
+    AB = (A[..., :, None] * Bp[..., None, :]).reshape(-1, 6, 9)
+    Q[:, 1:, :4, :4] = c[..., None, None] * np.eye(4) - sign * 2 * (
+        AB @ S.reshape(16, 9).T).reshape(-1, 6, 4, 4)
     Q[:, 1:, 4:, 4:] = 4 * np.eye(4)
-    xy = 2 * (np.einsum("bir,rkl->bikl", Bp, G) - np.einsum("bir,rkl->bikl", A, H))
+    xy = 2 * (Bp @ G.reshape(3, 16) - sign * A @ H.reshape(3, 16)).reshape(-1, 6, 4, 4)
     Q[:, 1:, :4, 4:] = xy
     Q[:, 1:, 4:, :4] = np.swapaxes(xy, -1, -2)
     return Q
@@ -228,7 +236,7 @@ def coefficients(params: Complex, label: int = 0) -> Complex:
     y·y), leg 0."""
     T = chart(label)
     i, k = np.triu_indices(8)  # the products w_i w_k, i ≤ k, in the layout's order
-    Q = np.einsum("ai,njab,bk->njik", T, quadrics(params), T, optimize=True)
+    Q = T.T @ quadrics(params) @ T  # T_ai Q_ab T_bk
     c = Q[:, :, i, k] * np.where(i == k, 1.0, 2.0)
     out = np.empty_like(c)
     out[:, 0] = c[:, 0]
