@@ -307,6 +307,21 @@ def term_values(coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any, F
                     J[b, i, s] += (c * e) * zp * pre[f] * suf[f + 1]
 
 
+@njit_inline
+def newton_step(J: Any, r: Any, x: Any, b: int, n: int, settled: float) -> bool:
+    """One Newton step x[b] −= J⁻¹ r (r (N, 1) holds F, overwritten): whether to go on, i.e.
+    the step was finite and J not singular, and the step was above ``settled`` relative to
+    1 + max|x[b]| (:func:`newton`, :func:`newton_quadrics`)."""
+    if not solve(J, r) or not np.isfinite(r).all():
+        return False
+    big, top = 0.0, 0.0
+    for i in range(n):
+        big = max(big, abs(r[i, 0]))
+        top = max(top, abs(x[b, i]))
+        x[b, i] -= r[i, 0]
+    return big / (1.0 + top) > settled
+
+
 @njit
 def newton(coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any, steps: int,
            settled: float) -> None:
@@ -328,14 +343,7 @@ def newton(coef: Any, sym: Any, pw: Any, eq: Any, n: int, x: Any, p: Any, steps:
                 break
             for i in range(N):
                 r[i, 0] = F[0, i]
-            if not solve(J[0], r) or not np.isfinite(r).all():
-                break
-            big, top = 0.0, 0.0
-            for i in range(n):
-                big = max(big, abs(r[i, 0]))
-                top = max(top, abs(x[b, i]))
-                x[b, i] -= r[i, 0]
-            if big / (1.0 + top) <= settled:
+            if not newton_step(J[0], r, x, b, n, settled):
                 break
 
 
@@ -369,14 +377,7 @@ def newton_quadrics(Q: Any, inst: Any, x: Any, steps: int, settled: float) -> No
                 finite = finite and np.isfinite(f)
             if not (finite and np.isfinite(J).all()):
                 break
-            if not solve(J, r) or not np.isfinite(r).all():
-                break
-            big, top = 0.0, 0.0
-            for i in range(n):
-                big = max(big, abs(r[i, 0]))
-                top = max(top, abs(x[b, i]))
-                x[b, i] -= r[i, 0]
-            if big / (1.0 + top) <= settled:
+            if not newton_step(J, r, x, b, n, settled):
                 break
 
 

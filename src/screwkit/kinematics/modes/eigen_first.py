@@ -81,15 +81,28 @@ def newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Comp
     point at a time, when numba is there (:func:`.compiled.newton_terms`)."""
     if compiled.AVAILABLE:
         return compiled.newton_terms(system, x, p, steps, SETTLED)
+
+    def values(xa: Complex, active: NDArray[np.intp]) -> tuple[Complex, Complex]:
+        F, J, _ = system.evaluate(xa, p[active], want_jp=False)
+        return F, J
+
+    return _newton_steps(x, steps, values)
+
+
+def _newton_steps(x: Complex, steps: int,
+                  values: Callable[[Complex, NDArray[np.intp]], tuple[Complex, Complex]]
+                  ) -> Complex:
+    """The numpy route of :func:`newton` and :func:`newton_dense`: up to ``steps`` Newton
+    steps from x (P, n), F and ∂F/∂x of the points ``active`` at xa from ``values``."""
     x = np.array(x, dtype=complex)
     n = x.shape[1]
     active = np.arange(len(x))
     for _ in range(steps):
         if not len(active):
             break
-        xa, pa = x[active], p[active]
+        xa = x[active]
         with np.errstate(all="ignore"):
-            F, J, _ = system.evaluate(xa, pa, want_jp=False)
+            F, J = values(xa, active)
             ok: NDArray[np.bool_] = np.asarray(np.isfinite(F).all(1) & np.isfinite(J).all((1, 2)),
                                                dtype=bool)
             Js: Complex = np.where(ok[:, None, None], J, np.eye(n))
@@ -113,31 +126,14 @@ def newton_dense(Q: Complex, inst: NDArray[np.intp], x: Complex, steps: int) -> 
     at a time, when numba is there (:func:`.compiled.newton_quadrics`)."""
     if compiled.AVAILABLE:
         return compiled.newton_quadrics(Q, inst, x, steps, SETTLED)
-    x = np.array(x, dtype=complex)
-    P, n = x.shape
-    active = np.arange(P)
-    for _ in range(steps):
-        if not len(active):
-            break
-        xa = x[active]
+    n = x.shape[1]
+
+    def values(xa: Complex, active: NDArray[np.intp]) -> tuple[Complex, Complex]:
         z = np.concatenate([xa, np.ones((len(active), 1))], axis=1)
-        with np.errstate(all="ignore"):
-            Qz = (Q[inst[active]] @ z[:, None, :, None])[..., 0]  # (P, N, n + 1)
-            F = (Qz @ z[:, :, None])[..., 0]
-            J = 2.0 * Qz[:, :, :n]
-            ok: NDArray[np.bool_] = np.asarray(np.isfinite(F).all(1) & np.isfinite(J).all((1, 2)),
-                                               dtype=bool)
-            Js: Complex = np.where(ok[:, None, None], J, np.eye(n))
-            Fs: Complex = np.where(ok[:, None], F, 0.0)
-            try:
-                step: Complex = np.asarray(np.linalg.solve(Js, Fs[..., None])[..., 0], dtype=complex)
-            except np.linalg.LinAlgError:  # an exactly singular Jacobian somewhere
-                step = np.asarray(np.einsum("pij,pj->pi", np.linalg.pinv(Js), Fs), dtype=complex)
-            ok &= np.isfinite(step).all(1)
-            x[active[ok]] = xa[ok] - step[ok]
-            size = np.abs(step).max(1) / (1.0 + np.abs(xa).max(1))
-        active = active[ok & (size > SETTLED)]
-    return x
+        Qz = (Q[inst[active]] @ z[:, None, :, None])[..., 0]  # (P, N, n + 1)
+        return (Qz @ z[:, :, None])[..., 0], 2.0 * Qz[:, :, :n]
+
+    return _newton_steps(x, steps, values)
 
 
 def eigen_route(route: EigenRoute, targets: Complex
