@@ -59,6 +59,8 @@ def test_the_compiled_route_gives_the_numpy_routes_16(monkeypatch: pytest.Monkey
     assert new.route == old.route and new.route.count(ELIMINATION) >= 0.99 * INSTANCES
     assert (new.found == 16).mean() >= 0.99
     assert np.array_equal(new.found, old.found) and np.array_equal(new.real_count, old.real_count)
+    # the certified count may differ by a few points: a polished point's β is round-off, so a
+    # point at the α threshold can fall either side with another summation order
     assert abs(int(new.certified.sum()) - int(old.certified.sum())) <= 0.01 * len(new.x)
     for b in range(INSTANCES):
         a, c = new.of(b), old.of(b)
