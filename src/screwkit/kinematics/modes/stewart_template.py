@@ -22,7 +22,15 @@ the 40 values of ξ1 as its eigenvalues and the basis monomials' values as its e
 Geometry*, ch. 2 §4); B contains 1 and the seven unknowns, which are read off them.
 
 Dropped E columns are combinations of the kept ones at a generic instance: only the column
-space of M_E takes part in the elimination, so they change nothing. The points are unpolished;
+space of M_E takes part in the elimination, so they change nothing.
+
+The square matrix is solved in its block triangular form (:func:`block_triangular`: blocks of
+6, 1, 313 and 206), each block's matrix and its coupling to earlier blocks filled on its own
+(:func:`_plan`). Only the rows of R enter the action matrix, and the last block is read by no
+later block and holds one of them: it is solved for that row alone, as the row of its inverse
+times the right-hand side (one transposed solve of its LU with one right-hand side, not 40;
+Golub & Van Loan 2013, *Matrix Computations*, §3.2). A batch's chunks are spread over the
+cores in threads (LAPACK releases the GIL); each instance's arithmetic is the same either way. The points are unpolished;
 modes/stewart_solve.py polishes, certifies and falls back to the homotopy.
 """
 
@@ -283,10 +291,28 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
 
 
 def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Complex]:
-    """:func:`template_solve` of a few instances: the block-triangular solve
-    (:func:`_plan`), the action matrix and its eigenproblem. ``work`` keeps the zero-filled
-    arrays of one thread from chunk to chunk: every chunk writes the same (structurally
-    nonzero) entries of them, and LAPACK's solves do not overwrite them."""
+    """:func:`template_solve` of a few instances: the action matrices, their eigenproblem
+    and the points read off the eigenvectors."""
+    lay = _layout()
+    m = len(data.BASIS)
+    Am, good = action_matrices(p, label, work)
+    vals, vecs = np.linalg.eig(Am)
+    w = vecs[:, lay["unit"][1:], :] / vecs[:, lay["unit"][:1], :]  # (b, 7, 40)
+    one = np.ones((len(p), 1, m))
+    z = np.einsum("ij,bjm->bmi", chart(label), np.concatenate([one, w], axis=1))
+    z /= (z[..., :4] @ PATCH)[..., None]  # on the system's patch
+    return np.where(good[:, None, None], z, np.nan), np.where(good[:, None], vals, np.nan)
+
+
+def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = None
+                    ) -> tuple[Any, NDArray[np.bool_]]:
+    """The action matrices of ξ1 (B, 40, 40) of the instances p (B, 42) in the chart
+    ``label`` (module docstring; real for real parameters), by the block-triangular solve of
+    :func:`_plan`, and whether each is finite (an instance whose template is singular or not
+    finite gets the identity, marked False). ``work`` keeps one thread's zero-filled arrays
+    from call to call: every call writes the same (structurally nonzero) entries of them,
+    and LAPACK's solves do not overwrite them."""
+    work = {} if work is None else work
     lay = _layout()
     real = bool(np.all(p.imag == 0))
     dtype = np.float64 if real else np.complex128
@@ -294,7 +320,8 @@ def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Compl
     c: Any = coefficients(p, label).reshape(len(p), -1)
     c = c.real if real else c
     good: NDArray[np.bool_] = np.asarray(np.isfinite(c).all(axis=1), dtype=bool)
-    X: Any = np.empty((len(p), n, m), dtype=dtype)
+    X: Any = np.empty((len(p), n, m), dtype=dtype)  # rows no R reads stay unset
+
     def zeros(name: str, i: int, shape: tuple[int, int]) -> Any:
         key = f"{name}{i}"
         if key not in work or work[key].shape[0] != len(p) or work[key].dtype != dtype:
@@ -339,12 +366,7 @@ def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Compl
     good &= np.isfinite(Am).all(axis=(1, 2))
     if not good.all():
         Am[~good] = np.eye(m)
-    vals, vecs = np.linalg.eig(Am)
-    w = vecs[:, lay["unit"][1:], :] / vecs[:, lay["unit"][:1], :]  # (b, 7, 40)
-    one = np.ones((len(p), 1, m))
-    z = np.einsum("ij,bjm->bmi", chart(label), np.concatenate([one, w], axis=1))
-    z /= (z[..., :4] @ PATCH)[..., None]  # on the system's patch
-    return np.where(good[:, None, None], z, np.nan), np.where(good[:, None], vals, np.nan)
+    return Am, good
 
 
 @lru_cache(maxsize=1)
