@@ -231,3 +231,17 @@ def test_threads_change_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
         assert np.array_equal(a, b, equal_nan=True)
     alone = template_solve(p[-1:])
     assert np.array_equal(alone[0][0], three[0][-1]) and np.array_equal(alone[1][0], three[1][-1])
+
+
+def test_a_real_instance_in_a_batch_with_complex_ones_is_eliminated_as_alone() -> None:
+    """Real arithmetic for a real instance (exact conjugate pairs, which eigen_first's pairing
+    relies on) whatever else its chunk holds: bit for bit what it gives alone."""
+    p, _ = random_stewart(np.random.default_rng(39), 6)
+    q, _ = random_stewart(np.random.default_rng(40), 3, complex_values=True)
+    mixed = np.concatenate([p.real.astype(complex)[:3], q, p.real.astype(complex)[3:]])
+    pts, keys = template_solve(mixed)
+    for b in range(len(mixed)):
+        alone = template_solve(mixed[b:b + 1])
+        assert np.array_equal(alone[0][0], pts[b]) and np.array_equal(alone[1][0], keys[b]), b
+    for b in (0, 1, 2, 6, 7, 8):
+        assert np.array_equal(np.sort_complex(keys[b]), np.sort_complex(keys[b].conj()))

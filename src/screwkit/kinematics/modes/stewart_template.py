@@ -265,18 +265,25 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
     points come in exact conjugate pairs with conjugate ξ1 and the real ones have real ξ1).
     An instance whose template is singular or not finite gets NaN points. A batch of more
     than one chunk is split into :data:`THREADS` contiguous parts eliminated side by side
-    (LAPACK releases the GIL); each instance's arithmetic is the same either way."""
+    (LAPACK releases the GIL); each instance's arithmetic is the same either way, and the
+    same as alone (a real instance's is real in a batch with complex ones too)."""
     B = len(params)
     m = len(data.BASIS)
     points = np.full((B, m, 8), np.nan, dtype=complex)
     keys = np.full((B, m), np.nan, dtype=complex)
 
+    real = np.all(params.imag == 0, axis=1)
+
     def part(lo: int, hi: int) -> None:
         work: dict[str, Any] = {}
         with np.errstate(all="ignore"):
             for s in range(lo, hi, CHUNK):
-                e = min(s + CHUNK, hi)
-                points[s:e], keys[s:e] = _chunk(params[s:e], label, work)
+                # a chunk's real and complex instances apart: a real instance is eliminated
+                # in real arithmetic (exact conjugate pairs) whatever its batch holds
+                for mine in (real[s:s + CHUNK], ~real[s:s + CHUNK]):
+                    rows = s + np.flatnonzero(mine[:hi - s])
+                    if len(rows):
+                        points[rows], keys[rows] = _chunk(params[rows], label, work)
 
     threads = min(THREADS, -(-B // CHUNK))
     if threads <= 1:
@@ -323,8 +330,8 @@ def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = No
     X: Any = np.empty((len(p), n, m), dtype=dtype)  # rows no R reads stay unset
 
     def zeros(name: str, i: int, shape: tuple[int, int]) -> Any:
-        key = f"{name}{i}"
-        if key not in work or work[key].shape[0] != len(p) or work[key].dtype != dtype:
+        key = f"{name}{i}{dtype.__name__}{len(p)}"
+        if key not in work:
             work[key] = np.zeros((len(p), shape[0] * shape[1]), dtype=dtype)
         return work[key]
 
