@@ -14,13 +14,23 @@ at the anchor before (an event says so) rather than switched. An anchor mode tha
 mode reaches is born in the segment: it is tracked backward to where it stops assembling, and
 the fold is located by bisection of that step (:func:`fold_between`, as graph/closed_modes.py
 does for dyads). A tracked mode that stops assembling dies there, located the same way.
+A track must not continue onto another mode across a fold inside a step (modes/along_folds.py):
+a backward track that reaches a known mode's configuration is not taken past it and the step is
+bisected for its fold; after the segments, two modes at one configuration are cut at the fold
+of the one that jumped (:func:`~screwkit.kinematics.modes.along_folds.unshare`), and a fold
+that no other mode meets splits the track that crossed its step
+(:func:`~screwkit.kinematics.modes.along_folds.partner_folds`).
 Then the homotopy is solved again at the samples on both sides of every birth and death: a
 mode there that no known mode holds (an island between two anchors that meets a known mode at
-a fold) is tracked both ways to its own birth and death (:func:`_islands`).
+a fold) is tracked both ways to its own birth and death (:func:`_islands`), and both checks
+are run again.
 
 Guaranteed: every isolated real mode at every anchor (the homotopy's promise), continuity in
-between (the tracker's checks), no silent switch at an anchor. Not guaranteed: an island
-between two anchors that meets no known mode's fold next to a sample is not seen.
+between (the tracker's checks), no silent switch at an anchor, no two modes at one
+configuration at a sample. Not guaranteed: an island between two anchors that meets no known
+mode's fold next to a sample is not seen; a jump across a fold onto a mode that no track finds
+and whose fold partner no track finds either is not seen (docs/kinematics.md, "Every mode along
+the motion").
 """
 
 from __future__ import annotations

@@ -11,10 +11,13 @@ of them jumped. :func:`unshare` finds which: the one whose step into the shared 
 own configuration next to them, meets a fold (:func:`fold_in_step`, the bisection of
 :func:`fold_between`, as graph/closed_modes.py locates a dyad's fold between samples). It is cut
 at that fold (it dies, or is born, there: an event says so, and the fold is kept for
-:func:`~screwkit.kinematics.modes.along.fold_meetings`). Where neither step meets a fold the
-later-found mode is cut at the shared samples, with an event saying that one of the two jumped
-and which could not be told. Not caught: a jump that lands on a mode no other track holds (the
-anchors' matching, along.py, catches it only at an anchor).
+:func:`fold_meetings`). Where neither step meets a fold the later-found mode is cut at the
+shared samples, with an event saying that one of the two jumped and which could not be told.
+A jump onto a mode no other track holds is caught where it leaves a fold with no partner (two
+real roots merge at a fold, so two modes meet there): :func:`partner_folds` bisects the steps of
+the modes that cross that fold's step and splits the one that meets a fold. Not caught: a jump
+onto a mode no track finds whose fold partner no track finds either (the anchors' matching,
+along.py, catches a jump only at an anchor then).
 """
 
 from __future__ import annotations
