@@ -19,6 +19,7 @@ from screwkit.errors import InputError
 __all__ = [
     "GIMBAL_TOL",
     "cross",
+    "matvec",
     "elementary_rotation",
     "elevation_azimuth",
     "rot_x",
@@ -74,6 +75,15 @@ def cross(a: Array, b: Array) -> Array:
         ],
         -1,
     )
+
+
+def matvec(R: Array, x: Array) -> Array:
+    """R @ x for a stack of matrices R (..., 3, 3) and one vector x (3,), as one BLAS
+    matrix–vector product on the rows of every matrix stacked ((3K, 3) @ (3,)): the same
+    dot products as ``R @ x`` (bit for bit, tests/dual/test_spatial.py), an order of magnitude
+    faster for many small matrices, for which numpy's matmul calls BLAS once per matrix."""
+    R = np.asarray(R)
+    return np.asarray(np.reshape(R, (-1, 3)) @ x).reshape(R.shape[:-1])
 
 
 def elementary_rotation(c: Array, s: Array, axis: int) -> Array:

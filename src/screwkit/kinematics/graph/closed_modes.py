@@ -23,7 +23,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
-from screwkit.kinematics.graph.dyads import Placement, configuration, place, place_every
+from screwkit.kinematics.graph.dyads import (
+    Placement,
+    configuration,
+    discriminants,
+    place,
+    place_every,
+)
 from screwkit.kinematics.graph.step_folds import HiddenPair
 from screwkit.kinematics.graph.subchains import Decomposition
 from screwkit.kinematics.tracker.loop import Configuration
@@ -223,7 +229,11 @@ def held_modes(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array, 
         pl = place(mech, lay, dec, X[ks] + t[:, None] * (X[ks + 1] - X[ks]), signs[rows])
         return pl.discriminant, pl.assembles
 
-    pairs = hidden_pairs(evaluate, ok, disc) if N > 1 else []
+    def slopes(rows: NDArray[np.intp], ks: NDArray[np.intp], t: Array) -> Array:
+        return discriminants(mech, lay, dec, X[ks] + t[:, None] * (X[ks + 1] - X[ks]),
+                             signs[rows])
+
+    pairs = hidden_pairs(evaluate, ok, disc, slopes) if N > 1 else []
     gaps: dict[int, list[int]] = {}
     for pr in pairs:
         if pr.gap:
