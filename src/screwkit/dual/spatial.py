@@ -81,8 +81,12 @@ def matvec(R: Array, x: Array) -> Array:
     """R @ x for a stack of matrices R (..., 3, 3) and one vector x (3,), as one BLAS
     matrix–vector product on the rows of every matrix stacked ((3K, 3) @ (3,)): the same
     dot products as ``R @ x`` (bit for bit, tests/dual/test_spatial.py), an order of magnitude
-    faster for many small matrices, for which numpy's matmul calls BLAS once per matrix."""
+    faster for many small matrices, for which numpy's matmul calls BLAS once per matrix.
+    Matrices whose rows are not contiguous (transposed views) go to ``R @ x``: BLAS takes
+    those by columns, with another order of operations."""
     R = np.asarray(R)
+    if R.ndim < 3 or R.strides[-1] != R.itemsize or R.strides[-2] != 3 * R.itemsize:
+        return np.asarray(R @ x)
     return np.asarray(np.reshape(R, (-1, 3)) @ x).reshape(R.shape[:-1])
 
 

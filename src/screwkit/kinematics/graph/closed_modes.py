@@ -89,8 +89,10 @@ def mode_configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X:
     """Joint variables of one mode (N samples): the inputs as given, every angle counted
     continuously along each run of samples where the mode assembles (``start``: the angles
     at the run's first sample, when known from the drawing)."""
-    conf = configuration(mech, lay, np.where(mask[:, None, None, None], R, np.eye(3)),
-                         np.where(mask[:, None, None], p, 0.0))
+    whole = bool(mask.all())  # every sample assembles: the poses as they are, not copied
+    conf = configuration(mech, lay, R if whole else np.where(mask[:, None, None, None], R,
+                                                             np.eye(3)),
+                         p if whole else np.where(mask[:, None, None], p, 0.0))
     q = conf.scalars
     turning = [lay.scalar_col[f] for f in range(lay.m)
                if not lay.is_translation[f] and lay.scalar_col[f] >= 0]
@@ -114,8 +116,9 @@ def mode_frames(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, ok: NDArr
     tree: the identity (the drawing) where the mode does not assemble, as its configuration
     (every freedom 0) there; its joints' world screws, centres and axes from them. The loop
     residuals are left to ``build_mode``, which evaluates them anew from the configuration."""
-    R = np.where(ok[:, None, None, None], R, np.eye(3))
-    p = np.where(ok[:, None, None], p, 0.0)
+    if not ok.all():  # where every sample assembles the poses are used as they are
+        R = np.where(ok[:, None, None, None], R, np.eye(3))
+        p = np.where(ok[:, None, None], p, 0.0)
     screws, centres, axes = joint_screws(mech, lay, R, p)
     return GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes)
 
