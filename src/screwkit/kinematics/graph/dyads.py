@@ -129,12 +129,16 @@ def place_every(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array)
         branch = [step.drawn_branch, -step.drawn_branch][:step.branches]
         sigma = np.repeat(np.tile(np.array(branch, dtype=float), m), N)
         ends = [_widened(poses[b], count[b], m, N) for b in step.placed]
-        if step.branches == 2:  # every prefix on both branches
-            ends = [_widened(e, m, m_new, N) for e in ends]
-        b1, b2, dsc = dyad_poses(mech, step, sigma, ends[0], ends[1])
+        if step.kind == "RRR":  # the circles once per prefix, both branches from them
+            b1, b2, dsc = _rrr(mech, step, sigma, ends[0], ends[1], (m, m_new, N))
+            discs.append((dsc, m))
+        else:
+            if step.branches == 2:  # every prefix on both branches
+                ends = [_widened(e, m, m_new, N) for e in ends]
+            b1, b2, dsc = dyad_poses(mech, step, sigma, ends[0], ends[1])
+            discs.append((dsc, m_new))
         poses[step.bodies[0]], poses[step.bodies[1]] = b1, b2
         count[step.bodies[0]] = count[step.bodies[1]] = m_new
-        discs.append((dsc, m_new))
         m = m_new
     disc = np.empty((m * N, len(discs)))
     for d, (dsc, have) in enumerate(discs):
@@ -220,10 +224,7 @@ def dyad_poses(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pos
     L2 = mech.length_scale ** 2
     with np.errstate(invalid="ignore", divide="ignore"):
         if dy.kind == "RRR":
-            A, C, e, a, h2, disc = _circles(mech, dy, first, second)
-            Bw = A + a[:, None] * e + (sigma * np.sqrt(h2))[:, None] * np.cross(n, e)
-            return (_rotating(n, j3.at - j1.at, Bw - A, A, j1.at),
-                    _rotating(n, j3.at - j2.at, Bw - C, C, j2.at), disc)
+            return _rrr(mech, dy, sigma, first, second)
         if dy.kind == "RRP":
             A = _world(first, j1.at)
             Q = _world(second, j3.at)
@@ -276,6 +277,28 @@ def _circles(mech: Mechanism, dy: Dyad, first: Pose, second: Pose
         h2 = r1 - a ** 2
         disc = np.asarray(np.where(dist > 0.0, h2 / mech.length_scale ** 2, np.nan))
     return A, C, e, a, h2, disc
+
+
+def _rrr(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose,
+         widen: tuple[int, int, int] | None = None) -> tuple[Pose, Pose, Array]:
+    """:func:`dyad_poses` of an RRR dyad. With ``widen`` = (have, want, N) the placed poses
+    cover ``have`` branch prefixes and ``sigma`` ``want`` (:func:`place_every`): the circles'
+    intersection, which the branch does not change, is found once per prefix and repeated to
+    every branch (the same operations on the same values); the discriminant stays per
+    prefix."""
+    j1, j3, j2 = (mech.joints[k] for k in dy.joints)
+    n = dy.normal
+    A, C, e, a, h2, disc = _circles(mech, dy, first, second)
+    with np.errstate(invalid="ignore"):
+        base, root, side = A + a[:, None] * e, np.sqrt(h2), np.cross(n, e)
+        if widen is not None and widen[0] != widen[1]:
+            have, want, N = widen
+            A, C, base, root, side = (
+                np.repeat(x.reshape(have, N, *x.shape[1:]), want // have, axis=0)
+                .reshape(want * N, *x.shape[1:]) for x in (A, C, base, root, side))
+        Bw = base + (sigma * root)[:, None] * side
+    return (_rotating(n, j3.at - j1.at, Bw - A, A, j1.at),
+            _rotating(n, j3.at - j2.at, Bw - C, C, j2.at), disc)
 
 
 def discriminants(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
