@@ -289,7 +289,7 @@ def _rrr(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose,
     j1, j3, j2 = (mech.joints[k] for k in dy.joints)
     n = dy.normal
     A, C, e, a, h2, disc = _circles(mech, dy, first, second)
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore"):
         base, root, side = A + a[:, None] * e, np.sqrt(h2), np.cross(n, e)
         if widen is not None and widen[0] != widen[1]:
             have, want, N = widen
@@ -297,8 +297,8 @@ def _rrr(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose,
                 np.repeat(x.reshape(have, N, *x.shape[1:]), want // have, axis=0)
                 .reshape(want * N, *x.shape[1:]) for x in (A, C, base, root, side))
         Bw = base + (sigma * root)[:, None] * side
-    return (_rotating(n, j3.at - j1.at, Bw - A, A, j1.at),
-            _rotating(n, j3.at - j2.at, Bw - C, C, j2.at), disc)
+        return (_rotating(n, j3.at - j1.at, Bw - A, A, j1.at),
+                _rotating(n, j3.at - j2.at, Bw - C, C, j2.at), disc)
 
 
 def discriminants(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
