@@ -8,6 +8,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from screwkit.dual.spatial import (
+    MATVEC_FROM,
     cross,
     elementary_rotation,
     matvec,
@@ -42,10 +43,11 @@ def test_matvec_is_numpys_stacked_product_bit_for_bit() -> None:
     transposed views (left to numpy)."""
     rng = np.random.default_rng(4)
     x = rng.normal(size=3)
-    poses = rng.normal(size=(257, 5, 3, 3))
+    poses = rng.normal(size=(3 * MATVEC_FROM, 5, 3, 3))
     for R in (poses[:, 0].copy(), poses[:, 3], np.swapaxes(poses[:, 2], -1, -2),
-              poses.reshape(-1, 3, 3)[::3], np.broadcast_to(np.eye(3), (9, 3, 3)),
-              rng.normal(size=(4, 6, 3, 3)), rng.normal(size=(3, 3)) * 1e12):
+              poses.reshape(-1, 3, 3)[::3], np.broadcast_to(np.eye(3), (MATVEC_FROM, 3, 3)),
+              rng.normal(size=(4, MATVEC_FROM, 3, 3)), rng.normal(size=(5, 3, 3)),
+              rng.normal(size=(3, 3)) * 1e12):
         np.testing.assert_array_equal(matvec(R, x), R @ x)
     assert matvec(np.zeros((0, 3, 3)), x).shape == (0, 3)
 
