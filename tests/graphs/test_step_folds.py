@@ -116,6 +116,26 @@ def _pairs(mech: Mechanism, X: np.ndarray) -> list[tuple[float, float, bool]]:
             for p in held.pairs]
 
 
+@pytest.mark.parametrize(("example", "span"), [("watt_sixbar", 400.0), ("jansen_leg", 400.0),
+                                               ("double_wishbone", 20.0)])
+def test_the_slopes_discriminants_are_the_placements(example: str, span: float) -> None:
+    """The discriminants the fold search's slopes take alone (dyads.discriminants: the last
+    RRR dyads not posed) are the full placement's, bit for bit, on every branch combination
+    (RRR dyads; RSS and S–S legs, placed in full), over inputs ± ``span`` (deg)."""
+    from screwkit.io import load_spec
+    from screwkit.kinematics.graph.dyads import discriminants, place
+
+    root = Path(__file__).resolve().parents[2]
+    mech = load_spec(root / "examples" / "mechanisms" / f"{example}.toml").mechanism
+    lay, dec = graph_layout(mech), decompose(mech)
+    assert dec.complete and not dec.loops
+    X = np.radians(np.linspace(-span, span, 97))[:, None]
+    for signs in branch_combinations(dec):
+        S = np.repeat(signs[None], X.shape[0], axis=0)
+        np.testing.assert_array_equal(discriminants(mech, lay, dec, X, S),
+                                      place(mech, lay, dec, X, S).discriminant)
+
+
 def test_a_gap_inside_one_step_ends_the_drawn_mode() -> None:
     """The crank cannot turn through 177.04° … 182.96°: the drawn mode stops at the first fold
     (it used to run on through the step silently, a switch of mode), and the drawn branches

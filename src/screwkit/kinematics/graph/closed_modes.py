@@ -23,7 +23,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
-from screwkit.kinematics.graph.dyads import Placement, configuration, place, place_every
+from screwkit.kinematics.graph.dyads import (
+    Placement,
+    configuration,
+    discriminants,
+    place,
+    place_every,
+)
 from screwkit.kinematics.graph.step_folds import HiddenPair
 from screwkit.kinematics.graph.subchains import Decomposition
 from screwkit.kinematics.tracker.loop import Configuration
@@ -83,8 +89,10 @@ def mode_configuration(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, X:
     """Joint variables of one mode (N samples): the inputs as given, every angle counted
     continuously along each run of samples where the mode assembles (``start``: the angles
     at the run's first sample, when known from the drawing)."""
-    conf = configuration(mech, lay, np.where(mask[:, None, None, None], R, np.eye(3)),
-                         np.where(mask[:, None, None], p, 0.0))
+    whole = bool(mask.all())  # every sample assembles: the poses as they are, not copied
+    conf = configuration(mech, lay, R if whole else np.where(mask[:, None, None, None], R,
+                                                             np.eye(3)),
+                         p if whole else np.where(mask[:, None, None], p, 0.0))
     q = conf.scalars
     turning = [lay.scalar_col[f] for f in range(lay.m)
                if not lay.is_translation[f] and lay.scalar_col[f] >= 0]
@@ -108,8 +116,9 @@ def mode_frames(mech: Mechanism, lay: GraphLayout, R: Array, p: Array, ok: NDArr
     tree: the identity (the drawing) where the mode does not assemble, as its configuration
     (every freedom 0) there; its joints' world screws, centres and axes from them. The loop
     residuals are left to ``build_mode``, which evaluates them anew from the configuration."""
-    R = np.where(ok[:, None, None, None], R, np.eye(3))
-    p = np.where(ok[:, None, None], p, 0.0)
+    if not ok.all():  # where every sample assembles the poses are used as they are
+        R = np.where(ok[:, None, None, None], R, np.eye(3))
+        p = np.where(ok[:, None, None], p, 0.0)
     screws, centres, axes = joint_screws(mech, lay, R, p)
     return GraphFrames(R, p, screws, np.zeros((R.shape[0], 1, 6)), centres, axes)
 
@@ -223,7 +232,11 @@ def held_modes(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array, 
         pl = place(mech, lay, dec, X[ks] + t[:, None] * (X[ks + 1] - X[ks]), signs[rows])
         return pl.discriminant, pl.assembles
 
-    pairs = hidden_pairs(evaluate, ok, disc) if N > 1 else []
+    def slopes(rows: NDArray[np.intp], ks: NDArray[np.intp], t: Array) -> Array:
+        return discriminants(mech, lay, dec, X[ks] + t[:, None] * (X[ks + 1] - X[ks]),
+                             signs[rows])
+
+    pairs = hidden_pairs(evaluate, ok, disc, slopes) if N > 1 else []
     gaps: dict[int, list[int]] = {}
     for pr in pairs:
         if pr.gap:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.dual.spatial import cross
+from screwkit.dual.spatial import cross, matvec
 from screwkit.kinematics.tracker.loop import (
     Configuration,
     closure_error,
@@ -107,13 +107,13 @@ def joint_motion(mech: Mechanism, lay: GraphLayout, conf: Configuration, i: int
     else:  # R, C, H
         th = conf.scalars[:, lay.scalar_col[f0]]
         R = axis_rotation(u, th)
-    p = c - R @ c
+    p = c - matvec(R, c)
     if j.kind == "C":
         p = p + conf.scalars[:, lay.scalar_col[f0 + 1], None] * u
     elif j.kind == "H":
         p = p + (j.pitch * conf.scalars[:, lay.scalar_col[f0]])[:, None] * u
     if j.seat_offset is not None:  # M_j(q) · Trans(δ): the second body's seat is off by δ
-        p = p + R @ j.seat_offset
+        p = p + matvec(R, j.seat_offset)
     return R, p
 
 
@@ -187,8 +187,8 @@ def joint_screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
     axes = np.empty((N, J, 3))
     for i, j in enumerate(mech.joints):
         a, b = (lay.body_of[x] for x in j.bodies)
-        c = R[:, a] @ j.at + p[:, a]
-        u = R[:, a] @ j.axis
+        c = matvec(R[:, a], j.at) + p[:, a]
+        u = matvec(R[:, a], j.axis)
         centres[:, i], axes[:, i] = c, u
         f = lay.first_freedom[i]
         if j.kind == "P":
@@ -203,7 +203,7 @@ def joint_screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
         elif j.kind == "U":
             assert j.axis2 is not None
             S[:, :, f] = _line_screw(u, c)
-            S[:, :, f + 1] = _line_screw(R[:, b] @ j.axis2, c)
+            S[:, :, f + 1] = _line_screw(matvec(R[:, b], j.axis2), c)
         else:  # S: body increments about the child's own axes through the centre
             for k in range(3):
                 S[:, :, f + k] = _line_screw(R[:, b, :, k], c)

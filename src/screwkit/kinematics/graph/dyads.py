@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.dual.spatial import matvec
 from screwkit.kinematics.graph.closure import GraphLayout
 from screwkit.kinematics.graph.subchains import Decomposition, Driven, Dyad
 from screwkit.kinematics.tracker.loop import Configuration
@@ -128,12 +129,16 @@ def place_every(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array)
         branch = [step.drawn_branch, -step.drawn_branch][:step.branches]
         sigma = np.repeat(np.tile(np.array(branch, dtype=float), m), N)
         ends = [_widened(poses[b], count[b], m, N) for b in step.placed]
-        if step.branches == 2:  # every prefix on both branches
-            ends = [_widened(e, m, m_new, N) for e in ends]
-        b1, b2, dsc = dyad_poses(mech, step, sigma, ends[0], ends[1])
+        if step.kind == "RRR":  # the circles once per prefix, both branches from them
+            b1, b2, dsc = _rrr(mech, step, sigma, ends[0], ends[1], (m, m_new, N))
+            discs.append((dsc, m))
+        else:
+            if step.branches == 2:  # every prefix on both branches
+                ends = [_widened(e, m, m_new, N) for e in ends]
+            b1, b2, dsc = dyad_poses(mech, step, sigma, ends[0], ends[1])
+            discs.append((dsc, m_new))
         poses[step.bodies[0]], poses[step.bodies[1]] = b1, b2
         count[step.bodies[0]] = count[step.bodies[1]] = m_new
-        discs.append((dsc, m_new))
         m = m_new
     disc = np.empty((m * N, len(discs)))
     for d, (dsc, have) in enumerate(discs):
@@ -183,7 +188,7 @@ def driven_pose(mech: Mechanism, lay: GraphLayout, step: Driven, X: Array, paren
     x = X[:, lay.inputs.index(lay.first_freedom[step.joint])]
     if j.kind == "R":
         Mr = rotation_about(j.axis, x)
-        Mp = j.at - Mr @ j.at
+        Mp = j.at - matvec(Mr, j.at)
     else:
         Mr = np.broadcast_to(np.eye(3), (x.shape[0], 3, 3))
         Mp = x[:, None] * j.axis
@@ -195,7 +200,7 @@ def driven_pose(mech: Mechanism, lay: GraphLayout, step: Driven, X: Array, paren
 
 
 def _world(pose: Pose, x0: Array) -> Array:
-    return pose[0] @ x0 + pose[1]
+    return matvec(pose[0], x0) + pose[1]
 
 
 def dyad_poses(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose
@@ -219,23 +224,11 @@ def dyad_poses(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pos
     L2 = mech.length_scale ** 2
     with np.errstate(invalid="ignore", divide="ignore"):
         if dy.kind == "RRR":
-            A, C = _world(first, j1.at), _world(second, j2.at)
-            w = C - A
-            w -= np.outer(w @ n, n)
-            dist = np.linalg.norm(w, axis=1)
-            e = w / dist[:, None]
-            r1 = _sq(j3.at - j1.at, n)
-            r2 = _sq(j3.at - j2.at, n)
-            a = (dist ** 2 + r1 - r2) / (2.0 * dist)
-            h2 = r1 - a ** 2
-            Bw = A + a[:, None] * e + (sigma * np.sqrt(h2))[:, None] * np.cross(n, e)
-            return (_rotating(n, j3.at - j1.at, Bw - A, A, j1.at),
-                    _rotating(n, j3.at - j2.at, Bw - C, C, j2.at),
-                    np.asarray(np.where(dist > 0.0, h2 / L2, np.nan)))
+            return _rrr(mech, dy, sigma, first, second)
         if dy.kind == "RRP":
             A = _world(first, j1.at)
             Q = _world(second, j3.at)
-            dirn = second[0] @ j2.axis
+            dirn = matvec(second[0], j2.axis)
             q = Q - A
             along = np.einsum("ki,ki->k", q, dirn)
             perp = q - along[:, None] * dirn
@@ -244,7 +237,7 @@ def dyad_poses(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pos
             t = -along + sigma * np.sqrt(disc)
             Bw = Q + t[:, None] * dirn
             return (_rotating(n, j3.at - j1.at, Bw - A, A, j1.at),
-                    (second[0], Bw - second[0] @ j3.at), np.asarray(disc / L2))
+                    (second[0], Bw - matvec(second[0], j3.at)), np.asarray(disc / L2))
         if dy.kind == "RPR":
             A, C = _world(first, j1.at), _world(second, j2.at)
             w0 = j2.at - j1.at
@@ -254,14 +247,84 @@ def dyad_poses(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pos
             t = -uw + sigma * np.sqrt(disc)
             slid = w0[None, :] + t[:, None] * j3.axis
             Rb = _turn_each(n, slid, w)
-            return (Rb, A - Rb @ j1.at), (Rb, C - Rb @ j2.at), np.asarray(disc / L2)
+            return ((Rb, A - matvec(Rb, j1.at)), (Rb, C - matvec(Rb, j2.at)),
+                    np.asarray(disc / L2))
         # PRP: line–line
         Q1, Q2 = _world(first, j3.at), _world(second, j3.at)
-        d1, d2 = first[0] @ j1.axis, second[0] @ j2.axis
+        d1, d2 = matvec(first[0], j1.axis), matvec(second[0], j2.axis)
         s = (np.cross(Q2 - Q1, d2) @ n) / (np.cross(d1, d2) @ n)
         Bw = Q1 + s[:, None] * d1
-        return ((first[0], Bw - first[0] @ j3.at), (second[0], Bw - second[0] @ j3.at),
+        return ((first[0], Bw - matvec(first[0], j3.at)),
+                (second[0], Bw - matvec(second[0], j3.at)),
                 np.asarray(np.where(np.isfinite(s), 1.0, np.nan)))
+
+
+def _circles(mech: Mechanism, dy: Dyad, first: Pose, second: Pose
+             ) -> tuple[Array, Array, Array, Array, Array, Array]:
+    """An RRR dyad's circle–circle intersection up to the branch (module docstring): A, C, ŵ,
+    a, h² and the discriminant h²/L² (NaN where A and C coincide in the plane)."""
+    j1, j3, j2 = (mech.joints[k] for k in dy.joints)
+    n = dy.normal
+    with np.errstate(invalid="ignore", divide="ignore"):
+        A, C = _world(first, j1.at), _world(second, j2.at)
+        w = C - A
+        w -= np.outer(w @ n, n)
+        dist = np.linalg.norm(w, axis=1)
+        e = w / dist[:, None]
+        r1 = _sq(j3.at - j1.at, n)
+        r2 = _sq(j3.at - j2.at, n)
+        a = (dist ** 2 + r1 - r2) / (2.0 * dist)
+        h2 = r1 - a ** 2
+        disc = np.asarray(np.where(dist > 0.0, h2 / mech.length_scale ** 2, np.nan))
+    return A, C, e, a, h2, disc
+
+
+def _rrr(mech: Mechanism, dy: Dyad, sigma: Array, first: Pose, second: Pose,
+         widen: tuple[int, int, int] | None = None) -> tuple[Pose, Pose, Array]:
+    """:func:`dyad_poses` of an RRR dyad. With ``widen`` = (have, want, N) the placed poses
+    cover ``have`` branch prefixes and ``sigma`` ``want`` (:func:`place_every`): the circles'
+    intersection, which the branch does not change, is found once per prefix and repeated to
+    every branch (the same operations on the same values); the discriminant stays per
+    prefix."""
+    j1, j3, j2 = (mech.joints[k] for k in dy.joints)
+    n = dy.normal
+    A, C, e, a, h2, disc = _circles(mech, dy, first, second)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        base, root, side = A + a[:, None] * e, np.sqrt(h2), np.cross(n, e)
+        if widen is not None and widen[0] != widen[1]:
+            have, want, N = widen
+            A, C, base, root, side = (
+                np.repeat(x.reshape(have, N, *x.shape[1:]), want // have, axis=0)
+                .reshape(want * N, *x.shape[1:]) for x in (A, C, base, root, side))
+        Bw = base + (sigma * root)[:, None] * side
+        return (_rotating(n, j3.at - j1.at, Bw - A, A, j1.at),
+                _rotating(n, j3.at - j2.at, Bw - C, C, j2.at), disc)
+
+
+def discriminants(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: Array,
+                  signs: Array) -> Array:
+    """:func:`place`'s discriminants (K, D) alone, by the same operations: an RRR dyad whose
+    bodies no later step is placed on is not posed (the slopes of graph/step_folds.py need
+    the discriminants only)."""
+    poses: dict[str, Pose] = {GROUND: _ground(X.shape[0])}
+    disc = np.empty((X.shape[0], len(dec.dyads)))
+    d = 0
+    for i, step in enumerate(dec.steps):
+        later = {b for st in dec.steps[i + 1:]
+                 for b in (st.placed if isinstance(st, Dyad) else (st.parent,))}
+        if isinstance(step, Driven):
+            if step.body in later:
+                poses[step.body] = driven_pose(mech, lay, step, X, poses[step.parent])
+            continue
+        assert isinstance(step, Dyad), "a loop stage is placed by graph/loop_stage.py"
+        first, second = poses[step.placed[0]], poses[step.placed[1]]
+        if step.kind == "RRR" and not later & set(step.bodies):
+            disc[:, d] = _circles(mech, step, first, second)[-1]
+        else:
+            b1, b2, disc[:, d] = dyad_poses(mech, step, signs[:, d], first, second)
+            poses[step.bodies[0]], poses[step.bodies[1]] = b1, b2
+        d += 1
+    return disc
 
 
 def _sq(v: Array, n: Array) -> float:
@@ -274,7 +337,7 @@ def _rotating(n: Array, link0: Array, link: Array, pivot: Array, pivot0: Array) 
     """A body turned about n so its drawn link (from pivot0) lies along ``link`` (K, 3), with
     its pivot at ``pivot``."""
     Rb = _turn(n, link0, link)
-    return Rb, pivot - Rb @ pivot0
+    return Rb, pivot - matvec(Rb, pivot0)
 
 
 def _turn_each(n: Array, v0: Array, v: Array) -> Array:

@@ -70,18 +70,22 @@ class HiddenPair:
     gap: bool
 
 
-def hidden_pairs(evaluate: Evaluate, ok: NDArray[np.bool_], disc: Array) -> list[HiddenPair]:
+def hidden_pairs(evaluate: Evaluate, ok: NDArray[np.bool_], disc: Array,
+                 discriminants: Callable[[NDArray[np.intp], NDArray[np.intp], Array], Array]
+                 | None = None) -> list[HiddenPair]:
     """Every fold pair hidden inside one step (module docstring) of the modes whose
     assembling at the samples is ``ok`` (M, N), their discriminants there ``disc`` (M, N, S);
-    ``evaluate(rows, ks, t)`` gives both at interior points."""
+    ``evaluate(rows, ks, t)`` gives both at interior points, ``discriminants(rows, ks, t)``,
+    when given, the discriminants alone (the same values, for the slopes at every step)."""
     rows, ks = np.nonzero(ok[:, :-1] == ok[:, 1:])
     if rows.size == 0:
         return []
     g0, g1 = disc[rows, ks], disc[rows, ks + 1]  # (T, S)
     h = SLOPE_STEP
     T0 = rows.size
-    near = evaluate(np.concatenate([rows, rows]), np.concatenate([ks, ks]),
-                    np.concatenate([np.full(T0, h), np.full(T0, 1.0 - h)]))[0]
+    both = (np.concatenate([rows, rows]), np.concatenate([ks, ks]),
+            np.concatenate([np.full(T0, h), np.full(T0, 1.0 - h)]))
+    near = evaluate(*both)[0] if discriminants is None else discriminants(*both)
     s0, s1 = (near[:T0] - g0) / h, (g1 - near[T0:]) / h
     with np.errstate(invalid="ignore"):
         dip = ok[rows, ks][:, None] & (g0 > 0) & (g1 > 0) & (s0 < 0) & (s1 > 0)
