@@ -287,6 +287,11 @@ def joined(a: Certificate, b: Certificate) -> Certificate:
     return Certificate(**parts)
 
 
+def _cat(parts: list[Any]) -> Any:
+    """The parts joined (one part, the eigen route's alone: itself, no copy)."""
+    return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+
 def solve_eigen_first(route: EigenRoute, targets: Complex,
                       options: TrackOptions | None = None) -> Solutions:
     """Every isolated solution of the instances ``targets`` (B, k): the eigen route, the
@@ -321,6 +326,6 @@ def solve_eigen_first(route: EigenRoute, targets: Complex,
         at_infinity += np.bincount(instance[res.status == PathStatus.AT_INFINITY], minlength=B)
         failed += np.bincount(instance[res.status == PathStatus.FAILED], minlength=B)
     names = tuple(route.elimination if good else route.homotopy for good in ok)
-    return collect_solutions(system, targets, np.concatenate(xs), np.concatenate(inst),
-                             np.concatenate(status), np.concatenate(mult), at_infinity, failed,
-                             m, how, names, cert, None if len(redo) else np.arange(len(xs[0])))
+    return collect_solutions(system, targets, _cat(xs), _cat(inst), _cat(status), _cat(mult),
+                             at_infinity, failed, m, how, names, cert,
+                             None if len(redo) else np.arange(len(xs[0])))
