@@ -303,7 +303,7 @@ def solve_eigen_first(route: EigenRoute, targets: Complex,
     if len(rows) < len(i_eig):  # (else every row)
         cert, x_eig, i_eig = rows_of(cert, rows), x_eig[rows], i_eig[rows]
     xs, inst = [x_eig], [i_eig]
-    status = [np.full(len(inst[0]), PathStatus.REGULAR, dtype=np.int8)]
+    status = [np.full(len(inst[0]), int(PathStatus.REGULAR), dtype=np.int8)]
     mult = [np.ones(len(inst[0]), dtype=np.int64)]
     at_infinity, failed = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)
     redo = np.flatnonzero(~ok)
