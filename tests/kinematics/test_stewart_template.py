@@ -14,7 +14,7 @@ import pytest
 
 from screwkit.algebraic.solve import Solutions, solve_all
 from screwkit.errors import InputError
-from screwkit.kinematics.modes import eigen_first
+from screwkit.kinematics.modes import eigen_first, stewart_template
 from screwkit.kinematics.modes import stewart_template_data as data
 from screwkit.kinematics.modes.stewart import (
     leg_lengths,
@@ -26,6 +26,8 @@ from screwkit.kinematics.modes.stewart import (
 from screwkit.kinematics.modes.stewart_solve import HOMOTOPY, TEMPLATE, solve_stewart
 from screwkit.kinematics.modes.stewart_template import (
     UNKNOWNS,
+    action_matrices,
+    coefficients,
     monomials,
     template_solve,
 )
@@ -169,3 +171,77 @@ def test_a_point_that_arrives_far_off_is_polished_to_round_off() -> None:
     assert sol.route == (TEMPLATE,) and sol.found[0] == 40
     assert sol.certified_real_count[0] == sol.real_count[0] == 4
     assert _legs_close(sol, p[334:335].real) <= CLOSE
+
+
+def _dense_action_matrix(p: np.ndarray) -> tuple[np.ndarray, float]:
+    """The action matrix of one instance from the whole 526 × 526 square matrix, built here
+    from the template's rows (each equation's coefficients times its multiplier) and solved
+    by one dense LU: the route the block solve replaces; and that matrix's condition number."""
+    mono = monomials(data.DEGREE)
+    square = {mono[i]: c for c, i in enumerate(data.SQUARE)}
+    basis = {mono[i]: c for c, i in enumerate(data.BASIS)}
+    pairs = [tuple(int(v == i) + int(v == k) for v in range(1, UNKNOWNS + 1))
+             for i in range(8) for k in range(i, 8)]
+    coef = coefficients(p[None].astype(complex))[0].real
+    rows = np.asarray(data.ROWS).reshape(-1, 2)
+    M, Bm = np.zeros((len(rows), len(square))), np.zeros((len(rows), len(basis)))
+    for r, (eq, mult) in enumerate(rows):
+        for t, e in enumerate(pairs):
+            at = tuple(a + b for a, b in zip(e, mono[mult], strict=True))
+            if at in square:
+                M[r, square[at]] += coef[eq, t]
+            elif at in basis:
+                Bm[r, basis[at]] += coef[eq, t]
+    X = np.linalg.solve(M, -Bm)
+    A = np.zeros((40, 40))
+    for i, e in enumerate(mono[j] for j in data.BASIS):
+        up = tuple(a + (j == data.ACTION) for j, a in enumerate(e))
+        if up in basis:
+            A[i, basis[up]] = 1.0
+        else:
+            A[i] = X[square[up]]
+    return A, float(np.linalg.cond(M))
+
+
+def test_the_block_solve_gives_the_dense_solves_action_matrix() -> None:
+    """The block-triangular solve (the last block for its one R row alone, by a transposed
+    solve) gives the action matrix of one dense solve of the whole square matrix, to the
+    square matrix's conditioning: within 100 ε cond (a backward-stable solve's forward error;
+    cond is 1e6..1e10 here)."""
+    p, _ = random_stewart(np.random.default_rng(37), 6)
+    p = p.real
+    A, good = action_matrices(p.astype(complex))
+    assert good.all() and A.dtype == np.float64
+    for b in range(len(p)):
+        D, cond = _dense_action_matrix(p[b])
+        eps = np.finfo(float).eps
+        assert np.linalg.norm(A[b] - D) <= 100 * eps * cond * np.linalg.norm(D), (b, cond)
+
+
+def test_threads_change_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A batch split over threads gives bit for bit the points and keys of one thread, and of
+    each instance alone (the chunks and their arithmetic are the same)."""
+    p, _ = random_stewart(np.random.default_rng(38), 3 * stewart_template.CHUNK + 3)
+    p = p.real.astype(complex)
+    monkeypatch.setattr(stewart_template, "THREADS", 1)
+    one = template_solve(p)
+    monkeypatch.setattr(stewart_template, "THREADS", 3)
+    three = template_solve(p)
+    for a, b in zip(one, three, strict=True):
+        assert np.array_equal(a, b, equal_nan=True)
+    alone = template_solve(p[-1:])
+    assert np.array_equal(alone[0][0], three[0][-1]) and np.array_equal(alone[1][0], three[1][-1])
+
+
+def test_a_real_instance_in_a_batch_with_complex_ones_is_eliminated_as_alone() -> None:
+    """Real arithmetic for a real instance (exact conjugate pairs, which eigen_first's pairing
+    relies on) whatever else its chunk holds: bit for bit what it gives alone."""
+    p, _ = random_stewart(np.random.default_rng(39), 6)
+    q, _ = random_stewart(np.random.default_rng(40), 3, complex_values=True)
+    mixed = np.concatenate([p.real.astype(complex)[:3], q, p.real.astype(complex)[3:]])
+    pts, keys = template_solve(mixed)
+    for b in range(len(mixed)):
+        alone = template_solve(mixed[b:b + 1])
+        assert np.array_equal(alone[0][0], pts[b]) and np.array_equal(alone[1][0], keys[b]), b
+    for b in (0, 1, 2, 6, 7, 8):
+        assert np.array_equal(np.sort_complex(keys[b]), np.sort_complex(keys[b].conj()))

@@ -14,24 +14,34 @@ at the anchor before (an event says so) rather than switched. An anchor mode tha
 mode reaches is born in the segment: it is tracked backward to where it stops assembling, and
 the fold is located by bisection of that step (:func:`fold_between`, as graph/closed_modes.py
 does for dyads). A tracked mode that stops assembling dies there, located the same way.
+A track must not continue onto another mode across a fold inside a step (modes/along_folds.py):
+a backward track that reaches a known mode's configuration is not taken past it and the step is
+bisected for its fold; after the segments, two modes at one configuration are cut at the fold
+of the one that jumped (:func:`~screwkit.kinematics.modes.along_folds.unshare`), and a fold
+that no other mode meets splits the track that crossed its step
+(:func:`~screwkit.kinematics.modes.along_folds.partner_folds`).
 Then the homotopy is solved again at the samples on both sides of every birth and death: a
 mode there that no known mode holds (an island between two anchors that meets a known mode at
-a fold) is tracked both ways to its own birth and death (:func:`_islands`).
+a fold) is tracked both ways to its own birth and death (:func:`_islands`), and both checks
+are run again.
 
 Guaranteed: every isolated real mode at every anchor (the homotopy's promise), continuity in
-between (the tracker's checks), no silent switch at an anchor. Not guaranteed: an island
-between two anchors that meets no known mode's fold next to a sample is not seen.
+between (the tracker's checks), no silent switch at an anchor, no two modes at one
+configuration at a sample. Not guaranteed: an island between two anchors that meets no known
+mode's fold next to a sample is not seen; a jump across a fold onto a mode that no track finds
+and whose fold partner no track finds either is not seen (docs/kinematics.md, "Every mode along
+the motion").
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
-from screwkit.kinematics.graph.follow import SMALLEST_STEP, follow_drawn_mode, reach
+from screwkit.kinematics.graph.closure import GraphLayout
+from screwkit.kinematics.graph.follow import follow_drawn_mode
 from screwkit.kinematics.graph.motion import (
     MechanismMode,
     build_mode,
@@ -42,6 +52,17 @@ from screwkit.kinematics.graph.motion import (
     with_events,
 )
 from screwkit.kinematics.graph.subchains import Decomposition
+from screwkit.kinematics.modes.along_folds import (
+    Chain,
+    fold_between,
+    fold_in_step,
+    fold_meetings,
+    partner_folds,
+    pose_distance,
+    pose_vectors,
+    shared_at,
+    unshare,
+)
 from screwkit.kinematics.modes.every_mode import MechanismModes, every_mode
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
@@ -53,51 +74,18 @@ Array = NDArray[np.float64]
 MATCH_TOLERANCE = 1e-6
 #: sub-steps per sample when a segment is tracked again after a suspected path jump
 REFINE = 8
-#: bisection steps locating a birth or death between two samples (2⁻²⁶ of the step)
-FOLD_STEPS = 26
-#: a bisection step's continuation may split it down to this fraction of its length
-FOLD_SPLIT = 8
-#: ... once the half is this short (rad, or fraction of the length scale): a half wrongly
-#: refused then moves the fold by less than its length
-FINE_HALF = 1e-4
-#: two folds are one where their inputs agree to this (rad, or fraction of the length scale)
-SAME_FOLD = 1e-6
-#: ... and the two modes' body poses next to it to this
-FOLD_POSES = 1e-2
 #: anchors are at most this many samples apart
 ANCHOR_SPACING = 8
 #: measured homotopy time per anchor and generic solution (rounded up; ~0.1 s per 6R instance)
 SECONDS_PER_ANCHOR_ROOT = 5e-3
 
 
-@dataclass
-class _Chain:
-    """One mode over the samples: joint variables, where it holds, its events, and at how
-    many anchors it was met and certified."""
-
-    scalars: Array
-    spherical: Array
-    mask: NDArray[np.bool_]
-    events: list[str] = field(default_factory=list)
-    anchors_met: int = 0
-    anchors_certified: int = 0
-    #: where it is born or dies: the input there and the configuration next to it
-    folds: list[tuple[Array, Configuration]] = field(default_factory=list)
-
-    def conf_at(self, k: int) -> Configuration:
-        return Configuration(self.scalars[k:k + 1].copy(), self.spherical[k:k + 1].copy())
-
-    def put(self, idx: NDArray[np.intp], conf: Configuration) -> None:
-        self.scalars[idx] = conf.scalars
-        self.spherical[idx] = conf.spherical
-        self.mask[idx] = True
-
-
 @dataclass(frozen=True)
 class ModesAlong:
     """Every mode found along the inputs: ``configurations[k]`` (N samples) where
     ``masks[k]`` holds, with ``events[k]``; ``anchors`` the anchor samples; ``notes`` what was
-    found and how; ``meets`` the pairs of modes that meet at a fold (:func:`fold_meetings`)."""
+    found and how; ``meets`` the pairs of modes that meet at a fold (:func:`fold_meetings`);
+    ``folds[k]`` where mode k is born or dies (the input, the configuration next to it)."""
 
     configurations: tuple[Configuration, ...]
     masks: tuple[NDArray[np.bool_], ...]
@@ -106,6 +94,7 @@ class ModesAlong:
     notes: tuple[str, ...]
     solved: MechanismModes
     meets: tuple[tuple[int, int], ...] = ()
+    folds: tuple[tuple[tuple[Array, Configuration], ...], ...] = ()
 
 
 def anchor_samples(N: int, per_anchor: float) -> NDArray[np.intp]:
@@ -119,64 +108,6 @@ def anchor_samples(N: int, per_anchor: float) -> NDArray[np.intp]:
     affordable = max(2, int(0.5 * time_limit() / max(per_anchor, 1e-9)))
     K = max(ANCHOR_SPACING, int(np.ceil((N - 1) / max(affordable - 1, 1))))
     return np.unique(np.concatenate([np.arange(0, N, K), [N - 1]])).astype(np.intp)
-
-
-def pose_vectors(mech: Mechanism, lay: GraphLayout, conf: Configuration) -> Array:
-    """Every body's pose as one row per sample (rotation entries, positions / length). A rod
-    held by two balls (graph/idle.py) has an idle spin about its own line, which the tracker's
-    corrector and a formulation's decoding set differently: its rotation R is written as
-    (R u) uᵀ (u its drawn unit line) and its position as its first ball's centre, which that
-    spin does not change."""
-    from screwkit.kinematics.graph.idle import rods
-
-    if conf.size == 0:  # (every_mode's empty rows have no columns either)
-        return np.zeros((0, 12 * (len(mech.bodies) + 1)))
-    fr = graph_forward(mech, lay, conf)
-    n = conf.size
-    R, p = fr.R, fr.p
-    idle = rods(mech)
-    if idle:
-        R, p = R.copy(), p.copy()
-        for body, j1, j2 in idle:
-            c = mech.joints[j1].at
-            u = mech.joints[j2].at - c
-            u = u / np.linalg.norm(u)
-            b = lay.body_of[body]
-            p[:, b] = p[:, b] + R[:, b] @ c  # the first ball's centre, on the spin's line
-            R[:, b] = np.einsum("ni,j->nij", R[:, b] @ u, u)
-    return np.concatenate([R.reshape(n, -1), p.reshape(n, -1) / lay.length], axis=1)
-
-
-def pose_distance(mech: Mechanism, lay: GraphLayout, a: Configuration, b: Configuration
-                  ) -> Array:
-    """(n_a, n_b) largest pose difference between configurations ``a`` and ``b``."""
-    if a.size == 0 or b.size == 0:
-        return np.zeros((a.size, b.size))
-    pa, pb = pose_vectors(mech, lay, a), pose_vectors(mech, lay, b)
-    return np.asarray(np.abs(pa[:, None, :] - pb[None, :, :]).max(axis=2))
-
-
-def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from: Array,
-                 x_to: Array) -> tuple[Array, Configuration]:
-    """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the way
-    to ``x_to`` (which it does not reach): bisection of the segment, :data:`FOLD_STEPS`
-    halvings, each half reached by continuation (graph/follow.py ``reach``, in steps down to
-    the tracker's smallest while a half is longer than :data:`FINE_HALF`, then to
-    1/:data:`FOLD_SPLIT` of the half); the input there and the last configuration reached."""
-    lo, hi = np.asarray(x_from, dtype=float), np.asarray(x_to, dtype=float)
-    scale = np.where(np.array([lay.is_translation[f] for f in lay.inputs]), lay.length, 1.0)
-    for _ in range(FOLD_STEPS):
-        mid = 0.5 * (lo + hi)
-        h = float(np.max(np.abs(mid - lo) / scale))
-        # a half that ends just short of the fold needs steps as short as its distance to
-        # it: down to the tracker's smallest while the half is long, 1/FOLD_SPLIT of it after
-        got = reach(mech, lay, conf, lo, mid, SMALLEST_STEP if h > FINE_HALF
-                    else max(h / FOLD_SPLIT, 1e-12))
-        if got is None:
-            hi = mid
-        else:
-            lo, conf = mid, got
-    return np.asarray(0.5 * (lo + hi)), conf
 
 
 def _track(mech: Mechanism, lay: GraphLayout, start: Configuration, x0: Array, X: Array,
@@ -211,7 +142,7 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     anchors = anchor_samples(N, per_root * roots)
     check_cost(mech, N * max(roots, 1))  # at most every generic solution tracked throughout
     solved = every_mode(mech, X[anchors])
-    chains: list[_Chain] = []
+    chains: list[Chain] = []
     active: dict[int, int] = {}  # mode index at the current anchor → chain
     first = solved.configurations[0]
     for m in range(first.size):
@@ -220,8 +151,12 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
         _met(chains[active[m]], solved, 0, m)
     for i in range(len(anchors) - 1):
         active = _segment(mech, lay, X, anchors, i, solved, chains, active, write)
+    unshare(mech, lay, X, chains, MATCH_TOLERANCE, write)
+    partner_folds(mech, lay, X, chains, write)
     before = len(chains)
     extra = _islands(mech, lay, X, anchors, chains, write)
+    unshare(mech, lay, X, chains, MATCH_TOLERANCE, write)
+    partner_folds(mech, lay, X, chains, write)
     notes = _notes(solved, anchors, len(chains))
     if extra:
         notes += (f"the homotopy also at the {extra} sample(s) next to a birth or death: "
@@ -230,28 +165,12 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
                       tuple(c.mask for c in chains),
                       tuple(tuple(c.events) + (_certificate_event(c),) for c in chains),
                       anchors, notes, solved,
-                      fold_meetings(mech, lay, [c.folds for c in chains]))
-
-
-def fold_meetings(mech: Mechanism, lay: GraphLayout,
-                  folds: list[list[tuple[Array, Configuration]]]) -> tuple[tuple[int, int], ...]:
-    """The pairs of modes (indices into ``folds``) that meet at a fold: born or dying at the
-    same input (to :data:`SAME_FOLD` of a radian, or of the length scale) with body poses
-    there within :data:`FOLD_POSES` (at 2⁻²⁶ of a step from a fold, where two branches differ
-    by about the square root of that distance)."""
-    scale = np.where(np.array([lay.is_translation[f] for f in lay.inputs]), lay.length, 1.0)
-    flat = [(k, x, pose_vectors(mech, lay, c)[0]) for k, fs in enumerate(folds) for x, c in fs]
-    out = set()
-    for i, (a, xa, pa) in enumerate(flat):
-        for b, xb, pb in flat[i + 1:]:
-            if a != b and float(np.max(np.abs(xa - xb) / scale)) <= SAME_FOLD and \
-                    float(np.max(np.abs(pa - pb))) <= FOLD_POSES:
-                out.add((min(a, b), max(a, b)))
-    return tuple(sorted(out))
+                      fold_meetings(mech, lay, [c.folds for c in chains]),
+                      tuple(tuple(c.folds) for c in chains))
 
 
 def _islands(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.intp],
-             chains: list[_Chain], fmt: object) -> int:
+             chains: list[Chain], fmt: object) -> int:
     """Modes that reach no anchor but meet a known mode at a fold (an island between two
     anchors): the homotopy solved again at the samples on both sides of every birth and
     death, each mode there on no known mode tracked both ways (:func:`_island`). The count of
@@ -279,7 +198,7 @@ def _islands(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.in
 
 
 def _island(mech: Mechanism, lay: GraphLayout, X: Array, n: int, conf: Configuration,
-            anchors: NDArray[np.intp], chains: list[_Chain], fmt: object, certified: bool
+            anchors: NDArray[np.intp], chains: list[Chain], fmt: object, certified: bool
             ) -> None:
     """A mode found at sample ``n`` between anchors, tracked to where it is born and where it
     dies (both located by bisection); dropped where it reaches an anchor (there it is a mode
@@ -309,20 +228,20 @@ def _island(mech: Mechanism, lay: GraphLayout, X: Array, n: int, conf: Configura
                         "next to another mode's fold, between two anchors")
 
 
-def _new_chain(chains: list[_Chain], lay: GraphLayout, N: int) -> int:
-    chains.append(_Chain(np.zeros((N, lay.n_scalar)),
+def _new_chain(chains: list[Chain], lay: GraphLayout, N: int) -> int:
+    chains.append(Chain(np.zeros((N, lay.n_scalar)),
                          np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy(),
                          np.zeros(N, dtype=bool)))
     return len(chains) - 1
 
 
-def _met(chain: _Chain, solved: MechanismModes, i: int, m: int) -> None:
+def _met(chain: Chain, solved: MechanismModes, i: int, m: int) -> None:
     chain.anchors_met += 1
     chain.anchors_certified += int(bool(solved.certified[i][m]))
 
 
 def _segment(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.intp], i: int,
-             solved: MechanismModes, chains: list[_Chain], active: dict[int, int],
+             solved: MechanismModes, chains: list[Chain], active: dict[int, int],
              write: object) -> dict[int, int]:
     """Carry the modes of anchor i to anchor i + 1 (module docstring); the modes active at
     anchor i + 1 (its mode index → chain)."""
@@ -386,7 +305,7 @@ def _claims(mech: Mechanism, lay: GraphLayout,
 
 
 def _born(mech: Mechanism, lay: GraphLayout, X: Array, A: int, B: int, conf: Configuration,
-          chains: list[_Chain], fmt: object) -> int:
+          chains: list[Chain], fmt: object) -> int:
     """A mode found at anchor B that no mode tracked from anchor A reaches: tracked back to
     where it is born (a fold, by bisection), or to A where a path jump cut a mode there."""
     write = fmt if callable(fmt) else str
@@ -395,20 +314,34 @@ def _born(mech: Mechanism, lay: GraphLayout, X: Array, A: int, B: int, conf: Con
     chain.put(np.array([B]), conf)
     back = np.arange(B - 1, A - 1, -1)
     got, mask, stop = _track(mech, lay, conf, X[B], X[back])
+    # a track that reaches a known mode's configuration jumped onto it in the step before
+    # (along_folds.py): it is not taken past there, and the step is searched for the fold
+    mine = pose_vectors(mech, lay, got)
+    hit = shared_at([pose_vectors(mech, lay, Configuration(o.scalars[back], o.spherical[back]))
+                     for o in chains[:c]], [o.mask[back] for o in chains[:c]], mine, mask,
+                    MATCH_TOLERANCE)
+    if hit.any():
+        mask[int(np.argmax(hit)):] = False
     chain.put(back[mask], got.take(np.flatnonzero(mask)))
-    if stop is None:
+    if stop is None and not hit.any():
         chain.events.append(f"starts at {write(X[A])}: tracked back from {write(X[B])} it does "
                             "not continue a mode of this anchor (a path jump was refused there)")
         return c
     k = int(back[mask][-1]) if mask.any() else B
-    at, near = fold_between(mech, lay, chain.conf_at(k), X[k], X[k - 1])
+    found = fold_in_step(mech, lay, chain.conf_at(k), X[k], X[k - 1])
+    if found is None:  # (only where it met a known mode: a track that stops meets a fold)
+        chain.events.append(f"starts at {write(X[k])}: tracked back from {write(X[B])} it is "
+                            f"at a known mode's configuration at {write(X[k - 1])} with no fold "
+                            "in that step, so it is not taken past there")
+        return c
+    at, near = found
     chain.folds.append((at, near))
     chain.events.append(f"is born at {write(at)}: it starts assembling there (a fold, located "
                         "by bisection between samples)")
     return c
 
 
-def _certificate_event(chain: _Chain) -> str:
+def _certificate_event(chain: Chain) -> str:
     return (f"certified by Smale's α-test at {chain.anchors_certified} of the "
             f"{chain.anchors_met} anchor(s) where the homotopy finds it")
 

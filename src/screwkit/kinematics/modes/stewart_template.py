@@ -22,18 +22,29 @@ the 40 values of ξ1 as its eigenvalues and the basis monomials' values as its e
 Geometry*, ch. 2 §4); B contains 1 and the seven unknowns, which are read off them.
 
 Dropped E columns are combinations of the kept ones at a generic instance: only the column
-space of M_E takes part in the elimination, so they change nothing. The points are unpolished;
+space of M_E takes part in the elimination, so they change nothing.
+
+The square matrix is solved in its block triangular form (:func:`block_triangular`: blocks of
+6, 1, 313 and 206), each block's matrix and its coupling to earlier blocks filled on its own
+(:func:`_plan`). Only the rows of R enter the action matrix, and the last block is read by no
+later block and holds one of them: it is solved for that row alone, as the row of its inverse
+times the right-hand side (one transposed solve of its LU with one right-hand side, not 40;
+Golub & Van Loan 2013, *Matrix Computations*, §3.2). A batch's chunks are spread over the
+cores in threads (LAPACK releases the GIL); each instance's arithmetic is the same either way. The points are unpolished;
 modes/stewart_solve.py polishes, certifies and falls back to the homotopy.
 """
 
 from __future__ import annotations
 
 import itertools
+import os
+from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.linalg import lapack
 
 from screwkit.algebraic.polynomial import Complex
 from screwkit.kinematics.modes import stewart_template_data as data
@@ -45,6 +56,8 @@ UNKNOWNS = 7
 #: instances eliminated together (the template is 526 × 526: 2.2 MB each in float64; more
 #: at once gains nothing, the solves are LAPACK's one by one)
 CHUNK = 8
+#: threads over the chunks of a batch: the cores this process may use
+THREADS = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 def monomials(degree: int) -> list[tuple[int, ...]]:
@@ -255,50 +268,156 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
     """The 40 points (B, 40, 8) of the instances (B, 42) in Study coordinates on the patch,
     unpolished, eliminated in the chart ``label``, and their ξ1 (B, 40): the action matrix's
     eigenvalues (for real parameters the template and the action matrix are real, so the
-    points come in exact conjugate pairs with conjugate ξ1 and the real ones have real ξ1). An instance whose template is singular or
-    not finite gets NaN points."""
-    lay = _layout()
+    points come in exact conjugate pairs with conjugate ξ1 and the real ones have real ξ1).
+    An instance whose template is singular or not finite gets NaN points. A batch of more
+    than one chunk is split into :data:`THREADS` contiguous parts eliminated side by side
+    (LAPACK releases the GIL); each instance's arithmetic is the same either way, and the
+    same as alone (a real instance's is real in a batch with complex ones too)."""
     B = len(params)
-    real = bool(np.all(params.imag == 0))
-    dtype = np.float64 if real else np.complex128
-    n, m = len(data.SQUARE), len(data.BASIS)
+    m = len(data.BASIS)
     points = np.full((B, m, 8), np.nan, dtype=complex)
     keys = np.full((B, m), np.nan, dtype=complex)
-    with np.errstate(all="ignore"):
-        for s in range(0, B, CHUNK):
-            p = params[s:s + CHUNK]
-            c: Any = coefficients(p, label).reshape(len(p), -1)
-            c = c.real if real else c
-            flat: Any = np.zeros((len(p), n * n), dtype=dtype)
-            flat[:, lay["sq_dst"]] = c[:, lay["sq_src"]]
-            right: Any = np.zeros((len(p), n * m), dtype=dtype)
-            right[:, lay["b_dst"]] = -c[:, lay["b_src"]]
-            S, rhs = flat.reshape(-1, n, n), right.reshape(-1, n, m)
-            good: NDArray[np.bool_] = np.asarray(np.isfinite(c).all(axis=1), dtype=bool)
-            if not good.all():
-                S[~good] = np.eye(n)
-            X: Any = np.empty((len(p), n, m), dtype=dtype)
-            bounds = lay["bounds"]
-            for a, b in zip(bounds[:-1], bounds[1:], strict=True):  # block triangular
-                known = rhs[:, a:b] - S[:, a:b, :a] @ X[:, :a] if a else rhs[:, a:b]
-                X[:, a:b] = _solve(S[:, a:b, a:b], known, good)
-            R = X[:, lay["r_pos"]]
-            act = lay["action"]
-            Am: Any = np.zeros((len(p), m, m), dtype=dtype)
-            inside = np.flatnonzero(act >= 0)
-            Am[:, inside, act[inside]] = 1.0
-            Am[:, act < 0] = R[:, -1 - act[act < 0]]
-            good &= np.isfinite(Am).all(axis=(1, 2))
-            if not good.all():
-                Am[~good] = np.eye(m)
-            vals, vecs = np.linalg.eig(Am)
-            w = vecs[:, lay["unit"][1:], :] / vecs[:, lay["unit"][:1], :]  # (b, 7, 40)
-            one = np.ones((len(p), 1, m))
-            z = np.einsum("ij,bjm->bmi", chart(label), np.concatenate([one, w], axis=1))
-            z /= (z[..., :4] @ PATCH)[..., None]  # on the system's patch
-            points[s:s + CHUNK] = np.where(good[:, None, None], z, np.nan)
-            keys[s:s + CHUNK] = np.where(good[:, None], vals, np.nan)
+
+    real = np.all(params.imag == 0, axis=1)
+
+    def part(lo: int, hi: int) -> None:
+        work: dict[str, Any] = {}
+        with np.errstate(all="ignore"):
+            for s in range(lo, hi, CHUNK):
+                # a chunk's real and complex instances apart: a real instance is eliminated
+                # in real arithmetic (exact conjugate pairs) whatever its batch holds
+                for mine in (real[s:s + CHUNK], ~real[s:s + CHUNK]):
+                    rows = s + np.flatnonzero(mine[:hi - s])
+                    if len(rows):
+                        points[rows], keys[rows] = _chunk(params[rows], label, work)
+
+    threads = min(THREADS, -(-B // CHUNK))
+    if threads <= 1:
+        part(0, B)
+        return points, keys
+    # parts of whole chunks, as even as they come
+    cuts = [CHUNK * (-(-B // CHUNK) * t // threads) for t in range(threads)] + [B]
+    with ThreadPoolExecutor(threads) as pool:
+        for f in [pool.submit(part, a, b) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]:
+            f.result()
     return points, keys
+
+
+def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Complex]:
+    """:func:`template_solve` of a few instances: the action matrices, their eigenproblem
+    and the points read off the eigenvectors."""
+    lay = _layout()
+    m = len(data.BASIS)
+    Am, good = action_matrices(p, label, work)
+    vals, vecs = np.linalg.eig(Am)
+    w = vecs[:, lay["unit"][1:], :] / vecs[:, lay["unit"][:1], :]  # (b, 7, 40)
+    one = np.ones((len(p), 1, m))
+    z = np.einsum("ij,bjm->bmi", chart(label), np.concatenate([one, w], axis=1))
+    z /= (z[..., :4] @ PATCH)[..., None]  # on the system's patch
+    return np.where(good[:, None, None], z, np.nan), np.where(good[:, None], vals, np.nan)
+
+
+def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = None
+                    ) -> tuple[Any, NDArray[np.bool_]]:
+    """The action matrices of ξ1 (B, 40, 40) of the instances p (B, 42) in the chart
+    ``label`` (module docstring; real for real parameters), by the block-triangular solve of
+    :func:`_plan`, and whether each is finite (an instance whose template is singular or not
+    finite gets the identity, marked False). ``work`` keeps one thread's zero-filled arrays
+    from call to call: every call writes the same (structurally nonzero) entries of them,
+    and LAPACK's solves do not overwrite them."""
+    work = {} if work is None else work
+    lay = _layout()
+    real = bool(np.all(p.imag == 0))
+    dtype = np.float64 if real else np.complex128
+    n, m = len(data.SQUARE), len(data.BASIS)
+    c: Any = coefficients(p, label).reshape(len(p), -1)
+    c = c.real if real else c
+    good: NDArray[np.bool_] = np.asarray(np.isfinite(c).all(axis=1), dtype=bool)
+    X: Any = np.empty((len(p), n, m), dtype=dtype)  # rows no R reads stay unset
+
+    def zeros(name: str, i: int, shape: tuple[int, int]) -> Any:
+        key = f"{name}{i}{dtype.__name__}{len(p)}"
+        if key not in work:
+            work[key] = np.zeros((len(p), shape[0] * shape[1]), dtype=dtype)
+        return work[key]
+
+    for i, blk in enumerate(_plan()):
+        a, b, k = blk["start"], blk["stop"], blk["stop"] - blk["start"]
+        S: Any = zeros("S", i, (k, k))
+        S[:, blk["diag_dst"]] = c[:, blk["diag_src"]]
+        S = S.reshape(-1, k, k)
+        if not good.all():
+            S = S.copy()
+            S[~good] = np.eye(k)
+        rhs: Any = zeros("rhs", i, (k, m))
+        rhs[:, blk["rhs_dst"]] = -c[:, blk["rhs_src"]]
+        rhs = rhs.reshape(-1, k, m)
+        used = blk["used"]
+        below: Any = None
+        if len(used):
+            below = zeros("below", i, (k, len(used)))
+            below[:, blk["below_dst"]] = c[:, blk["below_src"]]
+            below = below.reshape(-1, k, len(used))
+        want = blk["want"]
+        if want is None:  # every row: later blocks read this one
+            known = rhs if below is None else rhs - below @ X[:, used]
+            X[:, a:b] = _solve(S, known, good)
+            continue
+        # only the rows ``want`` (R monomials, read by no later block): the rows of S⁻¹ they
+        # take, Z = S⁻ᵀ E, then X_want = Zᵀ (rhs − below · X_used)
+        Zt = np.swapaxes(_transposed_solve(S, np.eye(k, dtype=dtype)[:, want], good), -1, -2)
+        rows = Zt @ rhs
+        if below is not None:
+            rows = rows - (Zt @ below) @ X[:, used]
+        X[:, a + want] = rows
+    R = X[:, lay["r_pos"]]
+    act = lay["action"]
+    Am: Any = np.zeros((len(p), m, m), dtype=dtype)
+    inside = np.flatnonzero(act >= 0)
+    Am[:, inside, act[inside]] = 1.0
+    Am[:, act < 0] = R[:, -1 - act[act < 0]]
+    good &= np.isfinite(Am).all(axis=(1, 2))
+    if not good.all():
+        Am[~good] = np.eye(m)
+    return Am, good
+
+
+@lru_cache(maxsize=1)
+def _plan() -> list[dict[str, Any]]:
+    """The block-triangular solve of the template (:func:`_layout`), block by block: where
+    each coefficient goes in the block's diagonal matrix (k × k), in its coupling to the
+    columns of earlier blocks it touches (``used``; k × |used|) and in its right-hand side
+    (k × 40), as flat indices (``*_dst``) and their sources in the coefficients (``*_src``);
+    ``want``: the rows needed when no later block reads this one (only the R monomials in
+    it), else None (every row). Only X_R enters the action matrix, so such a block is solved
+    for those rows alone: one transposed solve with |want| right-hand sides instead of 40,
+    and no coupling product with 40 columns (the last block, 206 × 206, holds one R row)."""
+    lay = _layout()
+    n, m = len(data.SQUARE), len(data.BASIS)
+    row, col = np.divmod(lay["sq_dst"], n)
+    brow, bcol = np.divmod(lay["b_dst"], m)
+    src, bsrc = lay["sq_src"], lay["b_src"]
+    bounds = lay["bounds"]
+    r_pos = np.asarray(lay["r_pos"])
+    plan: list[dict[str, Any]] = []
+    read = np.zeros(n, dtype=bool)  # columns read by a later block
+    for a, b in reversed(list(zip(bounds[:-1], bounds[1:], strict=True))):
+        k = b - a
+        mine = (row >= a) & (row < b)
+        # (a row's entries in the columns of later blocks are structural zeros: _blocks)
+        diag, low = mine & (col >= a) & (col < b), mine & (col < a)
+        used = np.unique(col[low])
+        rhs = (brow >= a) & (brow < b)
+        want = np.sort(r_pos[(r_pos >= a) & (r_pos < b)]) - a
+        plan.append({
+            "start": int(a), "stop": int(b),
+            "diag_dst": (row[diag] - a) * k + col[diag] - a, "diag_src": src[diag],
+            "below_dst": (row[low] - a) * len(used) + np.searchsorted(used, col[low]),
+            "below_src": src[low], "used": used,
+            "rhs_dst": (brow[rhs] - a) * m + bcol[rhs], "rhs_src": bsrc[rhs],
+            "want": None if read[a:b].any() or len(want) >= min(k, m) else want})
+        read[used] = True
+    return plan[::-1]
 
 
 def _solve(S: Any, rhs: Any, good: NDArray[np.bool_]) -> Any:
@@ -314,3 +433,20 @@ def _solve(S: Any, rhs: Any, good: NDArray[np.bool_]) -> Any:
             except np.linalg.LinAlgError:
                 good[b] = False
         return out
+
+
+def _transposed_solve(S: Any, rhs: Any, good: NDArray[np.bool_]) -> Any:
+    """S⁻ᵀ·rhs for the stacked systems S (B, k, k) and one right-hand side (k, q): LAPACK's
+    LU of S with partial pivoting (getrf, the factorization np.linalg.solve makes of S) and
+    the transposed triangular solves (getrs, 'T'). An exactly singular or not finite system
+    is left NaN (``good`` cleared)."""
+    getrf, getrs = lapack.get_lapack_funcs(("getrf", "getrs"), (S,))
+    out = np.full((len(S),) + rhs.shape, np.nan, dtype=S.dtype)
+    for b in range(len(S)):
+        if not good[b]:
+            continue
+        lu, piv, info = getrf(S[b])
+        if info == 0:
+            out[b], info = getrs(lu, piv, rhs, trans=1)
+        good[b] &= info == 0
+    return out
