@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 
 from screwkit.algebraic import compiled
 from screwkit.algebraic.certify import bombieri_weyl_norm, certify, term_magnitude
@@ -24,9 +25,12 @@ def _instances(B: int, seed: int) -> np.ndarray:
     return p
 
 
-def test_the_dense_quadrics_are_the_term_tables_equations() -> None:
+@pytest.mark.parametrize("kernel", [True, False], ids=["compiled", "numpy"])
+def test_the_dense_quadrics_are_the_term_tables_equations(kernel: bool, monkeypatch) -> None:
     """F, ∂F/∂x from zᵀ Q z and 2 (Q z)[:n] equal the term table's at random complex points;
-    |z|ᵀ |Q| |z| equals its Σ|terms| (the α-test's rounding scale) to rounding."""
+    |z|ᵀ |Q| |z| equals its Σ|terms| (the α-test's rounding scale) to rounding; from the
+    compiled kernel (modes/stewart_kernels.py, where numba is there) and the numpy route."""
+    monkeypatch.setattr(compiled, "AVAILABLE", kernel)
     system = stewart_system()
     p = _instances(4, 3)
     rng = np.random.default_rng(1)

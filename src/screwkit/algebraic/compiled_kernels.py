@@ -415,7 +415,7 @@ def alpha_terms(coef: Any, abs_coef: Any, sym: Any, pw: Any, eq: Any, n: int, x:
 @njit
 def point_stats(b: int, J: Any, F: Any, delta: Any, inv: Any, step: Any, stats: Any) -> None:
     """:func:`alpha_terms`' step and ``stats`` of point b from its F[b] and J (N, n), with
-    ``inv`` (n, n) as workspace."""
+    ``inv`` (n, n) as workspace (squared moduli as re² + im², no temporaries)."""
     n = J.shape[1]
     finite = np.isfinite(F[b]).all() and np.isfinite(J).all()
     A = J.copy()
@@ -423,7 +423,7 @@ def point_stats(b: int, J: Any, F: Any, delta: Any, inv: Any, step: Any, stats: 
         A[:] = 0.0
         for i in range(n):
             A[i, i] = 1.0
-    norm_j = np.sqrt(np.sum(np.abs(A) ** 2))
+    norm_j = np.sqrt(np.sum(A.real * A.real + A.imag * A.imag))
     inv[:] = 0.0
     for i in range(n):
         inv[i, i] = 1.0
@@ -434,17 +434,17 @@ def point_stats(b: int, J: Any, F: Any, delta: Any, inv: Any, step: Any, stats: 
         stats[b, 0], stats[b, 1], stats[b, 2] = 1.0 if finite else 0.0, np.inf, norm_j
         stats[b, 3] = np.inf
         return
+    scaled, total = 0.0, 0.0
     for i in range(n):
         s = 0j
-        if finite:
-            for j in range(n):
-                s += inv[i, j] * F[b, j]
-        step[b, i] = s
-    scaled = 0.0
-    for i in range(n):
         for j in range(n):
-            scaled += abs(inv[i, j] * delta[b, j]) ** 2
-    stats[b, 0], stats[b, 1] = 1.0 if finite else 0.0, np.sqrt(np.sum(np.abs(inv) ** 2))
+            if finite:
+                s += inv[i, j] * F[b, j]
+            v = inv[i, j].real * inv[i, j].real + inv[i, j].imag * inv[i, j].imag
+            total += v
+            scaled += v * (delta[b, j] * delta[b, j])
+        step[b, i] = s
+    stats[b, 0], stats[b, 1] = 1.0 if finite else 0.0, np.sqrt(total)
     stats[b, 2], stats[b, 3] = norm_j, np.sqrt(scaled)
 
 

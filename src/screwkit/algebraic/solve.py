@@ -164,10 +164,10 @@ def collect_solutions(system: PolynomialSystem, targets: Complex, x: Complex,
     B = len(targets)
     if cert is None:
         cert = certify(system, x, targets[instance])
-    regular = status == PathStatus.REGULAR
-    radius = np.where(regular & cert.certified, cert.radius,
-                      1e-6 * (1.0 + np.abs(x).max(axis=1, initial=0.0)))
+    regular = status == int(PathStatus.REGULAR)  # (an int: an IntEnum costs numpy µs)
     if label is None:
+        radius = np.where(regular & cert.certified, cert.radius,
+                          1e-6 * (1.0 + np.abs(x).max(axis=1, initial=0.0)))
         label = distinct(x, radius, instance)
     keep = label == np.arange(len(x))
     assert cert.value is not None and cert.terms is not None

@@ -219,12 +219,14 @@ def _eigen_pass(route: EigenRoute, targets: Complex, label: int
     if len(unsure):
         cert = _replaced(cert, unsure, certify(system, xs[unsure], p[unsure],
                                                norm_f=norm_f[unsure]))
-    xs = np.concatenate([xs, xs[twin].conj()])
-    inst = np.concatenate([inst, inst[twin]])
-    finite = np.concatenate([finite, finite[twin]])
-    cert = joined(cert, _conjugate(rows_of(cert, twin)))
-    order = np.argsort(inst, kind="stable")
-    xs, inst, finite, cert = xs[order], inst[order], finite[order], rows_of(cert, order)
+    # the twins appended (conjugated), then every row sorted by instance: one gather per array
+    take = np.concatenate([np.arange(len(xs)), twin])
+    flip: NDArray[np.bool_] = np.arange(len(take)) >= len(xs)
+    if B > 1:  # (one instance: already in order, the twins after its points)
+        order = np.argsort(inst[take], kind="stable")
+        take, flip = take[order], flip[order]
+    xs, inst, finite, cert = xs[take], inst[take], finite[take], _mirrored(cert, take, flip)
+    xs[flip] = xs[flip].conj()
     if sixr_compiled.AVAILABLE:  # the same verdict, compiled (sixr_kernels.settled)
         return xs, inst, sixr_compiled.settled(xs, inst, finite, cert.newton, cert.certified,
                                                cert.radius, B, m, CONVERGED, DISTINCT), cert
@@ -266,13 +268,15 @@ def _replaced(cert: Certificate, rows: NDArray[np.intp], other: Certificate) -> 
     return Certificate(**parts)
 
 
-def _conjugate(cert: Certificate) -> Certificate:
-    """The certificate of the conjugate points of a real system: the same bounds, the
-    conjugate Newton points and values."""
-    parts: dict[str, Any] = {name: getattr(cert, name) for name in _FIELDS}
+def _mirrored(cert: Certificate, rows: NDArray[np.intp], flip: NDArray[np.bool_]
+              ) -> Certificate:
+    """The certificate of the points ``rows``, those marked ``flip`` conjugated: the conjugate
+    point of a real system has the same bounds, the conjugate Newton point and value."""
+    parts: dict[str, Any] = {name: (None if getattr(cert, name) is None
+                                    else getattr(cert, name)[rows]) for name in _FIELDS}
     for name in ("newton", "value"):
         if parts[name] is not None:
-            parts[name] = parts[name].conj()
+            parts[name][flip] = parts[name][flip].conj()
     return Certificate(**parts)
 
 
@@ -281,6 +285,11 @@ def joined(a: Certificate, b: Certificate) -> Certificate:
     parts: dict[str, Any] = {name: np.concatenate([getattr(a, name), getattr(b, name)])
                              for name in _FIELDS}
     return Certificate(**parts)
+
+
+def _cat(parts: list[Any]) -> Any:
+    """The parts joined (one part, the eigen route's alone: itself, no copy)."""
+    return parts[0] if len(parts) == 1 else np.concatenate(parts)
 
 
 def solve_eigen_first(route: EigenRoute, targets: Complex,
@@ -294,7 +303,7 @@ def solve_eigen_first(route: EigenRoute, targets: Complex,
     if len(rows) < len(i_eig):  # (else every row)
         cert, x_eig, i_eig = rows_of(cert, rows), x_eig[rows], i_eig[rows]
     xs, inst = [x_eig], [i_eig]
-    status = [np.full(len(inst[0]), PathStatus.REGULAR, dtype=np.int8)]
+    status = [np.full(len(inst[0]), int(PathStatus.REGULAR), dtype=np.int8)]
     mult = [np.ones(len(inst[0]), dtype=np.int64)]
     at_infinity, failed = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)
     redo = np.flatnonzero(~ok)
@@ -317,6 +326,6 @@ def solve_eigen_first(route: EigenRoute, targets: Complex,
         at_infinity += np.bincount(instance[res.status == PathStatus.AT_INFINITY], minlength=B)
         failed += np.bincount(instance[res.status == PathStatus.FAILED], minlength=B)
     names = tuple(route.elimination if good else route.homotopy for good in ok)
-    return collect_solutions(system, targets, np.concatenate(xs), np.concatenate(inst),
-                             np.concatenate(status), np.concatenate(mult), at_infinity, failed,
-                             m, how, names, cert, None if len(redo) else np.arange(len(xs[0])))
+    return collect_solutions(system, targets, _cat(xs), _cat(inst), _cat(status), _cat(mult),
+                             at_infinity, failed, m, how, names, cert,
+                             None if len(redo) else np.arange(len(xs[0])))

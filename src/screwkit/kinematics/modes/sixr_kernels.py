@@ -342,7 +342,8 @@ def settled(xs: Any, newton: Any, certified: Any, radius: Any, finite: Any, inst
             for k in range(j + 1, stop):
                 d = 0.0
                 for i in range(n):
-                    d += abs(xs[j, i] - xs[k, i]) ** 2
+                    z = xs[j, i] - xs[k, i]
+                    d += z.real * z.real + z.imag * z.imag
                 if not np.sqrt(d) > r[j - start] + r[k - start]:
                     good = False
                     break

@@ -18,8 +18,9 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
+from screwkit.algebraic import compiled
 from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex
 from screwkit.algebraic.solve import Solutions
@@ -31,7 +32,11 @@ from screwkit.kinematics.modes.stewart import (
     stewart_start,
     stewart_system,
 )
-from screwkit.kinematics.modes.stewart_template import quadrics, template_solve
+from screwkit.kinematics.modes.stewart_template import (
+    quadric_forms,
+    quadrics,
+    template_solve,
+)
 
 #: the charts of the template tried in turn on the instances still unsettled
 CHARTS = (0, 1, 2)
@@ -57,7 +62,18 @@ def dense_quadrics(targets: Complex) -> tuple[Complex, Complex]:
     """The system's symmetric matrices (B, 8, 9, 9) at the instances (B, 42), F_i = zᵀ Q_i z
     with z = (x, y, 1): the Study quadric and the six legs (:func:`.stewart_template.quadrics`,
     Husty 1996) and the patch r·x − 1; and their term-wise moduli, |z|ᵀ |Q|_i |z| = Σ|terms|
-    of F_i (the α-test's rounding scale): for the polish's dense Newton steps and α-test."""
+    of F_i (the α-test's rounding scale): for the polish's dense Newton steps and α-test.
+    Both in one compiled pass when numba is there (:func:`.stewart_kernels.dense_quadrics`:
+    the same sums, equal to this numpy route's to rounding)."""
+    if compiled.AVAILABLE:
+        from screwkit.kinematics.modes import stewart_kernels
+
+        G, H, S, patch = _kernel_forms()
+        Q = np.empty((len(targets), 8, 9, 9), dtype=complex)
+        Qabs = np.empty_like(Q)
+        stewart_kernels.dense_quadrics(np.ascontiguousarray(targets, dtype=complex), G, H, S,
+                                       patch, Q, Qabs)
+        return Q, Qabs
     out = []
     for absolute in (False, True):
         Q = np.zeros((len(targets), 8, 9, 9), dtype=complex)
@@ -66,6 +82,14 @@ def dense_quadrics(targets: Complex) -> tuple[Complex, Complex]:
         Q[:, 7, 8, 8] = 1.0 if absolute else -1.0
         out.append(Q)
     return out[0], out[1]
+
+
+@lru_cache(maxsize=1)
+def _kernel_forms() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                             NDArray[np.float64]]:
+    """G, H, S (:func:`.stewart_template.quadric_forms`) and the patch r, contiguous."""
+    G, H, S = (np.ascontiguousarray(v, dtype=float) for v in quadric_forms())
+    return G, H, S, np.ascontiguousarray(PATCH, dtype=float)
 
 
 @lru_cache(maxsize=1)

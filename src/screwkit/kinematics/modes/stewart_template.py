@@ -111,6 +111,12 @@ def _forms() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float
     return G, H, S
 
 
+def quadric_forms() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """G, H and S of :func:`quadrics` (the constant tensors of the leg quadrics), for its
+    compiled twin (modes/stewart_kernels.py)."""
+    return _forms()
+
+
 def quadrics(params: Complex, absolute: bool = False) -> Complex:
     """The symmetric matrices (B, 7, 8, 8) of modes/stewart.py's Study quadric and six leg
     quadrics (its module docstring) at the parameter rows (B, 42): zᵀ Q z is the equation.
