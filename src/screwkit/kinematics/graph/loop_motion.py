@@ -274,8 +274,9 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
     cut = step_pieces(mech, lay, X, lm.assembles[order], every)
     masks = cut.masks
     order = [order[r] for r in cut.rows]
+    of_row = [d if m == lm.again else m for m in order[:cut.source.shape[0]]]
     folds = [(cut.piece(r, k, bool(cut.source[r, k])), k, x, text)
-             for r, k, x, text in _folds(mech, lay, chain, X, cut.source)]
+             for r, k, x, text in _folds(mech, lay, chain, X, cut.source, of_row)]
     # in input order: a fold between samples k and k+1 at k + ½, one inside a step at k + t
     at = [k + 0.5 for _, k, _, _ in folds] + [p for p, _ in cut.events]
     folds += [f for _, f in cut.events]
@@ -317,13 +318,16 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
 
 
 def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
-           masks: NDArray[np.bool_]) -> list[tuple[int, int, Array, str]]:
-    """Every birth and death of the modes ``masks`` (M, N) between two samples, as (row,
-    sample before it, input rows at the fold, event text): located by bisection on the
-    segment X[k] → X[k+1] (all at once) where the loop's count of real solutions (its closed
-    form's assembling modes at one input) leaves its value at X[k]."""
+           masks: NDArray[np.bool_], modes: list[int]) -> list[tuple[int, int, Array, str]]:
+    """Every birth and death of the modes ``masks`` (M, N; row r the loop's mode
+    ``modes[r]``) between two samples, as (row, sample before it, input rows at the fold,
+    event text): for a loop of the RSRC quartic, where that mode's own root stops assembling
+    (graph/quartic_folds.py: two pairs of modes may fold inside one step), the mode that meets
+    it there named; else located by bisection on the segment X[k] → X[k+1] (all at once)
+    where the loop's count of real solutions (its closed form's assembling modes at one input)
+    leaves its value at X[k]."""
     from screwkit.kinematics.graph.motion import input_text
-    from screwkit.kinematics.registry import family_of
+    from screwkit.kinematics.registry import family_of, has_rsrc_quartic
 
     rows, ks = np.nonzero(masks[:, :-1] != masks[:, 1:])
     closed = family_of(chain.linkage).closed_form_for(chain.linkage)
@@ -331,6 +335,8 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         return [(int(r), int(k), X[k + 1], f"{'dies' if masks[r, k] else 'is born'} between "
                  f"{input_text(mech, lay, X[k])} and {input_text(mech, lay, X[k + 1])}")
                 for r, k in zip(rows, ks, strict=True)]
+    if has_rsrc_quartic(chain.linkage):
+        return _quartic_folds(mech, lay, chain, X, masks, modes, rows, ks)
     x0, x1 = X[ks], X[ks + 1]
 
     def count(t: Array) -> NDArray[np.intp]:
@@ -350,6 +356,31 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         what = "dies" if masks[r, k] else "is born"
         out.append((int(r), int(k), x, f"{what} at {input_text(mech, lay, x)}: the loop folds "
                                        "(two of its assembly modes meet)"))
+    return out
+
+
+def _quartic_folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
+                   masks: NDArray[np.bool_], modes: list[int], rows: NDArray[np.intp],
+                   ks: NDArray[np.intp]) -> list[tuple[int, int, Array, str]]:
+    """:func:`_folds` for a loop of the RSRC quartic: each mode's fold where its own root
+    stops assembling, over the rows the loop was solved on (the approach, then ``X``)."""
+    from screwkit.kinematics.graph.motion import input_text
+    from screwkit.kinematics.graph.quartic_folds import quartic_folds
+
+    A = approach(lay, X)
+    a = A.shape[0]
+    found = {(f.mode, f.k - a, f.dies): f for f in
+             quartic_folds(chain, chain.loop_inputs(np.vstack([A, X])))}
+    out = []
+    for r, k in zip(rows, ks, strict=True):
+        dies = bool(masks[r, k])
+        f = found[(modes[r], int(k), dies)]
+        x = X[k] + f.t * (X[k + 1] - X[k])
+        meet = (f"loop modes {min(f.mode, f.partner)} and {max(f.mode, f.partner)} meet"
+                if f.partner is not None else
+                f"loop mode {f.mode} meets a root that assembles at neither sample")
+        out.append((int(r), int(k), x, f"{'dies' if dies else 'is born'} at "
+                                       f"{input_text(mech, lay, x)}: the loop folds ({meet})"))
     return out
 
 

@@ -1,0 +1,107 @@
+"""Folds of a four-mode loop (the RSRC quartic) attributed to the two modes that meet there
+(graph/quartic_folds.py; issue 27: "births and deaths at folds are reported"): two different
+pairs of modes born inside one sample step are each placed at their own fold, checked against
+the quartic's discriminant located by a scalar root finder and against a fine-grid tracking of
+each mode's root, both written here from Bagci 1969 eqs. 3.58/3.59."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+from scipy.optimize import brentq
+
+import screwkit as sk
+from screwkit.kinematics.graph import solve_mechanism
+from screwkit.kinematics.graph.from_loop import mechanism_from_loop
+from screwkit.kinematics.graph.loop_subchain import loop_chain
+from screwkit.kinematics.graph.quartic_folds import quartic_folds
+
+#: an RSRC (seeded random dimensions of the family's property tests, rounded) whose modes 0, 1
+#: are born at θ0 ≈ 53.85° and modes 2, 3 at ≈ 57.59°: both inside the 5° step 53.5° → 58.5°
+P = dict(d1=1.407, d2=2.402, d3=0.566, a=1.617, b=-0.256, e=-0.046, delta0=-1.117, lambda0=-0.832)
+#: drawn at 58.5° (where every mode assembles), a turn in 5° steps: the last step holds both
+X = np.radians(np.arange(58.5, 58.5 + 361.0, 5.0))
+
+
+def _closure(phi: np.ndarray, theta: float) -> np.ndarray:
+    """W1² + (W2 / cos δ0)² − d2² (Bagci eqs. 3.58/3.59: W1 = d2 cos χ0, W2 = d2 cos δ0 sin
+    χ0), zero where the loop closes at output angle φ0 and input θ0."""
+    m0 = P["b"] * np.sin(P["lambda0"]) - P["d1"] * np.cos(P["lambda0"]) * np.sin(theta)
+    n0 = P["a"] - P["d1"] * np.cos(theta)
+    w1 = m0 * np.sin(phi) + n0 * np.cos(phi) + P["d3"]
+    w2 = n0 * np.sin(phi) - m0 * np.cos(phi) - P["e"] * np.sin(P["delta0"])
+    return w1 * w1 + (w2 / np.cos(P["delta0"])) ** 2 - P["d2"] ** 2
+
+
+def _quartic(theta: float) -> np.ndarray:
+    """The closure times (1 + τ²)² as a quartic in τ = tan(φ0/2): interpolated at 5 points."""
+    tau = np.array([-2.0, -1.0, 0.0, 1.0, 2.0])
+    return np.polyfit(tau, _closure(2 * np.arctan(tau), theta) * (1 + tau * tau) ** 2, 4)
+
+
+def _discriminant(theta: float) -> float:
+    """The quartic's discriminant up to a positive factor: ∏ (τi − τj)² over its roots."""
+    r = np.roots(_quartic(theta))
+    return float(np.real(np.prod([(r[i] - r[j]) ** 2 for i in range(4) for j in range(i)])))
+
+
+def _real_roots(theta: float) -> np.ndarray:
+    r = np.roots(_quartic(theta))
+    return np.sort(2 * np.arctan(np.real(r[np.abs(np.imag(r)) < 1e-9])))
+
+
+def _track_down(phi: float, hi: float, lo: float, folds: list[float]) -> float:
+    """Follow the root at φ0 = ``phi`` from θ0 = ``hi`` down to ``lo`` on a grid of 1e-4 rad,
+    the nearest root each step; where the count of real roots drops and this root is one of
+    the two closest roots just before (the pair that turns complex), the fold of ``folds``
+    inside that grid step."""
+    grid = np.linspace(hi, lo, int(np.ceil((hi - lo) / 1e-4)) + 1)
+    for t0, t1 in zip(grid, grid[1:], strict=False):
+        now, nxt = _real_roots(t0), _real_roots(t1)
+        phi = float(now[np.argmin(np.abs(np.angle(np.exp(1j * (now - phi)))))])
+        if nxt.size < now.size:
+            d = np.abs(np.angle(np.exp(1j * (now[:, None] - now[None, :])))) + np.eye(now.size) * 9
+            i, j = np.unravel_index(np.argmin(d), d.shape)
+            if phi in (now[i], now[j]):
+                return next(f for f in folds if t1 <= f <= t0)
+    raise AssertionError("the root does not end in the step")
+
+
+def test_two_pairs_born_inside_one_step_are_each_placed_at_their_own_fold() -> None:
+    lk = sk.rsrc(**P)
+    motion = sk.solve_motion(lk, X)
+    k = X.size - 2  # the last step, 413.5° → 418.5° (53.5° → 58.5° a turn on)
+    assert all(not md.assembles[k] and md.assembles[k + 1] for md in motion.modes)
+    # the independent folds: the discriminant's zeros inside the step (fine grid, then brentq)
+    grid = np.linspace(X[k], X[k + 1], 2001)
+    D = np.array([_discriminant(t) for t in grid])
+    change = np.flatnonzero(np.sign(D[:-1]) != np.sign(D[1:]))
+    folds = [brentq(_discriminant, grid[i], grid[i + 1], xtol=1e-15) for i in change]
+    assert len(folds) == 2 and folds[1] - folds[0] > np.radians(3.0)
+    # which fold each mode's root is born at, by tracking it down from the sample after
+    own = {m: _track_down(float(md.variables["phi0"][k + 1]), X[k + 1], X[k], folds)
+           for m, md in enumerate(motion.modes)}
+    assert own == {0: folds[0], 1: folds[0], 2: folds[1], 3: folds[1]}
+    mech = mechanism_from_loop(motion, 0, 0)
+    chain = loop_chain(mech)
+    assert chain is not None
+    found = {f.mode: f for f in quartic_folds(chain, chain.loop_inputs(X[:, None] - X[0]))
+             if f.k == k}
+    assert sorted(found) == [0, 1, 2, 3]
+    for m, f in found.items():
+        assert not f.dies
+        assert abs(X[k] + f.t * (X[k + 1] - X[k]) - own[m]) < 1e-9, m  # rad
+    assert {m: found[m].partner for m in found} == {0: 1, 1: 0, 2: 3, 3: 2}
+    # the graph's modes report it: each born at its own fold, the partner named
+    g = solve_mechanism(mech, X - X[0], every_mode=True)
+    births = {}
+    for md in g.modes:
+        for ev in md.events:
+            hit = re.match(r"is born at input.theta = ([\d.]+) deg: the loop folds \(loop modes "
+                           r"(\d) and (\d) meet\)", ev)
+            if hit and float(hit[1]) > np.degrees(X[k] - X[0]):
+                births[(int(hit[2]), int(hit[3]))] = float(hit[1])
+    assert births.keys() == {(0, 1), (2, 3)}
+    assert abs(births[(0, 1)] - np.degrees(folds[0] - X[0])) < 1e-3  # printed to 6 digits
+    assert abs(births[(2, 3)] - np.degrees(folds[1] - X[0])) < 1e-3
