@@ -7,6 +7,7 @@ each mode's root, both written here from Bagci 1969 eqs. 3.58/3.59."""
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 import numpy as np
 from scipy.optimize import brentq
@@ -16,6 +17,8 @@ from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.from_loop import mechanism_from_loop
 from screwkit.kinematics.graph.loop_subchain import loop_chain
 from screwkit.kinematics.graph.quartic_folds import quartic_folds
+from screwkit.kinematics.graph.subchains import decompose
+from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
 
 #: an RSRC (seeded random dimensions of the family's property tests, rounded) whose modes 0, 1
 #: are born at θ0 ≈ 53.85° and modes 2, 3 at ≈ 57.59°: both inside the 5° step 53.5° → 58.5°
@@ -68,16 +71,32 @@ def _track_down(phi: float, hi: float, lo: float, folds: list[float]) -> float:
     raise AssertionError("the root does not end in the step")
 
 
+def _folds_in_last_step() -> list[float]:
+    """The discriminant's zeros inside the last step (sign changes on a fine grid, brentq)."""
+    grid = np.linspace(X[-2], X[-1], 2001)
+    D = np.array([_discriminant(t) for t in grid])
+    change = np.flatnonzero(np.sign(D[:-1]) != np.sign(D[1:]))
+    return [brentq(_discriminant, grid[i], grid[i + 1], xtol=1e-15) for i in change]
+
+
+def _births(events: list[str], after: float, meet: str) -> dict[tuple[int, int], float]:
+    """The births after ``after`` (deg) in ``events``: (the two modes that meet) → input."""
+    out = {}
+    for ev in events:
+        hit = re.search(r"is born at .*input.theta = ([\d.]+) deg: .*folds \(" + meet +
+                        r" (\d) and (\d) meet\)", ev)
+        if hit and float(hit[1]) > after:
+            out[(int(hit[2]), int(hit[3]))] = float(hit[1])
+    return out
+
+
 def test_two_pairs_born_inside_one_step_are_each_placed_at_their_own_fold() -> None:
     lk = sk.rsrc(**P)
     motion = sk.solve_motion(lk, X)
     k = X.size - 2  # the last step, 413.5° → 418.5° (53.5° → 58.5° a turn on)
     assert all(not md.assembles[k] and md.assembles[k + 1] for md in motion.modes)
     # the independent folds: the discriminant's zeros inside the step (fine grid, then brentq)
-    grid = np.linspace(X[k], X[k + 1], 2001)
-    D = np.array([_discriminant(t) for t in grid])
-    change = np.flatnonzero(np.sign(D[:-1]) != np.sign(D[1:]))
-    folds = [brentq(_discriminant, grid[i], grid[i + 1], xtol=1e-15) for i in change]
+    folds = _folds_in_last_step()
     assert len(folds) == 2 and folds[1] - folds[0] > np.radians(3.0)
     # which fold each mode's root is born at, by tracking it down from the sample after
     own = {m: _track_down(float(md.variables["phi0"][k + 1]), X[k + 1], X[k], folds)
@@ -95,13 +114,30 @@ def test_two_pairs_born_inside_one_step_are_each_placed_at_their_own_fold() -> N
     assert {m: found[m].partner for m in found} == {0: 1, 1: 0, 2: 3, 3: 2}
     # the graph's modes report it: each born at its own fold, the partner named
     g = solve_mechanism(mech, X - X[0], every_mode=True)
-    births = {}
-    for md in g.modes:
-        for ev in md.events:
-            hit = re.match(r"is born at input.theta = ([\d.]+) deg: the loop folds \(loop modes "
-                           r"(\d) and (\d) meet\)", ev)
-            if hit and float(hit[1]) > np.degrees(X[k] - X[0]):
-                births[(int(hit[2]), int(hit[3]))] = float(hit[1])
+    births = _births([e for md in g.modes for e in md.events], np.degrees(X[k] - X[0]),
+                     "loop modes")
     assert births.keys() == {(0, 1), (2, 3)}
     assert abs(births[(0, 1)] - np.degrees(folds[0] - X[0])) < 1e-3  # printed to 6 digits
+    assert abs(births[(2, 3)] - np.degrees(folds[1] - X[0])) < 1e-3
+
+
+def test_a_loop_stage_places_each_pair_at_its_own_fold() -> None:
+    """The same RSRC as a loop stage (graph/loop_stage.py), hung on a thigh that a hip joint
+    turns (held still here): its modes are born at the same two folds, each pair at its own."""
+    motion = sk.solve_motion(sk.rsrc(**P), X)
+    loop = mechanism_from_loop(motion, 0, 0)
+    on_thigh = tuple(replace(j, bodies=tuple("thigh" if b == "ground" else b for b in j.bodies))
+                     for j in loop.joints)
+    hip = MechanismJoint("hip", "R", ("ground", "thigh"), np.array([0.5, -2.0, 1.0]),
+                         np.array([0.2, 0.3, 1.0]))
+    mech = Mechanism("knee", (Body("thigh"), *loop.bodies), (hip, *on_thigh),
+                     ("hip.theta", f"{loop.joints[0].name}.theta"))
+    assert decompose(mech).loops[0].kind == "RSRC"
+    g = solve_mechanism(mech, np.stack([np.zeros(X.size), X - X[0]], axis=1), every_mode=True)
+    assert g.method == "graph (closed forms)"
+    folds = _folds_in_last_step()
+    births = _births([e for md in g.modes for e in md.events], np.degrees(X[-2] - X[0]),
+                     "its modes")
+    assert births.keys() == {(0, 1), (2, 3)}
+    assert abs(births[(0, 1)] - np.degrees(folds[0] - X[0])) < 1e-3
     assert abs(births[(2, 3)] - np.degrees(folds[1] - X[0])) < 1e-3
