@@ -11,8 +11,11 @@ offers its closed form's branches, only the drawn branch's positions are built
 (:func:`drawn_branch`: the same numbers). :func:`loop_motion` builds the rest of each
 mode as for every graph (graph/motion.py's ``build_mode``: rates and accelerations from the
 stacked screw Jacobian, points, outputs, singularities) and locates where modes are born and
-die: at a fold of the loop, where the count of its real closed-form solutions changes by two,
-found by bisection between the samples around it (as graph/closed_modes.py's ``fold_inputs``).
+die: at a fold of the loop, found between the samples around it where that mode's own root
+stops assembling for a loop of the RSRC quartic (graph/quartic_folds.py: two pairs of its four
+modes may fold inside one step; the mode that meets it is named), else by bisection where the
+count of its real closed-form solutions changes by two (as graph/closed_modes.py's
+``fold_inputs``).
 """
 
 from __future__ import annotations

@@ -14,9 +14,10 @@ drawing and whose dyad branches are the drawing's, followed from the drawing unt
 stops assembling (its later runs, where it assembles again, are a mode of their own, as in
 graph/closed_modes.py).
 
-A mode is born or dies between two samples where one of its stages folds: the loop (its count
-of real closed-form solutions changes, graph/loop_motion.py's ``real_count``) or a dyad or leg
-(its discriminant crosses zero). Either is located by bisection of the input segment between
+A mode is born or dies between two samples where one of its stages folds: the loop (for the
+RSRC quartic where its loop mode's own root stops assembling, graph/quartic_folds.py, the loop
+mode that meets it named; else where its count of real closed-form solutions changes,
+graph/loop_motion.py's ``real_count``) or a dyad or leg (its discriminant crosses zero). Either is located by bisection of the input segment between
 the samples; for a dyad's fold the loop is carried along the segment on its branch (at each
 bisection point, the loop mode nearest the one at the bisection's last point). Rates and
 accelerations come from the stacked closure Jacobian (graph/motion.py's ``build_mode``).
