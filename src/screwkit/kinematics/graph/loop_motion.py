@@ -274,12 +274,14 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
                             "assembling before it")
     order = [d] + ([m for m in range(len(lm.confs)) if m != d and lm.assembles[m].any()]
                    if every else [])
-    cut = step_pieces(mech, lay, X, lm.assembles[order], every)
+    of_row = [d if m == lm.again else m for m in order]
+    cut = step_pieces(mech, lay, X, lm.assembles[order], every, chain, of_row)
     masks = cut.masks
     order = [order[r] for r in cut.rows]
-    of_row = [d if m == lm.again else m for m in order[:cut.source.shape[0]]]
-    folds = [(cut.piece(r, k, bool(cut.source[r, k])), k, x, text)
-             for r, k, x, text in _folds(mech, lay, chain, X, cut.source, of_row)]
+    # a fold of a piece dropped (the drawn mode's after its first fold, with the drawn mode
+    # alone) is not reported
+    folds = [(i, k, x, text) for r, k, x, text in _folds(mech, lay, chain, X, cut.source, of_row)
+             if (i := cut.piece(r, k, bool(cut.source[r, k]))) is not None]
     # in input order: a fold between samples k and k+1 at k + ½, one inside a step at k + t
     at = [k + 0.5 for _, k, _, _ in folds] + [p for p, _ in cut.events]
     folds += [f for _, f in cut.events]
@@ -297,7 +299,7 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
                 events.insert(0, f"stops assembling after input "
                                  f"{input_text(mech, lay, X[stop - 1])} (a limit position or "
                                  f"dead centre before {input_text(mech, lay, X[stop])})")
-        label = ("drawn" if row == 0 else "one of the loop's two modes" if row in cut.islands
+        label = ("drawn" if row == 0 else cut.island_name if row in cut.islands
                  else f"loop mode {d} (the drawn branches again, after the drawn mode's fold)"
                  if m == lm.again else f"loop mode {m}") + cut.labels[row]
         modes.append(replace(with_events(md, [*events, *md.events]), label=label,
@@ -425,32 +427,41 @@ class StepPieces:
     labels: list[str]
     events: list[tuple[float, tuple[int, int, Array, str]]]
     islands: frozenset[int] = frozenset()
+    island_name: str = "one of the loop's two modes"
 
-    def piece(self, row: int, k: int, dies: bool) -> int:
-        """The piece of mode ``row`` that dies after sample k (``dies``) or is born before k+1."""
+    def piece(self, row: int, k: int, dies: bool) -> int | None:
+        """The piece of mode ``row`` that dies after sample k (``dies``) or is born before k+1
+        (None: that piece is not kept)."""
         n = k if dies else k + 1
-        return next(i for i, (r, m) in enumerate(zip(self.rows, self.masks, strict=True))
-                    if r == row and m[n])
+        return next((i for i, (r, m) in enumerate(zip(self.rows, self.masks, strict=True))
+                     if r == row and m[n]), None)
 
 
 def step_pieces(mech: Mechanism, lay: GraphLayout, X: Array, masks: NDArray[np.bool_],
-                every: bool) -> StepPieces:
-    """The modes ``masks`` (M, N) of a loop that is one two-branch dyad or leg on its driven
-    joint (graph/subchains.py: its two loop modes are that sub-chain's two branches, and they
-    fold together), cut where the sub-chain's discriminant dips below zero inside one step, and
-    with ``every`` its islands inside one step as modes on no sample (graph/step_folds.py; the
-    drawn mode, row 0, ends at its first fold); any other loop's modes as they are."""
+                every: bool, chain: LoopChain, modes: list[int]) -> StepPieces:
+    """The modes ``masks`` (M, N; row r the loop's mode ``modes[r]``) of a loop that is one
+    two-branch dyad or leg on its driven joint (graph/subchains.py: its two loop modes are that
+    sub-chain's two branches, and they fold together), cut where the sub-chain's discriminant
+    dips below zero inside one step, and with ``every`` its islands inside one step as modes on
+    no sample (graph/step_folds.py; the drawn mode, row 0, ends at its first fold); a loop of
+    the RSRC quartic from its quartic's discriminant (graph/quartic_steps.py); any other loop's
+    modes as they are."""
     from screwkit.kinematics.graph.closed_modes import ISLAND, SAME_AGAIN, drawn_combination
     from screwkit.kinematics.graph.dyads import place
     from screwkit.kinematics.graph.motion import input_text
     from screwkit.kinematics.graph.step_folds import hidden_pairs
     from screwkit.kinematics.graph.subchains import decompose
+    from screwkit.kinematics.registry import has_rsrc_quartic
 
     M, N = masks.shape
     rows, pieces, labels = list(range(M)), list(masks), [""] * M
     dec = decompose(mech)
     if N < 2 or not dec.complete or dec.loops or len(dec.dyads) != 1 or \
             dec.dyads[0].branches != 2:
+        if N > 1 and has_rsrc_quartic(chain.linkage):
+            from screwkit.kinematics.graph.quartic_steps import quartic_pieces
+
+            return quartic_pieces(mech, lay, chain, X, masks, modes, every)
         return StepPieces(masks, rows, masks, labels, [])
     # the two branches share the discriminant (they fold together): the drawing's alone, over
     # the drawn mode's samples unless every mode is asked for

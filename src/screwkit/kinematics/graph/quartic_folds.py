@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, RSRCMotion, rsrc_motion
 from screwkit.kinematics.graph.loop_subchain import LoopChain
 
 Array = NDArray[np.float64]
@@ -60,7 +61,6 @@ def quartic_folds(chain: LoopChain, L: Array) -> list[QuarticFold]:
     """Every birth and death of the loop's modes between consecutive rows of the loop inputs
     ``L`` (K, 1), the rows its modes were solved on (module docstring)."""
     from screwkit.kinematics.closed_forms.closed_form_motion import rsrc_dimensions
-    from screwkit.kinematics.closed_forms.rsrc import rsrc_motion
 
     dims = rsrc_dimensions(chain.linkage)[0]
     theta = L[:, 0]
@@ -72,16 +72,34 @@ def quartic_folds(chain: LoopChain, L: Array) -> list[QuarticFold]:
         return []
     dies = ok[ks, ms]
     start = np.where(dies, ks, ks + 1)
-    th0, th1 = theta[start], theta[2 * ks + 1 - start]  # from where it assembles
+    t_from, _, _ = follow(dims, theta[start], theta[2 * ks + 1 - start],
+                          features(mot, start, cols[ms], dims.length_scale))
+    t = np.where(dies, t_from, 1.0 - t_from)
+    out = []
+    for i in range(ks.size):
+        mate = [j for j in range(ks.size) if j != i and ks[j] == ks[i] and dies[j] == dies[i]
+                and abs(t[j] - t[i]) <= SAME_FOLD]
+        out.append(QuarticFold(int(ms[i]), int(ks[i]), bool(dies[i]), float(t[i]),
+                               int(ms[mate[0]]) if mate else None))
+    return out
+
+
+def follow(dims: RSRCDimensions, th0: Array, th1: Array, ref: Array
+           ) -> tuple[Array, NDArray[np.bool_], Array]:
+    """The roots whose features (:func:`features`) at the inputs ``th0`` (T,) are ``ref``
+    (T, 5), followed towards ``th1`` (module docstring): the fraction of the way where each
+    stops assembling (to 2⁻⁵⁰; 1 where it reaches ``th1``), whether it reaches ``th1``, and
+    its features at ``th1`` where it does."""
+
     length = max(dims.length_scale, np.finfo(float).tiny)
-    ref = _features(mot.phi0[start, cols[ms]], mot.chi0[start, cols[ms]],
-                    mot.S[start, cols[ms]], length)
-    T = ks.size
+    T = th0.size
     lo, hi = np.zeros(T), np.ones(T)
     frac = np.arange(SECTIONS + 1) / SECTIONS
     r = np.arange(T)
     n = SECTIONS + 1
-    for _ in range(ROUNDS):
+    reached = np.zeros(T, dtype=bool)
+    at_end = np.full_like(ref, np.nan)
+    for round_ in range(ROUNDS):
         u = lo[:, None] + (hi - lo)[:, None] * frac  # (T, n): u[:, 0] = lo, u[:, -1] = hi
         sweep = rsrc_motion(dims, (th0[:, None] + u * (th1 - th0)[:, None]).reshape(-1))
         A = sweep.assembles.reshape(T, n, 4)
@@ -90,19 +108,21 @@ def quartic_folds(chain: LoopChain, L: Array) -> list[QuarticFold]:
         col = np.argmin(np.where(A[:, 0], np.nan_to_num(gap, nan=np.inf), np.inf), axis=1)
         alive = A[r, :, col]  # (T, n) the mode's root along the sections
         alive[:, 0] = True
+        if round_ == 0:
+            reached = np.asarray(alive.all(axis=1), dtype=bool)
+            at_end[reached] = F[r, n - 1, col][reached]
         first = np.where(alive.all(axis=1), n - 1, np.argmax(~alive, axis=1))
         last = first - 1
         ref = F[r, last, col]
         lo, hi = u[r, last], u[r, first]
-    t_from = 0.5 * (lo + hi)
-    t = np.where(dies, t_from, 1.0 - t_from)
-    out = []
-    for i in range(T):
-        mate = [j for j in range(T) if j != i and ks[j] == ks[i] and dies[j] == dies[i]
-                and abs(t[j] - t[i]) <= SAME_FOLD]
-        out.append(QuarticFold(int(ms[i]), int(ks[i]), bool(dies[i]), float(t[i]),
-                               int(ms[mate[0]]) if mate else None))
-    return out
+    return np.where(reached, 1.0, 0.5 * (lo + hi)), reached, at_end
+
+
+def features(mot: RSRCMotion, rows: NDArray[np.intp], cols: NDArray[np.intp],
+             length: float) -> Array:
+    """The features (:func:`_features`) of ``mot``'s roots at ``rows``, ``cols`` (T,)."""
+    return _features(mot.phi0[rows, cols], mot.chi0[rows, cols], mot.S[rows, cols],
+                     max(length, np.finfo(float).tiny))
 
 
 def _features(phi: Array, chi: Array, s: Array, length: float) -> Array:
