@@ -14,6 +14,8 @@ import pytest
 from scipy.optimize import brentq
 
 import screwkit as sk
+from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions
+from screwkit.kinematics.closed_forms.rsrc.positions import quartic_discriminant, rsrc_positions
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.from_loop import mechanism_from_loop
 from screwkit.kinematics.graph.loop_subchain import loop_chain
@@ -209,3 +211,22 @@ def test_two_folds_of_a_four_mode_loop_inside_one_step_cut_its_modes() -> None:
             assert counts == [2, 0, 2] and not islands
     drawn = g.modes[0]
     assert drawn.assembles.sum() == 2 and "the first of two folds" not in drawn.events[1]
+
+
+def test_the_discriminant_s_sign_is_the_count_and_its_zeros_are_the_folds() -> None:
+    """``quartic_discriminant`` (its invariants' form) against the real roots' count on a
+    0.1° grid (positive: four or none, negative: two) and against the zeros of the discriminant
+    built here from the roots of the closure's quartic (np.roots), by brentq, to 1e-10 rad."""
+    for dims in (P, Q):
+        d = RSRCDimensions(**dims)
+        th = np.radians(np.arange(0.0, 360.0, 0.1))
+        D = quartic_discriminant(d, th)
+        n = rsrc_positions(d, th).n_assemblies
+        assert np.all(np.where(D > 0, n % 4 == 0, n == 2))
+        change = np.flatnonzero(np.sign(D[:-1]) != np.sign(D[1:]))
+        assert change.size >= 4
+        for i in change:
+            mine = brentq(lambda t, d=d: float(quartic_discriminant(d, t)[0]), th[i], th[i + 1],
+                          xtol=1e-15)
+            ref = _zeros(th[i], th[i + 1], dims)
+            assert len(ref) == 1 and abs(mine - ref[0]) < 1e-10

@@ -76,16 +76,15 @@ def quartic_steps(chain: LoopChain, L: Array, first: int, last: int) -> list[Qua
     ks = ks[count[ks] == count[ks + 1]]
     if ks.size == 0:
         return []
-    th0, th1 = theta[ks], theta[ks + 1]
-
-    def disc(t: Array) -> Array:
-        return quartic_discriminant(dims, th0 + t * (th1 - th0))
-
-    g0, g1 = disc(np.zeros(ks.size)), disc(np.ones(ks.size))
-    h = SLOPE_STEP
-    s0, s1 = (disc(np.full(ks.size, h)) - g0) / h, (g1 - disc(np.full(ks.size, 1 - h))) / h
+    at = quartic_discriminant(dims, theta[first:last + 1])  # at the samples
+    g0, g1 = at[ks - first], at[ks + 1 - first]
     sign = np.sign(g0)
-    pick = (np.sign(g1) == sign) & (sign * s0 < 0) & (sign * s1 > 0)
+    ks, g0, g1, sign = (v[np.sign(g1) == sign] for v in (ks, g0, g1, sign))
+    th0, th1 = theta[ks], theta[ks + 1]
+    h = SLOPE_STEP
+    s0 = (quartic_discriminant(dims, th0 + h * (th1 - th0)) - g0) / h
+    s1 = (g1 - quartic_discriminant(dims, th1 - h * (th1 - th0))) / h
+    pick = (sign * s0 < 0) & (sign * s1 > 0)
     if not pick.any():
         return []
     ks, th0, th1, sign = ks[pick], th0[pick], th1[pick], sign[pick]

@@ -168,12 +168,11 @@ def quartic_discriminant(dims: RSRCDimensions, theta0: ArrayLike) -> FloatArray:
     # times (1 + t²)² with t = tan(φ0/2): a t⁴ + b t³ + c t² + d t + e
     a, b, c = a0 - a1 + a2, 2.0 * b1 - 4.0 * b2, 2.0 * a0 - 6.0 * a2
     d, e = 2.0 * b1 + 4.0 * b2, a0 + a1 + a2
-    return np.asarray(
-        256 * a**3 * e**3 - 192 * a**2 * b * d * e**2 - 128 * a**2 * c**2 * e**2
-        + 144 * a**2 * c * d**2 * e - 27 * a**2 * d**4 + 144 * a * b**2 * c * e**2
-        - 6 * a * b**2 * d**2 * e - 80 * a * b * c**2 * d * e + 18 * a * b * c * d**3
-        + 16 * a * c**4 * e - 4 * a * c**3 * d**2 - 27 * b**4 * e**2 + 18 * b**3 * c * d * e
-        - 4 * b**3 * d**3 - 4 * b**2 * c**3 * e + b**2 * c**2 * d**2, dtype=np.float64)
+    # (4 Δ0³ − Δ1²) / 27 with the invariants Δ0 = c² − 3bd + 12ae and
+    # Δ1 = 2c³ − 9bcd + 27b²e + 27ad² − 72ace
+    i0 = c * c - 3.0 * b * d + 12.0 * a * e
+    i1 = c * (2.0 * c * c - 9.0 * b * d - 72.0 * a * e) + 27.0 * (b * b * e + a * d * d)
+    return np.asarray((4.0 * i0 * i0 * i0 - i1 * i1) / 27.0, dtype=np.float64)
 
 
 def _output_angles_special(
