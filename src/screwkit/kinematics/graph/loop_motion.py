@@ -340,8 +340,14 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         return [(int(r), int(k), X[k + 1], f"{'dies' if masks[r, k] else 'is born'} between "
                  f"{input_text(mech, lay, X[k])} and {input_text(mech, lay, X[k + 1])}")
                 for r, k in zip(rows, ks, strict=True)]
+    out: list[tuple[int, int, Array, str]] = []
     if has_rsrc_quartic(chain.linkage):
-        return _quartic_folds(mech, lay, chain, X, masks, modes, rows, ks)
+        out = _quartic_folds(mech, lay, chain, X, masks, modes, rows, ks)
+        done = {(r, k) for r, k, _, _ in out}  # the rest (none expected) by the count
+        rest = np.array([(r, k) not in done for r, k in zip(rows, ks, strict=True)])
+        rows, ks = rows[rest], ks[rest]
+        if rows.size == 0:
+            return out
     x0, x1 = X[ks], X[ks + 1]
 
     def count(t: Array) -> NDArray[np.intp]:
@@ -356,7 +362,6 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         lo = np.where(same, mid, lo)
         hi = np.where(same, hi, mid)
     at = x0 + (0.5 * (lo + hi))[:, None] * (x1 - x0)
-    out = []
     for r, k, x in zip(rows, ks, at, strict=True):
         what = "dies" if masks[r, k] else "is born"
         out.append((int(r), int(k), x, f"{what} at {input_text(mech, lay, x)}: the loop folds "
@@ -368,7 +373,9 @@ def _quartic_folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array
                    masks: NDArray[np.bool_], modes: list[int], rows: NDArray[np.intp],
                    ks: NDArray[np.intp]) -> list[tuple[int, int, Array, str]]:
     """:func:`_folds` for a loop of the RSRC quartic: each mode's fold where its own root
-    stops assembling, over the rows the loop was solved on (the approach, then ``X``)."""
+    stops assembling, over the rows the loop was solved on (the approach, then ``X``); a
+    change of a mode's samples where its root does not change (none expected: the modes are
+    these roots) is left out, for the caller's count."""
     from screwkit.kinematics.graph.motion import input_text
     from screwkit.kinematics.graph.quartic_folds import quartic_folds
 
@@ -379,7 +386,9 @@ def _quartic_folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array
     out = []
     for r, k in zip(rows, ks, strict=True):
         dies = bool(masks[r, k])
-        f = found[(modes[r], int(k), dies)]
+        f = found.get((modes[r], int(k), dies))
+        if f is None:
+            continue
         x = X[k] + f.t * (X[k + 1] - X[k])
         meet = (f"loop modes {min(f.mode, f.partner)} and {max(f.mode, f.partner)} meet"
                 if f.partner is not None else

@@ -285,10 +285,11 @@ def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: li
             return real_count(st.chain, st.chain.loop_inputs(x)).reshape(ts.shape)
 
         own = _own_folds(lay, st, X, a, combos[i[sel], d], k[sel], ka[sel] == k[sel])
-        if own is None:
-            t, _ = _bisect(sel.size, count)
-        else:
-            t, partner[sel] = own
+        t = np.full(sel.size, np.nan) if own is None else own[0]
+        if np.isnan(t).any():  # where no loop mode's own fold is found: the count's
+            t = np.where(np.isnan(t), _bisect(sel.size, count)[0], t)
+        if own is not None:
+            partner[sel] = own[1]
         xb[sel] = xa[sel] + t[:, None] * (xb[sel] - xa[sel])
     t, failing = _first_failure(mech, lay, dec, loops, xa, xb, combos[i], a + ka)
     named = np.where(failing >= 0, failing, folding)
@@ -312,7 +313,8 @@ def _own_folds(lay: GraphLayout, st: LoopStage, X: Array, a: int, modes: Array,
     """For a loop of the RSRC quartic (None for any other), where each of its ``modes`` (T,)
     stops assembling between samples ``ks`` and ``ks`` + 1, from the sample where it assembles
     (that at ``ks`` where it ``dies``), as the fraction of the step from there, and the loop
-    mode that meets it (−1: none on a sample): its own root followed (graph/quartic_folds.py),
+    mode that meets it (−1: none on a sample; NaN and −1 where the loop mode's root does not
+    change there, none expected): its own root followed (graph/quartic_folds.py),
     over the rows the stage was solved on (:func:`stage_modes`: the approach, ``X``, the
     drawing)."""
     from screwkit.kinematics.graph.quartic_folds import quartic_folds
@@ -323,10 +325,10 @@ def _own_folds(lay: GraphLayout, st: LoopStage, X: Array, a: int, modes: Array,
     x = np.append(np.vstack([approach(lay, X), X])[:, _column(lay, st)], 0.0)
     found = {(f.mode, f.k, f.dies): f for f in
              quartic_folds(st.chain, st.chain.loop_inputs(x[:, None]))}
-    folds = [found[(int(m), a + int(kk), bool(dd))] for m, kk, dd in
+    folds = [found.get((int(m), a + int(kk), bool(dd))) for m, kk, dd in
              zip(modes, ks, dies, strict=True)]
-    t = np.array([f.t if f.dies else 1.0 - f.t for f in folds])
-    return t, np.array([-1 if f.partner is None else f.partner for f in folds])
+    t = np.array([np.nan if f is None else f.t if f.dies else 1.0 - f.t for f in folds])
+    return t, np.array([-1 if f is None or f.partner is None else f.partner for f in folds])
 
 
 def _first_failure(mech: Mechanism, lay: GraphLayout, dec: Decomposition,
