@@ -158,8 +158,11 @@ def test_every_mode_closes_and_the_folds_are_named(
     births = sum(e.startswith(("dies", "is born")) for md in motion.modes for e in md.events)
     if mech.name.endswith("loop folding leg"):  # the loop's folds and the leg's
         assert len(motion.modes) == 5 and births >= 4
-        assert any("the RSRC loop input–sphere–coupler_R–output_C folds (two of its assembly "
-                   "modes meet)" in e for md in motion.modes for e in md.events)
+        # the loop's two modes that fold (its modes 1 and 2; 0 and 3 are whole) named
+        assert any("the RSRC loop input–sphere–coupler_R–output_C folds (its modes 1 and 2 "
+                   "meet)" in e for md in motion.modes for e in md.events)
+        # loop mode 2 meets mode 1 alone: not the drawn loop mode's leg branches born nearby
+        assert motion.notes[1].endswith("{0, 1, 4}, {2, 3}")
     elif mech.name.endswith("folding leg"):
         assert births >= 4 and len(motion.modes) == 5
         assert "the drawn branches again" in motion.modes[-1].label

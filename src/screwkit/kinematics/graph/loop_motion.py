@@ -11,8 +11,11 @@ offers its closed form's branches, only the drawn branch's positions are built
 (:func:`drawn_branch`: the same numbers). :func:`loop_motion` builds the rest of each
 mode as for every graph (graph/motion.py's ``build_mode``: rates and accelerations from the
 stacked screw Jacobian, points, outputs, singularities) and locates where modes are born and
-die: at a fold of the loop, where the count of its real closed-form solutions changes by two,
-found by bisection between the samples around it (as graph/closed_modes.py's ``fold_inputs``).
+die: at a fold of the loop, found between the samples around it where that mode's own root
+stops assembling for a loop of the RSRC quartic (graph/quartic_folds.py: two pairs of its four
+modes may fold inside one step; the mode that meets it is named), else by bisection where the
+count of its real closed-form solutions changes by two (as graph/closed_modes.py's
+``fold_inputs``).
 """
 
 from __future__ import annotations
@@ -271,11 +274,14 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
                             "assembling before it")
     order = [d] + ([m for m in range(len(lm.confs)) if m != d and lm.assembles[m].any()]
                    if every else [])
-    cut = step_pieces(mech, lay, X, lm.assembles[order], every)
+    of_row = [d if m == lm.again else m for m in order]
+    cut = step_pieces(mech, lay, X, lm.assembles[order], every, chain, of_row)
     masks = cut.masks
     order = [order[r] for r in cut.rows]
-    folds = [(cut.piece(r, k, bool(cut.source[r, k])), k, x, text)
-             for r, k, x, text in _folds(mech, lay, chain, X, cut.source)]
+    # a fold of a piece dropped (the drawn mode's after its first fold, with the drawn mode
+    # alone) is not reported
+    folds = [(i, k, x, text) for r, k, x, text in _folds(mech, lay, chain, X, cut.source, of_row)
+             if (i := cut.piece(r, k, bool(cut.source[r, k]))) is not None]
     # in input order: a fold between samples k and k+1 at k + ½, one inside a step at k + t
     at = [k + 0.5 for _, k, _, _ in folds] + [p for p, _ in cut.events]
     folds += [f for _, f in cut.events]
@@ -293,7 +299,7 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
                 events.insert(0, f"stops assembling after input "
                                  f"{input_text(mech, lay, X[stop - 1])} (a limit position or "
                                  f"dead centre before {input_text(mech, lay, X[stop])})")
-        label = ("drawn" if row == 0 else "one of the loop's two modes" if row in cut.islands
+        label = ("drawn" if row == 0 else cut.island_name if row in cut.islands
                  else f"loop mode {d} (the drawn branches again, after the drawn mode's fold)"
                  if m == lm.again else f"loop mode {m}") + cut.labels[row]
         modes.append(replace(with_events(md, [*events, *md.events]), label=label,
@@ -317,13 +323,16 @@ def loop_motion(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array, X
 
 
 def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
-           masks: NDArray[np.bool_]) -> list[tuple[int, int, Array, str]]:
-    """Every birth and death of the modes ``masks`` (M, N) between two samples, as (row,
-    sample before it, input rows at the fold, event text): located by bisection on the
-    segment X[k] → X[k+1] (all at once) where the loop's count of real solutions (its closed
-    form's assembling modes at one input) leaves its value at X[k]."""
+           masks: NDArray[np.bool_], modes: list[int]) -> list[tuple[int, int, Array, str]]:
+    """Every birth and death of the modes ``masks`` (M, N; row r the loop's mode
+    ``modes[r]``) between two samples, as (row, sample before it, input rows at the fold,
+    event text): for a loop of the RSRC quartic, where that mode's own root stops assembling
+    (graph/quartic_folds.py: two pairs of modes may fold inside one step), the mode that meets
+    it there named; else located by bisection on the segment X[k] → X[k+1] (all at once)
+    where the loop's count of real solutions (its closed form's assembling modes at one input)
+    leaves its value at X[k]."""
     from screwkit.kinematics.graph.motion import input_text
-    from screwkit.kinematics.registry import family_of
+    from screwkit.kinematics.registry import family_of, has_rsrc_quartic
 
     rows, ks = np.nonzero(masks[:, :-1] != masks[:, 1:])
     closed = family_of(chain.linkage).closed_form_for(chain.linkage)
@@ -331,6 +340,14 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         return [(int(r), int(k), X[k + 1], f"{'dies' if masks[r, k] else 'is born'} between "
                  f"{input_text(mech, lay, X[k])} and {input_text(mech, lay, X[k + 1])}")
                 for r, k in zip(rows, ks, strict=True)]
+    out: list[tuple[int, int, Array, str]] = []
+    if has_rsrc_quartic(chain.linkage):
+        out = _quartic_folds(mech, lay, chain, X, masks, modes, rows, ks)
+        done = {(r, k) for r, k, _, _ in out}  # the rest (none expected) by the count
+        rest = np.array([(r, k) not in done for r, k in zip(rows, ks, strict=True)])
+        rows, ks = rows[rest], ks[rest]
+        if rows.size == 0:
+            return out
     x0, x1 = X[ks], X[ks + 1]
 
     def count(t: Array) -> NDArray[np.intp]:
@@ -345,11 +362,39 @@ def _folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
         lo = np.where(same, mid, lo)
         hi = np.where(same, hi, mid)
     at = x0 + (0.5 * (lo + hi))[:, None] * (x1 - x0)
-    out = []
     for r, k, x in zip(rows, ks, at, strict=True):
         what = "dies" if masks[r, k] else "is born"
         out.append((int(r), int(k), x, f"{what} at {input_text(mech, lay, x)}: the loop folds "
                                        "(two of its assembly modes meet)"))
+    return out
+
+
+def _quartic_folds(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array,
+                   masks: NDArray[np.bool_], modes: list[int], rows: NDArray[np.intp],
+                   ks: NDArray[np.intp]) -> list[tuple[int, int, Array, str]]:
+    """:func:`_folds` for a loop of the RSRC quartic: each mode's fold where its own root
+    stops assembling, over the rows the loop was solved on (the approach, then ``X``); a
+    change of a mode's samples where its root does not change (none expected: the modes are
+    these roots) is left out, for the caller's count."""
+    from screwkit.kinematics.graph.motion import input_text
+    from screwkit.kinematics.graph.quartic_folds import quartic_folds
+
+    A = approach(lay, X)
+    a = A.shape[0]
+    found = {(f.mode, f.k - a, f.dies): f for f in
+             quartic_folds(chain, chain.loop_inputs(np.vstack([A, X])))}
+    out = []
+    for r, k in zip(rows, ks, strict=True):
+        dies = bool(masks[r, k])
+        f = found.get((modes[r], int(k), dies))
+        if f is None:
+            continue
+        x = X[k] + f.t * (X[k + 1] - X[k])
+        meet = (f"loop modes {min(f.mode, f.partner)} and {max(f.mode, f.partner)} meet"
+                if f.partner is not None else
+                f"loop mode {f.mode} meets a root that assembles at neither sample")
+        out.append((int(r), int(k), x, f"{'dies' if dies else 'is born'} at "
+                                       f"{input_text(mech, lay, x)}: the loop folds ({meet})"))
     return out
 
 
@@ -391,32 +436,41 @@ class StepPieces:
     labels: list[str]
     events: list[tuple[float, tuple[int, int, Array, str]]]
     islands: frozenset[int] = frozenset()
+    island_name: str = "one of the loop's two modes"
 
-    def piece(self, row: int, k: int, dies: bool) -> int:
-        """The piece of mode ``row`` that dies after sample k (``dies``) or is born before k+1."""
+    def piece(self, row: int, k: int, dies: bool) -> int | None:
+        """The piece of mode ``row`` that dies after sample k (``dies``) or is born before k+1
+        (None: that piece is not kept)."""
         n = k if dies else k + 1
-        return next(i for i, (r, m) in enumerate(zip(self.rows, self.masks, strict=True))
-                    if r == row and m[n])
+        return next((i for i, (r, m) in enumerate(zip(self.rows, self.masks, strict=True))
+                     if r == row and m[n]), None)
 
 
 def step_pieces(mech: Mechanism, lay: GraphLayout, X: Array, masks: NDArray[np.bool_],
-                every: bool) -> StepPieces:
-    """The modes ``masks`` (M, N) of a loop that is one two-branch dyad or leg on its driven
-    joint (graph/subchains.py: its two loop modes are that sub-chain's two branches, and they
-    fold together), cut where the sub-chain's discriminant dips below zero inside one step, and
-    with ``every`` its islands inside one step as modes on no sample (graph/step_folds.py; the
-    drawn mode, row 0, ends at its first fold); any other loop's modes as they are."""
+                every: bool, chain: LoopChain, modes: list[int]) -> StepPieces:
+    """The modes ``masks`` (M, N; row r the loop's mode ``modes[r]``) of a loop that is one
+    two-branch dyad or leg on its driven joint (graph/subchains.py: its two loop modes are that
+    sub-chain's two branches, and they fold together), cut where the sub-chain's discriminant
+    dips below zero inside one step, and with ``every`` its islands inside one step as modes on
+    no sample (graph/step_folds.py; the drawn mode, row 0, ends at its first fold); a loop of
+    the RSRC quartic from its quartic's discriminant (graph/quartic_steps.py); any other loop's
+    modes as they are."""
     from screwkit.kinematics.graph.closed_modes import ISLAND, SAME_AGAIN, drawn_combination
     from screwkit.kinematics.graph.dyads import place
     from screwkit.kinematics.graph.motion import input_text
     from screwkit.kinematics.graph.step_folds import hidden_pairs
     from screwkit.kinematics.graph.subchains import decompose
+    from screwkit.kinematics.registry import has_rsrc_quartic
 
     M, N = masks.shape
     rows, pieces, labels = list(range(M)), list(masks), [""] * M
     dec = decompose(mech)
     if N < 2 or not dec.complete or dec.loops or len(dec.dyads) != 1 or \
             dec.dyads[0].branches != 2:
+        if N > 1 and has_rsrc_quartic(chain.linkage):
+            from screwkit.kinematics.graph.quartic_steps import quartic_pieces
+
+            return quartic_pieces(mech, lay, chain, X, masks, modes, every)
         return StepPieces(masks, rows, masks, labels, [])
     # the two branches share the discriminant (they fold together): the drawing's alone, over
     # the drawn mode's samples unless every mode is asked for

@@ -14,9 +14,10 @@ drawing and whose dyad branches are the drawing's, followed from the drawing unt
 stops assembling (its later runs, where it assembles again, are a mode of their own, as in
 graph/closed_modes.py).
 
-A mode is born or dies between two samples where one of its stages folds: the loop (its count
-of real closed-form solutions changes, graph/loop_motion.py's ``real_count``) or a dyad or leg
-(its discriminant crosses zero). Either is located by bisection of the input segment between
+A mode is born or dies between two samples where one of its stages folds: the loop (for the
+RSRC quartic where its loop mode's own root stops assembling, graph/quartic_folds.py, the loop
+mode that meets it named; else where its count of real closed-form solutions changes,
+graph/loop_motion.py's ``real_count``) or a dyad or leg (its discriminant crosses zero). Either is located by bisection of the input segment between
 the samples; for a dyad's fold the loop is carried along the segment on its branch (at each
 bisection point, the loop mode nearest the one at the bisection's last point). Rates and
 accelerations come from the stacked closure Jacobian (graph/motion.py's ``build_mode``).
@@ -249,12 +250,14 @@ def _bisect(T: int, assembles: Callable[[Array], NDArray[Any]],
 
 def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: list[StageModes],
                 X: Array, a: int, combos: Array, held: NDArray[np.bool_], disc: Array
-                ) -> tuple[list[list[str]], list[tuple[int, int, int]]]:
+                ) -> tuple[list[list[str]], list[tuple[int, int, int, int]]]:
     """Each mode's births and deaths (modes: rows of ``combos`` (M', S), held at ``held``
     (M', N); ``disc`` (M', a + N, S) their stages' discriminants over the solved rows, the
     approach's ``a`` first), each located between its two samples, and every fold as (mode,
-    folding stage, sample k before it). Where a loop stage does not assemble at the far
-    sample, its fold (where its count of real solutions changes) bounds the search; the mode's
+    folding stage, sample k before it, the loop mode meeting it or −1). Where a loop stage does
+    not assemble at the far sample, its fold bounds the search: for a loop of the RSRC quartic
+    where its own mode's root stops assembling (:func:`_own_folds`: two pairs of its modes may
+    fold inside one step), else where its count of real solutions changes; the mode's
     own end is then the first place, from the sample where it assembles, where any of its
     stages stops assembling (a leg on a loop mode just born may assemble only later)."""
     from screwkit.kinematics.graph.motion import input_text
@@ -268,6 +271,7 @@ def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: li
     folding = np.argmax(~(disc[i, a + kb] >= 0.0), axis=1)  # the first stage that fails
     stages = dec.stages
     xa, xb = X[ka], X[kb].copy()
+    partner = np.full(k.size, -1)
     for d, st in enumerate(stages):
         sel = np.flatnonzero(folding == d)
         if sel.size == 0 or not isinstance(st, LoopStage):
@@ -280,19 +284,51 @@ def fold_events(mech: Mechanism, lay: GraphLayout, dec: Decomposition, loops: li
             x = (s0[:, None] + ts * (s1 - s0)[:, None]).reshape(-1, 1)
             return real_count(st.chain, st.chain.loop_inputs(x)).reshape(ts.shape)
 
-        t, _ = _bisect(sel.size, count)
+        own = _own_folds(lay, st, X, a, combos[i[sel], d], k[sel], ka[sel] == k[sel])
+        t = np.full(sel.size, np.nan) if own is None else own[0]
+        if np.isnan(t).any():  # where no loop mode's own fold is found: the count's
+            t = np.where(np.isnan(t), _bisect(sel.size, count)[0], t)
+        if own is not None:
+            partner[sel] = own[1]
         xb[sel] = xa[sel] + t[:, None] * (xb[sel] - xa[sel])
     t, failing = _first_failure(mech, lay, dec, loops, xa, xb, combos[i], a + ka)
     named = np.where(failing >= 0, failing, folding)
+    partner = np.where(named == folding, partner, -1)
     at = xa + t[:, None] * (xb - xa)
-    for m, kk, x, d in zip(i, k, at, named, strict=True):
+    for m, kk, x, d, p in zip(i, k, at, named, partner, strict=True):
         st = stages[int(d)]
         what = "dies" if held[m, kk] else "is born"
-        how = ("two of its assembly modes meet" if isinstance(st, LoopStage)
-               else "its two branches meet")
+        how = ("its two branches meet" if not isinstance(st, LoopStage) else
+               "two of its assembly modes meet" if p < 0 else
+               f"its modes {min(p, int(combos[m, d]))} and {max(p, int(combos[m, d]))} meet")
         events[int(m)].append(f"{what} at {input_text(mech, lay, x)}: the {st.kind} {st.word} "
                               f"{stage_names(mech, st)} folds ({how})")
-    return events, [(int(m), int(d), int(kk)) for m, d, kk in zip(i, named, k, strict=True)]
+    return events, [(int(m), int(d), int(kk), int(p))
+                    for m, d, kk, p in zip(i, named, k, partner, strict=True)]
+
+
+def _own_folds(lay: GraphLayout, st: LoopStage, X: Array, a: int, modes: Array,
+               ks: NDArray[np.intp], dies: NDArray[np.bool_]
+               ) -> tuple[Array, NDArray[np.intp]] | None:
+    """For a loop of the RSRC quartic (None for any other), where each of its ``modes`` (T,)
+    stops assembling between samples ``ks`` and ``ks`` + 1, from the sample where it assembles
+    (that at ``ks`` where it ``dies``), as the fraction of the step from there, and the loop
+    mode that meets it (−1: none on a sample; NaN and −1 where the loop mode's root does not
+    change there, none expected): its own root followed (graph/quartic_folds.py),
+    over the rows the stage was solved on (:func:`stage_modes`: the approach, ``X``, the
+    drawing)."""
+    from screwkit.kinematics.graph.quartic_folds import quartic_folds
+    from screwkit.kinematics.registry import has_rsrc_quartic
+
+    if not has_rsrc_quartic(st.chain.linkage):
+        return None
+    x = np.append(np.vstack([approach(lay, X), X])[:, _column(lay, st)], 0.0)
+    found = {(f.mode, f.k, f.dies): f for f in
+             quartic_folds(st.chain, st.chain.loop_inputs(x[:, None]))}
+    folds = [found.get((int(m), a + int(kk), bool(dd))) for m, kk, dd in
+             zip(modes, ks, dies, strict=True)]
+    t = np.array([np.nan if f is None else f.t if f.dies else 1.0 - f.t for f in folds])
+    return t, np.array([-1 if f is None or f.partner is None else f.partner for f in folds])
 
 
 def _first_failure(mech: Mechanism, lay: GraphLayout, dec: Decomposition,
@@ -338,16 +374,18 @@ def _first_failure(mech: Mechanism, lay: GraphLayout, dec: Decomposition,
     return t, failing
 
 
-def _circuits(combos: Array, held: NDArray[np.bool_], joins: list[tuple[int, int, int]]
-              ) -> list[tuple[int, int]]:
+def _circuits(combos: Array, held: NDArray[np.bool_],
+              joins: list[tuple[int, int, int, int]]) -> list[tuple[int, int]]:
     """Pairs of modes that meet at a fold: at a fold of stage d between samples k and k+1, a
-    mode meets a mode whose branches differ in d alone and that is born or dies there."""
+    mode meets a mode whose branches differ in d alone and that is born or dies there (at a
+    loop's fold whose partner mode is known, ≥ 0, the one on that loop mode)."""
     turns = held[:, :-1] != held[:, 1:]
     pairs = []
-    for m, d, k in joins:
+    for m, d, k, partner in joins:
         others = np.delete(np.arange(combos.shape[1]), d)
         match = np.flatnonzero(np.all(combos[:, others] == combos[m, others], axis=1)
-                               & (combos[:, d] != combos[m, d]) & turns[:, k])
+                               & (combos[:, d] != combos[m, d]) & turns[:, k]
+                               & ((combos[:, d] == partner) | (partner < 0)))
         if match.size:
             pairs.append((int(match[0]), m))
     return pairs

@@ -65,6 +65,7 @@ __all__ = [
     "BLOCK_SIZE",
     "RSRCPositions",
     "rsrc_positions",
+    "quartic_discriminant",
     "solve_positions",
 ]
 
@@ -128,10 +129,11 @@ def _clip_unit(x: FloatArray, tol: float) -> tuple[FloatArray, BoolArray]:
     return np.clip(x, -1.0, 1.0), inside
 
 
-def _output_angles_general(
-    dims: RSRCDimensions, m0: FloatArray, n0: FloatArray, tol: float
-) -> FloatArray:
-    """phi0 roots (n, 4) of the input-output equation (3.62) through the quartic (3.63)."""
+def _trig_coefficients(
+    dims: RSRCDimensions, m0: FloatArray, n0: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """(a0, a1, b1, a2, b2) of the input-output equation (3.62), F1 sin² + F2 sin cos + F3 cos
+    + F4 sin − K = 0, as a0 + a1 cos φ0 + b1 sin φ0 + a2 cos 2φ0 + b2 sin 2φ0 = 0."""
     sd, cd = math.sin(dims.delta0), math.cos(dims.delta0)
     c2, s2 = cd * cd, sd * sd
     f1 = s2 * (n0 * n0 - m0 * m0)
@@ -139,11 +141,38 @@ def _output_angles_general(
     f3 = 2.0 * (dims.d3 * c2 * n0 + dims.e * sd * m0)
     f4 = 2.0 * (dims.d3 * c2 * m0 - dims.e * sd * n0)
     k = c2 * (dims.d2**2 - dims.d3**2 - n0 * n0) - m0 * m0 - dims.e**2 * s2
-    # F1 s^2 + F2 s c + F3 c + F4 s - K as a0 + a1 cos + b1 sin + a2 cos 2phi + b2 sin 2phi
-    phi, _ = real_roots_of_trig_quadratic(
-        0.5 * f1 - k, f3, f4, -0.5 * f1, 0.5 * f2, double_root_tol=tol
-    )
+    return 0.5 * f1 - k, f3, f4, -0.5 * f1, 0.5 * f2
+
+
+def _output_angles_general(
+    dims: RSRCDimensions, m0: FloatArray, n0: FloatArray, tol: float
+) -> FloatArray:
+    """phi0 roots (n, 4) of the input-output equation (3.62) through the quartic (3.63)."""
+    phi, _ = real_roots_of_trig_quadratic(*_trig_coefficients(dims, m0, n0),
+                                          double_root_tol=tol)
     return phi
+
+
+def quartic_discriminant(dims: RSRCDimensions, theta0: ArrayLike) -> FloatArray:
+    """The discriminant of the quartic (3.63) in tan(φ0/2) at each input angle (N,), divided
+    by the sixth power of the norm of the trigonometric coefficients of (3.62) (a positive
+    factor: the sign is the discriminant's, the value smooth in θ0): positive where four or
+    no roots are real, negative where two are, zero at a fold (a double root). The general
+    case only (δ0 neither a multiple of π/2): the others are quadratics."""
+    theta = check_input_angles(theta0)
+    arrays = RSRCDimensionArrays.from_dimensions(dims)
+    m0, n0 = input_terms(arrays, np.sin(theta), np.cos(theta))
+    a0, a1, b1, a2, b2 = _trig_coefficients(dims, m0, n0)
+    scale = np.sqrt(a0 * a0 + a1 * a1 + b1 * b1 + a2 * a2 + b2 * b2)
+    a0, a1, b1, a2, b2 = (x / scale for x in (a0, a1, b1, a2, b2))
+    # times (1 + t²)² with t = tan(φ0/2): a t⁴ + b t³ + c t² + d t + e
+    a, b, c = a0 - a1 + a2, 2.0 * b1 - 4.0 * b2, 2.0 * a0 - 6.0 * a2
+    d, e = 2.0 * b1 + 4.0 * b2, a0 + a1 + a2
+    # (4 Δ0³ − Δ1²) / 27 with the invariants Δ0 = c² − 3bd + 12ae and
+    # Δ1 = 2c³ − 9bcd + 27b²e + 27ad² − 72ace
+    i0 = c * c - 3.0 * b * d + 12.0 * a * e
+    i1 = c * (2.0 * c * c - 9.0 * b * d - 72.0 * a * e) + 27.0 * (b * b * e + a * d * d)
+    return np.asarray((4.0 * i0 * i0 * i0 - i1 * i1) / 27.0, dtype=np.float64)
 
 
 def _output_angles_special(

@@ -1,0 +1,232 @@
+"""Folds of a four-mode loop (the RSRC quartic) attributed to the two modes that meet there
+(graph/quartic_folds.py; issue 27: "births and deaths at folds are reported"): two different
+pairs of modes born inside one sample step are each placed at their own fold, checked against
+the quartic's discriminant located by a scalar root finder and against a fine-grid tracking of
+each mode's root, both written here from Bagci 1969 eqs. 3.58/3.59."""
+
+from __future__ import annotations
+
+import re
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import screwkit as sk
+from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions
+from screwkit.kinematics.closed_forms.rsrc.positions import quartic_discriminant, rsrc_positions
+from screwkit.kinematics.graph import solve_mechanism
+from screwkit.kinematics.graph.from_loop import mechanism_from_loop
+from screwkit.kinematics.graph.loop_subchain import loop_chain
+from screwkit.kinematics.graph.quartic_folds import quartic_folds
+from screwkit.kinematics.graph.subchains import decompose
+from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
+
+#: an RSRC (seeded random dimensions of the family's property tests, rounded) whose modes 0, 1
+#: are born at θ0 ≈ 53.85° and modes 2, 3 at ≈ 57.59°: both inside the 5° step 53.5° → 58.5°
+P = dict(d1=1.407, d2=2.402, d3=0.566, a=1.617, b=-0.256, e=-0.046, delta0=-1.117, lambda0=-0.832)
+#: drawn at 58.5° (where every mode assembles), a turn in 5° steps: the last step holds both
+X = np.radians(np.arange(58.5, 58.5 + 361.0, 5.0))
+
+
+def _closure(phi: np.ndarray, theta: float, P: dict[str, float] = P) -> np.ndarray:
+    """W1² + (W2 / cos δ0)² − d2² (Bagci eqs. 3.58/3.59: W1 = d2 cos χ0, W2 = d2 cos δ0 sin
+    χ0), zero where the loop closes at output angle φ0 and input θ0."""
+    m0 = P["b"] * np.sin(P["lambda0"]) - P["d1"] * np.cos(P["lambda0"]) * np.sin(theta)
+    n0 = P["a"] - P["d1"] * np.cos(theta)
+    w1 = m0 * np.sin(phi) + n0 * np.cos(phi) + P["d3"]
+    w2 = n0 * np.sin(phi) - m0 * np.cos(phi) - P["e"] * np.sin(P["delta0"])
+    return w1 * w1 + (w2 / np.cos(P["delta0"])) ** 2 - P["d2"] ** 2
+
+
+def _quartic(theta: float, P: dict[str, float] = P) -> np.ndarray:
+    """The closure times (1 + τ²)² as a quartic in τ = tan(φ0/2): interpolated at 5 points."""
+    tau = np.array([-2.0, -1.0, 0.0, 1.0, 2.0])
+    return np.polyfit(tau, _closure(2 * np.arctan(tau), theta, P) * (1 + tau * tau) ** 2, 4)
+
+
+def _discriminant(theta: float, P: dict[str, float] = P) -> float:
+    """The quartic's discriminant up to a positive factor: ∏ (τi − τj)² over its roots."""
+    r = np.roots(_quartic(theta, P))
+    return float(np.real(np.prod([(r[i] - r[j]) ** 2 for i in range(4) for j in range(i)])))
+
+
+def _real_roots(theta: float, P: dict[str, float]) -> np.ndarray:
+    r = np.roots(_quartic(theta, P))
+    return np.sort(2 * np.arctan(np.real(r[np.abs(np.imag(r)) < 1e-9])))
+
+
+def _track(phi: float, start: float, end: float, folds: list[float],
+           P: dict[str, float] = P) -> float | None:
+    """Follow the root at φ0 = ``phi`` from θ0 = ``start`` towards ``end`` on a grid of 1e-4
+    rad, the nearest root each step; where the count of real roots drops and this root is one
+    of the two closest roots just before (the pair that turns complex), the fold of ``folds``
+    inside that grid step (None: it reaches ``end``)."""
+    grid = np.linspace(start, end, int(np.ceil(abs(end - start) / 1e-4)) + 1)
+    for t0, t1 in zip(grid, grid[1:], strict=False):
+        now, nxt = _real_roots(t0, P), _real_roots(t1, P)
+        phi = float(now[np.argmin(np.abs(np.angle(np.exp(1j * (now - phi)))))])
+        if nxt.size < now.size:
+            d = np.abs(np.angle(np.exp(1j * (now[:, None] - now[None, :])))) + np.eye(now.size) * 9
+            i, j = np.unravel_index(np.argmin(d), d.shape)
+            if phi in (now[i], now[j]):
+                return next(f for f in folds if min(t0, t1) <= f <= max(t0, t1))
+    return None
+
+
+def _zeros(lo: float, hi: float, P: dict[str, float] = P) -> list[float]:
+    """The discriminant's zeros on [lo, hi] (sign changes on a fine grid, brentq)."""
+    grid = np.linspace(lo, hi, 2001)
+    D = np.array([_discriminant(t, P) for t in grid])
+    change = np.flatnonzero(np.sign(D[:-1]) != np.sign(D[1:]))
+    return [brentq(_discriminant, grid[i], grid[i + 1], args=(P,), xtol=1e-15) for i in change]
+
+
+def _folds_in_last_step() -> list[float]:
+    return _zeros(X[-2], X[-1])
+
+
+def _births(events: list[str], after: float, meet: str) -> dict[tuple[int, int], float]:
+    """The births after ``after`` (deg) in ``events``: (the two modes that meet) → input."""
+    out = {}
+    for ev in events:
+        hit = re.search(r"is born at .*input.theta = ([\d.]+) deg: .*folds \(" + meet +
+                        r" (\d) and (\d) meet\)", ev)
+        if hit and float(hit[1]) > after:
+            out[(int(hit[2]), int(hit[3]))] = float(hit[1])
+    return out
+
+
+def test_two_pairs_born_inside_one_step_are_each_placed_at_their_own_fold() -> None:
+    lk = sk.rsrc(**P)
+    motion = sk.solve_motion(lk, X)
+    k = X.size - 2  # the last step, 413.5° → 418.5° (53.5° → 58.5° a turn on)
+    assert all(not md.assembles[k] and md.assembles[k + 1] for md in motion.modes)
+    # the independent folds: the discriminant's zeros inside the step (fine grid, then brentq)
+    folds = _folds_in_last_step()
+    assert len(folds) == 2 and folds[1] - folds[0] > np.radians(3.0)
+    # which fold each mode's root is born at, by tracking it down from the sample after
+    own = {m: _track(float(md.variables["phi0"][k + 1]), X[k + 1], X[k], folds)
+           for m, md in enumerate(motion.modes)}
+    assert own == {0: folds[0], 1: folds[0], 2: folds[1], 3: folds[1]}
+    mech = mechanism_from_loop(motion, 0, 0)
+    chain = loop_chain(mech)
+    assert chain is not None
+    found = {f.mode: f for f in quartic_folds(chain, chain.loop_inputs(X[:, None] - X[0]))
+             if f.k == k}
+    assert sorted(found) == [0, 1, 2, 3]
+    for m, f in found.items():
+        assert not f.dies
+        assert abs(X[k] + f.t * (X[k + 1] - X[k]) - own[m]) < 1e-9, m  # rad
+    assert {m: found[m].partner for m in found} == {0: 1, 1: 0, 2: 3, 3: 2}
+    # the graph's modes report it: each born at its own fold, the partner named
+    g = solve_mechanism(mech, X - X[0], every_mode=True)
+    births = _births([e for md in g.modes for e in md.events], np.degrees(X[k] - X[0]),
+                     "loop modes")
+    assert births.keys() == {(0, 1), (2, 3)}
+    assert abs(births[(0, 1)] - np.degrees(folds[0] - X[0])) < 1e-3  # printed to 6 digits
+    assert abs(births[(2, 3)] - np.degrees(folds[1] - X[0])) < 1e-3
+
+
+def test_a_loop_stage_places_each_pair_at_its_own_fold() -> None:
+    """The same RSRC as a loop stage (graph/loop_stage.py), hung on a thigh that a hip joint
+    turns (held still here): its modes are born at the same two folds, each pair at its own."""
+    motion = sk.solve_motion(sk.rsrc(**P), X)
+    loop = mechanism_from_loop(motion, 0, 0)
+    on_thigh = tuple(replace(j, bodies=tuple("thigh" if b == "ground" else b for b in j.bodies))
+                     for j in loop.joints)
+    hip = MechanismJoint("hip", "R", ("ground", "thigh"), np.array([0.5, -2.0, 1.0]),
+                         np.array([0.2, 0.3, 1.0]))
+    mech = Mechanism("knee", (Body("thigh"), *loop.bodies), (hip, *on_thigh),
+                     ("hip.theta", f"{loop.joints[0].name}.theta"))
+    assert decompose(mech).loops[0].kind == "RSRC"
+    g = solve_mechanism(mech, np.stack([np.zeros(X.size), X - X[0]], axis=1), every_mode=True)
+    assert g.method == "graph (closed forms)"
+    folds = _folds_in_last_step()
+    births = _births([e for md in g.modes for e in md.events], np.degrees(X[-2] - X[0]),
+                     "its modes")
+    assert births.keys() == {(0, 1), (2, 3)}
+    assert abs(births[(0, 1)] - np.degrees(folds[0] - X[0])) < 1e-3
+    assert abs(births[(2, 3)] - np.degrees(folds[1] - X[0])) < 1e-3
+
+
+#: an RSRC (seeded random dimensions, rounded) with four modes, two of which (all that assemble
+#: there) have a 3.7° gap at θ0 ≈ 337.19°–340.89°, and a pair born at ≈ 15.94° whose roots die with
+#: different partners at ≈ 22.56° (one of them on no sample of a 10° sweep)
+Q = dict(d1=2.093, d2=2.189, d3=1.232, a=1.986, b=-0.759, e=0.529, delta0=1.320, lambda0=0.795)
+#: drawn at 4°, 10° steps: the steps 334° → 344° and 14° → 24° each hide two folds
+XQ = np.radians(np.arange(4.0, 364.0, 10.0))
+
+
+def _loop_mode(label: str) -> int:
+    hit = re.match(r"loop mode (\d)", label)
+    return 0 if label == "drawn" else int(hit[1]) if hit else -1
+
+
+def _at(event: str) -> float:
+    return float(event.split(" deg")[0].split("= ")[-1])
+
+
+def test_two_folds_of_a_four_mode_loop_inside_one_step_cut_its_modes() -> None:
+    """The gap: the two loop modes whose roots vanish between the samples (by a fine-grid
+    tracking) each die at the first zero of the discriminant and come back as modes of their
+    own at the second; the island: the root on no sample is a mode born and dying at the two
+    zeros, and the drawn mode, which rsrc_motion's samples match across the step to a root
+    born inside it, dies at its own fold and its run after is a mode born at the other."""
+    lk = sk.rsrc(**Q)
+    motion = sk.solve_motion(lk, XQ)
+    mech = mechanism_from_loop(motion, 0, 0)
+    g = solve_mechanism(mech, XQ - XQ[0], every_mode=True)
+    deg = np.degrees(XQ - XQ[0])
+    for k in (1, 33):  # 14° → 24° and 334° → 344°
+        z = _zeros(XQ[k], XQ[k + 1], Q)
+        assert len(z) == 2, k
+        zg = np.degrees(np.array(z) - XQ[0])
+        counts = [_real_roots(t, Q).size for t in (XQ[k], 0.5 * (z[0] + z[1]), XQ[k + 1])]
+        inside = [e for md in g.modes for e in md.events if "two folds between the samples at "
+                  f"input.theta = {deg[k]:g} deg" in e]
+        assert inside and all(min(abs(_at(e) - zg)) < 1e-3 for e in inside), k
+        # every mode at sample k whose root dies inside the step, and every one at k+1 whose
+        # root is born inside it, is reported so at the discriminant's zero it meets
+        for m, md in enumerate(motion.modes):
+            for n, end, word in ((k, XQ[k + 1], "dies"), (k + 1, XQ[k], "is born")):
+                if not md.assembles[n]:
+                    continue
+                f = _track(float(md.variables["phi0"][n]), XQ[n], end, z, Q)
+                mine = [_at(e) for gm in g.modes if _loop_mode(gm.label) == m and
+                        gm.assembles[n] for e in gm.events if e.startswith(word) and e in inside]
+                if f is None:
+                    assert not mine, (k, m, word)
+                else:
+                    assert len(mine) == 1 and abs(mine[0] - np.degrees(f - XQ[0])) < 1e-3, \
+                        (k, m, word)
+        islands = [md for md in g.modes if "an island inside one sample step" in md.label
+                   and any(e in inside for e in md.events)]
+        if counts[1] > counts[0]:  # 14° → 24°: one root on no sample, born and dying there
+            assert counts == [2, 4, 2] and len(islands) == 1
+            assert not islands[0].assembles.any()
+            assert [_at(e) for e in islands[0].events] == pytest.approx(list(zg), abs=1e-3)
+        else:  # 334° → 344°: a gap of two modes, no island
+            assert counts == [2, 0, 2] and not islands
+    drawn = g.modes[0]
+    assert drawn.assembles.sum() == 2 and "the first of two folds" not in drawn.events[1]
+
+
+def test_the_discriminant_s_sign_is_the_count_and_its_zeros_are_the_folds() -> None:
+    """``quartic_discriminant`` (its invariants' form) against the real roots' count on a
+    0.1° grid (positive: four or none, negative: two) and against the zeros of the discriminant
+    built here from the roots of the closure's quartic (np.roots), by brentq, to 1e-10 rad."""
+    for dims in (P, Q):
+        d = RSRCDimensions(**dims)
+        th = np.radians(np.arange(0.0, 360.0, 0.1))
+        D = quartic_discriminant(d, th)
+        n = rsrc_positions(d, th).n_assemblies
+        assert np.all(np.where(D > 0, n % 4 == 0, n == 2))
+        change = np.flatnonzero(np.sign(D[:-1]) != np.sign(D[1:]))
+        assert change.size >= 4
+        for i in change:
+            mine = brentq(lambda t, d=d: float(quartic_discriminant(d, t)[0]), th[i], th[i + 1],
+                          xtol=1e-15)
+            ref = _zeros(th[i], th[i + 1], dims)
+            assert len(ref) == 1 and abs(mine - ref[0]) < 1e-10
