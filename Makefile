@@ -36,10 +36,12 @@ demo: $(STAMP)
 	done
 
 ## Lint, type-check and run the whole test suite (installs Debian's chromium if missing).
+## The suite runs on two processes (pytest-xdist); one BLAS/OpenMP thread each, so the two
+## do not oversubscribe the cores. A targeted `python -m pytest tests/...` stays serial.
 test: $(STAMP) $(CHROMIUM)
 	$(BIN)/ruff check src tests validation benchmarks
 	$(BIN)/mypy
-	$(BIN)/python -m pytest
+	OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 $(BIN)/python -m pytest -n 2
 
 ## Benchmarks (not tests): prints a table.
 bench: $(STAMP)

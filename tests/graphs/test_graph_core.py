@@ -4,10 +4,12 @@ geometry, where a mode stops assembling, the analyze document, several inputs by
 from __future__ import annotations
 
 import json
+import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+import tomli_w
 from typer.testing import CliRunner
 
 import screwkit as sk
@@ -189,12 +191,53 @@ def test_a_motion_over_the_time_limit_is_refused_up_front() -> None:
     assert time.perf_counter() - t < 5.0  # refused before any solving
 
 
+#: the 80-column test's samples: every THIN-th of an example's rows, THIN × its step
+THIN = 5
+
+
+def thinned(path: Path, folder: Path) -> Path:
+    """A copy of the example ``path`` in ``folder`` sampled THIN times more coarsely (its
+    motion's ``rows``: every THIN-th and the last; its ``step``: THIN times longer): the same
+    commands print the same kinds of line, fewer table rows (the Delta robot's and the Stewart
+    platform's every mode ~5× faster)."""
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    motion = data.get("motion", {})
+    if "rows" in motion:
+        rows = motion["rows"]
+        motion["rows"] = rows[::THIN] + ([rows[-1]] if (len(rows) - 1) % THIN else [])
+    if "step" in motion:
+        motion["step"] = motion["step"] * THIN
+    copy = folder / path.name
+    copy.write_text(tomli_w.dumps(data), encoding="utf-8")
+    return copy
+
+
+def test_a_thinned_example_keeps_its_first_and_last_rows(tmp_path: Path) -> None:
+    spec = sk.load_spec(thinned(FOURBAR.parent / "delta_robot.toml", tmp_path))
+    full = sk.load_spec(FOURBAR.parent / "delta_robot.toml")
+    assert spec.inputs.shape[0] == 1 + (full.inputs.shape[0] - 1 + THIN - 1) // THIN
+    np.testing.assert_array_equal(spec.inputs[[0, -1]], full.inputs[[0, -1]])
+    np.testing.assert_array_equal(spec.inputs[:-1], full.inputs[::THIN][:spec.inputs.shape[0] - 1])
+    for path in sorted(FOURBAR.parent.glob("*.toml")):  # every example loads, thinned
+        coarse, fine = sk.load_spec(thinned(path, tmp_path)).inputs, sk.load_spec(path).inputs
+        assert 2 <= coarse.shape[0] < fine.shape[0] / 4, path.name
+        np.testing.assert_array_equal(coarse[0], fine[0])
+
+
 @pytest.mark.parametrize("command", ["validate", "analyze", "mobility", "dynamics", "limits"])
-def test_graph_commands_fit_80_columns(command: str) -> None:
-    """Every line a graph command prints fits 80 columns (errors excepted: one line each)."""
+def test_graph_commands_fit_80_columns(command: str, tmp_path: Path,
+                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every line a graph command prints fits 80 columns (errors excepted: one line each); on
+    every example, sampled more coarsely (:func:`thinned`: the lines' width is what is checked,
+    not their number), named as from the repository's root (examples/mechanisms/...)."""
     examples = sorted(FOURBAR.parent.glob("*.toml"))
+    folder = tmp_path / "examples" / "mechanisms"
+    folder.mkdir(parents=True)
+    monkeypatch.chdir(tmp_path)
     for path in examples:
-        r = CliRunner(env={"COLUMNS": "80"}).invoke(app, [command, str(path)])
+        thinned(path, folder)
+        name = f"examples/mechanisms/{path.name}"
+        r = CliRunner(env={"COLUMNS": "80"}).invoke(app, [command, name])
         lines = [line for line in r.output.splitlines() if not line.startswith("error:")]
         too_long = [line for line in lines if len(line) > 80]
         assert not too_long, (path.name, too_long[:2])
