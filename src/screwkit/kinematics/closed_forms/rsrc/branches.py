@@ -43,7 +43,8 @@ class BranchEvent:
     kind : "stops" (the branch merges with another one: a limit position / dead centre of the
         input, beyond which the loop does not close on it) or "starts".
     theta0 : input angle of the event: where the branch's own root stops assembling (folds.py:
-        followed section by section from the sample where it assembles, to 2⁻⁵⁰ of the step),
+        followed section by section from the sample where it assembles, to 2⁻⁵⁰ of the step,
+        the last point where it still assembles),
         else (none expected) where the count of roots changes, bisected to about 1e-15 rad on
         the side where the branch assembles.
     sample : index of the first sample after the event.
@@ -365,8 +366,7 @@ def _branch_events(dims: RSRCDimensions, mot: RSRCMotion, n_assemblies: IntArray
         if f is None:
             ev = BranchEvent(branch, kind, next(by_count), sample)
         else:
-            th = float(theta[sample - 1] + f.t * (theta[sample] - theta[sample - 1]))
-            ev = BranchEvent(branch, kind, th, sample, f.partner)
+            ev = BranchEvent(branch, kind, f.theta0, sample, f.partner)
         events.append(((sample, branch, 0.0 if f is None else f.t), ev))
     return tuple(e for _, e in sorted(events, key=lambda x: x[0]))
 

@@ -52,14 +52,16 @@ SAME_FOLD = 1e-12
 @dataclass(frozen=True)
 class BranchFold:
     """Column ``branch`` of an ``RSRCMotion`` is born or dies (``dies``) between samples k and
-    k+1 of its sweep, at the fraction ``t`` of that step; ``partner`` the column that meets it
-    there (None: a root that assembles at neither sample)."""
+    k+1 of its sweep, at the fraction ``t`` of that step, the input ``theta0`` (the last point
+    of its search where its root assembles, within 2⁻⁵⁰ of the step of the fold); ``partner``
+    the column that meets it there (None: a root that assembles at neither sample)."""
 
     branch: int
     k: int
     dies: bool
     t: float
     partner: int | None
+    theta0: float
 
 
 def branch_folds(dims: RSRCDimensions, mot: RSRCMotion,
@@ -73,15 +75,17 @@ def branch_folds(dims: RSRCDimensions, mot: RSRCMotion,
         return []
     dies = ok[ks, ms]
     start = np.where(dies, ks, ks + 1)
-    t_from, _, _ = follow(dims, theta[start], theta[2 * ks + 1 - start],
-                          features(mot, start, ms, dims.length_scale), double_root_tol)
+    th0, th1 = theta[start], theta[2 * ks + 1 - start]
+    t_from, _, _ = follow(dims, th0, th1, features(mot, start, ms, dims.length_scale),
+                          double_root_tol)
     t = np.where(dies, t_from, 1.0 - t_from)
+    at = th0 + t_from * (th1 - th0)  # as the search evaluated it
     out = []
     for i in range(ks.size):
         mate = [j for j in range(ks.size) if j != i and ks[j] == ks[i] and dies[j] == dies[i]
                 and abs(t[j] - t[i]) <= SAME_FOLD]
         out.append(BranchFold(int(ms[i]), int(ks[i]), bool(dies[i]), float(t[i]),
-                              int(ms[mate[0]]) if mate else None))
+                              int(ms[mate[0]]) if mate else None, float(at[i])))
     return out
 
 
@@ -90,8 +94,9 @@ def follow(dims: RSRCDimensions, th0: Array, th1: Array, ref: Array,
            ) -> tuple[Array, NDArray[np.bool_], Array]:
     """The roots whose features (:func:`features`) at the inputs ``th0`` (T,) are ``ref``
     (T, 5), followed towards ``th1`` (module docstring): the fraction of the way where each
-    stops assembling (to 2⁻⁵⁰; 1 where it reaches ``th1``), whether it reaches ``th1``, and
-    its features at ``th1`` where it does."""
+    stops assembling (the last point of the search where it still assembles, within 2⁻⁵⁰ of
+    the fold; 1 where it reaches ``th1``), whether it reaches ``th1``, and its features at
+    ``th1`` where it does."""
     from screwkit.kinematics.closed_forms.rsrc.branches import rsrc_motion
 
     length = max(dims.length_scale, np.finfo(float).tiny)
@@ -119,7 +124,7 @@ def follow(dims: RSRCDimensions, th0: Array, th1: Array, ref: Array,
         last = first - 1
         ref = F[r, last, col]
         lo, hi = u[r, last], u[r, first]
-    return np.where(reached, 1.0, 0.5 * (lo + hi)), reached, at_end
+    return np.where(reached, 1.0, lo), reached, at_end
 
 
 def features(mot: RSRCMotion, rows: NDArray[np.intp], cols: NDArray[np.intp],
