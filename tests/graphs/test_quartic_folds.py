@@ -14,6 +14,7 @@ import pytest
 from scipy.optimize import brentq
 
 import screwkit as sk
+from quartic_helpers import XQ, P, Q, X, real_roots, track, zeros
 from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions
 from screwkit.kinematics.closed_forms.rsrc.positions import quartic_discriminant, rsrc_positions
 from screwkit.kinematics.graph import solve_mechanism
@@ -23,68 +24,9 @@ from screwkit.kinematics.graph.quartic_folds import quartic_folds
 from screwkit.kinematics.graph.subchains import decompose
 from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
 
-#: an RSRC (seeded random dimensions of the family's property tests, rounded) whose modes 0, 1
-#: are born at θ0 ≈ 53.85° and modes 2, 3 at ≈ 57.59°: both inside the 5° step 53.5° → 58.5°
-P = dict(d1=1.407, d2=2.402, d3=0.566, a=1.617, b=-0.256, e=-0.046, delta0=-1.117, lambda0=-0.832)
-#: drawn at 58.5° (where every mode assembles), a turn in 5° steps: the last step holds both
-X = np.radians(np.arange(58.5, 58.5 + 361.0, 5.0))
-
-
-def _closure(phi: np.ndarray, theta: float, P: dict[str, float] = P) -> np.ndarray:
-    """W1² + (W2 / cos δ0)² − d2² (Bagci eqs. 3.58/3.59: W1 = d2 cos χ0, W2 = d2 cos δ0 sin
-    χ0), zero where the loop closes at output angle φ0 and input θ0."""
-    m0 = P["b"] * np.sin(P["lambda0"]) - P["d1"] * np.cos(P["lambda0"]) * np.sin(theta)
-    n0 = P["a"] - P["d1"] * np.cos(theta)
-    w1 = m0 * np.sin(phi) + n0 * np.cos(phi) + P["d3"]
-    w2 = n0 * np.sin(phi) - m0 * np.cos(phi) - P["e"] * np.sin(P["delta0"])
-    return w1 * w1 + (w2 / np.cos(P["delta0"])) ** 2 - P["d2"] ** 2
-
-
-def _quartic(theta: float, P: dict[str, float] = P) -> np.ndarray:
-    """The closure times (1 + τ²)² as a quartic in τ = tan(φ0/2): interpolated at 5 points."""
-    tau = np.array([-2.0, -1.0, 0.0, 1.0, 2.0])
-    return np.polyfit(tau, _closure(2 * np.arctan(tau), theta, P) * (1 + tau * tau) ** 2, 4)
-
-
-def _discriminant(theta: float, P: dict[str, float] = P) -> float:
-    """The quartic's discriminant up to a positive factor: ∏ (τi − τj)² over its roots."""
-    r = np.roots(_quartic(theta, P))
-    return float(np.real(np.prod([(r[i] - r[j]) ** 2 for i in range(4) for j in range(i)])))
-
-
-def _real_roots(theta: float, P: dict[str, float]) -> np.ndarray:
-    r = np.roots(_quartic(theta, P))
-    return np.sort(2 * np.arctan(np.real(r[np.abs(np.imag(r)) < 1e-9])))
-
-
-def _track(phi: float, start: float, end: float, folds: list[float],
-           P: dict[str, float] = P) -> float | None:
-    """Follow the root at φ0 = ``phi`` from θ0 = ``start`` towards ``end`` on a grid of 1e-4
-    rad, the nearest root each step; where the count of real roots drops and this root is one
-    of the two closest roots just before (the pair that turns complex), the fold of ``folds``
-    inside that grid step (None: it reaches ``end``)."""
-    grid = np.linspace(start, end, int(np.ceil(abs(end - start) / 1e-4)) + 1)
-    for t0, t1 in zip(grid, grid[1:], strict=False):
-        now, nxt = _real_roots(t0, P), _real_roots(t1, P)
-        phi = float(now[np.argmin(np.abs(np.angle(np.exp(1j * (now - phi)))))])
-        if nxt.size < now.size:
-            d = np.abs(np.angle(np.exp(1j * (now[:, None] - now[None, :])))) + np.eye(now.size) * 9
-            i, j = np.unravel_index(np.argmin(d), d.shape)
-            if phi in (now[i], now[j]):
-                return next(f for f in folds if min(t0, t1) <= f <= max(t0, t1))
-    return None
-
-
-def _zeros(lo: float, hi: float, P: dict[str, float] = P) -> list[float]:
-    """The discriminant's zeros on [lo, hi] (sign changes on a fine grid, brentq)."""
-    grid = np.linspace(lo, hi, 2001)
-    D = np.array([_discriminant(t, P) for t in grid])
-    change = np.flatnonzero(np.sign(D[:-1]) != np.sign(D[1:]))
-    return [brentq(_discriminant, grid[i], grid[i + 1], args=(P,), xtol=1e-15) for i in change]
-
 
 def _folds_in_last_step() -> list[float]:
-    return _zeros(X[-2], X[-1])
+    return zeros(X[-2], X[-1])
 
 
 def _births(events: list[str], after: float, meet: str) -> dict[tuple[int, int], float]:
@@ -107,7 +49,7 @@ def test_two_pairs_born_inside_one_step_are_each_placed_at_their_own_fold() -> N
     folds = _folds_in_last_step()
     assert len(folds) == 2 and folds[1] - folds[0] > np.radians(3.0)
     # which fold each mode's root is born at, by tracking it down from the sample after
-    own = {m: _track(float(md.variables["phi0"][k + 1]), X[k + 1], X[k], folds)
+    own = {m: track(float(md.variables["phi0"][k + 1]), X[k + 1], X[k], folds)
            for m, md in enumerate(motion.modes)}
     assert own == {0: folds[0], 1: folds[0], 2: folds[1], 3: folds[1]}
     mech = mechanism_from_loop(motion, 0, 0)
@@ -151,14 +93,6 @@ def test_a_loop_stage_places_each_pair_at_its_own_fold() -> None:
     assert abs(births[(2, 3)] - np.degrees(folds[1] - X[0])) < 1e-3
 
 
-#: an RSRC (seeded random dimensions, rounded) with four modes, two of which (all that assemble
-#: there) have a 3.7° gap at θ0 ≈ 337.19°–340.89°, and a pair born at ≈ 15.94° whose roots die with
-#: different partners at ≈ 22.56° (one of them on no sample of a 10° sweep)
-Q = dict(d1=2.093, d2=2.189, d3=1.232, a=1.986, b=-0.759, e=0.529, delta0=1.320, lambda0=0.795)
-#: drawn at 4°, 10° steps: the steps 334° → 344° and 14° → 24° each hide two folds
-XQ = np.radians(np.arange(4.0, 364.0, 10.0))
-
-
 def _loop_mode(label: str) -> int:
     hit = re.match(r"loop mode (\d)", label)
     return 0 if label == "drawn" else int(hit[1]) if hit else -1
@@ -180,10 +114,10 @@ def test_two_folds_of_a_four_mode_loop_inside_one_step_cut_its_modes() -> None:
     g = solve_mechanism(mech, XQ - XQ[0], every_mode=True)
     deg = np.degrees(XQ - XQ[0])
     for k in (1, 33):  # 14° → 24° and 334° → 344°
-        z = _zeros(XQ[k], XQ[k + 1], Q)
+        z = zeros(XQ[k], XQ[k + 1], Q)
         assert len(z) == 2, k
         zg = np.degrees(np.array(z) - XQ[0])
-        counts = [_real_roots(t, Q).size for t in (XQ[k], 0.5 * (z[0] + z[1]), XQ[k + 1])]
+        counts = [real_roots(t, Q).size for t in (XQ[k], 0.5 * (z[0] + z[1]), XQ[k + 1])]
         inside = [e for md in g.modes for e in md.events if "two folds between the samples at "
                   f"input.theta = {deg[k]:g} deg" in e]
         assert inside and all(min(abs(_at(e) - zg)) < 1e-3 for e in inside), k
@@ -193,7 +127,7 @@ def test_two_folds_of_a_four_mode_loop_inside_one_step_cut_its_modes() -> None:
             for n, end, word in ((k, XQ[k + 1], "dies"), (k + 1, XQ[k], "is born")):
                 if not md.assembles[n]:
                     continue
-                f = _track(float(md.variables["phi0"][n]), XQ[n], end, z, Q)
+                f = track(float(md.variables["phi0"][n]), XQ[n], end, z, Q)
                 mine = [_at(e) for gm in g.modes if _loop_mode(gm.label) == m and
                         gm.assembles[n] for e in gm.events if e.startswith(word) and e in inside]
                 if f is None:
@@ -228,5 +162,5 @@ def test_the_discriminant_s_sign_is_the_count_and_its_zeros_are_the_folds() -> N
         for i in change:
             mine = brentq(lambda t, d=d: float(quartic_discriminant(d, t)[0]), th[i], th[i + 1],
                           xtol=1e-15)
-            ref = _zeros(th[i], th[i + 1], dims)
+            ref = zeros(th[i], th[i + 1], dims)
             assert len(ref) == 1 and abs(mine - ref[0]) < 1e-10

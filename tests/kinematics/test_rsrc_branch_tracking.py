@@ -49,16 +49,16 @@ def test_the_identity_shortcut_never_changes_the_matching(monkeypatch, samples):
         accepted.append(ok.mean())
         return ok
 
-    for dims in _mechanisms(60):
+    for dims in _mechanisms(60):  # the sweep's own matching: no fold search (its own sweeps)
         with monkeypatch.context() as m:
             m.setattr(branches, "_identity_is_best", counting)
-            fast = rsrc_motion(dims, theta)
+            fast = rsrc_motion(dims, theta, events=False)
         if not fast.assembles.any():
             continue
         with monkeypatch.context() as m:
             m.setattr(branches, "_identity_is_best",
                       lambda prev, *a, **k: np.zeros(prev[0].shape[0], dtype=bool))
-            full = rsrc_motion(dims, theta)
+            full = rsrc_motion(dims, theta, events=False)
         np.testing.assert_array_equal(fast.assembles, full.assembles)
         np.testing.assert_array_equal(fast.inversion_label, full.inversion_label)
         np.testing.assert_array_equal(fast.phi0, full.phi0)

@@ -45,7 +45,7 @@ from screwkit.model.linkage import Linkage
 
 if TYPE_CHECKING:
     from screwkit.kinematics.closed_forms.rccc import RCCCDimensions, RCCCMotion
-    from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions, RSRCMotion
+    from screwkit.kinematics.closed_forms.rsrc import BranchEvent, RSRCDimensions, RSRCMotion
     from screwkit.kinematics.closed_forms.rssr import RSSRDimensions, RSSRMotion
     from screwkit.kinematics.tracker.loop import Layout
 
@@ -142,12 +142,12 @@ def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
     rates = mot.rates
     modes: list[ModeMotion] = []
     expect_modes(int(mot.assembles.any(axis=0).sum()))
+    mode_of = np.cumsum(mot.assembles.any(axis=0)) - 1  # column → mode
     for j in range(mot.phi0.shape[1]):
         ok = mot.assembles[:, j]
         if not ok.any():
             continue
-        events = [f"{e.kind} assembling at input {format_inputs(linkage, np.array([e.theta0]))} "
-                  "(limit position or dead centre)" for e in mot.events if e.branch == j]
+        events = [_event_text(linkage, mot, mode_of, e) for e in mot.events if e.branch == j]
         conf = configuration(j, ALL)
         md = mode_from_configuration(linkage, lay, conf, ok.copy(), X, Xd, Xdd, events)
         seed_v = {"theta0": theta, "phi0": mot.phi0[:, j], "chi0": mot.chi0[:, j]}
@@ -168,6 +168,29 @@ def rsrc_closed_motion(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> Mot
         raise _no_modes(linkage, X, describe_intervals(assembling_intervals(dims)))
     return Motion(linkage, X, Xd, Xdd, tuple(modes), method="closed",
                   solver=FOURBAR_SOLVER if planar else RSRC_SOLVER)
+
+
+def _event_text(linkage: Linkage, mot: RSRCMotion, mode_of: NDArray[np.intp],
+                e: BranchEvent) -> str:
+    """A branch event of ``rsrc_motion`` as a mode's event: where its root stops or starts
+    assembling and the mode that meets it there (closed_forms/rsrc/folds.py); where the mode
+    assembles at both samples of the step, its root dies inside it and its samples after are
+    another root's, born inside it (closed_forms/rsrc/hidden_folds.py)."""
+    across = bool(mot.assembles[e.sample - 1, e.branch] and mot.assembles[e.sample, e.branch])
+    m = int(mode_of[e.branch])
+    if e.partner is not None:
+        a, b = sorted((m, int(mode_of[e.partner])))
+        meet = f": modes {a} and {b} meet"
+    else:
+        meet = f": mode {m} meets a root that assembles at neither sample" if across else ""
+    text = (f"{e.kind} assembling at input {format_inputs(linkage, np.array([e.theta0]))} "
+            f"(limit position or dead centre{meet})")
+    if not across:
+        return text
+    return text + ("; its samples after this step are on another root, born inside the step"
+                   if e.kind == "stops" else
+                   "; its samples after this step are on this root, its root before dies "
+                   "inside the step")
 
 
 def _rsrc_solution(linkage: Linkage, X: Array, Xd: Array, Xdd: Array) -> tuple[

@@ -42,15 +42,22 @@ class BranchEvent:
     branch : column of the motion arrays.
     kind : "stops" (the branch merges with another one: a limit position / dead centre of the
         input, beyond which the loop does not close on it) or "starts".
-    theta0 : input angle of the event, refined by bisection to about 1e-15 rad, on the side where
-        the branch assembles (its two roots there are a double root to within the tolerance).
+    theta0 : input angle of the event: where the branch's own root stops assembling (folds.py:
+        followed section by section from the sample where it assembles, to 2⁻⁵⁰ of the step,
+        the last point where it still assembles),
+        else (none expected) where the count of roots changes, bisected to about 1e-15 rad on
+        the side where the branch assembles.
     sample : index of the first sample after the event.
+    partner : the branch (column) that meets it there (its own search ends at the same place
+        in the same step), None where that root assembles at neither sample or the event was
+        placed by the count.
     """
 
     branch: int
     kind: Literal["stops", "starts"]
     theta0: float
     sample: int
+    partner: int | None = None
 
 
 @dataclass(frozen=True)
@@ -259,6 +266,7 @@ def rsrc_motion(
     theta0_ddot: ArrayLike = 0.0,
     *,
     double_root_tol: float = DEFAULT_DOUBLE_ROOT_TOL,
+    events: bool = True,
 ) -> RSRCMotion:
     """Track every assembly mode continuously over a sweep of input angles (Bagci 1969, §3.4),
     with the velocities and accelerations of every branch (eqs. 3.77-3.82).
@@ -274,7 +282,8 @@ def rsrc_motion(
     the count of roots changes).  The per-step permutations are then composed along the
     sweep (a loop over the steps that change the order only).  phi0 is unwrapped along each run
     of valid samples, and every place where a branch stops or starts assembling is reported
-    with its input angle, refined by bisection.
+    with its input angle, where that branch's own root stops assembling, and the branch it
+    meets there (folds.py's ``branch_folds``: two pairs of branches may fold inside one step).
 
     Positions and rates come from one pass of `rsrc_kinematics` (d/d theta0 and
     d²/d theta0²); the rates at ``theta0_dot``, ``theta0_ddot`` follow by the chain rule,
@@ -296,6 +305,8 @@ def rsrc_motion(
         Input angular velocity (rad/s) and acceleration (rad/s²): scalars or shape (N,).
     double_root_tol
         As in `rsrc_positions`.
+    events
+        False: no events (the fold search's own sweeps, folds.py, which call this).
     """
     theta = check_input_angles(theta0_sweep, "theta0_sweep")
     n = theta.shape[0]
@@ -322,21 +333,69 @@ def rsrc_motion(
     rates = _branch_rates(deriv, take, td, tdd)
     labels = take(pos.inversion_label)
 
-    # events: branch stops (valid -> invalid) or starts (invalid -> valid)
-    change = assembles[1:] != assembles[:-1]
-    k_idx, branch_idx = np.nonzero(change)
+    out = RSRCMotion(theta, phi, take(pos.chi0), take(pos.S), assembles, labels, (), rates)
+    if not events:
+        return out
+    return replace(out, events=_branch_events(dims, out, pos.n_assemblies, double_root_tol))
+
+
+def _branch_events(dims: RSRCDimensions, mot: RSRCMotion, n_assemblies: IntArray,
+                   tol: float) -> tuple[BranchEvent, ...]:
+    """Where each branch of ``mot`` stops (valid -> invalid) or starts (invalid -> valid): at
+    its own root's fold with its partner (folds.py), else (none expected: the branches are
+    these roots) where the count of roots changes (`_refine_events`)."""
+    from screwkit.kinematics.closed_forms.rsrc.folds import branch_folds
+
+    theta, assembles = mot.theta0, mot.assembles
+    k_idx, branch_idx = np.nonzero(assembles[1:] != assembles[:-1])
     samples = k_idx + 1
-    events: list[BranchEvent] = []
-    if samples.size:
-        theta_event = _refine_events(dims, theta, pos.n_assemblies, samples, double_root_tol)
-        for sample, branch, th in zip(samples.tolist(), branch_idx.tolist(),
-                                      theta_event.tolist(), strict=True):
-            kind: Literal["stops", "starts"] = (
-                "stops" if bool(assembles[sample - 1, branch]) else "starts"
-            )
-            events.append(BranchEvent(branch, kind, th, sample))
-    return RSRCMotion(theta, phi, take(pos.chi0), take(pos.S), assembles, labels, tuple(events),
-                      rates)
+    hidden = _hidden_events(dims, mot)
+    if not samples.size:
+        return tuple(e for _, e in sorted(hidden, key=lambda x: x[0]))
+    found = {(f.branch, f.k): f for f in branch_folds(dims, mot, tol) if 0.0 < f.t < 1.0}
+    fold = [found.get((b, s - 1)) for b, s in zip(branch_idx.tolist(), samples.tolist(),
+                                                   strict=True)]
+    rest = np.array([f is None for f in fold])
+    by_count = iter(_refine_events(dims, theta, n_assemblies, samples[rest], tol).tolist()
+                    if rest.any() else [])
+    events = hidden
+    for sample, branch, f in zip(samples.tolist(), branch_idx.tolist(), fold, strict=True):
+        kind: Literal["stops", "starts"] = (
+            "stops" if bool(assembles[sample - 1, branch]) else "starts"
+        )
+        if f is None:
+            ev = BranchEvent(branch, kind, next(by_count), sample)
+        else:
+            ev = BranchEvent(branch, kind, f.theta0, sample, f.partner)
+        events.append(((sample, branch, 0.0 if f is None else f.t), ev))
+    return tuple(e for _, e in sorted(events, key=lambda x: x[0]))
+
+
+def _hidden_events(dims: RSRCDimensions, mot: RSRCMotion
+                   ) -> list[tuple[tuple[int, int, float], BranchEvent]]:
+    """Where a branch that assembles at both samples of a step is matched onto another root:
+    its root dies inside the step and the root it is matched onto at the next sample is born
+    inside it (two folds of the quartic inside one step, hidden_folds.py), each with its sort
+    key (sample, branch, fraction of the step) and the branch its root meets there (the one
+    whose root dies or is born at the same fraction; None: a root on neither sample)."""
+    from screwkit.kinematics.closed_forms.rsrc.hidden_folds import hidden_steps
+
+    theta = mot.theta0
+    cols = np.flatnonzero(mot.assembles.any(axis=0))
+    out: list[tuple[tuple[int, int, float], BranchEvent]] = []
+    for s in hidden_steps(dims, mot, 0, theta.size - 1):
+        sides: tuple[tuple[dict[int, float], Literal["stops", "starts"]], ...] = (
+            (s.dies, "stops"), (s.born, "starts"))
+        for what, kind in sides:
+            for m, t in what.items():
+                b = int(cols[m])
+                if not (mot.assembles[s.k, b] and mot.assembles[s.k + 1, b]):
+                    continue
+                mate = [int(cols[n]) for n, u in what.items() if n != m and u == t]
+                th = float(theta[s.k] + t * (theta[s.k + 1] - theta[s.k]))
+                out.append(((s.k + 1, b, t),
+                            BranchEvent(b, kind, th, s.k + 1, mate[0] if mate else None)))
+    return out
 
 
 def _branch_rates(deriv: RSRCRates, take: Callable[[np.ndarray], np.ndarray], td: FloatArray,
