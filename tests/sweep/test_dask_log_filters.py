@@ -7,6 +7,7 @@ load). The callback here fails the same way, through tornado's own IOLoop and lo
 from __future__ import annotations
 
 import logging
+import threading
 
 from tornado.ioloop import IOLoop
 
@@ -24,15 +25,24 @@ def sync():  # the names tornado's message quotes: "sync.<locals>.cancel"
 
 
 def _run(callback, caplog) -> list[logging.LogRecord]:
-    caplog.clear()
-    loop = IOLoop(make_current=False)
-    try:
-        loop.add_callback(callback)
-        loop.add_callback(loop.stop)
-        with caplog.at_level(logging.ERROR, logger="tornado.application"):
+    """``callback`` run by a fresh tornado IOLoop in its own thread (as Dask runs its loop; the
+    test's thread may hold another running event loop), tornado's error records returned."""
+
+    def loop_thread() -> None:
+        loop = IOLoop(make_current=False)
+        try:
+            loop.add_callback(callback)
+            loop.add_callback(loop.stop)
             loop.start()
-    finally:
-        loop.close()
+        finally:
+            loop.close()
+
+    caplog.clear()
+    with caplog.at_level(logging.ERROR, logger="tornado.application"):
+        thread = threading.Thread(target=loop_thread)
+        thread.start()
+        thread.join(30)
+    assert not thread.is_alive()
     return [r for r in caplog.records if r.name == "tornado.application"]
 
 
