@@ -19,8 +19,10 @@ RSRC quartic where its loop mode's own root stops assembling, graph/quartic_fold
 mode that meets it named; else where its count of real closed-form solutions changes,
 graph/loop_motion.py's ``real_count``) or a dyad or leg (its discriminant crosses zero). Either is located by bisection of the input segment between
 the samples; for a dyad's fold the loop is carried along the segment on its branch (at each
-bisection point, the loop mode nearest the one at the bisection's last point). Rates and
-accelerations come from the stacked closure Jacobian (graph/motion.py's ``build_mode``).
+bisection point, the loop mode nearest the one at the bisection's last point). Two folds of
+a loop of the RSRC quartic inside one step (a gap, an island) are found by the single loop's
+search and cut its modes there (graph/stage_steps.py). Rates and accelerations come from the
+stacked closure Jacobian (graph/motion.py's ``build_mode``).
 """
 
 from __future__ import annotations
@@ -407,6 +409,7 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
         input_text,
         with_events,
     )
+    from screwkit.kinematics.graph.stage_steps import stage_pieces, stage_steps
 
     N = X.shape[0]
     A = approach(lay, X)
@@ -438,31 +441,46 @@ def loop_stage_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
                             f"first input row {input_text(mech, lay, X[0])}: the mechanism stops "
                             "assembling before it")
     stop = int(np.argmin(ok[0, a:])) if not ok[0, a:].all() else N
-    drawn = np.arange(N) < stop
-    conf = configuration_from_poses(mech, lay, R[0], p[0], rows,
-                                    np.concatenate([np.ones(a, dtype=bool), drawn]), True)
-    mode = build_mode(mech, lay, conf.take(slice(a, None)), drawn, X, Xd, Xdd,
-                      mode_frames(mech, lay, R[0, a:], p[0, a:], drawn))
     picked = [0] + [m for m in range(1, M) if ok[m, a:].any()]
-    masks = [drawn, *(ok[m, a:] for m in picked[1:])]
+    masks = [np.arange(N) < stop, *(ok[m, a:] for m in picked[1:])]
     again = ok[0, a:] & (np.arange(N) >= stop)  # the drawn combination after its first fold
     if every and again.any():
         picked.append(0)
         masks.append(again)
     held = np.array(masks)
     folds, joins = fold_events(mech, lay, dec, loops, X, a, combos[picked], held, disc[picked])
-    modes = [drawn_with_events(mech, lay, mode, X, stop, folds[0])]
-    for n, (m, ev) in enumerate(zip(picked[1:], folds[1:], strict=True), start=1):
-        conf = configuration_from_poses(mech, lay, R[m, a:], p[m, a:], X, held[n], False)
-        md = build_mode(mech, lay, conf, held[n], X, Xd, Xdd,
-                        mode_frames(mech, lay, R[m, a:], p[m, a:], held[n]))
-        label = f"branches {combination_label(mech, dec, loops, combos[m])}"
-        if m == 0:
-            label += " (the drawn branches again, after the drawn mode's fold)"
+    # two folds of a loop mode inside one step cut its modes; islands on no sample
+    # (graph/stage_steps.py), the drawn mode ending at its first
+    steps = stage_steps(lay, dec, rows, a, N - 1 if every else stop - 1)
+    cut = stage_pieces(mech, lay, dec, X, steps, combos[picked], held, folds, joins, every)
+    drawn = cut.masks[0]
+    stop = int(np.argmin(drawn)) if not drawn.all() else N
+    conf = configuration_from_poses(mech, lay, R[0], p[0], rows,
+                                    np.concatenate([np.ones(a, dtype=bool), drawn]), True)
+    mode = build_mode(mech, lay, conf.take(slice(a, None)), drawn, X, Xd, Xdd,
+                      mode_frames(mech, lay, R[0, a:], p[0, a:], drawn))
+    modes = [drawn_with_events(mech, lay, mode, X, stop, cut.events[0])]
+    for n, (r, ev) in enumerate(zip(cut.rows[1:], cut.events[1:], strict=True), start=1):
+        m = picked[max(r, 0)]
+        ok_n = cut.masks[n]
+        conf = configuration_from_poses(mech, lay, R[m, a:], p[m, a:], X, ok_n, False)
+        md = build_mode(mech, lay, conf, ok_n, X, Xd, Xdd,
+                        mode_frames(mech, lay, R[m, a:], p[m, a:], ok_n))
+        if r < 0:  # an island of a loop stage, on no sample
+            label = cut.labels[n]
+        else:
+            label = f"branches {combination_label(mech, dec, loops, combos[m])}"
+            if m == 0:
+                label += (" (the drawn branches again, after the drawn mode's fold)" if r
+                          else "")
+            label += cut.labels[n]
         modes.append(replace(with_events(md, [*ev, *md.events]), label=label, index=len(modes)))
     notes: tuple[str, ...] = (skipped,) if skipped else ()
     if every:
-        circuits = groups(len(modes), _circuits(combos[picked], held, joins))
+        rows_p = np.array([max(r, 0) for r in cut.rows])
+        joined = [(cut.piece(r, k if held[r, k] else k + 1), d, k, q) for r, d, k, q in joins]
+        circuits = groups(len(modes), _circuits(combos[picked][rows_p], cut.masks, joined)
+                          + cut.meets)
         notes = (f"{M} branch combination(s) of {len(dec.stages)} sub-chain(s) (loop modes × "
                  f"dyad and leg branches); {len(modes)} mode(s) assemble over these inputs",
                  "circuits (modes that meet at a fold, where the input must turn back to go "
