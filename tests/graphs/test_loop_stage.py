@@ -8,13 +8,12 @@ tracker; rates against finite differences; every mode's loops close."""
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 from scipy.optimize import brentq
 
 import screwkit as sk
+from loop_stage_helpers import knee
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
 from screwkit.kinematics.graph.follow import follow_drawn_mode
@@ -234,23 +233,11 @@ def _fourbar() -> Mechanism:
     return mechanism_from_loop(sk.solve_motion(lk, np.radians([30.0, 32.0])), 0, 0)
 
 
-def _knee(loop: Mechanism) -> Mechanism:
-    """The loop hung on a thigh that a hip joint turns (about an axis across the four-bar's
-    normal, so the thigh moves out of its plane): the loop's ground is the thigh, its crank
-    driven from the thigh by a second input (a knee inside a serial chain)."""
-    on_thigh = tuple(replace(j, bodies=tuple("thigh" if b == "ground" else b for b in j.bodies))
-                     for j in loop.joints)
-    hip = MechanismJoint("hip", "R", ("ground", "thigh"), np.array([0.5, -2.0, 1.0]),
-                         np.array([0.2, 0.3, 1.0]))
-    return Mechanism("knee", (Body("thigh"), *loop.bodies), (hip, *on_thigh),
-                     ("hip.theta", f"{loop.joints[0].name}.theta"))
-
-
 @pytest.mark.parametrize("family", ["RSRC", "4R"])
 def test_a_loop_hung_on_a_driven_body_is_the_loop_alone_in_that_body_s_frame(family: str
                                                                              ) -> None:
     loop = _loop() if family == "RSRC" else _fourbar()
-    mech = _knee(loop)
+    mech = knee(loop)
     dec = decompose(mech)
     assert dec.complete and dec.loops[0].parent == "thigh" and dec.loops[0].kind == family
     # the same four-bar on the ground is a crank and an RRR dyad, not a loop stage

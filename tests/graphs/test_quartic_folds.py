@@ -15,6 +15,7 @@ import pytest
 from scipy.optimize import brentq
 
 import screwkit as sk
+from loop_stage_helpers import knee
 from quartic_helpers import XQ, P, Q, X, real_roots, track, zeros
 from screwkit.kinematics.closed_forms.rsrc import RSRCDimensions
 from screwkit.kinematics.closed_forms.rsrc.positions import quartic_discriminant, rsrc_positions
@@ -168,16 +169,6 @@ def test_the_discriminant_s_sign_is_the_count_and_its_zeros_are_the_folds() -> N
             assert len(ref) == 1 and abs(mine - ref[0]) < 1e-10
 
 
-def _knee(loop: Mechanism) -> Mechanism:
-    """The loop hung on a thigh that a hip joint turns (held still in the tests)."""
-    on_thigh = tuple(replace(j, bodies=tuple("thigh" if b == "ground" else b for b in j.bodies))
-                     for j in loop.joints)
-    hip = MechanismJoint("hip", "R", ("ground", "thigh"), np.array([0.5, -2.0, 1.0]),
-                         np.array([0.2, 0.3, 1.0]))
-    return Mechanism("knee", (Body("thigh"), *loop.bodies), (hip, *on_thigh),
-                     ("hip.theta", f"{loop.joints[0].name}.theta"))
-
-
 def _theta(event: str) -> float:
     """The input angle (deg) an event is at."""
     hit = re.search(r" at .*?input\.theta = (-?[\d.]+) deg", event)
@@ -200,7 +191,7 @@ def test_a_loop_stage_cuts_its_modes_at_two_folds_inside_one_step() -> None:
     (0.05°: no two folds inside one step there), to 1e-3° (events printed to 6 digits)."""
     motion = sk.solve_motion(sk.rsrc(**Q), XQ)
     loop = mechanism_from_loop(motion, 0, 0)
-    mech = _knee(loop)
+    mech = knee(loop)
     g = solve_mechanism(mech, np.stack([np.zeros(XQ.size), XQ - XQ[0]], axis=1),
                         every_mode=True)
     single = solve_mechanism(loop, XQ - XQ[0], every_mode=True)

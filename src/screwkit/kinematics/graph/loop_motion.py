@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 from screwkit.kinematics.graph.closure import GraphFrames, GraphLayout, joint_screws
 from screwkit.kinematics.graph.loop_subchain import APPROACH_STEP, LoopChain, is_drawing
 from screwkit.kinematics.graph.step_folds import HiddenPair as HiddenPairT
+from screwkit.kinematics.graph.step_folds import hidden_fold_text
 from screwkit.kinematics.motion import AssemblyError, ModeMotion, Motion
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.kinematics.tracker.mode_frames import ModePoses
@@ -499,13 +500,9 @@ def step_pieces(mech: Mechanism, lay: GraphLayout, X: Array, masks: NDArray[np.b
 
     def event(i: int, p: HiddenPairT, end: int) -> None:
         x = X[p.k] + p.t[end] * (X[p.k + 1] - X[p.k])
-        what = "dies" if (end == 0) == p.gap else "is born"
-        events.append((p.k + p.t[end], (i, p.k, x, (
-            f"{what} at {input_text(mech, lay, x)}: the loop folds (two of its assembly modes "
-            f"meet; {'the first' if end == 0 else 'the second'} of two folds between the "
-            f"samples at {input_text(mech, lay, X[p.k])} and "
-            f"{input_text(mech, lay, X[p.k + 1])}, where it "
-            f"{'assembles' if p.gap else 'does not assemble'})"))))
+        events.append((p.k + p.t[end], (i, p.k, x, hidden_fold_text(
+            (end == 0) == p.gap, input_text(mech, lay, x), end == 0,
+            input_text(mech, lay, X[p.k]), input_text(mech, lay, X[p.k + 1]), p.gap))))
 
     for i, (r, part) in enumerate(zip(rows, pieces, strict=True)):
         for p in pairs:

@@ -17,6 +17,7 @@ from screwkit.kinematics.closed_forms.rsrc.hidden_folds import QuarticStep, hidd
 from screwkit.kinematics.graph.closure import GraphLayout
 from screwkit.kinematics.graph.loop_motion import StepPieces
 from screwkit.kinematics.graph.loop_subchain import LoopChain
+from screwkit.kinematics.graph.step_folds import hidden_fold_text
 from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]
@@ -69,12 +70,9 @@ def quartic_pieces(mech: Mechanism, lay: GraphLayout, chain: LoopChain, X: Array
         k = s.k - a
         x = X[k] + t * (X[k + 1] - X[k])
         first = abs(t - s.t[0]) <= abs(t - s.t[1])
-        events.append((k + t, (i, k, x, (
-            f"{'dies' if dies else 'is born'} at {input_text(mech, lay, x)}: the loop folds "
-            f"(two of its assembly modes meet; {'the first' if first else 'the second'} "
-            f"of two folds between the samples at {input_text(mech, lay, X[k])} and "
-            f"{input_text(mech, lay, X[k + 1])}, where it "
-            f"{'assembles' if gap else 'does not assemble'})"))))
+        events.append((k + t, (i, k, x, hidden_fold_text(
+            dies, input_text(mech, lay, x), first, input_text(mech, lay, X[k]),
+            input_text(mech, lay, X[k + 1]), gap))))
 
     for i, (r, part) in enumerate(zip(rows, pieces, strict=True)):
         for s in steps:

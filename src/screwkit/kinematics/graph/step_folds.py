@@ -70,6 +70,15 @@ class HiddenPair:
     gap: bool
 
 
+def hidden_fold_text(dies: bool, at: str, first: bool, lo: str, hi: str, gap: bool) -> str:
+    """The event of a loop mode at one of two folds inside one step (a gap where it
+    ``assembles`` at both samples, an island where it does not); ``at``, ``lo`` and ``hi`` the
+    fold's and the step's samples' inputs as text."""
+    return (f"{'dies' if dies else 'is born'} at {at}: the loop folds (two of its assembly modes "
+            f"meet; {'the first' if first else 'the second'} of two folds between the samples "
+            f"at {lo} and {hi}, where it {'assembles' if gap else 'does not assemble'})")
+
+
 def hidden_pairs(evaluate: Evaluate, ok: NDArray[np.bool_], disc: Array,
                  discriminants: Callable[[NDArray[np.intp], NDArray[np.intp], Array], Array]
                  | None = None) -> list[HiddenPair]:
