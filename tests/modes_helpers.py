@@ -39,6 +39,19 @@ def check_jacobians(system: PolynomialSystem, x: np.ndarray, p: np.ndarray) -> N
         assert np.allclose(d, Jp[:, :, i], rtol=1e-6, atol=1e-6), f"∂F/∂{system.parameters[i]}"
 
 
+def random_loop(rng: np.random.Generator, kinds: str, inputs: list[str]) -> Mechanism:
+    """A loop of joints of ``kinds`` (R, P, C) on random lines, some joints' bodies listed
+    against the walk, driven at the freedoms ``inputs`` (e.g. "j0.theta")."""
+    bodies = [Body(f"l{i}") for i in range(1, len(kinds))]
+    names = [GROUND, *(b.name for b in bodies), GROUND]
+    joints = []
+    for i, kind in enumerate(kinds):
+        a, b = (names[i], names[i + 1]) if rng.random() < 0.6 else (names[i + 1], names[i])
+        joints.append(MechanismJoint(f"j{i}", kind, (a, b), rng.normal(size=3),
+                                     rng.normal(size=3)))
+    return Mechanism("loop", tuple(bodies), tuple(joints), tuple(inputs))
+
+
 def random_r_loop(rng: np.random.Generator, n: int, inputs: list[int]) -> Mechanism:
     """A loop of n R joints on random lines, some joints' bodies listed against the walk."""
     bodies = [Body(f"l{i}") for i in range(1, n)]

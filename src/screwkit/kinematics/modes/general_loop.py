@@ -1,0 +1,238 @@
+"""A single loop of R, P and C joints with six free freedoms as the system of
+:mod:`.general_loop_system`: the loop's geometry at the inputs as the system's parameters, and
+the way back from solutions to the graph tracker's :class:`Configuration` (issue 27).
+
+The loop is walked from the ground, each joint's axis oriented along the walk (so that its
+values move the next body positively either way, as modes/r_loop.py does). Driven freedoms
+are fixed motions folded into the links; each free joint j gets a frame F_j on its line (z
+along the oriented axis), and the link between free joints j and j+1 is
+L_j = F_j⁻¹ G_j F_{j+1} (G_j the driven motions between them), split as
+Rz(φ) Tz(b) Tx(a) Rx(α) Rz(ψ) Tz(e) (:func:`~.general_loop_system.split_link`). The ψ and e of
+link j−1 and the φ and b of link j are screws about joint j's line: they are the system's
+parameters where the joint does not turn or slide, otherwise offsets of the joint's own
+variable, kept here so that a solution reads as joint values from the drawing.
+
+Not routed yet: :func:`~screwkit.kinematics.modes.every_mode.closure_formulation` does not
+take it, since its topologies have no start solutions (monodromy through this system is slow
+and loses paths; docs/kinematics.md "Closures as polynomials", "Where the guarantee ends").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from screwkit.algebraic.polynomial import PolynomialSystem
+from screwkit.errors import CapabilityError, InputError
+from screwkit.kinematics.graph.closure import GraphLayout, graph_layout
+from screwkit.kinematics.modes.general_loop_system import (
+    general_loop_system,
+    loop_layout,
+    split_link,
+)
+from screwkit.kinematics.tracker.loop import Configuration
+from screwkit.messages import listing
+from screwkit.model.mechanism import GROUND, Mechanism
+
+Array = NDArray[np.float64]
+#: below this sin α two consecutive free axes are taken as parallel (the normal is then chosen)
+PARALLEL = 1e-9
+
+
+def _screw(c: Array, w: Array, theta: float, slide: float) -> Array:
+    """The 4×4 motion: turn θ about the line (c, w) and slide along w."""
+    K = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+    R = np.eye(3) + np.sin(theta) * K + (1.0 - np.cos(theta)) * (K @ K)
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, c - R @ c + slide * w
+    return T
+
+
+def _frame(c: Array, w: Array) -> Array:
+    """A frame on the line (c, w): z along w, x along the cross product with the coordinate
+    axis least aligned with w."""
+    x = np.cross(w, np.eye(3)[int(np.argmin(np.abs(w)))])
+    x /= np.linalg.norm(x)
+    F = np.eye(4)
+    F[:3, :3], F[:3, 3] = np.stack([x, np.cross(w, x), w], axis=1), c
+    return F
+
+
+def _split_real(L: Array) -> tuple[float, float, float, float, float, float]:
+    """(φ, b, a, α, ψ, e) of a real link (split_link, or the parallel case: the normal along
+    the offset between the lines, or any when they coincide)."""
+    R, t = L[:3, :3], L[:3, 3]
+    if np.hypot(R[0, 2], R[1, 2]) > PARALLEL:
+        (cp, sp), b, a, (ca, sa), (cs, ss), e = split_link(L.astype(complex))
+        return (float(np.arctan2(sp.real, cp.real)), b.real, a.real,
+                float(np.arctan2(sa.real, ca.real)), float(np.arctan2(ss.real, cs.real)), e.real)
+    phi = float(np.arctan2(t[1], t[0])) if np.hypot(t[0], t[1]) > PARALLEL else 0.0
+    a = float(np.hypot(t[0], t[1]))
+    alpha = 0.0 if R[2, 2] > 0 else np.pi
+    M = _screw(np.zeros(3), np.array([1.0, 0, 0]), alpha, 0.0)[:3, :3].T @ \
+        _screw(np.zeros(3), np.array([0, 0, 1.0]), phi, 0.0)[:3, :3].T @ R
+    return phi, float(t[2]), a, alpha, float(np.arctan2(M[1, 0], M[0, 0])), 0.0
+
+
+@dataclass(frozen=True)
+class _Walk:
+    """The loop from the ground: joint indices, oriented points and axes, and which of each
+    joint's freedoms (turn, slide) are free."""
+
+    order: tuple[int, ...]
+    points: tuple[Array, ...]
+    axes: tuple[Array, ...]
+    turn_free: tuple[bool, ...]
+    slide_free: tuple[bool, ...]
+
+
+def _walk(mech: Mechanism) -> _Walk:
+    if len(mech.topology.loops) != 1 or len(mech.topology.tree) + 1 != len(mech.joints):
+        raise CapabilityError(f"{mech.name}: the general loop formulation takes a single loop "
+                              f"and nothing else; this mechanism has "
+                              f"{len(mech.topology.loops)} loops")
+    bad = [j.name for j in mech.joints if j.kind not in "RPC"]
+    if bad:
+        raise CapabilityError(f"{mech.name}: joints {listing(bad)} are not R, P or C joints; "
+                              "the general loop formulation takes those only")
+    driven = set(mech.inputs)
+    order, points, axes, turn, slide = [], [], [], [], []
+    body, used = GROUND, set()
+    while True:
+        k = next((i for i, j in enumerate(mech.joints) if body in j.bodies and i not in used),
+                 None)
+        if k is None:
+            raise CapabilityError(f"{mech.name}: the loop does not pass through the ground")
+        j = mech.joints[k]
+        forward = j.bodies[0] == body
+        used.add(k)
+        order.append(k)
+        points.append(j.at)
+        axes.append(j.axis if forward else -j.axis)
+        turn.append(j.kind in "RC" and f"{j.name}.theta" not in driven)
+        slide.append(j.kind in "PC" and f"{j.name}.s" not in driven)
+        body = j.bodies[1] if forward else j.bodies[0]
+        if body == GROUND:
+            return _Walk(tuple(order), tuple(points), tuple(axes), tuple(turn), tuple(slide))
+
+
+def loop_kinds(mech: Mechanism) -> str:
+    """The free joints' kinds round the loop from the first free joint after the ground
+    (R: turns only, P: slides only, C: both), e.g. "RPRRRR"."""
+    w = _walk(mech)
+    return "".join("C" if t and s else "R" if t else "P"
+                   for t, s in zip(w.turn_free, w.slide_free, strict=True) if t or s)
+
+
+@dataclass(frozen=True)
+class GeneralLoop:
+    """A single loop of R, P and C joints as a formulation over rows of inputs."""
+
+    mechanism: Mechanism
+    kinds: str
+    system: PolynomialSystem
+
+    def _instance(self, row: Array) -> tuple[Array, Array, Array]:
+        """Parameters (k,), turn offsets Φ (n,) and slide offsets (n,) at one row of inputs."""
+        mech, w = self.mechanism, _walk(self.mechanism)
+        value = dict(zip(mech.inputs, row, strict=True))
+        free = [i for i in range(len(w.order)) if w.turn_free[i] or w.slide_free[i]]
+        frames = [_frame(w.points[i], w.axes[i]) for i in free]
+        links = []
+        for n_j, i in enumerate(free):
+            G = np.eye(4)
+            nxt = free[(n_j + 1) % len(free)]
+            steps = list(range(i, len(w.order))) + list(range(0, nxt)) if nxt <= i else \
+                list(range(i, nxt))
+            for s in steps:
+                joint = mech.joints[w.order[s]]
+                th = value.get(f"{joint.name}.theta", 0.0) if not w.turn_free[s] else 0.0
+                sl = value.get(f"{joint.name}.s", 0.0) if not w.slide_free[s] else 0.0
+                G = G @ _screw(w.points[s], w.axes[s], th, sl)
+            links.append(np.linalg.inv(frames[n_j]) @ G @ frames[(n_j + 1) % len(free)])
+        parts = [_split_real(L) for L in links]
+        lay, L = loop_layout(self.kinds), max(mech.length_scale, 1e-12)
+        p = np.zeros(lay.n_parameters)
+        turn_off, slide_off = np.zeros(len(free)), np.zeros(len(free))
+        k = lay.n_unknowns
+        for j in range(len(free)):
+            phi, b, a, alpha, _, _ = parts[j]
+            psi, e = parts[j - 1][4], parts[j - 1][5]
+            turn_off[j], slide_off[j] = phi + psi, b + e
+            if lay.phi[j] >= 0:
+                p[lay.phi[j] - k: lay.phi[j] - k + 2] = np.cos(turn_off[j] / 2), np.sin(
+                    turn_off[j] / 2)
+            if lay.b[j] >= 0:
+                p[lay.b[j] - k] = slide_off[j] / L
+            p[lay.a[j] - k] = a / L
+            p[lay.alpha[j] - k: lay.alpha[j] - k + 2] = np.cos(alpha / 2), np.sin(alpha / 2)
+        return p, turn_off, slide_off
+
+    def parameters(self, input_values: ArrayLike) -> Array:
+        """The parameters (B, k) at rows of inputs (B, n_inputs) (radians, metres)."""
+        X = np.atleast_2d(np.asarray(input_values, dtype=float))
+        if X.shape[1:] != (len(self.mechanism.inputs),):
+            raise InputError(f"{self.mechanism.name}: rows of {len(self.mechanism.inputs)} "
+                             f"input values are needed; got shape {X.shape}")
+        return np.array([self._instance(row)[0] for row in X])
+
+    def _free(self) -> list[tuple[int, int]]:
+        """(free joint j, its mechanism joint index) round the loop."""
+        w = _walk(self.mechanism)
+        return [(j, w.order[i]) for j, i in enumerate(
+            i for i in range(len(w.order)) if w.turn_free[i] or w.slide_free[i])]
+
+    def unknowns(self, scalars: ArrayLike, input_values: ArrayLike) -> Array:
+        """The system's unknowns (N, n) at the graph tracker's joint values (N, n_scalar) at
+        one row of inputs: the way in, independent of :meth:`configuration`."""
+        S = np.atleast_2d(np.asarray(scalars, dtype=float))
+        row = np.asarray(input_values, dtype=float).reshape(-1)
+        _, turn_off, slide_off = self._instance(row)
+        lay, glay = loop_layout(self.kinds), graph_layout(self.mechanism)
+        x = np.zeros((S.shape[0], lay.n_unknowns))
+        for j, k in self._free():
+            f0 = glay.first_freedom[k]
+            if lay.cs[j] >= 0:
+                q = S[:, glay.scalar_col[f0]] + turn_off[j]
+                x[:, lay.cs[j]], x[:, lay.cs[j] + 1] = np.cos(q), np.sin(q)
+            if lay.d[j] >= 0:
+                f = f0 + (1 if self.mechanism.joints[k].kind == "C" else 0)
+                x[:, lay.d[j]] = (S[:, glay.scalar_col[f]] + slide_off[j]) / max(
+                    self.mechanism.length_scale, 1e-12)
+        return x
+
+    def configuration(self, solutions: ArrayLike, input_values: ArrayLike
+                      ) -> tuple[Configuration, GraphLayout]:
+        """The graph tracker's configurations (N) of real solutions (N, n) at one row."""
+        mech = self.mechanism
+        row = np.asarray(input_values, dtype=float).reshape(-1)
+        if row.shape != (len(mech.inputs),):
+            raise InputError(f"{mech.name}: {len(mech.inputs)} input values are needed")
+        sol = np.real(np.atleast_2d(np.asarray(solutions)))
+        _, turn_off, slide_off = self._instance(row)
+        lay, glay = loop_layout(self.kinds), graph_layout(mech)
+        scalars = np.zeros((sol.shape[0], glay.n_scalar))
+        for name, v in zip(mech.inputs, row, strict=True):
+            joint, freedom = name.split(".")
+            k = next(i for i, j in enumerate(mech.joints) if j.name == joint)
+            f = glay.first_freedom[k] + mech.joints[k].freedoms.index(freedom)
+            scalars[:, glay.scalar_col[f]] = v
+        for j, k in self._free():
+            f0 = glay.first_freedom[k]
+            if lay.cs[j] >= 0:
+                q = np.arctan2(sol[:, lay.cs[j] + 1], sol[:, lay.cs[j]]) - turn_off[j]
+                scalars[:, glay.scalar_col[f0]] = np.mod(q + np.pi, 2 * np.pi) - np.pi
+            if lay.d[j] >= 0:
+                f = f0 + (1 if mech.joints[k].kind == "C" else 0)
+                scalars[:, glay.scalar_col[f]] = sol[:, lay.d[j]] * max(
+                    mech.length_scale, 1e-12) - slide_off[j]
+        return Configuration(scalars, np.zeros((sol.shape[0], 0, 3, 3))), glay
+
+
+def general_loop(mech: Mechanism) -> GeneralLoop:
+    """The general loop formulation of ``mech`` (a CapabilityError where it does not fit)."""
+    kinds = loop_kinds(mech)
+    return GeneralLoop(mech, kinds, general_loop_system(kinds))
+
