@@ -266,6 +266,9 @@ def test_sigterm_is_an_interrupt_with_its_own_exit_code():
 
 def test_a_task_that_kills_every_worker_running_it_stops_with_one_sentence():
     import dask
+    import distributed  # noqa: F401 - its config defaults must exist before dask.config.set:
+    # a block that creates the "distributed" key deletes it on leaving, defaults and all, and
+    # the next embedded cluster in this process fails with KeyError('distributed')
 
     # one death is enough here (Dask's default tries it on four workers in turn)
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
