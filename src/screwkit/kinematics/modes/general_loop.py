@@ -32,9 +32,10 @@ from screwkit.kinematics.modes.general_loop_system import (
     loop_layout,
     split_link,
 )
+from screwkit.kinematics.modes.r_loop import loop_walk
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.messages import listing
-from screwkit.model.mechanism import GROUND, Mechanism
+from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]
 #: below this sin α two consecutive free axes are taken as parallel (the normal is then chosen)
@@ -98,24 +99,13 @@ def _walk(mech: Mechanism) -> _Walk:
         raise CapabilityError(f"{mech.name}: joints {listing(bad)} are not R, P or C joints; "
                               "the general loop formulation takes those only")
     driven = set(mech.inputs)
-    order, points, axes, turn, slide = [], [], [], [], []
-    body, used = GROUND, set()
-    while True:
-        k = next((i for i, j in enumerate(mech.joints) if body in j.bodies and i not in used),
-                 None)
-        if k is None:
-            raise CapabilityError(f"{mech.name}: the loop does not pass through the ground")
-        j = mech.joints[k]
-        forward = j.bodies[0] == body
-        used.add(k)
-        order.append(k)
-        points.append(j.at)
-        axes.append(j.axis if forward else -j.axis)
-        turn.append(j.kind in "RC" and f"{j.name}.theta" not in driven)
-        slide.append(j.kind in "PC" and f"{j.name}.s" not in driven)
-        body = j.bodies[1] if forward else j.bodies[0]
-        if body == GROUND:
-            return _Walk(tuple(order), tuple(points), tuple(axes), tuple(turn), tuple(slide))
+    steps = loop_walk(mech)
+    joints = [mech.joints[k] for k, _ in steps]
+    return _Walk(tuple(k for k, _ in steps), tuple(j.at for j in joints),
+                 tuple(j.axis if forward else -j.axis
+                       for j, (_, forward) in zip(joints, steps, strict=True)),
+                 tuple(j.kind in "RC" and f"{j.name}.theta" not in driven for j in joints),
+                 tuple(j.kind in "PC" and f"{j.name}.s" not in driven for j in joints))
 
 
 def loop_kinds(mech: Mechanism) -> str:

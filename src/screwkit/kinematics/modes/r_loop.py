@@ -83,7 +83,17 @@ def _walk(mech: Mechanism) -> tuple[list[int], list[Array]]:
     if bad:
         raise CapabilityError(f"{mech.name}: joints {listing(bad)} are not R joints; the 6R "
                               "formulation takes loops of R joints only")
-    order, axes, body, used = [], [], GROUND, set()
+    steps = loop_walk(mech)
+    return ([k for k, _ in steps],
+            [mech.joints[k].axis if forward else -mech.joints[k].axis for k, forward in steps])
+
+
+def loop_walk(mech: Mechanism) -> list[tuple[int, bool]]:
+    """A single loop's joints in order from the ground, each with whether the walk runs from
+    its first body to its second (``forward``); a CapabilityError where the loop does not pass
+    through the ground."""
+    steps: list[tuple[int, bool]] = []
+    body, used = GROUND, set()
     while True:
         k = next((i for i, j in enumerate(mech.joints) if body in j.bodies and i not in used),
                  None)
@@ -92,11 +102,10 @@ def _walk(mech: Mechanism) -> tuple[list[int], list[Array]]:
         j = mech.joints[k]
         forward = j.bodies[0] == body
         used.add(k)
-        order.append(k)
-        axes.append(j.axis if forward else -j.axis)
+        steps.append((k, forward))
         body = j.bodies[1] if forward else j.bodies[0]
         if body == GROUND:
-            return order, axes
+            return steps
 
 
 def r_loop_instance(mech: Mechanism, input_values: ArrayLike = ()) -> RLoopInstance:
