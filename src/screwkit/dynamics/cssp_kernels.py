@@ -206,7 +206,8 @@ def cssp_loads(rot: Any, org: Any, angvel: Any, angacc: Any, acc: Any, cen: Any,
     block_nan = np.zeros(4, dtype=np.bool_)
     scale2 = 0.0
     counted = 0
-    for start in range(0, n, TILE):
+    for tile in range((n + TILE - 1) // TILE):
+        start = tile * TILE  # not range(0, n, TILE): numba's start could be negative to LLVM
         m = min(TILE, n - start)
         _gather(rot, _ROT, 27, start, m, x)
         _gather(org, _ORG, 9, start, m, x)
