@@ -11,6 +11,11 @@ docstring) and the reported loads (:func:`screwkit.dynamics.cssp_fused_dynamics.
 is the numpy route's with its operations in the same order; the numpy route only skips products
 with a constant zero and sums with one, which change nothing but the sign of a zero. No
 fastmath: the loads are the numpy route's bit for bit (tests/dynamics/test_cssp_compiled.py).
+
+The tiles are counted, ``start = tile * TILE``: stepped by ``range(0, n, TILE)``, numba's
+wraparound of negative indices left LLVM unable to prove ``start + k`` non-negative, and every
+row's gather and scatter became masked vector gathers and scatters (the whole call 2× slower;
+the test checks the optimised IR for them).
 """
 
 from __future__ import annotations
