@@ -11,6 +11,11 @@ docstring) and the reported loads (:func:`screwkit.dynamics.cssp_fused_dynamics.
 is the numpy route's with its operations in the same order; the numpy route only skips products
 with a constant zero and sums with one, which change nothing but the sign of a zero. No
 fastmath: the loads are the numpy route's bit for bit (tests/dynamics/test_cssp_compiled.py).
+
+The tiles are counted, ``start = tile * TILE``: stepped by ``range(0, n, TILE)``, numba's
+wraparound of negative indices left LLVM unable to prove ``start + k`` non-negative, and every
+row's gather and scatter became masked vector gathers and scatters (the whole call 2× slower;
+the test checks the optimised IR for them).
 """
 
 from __future__ import annotations
@@ -206,7 +211,8 @@ def cssp_loads(rot: Any, org: Any, angvel: Any, angacc: Any, acc: Any, cen: Any,
     block_nan = np.zeros(4, dtype=np.bool_)
     scale2 = 0.0
     counted = 0
-    for start in range(0, n, TILE):
+    for tile in range((n + TILE - 1) // TILE):
+        start = tile * TILE  # not range(0, n, TILE): numba's start could be negative to LLVM
         m = min(TILE, n - start)
         _gather(rot, _ROT, 27, start, m, x)
         _gather(org, _ORG, 9, start, m, x)

@@ -102,7 +102,8 @@ def lean_rows(ct: Any, st: Any, w: Any, wd: Any, s1: Any, s1d: Any, s1dd: Any, d
     n = ct.shape[0]
     buf = np.zeros((_IN + 7, TILE))
     a4, a2, sa, ca, a1 = p[0], p[6], p[1], p[2], p[5]
-    for t0 in range(0, n, TILE):
+    for tile in range((n + TILE - 1) // TILE):
+        t0 = tile * TILE  # not range(0, n, TILE): numba's t0 could be negative to LLVM
         m = min(TILE, n - t0)
         _fill(buf, _IN, w, t0, m)
         _fill(buf, _IN + 1, wd, t0, m)
