@@ -47,6 +47,7 @@ from numpy.typing import NDArray
 from scipy.linalg import lapack
 
 from screwkit.algebraic.polynomial import Complex
+from screwkit.kinematics.modes import stewart_sparse
 from screwkit.kinematics.modes import stewart_template_data as data
 from screwkit.kinematics.modes.stewart import PATCH, quaternion_product, rotation_numerator
 
@@ -198,6 +199,13 @@ def _layout() -> dict[str, Any]:
             "r_pos": new_col[data.KEPT:]}
 
 
+def layout() -> dict[str, Any]:
+    """Where each coefficient of the template goes (flat indices into the square matrix and
+    the right-hand side, rows and columns renumbered block by block), the block bounds, the
+    action matrix's rows and R's columns (``r_pos``): for :mod:`.stewart_sparse`."""
+    return _layout()
+
+
 def _blocks(n: int, dst: Index, src: Index) -> list[tuple[Index, Index]]:
     """:func:`block_triangular` of the square matrix, its pattern read at a random instance (a
     structural zero, such as y·y in the differences, is exactly zero there)."""
@@ -328,17 +336,44 @@ def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = No
     work = {} if work is None else work
     lay = _layout()
     real = bool(np.all(p.imag == 0))
-    dtype = np.float64 if real else np.complex128
-    n, m = len(data.SQUARE), len(data.BASIS)
+    m = len(data.BASIS)
     c: Any = coefficients(p, label).reshape(len(p), -1)
     c = c.real if real else c
     good: NDArray[np.bool_] = np.asarray(np.isfinite(c).all(axis=1), dtype=bool)
-    X: Any = np.empty((len(p), n, m), dtype=dtype)  # rows no R reads stay unset
+    # a whole group of real instances in chart 0: the sparse route (one group costs about
+    # what the LAPACK route costs per instance, so a lone instance stays with LAPACK)
+    if real and label == 0 and stewart_sparse.AVAILABLE and len(p) >= stewart_sparse.GROUP:
+        R, fine = stewart_sparse.r_rows(np.where(good[:, None], c, 0.0))
+        redo = np.flatnonzero(good & ~fine)  # the growth check's rejects: by LAPACK
+        if len(redo):
+            some = good[redo]
+            R[redo] = _r_by_blocks(c[redo], some, work)
+            good[redo] = some
+    else:
+        R = _r_by_blocks(c, good, work)
+    act = lay["action"]
+    Am: Any = np.zeros((len(p), m, m), dtype=R.dtype)
+    inside = np.flatnonzero(act >= 0)
+    Am[:, inside, act[inside]] = 1.0
+    Am[:, act < 0] = R[:, -1 - act[act < 0]]
+    good &= np.isfinite(Am).all(axis=(1, 2))
+    if not good.all():
+        Am[~good] = np.eye(m)
+    return Am, good
+
+
+def _r_by_blocks(c: Any, good: NDArray[np.bool_], work: dict[str, Any]) -> Any:
+    """X_R (B, 29, 40) of the template coefficients c (B, 252), real or complex, by the
+    block-triangular solve of :func:`_plan` with LAPACK's LU (partial pivoting within each
+    block); an instance whose blocks are singular is cleared in ``good``."""
+    dtype = c.dtype.type
+    n, m = len(data.SQUARE), len(data.BASIS)
+    X: Any = np.empty((len(c), n, m), dtype=dtype)  # rows no R reads stay unset
 
     def zeros(name: str, i: int, shape: tuple[int, int]) -> Any:
-        key = f"{name}{i}{dtype.__name__}{len(p)}"
+        key = f"{name}{i}{dtype.__name__}{len(c)}"
         if key not in work:
-            work[key] = np.zeros((len(p), shape[0] * shape[1]), dtype=dtype)
+            work[key] = np.zeros((len(c), shape[0] * shape[1]), dtype=dtype)
         return work[key]
 
     for i, blk in enumerate(_plan()):
@@ -370,16 +405,7 @@ def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = No
         if below is not None:
             rows = rows - (Zt @ below) @ X[:, used]
         X[:, a + want] = rows
-    R = X[:, lay["r_pos"]]
-    act = lay["action"]
-    Am: Any = np.zeros((len(p), m, m), dtype=dtype)
-    inside = np.flatnonzero(act >= 0)
-    Am[:, inside, act[inside]] = 1.0
-    Am[:, act < 0] = R[:, -1 - act[act < 0]]
-    good &= np.isfinite(Am).all(axis=(1, 2))
-    if not good.all():
-        Am[~good] = np.eye(m)
-    return Am, good
+    return X[:, _layout()["r_pos"]]
 
 
 @lru_cache(maxsize=1)
