@@ -117,3 +117,23 @@ def test_an_instance_failing_the_check_is_solved_by_lapack(
     c[3, 0] = np.inf
     _, ok = stewart_sparse.r_rows(c)
     assert not ok[3] and ok[np.arange(9) != 3].all()
+
+
+def test_the_vector_kernel_is_the_plain_one_bit_for_bit() -> None:
+    from screwkit.kinematics.modes import stewart_sparse_kernels as kernels
+
+    plan = stewart_sparse.schedule()
+    G = kernels.LANES
+    c = _coefficients(45, G)
+    outs = []
+    for kernel in (kernels.eliminate, kernels.eliminate_vector):
+        w, U = np.zeros((plan["columns"], G)), np.zeros((len(plan["u_col"]), G))
+        out = np.zeros((plan["left"], plan["out_col"].shape[1], G))
+        big = np.zeros(G)
+        kernel(np.ascontiguousarray(c.T), plan["init_ptr"], plan["init_col"], plan["init_src"],
+               plan["upd_ptr"], plan["upd_step"], plan["pivot_col"], plan["u_ptr"],
+               plan["u_col"], plan["out_col"], w, U, out, big)
+        assert np.all(w == 0.0) and np.isfinite(out).all()
+        outs.append((out, big))
+    np.testing.assert_array_equal(outs[0][0], outs[1][0])
+    np.testing.assert_array_equal(outs[0][1], outs[1][1])

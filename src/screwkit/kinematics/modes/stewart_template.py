@@ -54,9 +54,9 @@ from screwkit.kinematics.modes.stewart import PATCH, quaternion_product, rotatio
 Index = NDArray[np.intp]
 #: affine unknowns w = (ξ1, ξ2, ξ3, y0, y1, y2, y3)
 UNKNOWNS = 7
-#: instances eliminated together (the template is 526 × 526: 2.2 MB each in float64; more
-#: at once gains nothing, the solves are LAPACK's one by one)
-CHUNK = 8
+#: instances eliminated together: one group of the sparse route (:mod:`.stewart_sparse`); the
+#: LAPACK route's solves are one by one, so its chunk size matters little
+CHUNK = stewart_sparse.GROUP
 #: threads over the chunks of a batch: the cores this process may use
 THREADS = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
