@@ -29,8 +29,15 @@ The square matrix is solved in its block triangular form (:func:`block_triangula
 (:func:`_plan`). Only the rows of R enter the action matrix, and the last block is read by no
 later block and holds one of them: it is solved for that row alone, as the row of its inverse
 times the right-hand side (one transposed solve of its LU with one right-hand side, not 40;
-Golub & Van Loan 2013, *Matrix Computations*, §3.2). A batch's chunks are spread over the
-cores in threads (LAPACK releases the GIL); each instance's arithmetic is the same either way. The points are unpolished;
+Golub & Van Loan 2013, *Matrix Computations*, §3.2). That is the LAPACK route; a whole
+group of :data:`.stewart_sparse.GROUP` real instances in chart 0 takes the sparse route
+instead (:mod:`.stewart_sparse`: one pivot sequence for every instance, the group side by side
+in vector operations, ~2.3× less CPU per instance in a batch; its rejects go to the LAPACK
+route), and a lone instance, a short group, a complex one or another chart the LAPACK route.
+So an instance's raw points alone and in a batch can differ (two pivotings); after the polish
+they agree to ~1e-10 (relative). A batch's chunks are spread over the
+cores in threads (LAPACK releases the GIL; BLAS's own threads held at one meanwhile, by
+threadpoolctl); each instance's arithmetic is the same on either. The points are unpolished;
 modes/stewart_solve.py polishes, certifies and falls back to the homotopy.
 """
 
@@ -279,8 +286,10 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
     points come in exact conjugate pairs with conjugate ξ1 and the real ones have real ξ1).
     An instance whose template is singular or not finite gets NaN points. A batch of more
     than one chunk is split into :data:`THREADS` contiguous parts eliminated side by side
-    (LAPACK releases the GIL); each instance's arithmetic is the same either way, and the
-    same as alone (a real instance's is real in a batch with complex ones too)."""
+    (LAPACK and the sparse kernel release the GIL); each instance's arithmetic is the same
+    either way. It is the same as alone, but for the instances in whole groups of real ones
+    (the sparse route, module docstring); a real instance's is real in a batch with complex
+    ones too."""
     B = len(params)
     m = len(data.BASIS)
     points = np.full((B, m, 8), np.nan, dtype=complex)
@@ -303,12 +312,25 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
     if threads <= 1:
         part(0, B)
         return points, keys
-    # parts of whole chunks, as even as they come
+    # parts of whole chunks, as even as they come; OpenBLAS's own threads held at one while
+    # they run (else each part's LAPACK calls start threads of their own on the same cores:
+    # 56 against 1.8 ms per instance in a batch of 1,000 by the LAPACK route, 2.8 against 1.8
+    # by the sparse route, with OPENBLAS_NUM_THREADS unset; 2 cores, load ~3)
     cuts = [CHUNK * (-(-B // CHUNK) * t // threads) for t in range(threads)] + [B]
-    with ThreadPoolExecutor(threads) as pool:
+    with blas_controller().limit(limits=1, user_api="blas"), \
+            ThreadPoolExecutor(threads) as pool:
         for f in [pool.submit(part, a, b) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]:
             f.result()
     return points, keys
+
+
+@lru_cache(maxsize=1)
+def blas_controller() -> Any:
+    """threadpoolctl's view of the BLAS libraries loaded (found once: ~3 ms; a limit then
+    costs ~20 µs), for holding BLAS's threads at one while a batch runs in threads."""
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
 
 
 def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Complex]:
