@@ -309,18 +309,21 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
                         points[rows], keys[rows] = _chunk(params[rows], label, work)
 
     threads = min(THREADS, -(-B // CHUNK))
-    if threads <= 1:
-        part(0, B)
-        return points, keys
-    # parts of whole chunks, as even as they come; OpenBLAS's own threads held at one while
-    # they run (else each part's LAPACK calls start threads of their own on the same cores:
-    # 56 against 1.8 ms per instance in a batch of 1,000 by the LAPACK route, 2.8 against 1.8
-    # by the sparse route, with OPENBLAS_NUM_THREADS unset; 2 cores, load ~3)
-    cuts = [CHUNK * (-(-B // CHUNK) * t // threads) for t in range(threads)] + [B]
-    with blas_controller().limit(limits=1, user_api="blas"), \
-            ThreadPoolExecutor(threads) as pool:
-        for f in [pool.submit(part, a, b) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]:
-            f.result()
+    # BLAS's own threads held at one: with a batch in threads, else each part's LAPACK calls
+    # start threads of their own on the same cores (56 against 1.8 ms per instance in a batch
+    # of 1,000 by the LAPACK route, 2.8 against 1.8 by the sparse route, OPENBLAS_NUM_THREADS
+    # unset; 2 cores, load ~3); alone too, so that the arithmetic (a threaded LU sums in
+    # another order) is the same whatever the threads
+    with blas_controller().limit(limits=1, user_api="blas"):
+        if threads <= 1:
+            part(0, B)
+            return points, keys
+        # parts of whole chunks, as even as they come
+        cuts = [CHUNK * (-(-B // CHUNK) * t // threads) for t in range(threads)] + [B]
+        with ThreadPoolExecutor(threads) as pool:
+            for f in [pool.submit(part, a, b)
+                      for a, b in zip(cuts[:-1], cuts[1:], strict=True)]:
+                f.result()
     return points, keys
 
 
