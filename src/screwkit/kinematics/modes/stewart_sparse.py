@@ -8,20 +8,20 @@ rows in R and B alone, C_R·X_R + C_B = 0, solved densely (29 × 29, LAPACK with
 pivoting). The pivot sequence is chosen once, from the pattern and one random real instance:
 Markowitz's rule (the pivot with the least (row count − 1)·(column count − 1)), among the
 entries at least :data:`THRESHOLD` times their column's largest (threshold partial pivoting;
-Duff, Erisman & Reid, *Direct Methods for Sparse Matrices*, 2nd ed. 2017, §7.8 and §10.2).
+Duff, Erisman & Reid, *Direct Methods for Sparse Matrices*, 2nd ed. 2017, on both).
 The elimination with that sequence is then a fixed list of operations: 3.1 Mflop per instance
-against ~30 Mflop for the block-triangular dense LUs (313 and 206). It runs row by row (each row gathered in
-a dense accumulator, the earlier pivot rows subtracted from it in order: Gilbert & Peierls 1988,
-the same operations in the same order as the right-looking elimination), :data:`GROUP`
-instances side by side, the instance the innermost index
-(:func:`.stewart_sparse_kernels.eliminate`): one vector operation per arithmetic operation of
-the pattern and no index arithmetic per instance.
+against ~30 Mflop for the block-triangular dense LUs (313 and 206). It runs row by row (each
+row gathered in a dense accumulator, the earlier pivot rows subtracted from it in order:
+Gilbert & Peierls 1988, the same operations in the same order as the right-looking
+elimination), :data:`GROUP` instances side by side, the instance the innermost index
+(:mod:`.stewart_sparse_kernels`): one vector operation per arithmetic operation of the
+pattern, its indices read once for the whole group.
 
 A pivot fixed beforehand can be small at another instance, and here it often is: the
 multipliers reach 4e5 at the median instance, 6e8 at the 99th percentile (800 bench
 instances), and the R rows are further from a dense partial-pivoting LU of the whole template
-than the block-triangular LAPACK route's (relative, over 400 instances: median 3e-7 against
-1e-10, 90th percentile 3e-5 against 5e-9, a few in a thousand 1e-2 and worse). The multiplier
+than the block-triangular LAPACK route's (relative, over 200 instances: median 4e-7 against
+1e-10, 90th percentile 2e-5 against 6e-9, 99th 3e-3 against 4e-7, the worst 1.8). The multiplier
 does not predict which (correlation of the logarithms 0.4). So the check that decides is the
 caller's: the eigen route polishes every point by Newton's method and certifies the 40 by the
 α-test (:mod:`.eigen_first`), and an instance not settled goes to the next chart, eliminated by
