@@ -168,6 +168,12 @@ def _flops(u_ptr: list[int], upd_step: list[int]) -> int:
     return int(np.sum(2 * length[np.asarray(upd_step, dtype=np.intp)] + 1))
 
 
+def prepare() -> None:
+    """The schedule made and the kernel compiled (or loaded from numba's cache), once per
+    process: before a batch's threads start, so that they do not each make them."""
+    _kernel()
+
+
 @lru_cache(maxsize=1)
 def _kernel() -> Any:
     """:func:`.stewart_sparse_kernels.eliminate_vector`, or its plain twin

@@ -314,6 +314,8 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
     # of 1,000 by the LAPACK route, 2.8 against 1.8 by the sparse route, OPENBLAS_NUM_THREADS
     # unset; 2 cores, load ~3); alone too, so that the arithmetic (a threaded LU sums in
     # another order) is the same whatever the threads
+    if stewart_sparse.AVAILABLE and label == 0 and real.sum() >= stewart_sparse.GROUP:
+        stewart_sparse.prepare()
     with blas_controller().limit(limits=1, user_api="blas"):
         if threads <= 1:
             part(0, B)
