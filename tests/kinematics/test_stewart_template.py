@@ -252,3 +252,25 @@ def test_a_real_instance_in_a_batch_with_complex_ones_is_eliminated_as_alone() -
         assert np.array_equal(alone[0][0], pts[b]) and np.array_equal(alone[1][0], keys[b]), b
     for b in (0, 1, 2, 6, 7, 8):
         assert np.array_equal(np.sort_complex(keys[b]), np.sort_complex(keys[b].conj()))
+
+
+def test_blas_runs_one_thread_inside_a_batch(monkeypatch: pytest.MonkeyPatch) -> None:
+    """While a batch is eliminated (in threads of its own), BLAS's threads are held at one, and
+    released after (else OpenBLAS's threads and the batch's share the same cores)."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    seen: list[int] = []
+    inner = stewart_template.action_matrices
+
+    def spy(*args: object, **kwargs: object) -> object:
+        seen.extend(i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas")
+        return inner(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(stewart_template, "action_matrices", spy)
+    monkeypatch.setattr(stewart_template, "THREADS", 2)
+    p, _ = random_stewart(np.random.default_rng(46), 2 * stewart_template.CHUNK + 1)
+    with threadpool_limits(2, user_api="blas"):
+        template_solve(p.real.astype(complex))
+        after = [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+    assert seen and set(seen) == {1}
+    assert set(after) == {2}
