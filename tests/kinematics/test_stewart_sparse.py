@@ -137,3 +137,35 @@ def test_the_vector_kernel_is_the_plain_one_bit_for_bit() -> None:
         outs.append((out, big))
     np.testing.assert_array_equal(outs[0][0], outs[1][0])
     np.testing.assert_array_equal(outs[0][1], outs[1][1])
+
+
+def test_a_mixed_batch_gives_each_instance_its_poses(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A batch of real and complex instances: a chunk of real ones alone takes the sparse
+    route, a chunk with complex ones the LAPACK route (complex arithmetic for those, real for
+    the real ones); every instance's poses are the ones it has in a batch of its own kind, the
+    real ones' conjugate pairs exact."""
+    G = stewart_sparse.GROUP
+    p, _ = random_stewart(np.random.default_rng(47), 2 * G)
+    q, _ = random_stewart(np.random.default_rng(48), 3, complex_values=True)
+    real = p.real.astype(complex)
+    mixed = np.concatenate([real[:G], q[:1], real[G:], q[1:]])
+    where_real = np.r_[0:G, G + 1:2 * G + 1]
+    where_complex = (G, 2 * G + 1, 2 * G + 2)
+    groups: list[int] = []
+    inner = stewart_sparse.r_rows
+
+    def spy(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        groups.append(len(c))
+        return inner(c)
+
+    monkeypatch.setattr(stewart_sparse, "r_rows", spy)
+    sol = solve_stewart(mixed)
+    assert groups == [G]  # the first chunk, real only; the others hold complex instances
+    monkeypatch.setattr(stewart_sparse, "r_rows", inner)
+    alone_real, alone_complex = solve_stewart(real), solve_stewart(q)
+    assert np.all(sol.found == 40) and sol.route == (TEMPLATE,) * len(mixed)
+    for k, b in enumerate(where_real):
+        x = sol.of(int(b))
+        assert _matched(x, alone_real.of(k)) <= MATCH and _matched(x, x.conj()) <= MATCH, b
+    for k, b in enumerate(where_complex):
+        assert _matched(sol.of(b), alone_complex.of(k)) <= MATCH, b
