@@ -57,6 +57,7 @@ from screwkit.algebraic import compiled  # noqa: E402
 from screwkit.algebraic.path import TrackOptions  # noqa: E402
 from screwkit.algebraic.solve import solve_all  # noqa: E402
 from screwkit.algebraic.track import track_parameter_homotopy  # noqa: E402
+from screwkit.kinematics.modes import stewart_sparse  # noqa: E402
 from screwkit.kinematics.modes.loop6r import (  # noqa: E402
     loop6r_start,
     loop6r_system,
@@ -158,6 +159,16 @@ def _stewart_rows() -> list[dict[str, Any]]:
     w_batch = (time.perf_counter() - w0) / BATCH
     complete = int((sol.found == 40).sum())
     by_template = sum(r == TEMPLATE for r in sol.route)
+    # the batch with the sparse elimination off (every instance by the LAPACK route) and on,
+    # alternating (CPU time; medians of 3: the load moves)
+    routes: dict[bool, list[float]] = {}
+    for on in (False, True) * 3:
+        stewart_sparse.AVAILABLE = on and compiled.AVAILABLE
+        t0 = time.process_time()
+        solve_stewart(p)
+        routes.setdefault(on, []).append((time.process_time() - t0) / BATCH)
+    stewart_sparse.AVAILABLE = compiled.AVAILABLE
+    t_lapack, t_sparse_route = (float(np.median(routes[k])) for k in (False, True))
     gap = 0.0
     for b in range(nb):  # every homotopy solution within reach of one of the template route's
         a, h = sol.of(b), hom.of(b)
@@ -201,6 +212,11 @@ def _stewart_rows() -> list[dict[str, Any]]:
          + f"; the same run's elapsed time: the template's chunks on {TEMPLATE_THREADS} "
            f"thread(s) (modes/stewart_template.py THREADS; the CPU row above sums them); "
            f"a shared machine's load inflates it"},
+        {"name": f"Stewart FK, batch of {BATCH}, LAPACK route only", "value": t_lapack * 1e3,
+         "unit": "ms/instance", "target": "",
+         "note": f"every instance by the block-triangular LAPACK solve (the sparse elimination "
+                 f"off): {t_lapack / t_sparse_route:.1f}× the default route's "
+                 f"{t_sparse_route * 1e3:.2f} ms (CPU, medians of 3, alternating)"},
         {"name": f"Stewart FK by the homotopy, batch of {nb}", "value": t_fast_batch * 1e3,
          "unit": "ms/instance", "target": "",
          "note": f"the template route on the same {nb}: {t_tmpl_nb * 1e3:.1f} ms/instance "

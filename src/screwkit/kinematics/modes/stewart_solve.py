@@ -33,6 +33,8 @@ from screwkit.kinematics.modes.stewart import (
     stewart_system,
 )
 from screwkit.kinematics.modes.stewart_template import (
+    CHUNK,
+    blas_controller,
     quadric_forms,
     quadrics,
     template_solve,
@@ -105,4 +107,11 @@ def solve_stewart(params: ArrayLike, options: TrackOptions | None = None) -> Sol
     (B, 42) (:func:`.stewart.stewart_parameters`): the template, the parameter homotopy
     (``options``) for the instances it does not settle (module docstring). ``route`` says
     which ran for each instance."""
-    return eigen_first.solve_eigen_first(stewart_route(), _targets(params), options)
+    targets = _targets(params)
+    if len(targets) < 2 * CHUNK:
+        return eigen_first.solve_eigen_first(stewart_route(), targets, options)
+    # a batch runs on the cores in threads of its own (template_solve): BLAS's threads held at
+    # one for the whole solve, not only the elimination (OpenBLAS's threads, woken by a later
+    # small product, spin on the cores the batch's threads use)
+    with blas_controller().limit(limits=1, user_api="blas"):
+        return eigen_first.solve_eigen_first(stewart_route(), targets, options)

@@ -29,8 +29,15 @@ The square matrix is solved in its block triangular form (:func:`block_triangula
 (:func:`_plan`). Only the rows of R enter the action matrix, and the last block is read by no
 later block and holds one of them: it is solved for that row alone, as the row of its inverse
 times the right-hand side (one transposed solve of its LU with one right-hand side, not 40;
-Golub & Van Loan 2013, *Matrix Computations*, §3.2). A batch's chunks are spread over the
-cores in threads (LAPACK releases the GIL); each instance's arithmetic is the same either way. The points are unpolished;
+Golub & Van Loan 2013, *Matrix Computations*, §3.2). That is the LAPACK route; a whole
+group of :data:`.stewart_sparse.GROUP` real instances in chart 0 takes the sparse route
+instead (:mod:`.stewart_sparse`: one pivot sequence for every instance, the group side by side
+in vector operations, ~2.3× less CPU per instance in a batch; its rejects go to the LAPACK
+route), and a lone instance, a short group, a complex one or another chart the LAPACK route.
+So an instance's raw points alone and in a batch can differ (two pivotings); after the polish
+they agree to ~1e-10 (relative). A batch's chunks are spread over the
+cores in threads (LAPACK releases the GIL; BLAS's own threads held at one meanwhile, by
+threadpoolctl); each instance's arithmetic is the same on either. The points are unpolished;
 modes/stewart_solve.py polishes, certifies and falls back to the homotopy.
 """
 
@@ -47,15 +54,16 @@ from numpy.typing import NDArray
 from scipy.linalg import lapack
 
 from screwkit.algebraic.polynomial import Complex
+from screwkit.kinematics.modes import stewart_sparse
 from screwkit.kinematics.modes import stewart_template_data as data
 from screwkit.kinematics.modes.stewart import PATCH, quaternion_product, rotation_numerator
 
 Index = NDArray[np.intp]
 #: affine unknowns w = (ξ1, ξ2, ξ3, y0, y1, y2, y3)
 UNKNOWNS = 7
-#: instances eliminated together (the template is 526 × 526: 2.2 MB each in float64; more
-#: at once gains nothing, the solves are LAPACK's one by one)
-CHUNK = 8
+#: instances eliminated together: one group of the sparse route (:mod:`.stewart_sparse`); the
+#: LAPACK route's solves are one by one, so its chunk size matters little
+CHUNK = stewart_sparse.GROUP
 #: threads over the chunks of a batch: the cores this process may use
 THREADS = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
@@ -198,6 +206,13 @@ def _layout() -> dict[str, Any]:
             "r_pos": new_col[data.KEPT:]}
 
 
+def layout() -> dict[str, Any]:
+    """Where each coefficient of the template goes (flat indices into the square matrix and
+    the right-hand side, rows and columns renumbered block by block), the block bounds, the
+    action matrix's rows and R's columns (``r_pos``): for :mod:`.stewart_sparse`."""
+    return _layout()
+
+
 def _blocks(n: int, dst: Index, src: Index) -> list[tuple[Index, Index]]:
     """:func:`block_triangular` of the square matrix, its pattern read at a random instance (a
     structural zero, such as y·y in the differences, is exactly zero there)."""
@@ -271,8 +286,10 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
     points come in exact conjugate pairs with conjugate ξ1 and the real ones have real ξ1).
     An instance whose template is singular or not finite gets NaN points. A batch of more
     than one chunk is split into :data:`THREADS` contiguous parts eliminated side by side
-    (LAPACK releases the GIL); each instance's arithmetic is the same either way, and the
-    same as alone (a real instance's is real in a batch with complex ones too)."""
+    (LAPACK and the sparse kernel release the GIL); each instance's arithmetic is the same
+    either way. It is the same as alone, but for the instances in whole groups of real ones
+    (the sparse route, module docstring); a real instance's is real in a batch with complex
+    ones too."""
     B = len(params)
     m = len(data.BASIS)
     points = np.full((B, m, 8), np.nan, dtype=complex)
@@ -292,15 +309,33 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
                         points[rows], keys[rows] = _chunk(params[rows], label, work)
 
     threads = min(THREADS, -(-B // CHUNK))
-    if threads <= 1:
-        part(0, B)
-        return points, keys
-    # parts of whole chunks, as even as they come
-    cuts = [CHUNK * (-(-B // CHUNK) * t // threads) for t in range(threads)] + [B]
-    with ThreadPoolExecutor(threads) as pool:
-        for f in [pool.submit(part, a, b) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]:
-            f.result()
+    # BLAS's own threads held at one: with a batch in threads, else each part's LAPACK calls
+    # start threads of their own on the same cores (56 against 1.8 ms per instance in a batch
+    # of 1,000 by the LAPACK route, 2.8 against 1.8 by the sparse route, OPENBLAS_NUM_THREADS
+    # unset; 2 cores, load ~3); alone too, so that the arithmetic (a threaded LU sums in
+    # another order) is the same whatever the threads
+    if stewart_sparse.AVAILABLE and label == 0 and real.sum() >= stewart_sparse.GROUP:
+        stewart_sparse.prepare()
+    with blas_controller().limit(limits=1, user_api="blas"):
+        if threads <= 1:
+            part(0, B)
+            return points, keys
+        # parts of whole chunks, as even as they come
+        cuts = [CHUNK * (-(-B // CHUNK) * t // threads) for t in range(threads)] + [B]
+        with ThreadPoolExecutor(threads) as pool:
+            for f in [pool.submit(part, a, b)
+                      for a, b in zip(cuts[:-1], cuts[1:], strict=True)]:
+                f.result()
     return points, keys
+
+
+@lru_cache(maxsize=1)
+def blas_controller() -> Any:
+    """threadpoolctl's view of the BLAS libraries loaded (found once: ~3 ms; a limit then
+    costs ~20 µs), for holding BLAS's threads at one while a batch runs in threads."""
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
 
 
 def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Complex]:
@@ -328,17 +363,44 @@ def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = No
     work = {} if work is None else work
     lay = _layout()
     real = bool(np.all(p.imag == 0))
-    dtype = np.float64 if real else np.complex128
-    n, m = len(data.SQUARE), len(data.BASIS)
+    m = len(data.BASIS)
     c: Any = coefficients(p, label).reshape(len(p), -1)
     c = c.real if real else c
     good: NDArray[np.bool_] = np.asarray(np.isfinite(c).all(axis=1), dtype=bool)
-    X: Any = np.empty((len(p), n, m), dtype=dtype)  # rows no R reads stay unset
+    # a whole group of real instances in chart 0: the sparse route (one group costs about
+    # what the LAPACK route costs per instance, so a lone instance stays with LAPACK)
+    if real and label == 0 and stewart_sparse.AVAILABLE and len(p) >= stewart_sparse.GROUP:
+        R, fine = stewart_sparse.r_rows(np.where(good[:, None], c, 0.0))
+        redo = np.flatnonzero(good & ~fine)  # the growth check's rejects: by LAPACK
+        if len(redo):
+            some = good[redo]
+            R[redo] = _r_by_blocks(c[redo], some, work)
+            good[redo] = some
+    else:
+        R = _r_by_blocks(c, good, work)
+    act = lay["action"]
+    Am: Any = np.zeros((len(p), m, m), dtype=R.dtype)
+    inside = np.flatnonzero(act >= 0)
+    Am[:, inside, act[inside]] = 1.0
+    Am[:, act < 0] = R[:, -1 - act[act < 0]]
+    good &= np.isfinite(Am).all(axis=(1, 2))
+    if not good.all():
+        Am[~good] = np.eye(m)
+    return Am, good
+
+
+def _r_by_blocks(c: Any, good: NDArray[np.bool_], work: dict[str, Any]) -> Any:
+    """X_R (B, 29, 40) of the template coefficients c (B, 252), real or complex, by the
+    block-triangular solve of :func:`_plan` with LAPACK's LU (partial pivoting within each
+    block); an instance whose blocks are singular is cleared in ``good``."""
+    dtype = c.dtype.type
+    n, m = len(data.SQUARE), len(data.BASIS)
+    X: Any = np.empty((len(c), n, m), dtype=dtype)  # rows no R reads stay unset
 
     def zeros(name: str, i: int, shape: tuple[int, int]) -> Any:
-        key = f"{name}{i}{dtype.__name__}{len(p)}"
+        key = f"{name}{i}{dtype.__name__}{len(c)}"
         if key not in work:
-            work[key] = np.zeros((len(p), shape[0] * shape[1]), dtype=dtype)
+            work[key] = np.zeros((len(c), shape[0] * shape[1]), dtype=dtype)
         return work[key]
 
     for i, blk in enumerate(_plan()):
@@ -370,16 +432,7 @@ def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = No
         if below is not None:
             rows = rows - (Zt @ below) @ X[:, used]
         X[:, a + want] = rows
-    R = X[:, lay["r_pos"]]
-    act = lay["action"]
-    Am: Any = np.zeros((len(p), m, m), dtype=dtype)
-    inside = np.flatnonzero(act >= 0)
-    Am[:, inside, act[inside]] = 1.0
-    Am[:, act < 0] = R[:, -1 - act[act < 0]]
-    good &= np.isfinite(Am).all(axis=(1, 2))
-    if not good.all():
-        Am[~good] = np.eye(m)
-    return Am, good
+    return X[:, _layout()["r_pos"]]
 
 
 @lru_cache(maxsize=1)
