@@ -85,6 +85,7 @@ class ModesAlong:
     """Every mode found along the inputs: ``configurations[k]`` (N samples) where
     ``masks[k]`` holds, with ``events[k]``; ``anchors`` the anchor samples; ``notes`` what was
     found and how; ``meets`` the pairs of modes that meet at a fold (:func:`fold_meetings`);
+    ``islands`` the modes inside one sample step (on no sample; modes/step_islands.py);
     ``folds[k]`` where mode k is born or dies (the input, the configuration next to it)."""
 
     configurations: tuple[Configuration, ...]
@@ -95,6 +96,7 @@ class ModesAlong:
     solved: MechanismModes
     meets: tuple[tuple[int, int], ...] = ()
     folds: tuple[tuple[tuple[Array, Configuration], ...], ...] = ()
+    islands: tuple[int, ...] = ()
 
 
 def anchor_samples(N: int, per_anchor: float) -> NDArray[np.intp]:
@@ -157,16 +159,23 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     extra = _islands(mech, lay, X, anchors, chains, write)
     unshare(mech, lay, X, chains, MATCH_TOLERANCE, write)
     partner_folds(mech, lay, X, chains, write)
-    notes = _notes(solved, anchors, len(chains))
+    from screwkit.kinematics.modes.step_islands import step_islands
+
+    islands, island_notes = step_islands(mech, lay, X, write)
+    first_island = len(chains)
+    chains.extend(islands)
+    notes = _notes(solved, anchors, first_island)
     if extra:
         notes += (f"the homotopy also at the {extra} sample(s) next to a birth or death: "
-                  f"{len(chains) - before} mode(s) found there that reach no anchor (islands)",)
+                  f"{first_island - before} mode(s) found there that reach no anchor (islands)",)
+    notes += island_notes
     return ModesAlong(tuple(Configuration(c.scalars, c.spherical) for c in chains),
                       tuple(c.mask for c in chains),
                       tuple(tuple(c.events) + (_certificate_event(c),) for c in chains),
                       anchors, notes, solved,
                       fold_meetings(mech, lay, [c.folds for c in chains]),
-                      tuple(tuple(c.folds) for c in chains))
+                      tuple(tuple(c.folds) for c in chains),
+                      tuple(range(first_island, len(chains))))
 
 
 def _islands(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.intp],
@@ -374,6 +383,7 @@ def every_mode_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     why) where no formulation takes it."""
     from screwkit.budget import ResourceLimitError
     from screwkit.errors import CapabilityError
+    from screwkit.kinematics.graph.closed_modes import ISLAND
 
     only = "every mode: only the drawn mode is found for this mechanism: "
     if misfits(mech):
@@ -398,15 +408,16 @@ def every_mode_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
                               f"{input_text(mech, lay, X[both[int(np.argmax(far))]])}"
                               ": a possible branch switch of the drawn mode's tracker")
             drawn = with_events(drawn, [*drawn.events, *events])
-        elif m.any():
+        elif m.any() or k in along.islands:
             other.append(k)
     modes = [replace(drawn, label="drawn")]
     index = {k: i for i, k in enumerate([mine, *other]) if k is not None}
     for k in other:
         md = build_mode(mech, lay, along.configurations[k], along.masks[k], X, Xd, Xdd)
+        how = (f"(homotopy between two folds inside one sample step){ISLAND}"
+               if k in along.islands else "(homotopy at anchors, tracked between)")
         modes.append(replace(with_events(md, [*along.events[k], *md.events]),
-                             label=f"mode {len(modes)} (homotopy at anchors, tracked between)",
-                             index=len(modes)))
+                             label=f"mode {len(modes)} {how}", index=len(modes)))
     joins = [(index[a], index[b]) for a, b in along.meets if a in index and b in index]
     notes = [*along.notes, "circuits (modes that meet at a fold, where the input must turn "
              "back to go on): " + ", ".join("{" + ", ".join(map(str, c)) + "}"
