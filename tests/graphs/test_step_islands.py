@@ -1,0 +1,243 @@
+"""Folds and islands inside one sample step on the homotopy route (issue 27; modes/planar_folds.py,
+modes/step_islands.py): every fold of a planar mechanism's input as the critical points of its
+projection, and the island modes between two folds inside one step.
+
+Checked against things independent of the critical-point system: the distance law of a
+four-bar's dyad (|A − D| = b ± c, crank angle by arccos) and of an RRR dyad from the crank to the
+ground (|E − F| = g₁ ± g₂), on random mechanisms; the closed-form sub-chain route's island modes
+(graph/step_folds.py) on the ISLAND six-bar of tests/graphs/test_step_folds.py; the homotopy
+route's own births and deaths (bisection of the tracked modes) on the Stephenson III six-bar;
+the critical points' count at two random kernel scalings h and by monodromy from one of them."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from tests.graphs.test_step_folds import (
+    ISLAND_DRAWN,
+    ISLAND_INPUTS,
+    Z,
+    _crank_at,
+    _island_dims,
+    _meet,
+    _sixbar,
+)
+
+import screwkit as sk
+from screwkit.algebraic.monodromy import MonodromyOptions
+from screwkit.algebraic.solve import StartSolutions
+from screwkit.kinematics.graph import solve_mechanism
+from screwkit.kinematics.graph.closure import graph_layout
+from screwkit.kinematics.modes import step_islands as step_islands_module
+from screwkit.kinematics.modes.along import modes_along
+from screwkit.kinematics.modes.planar import planar_formulation
+from screwkit.kinematics.modes.planar_folds import fold_system, input_folds
+from screwkit.kinematics.modes.starts import start_solutions
+from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
+
+EXAMPLES = Path(__file__).parents[2] / "examples" / "mechanisms"
+#: fold inputs agree to this (rad): the critical points are Newton-converged, the distance
+#: law exact; the task's bar is 1e-8
+FOLD_RAD = 1e-9
+
+
+def _joint(name: str, a: str, b: str, at: np.ndarray) -> MechanismJoint:
+    return MechanismJoint(name, "R", (a, b), np.array([*at, 0.0]), Z)
+
+
+def _with_dyad(a: float, b: float, c: float, d: float, rE: float, F: np.ndarray, g1: float,
+               g2: float, drawn: float) -> Mechanism:
+    """A four-bar O–A–B–D (crank a at O, rocker c pivoted at (d, 0)) with an RRR dyad
+    E–G–F (E on the crank at radius rE, one radian ahead of A; F on the ground), drawn at
+    crank angle ``drawn`` (rad)."""
+    A = a * np.array([np.cos(drawn), np.sin(drawn)])
+    D = np.array([d, 0.0])
+    E = rE * np.array([np.cos(drawn + 1.0), np.sin(drawn + 1.0)])
+    return Mechanism("four-bar with a dyad", tuple(Body(n) for n in ("crank", "coupler",
+                                                                    "rocker", "b3", "b4")),
+                     (_joint("O", "ground", "crank", np.zeros(2)),
+                      _joint("A", "crank", "coupler", A),
+                      _joint("B", "coupler", "rocker", _meet(A, b, D, c)),
+                      _joint("D", "rocker", "ground", D),
+                      _joint("E", "crank", "b3", E), _joint("G", "b3", "b4", _meet(E, g1, F, g2)),
+                      _joint("F", "b4", "ground", F)), ("O.theta",))
+
+
+def _law(r1: float, r2: float, lo: float, hi: float) -> np.ndarray:
+    """Angles φ (one turn) where |r1 e^{iφ} − r2| is ``lo`` or ``hi`` (law of cosines)."""
+    out = []
+    for dist in (lo, hi):
+        cos = (r1 * r1 + r2 * r2 - dist * dist) / (2 * r1 * r2)
+        if abs(cos) <= 1.0:
+            out += [np.arccos(cos), -np.arccos(cos)]
+    return np.array(out)
+
+
+def _distance_law_folds(a: float, b: float, c: float, d: float, rE: float, F: np.ndarray,
+                        g1: float, g2: float, drawn: float) -> np.ndarray:
+    """Every fold input (from the drawing, one turn) of :func:`_with_dyad` where the other
+    sub-chain assembles, each twice (the other sub-chain's two branches), sorted."""
+    def fourbar_ok(theta: np.ndarray) -> np.ndarray:
+        r = np.abs(a * np.exp(1j * theta) - d)
+        return (r >= abs(b - c)) & (r <= b + c)
+
+    argF = np.angle(F[0] + 1j * F[1])
+    def dyad_ok(theta: np.ndarray) -> np.ndarray:
+        r = np.abs(rE * np.exp(1j * (theta + 1.0)) - (F[0] + 1j * F[1]))
+        return (r >= abs(g1 - g2)) & (r <= g1 + g2)
+
+    crank = _law(a, d, abs(b - c), b + c)
+    crank = crank[dyad_ok(crank)]
+    dyad = _law(rE, float(np.hypot(*F)), abs(g1 - g2), g1 + g2) + argF - 1.0
+    dyad = dyad[fourbar_ok(dyad)]
+    folds = np.mod(np.concatenate([crank, dyad]) - drawn, 2 * np.pi)
+    return np.sort(np.repeat(folds, 2))
+
+
+def _random_sixbar(seed: int) -> tuple[Mechanism, tuple]:
+    """A random four-bar with a dyad whose folds are real in both sub-chains, drawn at a
+    crank angle where both assemble."""
+    rng = np.random.default_rng(seed)
+    F = np.array([-2.0, -3.0])
+    while True:
+        a, d = 1.0, rng.uniform(2.0, 3.5)
+        b, c = rng.uniform(1.0, 3.5), rng.uniform(0.8, 2.5)
+        rE = rng.uniform(0.2, 0.6)
+        g = rng.uniform(np.hypot(*F) - 0.8 * rE, np.hypot(*F) + 0.8 * rE)
+        g1 = rng.uniform(0.45, 0.55) * g
+        g2 = g - g1
+        for drawn in rng.uniform(0.0, 2 * np.pi, 50):
+            rA = abs(a * np.exp(1j * drawn) - d)
+            rG = abs(rE * np.exp(1j * (drawn + 1.0)) - (F[0] + 1j * F[1]))
+            if abs(b - c) + 0.05 < rA < b + c - 0.05 and abs(g1 - g2) + 0.02 < rG < g - 0.02:
+                dims = (a, b, c, d, rE, F, g1, g2, float(drawn))
+                return _with_dyad(*dims), dims
+
+
+def _circular_gap(got: np.ndarray, want: np.ndarray) -> float:
+    diff = np.mod(got - want + np.pi, 2 * np.pi) - np.pi
+    return float(np.abs(diff).max(initial=0.0))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_random_sixbars_folds_are_the_distance_laws(seed: int) -> None:
+    mech, dims = _random_sixbar(seed)
+    want = _distance_law_folds(*dims)
+    assert want.size >= 4  # both sub-chains fold somewhere the other assembles
+    folds = input_folds(planar_formulation(mech), [0.0])
+    got = np.sort(np.mod(folds.inputs, 2 * np.pi))
+    assert got.size == want.size and folds.certified.all() and folds.singular == 0
+    assert _circular_gap(got, want) <= FOLD_RAD
+
+
+@pytest.mark.parametrize("seed", [3, 4, 5])
+def test_random_fourbars_folds_are_the_distance_law(seed: int) -> None:
+    _, (a, b, c, d, _, _, _, _, drawn) = _random_sixbar(seed)
+    six = _sixbar(a, b, c, d, np.degrees(drawn))
+    mech = Mechanism("four-bar", six.bodies[:3], six.joints[:4], ("O.theta",))
+    folds = input_folds(planar_formulation(mech), [0.0])
+    want = np.sort(np.mod(_law(a, d, abs(b - c), b + c) - drawn, 2 * np.pi))
+    got = np.sort(np.mod(folds.inputs, 2 * np.pi))
+    assert got.size == want.size and folds.certified.all()
+    assert _circular_gap(got, want) <= FOLD_RAD
+
+
+def test_the_count_of_critical_points_is_stable() -> None:
+    """Two random kernel scalings h give the same critical points; monodromy finds as many
+    generic ones as the total-degree start set holds. The four-bar's and the dyad's blocks of
+    ∂F/∂x are apart, so the critical points are two components (the kernel v in one block,
+    16 each) that no monodromy loop joins: it starts from one solution of each."""
+    mech = _sixbar(*_island_dims(), ISLAND_DRAWN)
+    form = planar_formulation(mech)
+    one, two = input_folds(form, [0.0]), input_folds(form, [0.0], seed=5)
+    assert one.found == two.found == 16 and one.inputs.size == two.inputs.size == 8
+    assert np.abs(one.inputs - two.inputs).max() <= 1e-10
+    system = fold_system(form)
+    start = start_solutions(system)
+    assert start.generic_count == one.generic_count == 32
+    v = np.abs(start.x[:, 6:])  # (vB, vG): B and G are the unknown joints
+    fourbar = v[:, 2:].max(axis=1) <= 1e-9 * v[:, :2].max(axis=1)
+    dyad = v[:, :2].max(axis=1) <= 1e-9 * v[:, 2:].max(axis=1)
+    assert fourbar.sum() == dyad.sum() == 16
+    seeds = start.x[[int(np.argmax(fourbar)), int(np.argmax(dyad))]]
+    again = StartSolutions.by_monodromy(system, start.p, seeds,
+                                        MonodromyOptions(stale_loops=9, seed=1))
+    assert again.generic_count == start.generic_count
+
+
+def _fmt(x: np.ndarray) -> str:
+    return repr(float(np.degrees(x[0])))
+
+
+def test_the_island_sixbar_on_the_homotopy_route_has_the_closed_form_islands() -> None:
+    """The ISLAND six-bar's mirror span lies inside the step 180° → 190° of input: the
+    homotopy route finds its four modes on no sample, each born and dying at the distance
+    law's folds and at the closed-form route's (graph/step_folds.py)."""
+    a, b, c, d = _island_dims()
+    mech = _sixbar(a, b, c, d, ISLAND_DRAWN)
+    lay = graph_layout(mech)
+    along = modes_along(mech, lay, ISLAND_INPUTS[:, None], _fmt)
+    born = 360.0 - _crank_at(a, d, b + c) - ISLAND_DRAWN
+    dies = 360.0 - _crank_at(a, d, abs(b - c)) - ISLAND_DRAWN
+    assert len(along.islands) == 4 and len(along.masks) == 8
+    closed = solve_mechanism(mech, ISLAND_INPUTS[:, None], every_mode=True)
+    theirs = [md for md in closed.modes if "island inside one sample step" in md.label]
+    assert len(theirs) == 4
+    for k in along.islands:
+        assert not along.masks[k].any()
+        events = along.events[k]
+        got = [re.match(r"(is born|dies) at ([-\d.e]+): it (starts|stops) assembling there \(a "
+                        r"fold: a critical point", e) for e in events[:2]]
+        assert got[0] and got[0][1] == "is born" and got[1] and got[1][1] == "dies", events
+        assert abs(np.radians(float(got[0][2]) - born)) <= FOLD_RAD
+        assert abs(np.radians(float(got[1][2]) - dies)) <= FOLD_RAD
+        assert "an island inside one sample step" in events[2]
+        assert [x for x, _ in along.folds[k]][0][0] == pytest.approx(np.radians(born), abs=1e-12)
+    for md in theirs:  # the closed-form route's (printed to 6 digits) agree
+        assert md.events[0].startswith(f"is born at O.theta = {born:.6g} deg")
+        assert md.events[1].startswith(f"dies at O.theta = {dies:.6g} deg")
+    # the four are distinct modes, two meeting at each fold (the four-bar's branches)
+    islands = set(along.islands)
+    meets = [m for m in along.meets if set(m) <= islands]
+    assert len(meets) == 2 and len({k for m in meets for k in m}) == 4
+
+
+def test_the_island_modes_are_reported_by_solve_mechanism_on_the_homotopy_route(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The same six-bar with its closed-form decomposition withheld (graph/motion.py then
+    takes the homotopy route): eight modes, four labelled islands on no sample."""
+    from screwkit.kinematics.graph import motion as motion_module
+    from screwkit.kinematics.graph.subchains import Decomposition
+
+    mech = _sixbar(*_island_dims(), ISLAND_DRAWN)
+    monkeypatch.setattr(motion_module, "decompose", lambda m: Decomposition(
+        (), tuple(b.name for b in m.bodies), ()))
+    got = solve_mechanism(mech, ISLAND_INPUTS[:, None], every_mode=True)
+    assert got.method == "graph (homotopy at anchors, tracking between)"
+    islands = [md for md in got.modes if "island inside one sample step" in md.label]
+    assert len(got.modes) == 8 and len(islands) == 4
+    assert all(not md.assembles.any() for md in islands)
+
+
+def test_the_stephenson_sixbar_is_unchanged_and_its_folds_are_the_critical_points(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """No step of the Stephenson III motion holds two folds: its modes, events and notes are
+    those without the island search (but for the search's own note), and the births and
+    deaths the anchored tracking locates by bisection are critical points of the input."""
+    mech = sk.load_spec(EXAMPLES / "stephenson3_sixbar.toml").mechanism
+    lay = graph_layout(mech)
+    X = np.arange(np.radians(180.0), np.radians(300.0) + 1e-9, np.radians(6.0))[:, None]
+    got = modes_along(mech, lay, X, _fmt)
+    monkeypatch.setattr(step_islands_module, "step_islands", lambda *a: ([], ()))
+    before = modes_along(mech, lay, X, _fmt)
+    assert got.notes[:-1] == before.notes and "0 step(s) hold two or more" in got.notes[-1]
+    assert got.events == before.events and got.islands == ()
+    assert all(np.array_equal(m, n) for m, n in zip(got.masks, before.masks, strict=True))
+    folds = input_folds(planar_formulation(mech), X[0])
+    located = [float(x[0]) for fs in got.folds for x, _ in fs]
+    assert len(located) == 4
+    for x in located:  # bisection to 2⁻²⁶ of a 6° step, reached by continuation
+        assert np.abs(folds.inputs - x).min() <= 1e-6
