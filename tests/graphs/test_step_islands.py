@@ -32,7 +32,8 @@ from screwkit.algebraic.solve import StartSolutions
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closure import graph_layout
 from screwkit.kinematics.modes import step_islands as step_islands_module
-from screwkit.kinematics.modes.along import modes_along
+from screwkit.kinematics.modes.along import modes_along, pose_vectors
+from screwkit.kinematics.modes.every_mode import every_mode
 from screwkit.kinematics.modes.planar import planar_formulation
 from screwkit.kinematics.modes.planar_folds import fold_system, input_folds
 from screwkit.kinematics.modes.starts import start_solutions
@@ -224,20 +225,57 @@ def test_the_island_modes_are_reported_by_solve_mechanism_on_the_homotopy_route(
 
 def test_the_stephenson_sixbar_is_unchanged_and_its_folds_are_the_critical_points(
         monkeypatch: pytest.MonkeyPatch) -> None:
-    """No step of the Stephenson III motion holds two folds: its modes, events and notes are
-    those without the island search (but for the search's own note), and the births and
-    deaths the anchored tracking locates by bisection are critical points of the input."""
+    """No step of the Stephenson III motion holds two folds and every run of samples between
+    folds holds an anchor: its modes, events and folds are those found without the fold
+    search (as before it), and the births and deaths the anchored tracking locates by
+    bisection are critical points of the input."""
     mech = sk.load_spec(EXAMPLES / "stephenson3_sixbar.toml").mechanism
     lay = graph_layout(mech)
     X = np.arange(np.radians(180.0), np.radians(300.0) + 1e-9, np.radians(6.0))[:, None]
     got = modes_along(mech, lay, X, _fmt)
-    monkeypatch.setattr(step_islands_module, "step_islands", lambda *a: ([], ()))
+    monkeypatch.setattr(step_islands_module, "fold_values", lambda m, x: (-1, None, "off"))
     before = modes_along(mech, lay, X, _fmt)
-    assert got.notes[:-1] == before.notes and "0 step(s) hold two or more" in got.notes[-1]
-    assert got.events == before.events and got.islands == ()
+    assert "0 step(s) hold two or more" in got.notes[-1] and "not searched" in before.notes[-1]
+    assert got.notes[1:-1] == before.notes[1:-1] and "every run of samples" in got.notes[0]
+    assert got.events == before.events and got.islands == before.islands == ()
     assert all(np.array_equal(m, n) for m, n in zip(got.masks, before.masks, strict=True))
+    assert [[x for x, _ in f] for f in got.folds] == [[x for x, _ in f] for f in before.folds]
     folds = input_folds(planar_formulation(mech), X[0])
     located = [float(x[0]) for fs in got.folds for x, _ in fs]
-    assert len(located) == 4
+    assert len(located) == 4 and folds.inputs.size == 2
     for x in located:  # bisection to 2⁻²⁶ of a 6° step, reached by continuation
         assert np.abs(folds.inputs - x).min() <= 1e-6
+
+
+def test_an_island_on_samples_between_two_anchors_is_found_from_the_folds() -> None:
+    """The ISLAND six-bar sampled every 0.9° from 151.2°: the anchors (every eighth sample)
+    fall at 180° and 187.2°, around the mirror span 181° … 187° that holds six samples, and
+    no mode lives at any anchor, so no track meets it. The homotopy at a sample of the run
+    between its folds finds its four modes, each on those six samples, one to one with the
+    homotopy solved anew at every sample (none elsewhere), born and dying at the distance
+    law's folds."""
+    a, b, c, d = _island_dims()
+    mech = _sixbar(a, b, c, d, ISLAND_DRAWN)
+    lay = graph_layout(mech)
+    X = np.radians(np.arange(151.2, 220.0, 0.9))[:, None]
+    along = modes_along(mech, lay, X, _fmt)
+    assert np.degrees(X[along.anchors[4:6], 0]) == pytest.approx([180.0, 187.2])
+    born = 360.0 - _crank_at(a, d, b + c) - ISLAND_DRAWN
+    dies = 360.0 - _crank_at(a, d, abs(b - c)) - ISLAND_DRAWN
+    inside = (np.degrees(X[:, 0]) > born) & (np.degrees(X[:, 0]) < dies)
+    assert inside.sum() == 6 and len(along.masks) == 4
+    every = every_mode(mech, X)
+    assert [c.size for c in every.configurations] == (4 * inside).tolist()
+    for m, events in zip(along.masks, along.events, strict=True):
+        assert np.array_equal(m, inside)
+        got = [re.match(r"(is born|dies) at ([-\d.e]+):", e) for e in events[:2]]
+        assert got[0] and got[1] and got[0][1] == "is born" and got[1][1] == "dies"
+        assert abs(np.radians(float(got[0][2]) - born)) <= FOLD_RAD
+        assert abs(np.radians(float(got[1][2]) - dies)) <= FOLD_RAD
+        assert "alone in a run of samples between two fold inputs" in events[1]
+    mine = [pose_vectors(mech, lay, c) for c in along.configurations]
+    for n in np.flatnonzero(inside):
+        theirs = pose_vectors(mech, lay, every.configurations[n])
+        gaps = np.abs(np.array([p[n] for p in mine])[:, None] - theirs[None]).max(axis=2)
+        assert sorted(np.argmin(gaps, axis=1).tolist()) == [0, 1, 2, 3]
+        assert gaps.min(axis=1).max() <= 1e-8

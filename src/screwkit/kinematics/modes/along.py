@@ -143,6 +143,9 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     per_root = getattr(form, "seconds_per_root", SECONDS_PER_ANCHOR_ROOT)
     anchors = anchor_samples(N, per_root * roots)
     check_cost(mech, N * max(roots, 1))  # at most every generic solution tracked throughout
+    from screwkit.kinematics.modes.step_islands import fold_values, run_samples, step_islands
+
+    folds = fold_values(mech, X)
     solved = every_mode(mech, X[anchors])
     chains: list[Chain] = []
     active: dict[int, int] = {}  # mode index at the current anchor → chain
@@ -156,17 +159,18 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     unshare(mech, lay, X, chains, MATCH_TOLERANCE, write)
     partner_folds(mech, lay, X, chains, write)
     before = len(chains)
-    extra = _islands(mech, lay, X, anchors, chains, write)
+    runs = run_samples(X[:, folds[0]], folds[1], anchors) if folds[1] is not None else \
+        np.zeros(0, dtype=np.intp)
+    extra = _islands(mech, lay, X, anchors, chains, write, runs)
     unshare(mech, lay, X, chains, MATCH_TOLERANCE, write)
     partner_folds(mech, lay, X, chains, write)
-    from screwkit.kinematics.modes.step_islands import step_islands
-
-    islands, island_notes = step_islands(mech, lay, X, write)
+    islands, island_notes = step_islands(mech, lay, X, write, folds)
     first_island = len(chains)
     chains.extend(islands)
-    notes = _notes(solved, anchors, first_island)
+    notes = _notes(solved, anchors, first_island, folds[1] is not None)
     if extra:
-        notes += (f"the homotopy also at the {extra} sample(s) next to a birth or death: "
+        notes += (f"the homotopy also at the {extra} sample(s) next to a birth or death or "
+                  "alone in a run of samples between two fold inputs with no anchor: "
                   f"{first_island - before} mode(s) found there that reach no anchor (islands)",)
     notes += island_notes
     return ModesAlong(tuple(Configuration(c.scalars, c.spherical) for c in chains),
@@ -179,12 +183,14 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
 
 
 def _islands(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.intp],
-             chains: list[Chain], fmt: object) -> int:
-    """Modes that reach no anchor but meet a known mode at a fold (an island between two
-    anchors): the homotopy solved again at the samples on both sides of every birth and
-    death, each mode there on no known mode tracked both ways (:func:`_island`). The count of
-    samples solved."""
-    near: set[int] = set()
+             chains: list[Chain], fmt: object, runs: NDArray[np.intp]) -> int:
+    """Modes that reach no anchor (an island between two anchors): the homotopy solved again
+    at the samples on both sides of every birth and death (an island that meets a known mode
+    at a fold) and at ``runs``, one sample of each run between fold inputs that holds no
+    anchor (modes/step_islands.py ``run_samples``: any island on samples), each mode there on
+    no known mode tracked both ways (:func:`_island`). The count of samples solved."""
+    runs_set = set(runs.tolist())
+    near: set[int] = set(runs_set)
     for c in chains:
         for k in np.flatnonzero(c.mask[:-1] != c.mask[1:]).tolist():
             near.update((k, k + 1))
@@ -201,14 +207,16 @@ def _islands(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.in
                     np.stack([c.scalars[n] for c in known]),
                     np.stack([c.spherical[n] for c in known]))).min() <= MATCH_TOLERANCE:
                 continue
-            _island(mech, lay, X, n, conf, anchors, chains, fmt,
+            where = ("alone in a run of samples between two fold inputs"
+                     if n in runs_set else "next to another mode's fold")
+            _island(mech, lay, X, n, conf, anchors, chains, fmt, where,
                     bool(solved.certified[r][j]))
     return int(rows.size)
 
 
 def _island(mech: Mechanism, lay: GraphLayout, X: Array, n: int, conf: Configuration,
-            anchors: NDArray[np.intp], chains: list[Chain], fmt: object, certified: bool
-            ) -> None:
+            anchors: NDArray[np.intp], chains: list[Chain], fmt: object, where: str,
+            certified: bool) -> None:
     """A mode found at sample ``n`` between anchors, tracked to where it is born and where it
     dies (both located by bisection); dropped where it reaches an anchor (there it is a mode
     already followed)."""
@@ -234,7 +242,7 @@ def _island(mech: Mechanism, lay: GraphLayout, X: Array, n: int, conf: Configura
     chain.folds.append((at, near))
     chain.events.append(f"dies at {write(at)}: it stops assembling there (a fold, located by "
                         f"bisection between samples); found by the homotopy at {write(X[n])}, "
-                        "next to another mode's fold, between two anchors")
+                        f"{where}, between two anchors")
 
 
 def _new_chain(chains: list[Chain], lay: GraphLayout, N: int) -> int:
@@ -355,7 +363,8 @@ def _certificate_event(chain: Chain) -> str:
             f"{chain.anchors_met} anchor(s) where the homotopy finds it")
 
 
-def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int) -> tuple[str, ...]:
+def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int, runs: bool
+           ) -> tuple[str, ...]:
     real = sum(c.size for c in solved.configurations)
     cert = sum(int(c.sum()) for c in solved.certified)
     found = (f"{int(solved.found.min())}" if solved.found.min() == solved.found.max()
@@ -365,8 +374,11 @@ def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int) -> tup
              f"{' …' if len(anchors) > 6 else ''}) finds {found} distinct complex solution(s) "
              f"per anchor, generic count {solved.generic_count} ({solved.how_found}); {real} "
              f"real mode(s) over the anchors, {cert} certified by Smale's α-test; {count} "
-             "mode(s) tracked between anchors with jump checks (an island between two anchors "
-             "is found only where it meets a known mode at a fold)"]
+             "mode(s) tracked between anchors with jump checks " + (
+                 "(and the homotopy at one sample of every run of samples between two fold "
+                 "inputs that holds no anchor: an island between two anchors is found)" if runs
+                 else "(an island between two anchors is found only where it meets a known "
+                 "mode at a fold)")]
     if solved.continuum.any():
         notes.append(f"at {int(solved.continuum.sum())} anchor(s) the solutions include a "
                      "continuum (a curve of assemblies), whose points are not isolated modes")

@@ -47,24 +47,25 @@ MAX_PATHS = 4096
 SAME_MODE = 1e-6
 
 
-def fold_values(mech: Mechanism, X: Array) -> tuple[int, Array, str]:
+def fold_values(mech: Mechanism, X: Array) -> tuple[int, Array | None, str]:
     """The varying input (column of ``X``) and every fold input of it (sorted, radians, one
-    turn; empty with the reason when not found), and a note of how they were found."""
+    turn from the first sample's; None where they are not searched), and a note of how they
+    were found or why not."""
     varying = np.flatnonzero(np.ptp(X, axis=0) > 0) if X.shape[0] > 1 else np.zeros(0, int)
     if varying.size != 1:
-        return -1, np.zeros(0), (f"{varying.size} inputs vary along the motion; the folds are "
-                                 "found as critical points of one varying input only")
+        return -1, None, (f"{varying.size} inputs vary along the motion; the folds are "
+                          "found as critical points of one varying input only")
     j = int(varying[0])
     form = closure_formulation(mech)
     method = getattr(form, "input_folds", None)
     system = getattr(form, "fold_system", None)
     if not callable(method) or not callable(system):
-        return j, np.zeros(0), (f"the {type(form).__name__} has no critical-point system of "
-                                "its input (only the planar R formulation has one)")
+        return j, None, (f"the {type(form).__name__} has no critical-point system of its "
+                         "input (only the planar R formulation has one)")
     paths = bezout_number(system())
     if paths > MAX_PATHS:
-        return j, np.zeros(0), (f"its critical-point system would start from {paths} "
-                                f"total-degree paths, more than {MAX_PATHS}")
+        return j, None, (f"its critical-point system would start from {paths} total-degree "
+                         f"paths, more than {MAX_PATHS}")
     folds = method(X[0], j)
     vals = np.sort(np.mod(folds.inputs - X[0, j], 2 * np.pi) + X[0, j])
     note = (f"{vals.size} real critical point(s) of {mech.inputs[j]} (folds; "
@@ -92,12 +93,27 @@ def folds_in_steps(x: Array, vals: Array) -> list[tuple[int, Array]]:
     return out
 
 
-def step_islands(mech: Mechanism, lay: GraphLayout, X: Array, write: Callable[[Array], str]
-                 ) -> tuple[list[Chain], tuple[str, ...]]:
+def run_samples(x: Array, vals: Array, anchors: NDArray[np.intp]) -> NDArray[np.intp]:
+    """One sample (the middle) of each run of consecutive samples of the input ``x`` with no
+    fold input ``vals`` (one turn) between them, where the run holds no anchor. Over such a
+    run no mode is born or dies, so a mode at any of its samples is at all of them: the
+    homotopy there finds every mode of the run."""
+    below = np.floor((x[:, None] - vals[None, :]) / (2 * np.pi)).sum(axis=1)  # folds ≤ x
+    cut = np.flatnonzero(below[1:] != below[:-1]) + 1
+    held = set(anchors.tolist())
+    out = []
+    for a, b in zip([0, *cut.tolist()], [*cut.tolist(), x.size], strict=True):
+        if not held & set(range(a, b)):
+            out.append((a + b - 1) // 2)
+    return np.array(out, dtype=np.intp)
+
+
+def step_islands(mech: Mechanism, lay: GraphLayout, X: Array, write: Callable[[Array], str],
+                 folds: tuple[int, Array | None, str]) -> tuple[list[Chain], tuple[str, ...]]:
     """The island modes inside one sample step (module docstring), each a :class:`Chain` on
-    no sample with its birth and death, and the notes."""
-    j, vals, note = fold_values(mech, X)
-    if vals.size == 0:
+    no sample with its birth and death, and the notes; ``folds`` is :func:`fold_values`."""
+    j, vals, note = folds
+    if vals is None:
         return [], (f"folds inside one step: not searched as critical points ({note}): an "
                     "island inside one sample step that meets no known mode is not seen",)
     steps = folds_in_steps(X[:, j], vals)
