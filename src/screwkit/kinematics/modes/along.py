@@ -20,15 +20,19 @@ bisected for its fold; after the segments, two modes at one configuration are cu
 of the one that jumped (:func:`~screwkit.kinematics.modes.along_folds.unshare`), and a fold
 that no other mode meets splits the track that crossed its step
 (:func:`~screwkit.kinematics.modes.along_folds.partner_folds`).
-Then the homotopy is solved again at the samples on both sides of every birth and death: a
-mode there that no known mode holds (an island between two anchors that meets a known mode at
-a fold) is tracked both ways to its own birth and death (:func:`_islands`), and both checks
-are run again.
+Then the homotopy is solved again at the samples on both sides of every birth and death, and
+where the input's folds are known as critical points (modes/step_islands.py, planar R graphs
+with one varying input) at one sample of every run between fold inputs that holds no anchor:
+a mode there that no known mode holds (an island between two anchors) is tracked both ways to
+its own birth and death (:func:`_islands`), and both checks are run again. Last, the islands
+inside one sample step are found between the folds (modes/step_islands.py).
 
 Guaranteed: every isolated real mode at every anchor (the homotopy's promise), continuity in
 between (the tracker's checks), no silent switch at an anchor, no two modes at one
-configuration at a sample. Not guaranteed: an island between two anchors that meets no known
-mode's fold next to a sample is not seen; a jump across a fold onto a mode that no track finds
+configuration at a sample; with the folds known, every island (as far as the critical points'
+start set is complete). Not guaranteed: without them (other formulations, several inputs
+varying), an island between two anchors that meets no known mode's fold next to a sample is
+not seen; a jump across a fold onto a mode that no track finds
 and whose fold partner no track finds either is not seen (docs/kinematics.md, "Every mode along
 the motion").
 """
