@@ -279,3 +279,41 @@ def test_an_island_on_samples_between_two_anchors_is_found_from_the_folds() -> N
         gaps = np.abs(np.array([p[n] for p in mine])[:, None] - theirs[None]).max(axis=2)
         assert sorted(np.argmin(gaps, axis=1).tolist()) == [0, 1, 2, 3]
         assert gaps.min(axis=1).max() <= 1e-8
+
+
+def test_steps_and_runs_between_folds_in_either_order_and_across_a_turn() -> None:
+    """The bookkeeping of modes/step_islands.py on hand-made inputs: fold inputs given within
+    one turn of the first sample are found in every turn, in sample order."""
+    from screwkit.kinematics.modes.step_islands import folds_in_steps, run_samples
+
+    r = np.radians
+    vals = r(np.array([5.0, 7.0, 355.0]))
+    up = folds_in_steps(r(np.array([0.0, 10.0, 20.0])), vals)
+    assert len(up) == 1 and up[0][0] == 0 and np.degrees(up[0][1]) == pytest.approx([5, 7])
+    down = folds_in_steps(r(np.array([20.0, 10.0, 0.0])), vals)
+    assert len(down) == 1 and down[0][0] == 1 and np.degrees(down[0][1]) == pytest.approx([7, 5])
+    turn = folds_in_steps(r(np.array([350.0, 365.0])), r(np.array([352.0, 362.0])))
+    assert np.degrees(turn[0][1]) == pytest.approx([352, 362])
+    assert folds_in_steps(r(np.array([0.0, 6.0, 10.0])), vals) == []  # one fold per step
+    x = r(np.arange(0.0, 100.0, 1.0))
+    folds = r(np.array([10.5, 20.5]))
+    assert run_samples(x, folds, np.arange(0, 100, 8)).tolist() == []
+    assert run_samples(x, folds, np.array([0, 99])).tolist() == [15]
+    assert run_samples(x + 2 * np.pi, folds, np.array([0, 99])).tolist() == [15]
+
+
+def test_the_island_inside_one_step_met_from_above() -> None:
+    """The ISLAND six-bar's inputs in the other order: the island modes are born at the upper
+    fold (187°) and die at the lower (181°)."""
+    a, b, c, d = _island_dims()
+    mech = _sixbar(a, b, c, d, ISLAND_DRAWN)
+    along = modes_along(mech, graph_layout(mech), ISLAND_INPUTS[::-1, None], _fmt)
+    upper = 360.0 - _crank_at(a, d, abs(b - c)) - ISLAND_DRAWN
+    lower = 360.0 - _crank_at(a, d, b + c) - ISLAND_DRAWN
+    assert len(along.islands) == 4
+    for k in along.islands:
+        born = re.match(r"is born at ([-\d.e]+):", along.events[k][0])
+        dies = re.match(r"dies at ([-\d.e]+):", along.events[k][1])
+        assert born and dies, along.events[k]
+        assert abs(np.radians(float(born[1]) - upper)) <= FOLD_RAD
+        assert abs(np.radians(float(dies[1]) - lower)) <= FOLD_RAD
