@@ -33,10 +33,12 @@ from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closure import graph_layout
 from screwkit.kinematics.modes import step_islands as step_islands_module
 from screwkit.kinematics.modes.along import modes_along, pose_vectors
+from screwkit.kinematics.modes.along_folds import Chain
 from screwkit.kinematics.modes.every_mode import every_mode
 from screwkit.kinematics.modes.planar import planar_formulation
 from screwkit.kinematics.modes.planar_folds import fold_system, input_folds
 from screwkit.kinematics.modes.starts import start_solutions
+from screwkit.kinematics.modes.step_islands import fold_values, unreported
 from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
 
 EXAMPLES = Path(__file__).parents[2] / "examples" / "mechanisms"
@@ -204,6 +206,22 @@ def test_the_island_sixbar_on_the_homotopy_route_has_the_closed_form_islands() -
     islands = set(along.islands)
     meets = [m for m in along.meets if set(m) <= islands]
     assert len(meets) == 2 and len({k for m in meets for k in m}) == 4
+    # every fold inside the steps (3°, 181°, 187°) is reported; without the island modes, or
+    # without the modes dying at 3°, the note names what no mode reports
+    folds = fold_values(mech, ISLAND_INPUTS[:, None])
+    chains = [Chain(c.scalars, c.spherical, m, list(e), folds=list(f)) for c, m, e, f in
+              zip(along.configurations, along.masks, along.events, along.folds, strict=True)]
+    assert unreported(ISLAND_INPUTS[:, None], folds, chains, _fmt)[0].startswith(
+        "every one of the 3 fold input(s)")
+    without = unreported(ISLAND_INPUTS[:, None], folds,
+                         [ch for k, ch in enumerate(chains) if k not in islands], _fmt)[0]
+    named = re.search(r"\(([-\d.e]+); ([-\d.e]+)\)", without)
+    assert without.startswith("2 of the 3 fold input(s)") and named, without
+    assert np.radians(np.array([float(named[1]), float(named[2])]) - [born, dies]) == \
+        pytest.approx([0.0, 0.0], abs=1e-8)
+    early = unreported(ISLAND_INPUTS[:, None], folds, [chains[k] for k in islands], _fmt)[0]
+    assert early.startswith("1 of the 3 fold input(s) inside the motion's steps are no "
+                            "reported mode's birth or death (3.0")
 
 
 def test_the_island_modes_are_reported_by_solve_mechanism_on_the_homotopy_route(
@@ -235,8 +253,10 @@ def test_the_stephenson_sixbar_is_unchanged_and_its_folds_are_the_critical_point
     got = modes_along(mech, lay, X, _fmt)
     monkeypatch.setattr(step_islands_module, "fold_values", lambda m, x: (-1, None, "off"))
     before = modes_along(mech, lay, X, _fmt)
-    assert "0 step(s) hold two or more" in got.notes[-1] and "not searched" in before.notes[-1]
-    assert got.notes[1:-1] == before.notes[1:-1] and "every run of samples" in got.notes[0]
+    assert "0 step(s) hold two or more" in got.notes[-2] and "not searched" in before.notes[-1]
+    assert got.notes[-1] == ("every one of the 2 fold input(s) inside the motion's steps is a "
+                             "birth or death of the modes reported")
+    assert got.notes[1:-2] == before.notes[1:-1] and "every run of samples" in got.notes[0]
     assert got.events == before.events and got.islands == before.islands == ()
     assert all(np.array_equal(m, n) for m, n in zip(got.masks, before.masks, strict=True))
     assert [[x for x, _ in f] for f in got.folds] == [[x for x, _ in f] for f in before.folds]

@@ -147,7 +147,12 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     per_root = getattr(form, "seconds_per_root", SECONDS_PER_ANCHOR_ROOT)
     anchors = anchor_samples(N, per_root * roots)
     check_cost(mech, N * max(roots, 1))  # at most every generic solution tracked throughout
-    from screwkit.kinematics.modes.step_islands import fold_values, run_samples, step_islands
+    from screwkit.kinematics.modes.step_islands import (
+        fold_values,
+        run_samples,
+        step_islands,
+        unreported,
+    )
 
     folds = fold_values(mech, X)
     solved = every_mode(mech, X[anchors])
@@ -176,7 +181,7 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
         notes += (f"the homotopy also at the {extra} sample(s) next to a birth or death or "
                   "alone in a run of samples between two fold inputs with no anchor: "
                   f"{first_island - before} mode(s) found there that reach no anchor (islands)",)
-    notes += island_notes
+    notes += island_notes + unreported(X, folds, chains, write)
     return ModesAlong(tuple(Configuration(c.scalars, c.spherical) for c in chains),
                       tuple(c.mask for c in chains),
                       tuple(tuple(c.events) + (_certificate_event(c),) for c in chains),

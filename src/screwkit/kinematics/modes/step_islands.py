@@ -144,6 +144,39 @@ def step_islands(mech: Mechanism, lay: GraphLayout, X: Array, write: Callable[[A
                     f"{len(chains)} island mode(s) on no sample",)
 
 
+def unreported(X: Array, folds: tuple[int, Array | None, str],
+               chains: list[Chain], write: Callable[[Array], str]) -> tuple[str, ...]:
+    """A note on whether every fold input strictly inside the motion's steps is a birth or
+    death some mode reports (to :data:`SNAP`): two real branches meet at a fold, so one that
+    no mode reports means a mode is missing there or a track crossed it (none when the folds
+    are not known)."""
+    j, vals, _ = folds
+    if vals is None or X.shape[0] < 2:
+        return ()
+    x = X[:, j]
+    reported = np.array([at[j] for c in chains for at, _ in c.folds])
+    missing, count = [], 0
+    for k in range(x.size - 1):
+        lo, hi = sorted((float(x[k]), float(x[k + 1])))
+        turns = np.arange(np.floor((lo - vals.max(initial=0.0)) / (2 * np.pi)),
+                          np.floor((hi - vals.min(initial=0.0)) / (2 * np.pi)) + 1)
+        cand = (vals[None, :] + 2 * np.pi * turns[:, None]).reshape(-1)
+        cand = np.unique(np.round(cand[(cand > lo) & (cand < hi)] / SAME_INPUT)) * SAME_INPUT
+        for v in cand.tolist():
+            count += 1
+            if reported.size == 0 or np.abs(reported - v).min() > SNAP:
+                row = X[k].copy()
+                row[j] = v
+                missing.append(write(row))
+    if not missing:
+        return (f"every one of the {count} fold input(s) inside the motion's steps is a birth "
+                "or death of the modes reported",)
+    return (f"{len(missing)} of the {count} fold input(s) inside the motion's steps are no "
+            f"reported mode's birth or death ({'; '.join(missing[:4])}"
+            f"{' …' if len(missing) > 4 else ''}): a mode may be missing there, or a track "
+            "crossed the fold",)
+
+
 def _known(mech: Mechanism, lay: GraphLayout, seen: list[tuple[Chain, Array, Configuration]],
            conf: Configuration, x: Array, j: int) -> bool:
     """Whether an island already found (at another interval's middle) is the mode ``conf``
