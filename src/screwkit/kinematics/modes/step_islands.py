@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.algebraic.total_degree import bezout_number
+from screwkit.errors import ScrewkitError
 from screwkit.kinematics.graph.closure import GraphLayout
 from screwkit.kinematics.graph.follow import reach
 from screwkit.kinematics.modes.along_folds import Chain, fold_in_step, pose_distance
@@ -66,7 +67,10 @@ def fold_values(mech: Mechanism, X: Array) -> tuple[int, Array | None, str]:
     if paths > MAX_PATHS:
         return j, None, (f"its critical-point system would start from {paths} total-degree "
                          f"paths, more than {MAX_PATHS}")
-    folds = method(X[0], j)
+    try:
+        folds = method(X[0], j)
+    except ScrewkitError as err:  # (a formulation that cannot write its input's circle)
+        return j, None, str(err)
     vals = np.sort(np.mod(folds.inputs - X[0, j], 2 * np.pi) + X[0, j])
     note = (f"{vals.size} real critical point(s) of {mech.inputs[j]} (folds; "
             f"{int(folds.certified.sum())} certified real by Smale's α-test) of "
