@@ -36,7 +36,7 @@ from screwkit.kinematics.modes.along import modes_along, pose_vectors
 from screwkit.kinematics.modes.along_folds import Chain
 from screwkit.kinematics.modes.every_mode import every_mode
 from screwkit.kinematics.modes.planar import planar_formulation
-from screwkit.kinematics.modes.planar_folds import fold_system, input_folds
+from screwkit.kinematics.modes.planar_folds import input_folds
 from screwkit.kinematics.modes.starts import start_solutions
 from screwkit.kinematics.modes.step_islands import fold_values, unreported
 from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
@@ -149,22 +149,25 @@ def test_random_fourbars_folds_are_the_distance_law(seed: int) -> None:
 
 
 def test_the_count_of_critical_points_is_stable() -> None:
-    """Two random kernel scalings h give the same critical points; monodromy finds as many
-    generic ones as the total-degree start set holds. The four-bar's and the dyad's blocks of
-    ∂F/∂x are apart, so the critical points are two components (the kernel v in one block,
-    16 each) that no monodromy loop joins: it starts from one solution of each."""
+    """Two random kernel scalings h give the same critical points, every generic one ending
+    finite (none failed or at infinity); monodromy finds as many generic ones as the
+    total-degree start set holds. The four-bar's and the dyad's blocks of ∂F/∂x are apart, so
+    the critical points are two components (the kernel v in one block, 8 each) that no
+    monodromy loop joins: it starts from one solution of each."""
     mech = _sixbar(*_island_dims(), ISLAND_DRAWN)
     form = planar_formulation(mech)
     one, two = input_folds(form, [0.0]), input_folds(form, [0.0], seed=5)
-    assert one.found == two.found == 16 and one.inputs.size == two.inputs.size == 8
+    assert one.found == two.found == one.generic_count == 16
+    assert one.failed == one.at_infinity == two.failed == two.at_infinity == 0
+    assert one.inputs.size == two.inputs.size == 8
     assert np.abs(one.inputs - two.inputs).max() <= 1e-10
-    system = fold_system(form)
+    system = form.fold_system()
     start = start_solutions(system)
-    assert start.generic_count == one.generic_count == 32
+    assert start.generic_count == 16 and start.how_found.startswith("total-degree")
     v = np.abs(start.x[:, 6:])  # (vB, vG): B and G are the unknown joints
     fourbar = v[:, 2:].max(axis=1) <= 1e-9 * v[:, :2].max(axis=1)
     dyad = v[:, :2].max(axis=1) <= 1e-9 * v[:, 2:].max(axis=1)
-    assert fourbar.sum() == dyad.sum() == 16
+    assert fourbar.sum() == dyad.sum() == 8
     seeds = start.x[[int(np.argmax(fourbar)), int(np.argmax(dyad))]]
     again = StartSolutions.by_monodromy(system, start.p, seeds,
                                         MonodromyOptions(stale_loops=9, seed=1))

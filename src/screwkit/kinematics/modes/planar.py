@@ -111,12 +111,13 @@ class PlanarFormulation:
                 row += 2
         return Grouping((tuple(range(0, n, 2)), tuple(range(1, n, 2))), basis, mix)
 
-    def fold_system(self) -> PolynomialSystem:
-        """The kernel system whose real solutions are the folds of one input
+    def fold_system(self, which: int = 0) -> PolynomialSystem:
+        """The kernel system whose real solutions are the folds of input ``which``
         (modes/planar_folds.py)."""
-        from screwkit.kinematics.modes.planar_folds import fold_system
+        from screwkit.kinematics.modes.planar_folds import fold_system, placed_circles
 
-        return fold_system(self)
+        drawn = np.zeros(len(self.mechanism.inputs))
+        return fold_system(self, placed_circles(self, drawn, which).moving)
 
     def input_folds(self, reference: ArrayLike, which: int = 0) -> InputFolds:
         """Every fold of input ``which``, the other inputs at the row ``reference``

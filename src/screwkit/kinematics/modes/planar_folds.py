@@ -67,6 +67,8 @@ class InputFolds:
     certified: NDArray[np.bool_]
     found: int
     singular: int
+    failed: int
+    at_infinity: int
     generic_count: int
     how_found: str
 
@@ -82,22 +84,77 @@ def _derivative(poly: Poly, index: int) -> Poly:
     return Poly(out)
 
 
-def fold_system(form: PlanarFormulation) -> PolynomialSystem:
-    """The kernel system (module docstring) of ``form``'s topology: unknowns x (2u), c, s,
-    v (2u); parameters each placed joint's (x₀, x_c, x_s, y₀, y_c, y_s), the rigid bodies'
-    (as in modes/planar.py), then h (2u)."""
+@dataclass(frozen=True)
+class PlacedCircles:
+    """How the placed joints move with one input Δ: joint i at z₀ᵢ + rᵢ e^{iσΔ} (complex plane
+    coordinates; rᵢ = 0 for a joint that does not move with it), lengths divided by ``scale``
+    about ``origin``."""
+
+    centre: Complex
+    arm: Complex
+    sigma: float
+    moving: tuple[bool, ...]
+    origin: complex
+    scale: float
+
+
+def placed_circles(form: PlanarFormulation, reference: ArrayLike, which: int) -> PlacedCircles:
+    """The placed joints' circles in input ``which`` about the input row ``reference``, read
+    off the formulation's parameters at three angles (a discrete Fourier fit) and checked at a
+    fourth; a CapabilityError where they are not circles of that input."""
+    ref = np.asarray(reference, dtype=float).reshape(-1)
+    angles = 2 * np.pi * np.arange(4) / 3 + np.array([0.0, 0.0, 0.0, 0.7])
+    rows = np.tile(ref, (4, 1))
+    rows[:, which] += angles
+    nk = 2 * len(form.known_joints)
+    z = form.parameters(rows)[:, :nk]
+    z = z[:, 0::2] + 1j * z[:, 1::2]
+    a0 = z[:3].mean(axis=0)
+    ac = (2 / 3) * np.cos(angles[:3]) @ z[:3]
+    as_ = (2 / 3) * np.sin(angles[:3]) @ z[:3]
+    size = max(1.0, float(np.abs(z).max()))
+    moving = np.abs(ac) > FIT * size
+    sigma = 1.0
+    if moving.any():
+        sigma = float(np.real(as_[moving][0] / (1j * ac[moving][0])))
+    fit = a0 + ac * np.cos(angles[3]) + as_ * np.sin(angles[3])
+    circle = np.abs(as_ - 1j * sigma * ac).max(initial=0.0) <= FIT * size
+    if np.abs(fit - z[3]).max() > FIT * size or not circle or abs(abs(sigma) - 1) > FIT:
+        raise CapabilityError(f"{form.mechanism.name}: the joints placed by input "
+                              f"{form.mechanism.inputs[which]} do not move on circles of it "
+                              "alone, so its folds are not found as critical points")
+    origin = complex(a0.mean())
+    scale = float(form.mechanism.length_scale)
+    return PlacedCircles((a0 - origin) / scale, ac / scale, float(np.sign(sigma)),
+                         tuple(bool(m) for m in moving), origin, scale)
+
+
+def fold_system(form: PlanarFormulation, moving: tuple[bool, ...]) -> PolynomialSystem:
+    """The kernel system (module docstring) of ``form``'s topology with the placed joints
+    ``moving`` with the input: unknowns x (2u), c, s, v (2u); parameters each placed joint's
+    centre (x₀, y₀) and, where it moves, its arm (r_x, r_y) (x = x₀ + r_x c − r_y s,
+    y = y₀ + r_y c + r_x s), the rigid bodies' (as in modes/planar.py), then h (2u)."""
     known, unknown, rigid = form.known_joints, form.unknown_joints, form.rigid
     n = 2 * len(unknown)
     n_body = sum(2 * len(js) - 3 for _, js in rigid)
-    sym = [Poly.variable(i) for i in range(2 * n + 2 + 6 * len(known) + n_body + n)]
+    n_placed = 2 * len(known) + 2 * sum(moving)
+    sym = [Poly.variable(i) for i in range(2 * n + 2 + n_placed + n_body + n)]
     c, s = sym[n], sym[n + 1]
     v = sym[n + 2:2 * n + 2]
     par = 2 * n + 2
     point = {k: (sym[2 * i], sym[2 * i + 1]) for i, k in enumerate(unknown)}
-    for i, k in enumerate(known):
-        a = sym[par + 6 * i:par + 6 * i + 6]
-        point[k] = (a[0] + a[1] * c + a[2] * s, a[3] + a[4] * c + a[5] * s)
-    par += 6 * len(known)
+    params = []
+    for k, move in zip(known, moving, strict=True):
+        x0, y0 = sym[par], sym[par + 1]
+        params += [f"x0_{k}", f"y0_{k}"]
+        par += 2
+        if move:
+            rx, ry = sym[par], sym[par + 1]
+            params += [f"rx_{k}", f"ry_{k}"]
+            par += 2
+            point[k] = (x0 + rx * c - ry * s, y0 + ry * c + rx * s)
+        else:
+            point[k] = (x0, y0)
     eqs = closure_equations(point, rigid, sym[par:par + n_body])
     h = sym[par + n_body:]
     kernel = []
@@ -111,35 +168,26 @@ def fold_system(form: PlanarFormulation) -> PolynomialSystem:
         unit = unit + h[j] * v[j]
     names = [f"{w}{k}" for k in unknown for w in "xy"] + ["c", "s"] + \
         [f"v{w}{k}" for k in unknown for w in "xy"]
-    params = [f"{w}{k}" for k in known for w in ("x0", "xc", "xs", "y0", "yc", "ys")]
     params += [f"{w}{b}" for b, js in rigid for w in (["L2_"] + [f"M{m}{q}_" for m in js[2:]
                                                                   for q in "ri"])]
     params += [f"h{j}" for j in range(n)]
     return compile_system([*eqs, c * c + s * s - 1.0, *kernel, unit - 1.0], names, params)
 
 
-def fold_parameters(form: PlanarFormulation, reference: ArrayLike, which: int = 0,
+def fold_parameters(form: PlanarFormulation, circles: PlacedCircles,
                     seed: int = KERNEL_SEED) -> Array:
-    """The kernel system's parameters for ``form`` with input ``which`` varying about the
-    input row ``reference`` (the others held there)."""
-    ref = np.asarray(reference, dtype=float).reshape(-1)
-    angles = 2 * np.pi * np.arange(4) / 3 + np.array([0.0, 0.0, 0.0, 0.7])
-    rows = np.tile(ref, (4, 1))
-    rows[:, which] += angles
-    p = form.parameters(rows)
-    nk = 2 * len(form.known_joints)
-    placed = p[:3, :nk]
-    a0 = placed.mean(axis=0)
-    ac = (2 / 3) * np.cos(angles[:3]) @ placed
-    as_ = (2 / 3) * np.sin(angles[:3]) @ placed
-    fit = a0 + ac * np.cos(angles[3]) + as_ * np.sin(angles[3])
-    if np.abs(fit - p[3, :nk]).max() > FIT * max(1.0, float(np.abs(placed).max())):
-        raise CapabilityError(f"{form.mechanism.name}: the joints placed by input "
-                              f"{form.mechanism.inputs[which]} do not move on circles of it "
-                              "alone, so its folds are not found as critical points")
-    coef = np.stack([a0[0::2], ac[0::2], as_[0::2], a0[1::2], ac[1::2], as_[1::2]], -1)
+    """The kernel system's parameters for ``form`` with the placed joints on ``circles``."""
+    cols: list[float] = []
+    for z0, r, move in zip(circles.centre, circles.arm, circles.moving, strict=True):
+        cols += [z0.real, z0.imag] + ([r.real, r.imag] if move else [])
+    drawn = np.zeros((1, len(form.mechanism.inputs)))  # (the bodies' part is the same at any)
+    body = form.parameters(drawn)[0, 2 * len(form.known_joints):]
+    scaled, i = body.copy(), 0
+    for _, js in form.rigid:  # L² in the scaled lengths; the ratios M keep
+        scaled[i] /= circles.scale ** 2
+        i += 2 * len(js) - 3
     h = np.random.default_rng(seed).standard_normal(2 * len(form.unknown_joints))
-    return np.concatenate([coef.reshape(-1), p[0, nk:], h])
+    return np.concatenate([np.array(cols), scaled, h])
 
 
 def input_folds(form: PlanarFormulation, reference: ArrayLike, which: int = 0,
@@ -147,19 +195,24 @@ def input_folds(form: PlanarFormulation, reference: ArrayLike, which: int = 0,
     """Every fold of input ``which`` of ``form``'s mechanism, the other inputs at the row
     ``reference`` (module docstring); ``seed`` picks h."""
     ref = np.asarray(reference, dtype=float).reshape(-1)
-    system = fold_system(form)
+    circles = placed_circles(form, ref, which)
+    system = fold_system(form, circles.moving)
     n = 2 * len(form.unknown_joints)
     groups = (tuple(range(n + 2)), tuple(range(n + 2, 2 * n + 2)))
     start = start_solutions(system, grouping=Grouping(groups))
-    sol = solve_all(system, fold_parameters(form, ref, which, seed), start)
+    sol = solve_all(system, fold_parameters(form, circles, seed), start)
     xcs = sol.x[:, :n + 2]
     real = np.abs(xcs.imag).max(axis=1, initial=0.0) <= REAL * (
         1.0 + np.abs(xcs).max(axis=1, initial=0.0))
     regular = sol.status == PathStatus.REGULAR
     keep = real & regular
     cs = xcs[keep, n:].real
-    at = ref[which] + np.arctan2(cs[:, 1], cs[:, 0])
+    at = ref[which] + circles.sigma * np.arctan2(cs[:, 1], cs[:, 0])
     order = np.argsort(at, kind="stable")
-    return InputFolds(which, ref, at[order], xcs[keep, :n].real[order],
-                      sol.certified_real[keep][order], int(sol.found[0]),
-                      int(np.count_nonzero(real & ~regular)), sol.generic_count, sol.how_found)
+    xy = xcs[keep, :n].real * circles.scale
+    xy[:, 0::2] += circles.origin.real
+    xy[:, 1::2] += circles.origin.imag
+    return InputFolds(which, ref, at[order], xy[order], sol.certified_real[keep][order],
+                      int(sol.found[0]), int(np.count_nonzero(real & ~regular)),
+                      int(sol.failed[0]), int(sol.at_infinity[0]), sol.generic_count,
+                      sol.how_found)

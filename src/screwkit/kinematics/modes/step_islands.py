@@ -63,7 +63,7 @@ def fold_values(mech: Mechanism, X: Array) -> tuple[int, Array | None, str]:
     if not callable(method) or not callable(system):
         return j, None, (f"the {type(form).__name__} has no critical-point system of its "
                          "input (only the planar R formulation has one)")
-    paths = bezout_number(system())
+    paths = bezout_number(system(j))
     if paths > MAX_PATHS:
         return j, None, (f"its critical-point system would start from {paths} total-degree "
                          f"paths, more than {MAX_PATHS}")
