@@ -32,7 +32,7 @@ from screwkit.algebraic.solve import StartSolutions
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closure import graph_layout
 from screwkit.kinematics.modes import step_islands as step_islands_module
-from screwkit.kinematics.modes.along import modes_along, pose_vectors
+from screwkit.kinematics.modes.along import ModesAlong, modes_along, pose_vectors
 from screwkit.kinematics.modes.along_folds import Chain
 from screwkit.kinematics.modes.every_mode import every_mode
 from screwkit.kinematics.modes.planar import planar_formulation
@@ -390,3 +390,40 @@ def test_random_stephenson_sixbars_folds_are_where_the_closure_jacobian_drops_ra
             jac.append(((rp - rm) / (2 * h)).reshape(-1))
         sv = np.linalg.svd(np.array(jac).T, compute_uv=False)
         assert sv[-1] <= 1e-6 * sv[0], sv
+
+
+def test_an_s_bend_inside_one_step_of_a_random_stephenson_sixbar() -> None:
+    """A random Stephenson III six-bar whose curve bends back twice within 0.49° (folds at
+    -18.730° and -18.236°), inside the step -20° → -18°: one mode dies at the upper fold,
+    another is born at the lower, and the piece between them (no sample on it) is a mode of
+    its own that meets both. At the step's middle the modes that live there are as many as a
+    fresh homotopy solve finds."""
+    mech = _stephenson(3)
+    lay = graph_layout(mech)
+    X = np.radians(np.arange(-60.0, 20.01, 2.0))[:, None]
+    along = modes_along(mech, lay, X, _fmt)
+    folds = input_folds(planar_formulation(mech), [0.0]).inputs
+    lower, upper = folds[(folds > np.radians(-20.0)) & (folds < np.radians(-18.0))]
+    assert np.degrees(upper - lower) == pytest.approx(0.494, abs=1e-3)
+    assert len(along.islands) == 1
+    (k,) = along.islands
+    (born, _), (dies, _) = along.folds[k]
+    assert [born[0], dies[0]] == pytest.approx([lower, upper], abs=1e-12)
+    assert {m for pair in along.meets for m in pair if k in pair} == {k, *(
+        m for m in range(len(along.masks)) if m != k and any(
+            abs(x[0] - v) <= 1e-6 for x, _ in along.folds[m] for v in (lower, upper)))}
+    assert sum(1 for pair in along.meets if k in pair) == 2
+    middle = 0.5 * (lower + upper)
+    alive = [m for m in range(len(along.masks)) if m == k or _holds(along, m, middle, X)]
+    assert len(alive) == every_mode(mech, [[middle]]).configurations[0].size == 4
+    assert along.notes[-1].startswith("every one of the")
+
+
+def _holds(along: ModesAlong, m: int, x: float, X: np.ndarray) -> bool:
+    """Whether mode m lives at input x between two samples: it holds at a neighbouring sample
+    and no birth or death of it lies between that sample and x."""
+    k = int(np.searchsorted(X[:, 0], x)) - 1
+    ends = [f[0][0] for f in along.folds[m]]
+    left = along.masks[m][k] and not any(X[k, 0] < e < x for e in ends)
+    right = along.masks[m][k + 1] and not any(x < e < X[k + 1, 0] for e in ends)
+    return bool(left or right)
