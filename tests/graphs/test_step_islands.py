@@ -172,6 +172,15 @@ def test_the_count_of_critical_points_is_stable() -> None:
     again = StartSolutions.by_monodromy(system, start.p, seeds,
                                         MonodromyOptions(stale_loops=9, seed=1))
     assert again.generic_count == start.generic_count
+    # the Stephenson III six-bar's critical points are one component: monodromy from one
+    # start solution stabilises at the total-degree start's 24
+    six = planar_formulation(sk.load_spec(EXAMPLES / "stephenson3_sixbar.toml").mechanism)
+    system = six.fold_system()
+    start = start_solutions(system)
+    assert start.generic_count == 24
+    again = StartSolutions.by_monodromy(system, start.p, start.x[:1],
+                                        MonodromyOptions(stale_loops=9, seed=1))
+    assert again.generic_count == 24
 
 
 def _fmt(x: np.ndarray) -> str:
