@@ -5,9 +5,12 @@ With the other inputs fixed, the mechanism's configurations x (its unknown joint
 coordinates, modes/planar.py) over the input θ form a curve F(x; θ) = 0. A fold, where modes
 are born or die, is a point of the curve where the input cannot move to first order: ∂F/∂x is
 singular there. The input is made an unknown on its circle, (c, s) = (cos Δ, sin Δ) with
-Δ = θ − θ_ref: each placed joint moves on a circle about its input pivot, so its (x, y) is
-a + b c + d s (a, b, d read off the formulation's own parameters at three angles, a discrete
-Fourier fit, checked at a fourth). The square system
+Δ = θ − θ_ref: each placed joint that moves with the input is on a circle about its pivot,
+z₀ + r e^{±iΔ}, so its (x, y) is (x₀ + r_x c − r_y s, y₀ + r_y c + r_x s) (centre and arm read
+off the formulation's own parameters at three angles, a discrete Fourier fit, checked at a
+fourth; lengths divided by the length scale). Written with that structure, the topology's
+generic count is the mechanism's and no path diverges at it (with every coordinate a free
+linear function of (c, s), most paths failed on the Stephenson III six-bar). The square system
 
     F(x; c, s) = 0,   c² + s² = 1,   ∂F/∂x(x; c, s) v = 0,   h·v = 1
 
@@ -15,9 +18,11 @@ Fourier fit, checked at a fourth). The square system
 2005, §13.4 and ch. 15, critical points of a projection by this "kernel" system) has the folds
 as its real solutions in (x, c, s). With real h a real fold is a real solution in every
 unknown, so the α-test (algebraic/certify.py) certifies it real. It is solved once per
-mechanism by the package's homotopy: start solutions of its topology by the two-group
-multi-homogeneous homotopy ({x, c, s} and {v}: the kernel equations are bilinear; 32 paths for
-a four-bar with a dyad, total degree 512), then a parameter homotopy to the mechanism.
+mechanism by the package's homotopy: start solutions of its topology (modes/starts.py: the
+total-degree homotopy, 512 paths for a four-bar with a dyad or a Stephenson III six-bar, after
+the two-group multi-homogeneous one, {x, c, s} and {v}, has failed paths), then a parameter
+homotopy to the mechanism (docs/kinematics.md, "Every mode along the motion", for the counts
+and how the start sets' completeness was checked).
 
 Not taken: more than one varying input at once (a path in several inputs is a curve in their
 space; its folds need the path's own parametrisation), and a fold where the kernel is more
