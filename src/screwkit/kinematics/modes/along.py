@@ -20,15 +20,19 @@ bisected for its fold; after the segments, two modes at one configuration are cu
 of the one that jumped (:func:`~screwkit.kinematics.modes.along_folds.unshare`), and a fold
 that no other mode meets splits the track that crossed its step
 (:func:`~screwkit.kinematics.modes.along_folds.partner_folds`).
-Then the homotopy is solved again at the samples on both sides of every birth and death: a
-mode there that no known mode holds (an island between two anchors that meets a known mode at
-a fold) is tracked both ways to its own birth and death (:func:`_islands`), and both checks
-are run again.
+Then the homotopy is solved again at the samples on both sides of every birth and death, and
+where the input's folds are known as critical points (modes/step_islands.py, planar R graphs
+with one varying input) at one sample of every run between fold inputs that holds no anchor:
+a mode there that no known mode holds (an island between two anchors) is tracked both ways to
+its own birth and death (:func:`_islands`), and both checks are run again. Last, the islands
+inside one sample step are found between the folds (modes/step_islands.py).
 
 Guaranteed: every isolated real mode at every anchor (the homotopy's promise), continuity in
 between (the tracker's checks), no silent switch at an anchor, no two modes at one
-configuration at a sample. Not guaranteed: an island between two anchors that meets no known
-mode's fold next to a sample is not seen; a jump across a fold onto a mode that no track finds
+configuration at a sample; with the folds known, every island (as far as the critical points'
+start set is complete). Not guaranteed: without them (other formulations, several inputs
+varying), an island between two anchors that meets no known mode's fold next to a sample is
+not seen; a jump across a fold onto a mode that no track finds
 and whose fold partner no track finds either is not seen (docs/kinematics.md, "Every mode along
 the motion").
 """
@@ -85,6 +89,7 @@ class ModesAlong:
     """Every mode found along the inputs: ``configurations[k]`` (N samples) where
     ``masks[k]`` holds, with ``events[k]``; ``anchors`` the anchor samples; ``notes`` what was
     found and how; ``meets`` the pairs of modes that meet at a fold (:func:`fold_meetings`);
+    ``islands`` the modes inside one sample step (on no sample; modes/step_islands.py);
     ``folds[k]`` where mode k is born or dies (the input, the configuration next to it)."""
 
     configurations: tuple[Configuration, ...]
@@ -95,6 +100,7 @@ class ModesAlong:
     solved: MechanismModes
     meets: tuple[tuple[int, int], ...] = ()
     folds: tuple[tuple[tuple[Array, Configuration], ...], ...] = ()
+    islands: tuple[int, ...] = ()
 
 
 def anchor_samples(N: int, per_anchor: float) -> NDArray[np.intp]:
@@ -141,6 +147,14 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     per_root = getattr(form, "seconds_per_root", SECONDS_PER_ANCHOR_ROOT)
     anchors = anchor_samples(N, per_root * roots)
     check_cost(mech, N * max(roots, 1))  # at most every generic solution tracked throughout
+    from screwkit.kinematics.modes.step_islands import (
+        fold_values,
+        run_samples,
+        step_islands,
+        unreported,
+    )
+
+    folds = fold_values(mech, X)
     solved = every_mode(mech, X[anchors])
     chains: list[Chain] = []
     active: dict[int, int] = {}  # mode index at the current anchor → chain
@@ -154,28 +168,38 @@ def modes_along(mech: Mechanism, lay: GraphLayout, X: Array, fmt: object) -> Mod
     unshare(mech, lay, X, chains, MATCH_TOLERANCE, write)
     partner_folds(mech, lay, X, chains, write)
     before = len(chains)
-    extra = _islands(mech, lay, X, anchors, chains, write)
+    runs = run_samples(X[:, folds[0]], folds[1], anchors) if folds[1] is not None else \
+        np.zeros(0, dtype=np.intp)
+    extra = _islands(mech, lay, X, anchors, chains, write, runs)
     unshare(mech, lay, X, chains, MATCH_TOLERANCE, write)
     partner_folds(mech, lay, X, chains, write)
-    notes = _notes(solved, anchors, len(chains))
+    islands, island_notes = step_islands(mech, lay, X, write, folds)
+    first_island = len(chains)
+    chains.extend(islands)
+    notes = _notes(solved, anchors, first_island, folds[1] is not None)
     if extra:
-        notes += (f"the homotopy also at the {extra} sample(s) next to a birth or death: "
-                  f"{len(chains) - before} mode(s) found there that reach no anchor (islands)",)
+        notes += (f"the homotopy also at the {extra} sample(s) next to a birth or death or "
+                  "alone in a run of samples between two fold inputs with no anchor: "
+                  f"{first_island - before} mode(s) found there that reach no anchor (islands)",)
+    notes += island_notes + unreported(X, folds, chains, write)
     return ModesAlong(tuple(Configuration(c.scalars, c.spherical) for c in chains),
                       tuple(c.mask for c in chains),
                       tuple(tuple(c.events) + (_certificate_event(c),) for c in chains),
                       anchors, notes, solved,
                       fold_meetings(mech, lay, [c.folds for c in chains]),
-                      tuple(tuple(c.folds) for c in chains))
+                      tuple(tuple(c.folds) for c in chains),
+                      tuple(range(first_island, len(chains))))
 
 
 def _islands(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.intp],
-             chains: list[Chain], fmt: object) -> int:
-    """Modes that reach no anchor but meet a known mode at a fold (an island between two
-    anchors): the homotopy solved again at the samples on both sides of every birth and
-    death, each mode there on no known mode tracked both ways (:func:`_island`). The count of
-    samples solved."""
-    near: set[int] = set()
+             chains: list[Chain], fmt: object, runs: NDArray[np.intp]) -> int:
+    """Modes that reach no anchor (an island between two anchors): the homotopy solved again
+    at the samples on both sides of every birth and death (an island that meets a known mode
+    at a fold) and at ``runs``, one sample of each run between fold inputs that holds no
+    anchor (modes/step_islands.py ``run_samples``: any island on samples), each mode there on
+    no known mode tracked both ways (:func:`_island`). The count of samples solved."""
+    runs_set = set(runs.tolist())
+    near: set[int] = set(runs_set)
     for c in chains:
         for k in np.flatnonzero(c.mask[:-1] != c.mask[1:]).tolist():
             near.update((k, k + 1))
@@ -192,14 +216,16 @@ def _islands(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.in
                     np.stack([c.scalars[n] for c in known]),
                     np.stack([c.spherical[n] for c in known]))).min() <= MATCH_TOLERANCE:
                 continue
-            _island(mech, lay, X, n, conf, anchors, chains, fmt,
+            where = ("alone in a run of samples between two fold inputs"
+                     if n in runs_set else "next to another mode's fold")
+            _island(mech, lay, X, n, conf, anchors, chains, fmt, where,
                     bool(solved.certified[r][j]))
     return int(rows.size)
 
 
 def _island(mech: Mechanism, lay: GraphLayout, X: Array, n: int, conf: Configuration,
-            anchors: NDArray[np.intp], chains: list[Chain], fmt: object, certified: bool
-            ) -> None:
+            anchors: NDArray[np.intp], chains: list[Chain], fmt: object, where: str,
+            certified: bool) -> None:
     """A mode found at sample ``n`` between anchors, tracked to where it is born and where it
     dies (both located by bisection); dropped where it reaches an anchor (there it is a mode
     already followed)."""
@@ -225,7 +251,7 @@ def _island(mech: Mechanism, lay: GraphLayout, X: Array, n: int, conf: Configura
     chain.folds.append((at, near))
     chain.events.append(f"dies at {write(at)}: it stops assembling there (a fold, located by "
                         f"bisection between samples); found by the homotopy at {write(X[n])}, "
-                        "next to another mode's fold, between two anchors")
+                        f"{where}, between two anchors")
 
 
 def _new_chain(chains: list[Chain], lay: GraphLayout, N: int) -> int:
@@ -346,7 +372,8 @@ def _certificate_event(chain: Chain) -> str:
             f"{chain.anchors_met} anchor(s) where the homotopy finds it")
 
 
-def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int) -> tuple[str, ...]:
+def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int, runs: bool
+           ) -> tuple[str, ...]:
     real = sum(c.size for c in solved.configurations)
     cert = sum(int(c.sum()) for c in solved.certified)
     found = (f"{int(solved.found.min())}" if solved.found.min() == solved.found.max()
@@ -356,8 +383,11 @@ def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int) -> tup
              f"{' …' if len(anchors) > 6 else ''}) finds {found} distinct complex solution(s) "
              f"per anchor, generic count {solved.generic_count} ({solved.how_found}); {real} "
              f"real mode(s) over the anchors, {cert} certified by Smale's α-test; {count} "
-             "mode(s) tracked between anchors with jump checks (an island between two anchors "
-             "is found only where it meets a known mode at a fold)"]
+             "mode(s) tracked between anchors with jump checks " + (
+                 "(and the homotopy at one sample of every run of samples between two fold "
+                 "inputs that holds no anchor: an island between two anchors is found)" if runs
+                 else "(an island between two anchors is found only where it meets a known "
+                 "mode at a fold)")]
     if solved.continuum.any():
         notes.append(f"at {int(solved.continuum.sum())} anchor(s) the solutions include a "
                      "continuum (a curve of assemblies), whose points are not isolated modes")
@@ -374,6 +404,7 @@ def every_mode_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
     why) where no formulation takes it."""
     from screwkit.budget import ResourceLimitError
     from screwkit.errors import CapabilityError
+    from screwkit.kinematics.graph.closed_modes import ISLAND
 
     only = "every mode: only the drawn mode is found for this mechanism: "
     if misfits(mech):
@@ -398,15 +429,16 @@ def every_mode_motion(mech: Mechanism, lay: GraphLayout, dec: Decomposition, X: 
                               f"{input_text(mech, lay, X[both[int(np.argmax(far))]])}"
                               ": a possible branch switch of the drawn mode's tracker")
             drawn = with_events(drawn, [*drawn.events, *events])
-        elif m.any():
+        elif m.any() or k in along.islands:
             other.append(k)
     modes = [replace(drawn, label="drawn")]
     index = {k: i for i, k in enumerate([mine, *other]) if k is not None}
     for k in other:
         md = build_mode(mech, lay, along.configurations[k], along.masks[k], X, Xd, Xdd)
+        how = (f"(homotopy between two folds inside one sample step){ISLAND}"
+               if k in along.islands else "(homotopy at anchors, tracked between)")
         modes.append(replace(with_events(md, [*along.events[k], *md.events]),
-                             label=f"mode {len(modes)} (homotopy at anchors, tracked between)",
-                             index=len(modes)))
+                             label=f"mode {len(modes)} {how}", index=len(modes)))
     joins = [(index[a], index[b]) for a, b in along.meets if a in index and b in index]
     notes = [*along.notes, "circuits (modes that meet at a fold, where the input must turn "
              "back to go on): " + ", ".join("{" + ", ".join(map(str, c)) + "}"

@@ -22,10 +22,15 @@ members of the family.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+if TYPE_CHECKING:
+    from screwkit.kinematics.modes.planar_folds import InputFolds
 
 from screwkit.algebraic.multi_homogeneous import Grouping
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
@@ -105,6 +110,21 @@ class PlanarFormulation:
                 mix[row + 1, row], mix[row + 1, row + 1] = 1.0, -1.0j
                 row += 2
         return Grouping((tuple(range(0, n, 2)), tuple(range(1, n, 2))), basis, mix)
+
+    def fold_system(self, which: int = 0) -> PolynomialSystem:
+        """The kernel system whose real solutions are the folds of input ``which``
+        (modes/planar_folds.py)."""
+        from screwkit.kinematics.modes.planar_folds import fold_system, placed_circles
+
+        drawn = np.zeros(len(self.mechanism.inputs))
+        return fold_system(self, placed_circles(self, drawn, which).moving)
+
+    def input_folds(self, reference: ArrayLike, which: int = 0) -> InputFolds:
+        """Every fold of input ``which``, the other inputs at the row ``reference``
+        (modes/planar_folds.py)."""
+        from screwkit.kinematics.modes.planar_folds import input_folds
+
+        return input_folds(self, reference, which)
 
     def _placed_body_of(self, joint: int) -> str:
         names = [b for b, _ in self.placed]
@@ -228,21 +248,30 @@ def _compile(known: tuple[int, ...], unknown: tuple[int, ...],
         2 * len(js) - 3 for _, js in rigid))]
     point = {k: (sym[2 * i], sym[2 * i + 1]) for i, k in enumerate(unknown)}
     point |= {k: (sym[n + 2 * i], sym[n + 2 * i + 1]) for i, k in enumerate(known)}
-    nxt = n + 2 * len(known)
-    eqs = []
-    for _, js in rigid:
-        (x1, y1), (x2, y2) = point[js[0]], point[js[1]]
-        dx, dy = x2 - x1, y2 - y1
-        eqs.append(dx * dx + dy * dy - sym[nxt])
-        nxt += 1
-        for m in js[2:]:
-            mc, ms = sym[nxt], sym[nxt + 1]
-            nxt += 2
-            xm, ym = point[m]
-            eqs.append(xm - x1 - (mc * dx - ms * dy))
-            eqs.append(ym - y1 - (ms * dx + mc * dy))
+    eqs = closure_equations(point, rigid, sym[n + 2 * len(known):])
     names = [f"{c}{k}" for k in unknown for c in "xy"]
     params = [f"{c}{k}" for k in known for c in "xy"]
     params += [f"{w}{b}" for b, js in rigid for w in (["L2_"] + [f"M{m}{c}_" for m in js[2:]
                                                                   for c in "ri"])]
     return compile_system(eqs, names, params)
+
+
+def closure_equations(point: dict[int, tuple[Poly, Poly]],
+                      rigid: Sequence[tuple[str, tuple[int, ...]]],
+                      body_symbols: Sequence[Poly]) -> list[Poly]:
+    """The rigid bodies' equations (module docstring) with every joint's (x, y) given by
+    ``point`` and each body's L², (Re M, Im M) … taken in order from ``body_symbols``."""
+    eqs = []
+    nxt = 0
+    for _, js in rigid:
+        (x1, y1), (x2, y2) = point[js[0]], point[js[1]]
+        dx, dy = x2 - x1, y2 - y1
+        eqs.append(dx * dx + dy * dy - body_symbols[nxt])
+        nxt += 1
+        for m in js[2:]:
+            mc, ms = body_symbols[nxt], body_symbols[nxt + 1]
+            nxt += 2
+            xm, ym = point[m]
+            eqs.append(xm - x1 - (mc * dx - ms * dy))
+            eqs.append(ym - y1 - (ms * dx + mc * dy))
+    return eqs
