@@ -1,8 +1,9 @@
 """Every assembly mode of a mechanism at given input values, by the homotopy (issue 27).
 
 :func:`closure_formulation` picks the formulation of this package that fits the mechanism (a
-planar R-joint graph; a single loop of R joints with six free; an RSSR, RSRC or RCCC driven at
-a ground R joint) and :func:`every_mode` solves it for every row of inputs in one batched
+planar R-joint graph; a single loop of R joints with six free; a single loop of R, P and C
+joints with six free freedoms (modes/rpc_loop.py); an RSSR, RSRC or RCCC driven at a ground R
+joint) and :func:`every_mode` solves it for every row of inputs in one batched
 parameter homotopy from the topology's start solutions; a 6-6 Stewart–Gough platform (U–P–S or
 S–P–S legs) by the Study-coordinate system, its poses decoded into joint variables
 (modes/stewart_decode.py); a Delta robot by the same system with the elbow balls as base
@@ -99,6 +100,10 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         return rod_loop(mech)
     if single and sorted(j.kind for j in mech.joints) == ["C", "C", "C", "R"]:
         return rccc_loop(mech)
+    if kinds <= {"R", "P", "C"} and kinds & {"P", "C"} and len(mech.topology.loops) == 1:
+        from screwkit.kinematics.modes.rpc_loop import rpc_loop
+
+        return rpc_loop(mech)  # a CapabilityError where the axes formulation does not take it
     if kinds <= {"U", "P", "S"} and len(mech.joints) == 18:
         from screwkit.kinematics.modes.stewart_decode import stewart_formulation
 
@@ -111,6 +116,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         f"{mech.name}: no polynomial formulation takes this mechanism yet (joints "
         f"{''.join(sorted(j.kind for j in mech.joints))}, {len(mech.topology.loops)} loops); there are "
         "formulations for planar R-joint graphs, single R loops with six free joints, "
+        "single loops of R, P and C joints with six free freedoms, "
         "RSSR, RSRC and RCCC loops driven at a ground R joint, 6-6 Stewart–Gough "
         "platforms (U–P–S or S–P–S legs driven at the P joints) and Delta robots (three "
         "driven arms, each with an S–S parallelogram to the plate)")
