@@ -3,20 +3,21 @@ joint axes (:mod:`.rpc_quadrics`; issue 27): the formulation that
 :func:`~screwkit.kinematics.modes.every_mode.closure_formulation` routes such loops to.
 
 The loop is read as :mod:`.general_loop` reads it (driven freedoms folded into the links, the
-Denavit–Hartenberg values of each free joint from the drawing, :class:`.GeneralLoop`); its
-parameters are turned into the quadrics' (:func:`.rpc_parameters`), and each solution back into
-the general system's unknowns (:func:`.general_unknowns`) and from there into the graph
+Denavit–Hartenberg values of each free joint from the drawing, :class:`.GeneralLoop`). The
+quadrics want a turning joint last (the ground link between two turning joints) and no parallel
+axes where they divide by sin α or need a run's basis (:func:`.parallel_links`), so the free
+joints are relabelled cyclically (joint r first: the loop's product ∏ Z_j K_j = I is unchanged
+under a cyclic shift) by the first shift r that satisfies both in the drawing. Its parameters
+are turned into the quadrics' (:func:`.rpc_parameters`), and each solution back into the general
+system's unknowns (:func:`.general_unknowns`, shifted back) and from there into the graph
 tracker's joint values (:meth:`.GeneralLoop.configuration`).
 
-Start solutions per topology come from monodromy (:mod:`.starts`, kept on disk) stopped at the
-system's generic count: the loop's count (:data:`LOOP_COUNTS`) times 2^#P, since each P joint's
-angle enters as its cosine and the system also holds the mirror loops (θ → −θ at a P joint).
-:meth:`RPCLoop.solve` drops the mirrors' solutions (:func:`.mirrored`), so the result counts
-the loop's solutions and names the loop's generic count. A loop is refused (CapabilityError;
-the generic solver then searches it by random starts) where two consecutive moving axes are
-parallel (k = a / sin α; :data:`.rpc_quadrics.PARALLEL`), where a P joint's angle is within
-:data:`MIRROR_GAP` of 0 or π (the loop's solutions and its mirror's meet: double roots), and
-where fewer than three joints turn (such a loop closes only for special dimensions).
+Start solutions per topology (the relabelled kinds) come from monodromy or a total-degree
+homotopy (:mod:`.starts`, kept on disk), stopped at the loop's generic count
+(:data:`LOOP_COUNTS`). A loop is refused (CapabilityError; the generic solver then searches it
+by random starts) where fewer than three joints turn (such a loop closes only for special
+dimensions) and where no shift avoids parallel axes (at a row of inputs, too, since driven
+joints folded into a link change its twist).
 """
 
 from __future__ import annotations
@@ -27,13 +28,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import PolynomialSystem
-from screwkit.algebraic.solve import Solutions, StartSolutions, solve_all
+from screwkit.algebraic.solve import StartSolutions
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout
 from screwkit.kinematics.modes.general_loop import GeneralLoop, general_loop
+from screwkit.kinematics.modes.general_loop_system import loop_layout
 from screwkit.kinematics.modes.rpc_quadrics import (
     general_unknowns,
-    mirrored,
+    parallel_links,
     quadric_layout,
     random_rpc,
     rpc_parameters,
@@ -48,16 +50,13 @@ Array = NDArray[np.float64]
 #: the generic number of assemblies of a loop, by its free joints up to rotation and reversal
 #: (:func:`canonical`). Loops of R and P joints: 5R1P 16, 4R2P 8, 3R3P 2 (Kohli & Osvatic 1993;
 #: Mavroidis & Roth 1994). Loops with C joints: measured here (docs/kinematics.md, "A single
-#: loop of R, P and C joints"): monodromy of this system from two seeds and a total-degree
-#: homotopy at a third point agree on every one (CRCR: 4, below the 8 of the 4R2P it
-#: specialises).
+#: loop of R, P and C joints"): monodromy from two seeds and a total-degree homotopy agree on
+#: every one (CRCR: 4, below the 8 of the 4R2P it specialises).
 LOOP_COUNTS = {
     "PRRRRR": 16, "PPRRRR": 8, "PRPRRR": 8, "PRRPRR": 8, "PPPRRR": 2, "PPRPRR": 2,
     "PRPRPR": 2, "CCC": 2, "CCRR": 8, "CCPR": 2, "CRCR": 4, "CPCR": 2, "CRRRR": 16,
     "CPRRR": 8, "CRPRR": 8, "CPPRR": 2, "CPRRP": 2, "CPRPR": 2, "CRPPR": 2,
 }
-#: a P joint's |sin θ| below this: its loop and mirror are too close to tell apart (refused)
-MIRROR_GAP = 1e-3
 
 
 def canonical(kinds: str) -> str:
@@ -69,7 +68,6 @@ def canonical(kinds: str) -> str:
 def loop_count(kinds: str) -> int:
     """The generic count of assemblies of a loop of free joints ``kinds`` (:data:`LOOP_COUNTS`);
     a CapabilityError where fewer than three joints turn or the topology has no count."""
-    quadric_layout(kinds)  # six freedoms of R, P and C
     if sum(k in "RC" for k in kinds) < 3:
         raise CapabilityError(f"a loop of free joints {kinds} turns at fewer than three joints; "
                               "it closes only for special dimensions, which the R/P/C axes "
@@ -80,30 +78,47 @@ def loop_count(kinds: str) -> int:
     return LOOP_COUNTS[key]
 
 
-def without(sol: Solutions, keep: NDArray[np.bool_], generic_count: int,
-            how_found: str) -> Solutions:
-    """``sol`` with only the solutions ``keep`` (per-instance counts recounted), and the given
-    generic count and how-found text."""
-    B = len(sol.found)
+def shift_parameters(kinds: str, r: int, p_dh: ArrayLike) -> Array:
+    """Rows of :mod:`.general_loop_system` parameters (B, k) of free joints ``kinds`` as those
+    of the loop relabelled to start at joint r (kinds[r:] + kinds[:r])."""
+    P = np.atleast_2d(np.asarray(p_dh))
+    n, old = len(kinds), loop_layout(kinds)
+    new = loop_layout(kinds[r:] + kinds[:r])
+    out = np.zeros_like(P)
+    for jn in range(n):
+        j = (jn + r) % n
+        for field, width in (("phi", 2), ("b", 1), ("a", 1), ("alpha", 2)):
+            i, k = getattr(old, field)[j], getattr(new, field)[jn]
+            if i >= 0:
+                out[:, k - new.n_unknowns: k - new.n_unknowns + width] = \
+                    P[:, i - old.n_unknowns: i - old.n_unknowns + width]
+    return out
 
-    def count(mask: NDArray[np.bool_]) -> NDArray[np.int64]:
-        return np.bincount(sol.instance[keep & mask], minlength=B).astype(np.int64)
 
-    every = np.ones(len(keep), dtype=bool)
-    return Solutions(sol.x[keep], sol.instance[keep], sol.status[keep], sol.certified[keep],
-                     sol.certified_real[keep], sol.real[keep], sol.alpha[keep],
-                     sol.beta[keep], sol.gamma[keep], sol.radius[keep], sol.residual[keep],
-                     sol.multiplicity[keep], count(every), count(sol.real),
-                     count(sol.certified_real), sol.at_infinity, sol.failed, generic_count,
-                     how_found, sol.route)
+def unshift_unknowns(kinds: str, r: int, x_dh: ArrayLike) -> NDArray[np.complex128]:
+    """General-system unknowns (N, n) of the loop relabelled to start at joint r, back in the
+    labelling of ``kinds``."""
+    X = np.atleast_2d(np.asarray(x_dh, dtype=complex))
+    n, old = len(kinds), loop_layout(kinds)
+    new = loop_layout(kinds[r:] + kinds[:r])
+    out = np.zeros_like(X)
+    for jn in range(n):
+        j = (jn + r) % n
+        if old.cs[j] >= 0:
+            out[:, old.cs[j]: old.cs[j] + 2] = X[:, new.cs[jn]: new.cs[jn] + 2]
+        if old.d[j] >= 0:
+            out[:, old.d[j]] = X[:, new.d[jn]]
+    return out
 
 
 @dataclass(frozen=True)
 class RPCLoop:
-    """A single R/P/C loop (:func:`rpc_loop`) as a formulation over rows of inputs."""
+    """A single R/P/C loop (:func:`rpc_loop`) as a formulation over rows of inputs: the loop's
+    free joints relabelled to start at joint ``shift`` (``kinds`` is the relabelled string)."""
 
     mechanism: Mechanism
     kinds: str
+    shift: int
     system: PolynomialSystem
     general: GeneralLoop
     #: the formulation's name in a Motion's solver text
@@ -114,23 +129,20 @@ class RPCLoop:
         """The loop's generic count of assemblies (:func:`loop_count`)."""
         return loop_count(self.kinds)
 
+    def dh(self, input_values: ArrayLike) -> Array:
+        """The relabelled loop's general-system parameters (B, k) at rows of inputs."""
+        return shift_parameters(self.general.kinds, self.shift,
+                                self.general.parameters(input_values))
+
     def parameters(self, input_values: ArrayLike) -> Array:
         """The quadrics' parameters (B, k) at rows of inputs (B, n_inputs); a CapabilityError
-        where a row's geometry is refused (module docstring)."""
-        p_dh = self.general.parameters(input_values)
-        p = rpc_parameters(self.kinds, p_dh)
-        lay = quadric_layout(self.kinds)
-        for j, c in enumerate(lay.c):
-            if c < 0:
-                continue
-            cos_t = np.real(p[:, c] - p[:, lay.cos_a[j - 1]] * p[:, lay.cos_a[j]])
-            if (np.abs(p[:, lay.v[j]]) <= MIRROR_GAP * np.hypot(np.abs(p[:, lay.v[j]]),
-                                                                 np.abs(cos_t))).any():
-                raise CapabilityError(
-                    f"{self.mechanism.name}: the angle at P joint {j} of the loop {self.kinds} "
-                    "is 0 or π, where the axes formulation cannot tell the loop from its "
-                    "mirror (double roots)")
-        return np.real(p)
+        where a row's axes are parallel (module docstring)."""
+        p_dh = self.dh(input_values)
+        if parallel_links(self.kinds, p_dh).any():
+            raise CapabilityError(f"{self.mechanism.name}: at these inputs two axes of the loop "
+                                  f"({self.kinds}) that the R/P/C axes formulation relates are "
+                                  "parallel")
+        return np.real(rpc_parameters(self.kinds, p_dh))
 
     def configuration(self, solutions: ArrayLike, input_values: ArrayLike
                       ) -> tuple[Configuration, GraphLayout]:
@@ -140,47 +152,46 @@ class RPCLoop:
         n_in = len(self.mechanism.inputs)
         rows = np.asarray(input_values, dtype=float).reshape(-1, n_in)
         rows = np.broadcast_to(rows, (len(X), n_in)) if len(rows) == 1 else rows
-        distinct, back = np.unique(rows, axis=0, return_inverse=True)
-        back = back.reshape(-1)
+        x_dh = np.zeros((len(X), self.general.system.n))
+        for row in np.unique(rows, axis=0):
+            at = np.flatnonzero((rows == row).all(axis=1))
+            p_dh = self.dh(row[None, :])
+            x = general_unknowns(self.kinds, X[at], rpc_parameters(self.kinds, p_dh), p_dh)
+            x_dh[at] = np.real(unshift_unknowns(self.general.kinds, self.shift, x))
+        if len(X) == 0:
+            return self.general.configuration(x_dh, np.zeros(n_in))
         scalars, lay = None, None
-        for r, row in enumerate(distinct):
-            at = np.flatnonzero(back == r)
-            p_dh = self.general.parameters(row[None, :])
-            x_dh = general_unknowns(self.kinds, X[at], rpc_parameters(self.kinds, p_dh), p_dh)
-            conf, lay = self.general.configuration(np.real(x_dh), row)
+        for row in np.unique(rows, axis=0):
+            at = np.flatnonzero((rows == row).all(axis=1))
+            conf, lay = self.general.configuration(x_dh[at], row)
             if scalars is None:
                 scalars = np.zeros((len(X), conf.scalars.shape[1]))
             scalars[at] = conf.scalars
-        if lay is None:
-            conf, lay = self.general.configuration(np.zeros((0, self.general.system.n)),
-                                                   np.zeros(n_in))
-            return conf, lay
-        assert scalars is not None
+        assert scalars is not None and lay is not None
         return Configuration(scalars, np.zeros((len(X), 0, 3, 3))), lay
 
     def start(self) -> StartSolutions:
-        """Every solution of the system at a generic complex point (cached per topology):
-        monodromy stopped at the loop's count times 2^#P (module docstring)."""
+        """Every solution of the system at a generic complex point (cached per topology),
+        stopped at the loop's generic count (module docstring)."""
         return start_solutions(self.system, lambda rng: random_rpc(self.kinds, rng, 1),
-                               self.generic_count * 2 ** self.kinds.count("P"))
-
-    def solve(self, p: ArrayLike) -> Solutions:
-        """Every solution of the loop at parameter rows p: the parameter homotopy from
-        :meth:`start`, the mirrors' solutions dropped."""
-        P = np.atleast_2d(np.asarray(p, dtype=float))
-        start = self.start()
-        sol = solve_all(self.system, P, start)
-        keep = ~mirrored(self.kinds, sol.x, P[sol.instance])
-        n_p = self.kinds.count("P")
-        how = start.how_found + (
-            f"; the {2 ** n_p - 1} mirror loop(s) of the {n_p} P joint(s) dropped"
-            if n_p else "")
-        return without(sol, keep, self.generic_count, how)
+                               self.generic_count)
 
 
 def rpc_loop(mech: Mechanism) -> RPCLoop:
     """The R/P/C axes formulation of the single loop ``mech`` (a CapabilityError where it does
     not take it: module docstring)."""
     general = general_loop(mech)
-    loop_count(general.kinds)
-    return RPCLoop(mech, general.kinds, rpc_system(general.kinds), general)
+    kinds = general.kinds
+    loop_count(kinds)
+    p_dh = general.parameters(np.zeros((1, len(mech.inputs))))
+    for r in range(len(kinds)):
+        shifted = kinds[r:] + kinds[:r]
+        if shifted[-1] == "P":
+            continue
+        quadric_layout(shifted)
+        if not parallel_links(shifted, shift_parameters(kinds, r, p_dh)).any():
+            return RPCLoop(mech, shifted, r, rpc_system(shifted), general)
+    raise CapabilityError(f"{mech.name}: in every labelling of the loop ({kinds}) two axes that "
+                          "the R/P/C axes formulation relates are parallel (a link of zero "
+                          "twist between turning joints, or a run of P joints whose end axes "
+                          "are parallel)")
