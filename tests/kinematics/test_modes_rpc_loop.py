@@ -292,3 +292,16 @@ def test_a_denavit_hartenberg_loop_gets_certified_modes_end_to_end(kinds: str) -
     assert "R/P/C loop polynomial homotopy" in m.solver
     assert not any("cannot promise" in n for n in m.notes)
     assert any("certified" in n for n in m.notes)
+
+
+def test_every_mode_along_a_mechanism_with_an_r_p_c_loop() -> None:
+    """``solve_mechanism(..., every_mode=True)`` on a random RRPRRRR loop: the homotopy at the
+    anchors names the generic count (16) and certifies its real modes, and no note says that
+    every mode cannot be promised."""
+    from screwkit.kinematics.graph.motion import solve_mechanism
+
+    mech = random_loop(np.random.default_rng(3), "RRPRRRR", ["j0.theta"])
+    m = solve_mechanism(mech, np.linspace(0.0, 2 * np.pi, 37)[:, None], every_mode=True)
+    assert len(m.modes) >= 2
+    assert any("generic count 16" in n and "certified" in n for n in m.notes)
+    assert not any("cannot promise" in n for n in m.notes)

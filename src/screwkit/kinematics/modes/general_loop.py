@@ -12,9 +12,10 @@ link j−1 and the φ and b of link j are screws about joint j's line: they are 
 parameters where the joint does not turn or slide, otherwise offsets of the joint's own
 variable, kept here so that a solution reads as joint values from the drawing.
 
-Not routed yet: :func:`~screwkit.kinematics.modes.every_mode.closure_formulation` does not
-take it, since its topologies have no start solutions (monodromy through this system is slow
-and loses paths; docs/kinematics.md "Closures as polynomials", "Where the guarantee ends").
+Not solved itself: :mod:`.rpc_loop` reads the loop through it (its DH values, the way back to
+joint values) and solves the quadrics of :mod:`.rpc_quadrics`; this system (cubic, up to
+20,687 terms, on which monodromy was slow and lost paths) is the independent check of whole-
+loop closure (docs/kinematics.md "Closures as polynomials").
 """
 
 from __future__ import annotations

@@ -103,7 +103,8 @@ def _form_inputs(form: Formulation, rel: Array) -> Array:
 
 
 def formulation_name(form: Formulation) -> str:
-    """A short name of the formulation: "planar R loop", "6R", "RSSR", "RSRC" or "RCCC"."""
+    """A short name of the formulation: "planar R loop", "6R", "R/P/C loop", "RSSR", "RSRC" or
+    "RCCC"."""
     if isinstance(form, PlanarFormulation):
         return "planar R loop"
     kind = getattr(form, "kind", None)
