@@ -183,9 +183,26 @@ def test_a_cyclic_shift_keeps_the_loop() -> None:
         assert full_closure_residual(shifted, y[0], q[0].astype(complex)) <= 1e-10
 
 
-#: (mechanism joints, driven freedoms, free joints round the loop)
+#: (mechanism joints, driven freedoms): free RPRRRR, RRCRR, CCRR, RRCRR (a C driven at its
+#: slide), PCRR (at its turn), PRPRPR, PPRRRR, RRRRRR (a C driven at its slide: the 6R count
+#: by these quadrics), RCCR (an RCCC driven at a C joint's slide, which the RCCC formulation
+#: does not take), and PRRRRR (a P joint first after the ground)
 TOPOLOGIES = [("RRPRRRR", ["j0.theta"]), ("RRRCRR", ["j0.theta"]), ("RCCRR", ["j0.theta"]),
-              ("RCCRR", ["j1.s"]), ("RPRPRPR", ["j0.theta"]), ("RRPPRRR", ["j0.theta"])]
+              ("RCCRR", ["j1.s"]), ("RCCRR", ["j1.theta"]), ("RPRPRPR", ["j0.theta"]),
+              ("RRPPRRR", ["j0.theta"]), ("RRRRRC", ["j5.s"]), ("RCCC", ["j3.s"]),
+              ("RPRRRRR", ["j0.theta"])]
+
+
+def test_a_structure_of_three_c_joints_has_its_drawing_among_its_assemblies() -> None:
+    """A CCC loop without inputs (six freedoms, a structure): every_mode at the one row of no
+    inputs finds the drawing among its assemblies (generic count 2)."""
+    rng = np.random.default_rng(10)
+    mech = random_loop(rng, "CCC", [])
+    drawn = follow_drawn_mode(mech, graph_layout(mech), np.zeros((1, 0))).conf.scalars
+    found = every_mode(mech, np.zeros((1, 0)))
+    assert found.generic_count == 2
+    conf = found.configurations[0]
+    assert np.abs(np.angle(np.exp(1j * (conf.scalars - drawn)))).max(axis=1).min() <= 1e-8
 
 
 def _tracked(mech: Mechanism, inputs: list[str]) -> np.ndarray | None:

@@ -99,7 +99,10 @@ def closure_formulation(mech: Mechanism) -> Formulation:
                                                           ["C", "R", "R", "S"]):
         return rod_loop(mech)
     if single and sorted(j.kind for j in mech.joints) == ["C", "C", "C", "R"]:
-        return rccc_loop(mech)
+        try:
+            return rccc_loop(mech)
+        except CapabilityError:  # not driven at its ground R joint: the R/P/C loop below
+            pass
     if kinds <= {"R", "P", "C"} and kinds & {"P", "C"} and len(mech.topology.loops) == 1:
         from screwkit.kinematics.modes.rpc_loop import rpc_loop
 
@@ -167,7 +170,9 @@ def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:
     and metres from the drawing (module docstring). Equal rows are solved once (a closed
     motion's first and last rows, both anchors of modes/along.py: one homotopy of the
     Stewart example's eight)."""
-    X = np.atleast_2d(np.asarray(inputs, dtype=float)).reshape(-1, len(mech.inputs))
+    X = np.atleast_2d(np.asarray(inputs, dtype=float))
+    # a structure (no inputs) has rows of nothing: keep their count
+    X = X.reshape(X.shape[0], 0) if not mech.inputs else X.reshape(-1, len(mech.inputs))
     distinct, back = np.unique(X, axis=0, return_inverse=True)
     if len(distinct) == len(X):
         return _every_mode_rows(mech, X)

@@ -48,12 +48,13 @@ from screwkit.model.mechanism import Mechanism
 Array = NDArray[np.float64]
 
 #: the generic number of assemblies of a loop, by its free joints up to rotation and reversal
-#: (:func:`canonical`). Loops of R and P joints: 5R1P 16, 4R2P 8, 3R3P 2 (Kohli & Osvatic 1993;
-#: Mavroidis & Roth 1994). Loops with C joints: measured here (docs/kinematics.md, "A single
+#: (:func:`canonical`). Loops of R and P joints: 6R 16 (Lee & Liang 1988; a mechanism's loop
+#: whose C and P joints are driven at their slides, so that only R joints are free), 5R1P 16,
+#: 4R2P 8, 3R3P 2 (Kohli & Osvatic 1993; Mavroidis & Roth 1994). Loops with C joints: measured here (docs/kinematics.md, "A single
 #: loop of R, P and C joints"): monodromy from two seeds and a total-degree homotopy agree on
 #: every one (CRCR: 4, below the 8 of the 4R2P it specialises).
 LOOP_COUNTS = {
-    "PRRRRR": 16, "PPRRRR": 8, "PRPRRR": 8, "PRRPRR": 8, "PPPRRR": 2, "PPRPRR": 2,
+    "RRRRRR": 16, "PRRRRR": 16, "PPRRRR": 8, "PRPRRR": 8, "PRRPRR": 8, "PPPRRR": 2, "PPRPRR": 2,
     "PRPRPR": 2, "CCC": 2, "CCRR": 8, "CCPR": 2, "CRCR": 4, "CPCR": 2, "CRRRR": 16,
     "CPRRR": 8, "CRPRR": 8, "CPPRR": 2, "CPRRP": 2, "CPRPR": 2, "CRPPR": 2,
 }
@@ -150,7 +151,9 @@ class RPCLoop:
         inputs (n_inputs,) or one row per solution (N, n_inputs)."""
         X = np.atleast_2d(np.asarray(solutions))
         n_in = len(self.mechanism.inputs)
-        rows = np.asarray(input_values, dtype=float).reshape(-1, n_in)
+        rows = np.asarray(input_values, dtype=float)
+        rows = rows.reshape(-1, n_in) if n_in else rows.reshape(
+            rows.shape[0] if rows.ndim == 2 else 1, 0)
         rows = np.broadcast_to(rows, (len(X), n_in)) if len(rows) == 1 else rows
         x_dh = np.zeros((len(X), self.general.system.n))
         for row in np.unique(rows, axis=0):
