@@ -265,6 +265,38 @@ def test_a_parallel_pair_is_moved_to_the_ground_link_and_still_solved() -> None:
     assert checked >= 3
 
 
+def _rotation(u: np.ndarray, q: float) -> np.ndarray:
+    u = u / np.linalg.norm(u)
+    K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
+    return np.eye(3) + np.sin(q) * K + (1.0 - np.cos(q)) * (K @ K)
+
+
+def test_a_row_where_a_driven_joint_makes_related_axes_parallel_is_not_solved() -> None:
+    """An RRRPRRR loop driven at j4, with j1 ∥ j2 (moved to the ground link by the shift) and
+    j5's axis j2's turned by −0.7 about j4: at the input −0.7 the ends of the P joint's run
+    (j2 and j5 through the driven j4) are parallel. That row is not solved (no solution, its
+    paths counted failed, so that the loop solver searches it by random starts); the others
+    are."""
+    from screwkit.kinematics.modes.rpc_loop import PARALLEL_ROW
+
+    mech = random_loop(np.random.default_rng(4), "RRRPRRR", ["j4.theta"])
+    joints = list(mech.joints)
+    for k, axis in ((2, joints[1].axis), (5, _rotation(joints[4].axis, 0.7) @ joints[1].axis)):
+        j = joints[k]
+        joints[k] = MechanismJoint(j.name, j.kind, j.bodies, j.at, axis)
+    mech = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+    form = closure_formulation(mech)
+    assert isinstance(form, RPCLoop)
+    X = np.array([[0.0], [0.7], [-0.7], [0.3]])
+    p = form.parameters(X)
+    assert np.isnan(p).any(axis=1).tolist() == [False, False, True, False]
+    sol = form.solve(p)
+    assert sol.found[2] == 0 and sol.failed[2] == sol.generic_count
+    assert sol.route[2] == PARALLEL_ROW and PARALLEL_ROW not in sol.route[:2] + sol.route[3:]
+    assert (sol.found[[0, 1, 3]] > 0).all() and not (sol.instance == 2).any()
+    assert every_mode(mech, X).configurations[2].size == 0
+
+
 def test_a_loop_the_formulation_cannot_take_falls_back_to_random_starts() -> None:
     from screwkit.kinematics.solve_motion import solve_motion
     from screwkit.kinematics.tracker.algebraic_roots import loop_formulation

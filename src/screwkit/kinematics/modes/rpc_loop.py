@@ -16,19 +16,20 @@ Start solutions per topology (the relabelled kinds) come from monodromy or a tot
 homotopy (:mod:`.starts`, kept on disk), stopped at the loop's generic count
 (:data:`LOOP_COUNTS`). A loop is refused (CapabilityError; the generic solver then searches it
 by random starts) where fewer than three joints turn (such a loop closes only for special
-dimensions) and where no shift avoids parallel axes (at a row of inputs, too, since driven
-joints folded into a link change its twist).
+dimensions) and where no shift avoids parallel axes in the drawing; a row of inputs where a
+driven joint folded into a link makes related axes parallel is not solved (its paths count as
+failed, and the loop solver searches it by random starts).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import PolynomialSystem
-from screwkit.algebraic.solve import StartSolutions
+from screwkit.algebraic.solve import Solutions, StartSolutions, solve_all
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout
 from screwkit.kinematics.modes.general_loop import GeneralLoop, general_loop
@@ -46,6 +47,8 @@ from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]
+#: the route of a row whose related axes are parallel (not solved)
+PARALLEL_ROW = "not solved: two related axes of the loop are parallel at this row"
 
 #: the generic number of assemblies of a loop, by its free joints up to rotation and reversal
 #: (:func:`canonical`). Loops of R and P joints: 6R 16 (Lee & Liang 1988; a mechanism's loop
@@ -136,14 +139,52 @@ class RPCLoop:
                                 self.general.parameters(input_values))
 
     def parameters(self, input_values: ArrayLike) -> Array:
-        """The quadrics' parameters (B, k) at rows of inputs (B, n_inputs); a CapabilityError
-        where a row's axes are parallel (module docstring)."""
+        """The quadrics' parameters (B, k) at rows of inputs (B, n_inputs); NaN at a row where
+        two related axes are parallel (a driven joint folded into a link turns it to zero
+        twist), which :meth:`solve` does not solve."""
         p_dh = self.dh(input_values)
-        if parallel_links(self.kinds, p_dh).any():
-            raise CapabilityError(f"{self.mechanism.name}: at these inputs two axes of the loop "
-                                  f"({self.kinds}) that the R/P/C axes formulation relates are "
-                                  "parallel")
-        return np.real(rpc_parameters(self.kinds, p_dh))
+        with np.errstate(all="ignore"):
+            p = np.real(rpc_parameters(self.kinds, p_dh))
+        p[parallel_links(self.kinds, p_dh)] = np.nan
+        return p
+
+    def solve(self, p: ArrayLike) -> Solutions:
+        """Every solution at the parameter rows p (B, k): the parameter homotopy from
+        :meth:`start` at the rows with finite parameters; a row of parallel axes (NaN) gets
+        none, its paths counted as failed (so that the loop solver searches it by random
+        starts)."""
+        P = np.atleast_2d(np.asarray(p, dtype=float))
+        ok = np.flatnonzero(np.isfinite(P).all(axis=1))
+        start = self.start()
+        sol = solve_all(self.system, P[ok], start) if ok.size else None
+        if sol is not None and ok.size == len(P):
+            return sol
+        B = len(P)
+
+        def per_row(values: NDArray[np.int64] | None, fill: int) -> NDArray[np.int64]:
+            out = np.full(B, fill, dtype=np.int64)
+            if values is not None:
+                out[ok] = values
+            return out
+
+        n = self.system.n
+        if sol is None:
+            empty = np.zeros(0)
+            return Solutions(np.zeros((0, n), dtype=complex), np.zeros(0, dtype=np.intp),
+                             np.zeros(0, dtype=np.int8), empty.astype(bool),
+                             empty.astype(bool), empty.astype(bool), empty, empty, empty,
+                             empty, empty, np.zeros(0, dtype=np.int64), per_row(None, 0),
+                             per_row(None, 0), per_row(None, 0), per_row(None, 0),
+                             per_row(None, start.generic_count), start.generic_count,
+                             start.how_found, (PARALLEL_ROW,) * B)
+        route = [PARALLEL_ROW] * B
+        for i, b in enumerate(ok):
+            route[b] = sol.route[i]
+        return replace(sol, instance=ok[sol.instance], found=per_row(sol.found, 0),
+                       real_count=per_row(sol.real_count, 0),
+                       certified_real_count=per_row(sol.certified_real_count, 0),
+                       at_infinity=per_row(sol.at_infinity, 0),
+                       failed=per_row(sol.failed, start.generic_count), route=tuple(route))
 
     def configuration(self, solutions: ArrayLike, input_values: ArrayLike
                       ) -> tuple[Configuration, GraphLayout]:
