@@ -99,6 +99,20 @@ def test_a_loop_turning_at_fewer_than_three_joints_or_ending_in_p_is_refused() -
     assert canonical("RRPRRP") == canonical("PRRPRR") == "PRRPRR"
 
 
+def test_exactly_parallel_axes_are_reported_not_raised() -> None:
+    # RPRRRR with zero twists on links 0 and 1 and the P angle 0: z0 ∥ z2 exactly, the ends of
+    # the P joint's run (no basis); and a zero twist between two R joints (link 3)
+    g = loop_layout("RPRRRR")
+    p = np.random.default_rng(0).normal(size=(3, g.n_parameters))
+    for row, links in ((0, (0, 1)), (1, (3,)), (2, ())):
+        for j in links:
+            i = g.alpha[j] - g.n_unknowns
+            p[row, i: i + 2] = 1.0, 0.0
+    i = g.phi[1] - g.n_unknowns
+    p[:, i: i + 2] = 1.0, 0.0
+    assert parallel_links("RPRRRR", p).tolist() == [True, True, False]
+
+
 @pytest.mark.parametrize(("kinds", "min_sin", "at_least"), [
     ("RPRRRR", 0.0, 0.99), ("PRRPRR", 0.0, 0.99), ("PPRRRR", 0.0, 0.99),
     ("PRPRPR", 0.0, 0.99), ("PPPRRR", 0.0, 0.99), ("CCRR", 0.0, 0.99),

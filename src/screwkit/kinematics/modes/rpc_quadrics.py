@@ -293,9 +293,15 @@ def geometry(kinds: str, p_dh: ArrayLike) -> Geometry:
                 normals.append(R[..., 0])
         za, zb = np.broadcast_to(np.array([0, 0, 1.0 + 0j]), (B, 3)), R[..., 2]
         basis = np.stack([za, zb, np.cross(za, zb)], -1)  # columns
+        # exactly parallel ends (a zero twist in a drawing): no basis; NaN, which
+        # parallel_links reports through γ
+        flat = np.abs(np.linalg.det(basis)) < 1e-300
+        basis[flat] = np.eye(3)
 
-        def coefficients(v: list[Complex], M: Complex = basis) -> Complex:
+        def coefficients(v: list[Complex], M: Complex = basis,
+                         none: NDArray[np.bool_] = flat) -> Complex:
             out = np.linalg.solve(M[:, None], np.stack(v, 1)[..., None])[..., 0]
+            out[none] = np.nan
             return np.asarray(out, dtype=complex)
 
         run_axes.append(coefficients(axes))
