@@ -53,9 +53,10 @@ PARALLEL_ROW = "not solved: two related axes of the loop are parallel at this ro
 #: the generic number of assemblies of a loop, by its free joints up to rotation and reversal
 #: (:func:`canonical`). Loops of R and P joints: 6R 16 (Lee & Liang 1988; a mechanism's loop
 #: whose C and P joints are driven at their slides, so that only R joints are free), 5R1P 16,
-#: 4R2P 8, 3R3P 2 (Kohli & Osvatic 1993; Mavroidis & Roth 1994). Loops with C joints: measured here (docs/kinematics.md, "A single
-#: loop of R, P and C joints"): monodromy from two seeds and a total-degree homotopy agree on
-#: every one (CRCR: 4, below the 8 of the 4R2P it specialises).
+#: 4R2P 8, 3R3P 2 (Kohli & Osvatic 1993; Mavroidis & Roth 1994). Loops with C joints:
+#: measured (docs/kinematics.md, "A single loop of R, P and C joints ... in its joint axes"):
+#: monodromy of these quadrics from two seeds and a total-degree homotopy agree on every one,
+#: and on the R and P loops' (CRCR: 4, below the 8 of the 4R2P it specialises).
 LOOP_COUNTS = {
     "RRRRRR": 16, "PRRRRR": 16, "PPRRRR": 8, "PRPRRR": 8, "PRRPRR": 8, "PPPRRR": 2, "PPRPRR": 2,
     "PRPRPR": 2, "CCC": 2, "CCRR": 8, "CCPR": 2, "CRCR": 4, "CPCR": 2, "CRRRR": 16,
