@@ -279,6 +279,26 @@ def test_a_parallel_pair_is_moved_to_the_ground_link_and_still_solved() -> None:
     assert checked >= 3
 
 
+def test_a_p_axis_parallel_to_its_r_neighbour_is_taken_inside_its_run() -> None:
+    # RRPRRRR with the P joint j2 parallel to the R joint j1 before it: a link of zero twist
+    # inside the P joint's run, where nothing divides by sin α (no relabelling needed)
+    rng = np.random.default_rng(21)
+    checked = 0
+    for _ in range(8):
+        mech = _parallel(random_loop(rng, "RRPRRRR", ["j0.theta"]), 2, 1)
+        tracked = _tracked(mech, ["j0.theta"])
+        if tracked is None:
+            continue
+        form = closure_formulation(mech)
+        assert isinstance(form, RPCLoop) and form.shift == 0
+        found = every_mode(mech, [[INPUT]])
+        assert found.found[0] == 16
+        d = np.angle(np.exp(1j * (found.configurations[0].scalars - tracked)))
+        assert np.abs(d).max(axis=1).min() <= 1e-8
+        checked += 1
+    assert checked >= 3
+
+
 def _rotation(u: np.ndarray, q: float) -> np.ndarray:
     u = u / np.linalg.norm(u)
     K = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
