@@ -409,3 +409,46 @@ def test_every_mode_along_a_mechanism_with_an_r_p_c_loop() -> None:
     assert len(m.modes) >= 2
     assert any("generic count 16" in n and "certified" in n for n in m.notes)
     assert not any("cannot promise" in n for n in m.notes)
+
+
+SPEC = """[mechanism]
+family = "LOOP"
+name = "RRPRRRR loop"
+source = "screwkit test"
+
+[units]
+length = "mm"
+angle = "deg"
+{joints}
+[motion]
+start = 0
+stop = 360
+step = 10
+"""
+
+
+def test_a_spec_with_an_r_p_c_loop_is_solved_by_the_homotopy(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """A LOOP spec (TOML) with a P joint: ``solve_motion`` seeds its branches from the R/P/C
+    homotopy, and at every sample it has at least the modes that Newton from random starts
+    gives (``generic_motion(..., homotopy=False)``)."""
+    from screwkit.io.spec import load_spec
+    from screwkit.kinematics.solve_motion import solve_motion
+    from screwkit.kinematics.tracker.generic_motion import generic_motion
+
+    rng = np.random.default_rng(5)
+    lengths, twists = rng.uniform(50.0, 200.0, 7), np.degrees(rng.uniform(-1.2, 1.2, 7))
+    joints = "".join(
+        f'\n[[joints]]\nname = "j{i}"\nkind = "{k}"\nlength = {lengths[i]:.1f}\n'
+        f"twist = {twists[i]:.1f}\n" + ("input = true\n" if i == 0 else "")
+        for i, k in enumerate("RRPRRRR"))
+    path = tmp_path / "loop.toml"
+    path.write_text(SPEC.format(joints=joints), encoding="utf-8")
+    lk = load_spec(path).linkage
+    theta = np.radians(np.arange(0.0, 360.0, 10.0))
+    m = solve_motion(lk, theta, method="generic")
+    assert "R/P/C loop polynomial homotopy (generic count 16)" in m.solver
+    assert not any("cannot promise" in n for n in m.notes)
+    newton = generic_motion(lk, theta, homotopy=False)
+    mine = np.sum([md.assembles for md in m.modes], axis=0)
+    theirs = np.sum([md.assembles for md in newton.modes], axis=0)
+    assert (mine >= theirs).all() and mine.sum() > 0
