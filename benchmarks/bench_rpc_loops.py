@@ -16,9 +16,7 @@ Times are CPU seconds (process time), OPENBLAS_NUM_THREADS=1.
 from __future__ import annotations
 
 import os
-import sys
 import time
-from pathlib import Path
 from typing import Any
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -27,6 +25,7 @@ os.environ["SCREWKIT_CACHE_DIR"] = "off"
 import numpy as np  # noqa: E402
 
 from screwkit.algebraic.solve import solve_all  # noqa: E402
+from screwkit.kinematics.modes.general_loop_system import loop_layout  # noqa: E402
 from screwkit.kinematics.modes.rpc_loop import loop_count  # noqa: E402
 from screwkit.kinematics.modes.rpc_quadrics import (  # noqa: E402
     random_rpc,
@@ -35,13 +34,26 @@ from screwkit.kinematics.modes.rpc_quadrics import (  # noqa: E402
 )
 from screwkit.kinematics.modes.starts import start_solutions  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "kinematics"))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from test_modes_rpc_loop import real_dh  # noqa: E402
-
 FAMILIES = (("RPRRRR", "5R1P"), ("PRRPRR", "4R2P"), ("PRPRPR", "3R3P"), ("RRCRR", "RRCRR"),
             ("CCRR", "CCRR"))
 BATCH = 200
+
+
+def real_dh(kinds: str, rng: np.random.Generator, count: int) -> np.ndarray:
+    """``count`` random real loops (general-system parameters): every angle uniform, every
+    length standard normal (as tests/kinematics/test_modes_rpc_loop.py draws them)."""
+    g = loop_layout(kinds)
+    p = np.zeros((count, g.n_parameters))
+    for j in range(len(kinds)):
+        for idx in (g.phi[j], g.alpha[j]):
+            if idx >= 0:
+                t = rng.uniform(-np.pi, np.pi, count)
+                p[:, idx - g.n_unknowns], p[:, idx - g.n_unknowns + 1] = np.cos(t / 2), \
+                    np.sin(t / 2)
+        for idx in (g.b[j], g.a[j]):
+            if idx >= 0:
+                p[:, idx - g.n_unknowns] = rng.normal(size=count)
+    return p
 
 
 def _cpu(fn: Any) -> float:
