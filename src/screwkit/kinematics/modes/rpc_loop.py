@@ -55,7 +55,8 @@ PARALLEL_ROW = "not solved: two related axes of the loop are parallel at this ro
 #: whose C and P joints are driven at their slides, so that only R joints are free), 5R1P 16,
 #: 4R2P 8, 3R3P 2 (Kohli & Osvatic 1993; Mavroidis & Roth 1994). Loops with C joints:
 #: measured (docs/kinematics.md, "A single loop of R, P and C joints ... in its joint axes"):
-#: monodromy of these quadrics from two seeds and a total-degree homotopy agree on every one,
+#: monodromy of these quadrics from two seeds and a total-degree homotopy agree on every one
+#: (tools/rpc_loop_counts.py),
 #: and on the R and P loops' (CRCR: 4, below the 8 of the 4R2P it specialises).
 LOOP_COUNTS = {
     "RRRRRR": 16, "PRRRRR": 16, "PPRRRR": 8, "PRPRRR": 8, "PRRPRR": 8, "PPPRRR": 2, "PPRPRR": 2,
