@@ -452,3 +452,19 @@ def test_a_spec_with_an_r_p_c_loop_is_solved_by_the_homotopy(tmp_path) -> None: 
     mine = np.sum([md.assembles for md in m.modes], axis=0)
     theirs = np.sum([md.assembles for md in newton.modes], axis=0)
     assert (mine >= theirs).all() and mine.sum() > 0
+
+
+def test_a_start_set_short_of_the_count_is_named_incomplete(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Should monodromy stop short of a topology's count, the result still names the loop's
+    generic count (so that no row reads as complete) and says the start set is incomplete."""
+    from screwkit.algebraic.solve import StartSolutions
+
+    mech = random_loop(np.random.default_rng(7), "RRPRRRR", ["j0.theta"])
+    form = closure_formulation(mech)
+    assert isinstance(form, RPCLoop)
+    full = form.start()
+    short = StartSolutions(full.p, full.x[1:], len(full.x) - 1, full.how_found, full.paths)
+    monkeypatch.setattr(RPCLoop, "start", lambda self: short)
+    sol = form.solve(form.parameters([[INPUT]]))
+    assert sol.generic_count == 16 and "incomplete" in sol.how_found
+    assert sol.found[0] <= 15

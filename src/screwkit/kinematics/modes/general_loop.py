@@ -123,7 +123,13 @@ class GeneralLoop:
 
     mechanism: Mechanism
     kinds: str
-    system: PolynomialSystem
+
+    @property
+    def system(self) -> PolynomialSystem:
+        """The compiled system of the loop's free joints (compiled on first use: 0.26 s for
+        RPRRRR's 20,687 terms, 0.85 s for PRPRPR's 68,201, which :mod:`.rpc_loop` never
+        needs)."""
+        return general_loop_system(self.kinds)
 
     def _instance(self, row: Array) -> tuple[Array, Array, Array]:
         """Parameters (k,), turn offsets Φ (n,) and slide offsets (n,) at one row of inputs."""
@@ -225,5 +231,6 @@ class GeneralLoop:
 def general_loop(mech: Mechanism) -> GeneralLoop:
     """The general loop formulation of ``mech`` (a CapabilityError where it does not fit)."""
     kinds = loop_kinds(mech)
-    return GeneralLoop(mech, kinds, general_loop_system(kinds))
+    loop_layout(kinds)  # a CapabilityError without six freedoms of R, P and C
+    return GeneralLoop(mech, kinds)
 

@@ -158,6 +158,15 @@ class RPCLoop:
         P = np.atleast_2d(np.asarray(p, dtype=float))
         ok = np.flatnonzero(np.isfinite(P).all(axis=1))
         start = self.start()
+        sol = self._rows(P, ok, start)
+        if start.generic_count != self.generic_count:  # monodromy stopped short: say so
+            sol = replace(sol, generic_count=self.generic_count, how_found=(
+                f"{start.how_found}; {len(start.x)} of the generic count {self.generic_count}: "
+                "incomplete"))
+        return sol
+
+    def _rows(self, P: Array, ok: NDArray[np.intp], start: StartSolutions) -> Solutions:
+        """:meth:`solve` at the rows ``ok`` of P, the others (parallel axes) empty."""
         sol = solve_all(self.system, P[ok], start) if ok.size else None
         if sol is not None and ok.size == len(P):
             return sol
@@ -198,7 +207,7 @@ class RPCLoop:
         rows = rows.reshape(-1, n_in) if n_in else rows.reshape(
             rows.shape[0] if rows.ndim == 2 else 1, 0)
         rows = np.broadcast_to(rows, (len(X), n_in)) if len(rows) == 1 else rows
-        x_dh = np.zeros((len(X), self.general.system.n))
+        x_dh = np.zeros((len(X), loop_layout(self.general.kinds).n_unknowns))
         for row in np.unique(rows, axis=0):
             at = np.flatnonzero((rows == row).all(axis=1))
             p_dh = self.dh(row[None, :])
