@@ -5,6 +5,8 @@ configurations and against Newton from random starts on the loop."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -342,6 +344,12 @@ def test_a_loop_the_formulation_cannot_take_falls_back_to_random_starts() -> Non
     mech = random_loop(np.random.default_rng(9), "RPPPPRR", ["j0.theta"])
     with pytest.raises(CapabilityError, match="fewer than three"):
         closure_formulation(mech)
+    # a joint made off its drawing (a tolerance sweep's seat offset)
+    mech = random_loop(np.random.default_rng(9), "RRPRRRR", ["j0.theta"])
+    joints = list(mech.joints)
+    joints[3] = replace(joints[3], seat_offset=np.array([1e-4, 0.0, 0.0]))
+    with pytest.raises(CapabilityError, match="seat offset"):
+        closure_formulation(Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs))
     # two links of zero twist between turning joints (J4–J5, J6–J7): one of them can be the
     # ground link, not both, in any labelling (seed 4: the first of 0..4 that assembles)
     rng = np.random.default_rng(4)

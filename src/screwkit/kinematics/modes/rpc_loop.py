@@ -16,7 +16,8 @@ Start solutions per topology (the relabelled kinds) come from monodromy or a tot
 homotopy (:mod:`.starts`, kept on disk), stopped at the loop's generic count
 (:data:`LOOP_COUNTS`). A loop is refused (CapabilityError; the generic solver then searches it
 by random starts) where fewer than three joints turn (such a loop closes only for special
-dimensions) and where no shift avoids parallel axes in the drawing; a row of inputs where a
+dimensions), where a joint is made off its drawing (a seat offset), and where no shift avoids
+parallel axes in the drawing; a row of inputs where a
 driven joint folded into a link makes related axes parallel is not solved (its paths count as
 failed, and the loop solver searches it by random starts).
 """
@@ -235,6 +236,11 @@ class RPCLoop:
 def rpc_loop(mech: Mechanism) -> RPCLoop:
     """The R/P/C axes formulation of the single loop ``mech`` (a CapabilityError where it does
     not take it: module docstring)."""
+    off = [j.name for j in mech.joints if j.seat_offset is not None]
+    if off:
+        raise CapabilityError(f"{mech.name}: joints {', '.join(off)} are made off their drawing "
+                              "(a seat offset); the R/P/C axes formulation reads the loop from "
+                              "its drawing, so it does not take them")
     general = general_loop(mech)
     kinds = general.kinds
     loop_count(kinds)
