@@ -202,11 +202,14 @@ def test_a_cyclic_shift_keeps_the_loop() -> None:
 #: (mechanism joints, driven freedoms): free RPRRRR, RRCRR, CCRR, RRCRR (a C driven at its
 #: slide), PCRR (at its turn), PRPRPR, PPRRRR, RRRRRR (a C driven at its slide: the 6R count
 #: by these quadrics), RCCR (an RCCC driven at a C joint's slide, which the RCCC formulation
-#: does not take), and PRRRRR (a P joint first after the ground)
+#: does not take), PRRRRR (a P joint first after the ground), and loops with U joints (each
+#: two R joints on intersecting lines): RRPRRR, RRCRR, RRRRRR, RRRRRR (a U driven at its
+#: second freedom)
 TOPOLOGIES = [("RRPRRRR", ["j0.theta"]), ("RRRCRR", ["j0.theta"]), ("RCCRR", ["j0.theta"]),
               ("RCCRR", ["j1.s"]), ("RCCRR", ["j1.theta"]), ("RPRPRPR", ["j0.theta"]),
               ("RRPPRRR", ["j0.theta"]), ("RRRRRC", ["j5.s"]), ("RCCC", ["j3.s"]),
-              ("RPRRRRR", ["j0.theta"])]
+              ("RPRRRRR", ["j0.theta"]), ("RUPUR", ["j0.theta"]), ("RUCRR", ["j0.theta"]),
+              ("RRURRR", ["j0.theta"]), ("RURRRR", ["j1.theta2"])]
 
 
 def test_a_structure_of_three_c_joints_has_its_drawing_among_its_assemblies() -> None:

@@ -1,7 +1,7 @@
 """Every assembly mode of a mechanism at given input values, by the homotopy (issue 27).
 
 :func:`closure_formulation` picks the formulation of this package that fits the mechanism (a
-planar R-joint graph; a single loop of R joints with six free; a single loop of R, P and C
+planar R-joint graph; a single loop of R joints with six free; a single loop of R, P, C and U
 joints with six free freedoms (modes/rpc_loop.py); an RSSR, RSRC or RCCC driven at a ground R
 joint) and :func:`every_mode` solves it for every row of inputs in one batched
 parameter homotopy from the topology's start solutions; a 6-6 Stewart–Gough platform (U–P–S or
@@ -103,7 +103,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
             return rccc_loop(mech)
         except CapabilityError:  # not driven at its ground R joint: the R/P/C loop below
             pass
-    if kinds <= {"R", "P", "C"} and kinds & {"P", "C"} and len(mech.topology.loops) == 1:
+    if kinds <= {"R", "P", "C", "U"} and kinds & {"P", "C", "U"} and len(mech.topology.loops) == 1:
         from screwkit.kinematics.modes.rpc_loop import rpc_loop
 
         return rpc_loop(mech)  # a CapabilityError where the axes formulation does not take it
@@ -119,7 +119,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         f"{mech.name}: no polynomial formulation takes this mechanism yet (joints "
         f"{''.join(sorted(j.kind for j in mech.joints))}, {len(mech.topology.loops)} loops); there are "
         "formulations for planar R-joint graphs, single R loops with six free joints, "
-        "single loops of R, P and C joints with six free freedoms, "
+        "single loops of R, P, C and U joints with six free freedoms, "
         "RSSR, RSRC and RCCC loops driven at a ground R joint, 6-6 Stewart–Gough "
         "platforms (U–P–S or S–P–S legs driven at the P joints) and Delta robots (three "
         "driven arms, each with an S–S parallelogram to the plate)")

@@ -1,9 +1,11 @@
 """A single loop of R, P and C joints with six free freedoms from a mechanism, solved in its
 joint axes (:mod:`.rpc_quadrics`; issue 27): the formulation that
-:func:`~screwkit.kinematics.modes.every_mode.closure_formulation` routes such loops to.
+:func:`~screwkit.kinematics.modes.every_mode.closure_formulation` routes such loops to. A U
+joint is two R joints on intersecting lines.
 
-The loop is read as :mod:`.general_loop` reads it (driven freedoms folded into the links, the
-Denavit–Hartenberg values of each free joint from the drawing, :class:`.GeneralLoop`). The
+The loop is read as :mod:`.general_loop` reads it (driven freedoms folded into the links, a U
+joint as its two turns, the Denavit–Hartenberg values of each free joint from the drawing,
+:class:`.GeneralLoop`). The
 quadrics want a turning joint last (the ground link between two turning joints) and no parallel
 axes where they divide by sin α or need a run's basis (:func:`.parallel_links`), so the free
 joints are relabelled cyclically (joint r first: the loop's product ∏ Z_j K_j = I is unchanged
