@@ -40,15 +40,17 @@ def check_jacobians(system: PolynomialSystem, x: np.ndarray, p: np.ndarray) -> N
 
 
 def random_loop(rng: np.random.Generator, kinds: str, inputs: list[str]) -> Mechanism:
-    """A loop of joints of ``kinds`` (R, P, C) on random lines, some joints' bodies listed
-    against the walk, driven at the freedoms ``inputs`` (e.g. "j0.theta")."""
+    """A loop of joints of ``kinds`` (R, P, C, U) on random lines (a U joint with a random
+    second axis), some joints' bodies listed against the walk, driven at the freedoms
+    ``inputs`` (e.g. "j0.theta")."""
     bodies = [Body(f"l{i}") for i in range(1, len(kinds))]
     names = [GROUND, *(b.name for b in bodies), GROUND]
     joints = []
     for i, kind in enumerate(kinds):
         a, b = (names[i], names[i + 1]) if rng.random() < 0.6 else (names[i + 1], names[i])
         joints.append(MechanismJoint(f"j{i}", kind, (a, b), rng.normal(size=3),
-                                     rng.normal(size=3)))
+                                     rng.normal(size=3),
+                                     axis2=rng.normal(size=3) if kind == "U" else None))
     return Mechanism("loop", tuple(bodies), tuple(joints), tuple(inputs))
 
 

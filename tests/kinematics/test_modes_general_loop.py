@@ -25,7 +25,7 @@ from screwkit.model.mechanism import Mechanism, MechanismJoint
 #: (mechanism joints, driven freedoms, free joints round the loop from the first free one)
 TOPOLOGIES = [("RRPRRRR", ["j0.theta"], "RPRRRR"), ("RRRCRR", ["j0.theta"], "RRCRR"),
               ("CCRR", [], "CCRR"), ("RCRCR", ["j0.theta"], "CRCR"),
-              ("RCRCR", ["j1.s"], "RRRCR")]
+              ("RCRCR", ["j1.s"], "RRRCR"), ("RUPUR", ["j0.theta"], "RRPRRR")]
 #: the input value of the tracked configurations (rad or m from the drawing)
 INPUT = 0.3
 
@@ -44,7 +44,7 @@ def test_a_loop_without_six_free_freedoms_is_refused() -> None:
     rng = np.random.default_rng(6)
     with pytest.raises(CapabilityError, match="six freedoms"):
         general_loop(random_loop(rng, "RRPRRR", ["j0.theta"]))
-    with pytest.raises(CapabilityError, match="not R, P or C"):
+    with pytest.raises(CapabilityError, match="not R, P, C or U"):
         general_loop(random_loop(rng, "RSRR", ["j0.theta"]))
 
 

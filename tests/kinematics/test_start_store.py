@@ -4,7 +4,8 @@ written; a file is written whole (no temporary file is left) and is trusted only
 matches and every point solves the start system again (a moved point, another key, a damaged
 file, or fewer solutions than a known generic count are refused and solved anew);
 ``SCREWKIT_CACHE_DIR=off`` writes nothing; the folder follows the environment; a multi-homogeneous start with a failed path is
-not trusted to be complete and the total-degree homotopy solves it."""
+not trusted to be complete and the total-degree homotopy solves it; a total-degree start short
+of a known generic count is found by monodromy instead."""
 
 from __future__ import annotations
 
@@ -121,3 +122,23 @@ def test_a_multi_homogeneous_start_with_a_failed_path_falls_back_to_total_degree
     found = _solve(sixbar)
     assert starts.first_solve_paths() - before == 6 + 16  # both homotopies' paths
     assert found.how_found.startswith("total-degree") and found.generic_count == 6
+
+
+def test_a_total_degree_start_short_of_a_known_count_is_found_by_monodromy(store, monkeypatch):
+    # a CCRR loop's quadrics (Bézout number 64: the total-degree homotopy first), one of its
+    # 8 total-degree solutions dropped as if its path had failed: monodromy from a random
+    # closing instance finds the 8 instead
+    from screwkit.algebraic.solve import StartSolutions
+    from screwkit.kinematics.modes.rpc_quadrics import random_rpc, rpc_system
+
+    real = starts._by_total_degree
+
+    def one_lost(system, seed):
+        found = real(system, seed)
+        return StartSolutions(found.p, found.x[1:], found.generic_count - 1, found.how_found,
+                              found.paths)
+
+    monkeypatch.setattr(starts, "_by_total_degree", one_lost)
+    found = starts.start_solutions(rpc_system("CCRR"), lambda r: random_rpc("CCRR", r, 1), 8)
+    assert found.how_found.startswith("monodromy") and found.generic_count == 8
+    assert len(found.x) == 8

@@ -21,6 +21,12 @@ homotopy started at a random complex instance needs to find every solution.
 - :mod:`.rod_loops`: the RSSR (2) and RSRC (4) loops at one input;
 - :mod:`.rccc`: the RCCC loop at one input, in Plücker coordinates (2);
 - :mod:`.r_loop`: a Mechanism's single R loop (6R, 7R at one input) as a 6R instance;
+- :mod:`.rpc_quadrics`: a single loop of R, P and C joints with six free freedoms as quadrics
+  in its joint axes (5R1P 16, 4R2P 8, 3R3P 2, C loops measured); :mod:`.rpc_loop`: such a loop
+  of a Mechanism (U joints as two R joints), relabelled cyclically, its generic counts and
+  start solutions;
+  :mod:`.general_loop`: the same loop in joint cosines and sines (its reading and way back,
+  and the independent check);
 - :mod:`.starts`: start solutions per topology, kept on disk by :mod:`.start_store`;
   :mod:`.continuum`: a continuum told from
   isolated roots at a singular end point.

@@ -1,8 +1,9 @@
 """Every assembly mode of a mechanism at given input values, by the homotopy (issue 27).
 
 :func:`closure_formulation` picks the formulation of this package that fits the mechanism (a
-planar R-joint graph; a single loop of R joints with six free; an RSSR, RSRC or RCCC driven at
-a ground R joint) and :func:`every_mode` solves it for every row of inputs in one batched
+planar R-joint graph; a single loop of R joints with six free; a single loop of R, P, C and U
+joints with six free freedoms (modes/rpc_loop.py); an RSSR, RSRC or RCCC driven at a ground R
+joint) and :func:`every_mode` solves it for every row of inputs in one batched
 parameter homotopy from the topology's start solutions; a 6-6 Stewart–Gough platform (U–P–S or
 S–P–S legs) by the Study-coordinate system, its poses decoded into joint variables
 (modes/stewart_decode.py); a Delta robot by the same system with the elbow balls as base
@@ -98,7 +99,14 @@ def closure_formulation(mech: Mechanism) -> Formulation:
                                                           ["C", "R", "R", "S"]):
         return rod_loop(mech)
     if single and sorted(j.kind for j in mech.joints) == ["C", "C", "C", "R"]:
-        return rccc_loop(mech)
+        try:
+            return rccc_loop(mech)
+        except CapabilityError:  # not driven at its ground R joint: the R/P/C loop below
+            pass
+    if kinds <= {"R", "P", "C", "U"} and kinds & {"P", "C", "U"} and len(mech.topology.loops) == 1:
+        from screwkit.kinematics.modes.rpc_loop import rpc_loop
+
+        return rpc_loop(mech)  # a CapabilityError where the axes formulation does not take it
     if kinds <= {"U", "P", "S"} and len(mech.joints) == 18:
         from screwkit.kinematics.modes.stewart_decode import stewart_formulation
 
@@ -111,6 +119,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         f"{mech.name}: no polynomial formulation takes this mechanism yet (joints "
         f"{''.join(sorted(j.kind for j in mech.joints))}, {len(mech.topology.loops)} loops); there are "
         "formulations for planar R-joint graphs, single R loops with six free joints, "
+        "single loops of R, P, C and U joints with six free freedoms, "
         "RSSR, RSRC and RCCC loops driven at a ground R joint, 6-6 Stewart–Gough "
         "platforms (U–P–S or S–P–S legs driven at the P joints) and Delta robots (three "
         "driven arms, each with an S–S parallelogram to the plate)")
@@ -161,7 +170,9 @@ def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:
     and metres from the drawing (module docstring). Equal rows are solved once (a closed
     motion's first and last rows, both anchors of modes/along.py: one homotopy of the
     Stewart example's eight)."""
-    X = np.atleast_2d(np.asarray(inputs, dtype=float)).reshape(-1, len(mech.inputs))
+    X = np.atleast_2d(np.asarray(inputs, dtype=float))
+    # a structure (no inputs) has rows of nothing: keep their count
+    X = X.reshape(X.shape[0], 0) if not mech.inputs else X.reshape(-1, len(mech.inputs))
     distinct, back = np.unique(X, axis=0, return_inverse=True)
     if len(distinct) == len(X):
         return _every_mode_rows(mech, X)

@@ -1,4 +1,5 @@
-"""A single loop of R, P and C joints with six free freedoms as the system of
+"""A single loop of R, P, C and U joints with six free freedoms (a U joint as two R joints on
+intersecting lines) as the system of
 :mod:`.general_loop_system`: the loop's geometry at the inputs as the system's parameters, and
 the way back from solutions to the graph tracker's :class:`Configuration` (issue 27).
 
@@ -12,9 +13,10 @@ link j−1 and the φ and b of link j are screws about joint j's line: they are 
 parameters where the joint does not turn or slide, otherwise offsets of the joint's own
 variable, kept here so that a solution reads as joint values from the drawing.
 
-Not routed yet: :func:`~screwkit.kinematics.modes.every_mode.closure_formulation` does not
-take it, since its topologies have no start solutions (monodromy through this system is slow
-and loses paths; docs/kinematics.md "Closures as polynomials", "Where the guarantee ends").
+Not solved itself: :mod:`.rpc_loop` reads the loop through it (its DH values, the way back to
+joint values) and solves the quadrics of :mod:`.rpc_quadrics`; this system (cubic, up to
+20,687 terms, on which monodromy was slow and lost paths) is the independent check of whole-
+loop closure (docs/kinematics.md "Closures as polynomials").
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from screwkit.kinematics.modes.general_loop_system import (
 from screwkit.kinematics.modes.r_loop import loop_walk
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.messages import listing
-from screwkit.model.mechanism import Mechanism
+from screwkit.model.mechanism import Mechanism, MechanismJoint
 
 Array = NDArray[np.float64]
 #: below this sin α two consecutive free axes are taken as parallel (the normal is then chosen)
@@ -79,14 +81,32 @@ def _split_real(L: Array) -> tuple[float, float, float, float, float, float]:
 
 @dataclass(frozen=True)
 class _Walk:
-    """The loop from the ground: joint indices, oriented points and axes, and which of each
-    joint's freedoms (turn, slide) are free."""
+    """The loop from the ground as steps, each a line with a turn and/or a slide: the joint
+    index, oriented point and axis, the names of the step's turn and slide freedoms ("" where
+    it has none), their indices among the joint's freedoms (−1 where none) and whether each is
+    free. A U joint is two steps, two R joints on intersecting lines (its first axis, then its
+    second, as T = M_axis(θ1) M_axis2(θ2); the other way round when walked backwards)."""
 
     order: tuple[int, ...]
     points: tuple[Array, ...]
     axes: tuple[Array, ...]
+    turn_name: tuple[str, ...]
+    slide_name: tuple[str, ...]
+    turn_index: tuple[int, ...]
+    slide_index: tuple[int, ...]
     turn_free: tuple[bool, ...]
     slide_free: tuple[bool, ...]
+
+
+def _steps(joint: MechanismJoint, forward: bool) -> list[tuple[Array, str, str]]:
+    """A joint's steps along the walk: (oriented axis, turn freedom, slide freedom)."""
+    sign = 1.0 if forward else -1.0
+    if joint.kind == "U":
+        assert joint.axis2 is not None
+        both = [(sign * joint.axis, "theta1", ""), (sign * joint.axis2, "theta2", "")]
+        return both if forward else both[::-1]
+    return [(sign * joint.axis, "theta" if joint.kind in "RC" else "",
+             "s" if joint.kind in "PC" else "")]
 
 
 def _walk(mech: Mechanism) -> _Walk:
@@ -94,18 +114,25 @@ def _walk(mech: Mechanism) -> _Walk:
         raise CapabilityError(f"{mech.name}: the general loop formulation takes a single loop "
                               f"and nothing else; this mechanism has "
                               f"{len(mech.topology.loops)} loops")
-    bad = [j.name for j in mech.joints if j.kind not in "RPC"]
+    bad = [j.name for j in mech.joints if j.kind not in "RPCU"]
     if bad:
-        raise CapabilityError(f"{mech.name}: joints {listing(bad)} are not R, P or C joints; "
-                              "the general loop formulation takes those only")
+        raise CapabilityError(f"{mech.name}: joints {listing(bad)} are not R, P, C or U "
+                              "joints; the general loop formulation takes those only")
     driven = set(mech.inputs)
-    steps = loop_walk(mech)
-    joints = [mech.joints[k] for k, _ in steps]
-    return _Walk(tuple(k for k, _ in steps), tuple(j.at for j in joints),
-                 tuple(j.axis if forward else -j.axis
-                       for j, (_, forward) in zip(joints, steps, strict=True)),
-                 tuple(j.kind in "RC" and f"{j.name}.theta" not in driven for j in joints),
-                 tuple(j.kind in "PC" and f"{j.name}.s" not in driven for j in joints))
+    rows: list[tuple[int, Array, Array, str, str, int, int]] = []
+    for k, forward in loop_walk(mech):
+        j = mech.joints[k]
+        for axis, turn, slide in _steps(j, forward):
+            rows.append((k, j.at, axis, f"{j.name}.{turn}" if turn else "",
+                         f"{j.name}.{slide}" if slide else "",
+                         j.freedoms.index(turn) if turn else -1,
+                         j.freedoms.index(slide) if slide else -1))
+    return _Walk(tuple(r[0] for r in rows), tuple(r[1] for r in rows),
+                 tuple(r[2] for r in rows), tuple(r[3] for r in rows),
+                 tuple(r[4] for r in rows), tuple(r[5] for r in rows),
+                 tuple(r[6] for r in rows),
+                 tuple(bool(r[3]) and r[3] not in driven for r in rows),
+                 tuple(bool(r[4]) and r[4] not in driven for r in rows))
 
 
 def loop_kinds(mech: Mechanism) -> str:
@@ -122,7 +149,13 @@ class GeneralLoop:
 
     mechanism: Mechanism
     kinds: str
-    system: PolynomialSystem
+
+    @property
+    def system(self) -> PolynomialSystem:
+        """The compiled system of the loop's free joints (compiled on first use: 0.26 s for
+        RPRRRR's 20,687 terms, 0.85 s for PRPRPR's 68,201, which :mod:`.rpc_loop` never
+        needs)."""
+        return general_loop_system(self.kinds)
 
     def _instance(self, row: Array) -> tuple[Array, Array, Array]:
         """Parameters (k,), turn offsets Φ (n,) and slide offsets (n,) at one row of inputs."""
@@ -137,9 +170,8 @@ class GeneralLoop:
             steps = list(range(i, len(w.order))) + list(range(0, nxt)) if nxt <= i else \
                 list(range(i, nxt))
             for s in steps:
-                joint = mech.joints[w.order[s]]
-                th = value.get(f"{joint.name}.theta", 0.0) if not w.turn_free[s] else 0.0
-                sl = value.get(f"{joint.name}.s", 0.0) if not w.slide_free[s] else 0.0
+                th = value.get(w.turn_name[s], 0.0) if not w.turn_free[s] else 0.0
+                sl = value.get(w.slide_name[s], 0.0) if not w.slide_free[s] else 0.0
                 G = G @ _screw(w.points[s], w.axes[s], th, sl)
             links.append(np.linalg.inv(frames[n_j]) @ G @ frames[(n_j + 1) % len(free)])
         parts = [_split_real(L) for L in links]
@@ -168,10 +200,11 @@ class GeneralLoop:
                              f"input values are needed; got shape {X.shape}")
         return np.array([self._instance(row)[0] for row in X])
 
-    def _free(self) -> list[tuple[int, int]]:
-        """(free joint j, its mechanism joint index) round the loop."""
+    def _free(self) -> list[tuple[int, int, int, int]]:
+        """(free joint j, its mechanism joint index, the indices of its turn and slide among
+        that joint's freedoms) round the loop."""
         w = _walk(self.mechanism)
-        return [(j, w.order[i]) for j, i in enumerate(
+        return [(j, w.order[i], w.turn_index[i], w.slide_index[i]) for j, i in enumerate(
             i for i in range(len(w.order)) if w.turn_free[i] or w.slide_free[i])]
 
     def unknowns(self, scalars: ArrayLike, input_values: ArrayLike) -> Array:
@@ -182,14 +215,13 @@ class GeneralLoop:
         _, turn_off, slide_off = self._instance(row)
         lay, glay = loop_layout(self.kinds), graph_layout(self.mechanism)
         x = np.zeros((S.shape[0], lay.n_unknowns))
-        for j, k in self._free():
+        for j, k, ti, si in self._free():
             f0 = glay.first_freedom[k]
             if lay.cs[j] >= 0:
-                q = S[:, glay.scalar_col[f0]] + turn_off[j]
+                q = S[:, glay.scalar_col[f0 + ti]] + turn_off[j]
                 x[:, lay.cs[j]], x[:, lay.cs[j] + 1] = np.cos(q), np.sin(q)
             if lay.d[j] >= 0:
-                f = f0 + (1 if self.mechanism.joints[k].kind == "C" else 0)
-                x[:, lay.d[j]] = (S[:, glay.scalar_col[f]] + slide_off[j]) / max(
+                x[:, lay.d[j]] = (S[:, glay.scalar_col[f0 + si]] + slide_off[j]) / max(
                     self.mechanism.length_scale, 1e-12)
         return x
 
@@ -209,14 +241,13 @@ class GeneralLoop:
             k = next(i for i, j in enumerate(mech.joints) if j.name == joint)
             f = glay.first_freedom[k] + mech.joints[k].freedoms.index(freedom)
             scalars[:, glay.scalar_col[f]] = v
-        for j, k in self._free():
+        for j, k, ti, si in self._free():
             f0 = glay.first_freedom[k]
             if lay.cs[j] >= 0:
                 q = np.arctan2(sol[:, lay.cs[j] + 1], sol[:, lay.cs[j]]) - turn_off[j]
-                scalars[:, glay.scalar_col[f0]] = np.mod(q + np.pi, 2 * np.pi) - np.pi
+                scalars[:, glay.scalar_col[f0 + ti]] = np.mod(q + np.pi, 2 * np.pi) - np.pi
             if lay.d[j] >= 0:
-                f = f0 + (1 if mech.joints[k].kind == "C" else 0)
-                scalars[:, glay.scalar_col[f]] = sol[:, lay.d[j]] * max(
+                scalars[:, glay.scalar_col[f0 + si]] = sol[:, lay.d[j]] * max(
                     mech.length_scale, 1e-12) - slide_off[j]
         return Configuration(scalars, np.zeros((sol.shape[0], 0, 3, 3))), glay
 
@@ -224,5 +255,6 @@ class GeneralLoop:
 def general_loop(mech: Mechanism) -> GeneralLoop:
     """The general loop formulation of ``mech`` (a CapabilityError where it does not fit)."""
     kinds = loop_kinds(mech)
-    return GeneralLoop(mech, kinds, general_loop_system(kinds))
+    loop_layout(kinds)  # a CapabilityError without six freedoms of R, P and C
+    return GeneralLoop(mech, kinds)
 

@@ -53,9 +53,10 @@ def start_solutions(system: PolynomialSystem, random_instance: RandomInstance | 
     """Every solution of ``system`` at a generic complex parameter vector, kept per topology
     (module docstring): for a Bézout number ≤ :data:`TOTAL_DEGREE_PATHS` (or when no random
     instance is given) by the multi-homogeneous homotopy of ``grouping`` when its count is
-    below the total degree, else by total degree; otherwise by monodromy from
-    ``random_instance(rng)`` (p (1, k), x (1, n), complex) until ``generic_count`` solutions
-    are known."""
+    below the total degree, else by total degree (by monodromy after all when it ends at
+    fewer or more than a given ``generic_count`` and a random instance is given); otherwise by
+    monodromy from ``random_instance(rng)`` (p (1, k), x (1, n), complex) until
+    ``generic_count`` solutions are known."""
     key = system_key(system)
     if key not in _CACHE:
         found = start_store.load(key, system, generic_count)
@@ -95,12 +96,21 @@ def _solve(system: PolynomialSystem, random_instance: RandomInstance | None,
             if found is not None:
                 return found
         found = _by_total_degree(system, seed)
+        if (random_instance is not None and generic_count is not None
+                and found.generic_count != generic_count):  # a path lost: monodromy instead
+            _PATHS[0] += found.paths
+            found = _by_monodromy(system, random_instance, generic_count, seed)
     else:
-        p0, x0 = random_instance(np.random.default_rng(seed))
-        options = MonodromyOptions(expected=generic_count, seed=seed)
-        found = StartSolutions.by_monodromy(system, p0[0], x0[0], options)
+        found = _by_monodromy(system, random_instance, generic_count, seed)
     _PATHS[0] += found.paths
     return found
+
+
+def _by_monodromy(system: PolynomialSystem, random_instance: RandomInstance,
+                  generic_count: int | None, seed: int) -> StartSolutions:
+    p0, x0 = random_instance(np.random.default_rng(seed))
+    options = MonodromyOptions(expected=generic_count, seed=seed)
+    return StartSolutions.by_monodromy(system, p0[0], x0[0], options)
 
 
 def _by_multi_homogeneous(system: PolynomialSystem, grouping: Grouping,

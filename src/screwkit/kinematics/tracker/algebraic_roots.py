@@ -2,7 +2,8 @@
 for single loops"), for the generic loop solver's root searches.
 
 Where a formulation of :mod:`screwkit.kinematics.modes` fits the loop (a planar R loop; an R
-loop with six free joints; an RSSR, RSRC or RCCC driven at a ground R joint), the generic
+loop with six free joints; a loop of R, P and C joints with six free freedoms; an RSSR, RSRC or
+RCCC driven at a ground R joint), the generic
 solver seeds its branches from every real solution of one batched parameter homotopy over the
 rows searched, instead of Newton from random starts, which cannot promise every root.
 
@@ -102,7 +103,8 @@ def _form_inputs(form: Formulation, rel: Array) -> Array:
 
 
 def formulation_name(form: Formulation) -> str:
-    """A short name of the formulation: "planar R loop", "6R", "RSSR", "RSRC" or "RCCC"."""
+    """A short name of the formulation: "planar R loop", "6R", "R/P/C loop", "RSSR", "RSRC" or
+    "RCCC"."""
     if isinstance(form, PlanarFormulation):
         return "planar R loop"
     kind = getattr(form, "kind", None)
@@ -143,13 +145,17 @@ def closed_somewhere(linkage: Linkage, lay: Layout, starts: int = DRAWING_STARTS
 def _may_fit(linkage: Linkage, lay: Layout) -> bool:
     """Whether a formulation may take the loop, from its joints alone (before the drawing is
     searched): R joints only, planar (every link keeps the z axis, up to its sign) or with six
-    free joints; or
-    four joints making an RSSR, RSRC or RCCC."""
+    free joints; R, P and C joints (some P or C) with six free freedoms; or four joints making
+    an RSSR, RSRC or RCCC."""
     kinds = sorted(j.kind for j in linkage.joints)
     if set(kinds) == {"R"}:
         planar = bool(np.all(np.abs(np.abs(constants(linkage, lay)[0][:, 2, 2]) - 1.0)
                              < 1e-12))
         return planar or len(kinds) - len(linkage.inputs) == 6
+    if set(kinds) <= {"R", "P", "C"} and set(kinds) & {"P", "C"}:
+        freedoms = sum(2 if k == "C" else 1 for k in kinds)
+        if freedoms - len(linkage.inputs) == 6:
+            return True
     return len(linkage.inputs) == 1 and kinds in (["R", "R", "S", "S"], ["C", "R", "R", "S"],
                                                   ["C", "C", "C", "R"])
 
