@@ -60,6 +60,26 @@ def test_an_h_joint_is_refused_as_not_algebraic() -> None:
         every_mode(helical, [[0.0]])
 
 
+@pytest.mark.parametrize("which", ["7R", "fourbar_graph"])
+def test_a_joint_made_off_its_drawing_is_refused_not_solved_as_drawn(which: str) -> None:
+    """A seat offset (a part made off its drawing, as a hardpoint tolerance makes it) moves the
+    mechanism off what the formulations read: before, every_mode solved the drawn mechanism
+    and its graph-closure check then dropped every root, so a 7R loop with a 1 mm offset
+    silently had no mode at all (2 without it). Now it is refused, naming the joint."""
+    from dataclasses import replace
+
+    mech = (random_r_loop(np.random.default_rng(5), 7, [0]) if which == "7R" else
+            sk.load_spec(EXAMPLES / f"{which}.toml").mechanism)
+    X = np.full((1, len(mech.inputs)), 0.1)
+    assert every_mode(mech, X).configurations[0].size >= 1
+    joints = list(mech.joints)
+    delta = np.array([1e-3, 0.0, 0.0])
+    joints[2] = replace(joints[2], at=joints[2].at + delta, seat_offset=delta)
+    off = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+    with pytest.raises(CapabilityError, match=f"joints \\['{joints[2].name}'\\] are made off"):
+        every_mode(off, X)
+
+
 def test_a_mechanism_no_formulation_takes_is_refused_by_name() -> None:
     mech = sk.load_spec(EXAMPLES / "double_wishbone.toml").mechanism
     with pytest.raises(CapabilityError, match="no polynomial formulation takes"):

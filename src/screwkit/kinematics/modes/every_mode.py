@@ -87,6 +87,13 @@ def closure_formulation(mech: Mechanism) -> Formulation:
             "polynomial in cos θ and sin θ, so its closure is not algebraic and the homotopy "
             "cannot promise every mode: follow the mechanism with the graph tracker "
             "(solve_mechanism) instead")
+    off = [j.name for j in mech.joints if j.seat_offset is not None]
+    if off:
+        raise CapabilityError(
+            f"{mech.name}: joints {off} are made off their drawing (a seat offset, e.g. from a "
+            "hardpoint tolerance); the polynomial formulations read the mechanism from its "
+            "drawing and do not model that, so they would solve the drawn mechanism instead: "
+            "follow it with the graph tracker (solve_mechanism) instead")
     kinds = {j.kind for j in mech.joints}
     parallel = all(np.linalg.norm(np.cross(j.axis, mech.joints[0].axis)) < 1e-9
                    for j in mech.joints)
