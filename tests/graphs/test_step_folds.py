@@ -50,23 +50,29 @@ def _meet(c1: np.ndarray, r1: float, c2: np.ndarray, r2: float) -> np.ndarray:
     return c1 + along * w / f + np.sqrt(r1 ** 2 - along ** 2) * np.array([-w[1], w[0]]) / f
 
 
-def _sixbar(a: float, b: float, c: float, d: float, drawn: float) -> Mechanism:
-    """The four-bar O–A–B–D (crank a at O, rocker c pivoted at (d, 0)) drawn at crank angle
-    ``drawn`` (deg), and a dyad E–G–F from the crank to the ground (E 0.3 a from O: it
-    assembles at every crank angle)."""
-    phi = np.radians(drawn)
-    A = a * np.array([np.cos(phi), np.sin(phi)])
+def _with_dyad(a: float, b: float, c: float, d: float, rE: float, F: np.ndarray, g1: float,
+               g2: float, drawn: float) -> Mechanism:
+    """A four-bar O–A–B–D (crank a at O, rocker c pivoted at (d, 0)) with an RRR dyad
+    E–G–F (E on the crank at radius rE, one radian ahead of A; F on the ground), drawn at
+    crank angle ``drawn`` (rad)."""
+    A = a * np.array([np.cos(drawn), np.sin(drawn)])
     D = np.array([d, 0.0])
-    E = 0.3 * a * np.array([np.cos(phi + 1.0), np.sin(phi + 1.0)])
-    F = np.array([-2.0, -3.0])
+    E = rE * np.array([np.cos(drawn + 1.0), np.sin(drawn + 1.0)])
     return Mechanism("four-bar with a dyad", tuple(Body(n) for n in ("crank", "coupler",
                                                                     "rocker", "b3", "b4")),
                      (_joint("O", "ground", "crank", np.zeros(2)),
                       _joint("A", "crank", "coupler", A),
                       _joint("B", "coupler", "rocker", _meet(A, b, D, c)),
                       _joint("D", "rocker", "ground", D),
-                      _joint("E", "crank", "b3", E), _joint("G", "b3", "b4", _meet(E, 3.0, F, 2.5)),
+                      _joint("E", "crank", "b3", E), _joint("G", "b3", "b4", _meet(E, g1, F, g2)),
                       _joint("F", "b4", "ground", F)), ("O.theta",))
+
+
+def _sixbar(a: float, b: float, c: float, d: float, drawn: float) -> Mechanism:
+    """The four-bar O–A–B–D (crank a at O, rocker c pivoted at (d, 0)) drawn at crank angle
+    ``drawn`` (deg), and a dyad E–G–F from the crank to the ground (E 0.3 a from O: it
+    assembles at every crank angle)."""
+    return _with_dyad(a, b, c, d, 0.3 * a, np.array([-2.0, -3.0]), 3.0, 2.5, np.radians(drawn))
 
 
 def _island_dims() -> tuple[float, float, float, float]:

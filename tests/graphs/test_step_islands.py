@@ -19,11 +19,10 @@ import pytest
 from tests.graphs.test_step_folds import (
     ISLAND_DRAWN,
     ISLAND_INPUTS,
-    Z,
     _crank_at,
     _island_dims,
-    _meet,
     _sixbar,
+    _with_dyad,
 )
 
 import screwkit as sk
@@ -39,34 +38,12 @@ from screwkit.kinematics.modes.planar import planar_formulation
 from screwkit.kinematics.modes.planar_folds import input_folds
 from screwkit.kinematics.modes.starts import start_solutions
 from screwkit.kinematics.modes.step_islands import fold_values, unreported
-from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
+from screwkit.model.mechanism import Mechanism
 
 EXAMPLES = Path(__file__).parents[2] / "examples" / "mechanisms"
 #: fold inputs agree to this (rad): the critical points are Newton-converged, the distance
 #: law exact; the task's bar is 1e-8
 FOLD_RAD = 1e-9
-
-
-def _joint(name: str, a: str, b: str, at: np.ndarray) -> MechanismJoint:
-    return MechanismJoint(name, "R", (a, b), np.array([*at, 0.0]), Z)
-
-
-def _with_dyad(a: float, b: float, c: float, d: float, rE: float, F: np.ndarray, g1: float,
-               g2: float, drawn: float) -> Mechanism:
-    """A four-bar O–A–B–D (crank a at O, rocker c pivoted at (d, 0)) with an RRR dyad
-    E–G–F (E on the crank at radius rE, one radian ahead of A; F on the ground), drawn at
-    crank angle ``drawn`` (rad)."""
-    A = a * np.array([np.cos(drawn), np.sin(drawn)])
-    D = np.array([d, 0.0])
-    E = rE * np.array([np.cos(drawn + 1.0), np.sin(drawn + 1.0)])
-    return Mechanism("four-bar with a dyad", tuple(Body(n) for n in ("crank", "coupler",
-                                                                    "rocker", "b3", "b4")),
-                     (_joint("O", "ground", "crank", np.zeros(2)),
-                      _joint("A", "crank", "coupler", A),
-                      _joint("B", "coupler", "rocker", _meet(A, b, D, c)),
-                      _joint("D", "rocker", "ground", D),
-                      _joint("E", "crank", "b3", E), _joint("G", "b3", "b4", _meet(E, g1, F, g2)),
-                      _joint("F", "b4", "ground", F)), ("O.theta",))
 
 
 def _law(r1: float, r2: float, lo: float, hi: float) -> np.ndarray:
