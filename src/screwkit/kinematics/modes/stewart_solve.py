@@ -34,6 +34,7 @@ from screwkit.kinematics.modes.stewart import (
 )
 from screwkit.kinematics.modes.stewart_template import (
     CHUNK,
+    THREADS,
     blas_controller,
     quadric_forms,
     quadrics,
@@ -96,10 +97,11 @@ def _kernel_forms() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[n
 
 @lru_cache(maxsize=1)
 def stewart_route() -> eigen_first.EigenRoute:
-    """The Stewart–Gough platform's eigen route (module docstring), keyed by ξ1."""
+    """The Stewart–Gough platform's eigen route (module docstring), keyed by ξ1; a batch's
+    polish and fast α-test on the template's :data:`.stewart_template.THREADS` threads."""
     return eigen_first.EigenRoute(stewart_system(), STEWART_GENERIC_COUNT, template_solve, CHARTS,
                                   stewart_start, TEMPLATE, HOMOTOPY, NEWTON_STEPS,
-                                  dense_quadrics)
+                                  dense_quadrics, THREADS)
 
 
 def solve_stewart(params: ArrayLike, options: TrackOptions | None = None) -> Solutions:
