@@ -9,10 +9,11 @@ runs without them (dhseqr 'E': numpy's ``eigvals``, the same eigenvalues bit for
 the Hessenberg reduction is formed once (dorghr), and each eigenvector is one solve with the
 LU of the Hessenberg H − λI (O(n²); Wilkinson 1965, *The Algebraic Eigenvalue Problem*, ch. 9;
 LAPACK's dhsein), mapped back at the wanted rows only. Inverse iteration with LAPACK's
-eigenvalue is backward stable like dgeev's vectors (a residual ~ε‖A‖), measured on the
-Stewart action matrices: 40 × 40, 0.19 ms for the eigenvalues and 0.07 for the vectors at 8
-rows against 0.29–0.30 ms by ``eig`` (CPU per matrix, 256 matrices, load ~3); the polished
-and certified Stewart poses are the same (docs/kinematics.md). LAPACK is scipy's
+eigenvalue is backward stable like dgeev's vectors (a residual ~ε‖A‖). Measured on 512
+Stewart action matrices (40 × 40, CPU per matrix, one process, alternating, load ~2.4):
+0.236–0.249 ms against 0.289–0.299 by ``eig`` and 0.185–0.191 by ``eigvals`` (so ~0.05 for
+Q and the vectors at 8 rows); the polished and certified Stewart poses are the same
+(docs/kinematics.md). LAPACK is scipy's
 (``scipy.linalg.cython_lapack``), called from the compiled kernel
 (:mod:`.hessenberg_kernels`); without numba the caller uses numpy's ``eig``.
 """
