@@ -86,7 +86,7 @@ def eig_rows(A: Any, rows: Any, fn: Any, vals: Any, V: Any, ok: Any) -> None:
         for r in range(m):
             for j in range(n):
                 Qr[r, j] = a[j, src[r]]  # Q's rows wanted
-        eps3 = max(norm, 1.0) * 2.220446049250313e-16
+        eps3 = max(norm, 1e-290) * 2.220446049250313e-16  # LAPACK dlaein: ε‖H‖
         k = 0
         while k < n:
             lam = complex(wr[k], wi[k])
