@@ -5,14 +5,15 @@ template's 40 × 40 action matrices, whose eigenvectors are read at 8 of their 4
 
 numpy's ``eig`` (LAPACK dgeev with right vectors) accumulates the Schur vectors through the
 QR iteration and then solves and back-transforms all n eigenvectors; here the QR iteration
-runs without them (dhseqr 'E': numpy's ``eigvals``, the same eigenvalues bit for bit), Q of
-the Hessenberg reduction is formed once (dorghr), and each eigenvector is one solve with the
-LU of the Hessenberg H − λI (O(n²); Wilkinson 1965, *The Algebraic Eigenvalue Problem*, ch. 9;
-LAPACK's dhsein), mapped back at the wanted rows only. Inverse iteration with LAPACK's
+runs without them (dhseqr 'E': numpy's ``eigvals``, the same eigenvalues bit for bit), only
+the wanted rows of Q of the Hessenberg reduction are formed (from dgehrd's reflectors, not
+dorghr's whole Q), and each eigenvector is one solve with the LU of the Hessenberg H − λI
+(O(n²); Wilkinson 1965, *The Algebraic Eigenvalue Problem*, ch. 9; LAPACK's dhsein), mapped
+back at the wanted rows only. Inverse iteration with LAPACK's
 eigenvalue is backward stable like dgeev's vectors (a residual ~ε‖A‖). Measured on 512
 Stewart action matrices (40 × 40, CPU per matrix, one process, alternating, load ~2.4):
-0.236–0.249 ms against 0.289–0.299 by ``eig`` and 0.185–0.191 by ``eigvals`` (so ~0.05 for
-Q and the vectors at 8 rows); the polished and certified Stewart poses are the same
+0.219–0.224 ms against 0.281–0.287 by ``eig`` and 0.178–0.183 by ``eigvals`` (so ~0.04 for
+Q's rows and the vectors at 8 rows); the polished and certified Stewart poses are the same
 (docs/kinematics.md). LAPACK is scipy's
 (``scipy.linalg.cython_lapack``), called from the compiled kernel
 (:mod:`.hessenberg_kernels`); without numba the caller uses numpy's ``eig``.
@@ -33,7 +34,7 @@ AVAILABLE = compiled.AVAILABLE
 
 @lru_cache(maxsize=1)
 def _routines() -> NDArray[np.int64]:
-    """The addresses of LAPACK's dgebal, dgehrd, dorghr and dhseqr in scipy's cython_lapack."""
+    """The addresses of LAPACK's dgebal, dgehrd and dhseqr in scipy's cython_lapack."""
     from numba.extending import get_cython_function_address
 
     from screwkit.algebraic import hessenberg_kernels as kernels

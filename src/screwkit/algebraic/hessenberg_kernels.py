@@ -24,7 +24,7 @@ njit = numba.njit(cache=True, nogil=True, error_model="numpy")
 njit_fast = numba.njit(cache=True, nogil=True, error_model="numpy",
                        fastmath={"contract", "reassoc", "nsz", "arcp"})
 #: LAPACK's routines in the order of :func:`eig_rows`' ``fn``
-ROUTINES = ("dgebal", "dgehrd", "dorghr", "dhseqr")
+ROUTINES = ("dgebal", "dgehrd", "dhseqr")
 #: a solution entry this large rescales the solution (no overflow in the back substitution)
 BIG = 1e150
 
@@ -83,9 +83,7 @@ def eig_rows(A: Any, rows: Any, fn: Any, vals: Any, V: Any, ok: Any) -> None:
         for i in range(n):
             for j in range(n):
                 hr[i, j] = h[j, i]
-        for r in range(m):
-            for j in range(n):
-                Qr[r, j] = a[j, src[r]]  # Q's rows wanted
+        q_rows(a, tau, iv[1] - 1, iv[2] - 1, src, Qr)
         eps3 = max(norm, 1e-290) * 2.220446049250313e-16  # LAPACK dlaein: ε‖H‖
         k = 0
         while k < n:
@@ -110,7 +108,8 @@ def eig_rows(A: Any, rows: Any, fn: Any, vals: Any, V: Any, ok: Any) -> None:
 def reduce(A: Any, fn: Any, a: Any, h: Any, hq: Any, tau: Any, scale: Any, wr: Any, wi: Any,
            work: Any, iv: Any, ch: Any, z: Any) -> float:
     """LAPACK on one matrix A (n × n): balanced (dgebal 'B'), reduced to Hessenberg form h
-    (dgehrd; column-major, zero below the subdiagonal), Q in a (dorghr), the eigenvalues
+    (dgehrd; column-major, zero below the subdiagonal; its reflectors left in a and tau for
+    :func:`q_rows`), the eigenvalues
     wr + i·wi of h (dhseqr 'E', on the copy hq); ilo, ihi and info in iv[1:4] (info ≠ 0: a
     routine failed); ch (3,) and z (1,) workspace (the caller's: every array LAPACK reads must
     outlive the call, and numba frees a local after its last use in the code, which here is
@@ -136,12 +135,33 @@ def reduce(A: Any, fn: Any, a: Any, h: Any, hq: Any, tau: Any, scale: Any, wr: A
             h[j, i] = a[j, i] if i <= j + 1 else 0.0
             norm = max(norm, abs(h[j, i]))
     hq[:, :] = h
-    call_lapack(fn[2], (N, ILO, IHI, a.ctypes.data, N, tau.ctypes.data, work.ctypes.data,  # type: ignore[call-arg]
-                        LWORK, INFO))  # a: Q
-    call_lapack(fn[3], (ch[1:].ctypes.data, ch[2:].ctypes.data, N, ILO, IHI, hq.ctypes.data,  # type: ignore[call-arg]
+    call_lapack(fn[2], (ch[1:].ctypes.data, ch[2:].ctypes.data, N, ILO, IHI, hq.ctypes.data,  # type: ignore[call-arg]
                         N, wr.ctypes.data, wi.ctypes.data, z.ctypes.data, LDZ,
                         work.ctypes.data, LWORK, INFO))
     return norm
+
+
+@njit_fast
+def q_rows(a: Any, tau: Any, ilo: int, ihi: int, src: Any, Qr: Any) -> None:
+    """The rows src of Q (Qr (m, n)) from dgehrd's reflectors in a (column-major) and tau:
+    Q = H(ilo) ⋯ H(ihi − 1), H(i) = I − τ_i v vᵀ with v_{i+1} = 1 and v below it in column
+    i of a (LAPACK's dgehrd, 0-based), so that e_rᵀ Q is e_r's row times each H(i) in turn
+    (O(m n²) in place of dorghr's whole Q, 4/3 n³)."""
+    n = a.shape[0]
+    for r in range(src.shape[0]):
+        y = Qr[r]
+        for j in range(n):
+            y[j] = 0.0
+        y[src[r]] = 1.0
+        for i in range(ilo, ihi):
+            col = a[i]  # column i of A: the reflector's entries below row i + 1
+            d = y[i + 1]
+            for k in range(np.uint64(i + 2), np.uint64(ihi + 1)):
+                d += y[k] * col[k]
+            d *= tau[i]
+            y[i + 1] -= d
+            for k in range(np.uint64(i + 2), np.uint64(ihi + 1)):
+                y[k] -= d * col[k]
 
 
 @njit

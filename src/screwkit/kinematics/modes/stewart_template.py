@@ -344,8 +344,8 @@ def blas_controller() -> Any:
 def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Complex]:
     """:func:`template_solve` of a few instances: the action matrices, their eigenproblem
     and the points read off the eigenvectors (a real action matrix's by
-    :func:`.hessenberg_eig.eig_rows`: the eigenvalues and the 8 rows read, 0.24 against
-    0.29–0.30 ms per matrix by numpy's eig; a complex one's by numpy's eig)."""
+    :func:`.hessenberg_eig.eig_rows`: the eigenvalues and the 8 rows read, 0.22 against
+    0.28–0.29 ms per matrix by numpy's eig; a complex one's by numpy's eig)."""
     lay = _layout()
     m = len(data.BASIS)
     Am, good = action_matrices(p, label, work)
