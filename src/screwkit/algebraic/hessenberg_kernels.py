@@ -75,6 +75,9 @@ def eig_rows(A: Any, rows: Any, fn: Any, vals: Any, V: Any, ok: Any) -> None:
     src = np.empty(m, dtype=np.int64)
     fac = np.empty(m)
     for g in range(G):
+        if not np.isfinite(A[g]).all():  # (older LAPACKs' dgebal may loop forever on a NaN)
+            ok[g] = False
+            continue
         norm = reduce(A[g], fn, a, h, hq, tau, scale, wr, wi, work, iv, ch, z)
         if iv[3] != 0 or not np.isfinite(norm):
             ok[g] = False
