@@ -11,7 +11,7 @@ dorghr's whole Q), and each eigenvector is one solve with the LU of the Hessenbe
 (O(n²); Wilkinson 1965, *The Algebraic Eigenvalue Problem*, ch. 9; LAPACK's dhsein), mapped
 back at the wanted rows only. Inverse iteration with LAPACK's
 eigenvalue is backward stable like dgeev's vectors (a residual ~ε‖A‖). Measured on 512
-Stewart action matrices (40 × 40, CPU per matrix, one process, alternating, load ~2.4):
+Stewart action matrices (40 × 40, CPU per matrix, one process, alternating, load 2.2–2.5):
 0.219–0.224 ms against 0.281–0.287 by ``eig`` and 0.178–0.183 by ``eigvals`` (so ~0.04 for
 Q's rows and the vectors at 8 rows); the polished and certified Stewart poses are the same
 (docs/kinematics.md). LAPACK is scipy's
