@@ -117,3 +117,18 @@ def test_the_route_with_and_without_the_quadrics_finds_the_same() -> None:
         xa, xb = a.x[a.instance == i], b.x[b.instance == i]
         d = np.abs(xa[:, None] - xb[None]).max(axis=2) / (1.0 + np.abs(xa).max(axis=1))[:, None]
         assert d.min(axis=1).max() <= 1e-10 and d.min(axis=0).max() <= 1e-10
+
+
+def test_a_batchs_quadric_matrices_in_threads_are_each_instances(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A batch's quadric matrices made in parts on three threads are, bit for bit, each
+    instance's made alone."""
+    from screwkit.kinematics.modes import stewart_solve
+
+    monkeypatch.setattr(stewart_solve, "THREADS", 3)
+    p, _ = random_stewart(np.random.default_rng(52), 100)
+    p = p.real.astype(complex)
+    Q, Qabs = stewart_solve.dense_quadrics(p)
+    for b in (0, 33, 34, 66, 67, 99):
+        one, one_abs = stewart_solve.dense_quadrics(p[b:b + 1])
+        assert np.array_equal(Q[b], one[0]) and np.array_equal(Qabs[b], one_abs[0]), b

@@ -14,7 +14,7 @@ import pytest
 
 from screwkit.algebraic.solve import Solutions, solve_all
 from screwkit.errors import InputError
-from screwkit.kinematics.modes import eigen_first, stewart_sparse, stewart_template
+from screwkit.kinematics.modes import eigen_first, stewart_solve, stewart_sparse, stewart_template
 from screwkit.kinematics.modes import stewart_template_data as data
 from screwkit.kinematics.modes.stewart import (
     leg_lengths,
@@ -274,3 +274,35 @@ def test_blas_runs_one_thread_inside_a_batch(monkeypatch: pytest.MonkeyPatch) ->
         after = [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
     assert seen and set(seen) == {1}
     assert set(after) == {2}
+
+
+def test_the_polish_and_alpha_test_in_threads_change_nothing(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A batch's points polished and certified over threads (contiguous parts, each part's
+    kernel point by point) give bit for bit the points, certificates and verdicts of one
+    thread; the parts really ran apart (the first polish in three even parts; a pool runs
+    parts this small on one thread or more as they come, larger ones side by side)."""
+    import dataclasses
+
+    p, _ = random_stewart(np.random.default_rng(41), 8)
+    p = p.real.astype(complex)
+    route = eigen_first.EigenRoute(stewart_system(), 40, template_solve, (0, 1, 2),
+                                   stewart_start, TEMPLATE, HOMOTOPY, 6,
+                                   stewart_solve.dense_quadrics)
+    one = eigen_first.solve_eigen_first(route, p)
+    monkeypatch.setattr(eigen_first, "THREAD_POINTS", 8)
+    seen: list[int] = []
+    inner = eigen_first.newton_dense
+
+    def spy(Q: np.ndarray, inst: np.ndarray, x: np.ndarray, steps: int) -> np.ndarray:
+        seen.append(len(x))
+        return inner(Q, inst, x, steps)
+
+    monkeypatch.setattr(eigen_first, "newton_dense", spy)
+    three = eigen_first.solve_eigen_first(dataclasses.replace(route, threads=3), p)
+    first = seen[:3]
+    assert len(seen) >= 3 and max(first) - min(first) <= 1, seen
+    assert np.array_equal(one.x, three.x) and np.array_equal(one.instance, three.instance)
+    assert one.route == three.route and np.all(one.found == 40)
+    for name in ("certified", "real", "alpha", "beta", "gamma"):
+        assert np.array_equal(getattr(one, name), getattr(three, name)), name

@@ -19,6 +19,7 @@ instance the method that ran.
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -44,6 +45,9 @@ CONVERGED = 1e-8
 POLISH_ROUNDS = 3
 #: and as distinct from another when they are this far apart (relative)
 DISTINCT = 1e-6
+#: points at least per thread when a route polishes and certifies in threads (below, one
+#: thread: a pool costs ~0.1 ms to start)
+THREAD_POINTS = 512
 #: the fields of a certificate, in order
 _FIELDS = tuple(f.name for f in fields(Certificate))
 
@@ -72,6 +76,9 @@ class EigenRoute:
     #: fast α-test (:func:`.certify.certify`, ``dense``) then evaluate them instead of the term
     #: table (the same values to rounding; ‖f‖, the γ bound and the verdicts are unchanged)
     quadrics: Callable[[Complex], tuple[Complex, Complex]] | None = None
+    #: threads the polish and the fast α-test of a batch's points run on (their compiled
+    #: kernels release the GIL and go point by point: the same results on any number)
+    threads: int = 1
 
 
 def newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Complex:
@@ -189,14 +196,20 @@ def _eigen_pass(route: EigenRoute, targets: Complex, label: int
     p = targets[inst]
     Q, Qabs = (None, None) if route.quadrics is None else route.quadrics(targets)
 
-    def polish(x: Complex, rows: NDArray[np.intp] | slice) -> Complex:
+    def polish_part(x: Complex, rows: NDArray[np.intp] | slice) -> Complex:
         if Q is None:
             return newton(system, x, p[rows], route.newton_steps)
         return newton_dense(Q, inst[rows], x, route.newton_steps)
 
-    def fast_test(x: Complex, rows: NDArray[np.intp] | slice) -> Certificate:
+    def test_part(x: Complex, rows: NDArray[np.intp] | slice) -> Certificate:
         dense = None if Q is None or Qabs is None else (Q, Qabs, inst[rows])
         return certify(system, x, p[rows], fast=True, norm_f=norm_f[rows], dense=dense)
+
+    def polish(x: Complex, rows: NDArray[np.intp] | slice) -> Complex:
+        return in_threads(polish_part, x, rows, route.threads, np.concatenate)
+
+    def fast_test(x: Complex, rows: NDArray[np.intp] | slice) -> Certificate:
+        return in_threads(test_part, x, rows, route.threads, _joined_all)
 
     xs = polish(x.reshape(B * m, -1)[sel].astype(complex), slice(None))
     finite: NDArray[np.bool_] = np.asarray(np.isfinite(xs).all(1), dtype=bool)
@@ -247,6 +260,33 @@ def _eigen_pass(route: EigenRoute, targets: Complex, label: int
         apart[s:s + 256] = (gap > rm[s:s + 256, pi] + rm[s:s + 256, pj]).all(axis=1)
     ok[ok] = good[full].reshape(-1, m).all(axis=1) & apart
     return xs, inst, ok, cert
+
+
+def in_threads(fn: Callable[[Complex, Any], Any], x: Complex, rows: NDArray[np.intp] | slice,
+               threads: int, join: Callable[[list[Any]], Any]) -> Any:
+    """fn(x, rows) of a point-by-point computation, on up to ``threads`` threads over
+    contiguous parts of the points x (P, n) (rows: their rows of the caller's arrays), the
+    parts' results joined in order: the same as one call when fn treats each point on its own
+    (a compiled kernel that releases the GIL; at least :data:`THREAD_POINTS` points a
+    thread)."""
+    P = len(x)
+    parts = min(threads, P // THREAD_POINTS)
+    if parts <= 1:
+        return fn(x, rows)
+    index = np.arange(P)[rows] if isinstance(rows, slice) else rows
+    cuts = [P * t // parts for t in range(parts + 1)]
+    with ThreadPoolExecutor(parts) as pool:
+        futures = [pool.submit(fn, x[a:b], index[a:b]) for a, b in zip(cuts[:-1], cuts[1:],
+                                                                        strict=True)]
+        return join([f.result() for f in futures])
+
+
+def _joined_all(certs: list[Certificate]) -> Certificate:
+    """The certificates of the parts' points, in order."""
+    out = certs[0]
+    for c in certs[1:]:
+        out = joined(out, c)
+    return out
 
 
 def rows_of(cert: Certificate, rows: NDArray[np.intp]) -> Certificate:

@@ -15,6 +15,7 @@ route, with ``route`` naming per instance the method that ran.
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 
 import numpy as np
@@ -34,6 +35,7 @@ from screwkit.kinematics.modes.stewart import (
 )
 from screwkit.kinematics.modes.stewart_template import (
     CHUNK,
+    THREADS,
     blas_controller,
     quadric_forms,
     quadrics,
@@ -66,15 +68,29 @@ def dense_quadrics(targets: Complex) -> tuple[Complex, Complex]:
     Husty 1996) and the patch r·x − 1; and their term-wise moduli, |z|ᵀ |Q|_i |z| = Σ|terms|
     of F_i (the α-test's rounding scale): for the polish's dense Newton steps and α-test.
     Both in one compiled pass when numba is there (:func:`.stewart_kernels.dense_quadrics`:
-    the same sums, equal to this numpy route's to rounding)."""
+    the same sums, equal to this numpy route's to rounding; a batch in parts on the
+    template's threads)."""
     if compiled.AVAILABLE:
         from screwkit.kinematics.modes import stewart_kernels
 
         G, H, S, patch = _kernel_forms()
         Q = np.empty((len(targets), 8, 9, 9), dtype=complex)
         Qabs = np.empty_like(Q)
-        stewart_kernels.dense_quadrics(np.ascontiguousarray(targets, dtype=complex), G, H, S,
-                                       patch, Q, Qabs)
+        t = np.ascontiguousarray(targets, dtype=complex)
+
+        def part(a: int, b: int) -> None:
+            stewart_kernels.dense_quadrics(t[a:b], G, H, S, patch, Q[a:b], Qabs[a:b])
+
+        # a batch's instances in contiguous parts on the template's threads (the kernel
+        # releases the GIL and goes instance by instance: the same values)
+        parts = min(THREADS, len(t) // (2 * CHUNK))
+        if parts <= 1:
+            part(0, len(t))
+            return Q, Qabs
+        cuts = [len(t) * k // parts for k in range(parts + 1)]
+        with ThreadPoolExecutor(parts) as pool:
+            for f in [pool.submit(part, a, b) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]:
+                f.result()
         return Q, Qabs
     out = []
     for absolute in (False, True):
@@ -96,10 +112,11 @@ def _kernel_forms() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[n
 
 @lru_cache(maxsize=1)
 def stewart_route() -> eigen_first.EigenRoute:
-    """The Stewart–Gough platform's eigen route (module docstring), keyed by ξ1."""
+    """The Stewart–Gough platform's eigen route (module docstring), keyed by ξ1; a batch's
+    polish and fast α-test on the template's :data:`.stewart_template.THREADS` threads."""
     return eigen_first.EigenRoute(stewart_system(), STEWART_GENERIC_COUNT, template_solve, CHARTS,
                                   stewart_start, TEMPLATE, HOMOTOPY, NEWTON_STEPS,
-                                  dense_quadrics)
+                                  dense_quadrics, THREADS)
 
 
 def solve_stewart(params: ArrayLike, options: TrackOptions | None = None) -> Solutions:
