@@ -413,3 +413,26 @@ def _holds(along: ModesAlong, m: int, x: float, X: np.ndarray) -> bool:
     left = along.masks[m][k] and not any(X[k, 0] < e < x for e in ends)
     right = along.masks[m][k + 1] and not any(x < e < X[k + 1, 0] for e in ends)
     return bool(left or right)
+
+
+def test_a_fold_search_the_formulation_cannot_write_becomes_the_note(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Where the formulation cannot write its input's circles (placed_circles raises a
+    CapabilityError), the fold search is not taken and says why in the note, and the motion
+    is solved as without it. Before, fold_values asked for the critical-point system (to count
+    its paths) outside its try, so the error ended the whole every-mode motion (found by a
+    review: the error path had no test)."""
+    from screwkit.errors import CapabilityError
+    from screwkit.kinematics.modes import planar_folds
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise CapabilityError("the joints placed by input O.theta do not move on circles")
+
+    mech = _sixbar(1.0, 3.0, 2.0, 3.5, 30.0)
+    X = np.radians(np.arange(30.0, 60.0, 10.0))[:, None]
+    monkeypatch.setattr(planar_folds, "placed_circles", refuse)
+    j, vals, note = fold_values(mech, X)
+    assert j == 0 and vals is None and "do not move on circles" in note
+    got = modes_along(mech, graph_layout(mech), X, _fmt)
+    assert any("not searched as critical points" in n and "circles" in n for n in got.notes)
+    assert len(got.masks) >= 1 and all(m.any() for m in got.masks)

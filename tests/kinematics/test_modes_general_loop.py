@@ -19,6 +19,10 @@ from screwkit.kinematics.modes.general_loop_system import (
     full_closure_residual,
     general_loop_system,
     random_closing_instance,
+    rx,
+    rz,
+    split_link,
+    trans,
 )
 from screwkit.model.mechanism import Mechanism, MechanismJoint
 
@@ -107,3 +111,56 @@ def test_every_mode_of_the_6r_formulation_is_a_root_of_the_general_system() -> N
                            atol=1e-8)
         modes += len(x)
     assert modes >= 10
+
+
+@pytest.mark.parametrize("alpha", [1e-3, 1e-5, 1e-7, np.pi - 1e-7])
+def test_a_link_of_small_twist_splits_and_recomposes(alpha: float) -> None:
+    """split_link of Rz(φ) Tz(b) Tx(a) Rx(α) Rz(ψ) Tz(e) with α near 0 or π gives sin α to a
+    few ulps and recomposes the link to round-off. Before the fix sin α came from
+    √(1 − cos²α), which keeps only ~1e-16/sin²α of it (a relative error 1e-2 at α = 1e-7):
+    the normal's angle φ and the offsets b, e were then wrong, and a loop with two axes 1e-7
+    rad from parallel was solved as another loop (its tracked mode's closure residual 7e-3;
+    found by a review probe of near-parallel axes)."""
+    phi, b, a, psi, e = 0.7, 0.3, 0.8, -1.1, -0.4
+    H = (rz(np.cos(phi), np.sin(phi)) @ trans(2, b) @ trans(0, a)
+         @ rx(np.cos(alpha), np.sin(alpha)) @ rz(np.cos(psi), np.sin(psi)) @ trans(2, e))
+    (cp, sp), b2, a2, (ca, sa), (cs, ss), e2 = split_link(H)
+    assert abs(sa - np.sin(alpha)) <= 1e-9 * np.sin(alpha)
+    assert abs(cp * cp + sp * sp - 1) <= 1e-12 and abs(cs * cs + ss * ss - 1) <= 1e-12
+    back = (rz(cp, sp) @ trans(2, b2) @ trans(0, a2) @ rx(ca, sa) @ rz(cs, ss) @ trans(2, e2))
+    assert np.abs(back - H).max() <= 1e-12 * (1.0 + abs(b2) + abs(e2))
+
+
+@pytest.mark.parametrize("twist", [1e-7, 1e-5])
+def test_a_nearly_parallel_pair_is_read_to_round_off(twist: float) -> None:
+    """A 7R loop driven at j0 with j2's axis ``twist`` rad from j1's: the tracked
+    configuration closes the general system's whole loop to round-off of its largest DH value
+    (the common normal of nearly parallel axes is ~1/twist away, so the offsets are large).
+    Before split_link read sin α from the third column the residual was 7e-3 at 1e-7
+    (3e-7 at 1e-5): the loop read was another loop."""
+    rng = np.random.default_rng(8)
+    checked = 0
+    for _ in range(6):
+        mech = random_loop(rng, "RRRPRRR", ["j0.theta"])
+        joints = list(mech.joints)
+        a1 = joints[1].axis / np.linalg.norm(joints[1].axis)
+        n = np.cross(a1, [0.3, 0.5, 0.8])
+        n /= np.linalg.norm(n)
+        K = np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]])
+        turn = np.eye(3) + np.sin(twist) * K + (1.0 - np.cos(twist)) * (K @ K)
+        j = joints[2]
+        joints[2] = MechanismJoint(j.name, j.kind, j.bodies, j.at, turn @ a1)
+        mech = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+        lay = graph_layout(mech)
+        followed = follow_drawn_mode(mech, lay, np.linspace(0.0, INPUT, 7)[:, None])
+        if not followed.mask.all():
+            continue  # a limit position before INPUT
+        form = general_loop(mech)
+        x = form.unknowns(followed.conf.scalars[6:7], [INPUT])
+        p = form.parameters([[INPUT]])
+        size = float(np.abs(p).max())
+        assert size >= 0.1 / twist  # the offsets are large, as they must be
+        assert full_closure_residual(form.kinds, x[0].astype(complex),
+                                     p[0].astype(complex)) <= 1e-13 * size
+        checked += 1
+    assert checked >= 3

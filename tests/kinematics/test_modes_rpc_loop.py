@@ -284,6 +284,60 @@ def test_a_parallel_pair_is_moved_to_the_ground_link_and_still_solved() -> None:
     assert checked >= 3
 
 
+@pytest.mark.parametrize("twist", [1e-5, 1e-3])
+def test_a_nearly_parallel_pair_is_moved_to_the_ground_link_and_solved(twist: float) -> None:
+    """RRRPRRR with j2's axis ``twist`` rad from j1's (a link between two R joints nearly of
+    zero twist): the labelling puts that link at the ground, where nothing divides by its
+    sin α, and the tracked mode is among every_mode's. Before, the first labelling with
+    |sin α| ≥ 1e-6 was taken (shift 0, k = a / sin α ~ 1e4..1e6): no tracked mode at 1e-5 on
+    any of these loops, and on one of three at 1e-3 (found by a review probe)."""
+    rng = np.random.default_rng(8)
+    checked = 0
+    for _ in range(6):
+        mech = random_loop(rng, "RRRPRRR", ["j0.theta"])
+        joints = list(mech.joints)
+        a1 = joints[1].axis / np.linalg.norm(joints[1].axis)
+        j = joints[2]
+        joints[2] = MechanismJoint(j.name, j.kind, j.bodies, j.at,
+                                   _rotation(np.cross(a1, [0.3, 0.5, 0.8]), twist) @ a1)
+        mech = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+        tracked = _tracked(mech, ["j0.theta"])
+        if tracked is None:
+            continue
+        form = closure_formulation(mech)
+        assert isinstance(form, RPCLoop) and form.shift != 0
+        conf = every_mode(mech, [[INPUT]]).configurations[0]
+        d = np.angle(np.exp(1j * (conf.scalars - tracked)))
+        assert np.abs(d).max(axis=1).min() <= 1e-8
+        checked += 1
+    assert checked >= 3
+
+
+def test_real_solutions_failing_the_closure_check_are_counted_not_dropped_silently() -> None:
+    """RRRPRRR with j2's axis 1e-7 rad from j1's: the DH reading's common-normal feet are
+    ~1e7 lengths away, so the real solutions close the graph only to ~1e-9 of the length
+    scale, above every_mode's 1e-10: none is kept. The rejected count says so per row (and
+    modes_along's notes), where before every_mode gave no mode and no word of the real
+    solutions it dropped (found by a review probe of near-parallel axes)."""
+    from screwkit.kinematics.modes.along import modes_along
+
+    mech = random_loop(np.random.default_rng(8), "RRRPRRR", ["j0.theta"])
+    joints = list(mech.joints)
+    a1 = joints[1].axis / np.linalg.norm(joints[1].axis)
+    j = joints[2]
+    joints[2] = MechanismJoint(j.name, j.kind, j.bodies, j.at,
+                               _rotation(np.cross(a1, [0.3, 0.5, 0.8]), 1e-7) @ a1)
+    mech = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+    X = np.array([[INPUT], [INPUT + 0.1]])
+    found = every_mode(mech, X)
+    assert [c.size for c in found.configurations] == [0, 0]
+    assert (found.rejected > 0).all()
+    plain = every_mode(random_loop(np.random.default_rng(8), "RRRPRRR", ["j0.theta"]), X)
+    assert (plain.rejected == 0).all() and all(c.size for c in plain.configurations)
+    along = modes_along(mech, graph_layout(mech), X, str)
+    assert any("failed the graph closure" in note for note in along.notes)
+
+
 def test_a_p_axis_parallel_to_its_r_neighbour_is_taken_inside_its_run() -> None:
     # RRPRRRR with the P joint j2 parallel to the R joint j1 before it: a link of zero twist
     # inside the P joint's run, where nothing divides by sin α (no relabelling needed)

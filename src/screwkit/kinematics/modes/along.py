@@ -388,6 +388,12 @@ def _notes(solved: MechanismModes, anchors: NDArray[np.intp], count: int, runs: 
                  "inputs that holds no anchor: an island between two anchors is found)" if runs
                  else "(an island between two anchors is found only where it meets a known "
                  "mode at a fold)")]
+    if solved.rejected.any():
+        notes.append(f"at {int(np.count_nonzero(solved.rejected))} anchor(s) "
+                     f"{int(solved.rejected.sum())} real solution(s) of the polynomial system "
+                     "failed the graph closure check (1e-10 of the length scale) and are not "
+                     "modes: the formulation read the mechanism inaccurately there (e.g. two "
+                     "axes nearly parallel), so a mode may be missing")
     if solved.continuum.any():
         notes.append(f"at {int(solved.continuum.sum())} anchor(s) the solutions include a "
                      "continuum (a curve of assemblies), whose points are not isolated modes")

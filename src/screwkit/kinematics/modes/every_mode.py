@@ -138,7 +138,10 @@ class MechanismModes:
     (graph-tracker configurations), ``certified[b]`` whether each passed Smale's α-test,
     ``found`` the distinct complex solutions per row, ``continuum`` rows whose singular end
     points lie on a curve of solutions, ``generic_count`` and ``how_found`` from the start
-    solutions, ``worst_closure`` the largest loop residual of a kept mode."""
+    solutions, ``worst_closure`` the largest loop residual of a kept mode, ``rejected`` the
+    real regular solutions per row not kept because the graph closure exceeds
+    :data:`CLOSURE_TOLERANCE` (a formulation that read the mechanism inaccurately, e.g. two
+    axes nearly parallel, whose common normal's feet are far away)."""
 
     mechanism: Mechanism
     inputs: Array
@@ -149,6 +152,7 @@ class MechanismModes:
     generic_count: int
     how_found: str
     worst_closure: float
+    rejected: NDArray[np.int64]
 
 
 def formulation_start(form: Formulation) -> StartSolutions:
@@ -188,7 +192,7 @@ def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:
     return MechanismModes(mech, X, tuple(once.configurations[i] for i in idx),
                           tuple(once.certified[i] for i in idx), once.found[idx],
                           once.continuum[idx], once.generic_count, once.how_found,
-                          once.worst_closure)
+                          once.worst_closure, once.rejected[idx])
 
 
 def _every_mode_rows(mech: Mechanism, X: Array) -> MechanismModes:
@@ -197,6 +201,7 @@ def _every_mode_rows(mech: Mechanism, X: Array) -> MechanismModes:
     p = form.parameters(X)  # (B, n_in); the one-input loops read it as (B,)
     sol = solve_formulation(form, p)
     confs, certs, continuum, worst = [], [], np.zeros(len(X), dtype=bool), 0.0
+    rejected = np.zeros(len(X), dtype=np.int64)
     for b in range(len(X)):
         rows = np.flatnonzero((sol.instance == b) & sol.real)
         singular = np.flatnonzero((sol.instance == b) & (sol.status == PathStatus.SINGULAR))
@@ -208,10 +213,11 @@ def _every_mode_rows(mech: Mechanism, X: Array) -> MechanismModes:
             continue
         conf, lay = form.configuration(sol.x[rows], X[b])
         residual = np.abs(graph_forward(mech, lay, conf).residual).max(axis=(1, 2))
-        keep = (residual <= CLOSURE_TOLERANCE * max(mech.length_scale, 1.0)) & (
-            sol.status[rows] == PathStatus.REGULAR)
+        regular = sol.status[rows] == PathStatus.REGULAR
+        keep = (residual <= CLOSURE_TOLERANCE * max(mech.length_scale, 1.0)) & regular
+        rejected[b] = int(np.count_nonzero(regular & ~keep))
         worst = max(worst, float(residual[keep].max(initial=0.0)))
         confs.append(conf.take(np.flatnonzero(keep)))
         certs.append(sol.certified_real[rows][keep])
     return MechanismModes(mech, X, tuple(confs), tuple(certs), sol.found, continuum,
-                          sol.generic_count, sol.how_found, worst)
+                          sol.generic_count, sol.how_found, worst, rejected)

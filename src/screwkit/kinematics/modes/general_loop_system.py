@@ -267,11 +267,13 @@ def split_link(H: ArrayLike) -> tuple[tuple[complex, complex], complex, complex,
                                     tuple[complex, complex], tuple[complex, complex], complex]:
     """H = Rz(φ) Tz(b) Tx(a) Rx(α) Rz(ψ) Tz(e) for a rigid motion H (4×4, complex, with
     sin α ≠ 0): ((cos φ, sin φ), b, a, (cos α, sin α), (cos ψ, sin ψ), e), the z–x–z angles
-    read from H's third column and row."""
+    read from H's third column and row. sin α is the length of the third column's (x, y)
+    part, (sin φ sin α, −cos φ sin α): √(1 − cos²α) would keep only ~1e-16/sin²α of it near
+    α = 0 or π (a relative error 1e-2 at α = 1e-7)."""
     H = np.asarray(H, dtype=complex)
     R, t = H[:3, :3], H[:3, 3]
     ca = R[2, 2]
-    sa = np.sqrt(1 - ca * ca + 0j)
+    sa = np.sqrt(R[0, 2] * R[0, 2] + R[1, 2] * R[1, 2] + 0j)
     cphi, sphi = -R[1, 2] / sa, R[0, 2] / sa
     cpsi, spsi = R[2, 1] / sa, R[2, 0] / sa
     cols = np.array([[0, cphi, R[0, 2]], [0, sphi, R[1, 2]], [1, 0, R[2, 2]]], dtype=complex)

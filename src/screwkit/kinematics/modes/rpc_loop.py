@@ -9,7 +9,9 @@ joint as its two turns, the Denavit–Hartenberg values of each free joint from 
 quadrics want a turning joint last (the ground link between two turning joints) and no parallel
 axes where they divide by sin α or need a run's basis (:func:`.parallel_links`), so the free
 joints are relabelled cyclically (joint r first: the loop's product ∏ Z_j K_j = I is unchanged
-under a cyclic shift) by the first shift r that satisfies both in the drawing. Its parameters
+under a cyclic shift) by the first shift r whose related axes are at least
+:data:`WELL_APART` from parallel in the drawing (smallest |sin|), else the shift with the
+largest such sine (above :data:`.rpc_quadrics.PARALLEL`). Its parameters
 are turned into the quadrics' (:func:`.rpc_parameters`), and each solution back into the general
 system's unknowns (:func:`.general_unknowns`, shifted back) and from there into the graph
 tracker's joint values (:meth:`.GeneralLoop.configuration`).
@@ -38,10 +40,12 @@ from screwkit.kinematics.graph.closure import GraphLayout
 from screwkit.kinematics.modes.general_loop import GeneralLoop, general_loop
 from screwkit.kinematics.modes.general_loop_system import loop_layout
 from screwkit.kinematics.modes.rpc_quadrics import (
+    PARALLEL,
     general_unknowns,
     parallel_links,
     quadric_layout,
     random_rpc,
+    related_sines,
     rpc_parameters,
     rpc_system,
 )
@@ -50,6 +54,11 @@ from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
 
 Array = NDArray[np.float64]
+#: the first labelling whose related axes are this far from parallel (smallest |sin|) is taken;
+#: where none is, the labelling with the largest: k = a / sin α and the common normals' feet
+#: (~1/sin α away) make a nearly parallel pair ill-conditioned (a 7R loop with two axes 1e-5
+#: rad apart, labelled as drawn: no real solution found, the tracked mode among none)
+WELL_APART = 1e-2
 #: the route of a row whose related axes are parallel (not solved)
 PARALLEL_ROW = "not solved: two related axes of the loop are parallel at this row"
 
@@ -247,13 +256,21 @@ def rpc_loop(mech: Mechanism) -> RPCLoop:
     kinds = general.kinds
     loop_count(kinds)
     p_dh = general.parameters(np.zeros((1, len(mech.inputs))))
+    best, best_sine = -1, PARALLEL
     for r in range(len(kinds)):
         shifted = kinds[r:] + kinds[:r]
         if shifted[-1] == "P":
             continue
         quadric_layout(shifted)
-        if not parallel_links(shifted, shift_parameters(kinds, r, p_dh)).any():
-            return RPCLoop(mech, shifted, r, rpc_system(shifted), general)
+        sine = float(related_sines(shifted, shift_parameters(kinds, r, p_dh))[0])
+        if sine >= WELL_APART:
+            best = r
+            break
+        if sine >= best_sine:
+            best, best_sine = r, sine
+    if best >= 0:
+        shifted = kinds[best:] + kinds[:best]
+        return RPCLoop(mech, shifted, best, rpc_system(shifted), general)
     raise CapabilityError(f"{mech.name}: in every labelling of the loop ({kinds}) two axes that "
                           "the R/P/C axes formulation relates are parallel (a link of zero "
                           "twist between turning joints, or a run of P joints whose end axes "

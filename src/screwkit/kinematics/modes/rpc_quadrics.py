@@ -312,22 +312,29 @@ def geometry(kinds: str, p_dh: ArrayLike) -> Geometry:
                     tuple(run_axes), tuple(run_normals), tuple(run_gamma))
 
 
-def parallel_links(kinds: str, p_dh: ArrayLike) -> NDArray[np.bool_]:
-    """Per row (B,): whether a link between two turning joints (other than the ground) has
-    parallel axes, or an interior run's end axes are parallel (:data:`PARALLEL`)."""
+def related_sines(kinds: str, p_dh: ArrayLike) -> NDArray[np.float64]:
+    """Per row (B,): the smallest |sin| of the angle between two axes the quadrics relate
+    (a link between two turning joints other than the ground, whose k = a / sin α; an
+    interior run's end axes, its basis); 1 where there are none."""
     lay = quadric_layout(kinds)
     geo = geometry(kinds, p_dh) if lay.runs else None
-    bad = np.zeros(np.atleast_2d(np.asarray(p_dh)).shape[0], dtype=bool)
     P = np.atleast_2d(np.asarray(p_dh, dtype=complex))
+    low = np.ones(P.shape[0])
     gl, nu = loop_layout(kinds), loop_layout(kinds).n_unknowns
     for i, c in enumerate(lay.cos_a):
         if c >= 0:
             _, s = pair_angle(P[:, gl.alpha[i] - nu], P[:, gl.alpha[i] - nu + 1])
-            bad |= np.abs(s) < PARALLEL
+            low = np.minimum(low, np.abs(s))
     if geo is not None:
         for gamma in geo.run_gamma:
-            bad |= np.sqrt(np.abs(1.0 - gamma * gamma)) < PARALLEL
-    return bad
+            low = np.minimum(low, np.sqrt(np.abs(1.0 - gamma * gamma)))
+    return low
+
+
+def parallel_links(kinds: str, p_dh: ArrayLike) -> NDArray[np.bool_]:
+    """Per row (B,): whether a link between two turning joints (other than the ground) has
+    parallel axes, or an interior run's end axes are parallel (:data:`PARALLEL`)."""
+    return related_sines(kinds, p_dh) < PARALLEL
 
 
 def rpc_parameters(kinds: str, p_dh: ArrayLike) -> Complex:
@@ -470,5 +477,5 @@ def random_rpc(kinds: str, rng: np.random.Generator, count: int = 1
 
 
 __all__ = ["PARALLEL", "Geometry", "QuadricLayout", "Run", "general_unknowns", "geometry",
-           "parallel_links", "quadric_layout", "random_rpc", "rpc_axes", "rpc_parameters",
-           "rpc_system", "rpc_unknowns"]
+           "parallel_links", "quadric_layout", "random_rpc", "related_sines", "rpc_axes",
+           "rpc_parameters", "rpc_system", "rpc_unknowns"]

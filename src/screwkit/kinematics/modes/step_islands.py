@@ -63,13 +63,13 @@ def fold_values(mech: Mechanism, X: Array) -> tuple[int, Array | None, str]:
     if not callable(method) or not callable(system):
         return j, None, (f"the {type(form).__name__} has no critical-point system of its "
                          "input (only the planar R formulation has one)")
-    paths = bezout_number(system(j))
-    if paths > MAX_PATHS:
-        return j, None, (f"its critical-point system would start from {paths} total-degree "
-                         f"paths, more than {MAX_PATHS}")
-    try:
+    try:  # (a formulation that cannot write its input's circle: the system raises too)
+        paths = bezout_number(system(j))
+        if paths > MAX_PATHS:
+            return j, None, (f"its critical-point system would start from {paths} "
+                             f"total-degree paths, more than {MAX_PATHS}")
         folds = method(X[0], j)
-    except ScrewkitError as err:  # (a formulation that cannot write its input's circle)
+    except ScrewkitError as err:
         return j, None, str(err)
     vals = np.sort(np.mod(folds.inputs - X[0, j], 2 * np.pi) + X[0, j])
     note = (f"{vals.size} real critical point(s) of {mech.inputs[j]} (folds; "
