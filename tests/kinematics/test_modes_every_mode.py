@@ -14,7 +14,7 @@ from modes_helpers import random_r_loop
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import graph_layout
 from screwkit.kinematics.graph.follow import follow_drawn_mode
-from screwkit.kinematics.modes.every_mode import CLOSURE_TOLERANCE, every_mode
+from screwkit.kinematics.modes.every_mode import CLOSURE_TOLERANCE, closure_formulation, every_mode
 from screwkit.model.mechanism import Mechanism, MechanismJoint
 
 EXAMPLES = Path(__file__).parents[2] / "examples" / "mechanisms"
@@ -150,3 +150,36 @@ def test_equal_rows_are_solved_once_with_the_same_modes(monkeypatch) -> None:  #
         assert np.array_equal(got.configurations[k].scalars, alone.configurations[j].scalars)
         assert got.found[k] == alone.found[j]
     assert np.array_equal(got.inputs, X) and all(c.size == 2 for c in got.configurations)
+
+
+@pytest.mark.parametrize("twist", [0.0, 1e-5, 1e-3])
+def test_a_7r_loop_with_a_nearly_parallel_pair_keeps_its_tracked_mode(twist: float) -> None:
+    """A 7R loop with j2's axis ``twist`` rad from j1's: the 6R reading divides by each link's
+    sin α, so before, the parallel pair raised an InputError ("use planar"), at 1e-5 every_mode
+    had no mode and at 1e-3 it missed the tracked mode on one loop of two (found by a review
+    probe). Such a loop now goes to the R/P/C axes formulation, which puts that link at the
+    ground; a well-separated 7R loop stays on the 6R route."""
+    from tests.kinematics.test_modes_rpc_loop import INPUT, _rotation, _tracked
+
+    from screwkit.kinematics.modes.rpc_loop import RPCLoop
+
+    rng = np.random.default_rng(8)
+    checked = 0
+    for _ in range(6):
+        mech = random_r_loop(rng, 7, [0])
+        joints = list(mech.joints)
+        a1 = joints[1].axis / np.linalg.norm(joints[1].axis)
+        j = joints[2]
+        joints[2] = MechanismJoint(j.name, j.kind, j.bodies, j.at,
+                                   _rotation(np.cross(a1, [0.3, 0.5, 0.8]), twist) @ a1)
+        mech = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+        tracked = _tracked(mech, ["j0.theta"])
+        if tracked is None:
+            continue
+        assert isinstance(closure_formulation(mech), RPCLoop)
+        conf = every_mode(mech, [[INPUT]]).configurations[0]
+        assert np.abs(wrapped(conf.scalars - tracked)).max(axis=1).min() <= 1e-9
+        checked += 1
+    assert checked >= 2
+    assert not isinstance(closure_formulation(random_r_loop(np.random.default_rng(21), 7, [2])),
+                          RPCLoop)

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from screwkit.algebraic.polynomial import PolynomialSystem
 from screwkit.algebraic.solve import Solutions, StartSolutions, solve_all
 from screwkit.algebraic.track import PathStatus
-from screwkit.errors import CapabilityError
+from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
 from screwkit.kinematics.modes.continuum import on_a_continuum
 from screwkit.kinematics.modes.loop6r import loop6r_start, loop6r_system
@@ -53,6 +53,27 @@ class Formulation(Protocol):
 
     def configuration(self, solutions: ArrayLike, input_values: ArrayLike
                       ) -> tuple[Configuration, GraphLayout]: ...
+
+
+def _r_loop_formulation(mech: Mechanism) -> Formulation:
+    """A single R loop's formulation: the 6R axes system (elimination first) where the links
+    of its labelling are :data:`~screwkit.kinematics.modes.rpc_loop.WELL_APART` from parallel
+    in the drawing, else the R/P/C axes formulation, which relabels the loop so that a nearly
+    parallel pair is the ground link (the 6R reading divides by each link's sin α: a 7R loop
+    with two axes 1e-3 rad from parallel missed its tracked mode, at 1e-5 it had no mode, and
+    exactly parallel ones raised an InputError)."""
+    from screwkit.kinematics.modes.rpc_loop import WELL_APART, rpc_loop
+
+    form = _RLoopFormulation(mech, loop6r_system())
+    try:
+        p = form.parameters(np.zeros((1, len(mech.inputs))))[0]
+    except InputError:  # two consecutive axes exactly parallel
+        return rpc_loop(mech)
+    z1, z6, cos_alpha = p[0:3], p[3:6], p[6:11]
+    cosines = np.append(cos_alpha, float(z1 @ z6) / float(np.linalg.norm(z1) * np.linalg.norm(z6)))
+    if np.sqrt(np.maximum(1.0 - cosines**2, 0.0)).min() >= WELL_APART:
+        return form
+    return rpc_loop(mech)
 
 
 @dataclass(frozen=True)
@@ -100,7 +121,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
     if kinds == {"R"} and parallel:
         return planar_formulation(mech)
     if kinds == {"R"} and len(mech.topology.loops) == 1:
-        return _RLoopFormulation(mech, loop6r_system())
+        return _r_loop_formulation(mech)
     single = len(mech.topology.loops) == 1 and len(mech.joints) == 4
     if single and sorted(j.kind for j in mech.joints) in (["R", "R", "S", "S"],
                                                           ["C", "R", "R", "S"]):
