@@ -217,11 +217,14 @@ def _eigen_pass(route: EigenRoute, targets: Complex, label: int
     norm_f = bombieri_weyl_norm(system, targets)[inst]
     cert = fast_test(xs, slice(None))
     # a point still moving after its steps (it arrived far off and wandered before Newton's
-    # fast phase) gets more rounds, at most POLISH_ROUNDS
+    # fast phase) gets more rounds, at most POLISH_ROUNDS; after the first round only the last
+    # round's points are looked at again (the others' points and certificates are unchanged)
+    again = np.flatnonzero(finite)
     for _ in range(POLISH_ROUNDS):
+        xa = xs if len(again) == len(xs) else xs[again]
+        na = cert.newton if len(again) == len(xs) else cert.newton[again]
         with np.errstate(invalid="ignore"):
-            again = np.flatnonzero(finite & (np.abs(xs - cert.newton).max(axis=1)
-                                             > SETTLED * (1.0 + np.abs(xs).max(axis=1))))
+            again = again[np.abs(xa - na).max(axis=1) > SETTLED * (1.0 + np.abs(xa).max(axis=1))]
         if not len(again):
             break
         xs[again] = polish(xs[again], again)
