@@ -120,11 +120,12 @@ def test_complex_parameters_take_the_numpy_route() -> None:
     assert np.array_equal(a[1], b[1]) and np.array_equal(a[0], b[0])
 
 
-def test_the_compiled_verdict_is_the_pairwise_rule() -> None:
+def test_the_compiled_verdict_is_the_pairwise_rule(monkeypatch: pytest.MonkeyPatch) -> None:
     """sixr_compiled.settled (the distinctness test, with its shortcut on the first
     coordinate) against the rule written out in numpy: every pair of an instance's points
     apart by more than the sum of their radii, each point certified or converged and finite,
-    m points; on points with close first coordinates, near twins, large radii and NaN."""
+    m points; on points with close first coordinates, near twins, large radii and NaN; the
+    same on threads (parts of whole instances)."""
     rng = np.random.default_rng(5)
     B, m, n = 300, 12, 4
     xs = rng.normal(size=(B * m, n)) + 1j * rng.normal(size=(B * m, n))
@@ -158,3 +159,7 @@ def test_the_compiled_verdict_is_the_pairwise_rule() -> None:
         want[b] = apart[np.triu_indices(m, 1)].all()
     assert 0.2 < want.mean() < 0.9  # both verdicts occur
     np.testing.assert_array_equal(got, want)
+    monkeypatch.setattr(sixr_compiled, "SETTLED_POINTS", 500)  # 7 parts cut inside instances
+    threaded = sixr_compiled.settled(xs, inst, finite, newton, certified, radius, B, m, 1e-8,
+                                     1e-6, threads=7)
+    np.testing.assert_array_equal(threaded, want)

@@ -246,7 +246,8 @@ def _eigen_pass(route: EigenRoute, targets: Complex, label: int
     xs[flip] = xs[flip].conj()
     if sixr_compiled.AVAILABLE:  # the same verdict, compiled (sixr_kernels.settled)
         return xs, inst, sixr_compiled.settled(xs, inst, finite, cert.newton, cert.certified,
-                                               cert.radius, B, m, CONVERGED, DISTINCT), cert
+                                               cert.radius, B, m, CONVERGED, DISTINCT,
+                                               route.threads), cert
     scale = 1.0 + np.abs(xs).max(axis=1)
     with np.errstate(invalid="ignore"):
         settled = np.abs(xs - cert.newton).max(axis=1) <= CONVERGED * scale
