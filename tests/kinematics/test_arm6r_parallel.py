@@ -121,6 +121,7 @@ def test_industrial_arm_every_solution(name: str) -> None:
         T = _dh_forward(dh, t[None])[0]
         assert np.abs(R - T[:3, :3]).max() < 1e-12 and np.abs(p - T[:3, 3]).max() < 1e-12
     real_counts = []
+    certified = 0
     for _ in range(TARGETS):
         q0 = rng.uniform(-np.pi, np.pi, 6)
         target = arm_forward(C, U, home, q0)
@@ -128,7 +129,10 @@ def test_industrial_arm_every_solution(name: str) -> None:
         assert isinstance(res, ArmContinuation) and res.route == (ROUTE,)
         assert res.found == 8 == res.converged, (res.found, res.converged, q0.tolist())
         assert res.real_count == len(sols) and len(sols) % 2 == 0
-        assert not res.certified.any() and res.note == "converged, not certified"
+        # the α-test may fail only near a singularity (two solutions close together)
+        assert (res.certified | (res.condition > 1e3)).all(), (res.note, res.condition)
+        assert (res.radius[res.certified] < 1e-6).all()
+        certified += int(res.certified.sum())
         T = _dh_forward(dh, sols)
         Tt = _dh_forward(dh, q0[None])[0]
         assert np.abs(T - Tt).max() <= CLOSE
@@ -140,6 +144,7 @@ def test_industrial_arm_every_solution(name: str) -> None:
         assert _contains(sols, dense, 1e-6).all(), "dense Newton found a missed solution"
         real_counts.append(len(sols))
     assert max(real_counts) == 8  # all 8 real at some targets
+    assert certified >= 0.95 * sum(real_counts), (certified, sum(real_counts))
 
 
 def test_ur5_repro_no_longer_raises() -> None:

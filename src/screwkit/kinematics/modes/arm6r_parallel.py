@@ -20,22 +20,27 @@ the special one; those that stay finite end at its isolated solutions):
    are dropped, and the real ones are deduplicated (angles mod 2π).
 
 What is checked: every returned solution closes the exact forward kinematics
-(:func:`.arm6r.arm_forward`, position and rotation) to its ``residual``; the tests put it below
-1e-10 and compare the set with dense random Newton starts. What is not: the solutions are
-converged, not certified (the α-test of algebraic/certify.py needs a polynomial system and the
-arm's forward kinematics in joint angles is not one), and completeness rests on the
-perturbation argument (probability one for a small enough ε), not on a proof per target.
+(:func:`.arm6r.arm_forward`, position and rotation) to its ``residual``, and is certified by
+Smale's α-test on the arm's forward kinematics as polynomials in (cos q_i, sin q_i)
+(:mod:`.arm6r_certify`): a true real solution lies within ``radius``, one per ball. The tests
+compare the set with dense random Newton starts. What is not: completeness rests on the
+perturbation argument (every isolated solution of the exact arm is the end of a path, with
+probability one in the random tilt, for paths tracked without jumping), not on a proof per
+target.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.algebraic.polynomial import PolynomialSystem
 from screwkit.errors import CapabilityError, InputError
+from screwkit.kinematics.modes.arm6r_certify import arm_fk_system, certify_arm_solutions
 
 Array = NDArray[np.float64]
 Complex = NDArray[np.complex128]
@@ -223,8 +228,9 @@ def complex_joint_values(params: ArrayLike, x: ArrayLike, base_ref: Array, tool_
 class ArmContinuation:
     """The result of :func:`solve_parallel_arm` for one target. Per real solution (N,):
     ``residual`` (‖FK residual‖∞ on the exact arm), ``step`` (the last Newton step, ∞-norm),
-    ``condition`` (the FK Jacobian's condition number), ``certified`` (always False: converged,
-    not certified; module docstring). Per target: ``paths`` tracked (16), ``converged`` (paths
+    ``condition`` (the FK Jacobian's condition number), ``certified`` (a certified real zero of
+    the (cos, sin) system by Smale's α-test, :mod:`.arm6r_certify`), ``alpha`` and ``radius``
+    (a true zero within it, in (cos, sin) coordinates). Per target: ``paths`` tracked (16), ``converged`` (paths
     ending at a finite solution, complex ones included), ``found`` (distinct finite solutions:
     fewer than ``converged`` means two paths ended at one point, a double root or a jumped
     path) and ``real_count``, ``parallel`` (the joint pairs that sent the arm here; (6, 1) is
@@ -234,13 +240,28 @@ class ArmContinuation:
     step: Array
     condition: Array
     certified: NDArray[np.bool_]
+    alpha: Array
+    radius: Array
     paths: int
     converged: int
     found: int
     real_count: int
     parallel: tuple[tuple[int, int], ...]
     route: tuple[str, ...] = (ROUTE,)
-    note: str = "converged, not certified"
+    note: str = ""
+
+
+@lru_cache(maxsize=8)
+def _fk_system_of(key: bytes) -> PolynomialSystem:
+    a = np.frombuffer(key, dtype=float)
+    return arm_fk_system(a[:18].reshape(6, 3), a[18:36].reshape(6, 3),
+                         (a[36:45].reshape(3, 3), a[45:48]))
+
+
+def _fk_system(C: Array, U: Array, home: tuple[Array, Array]) -> PolynomialSystem:
+    """The arm's (cos, sin) system, cached per arm (a few hundredths of a second to build)."""
+    return _fk_system_of(np.concatenate([C.ravel(), U.ravel(), home[0].ravel(),
+                                         home[1].ravel()]).astype(float).tobytes())
 
 
 def _distinct(q: Complex, tol: float) -> NDArray[np.intp]:
@@ -301,7 +322,11 @@ def solve_parallel_arm(centres: ArrayLike, axes: ArrayLike,
     qr, _, last = _newton(C, U, home, tgt, qr, 1)  # one real step: its size is reported
     res, J = fk_residual(C, U, home, tgt, qr)
     cond = np.linalg.cond(J) if len(qr) else np.zeros(0)
-    result = ArmContinuation(np.abs(res).max(-1, initial=0.0), last, cond,
-                             np.zeros(len(qr), dtype=bool), paths, int(settled.sum()), len(q),
-                             len(qr), tuple(pairs))
+    cert = certify_arm_solutions(_fk_system(C, U, home), qr, tgt)
+    certified = cert.certified & cert.real
+    note = ("every real solution certified (α-test)" if certified.all() else
+            f"{int((~certified).sum())} of {len(qr)} real solutions converged, not certified")
+    result = ArmContinuation(np.abs(res).max(-1, initial=0.0), last, cond, certified,
+                             cert.alpha, cert.radius, paths, int(settled.sum()), len(q),
+                             len(qr), tuple(pairs), note=note)
     return qr, result
