@@ -163,6 +163,13 @@ def test_collinear_consecutive_joints_are_a_capability_error() -> None:
         arm_inverse_kinematics(C, U, home, home)
 
 
+def test_the_6r_loop_of_a_parallel_arm_is_a_capability_error_naming_the_joints() -> None:
+    C, U, home = _joint_lines(ARMS["UR5"])
+    with pytest.raises(CapabilityError, match="joints 2 and 3 .*arm_inverse_kinematics") as e:
+        arm6r_instance(C, U, home, home)
+    assert "planar" not in str(e.value)
+
+
 def test_general_arm_keeps_the_elimination_route() -> None:
     rng = np.random.default_rng(5)
     C, U = rng.normal(size=(6, 3)), rng.normal(size=(6, 3))

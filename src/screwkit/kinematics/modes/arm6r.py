@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.solve import Solutions
-from screwkit.errors import InputError
+from screwkit.errors import CapabilityError, InputError
 from screwkit.kinematics.modes.arm6r_parallel import (
     ArmContinuation,
     ground_parallel,
@@ -101,6 +101,13 @@ def arm6r_instance(centres: ArrayLike, axes: ArrayLike, tool_home: tuple[ArrayLi
     Rh, ph = (np.asarray(v, dtype=float) for v in tool_home)
     Rt, pt = (np.asarray(v, dtype=float) for v in target)
     move = Rt @ Rh.T  # the last link's motion from home: x ↦ move·x + shift
+    lines = [(i + 1, i + 2, U[i], U[i + 1]) for i in range(5)] + [(6, 1, move @ U[5], U[0])]
+    for i, j, u, v in lines:
+        if 1.0 - float(u @ v) ** 2 < 1e-12:
+            raise CapabilityError(
+                f"joints {i} and {j} of the arm are parallel{' at this target' if i == 6 else ''}"
+                f", where the 6R loop's k = a / sin α is infinite; arm_inverse_kinematics "
+                f"solves such arms (by a generic perturbation, modes/arm6r_parallel.py)")
     shift = pt - move @ ph
     c6, u6 = move @ C[5] + shift, move @ U[5]
     links = [PlacedLink(c6, u6, C[0], U[0])]
