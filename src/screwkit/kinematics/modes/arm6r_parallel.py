@@ -86,10 +86,10 @@ def ground_parallel(axes: Array, tool_home: tuple[ArrayLike, ArrayLike],
 
 
 def _skew(w: NDArray) -> NDArray:
-    z = np.zeros(w.shape[:-1], dtype=w.dtype)
-    return np.stack([np.stack([z, -w[..., 2], w[..., 1]], -1),
-                     np.stack([w[..., 2], z, -w[..., 0]], -1),
-                     np.stack([-w[..., 1], w[..., 0], z], -1)], -2)
+    out = np.zeros(w.shape + (3,), dtype=w.dtype)
+    out[..., 0, 1], out[..., 0, 2], out[..., 1, 2] = -w[..., 2], w[..., 1], -w[..., 0]
+    out[..., 1, 0], out[..., 2, 0], out[..., 2, 1] = w[..., 2], -w[..., 1], w[..., 0]
+    return out
 
 
 def _vee_skew(M: NDArray) -> NDArray:
