@@ -230,3 +230,22 @@ def _dense_poe(C: np.ndarray, U: np.ndarray, home: tuple, target: tuple,
         J = np.stack([(resid(q + 1e-7 * np.eye(6)[j]) - r) / 1e-7 for j in range(6)], -1)
         q = q - np.einsum("nij,nj->ni", np.linalg.pinv(J), r)
     return _wrap(q[np.abs(resid(q)).max(-1) < 1e-11])
+
+
+def test_nearly_parallel_arm_agrees_with_the_elimination_route() -> None:
+    """A UR5 with joint 3 tilted 5e-3 rad (sin α < PARALLEL_SIN: routed here) is also a general
+    arm the elimination can solve: the two methods give the same real solutions."""
+    C, U, home = _joint_lines(ARMS["UR5"])
+    U = U.copy()
+    U[2] = np.cos(5e-3) * U[2] + np.sin(5e-3) * np.array([1.0, 0.0, 0.0])
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q0 = rng.uniform(-np.pi, np.pi, 6)
+        target = arm_forward(C, U, home, q0)
+        sols, res = arm_inverse_kinematics(C, U, home, target)
+        assert isinstance(res, ArmContinuation) and res.parallel == ((2, 3), (3, 4))
+        inst = arm6r_instance(C, U, home, target)
+        sol = solve_loop6r(inst.params)
+        other = inst.joint_values(sol.x[sol.real])
+        assert len(other) == len(sols) and _contains(sols, q0[None], 1e-8).all()
+        assert _contains(sols, other, 1e-6).all() and _contains(other, sols, 1e-6).all()
