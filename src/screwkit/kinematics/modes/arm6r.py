@@ -11,7 +11,9 @@ joint 1) to one fixed in the link after (the tool's for joint 6).
 
 :func:`arm_inverse_kinematics` solves it: by elimination (a 24 × 24 eigenproblem, Raghavan &
 Roth 1993), with the parameter homotopy where elimination cannot settle all 16
-(modes/loop6r_solve.py).
+(modes/loop6r_solve.py). An arm with (nearly) parallel consecutive axes, where the loop's
+k_i = a_i / sin α_i are infinite, is solved by a generic perturbation instead
+(modes/arm6r_parallel.py).
 """
 
 from __future__ import annotations
@@ -22,7 +24,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.solve import Solutions
-from screwkit.errors import InputError
+from screwkit.errors import CapabilityError, InputError
+from screwkit.kinematics.modes.arm6r_parallel import (
+    ArmContinuation,
+    ground_parallel,
+    parallel_links,
+    solve_parallel_arm,
+)
 from screwkit.kinematics.modes.loop6r import PlacedLink, loop6r_axes, loop6r_parameters
 
 Array = NDArray[np.float64]
@@ -93,6 +101,13 @@ def arm6r_instance(centres: ArrayLike, axes: ArrayLike, tool_home: tuple[ArrayLi
     Rh, ph = (np.asarray(v, dtype=float) for v in tool_home)
     Rt, pt = (np.asarray(v, dtype=float) for v in target)
     move = Rt @ Rh.T  # the last link's motion from home: x ↦ move·x + shift
+    lines = [(i + 1, i + 2, U[i], U[i + 1]) for i in range(5)] + [(6, 1, move @ U[5], U[0])]
+    for i, j, u, v in lines:
+        if 1.0 - float(u @ v) ** 2 < 1e-12:
+            raise CapabilityError(
+                f"joints {i} and {j} of the arm are parallel{' at this target' if i == 6 else ''}"
+                f", where the 6R loop's k = a / sin α is infinite; arm_inverse_kinematics "
+                f"solves such arms (by a generic perturbation, modes/arm6r_parallel.py)")
     shift = pt - move @ ph
     c6, u6 = move @ C[5] + shift, move @ U[5]
     links = [PlacedLink(c6, u6, C[0], U[0])]
@@ -106,11 +121,20 @@ def arm6r_instance(centres: ArrayLike, axes: ArrayLike, tool_home: tuple[ArrayLi
 
 def arm_inverse_kinematics(centres: ArrayLike, axes: ArrayLike,
                            tool_home: tuple[ArrayLike, ArrayLike],
-                           target: tuple[ArrayLike, ArrayLike]) -> tuple[Array, Solutions]:
+                           target: tuple[ArrayLike, ArrayLike]
+                           ) -> tuple[Array, Solutions | ArmContinuation]:
     """Every real inverse-kinematics solution of the 6R arm (joint lines at home, base to
     tool; the home tool pose) at ``target`` (R, p): joint values from home (N, 6), and the
-    loop's :class:`Solutions` (all 16 complex solutions, certificates, the route that ran)."""
+    loop's :class:`Solutions` (all 16 complex solutions, certificates, the route that ran).
+    An arm with consecutive axes within :data:`.arm6r_parallel.PARALLEL_SIN` of parallel (a
+    UR, PUMA, KUKA arm), or whose joint 6 at the target is that near parallel to joint 1, goes to :func:`.arm6r_parallel.solve_parallel_arm` and its
+    :class:`.arm6r_parallel.ArmContinuation` instead."""
     from screwkit.kinematics.modes.loop6r_solve import solve_loop6r
+
+    U = np.asarray(axes, dtype=float)
+    if U.shape == (6, 3) and (parallel_links(U, np.asarray(centres, dtype=float))
+                              or ground_parallel(U, tool_home, target)):
+        return solve_parallel_arm(centres, axes, tool_home, target)
 
     inst = arm6r_instance(centres, axes, tool_home, target)
     sol = solve_loop6r(inst.params)
