@@ -205,9 +205,19 @@ def joint_screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
             S[:, :, f] = _line_screw(u, c)
             S[:, :, f + 1] = _line_screw(matvec(R[:, b], j.axis2), c)
         else:  # S: body increments about the child's own axes through the centre
-            for k in range(3):
-                S[:, :, f + k] = _line_screw(R[:, b, :, k], c)
+            _put_ball_screws(S[:, :, f:f + 3], R[:, b], c)
     return S, centres, axes
+
+
+def _put_ball_screws(out: Array, Rb: Array, c: Array) -> None:
+    """The three line screws (u_k; c × u_k) of a ball's freedoms, u_k the columns of Rb
+    (N, 3, 3), into ``out`` (N, 6, 3): :func:`_line_screw` for k = 0, 1, 2 at once, the same
+    products and differences as ``cross`` (bit for bit), without a call per column."""
+    out[:, :3] = Rb
+    c0, c1, c2 = c[:, 0, None], c[:, 1, None], c[:, 2, None]
+    out[:, 3] = c1 * Rb[:, 2] - c2 * Rb[:, 1]
+    out[:, 4] = c2 * Rb[:, 0] - c0 * Rb[:, 2]
+    out[:, 5] = c0 * Rb[:, 1] - c1 * Rb[:, 0]
 
 
 def loop_jacobian(mech: Mechanism, lay: GraphLayout, screws: Array) -> Array:

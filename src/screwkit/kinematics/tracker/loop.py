@@ -318,6 +318,15 @@ def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configura
     return Configuration(q, sph)
 
 
+def _ball_columns(lay: Layout) -> tuple[list[int], NDArray[np.intp]]:
+    """The spherical indices of the balls (in ``spherical_of_joint``'s order) and their
+    freedom columns (n_balls, 3)."""
+    ks = list(lay.spherical_of_joint.values())
+    idx = np.array([[f for f, jj in enumerate(lay.joint_of) if jj == j]
+                    for j in lay.spherical_of_joint], dtype=np.intp)
+    return ks, idx
+
+
 def rotation_matrix(w: Array) -> Array:
     """exp([w]×) of rotation vectors w (N, 3) by Rodrigues' formula (series near zero), as
     cos θ I + a [w]× + b w wᵀ (a = sin θ/θ, b = (1 − cos θ)/θ², [w]×² = w wᵀ − θ² I)."""
@@ -353,9 +362,9 @@ def configuration_difference(a: Configuration, b: Configuration, lay: Layout) ->
     turn = ~np.array(lay.is_translation)[scal]
     d[:, turn] = np.pi - np.mod(np.pi - d[:, turn], 2 * np.pi)
     out[:, scal] = d
-    for j, k in lay.spherical_of_joint.items():
-        idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
-        rel = np.swapaxes(b.spherical[:, k], -1, -2) @ a.spherical[:, k]
+    if lay.spherical_of_joint:  # every ball at once (the same arithmetic as one at a time)
+        ks, idx = _ball_columns(lay)
+        rel = np.swapaxes(b.spherical[:, ks], -1, -2) @ a.spherical[:, ks]
         out[:, idx] = rotation_vector(rel)
     return out
 
