@@ -1,0 +1,86 @@
+"""Every ball joint at once (issue 27, the Delta's every-mode speed): the batched increments,
+differences and line screws of the graph tracker are the one-ball-at-a-time arithmetic bit for
+bit, so the tracker's steps (and a rod's idle spin, which round-off steers) are unchanged.
+
+The references are written here the way tracker/loop.py and graph/closure.py wrote them before
+(a ``rotation_matrix`` / ``rotation_vector`` / ``cross`` call per ball and per column)."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import screwkit as sk
+from screwkit.dual.spatial import cross
+from screwkit.kinematics.graph.closure import GraphLayout, graph_forward, graph_layout
+from screwkit.kinematics.tracker.loop import (
+    Configuration,
+    apply_increment,
+    configuration_difference,
+    rotation_matrix,
+    rotation_vector,
+)
+from screwkit.model.mechanism import Mechanism
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "mechanisms"
+
+
+@lru_cache(maxsize=1)
+def _delta() -> tuple[Mechanism, GraphLayout]:
+    mech = sk.load_spec(EXAMPLES / "delta_robot.toml").mechanism
+    return mech, graph_layout(mech)
+
+
+def _balls(lay: GraphLayout) -> list[tuple[int, list[int]]]:
+    return [(k, [f for f, jj in enumerate(lay.joint_of) if jj == j])
+            for j, k in lay.spherical_of_joint.items()]
+
+
+def _random_conf(lay: GraphLayout, N: int, rng: np.random.Generator) -> Configuration:
+    w = rng.normal(size=(N * lay.n_spherical, 3))
+    return Configuration(rng.normal(size=(N, lay.n_scalar)),
+                         rotation_matrix(w).reshape(N, lay.n_spherical, 3, 3))
+
+
+@pytest.mark.parametrize("N", [1, 2, 3, 5, 8, 17, 130])
+def test_increments_and_differences_are_the_one_ball_arithmetic(N: int) -> None:
+    mech, lay = _delta()
+    assert lay.n_spherical == 12
+    rng = np.random.default_rng(N)
+    conf = _random_conf(lay, N, rng)
+    for scale in (1e-7, 1e-3, 1.0):  # the series branch, small and large turns
+        for delta in (rng.normal(size=(N, lay.m)) * scale,  # C order and a transposed view
+                      np.asfortranarray(rng.normal(size=(N, lay.m)) * scale)):
+            got = apply_increment(conf, delta, lay)
+            ref = conf.spherical.copy()
+            for k, idx in _balls(lay):
+                ref[:, k] = ref[:, k] @ rotation_matrix(delta[:, idx])
+            assert np.array_equal(got.spherical, ref)
+            diff = configuration_difference(got, conf, lay)
+            for k, idx in _balls(lay):
+                rel = np.swapaxes(conf.spherical[:, k], -1, -2) @ got.spherical[:, k]
+                assert np.array_equal(diff[:, idx], rotation_vector(rel))
+            # and the difference undoes the increment (to round-off) while every turn is
+            # under a half turn: an independent check of both
+            cols = [f for _, i in _balls(lay) for f in i]
+            if scale < 1.0:
+                assert np.abs(diff[:, cols] - delta[:, cols]).max() < 1e-13
+
+
+def test_ball_screws_are_the_line_screws_per_column() -> None:
+    mech, lay = _delta()
+    rng = np.random.default_rng(3)
+    for N in (1, 4, 33):
+        fr = graph_forward(mech, lay, _random_conf(lay, N, rng))
+        for i, j in enumerate(mech.joints):
+            if j.kind != "S":
+                continue
+            b = lay.body_of[j.bodies[1]]
+            f = lay.first_freedom[i]
+            for k in range(3):
+                u = fr.R[:, b, :, k]
+                ref = np.concatenate([u, cross(fr.centres[:, i], u)], -1)
+                assert np.array_equal(fr.screws[:, :, f + k], ref)
