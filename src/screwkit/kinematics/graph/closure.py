@@ -234,6 +234,7 @@ class JointTable:
     balls: NDArray[np.intp]
     ball_child: NDArray[np.intp]
     ball_cols: NDArray[np.intp]
+    loop_signs: Array
 
 
 _TABLES: dict[tuple[int, int], tuple[Mechanism, GraphLayout, JointTable]] = {}
@@ -253,9 +254,20 @@ def joint_table(mech: Mechanism, lay: GraphLayout) -> JointTable:
             np.array(balls, dtype=np.intp),
             np.array([lay.body_of[mech.joints[i].bodies[1]] for i in balls], dtype=np.intp),
             np.array([[lay.first_freedom[i] + k for k in range(3)] for i in balls],
-                     dtype=np.intp).reshape(-1, 3))
+                     dtype=np.intp).reshape(-1, 3), _loop_signs(mech, lay))
         _TABLES[key] = (mech, lay, table)
     return _TABLES[key][2]
+
+
+def _loop_signs(mech: Mechanism, lay: GraphLayout) -> Array:
+    """(6L, m): the sign of each freedom in each loop's six rows of the stacked Jacobian (0
+    where the loop does not hold it)."""
+    signs = np.zeros((6 * len(mech.topology.loops), lay.m))
+    for l, loop in enumerate(mech.topology.loops):
+        for k, sign in loop:
+            f0 = lay.first_freedom[k]
+            signs[6 * l:6 * l + 6, f0:f0 + len(mech.joints[k].freedoms)] = sign
+    return signs
 
 
 def _put_ball_screws(out: Array, Rb: Array, c: Array) -> None:
@@ -272,14 +284,10 @@ def _put_ball_screws(out: Array, Rb: Array, c: Array) -> None:
 def loop_jacobian(mech: Mechanism, lay: GraphLayout, screws: Array) -> Array:
     """The stacked loop-closure Jacobian (N, 6L, m): rows 6l…6l+5 hold sign·S_f for every
     freedom f of a joint of loop l (module docstring)."""
-    loops = mech.topology.loops
-    N = screws.shape[0]
-    Jac = np.zeros((N, 6 * len(loops), lay.m))
-    for l, loop in enumerate(loops):
-        for k, sign in loop:
-            f0 = lay.first_freedom[k]
-            n = len(mech.joints[k].freedoms)
-            Jac[:, 6 * l:6 * l + 6, f0:f0 + n] = sign * screws[:, :, f0:f0 + n]
+    signs = joint_table(mech, lay).loop_signs  # (6L, m): ±1 where a loop holds the freedom
+    rows = screws[:, np.arange(signs.shape[0]) % 6]
+    Jac = np.zeros((screws.shape[0],) + signs.shape)  # C order, as the solvers had it
+    np.multiply(signs, rows, out=Jac, where=signs != 0.0)
     return Jac
 
 
@@ -299,9 +307,8 @@ def body_twists(mech: Mechanism, lay: GraphLayout, screws: Array, qd: Array
     for k, parent, child in mech.topology.tree:
         sign = 1.0 if mech.joints[k].bodies[0] == parent else -1.0
         V[:, lay.body_of[child]] = V[:, lay.body_of[parent]] + sign * rel[:, k]
-    bias = np.empty_like(rel)
+    bias = lie_bracket(V[:, joint_table(mech, lay).first], rel)  # every joint at once
     for i, j in enumerate(mech.joints):
-        bias[:, i] = lie_bracket(V[:, lay.body_of[j.bodies[0]]], rel[:, i])
         if j.kind == "U":
             f = lay.first_freedom[i]
             bias[:, i] += lie_bracket(screws[:, :, f] * qd[:, f, None],

@@ -321,10 +321,18 @@ def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configura
 def _ball_columns(lay: Layout) -> tuple[list[int], NDArray[np.intp]]:
     """The spherical indices of the balls (in ``spherical_of_joint``'s order) and their
     freedom columns (n_balls, 3)."""
-    ks = list(lay.spherical_of_joint.values())
-    idx = np.array([[f for f, jj in enumerate(lay.joint_of) if jj == j]
-                    for j in lay.spherical_of_joint], dtype=np.intp)
-    return ks, idx
+    key = id(lay)
+    if key not in _BALLS or _BALLS[key][0] is not lay:
+        if len(_BALLS) >= 8:
+            _BALLS.pop(next(iter(_BALLS)))
+        idx = np.array([[f for f, jj in enumerate(lay.joint_of) if jj == j]
+                        for j in lay.spherical_of_joint], dtype=np.intp)
+        _BALLS[key] = (lay, list(lay.spherical_of_joint.values()), idx)
+    return _BALLS[key][1], _BALLS[key][2]
+
+
+#: the last few layouts' ball columns (:func:`_ball_columns`), kept with their layouts
+_BALLS: dict[int, tuple[Any, list[int], NDArray[np.intp]]] = {}
 
 
 def rotation_matrix(w: Array) -> Array:
