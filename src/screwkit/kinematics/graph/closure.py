@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from screwkit.dual.spatial import cross, matvec
+from screwkit.dual.spatial import MATVEC_FROM, cross, matvec
 from screwkit.kinematics.tracker.loop import (
     Configuration,
     closure_error,
@@ -160,17 +160,22 @@ def loop_residuals(mech: Mechanism, lay: GraphLayout, conf: Configuration, R: Ar
                    exact: bool = True) -> Array:
     """Every loop's closure twist (N, L, 6) from the body poses: E_j = T_a M_j T_b⁻¹ at each
     chord j, by the exact logarithm or its first-order form (:func:`graph_forward`)."""
-    residual = np.empty((conf.size, len(mech.topology.chords), 6))
-    for l, k in enumerate(mech.topology.chords):
-        Mr, Mp = joint_motion(mech, lay, conf, k)
-        a, b = (lay.body_of[x] for x in mech.joints[k].bodies)
-        Ra = R[:, a] @ Mr
-        pa = np.einsum("nij,nj->ni", R[:, a], Mp) + p[:, a]
-        Rbt = np.swapaxes(R[:, b], -1, -2)
-        ER = Ra @ Rbt
-        Ep = pa - np.einsum("nij,nj->ni", ER, p[:, b])
-        residual[:, l] = closure_twist(ER, Ep) if exact else closure_error(ER, Ep)
-    return residual
+    chords = mech.topology.chords
+    N, L = conf.size, len(chords)
+    if L == 0:
+        return np.empty((N, 0, 6))
+    Mr, Mp = np.empty((N, L, 3, 3)), np.empty((N, L, 3))
+    for l, k in enumerate(chords):
+        Mr[:, l], Mp[:, l] = joint_motion(mech, lay, conf, k)
+    a = [lay.body_of[mech.joints[k].bodies[0]] for k in chords]
+    b = [lay.body_of[mech.joints[k].bodies[1]] for k in chords]
+    # every chord at once: per chord the same products as one chord at a time (bit for bit,
+    # tests/kinematics/test_tracker_batched_balls.py)
+    Ra = R[:, a] @ Mr
+    pa = np.einsum("nlij,nlj->nli", R[:, a], Mp) + p[:, a]
+    ER = Ra @ np.swapaxes(R[:, b], -1, -2)
+    Ep = pa - np.einsum("nlij,nlj->nli", ER, p[:, b])
+    return closure_twist(ER, Ep) if exact else closure_error(ER, Ep)
 
 
 def _line_screw(u: Array, c: Array, pitch: float = 0.0) -> Array:
@@ -183,13 +188,20 @@ def joint_screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
     N = R.shape[0]
     S = np.empty((N, 6, lay.m))
     J = len(mech.joints)
-    centres = np.empty((N, J, 3))
-    axes = np.empty((N, J, 3))
+    t = joint_table(mech, lay)
+    if N < MATVEC_FROM:  # matvec's R @ x for every joint in one stacked product (bit for bit)
+        Ra = R[:, t.first]
+        centres = (Ra @ t.at[:, :, None])[..., 0] + p[:, t.first]
+        axes = (Ra @ t.axis[:, :, None])[..., 0]
+    else:  # matvec's one BLAS call per joint
+        centres = np.empty((N, J, 3))
+        axes = np.empty((N, J, 3))
+        for i, j in enumerate(mech.joints):
+            a = t.first[i]
+            centres[:, i] = matvec(R[:, a], j.at) + p[:, a]
+            axes[:, i] = matvec(R[:, a], j.axis)
     for i, j in enumerate(mech.joints):
-        a, b = (lay.body_of[x] for x in j.bodies)
-        c = matvec(R[:, a], j.at) + p[:, a]
-        u = matvec(R[:, a], j.axis)
-        centres[:, i], axes[:, i] = c, u
+        c, u = centres[:, i], axes[:, i]
         f = lay.first_freedom[i]
         if j.kind == "P":
             S[:, :3, f] = 0.0
@@ -203,24 +215,79 @@ def joint_screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
         elif j.kind == "U":
             assert j.axis2 is not None
             S[:, :, f] = _line_screw(u, c)
-            S[:, :, f + 1] = _line_screw(matvec(R[:, b], j.axis2), c)
-        else:  # S: body increments about the child's own axes through the centre
-            for k in range(3):
-                S[:, :, f + k] = _line_screw(R[:, b, :, k], c)
+            S[:, :, f + 1] = _line_screw(matvec(R[:, lay.body_of[j.bodies[1]]], j.axis2), c)
+    if t.balls.size:  # S: body increments about the child's own axes through the centre
+        out = np.empty((N, t.balls.size, 6, 3))
+        _put_ball_screws(out, R[:, t.ball_child], centres[:, t.balls])
+        S[:, :, t.ball_cols] = out.transpose(0, 2, 1, 3)
     return S, centres, axes
+
+
+@dataclass(frozen=True)
+class JointTable:
+    """Per joint of a mechanism, as arrays: its first body's pose index, drawn centre and axis;
+    the ball joints, their second bodies and their freedom columns (n_balls, 3)."""
+
+    first: NDArray[np.intp]
+    at: Array
+    axis: Array
+    balls: NDArray[np.intp]
+    ball_child: NDArray[np.intp]
+    ball_cols: NDArray[np.intp]
+    loop_signs: Array
+
+
+_TABLES: dict[tuple[int, int], tuple[Mechanism, GraphLayout, JointTable]] = {}
+
+
+def joint_table(mech: Mechanism, lay: GraphLayout) -> JointTable:
+    """The :class:`JointTable` of ``mech`` (the last few kept, as graph/follow.py's systems)."""
+    key = (id(mech), id(lay))
+    if key not in _TABLES:
+        if len(_TABLES) >= 8:
+            _TABLES.pop(next(iter(_TABLES)))
+        balls = [i for i, j in enumerate(mech.joints) if j.kind == "S"]
+        table = JointTable(
+            np.array([lay.body_of[j.bodies[0]] for j in mech.joints], dtype=np.intp),
+            np.array([j.at for j in mech.joints], dtype=float).reshape(-1, 3),
+            np.array([j.axis for j in mech.joints], dtype=float).reshape(-1, 3),
+            np.array(balls, dtype=np.intp),
+            np.array([lay.body_of[mech.joints[i].bodies[1]] for i in balls], dtype=np.intp),
+            np.array([[lay.first_freedom[i] + k for k in range(3)] for i in balls],
+                     dtype=np.intp).reshape(-1, 3), _loop_signs(mech, lay))
+        _TABLES[key] = (mech, lay, table)
+    return _TABLES[key][2]
+
+
+def _loop_signs(mech: Mechanism, lay: GraphLayout) -> Array:
+    """(6L, m): the sign of each freedom in each loop's six rows of the stacked Jacobian (0
+    where the loop does not hold it)."""
+    signs = np.zeros((6 * len(mech.topology.loops), lay.m))
+    for l, loop in enumerate(mech.topology.loops):
+        for k, sign in loop:
+            f0 = lay.first_freedom[k]
+            signs[6 * l:6 * l + 6, f0:f0 + len(mech.joints[k].freedoms)] = sign
+    return signs
+
+
+def _put_ball_screws(out: Array, Rb: Array, c: Array) -> None:
+    """The three line screws (u_k; c × u_k) of a ball's freedoms, u_k the columns of Rb
+    (..., 3, 3), into ``out`` (..., 6, 3): :func:`_line_screw` for k = 0, 1, 2 at once, the same
+    products and differences as ``cross`` (bit for bit), without a call per column."""
+    out[..., :3, :] = Rb
+    c0, c1, c2 = c[..., 0, None], c[..., 1, None], c[..., 2, None]
+    out[..., 3, :] = c1 * Rb[..., 2, :] - c2 * Rb[..., 1, :]
+    out[..., 4, :] = c2 * Rb[..., 0, :] - c0 * Rb[..., 2, :]
+    out[..., 5, :] = c0 * Rb[..., 1, :] - c1 * Rb[..., 0, :]
 
 
 def loop_jacobian(mech: Mechanism, lay: GraphLayout, screws: Array) -> Array:
     """The stacked loop-closure Jacobian (N, 6L, m): rows 6l…6l+5 hold sign·S_f for every
     freedom f of a joint of loop l (module docstring)."""
-    loops = mech.topology.loops
-    N = screws.shape[0]
-    Jac = np.zeros((N, 6 * len(loops), lay.m))
-    for l, loop in enumerate(loops):
-        for k, sign in loop:
-            f0 = lay.first_freedom[k]
-            n = len(mech.joints[k].freedoms)
-            Jac[:, 6 * l:6 * l + 6, f0:f0 + n] = sign * screws[:, :, f0:f0 + n]
+    signs = joint_table(mech, lay).loop_signs  # (6L, m): ±1 where a loop holds the freedom
+    rows = screws[:, np.arange(signs.shape[0]) % 6]
+    Jac = np.zeros((screws.shape[0],) + signs.shape)  # C order, as the solvers had it
+    np.multiply(signs, rows, out=Jac, where=signs != 0.0)
     return Jac
 
 
@@ -240,9 +307,8 @@ def body_twists(mech: Mechanism, lay: GraphLayout, screws: Array, qd: Array
     for k, parent, child in mech.topology.tree:
         sign = 1.0 if mech.joints[k].bodies[0] == parent else -1.0
         V[:, lay.body_of[child]] = V[:, lay.body_of[parent]] + sign * rel[:, k]
-    bias = np.empty_like(rel)
+    bias = lie_bracket(V[:, joint_table(mech, lay).first], rel)  # every joint at once
     for i, j in enumerate(mech.joints):
-        bias[:, i] = lie_bracket(V[:, lay.body_of[j.bodies[0]]], rel[:, i])
         if j.kind == "U":
             f = lay.first_freedom[i]
             bias[:, i] += lie_bracket(screws[:, :, f] * qd[:, f, None],

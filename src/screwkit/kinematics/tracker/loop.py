@@ -312,10 +312,27 @@ def apply_increment(conf: Configuration, delta: Array, lay: Layout) -> Configura
     cols = np.array(lay.scalar_col)
     scal = cols >= 0
     q[:, cols[scal]] += delta[:, np.nonzero(scal)[0]]
-    for j, k in lay.spherical_of_joint.items():
-        idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
-        sph[:, k] = sph[:, k] @ rotation_matrix(delta[:, idx])
+    if lay.spherical_of_joint:  # every ball at once, with one ball's arithmetic
+        ks, idx = _ball_columns(lay)
+        sph[:, ks] = sph[:, ks] @ _rotation_matrices(delta[:, idx])
     return Configuration(q, sph)
+
+
+def _ball_columns(lay: Layout) -> tuple[list[int], NDArray[np.intp]]:
+    """The spherical indices of the balls (in ``spherical_of_joint``'s order) and their
+    freedom columns (n_balls, 3)."""
+    key = id(lay)
+    if key not in _BALLS or _BALLS[key][0] is not lay:
+        if len(_BALLS) >= 8:
+            _BALLS.pop(next(iter(_BALLS)))
+        idx = np.array([[f for f, jj in enumerate(lay.joint_of) if jj == j]
+                        for j in lay.spherical_of_joint], dtype=np.intp)
+        _BALLS[key] = (lay, list(lay.spherical_of_joint.values()), idx)
+    return _BALLS[key][1], _BALLS[key][2]
+
+
+#: the last few layouts' ball columns (:func:`_ball_columns`), kept with their layouts
+_BALLS: dict[int, tuple[Any, list[int], NDArray[np.intp]]] = {}
 
 
 def rotation_matrix(w: Array) -> Array:
@@ -343,6 +360,33 @@ def rotation_matrix(w: Array) -> Array:
     return out
 
 
+def _rotation_matrices(w: Array) -> Array:
+    """:func:`rotation_matrix` of rotation vectors w (N, n, 3) (the freedoms of n balls, as
+    ``delta[:, idx]`` gathers them): the same operations on the same operands, so each ball's
+    rotation is :func:`rotation_matrix` of its own (N, 3) columns bit for bit (the squared
+    angle's einsum included; tests/kinematics/test_tracker_batched_balls.py)."""
+    th2 = np.einsum("nbi,nbi->nb", w, w)
+    th = np.sqrt(th2)
+    small = th2 < 1e-8
+    safe = np.where(small, 1.0, th)
+    a = np.where(small, 1.0 - th2 / 6.0, np.sin(safe) / safe)
+    b = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(safe)) / np.where(small, 1.0, th2))
+    c = 1.0 - b * th2
+    out = np.empty(w.shape[:2] + (3, 3))
+    w0, w1, w2 = w[..., 0], w[..., 1], w[..., 2]
+    bw0, bw1 = b * w0, b * w1
+    out[..., 0, 0] = c + bw0 * w0
+    out[..., 1, 1] = c + bw1 * w1
+    out[..., 2, 2] = c + b * w2 * w2
+    out[..., 0, 1] = bw0 * w1 - a * w2
+    out[..., 1, 0] = bw0 * w1 + a * w2
+    out[..., 0, 2] = bw0 * w2 + a * w1
+    out[..., 2, 0] = bw0 * w2 - a * w1
+    out[..., 1, 2] = bw1 * w2 - a * w0
+    out[..., 2, 1] = bw1 * w2 + a * w0
+    return out
+
+
 def configuration_difference(a: Configuration, b: Configuration, lay: Layout) -> Array:
     """Freedom increments (N, m) taking ``b`` to ``a``: scalar differences (angles wrapped to
     (−π, π]) and, for a spherical joint, the rotation vector of R_bᵀR_a (its own axes)."""
@@ -353,9 +397,9 @@ def configuration_difference(a: Configuration, b: Configuration, lay: Layout) ->
     turn = ~np.array(lay.is_translation)[scal]
     d[:, turn] = np.pi - np.mod(np.pi - d[:, turn], 2 * np.pi)
     out[:, scal] = d
-    for j, k in lay.spherical_of_joint.items():
-        idx = [f for f, jj in enumerate(lay.joint_of) if jj == j]
-        rel = np.swapaxes(b.spherical[:, k], -1, -2) @ a.spherical[:, k]
+    if lay.spherical_of_joint:  # every ball at once (the same arithmetic as one at a time)
+        ks, idx = _ball_columns(lay)
+        rel = np.swapaxes(b.spherical[:, ks], -1, -2) @ a.spherical[:, ks]
         out[:, idx] = rotation_vector(rel)
     return out
 
