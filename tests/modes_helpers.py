@@ -92,3 +92,17 @@ def rssr_reach(params: tuple[float, ...], theta: np.ndarray) -> tuple[np.ndarray
     along = w @ u3
     across = np.linalg.norm(w - along[:, None] * u3, axis=1)
     return np.hypot(along, across - d3), np.hypot(along, across + d3)
+
+
+def tilted(mech: Mechanism, k: int, to: int, twist: float) -> Mechanism:
+    """``mech`` with joint k's axis joint ``to``'s turned by ``twist`` rad (Rodrigues, about a
+    fixed direction normal to it): a nearly parallel pair for ``twist`` ≪ 1."""
+    joints = list(mech.joints)
+    a = joints[to].axis / np.linalg.norm(joints[to].axis)
+    n = np.cross(a, [0.3, 0.5, 0.8])
+    n /= np.linalg.norm(n)
+    K = np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]])
+    turn = np.eye(3) + np.sin(twist) * K + (1.0 - np.cos(twist)) * (K @ K)
+    j = joints[k]
+    joints[k] = MechanismJoint(j.name, j.kind, j.bodies, j.at, turn @ a)
+    return Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)

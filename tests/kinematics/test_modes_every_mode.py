@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import screwkit as sk
-from modes_helpers import random_r_loop
+from modes_helpers import random_r_loop, tilted
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import graph_layout
 from screwkit.kinematics.graph.follow import follow_drawn_mode
@@ -159,20 +159,14 @@ def test_a_7r_loop_with_a_nearly_parallel_pair_keeps_its_tracked_mode(twist: flo
     had no mode and at 1e-3 it missed the tracked mode on one loop of two (found by a review
     probe). Such a loop now goes to the R/P/C axes formulation, which puts that link at the
     ground; a well-separated 7R loop stays on the 6R route."""
-    from tests.kinematics.test_modes_rpc_loop import INPUT, _rotation, _tracked
+    from tests.kinematics.test_modes_rpc_loop import INPUT, _tracked
 
     from screwkit.kinematics.modes.rpc_loop import RPCLoop
 
     rng = np.random.default_rng(8)
     checked = 0
     for _ in range(6):
-        mech = random_r_loop(rng, 7, [0])
-        joints = list(mech.joints)
-        a1 = joints[1].axis / np.linalg.norm(joints[1].axis)
-        j = joints[2]
-        joints[2] = MechanismJoint(j.name, j.kind, j.bodies, j.at,
-                                   _rotation(np.cross(a1, [0.3, 0.5, 0.8]), twist) @ a1)
-        mech = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+        mech = tilted(random_r_loop(rng, 7, [0]), 2, 1, twist)
         tracked = _tracked(mech, ["j0.theta"])
         if tracked is None:
             continue

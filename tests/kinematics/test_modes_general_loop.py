@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from modes_helpers import random_loop, random_r_loop, relative_residual
+from modes_helpers import random_loop, random_r_loop, relative_residual, tilted
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import graph_layout
 from screwkit.kinematics.graph.follow import follow_drawn_mode
@@ -141,16 +141,7 @@ def test_a_nearly_parallel_pair_is_read_to_round_off(twist: float) -> None:
     rng = np.random.default_rng(8)
     checked = 0
     for _ in range(6):
-        mech = random_loop(rng, "RRRPRRR", ["j0.theta"])
-        joints = list(mech.joints)
-        a1 = joints[1].axis / np.linalg.norm(joints[1].axis)
-        n = np.cross(a1, [0.3, 0.5, 0.8])
-        n /= np.linalg.norm(n)
-        K = np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]])
-        turn = np.eye(3) + np.sin(twist) * K + (1.0 - np.cos(twist)) * (K @ K)
-        j = joints[2]
-        joints[2] = MechanismJoint(j.name, j.kind, j.bodies, j.at, turn @ a1)
-        mech = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+        mech = tilted(random_loop(rng, "RRRPRRR", ["j0.theta"]), 2, 1, twist)
         lay = graph_layout(mech)
         followed = follow_drawn_mode(mech, lay, np.linspace(0.0, INPUT, 7)[:, None])
         if not followed.mask.all():

@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from modes_helpers import random_loop
+from modes_helpers import random_loop, tilted
 from screwkit.algebraic.solve import solve_all
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import graph_layout
@@ -294,13 +294,7 @@ def test_a_nearly_parallel_pair_is_moved_to_the_ground_link_and_solved(twist: fl
     rng = np.random.default_rng(8)
     checked = 0
     for _ in range(6):
-        mech = random_loop(rng, "RRRPRRR", ["j0.theta"])
-        joints = list(mech.joints)
-        a1 = joints[1].axis / np.linalg.norm(joints[1].axis)
-        j = joints[2]
-        joints[2] = MechanismJoint(j.name, j.kind, j.bodies, j.at,
-                                   _rotation(np.cross(a1, [0.3, 0.5, 0.8]), twist) @ a1)
-        mech = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+        mech = tilted(random_loop(rng, "RRRPRRR", ["j0.theta"]), 2, 1, twist)
         tracked = _tracked(mech, ["j0.theta"])
         if tracked is None:
             continue
@@ -321,13 +315,7 @@ def test_real_solutions_failing_the_closure_check_are_counted_not_dropped_silent
     solutions it dropped (found by a review probe of near-parallel axes)."""
     from screwkit.kinematics.modes.along import modes_along
 
-    mech = random_loop(np.random.default_rng(8), "RRRPRRR", ["j0.theta"])
-    joints = list(mech.joints)
-    a1 = joints[1].axis / np.linalg.norm(joints[1].axis)
-    j = joints[2]
-    joints[2] = MechanismJoint(j.name, j.kind, j.bodies, j.at,
-                               _rotation(np.cross(a1, [0.3, 0.5, 0.8]), 1e-7) @ a1)
-    mech = Mechanism(mech.name, mech.bodies, tuple(joints), mech.inputs)
+    mech = tilted(random_loop(np.random.default_rng(8), "RRRPRRR", ["j0.theta"]), 2, 1, 1e-7)
     X = np.array([[INPUT], [INPUT + 0.1]])
     found = every_mode(mech, X)
     assert [c.size for c in found.configurations] == [0, 0]

@@ -88,16 +88,21 @@ class Arm6RInstance:
         return np.mod(q + np.pi, 2 * np.pi) - np.pi
 
 
-def arm6r_instance(centres: ArrayLike, axes: ArrayLike, tool_home: tuple[ArrayLike, ArrayLike],
-                   target: tuple[ArrayLike, ArrayLike]) -> Arm6RInstance:
-    """The 6R loop of the arm (joint lines at home, base to tool; the home tool pose) with its
-    tool held at ``target`` (R, p)."""
+def arm_lines(centres: ArrayLike, axes: ArrayLike) -> tuple[Array, Array]:
+    """A 6R arm's joint points (6, 3) and unit axes (6, 3), checked."""
     C = np.asarray(centres, dtype=float)
     U = np.asarray(axes, dtype=float)
     if C.shape != (6, 3) or U.shape != (6, 3):
         raise InputError(f"a 6R arm needs 6 joint points and 6 axes (6 × 3 each); got "
                          f"{C.shape} and {U.shape}")
-    U = U / np.linalg.norm(U, axis=1)[:, None]
+    return C, U / np.linalg.norm(U, axis=1)[:, None]
+
+
+def arm6r_instance(centres: ArrayLike, axes: ArrayLike, tool_home: tuple[ArrayLike, ArrayLike],
+                   target: tuple[ArrayLike, ArrayLike]) -> Arm6RInstance:
+    """The 6R loop of the arm (joint lines at home, base to tool; the home tool pose) with its
+    tool held at ``target`` (R, p)."""
+    C, U = arm_lines(centres, axes)
     Rh, ph = (np.asarray(v, dtype=float) for v in tool_home)
     Rt, pt = (np.asarray(v, dtype=float) for v in target)
     move = Rt @ Rh.T  # the last link's motion from home: x ↦ move·x + shift

@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from screwkit.algebraic.polynomial import PolynomialSystem
-from screwkit.errors import CapabilityError, InputError
+from screwkit.errors import CapabilityError
 from screwkit.kinematics.modes.arm6r_certify import arm_fk_system, certify_arm_solutions
 
 Array = NDArray[np.float64]
@@ -281,15 +281,10 @@ def solve_parallel_arm(centres: ArrayLike, axes: ArrayLike,
                        epsilon: float = EPSILON) -> tuple[Array, ArmContinuation]:
     """Every real inverse-kinematics solution (N, 6), from home, of a 6R arm with nearly
     parallel consecutive axes, by the generic perturbation of the module docstring."""
-    from screwkit.kinematics.modes.arm6r import arm6r_instance
+    from screwkit.kinematics.modes.arm6r import arm6r_instance, arm_lines
     from screwkit.kinematics.modes.loop6r_solve import solve_loop6r
 
-    C = np.asarray(centres, dtype=float)
-    U = np.asarray(axes, dtype=float)
-    if C.shape != (6, 3) or U.shape != (6, 3):
-        raise InputError(f"a 6R arm needs 6 joint points and 6 axes (6 × 3 each); got "
-                         f"{C.shape} and {U.shape}")
-    U = U / np.linalg.norm(U, axis=1)[:, None]
+    C, U = arm_lines(centres, axes)
     home = (np.asarray(tool_home[0], dtype=float), np.asarray(tool_home[1], dtype=float))
     tgt = (np.asarray(target[0], dtype=float), np.asarray(target[1], dtype=float))
     pairs = parallel_links(U, C) + ([(6, 1)] if ground_parallel(U, home, tgt) else [])
