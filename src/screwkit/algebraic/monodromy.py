@@ -61,7 +61,7 @@ def _loops(system: PolynomialSystem, p0: Complex, x: Complex, count: int,
     """Track x (m, n) around ``count`` random triangles p0 → p1 → p2 → p0 at once (one
     batched call per edge); the regular end points, the paths tracked and those that failed."""
     m = len(x)
-    scale = max(1.0, float(np.abs(p0).max(initial=0.0)))
+    scale = np.maximum(1.0, np.abs(p0))  # each parameter at its own size
     shape = (count, system.k)
     p1, p2 = (scale * (rng.standard_normal(shape) + 1j * rng.standard_normal(shape))
               for _ in range(2))

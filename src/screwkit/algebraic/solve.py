@@ -66,7 +66,9 @@ class StartSolutions:
         p, x, stats = monodromy_solve(system, np.asarray(p0, dtype=complex),
                                       np.asarray(x0, dtype=complex), options)
         how = (f"monodromy: {stats.found} solutions after {stats.loops} loops, stopped by "
-               f"{stats.stopped_by}")
+               f"{stats.stopped_by}" + (" (a lower bound on the generic count: no proof that "
+                                        "none is missing)" if stats.stopped_by != "expected count"
+                                        else ""))
         return StartSolutions(p, x, stats.found, how, stats.paths_tracked)
 
 

@@ -143,6 +143,15 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         from screwkit.kinematics.modes.delta import delta_formulation
 
         return delta_formulation(mech)  # a CapabilityError where it is not a Delta robot
+    if kinds <= {"R", "S", "U", "P"}:
+        from screwkit.kinematics.modes.spatial_points import spatial_point_formulation
+
+        try:
+            return spatial_point_formulation(mech)
+        except CapabilityError as err:
+            why = f" ({err})"
+    else:
+        why = ""
     raise CapabilityError(
         f"{mech.name}: no polynomial formulation takes this mechanism yet (joints "
         f"{''.join(sorted(j.kind for j in mech.joints))}, {len(mech.topology.loops)} loops); there are "
@@ -150,7 +159,8 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         "single loops of R, P, C and U joints with six free freedoms, "
         "RSSR, RSRC and RCCC loops driven at a ground R joint, 6-6 Stewart–Gough "
         "platforms (U–P–S or S–P–S legs driven at the P joints) and Delta robots (three "
-        "driven arms, each with an S–S parallelogram to the plate)")
+        "driven arms, each with an S–S parallelogram to the plate), and graphs of R, S and U "
+        f"joints driven from the ground{why}")
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 
 import numpy as np
 
@@ -49,19 +50,33 @@ def system_key(system: PolynomialSystem) -> str:
 
 def start_solutions(system: PolynomialSystem, random_instance: RandomInstance | None = None,
                     generic_count: int | None = None, seed: int = 0,
-                    grouping: Grouping | None = None) -> StartSolutions:
+                    grouping: Grouping | None = None,
+                    total_degree_paths: int = TOTAL_DEGREE_PATHS,
+                    then_monodromy: bool = False, stale_loops: int | None = None
+                    ) -> StartSolutions:
     """Every solution of ``system`` at a generic complex parameter vector, kept per topology
     (module docstring): for a Bézout number ≤ :data:`TOTAL_DEGREE_PATHS` (or when no random
     instance is given) by the multi-homogeneous homotopy of ``grouping`` when its count is
     below the total degree, else by total degree (by monodromy after all when it ends at
     fewer or more than a given ``generic_count`` and a random instance is given); otherwise by
     monodromy from ``random_instance(rng)`` (p (1, k), x (1, n), complex) until
-    ``generic_count`` solutions are known."""
+    ``generic_count`` solutions are known. ``total_degree_paths`` moves the limit
+    (:data:`TOTAL_DEGREE_PATHS`); ``then_monodromy`` loops the total-degree solutions round
+    monodromy loops until they stop growing, so that a path the total-degree homotopy lost
+    (systems with solution sets at infinity lose many) is found after all; ``stale_loops``
+    (monodromy without a known count) the loops in a row without a new solution that stop it
+    (:class:`~screwkit.algebraic.monodromy.MonodromyOptions`)."""
     key = system_key(system)
     if key not in _CACHE:
         found = start_store.load(key, system, generic_count)
         if found is None:
-            found = _solve(system, random_instance, generic_count, seed, grouping)
+            options = MonodromyOptions(expected=generic_count, seed=seed)
+            if stale_loops is not None:
+                options = replace(options, stale_loops=stale_loops)
+            found = _solve(system, random_instance, options, grouping, total_degree_paths)
+            if then_monodromy and random_instance is not None and not \
+                    found.how_found.startswith("monodromy"):
+                found = _then_monodromy(system, found, random_instance, options)
             start_store.save(key, found)
         _CACHE[key] = found
     return _CACHE[key]
@@ -88,9 +103,25 @@ def first_solve_paths() -> int:
     return _PATHS[0]
 
 
+def _then_monodromy(system: PolynomialSystem, found: StartSolutions,
+                    random_instance: RandomInstance, options: MonodromyOptions
+                    ) -> StartSolutions:
+    """``found`` completed by monodromy loops from its solutions at its parameters (from a
+    random instance when it has none), stopped when loops in a row find nothing new."""
+    if len(found.x) == 0:
+        more = _by_monodromy(system, random_instance, options)
+    else:
+        more = StartSolutions.by_monodromy(system, found.p, found.x, options)
+    _PATHS[0] += more.paths
+    return StartSolutions(more.p, more.x, more.generic_count,
+                          f"{found.how_found}; then {more.how_found}", found.paths + more.paths)
+
+
 def _solve(system: PolynomialSystem, random_instance: RandomInstance | None,
-           generic_count: int | None, seed: int, grouping: Grouping | None) -> StartSolutions:
-    if random_instance is None or bezout_number(system) <= TOTAL_DEGREE_PATHS:
+           options: MonodromyOptions, grouping: Grouping | None,
+           total_degree_paths: int = TOTAL_DEGREE_PATHS) -> StartSolutions:
+    generic_count, seed = options.expected, options.seed
+    if random_instance is None or bezout_number(system) <= total_degree_paths:
         if grouping is not None and mhom_bezout_of(system, grouping) < bezout_number(system):
             found = _by_multi_homogeneous(system, grouping, seed)
             if found is not None:
@@ -99,17 +130,16 @@ def _solve(system: PolynomialSystem, random_instance: RandomInstance | None,
         if (random_instance is not None and generic_count is not None
                 and found.generic_count != generic_count):  # a path lost: monodromy instead
             _PATHS[0] += found.paths
-            found = _by_monodromy(system, random_instance, generic_count, seed)
+            found = _by_monodromy(system, random_instance, options)
     else:
-        found = _by_monodromy(system, random_instance, generic_count, seed)
+        found = _by_monodromy(system, random_instance, options)
     _PATHS[0] += found.paths
     return found
 
 
 def _by_monodromy(system: PolynomialSystem, random_instance: RandomInstance,
-                  generic_count: int | None, seed: int) -> StartSolutions:
-    p0, x0 = random_instance(np.random.default_rng(seed))
-    options = MonodromyOptions(expected=generic_count, seed=seed)
+                  options: MonodromyOptions) -> StartSolutions:
+    p0, x0 = random_instance(np.random.default_rng(options.seed))
     return StartSolutions.by_monodromy(system, p0[0], x0[0], options)
 
 

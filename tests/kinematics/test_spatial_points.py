@@ -1,0 +1,227 @@
+"""The point formulation of spatial R/S/U graphs (modes/spatial_points.py, issue 27), checked
+against second methods: the closed forms (RSSR roots, the double wishbone's dyads), the Delta
+robot's Study-coordinate formulation and, for a platform no closed form takes (the five-link
+suspension), the Stewart–Gough elimination template on the same six rods. Every kept mode also
+closes every loop of the graph tracker's own closure (exact SE(3) logarithm), independent of the
+polynomials."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import screwkit as sk
+from screwkit.algebraic.solve import solve_all
+from screwkit.errors import CapabilityError
+from screwkit.kinematics.graph import solve_mechanism
+from screwkit.kinematics.graph.closure import graph_forward, graph_layout
+from screwkit.kinematics.graph.follow import follow_drawn_mode
+from screwkit.kinematics.modes.every_mode import closure_formulation, every_mode
+from screwkit.kinematics.modes.spatial_points import (
+    SpatialPointFormulation,
+    spatial_point_formulation,
+)
+from screwkit.kinematics.modes.stewart import pose_from_study, stewart_parameters
+from screwkit.kinematics.modes.stewart_solve import solve_stewart
+from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
+
+MECHANISMS = Path(__file__).resolve().parents[2] / "examples" / "mechanisms"
+
+
+def joint(name: str, kind: str, a: str, b: str, at: object,
+          axis: object = (0.0, 0.0, 1.0)) -> MechanismJoint:
+    return MechanismJoint(name, kind, (a, b), np.asarray(at, float), np.asarray(axis, float))
+
+
+def _random_rssr(rng: np.random.Generator) -> Mechanism:
+    """A spatial RSSR: random axes and ball centres, a short crank (every drawing closes)."""
+    O, A, B, D = (rng.uniform(-1.0, 1.0, 3) for _ in range(4))
+    A = O + 0.3 * (A - O) / np.linalg.norm(A - O)
+    return Mechanism("random RSSR", (Body("crank"), Body("rod"), Body("rocker")),
+                     (joint("O", "R", "ground", "crank", O, rng.normal(size=3)),
+                      joint("A", "S", "crank", "rod", A),
+                      joint("B", "S", "rod", "rocker", B),
+                      joint("D", "R", "rocker", "ground", D, rng.normal(size=3))), ("O.theta",))
+
+
+def _centres(mech: Mechanism, conf: object) -> np.ndarray:
+    return graph_forward(mech, graph_layout(mech), conf).centres  # type: ignore[arg-type]
+
+
+def _matched(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
+    """Every row of a (M, ...) is within tol of a row of b, and the counts are equal."""
+    if len(a) != len(b):
+        return False
+    return all(np.abs(b - x).reshape(len(b), -1).max(1).min() <= tol for x in a)
+
+
+def test_200_random_rssrs_point_modes_are_the_closed_form_modes() -> None:
+    """Issue 27's check "RSSR: 2" on 200 seeded random RSSRs, by the point formulation in one
+    batched parameter homotopy, each instance's real modes the closed form's (the rod-loop
+    formulation: the RSSR's quadratic), joint centres to 1e-9 of the length scale."""
+    rng = np.random.default_rng(2031)
+    mechs = [_random_rssr(rng) for _ in range(200)]
+    forms = [spatial_point_formulation(m) for m in mechs]
+    assert len({f.system.n for f in forms}) == 1 and forms[0].system.n == 3
+    theta = rng.uniform(-np.pi, np.pi, 200)
+    P = np.vstack([f.parameters([[t]]) for f, t in zip(forms, theta, strict=True)])
+    start = forms[0].start()
+    assert start.generic_count == 2
+    sol = solve_all(forms[0].system, P, start)
+    complete = int(np.count_nonzero(sol.found == 2))
+    assert complete >= 198, f"{200 - complete} of 200 instances short of 2 solutions"
+    agree = 0
+    for b, (m, f) in enumerate(zip(mechs, forms, strict=True)):
+        rows = np.flatnonzero((sol.instance == b) & sol.real)
+        closed = every_mode(m, [[theta[b]]])  # the RSSR's own (rod-loop) formulation
+        assert closure_formulation(m).__class__ is not SpatialPointFormulation
+        ours = np.zeros((0, 4, 3)) if rows.size == 0 else \
+            _centres(m, f.configuration(sol.x[rows], [theta[b]])[0])
+        theirs = np.zeros((0, 4, 3)) if closed.configurations[0].size == 0 else \
+            _centres(m, closed.configurations[0])
+        agree += _matched(ours, theirs, 1e-9 * m.length_scale)
+    assert agree >= 198
+
+
+def _perturbed_wishbone(rng: np.random.Generator) -> Mechanism:
+    """The bundled double wishbone, every hardpoint moved by up to 5 % of its size."""
+    mech = sk.load_spec(MECHANISMS / "double_wishbone.toml").mechanism
+    L = mech.length_scale
+    joints = tuple(MechanismJoint(j.name, j.kind, j.bodies,
+                                  j.at + rng.uniform(-0.05, 0.05, 3) * L, j.axis)
+                   for j in mech.joints)
+    return Mechanism("random wishbone", mech.bodies, joints, mech.inputs)
+
+
+def test_double_wishbones_point_modes_are_the_closed_form_dyads_modes() -> None:
+    """Twelve perturbed double wishbones at five lower-arm angles each: the homotopy on the
+    point formulation finds 4 complex solutions (2 upper-ball circles × 2 tie-rod ends), its
+    real modes certified, closing to 1e-10, and they are exactly the closed-form modes of the
+    graph's dyads (RSS and SS, graph/subchains.py)."""
+    rng = np.random.default_rng(2032)
+    x = np.radians(np.linspace(-10.0, 10.0, 5))
+    for _ in range(12):
+        mech = _perturbed_wishbone(rng)
+        form = closure_formulation(mech)
+        assert isinstance(form, SpatialPointFormulation)
+        found = every_mode(mech, x[:, None])
+        assert found.generic_count == 4 and (found.found == 4).all()
+        assert found.worst_closure <= 1e-10 * mech.length_scale
+        closed = solve_mechanism(mech, x, every_mode=True)
+        assert closed.method == "graph (closed forms)"
+        for n in range(x.size):
+            assert found.certified[n].all()
+            theirs = np.array([md.joint_centres[n] for md in closed.modes if md.assembles[n]])
+            ours = _centres(mech, found.configurations[n])
+            assert _matched(ours, theirs.reshape(len(theirs), -1, 3), 1e-9 * mech.length_scale)
+
+
+def test_the_delta_robot_by_points_has_the_modes_of_its_study_formulation() -> None:
+    """The Delta robot read as points (its plate held by six S–S rods: a 6-6 platform, 40
+    complex solutions by monodromy) against its own formulation (modes/delta.py: the Study
+    system with the elbow balls as base points): the same 16 plate poses at two inputs."""
+    mech = sk.load_spec(MECHANISMS / "delta_robot.toml").mechanism
+    form = spatial_point_formulation(mech)
+    assert form.system.n == 18 and form.start().generic_count == 40
+    X = np.array([[0.0, 0.0, 0.0], [0.2, -0.1, 0.05]])
+    own = every_mode(mech, X)
+    sol = solve_all(form.system, form.parameters(X), form.start())
+    for b in range(2):
+        rows = np.flatnonzero((sol.instance == b) & sol.real)
+        conf, lay = form.configuration(sol.x[rows], X[b])
+        assert np.abs(graph_forward(mech, lay, conf).residual).max() <= 1e-10
+        plate = lay.body_of["plate"]
+        ours = graph_forward(mech, lay, conf).p[:, plate]
+        theirs = graph_forward(mech, lay, own.configurations[b]).p[:, plate]
+        assert len(ours) == len(theirs) == own.configurations[b].size
+        assert _matched(ours, theirs, 1e-9 * mech.length_scale)
+
+
+@pytest.fixture(scope="module")
+def five_link() -> tuple[Mechanism, SpatialPointFormulation]:
+    mech = sk.load_spec(MECHANISMS / "five_link_suspension.toml").mechanism
+    form = closure_formulation(mech)
+    assert isinstance(form, SpatialPointFormulation)
+    return mech, form
+
+
+def test_the_five_link_uprights_are_the_stewart_platform_poses(
+        five_link: tuple[Mechanism, SpatialPointFormulation]) -> None:
+    """The five-link suspension's upright is a platform on six rods (five links and the
+    pushrod from the rocker): at three rocker angles its modes by the point formulation are
+    the real poses of the Stewart–Gough forward kinematics (Study coordinates, elimination
+    template, modes/stewart_solve.py) with the chassis balls and the turned rocker ball as base
+    points and the rods' drawn lengths as legs: the same count and the same upright poses."""
+    mech, form = five_link
+    assert form.start().generic_count == 40  # a general 6-6 platform's count
+    lay = graph_layout(mech)
+    up = lay.body_of["upright"]
+    pivot = mech.joint("rocker_pivot")
+    rods = [("pushrod_top", "pushrod_foot")] + [(f"{n}_in", f"{n}_out") for n in (
+        "upper_front", "upper_rear", "lower_front", "lower_rear", "toe_link")]
+    inner = np.array([mech.joint(a).at for a, _ in rods])
+    outer = np.array([mech.joint(b).at for _, b in rods])
+    lengths = np.linalg.norm(outer - inner, axis=1)
+    for theta in np.radians([-12.0, 0.0, 9.0]):
+        u, c = pivot.axis, pivot.at
+        K = np.array([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]])
+        Rr = np.eye(3) + np.sin(theta) * K + (1 - np.cos(theta)) * K @ K
+        base = inner.copy()
+        base[0] = c + Rr @ (inner[0] - c)
+        st = solve_stewart(stewart_parameters(base, outer, lengths)[None, :])
+        real = st.x[st.real]
+        R, t = pose_from_study(real)
+        theirs = np.real(np.concatenate([R.reshape(-1, 9), t], 1))
+        found = every_mode(mech, [[theta]])
+        fr = graph_forward(mech, lay, found.configurations[0])
+        ours = np.concatenate([fr.R[:, up].reshape(-1, 9), fr.p[:, up]], 1)
+        assert found.certified[0].all() and found.worst_closure <= 1e-10 * mech.length_scale
+        assert _matched(ours, theirs, 1e-8), (len(ours), len(theirs))
+
+
+def test_the_five_link_every_mode_motion_keeps_the_drawn_mode(
+        five_link: tuple[Mechanism, SpatialPointFormulation]) -> None:
+    """Along the rocker's travel the homotopy route (anchors, tracking between) gives every
+    mode; mode 0 is the drawn one and equals the tracker's own continuation from the drawing;
+    every mode closes to 1e-10 wherever it assembles."""
+    mech, _ = five_link
+    x = np.radians(np.linspace(-12.0, 12.0, 25))
+    motion = solve_mechanism(mech, x, every_mode=True)
+    assert motion.method.startswith("graph (homotopy")
+    assert len(motion.modes) >= 2
+    followed = follow_drawn_mode(mech, graph_layout(mech), x[:, None])
+    assert followed.mask.all() and motion.modes[0].assembles.all()
+    assert np.abs(motion.modes[0].conf.scalars - followed.conf.scalars).max() <= 1e-8
+    for md in motion.modes:
+        assert float(np.nanmax(md.closure_residual[md.assembles])) <= 1e-10
+
+
+def _with_joint(mech: Mechanism, extra: MechanismJoint, body: str | None = None) -> Mechanism:
+    bodies = mech.bodies + ((Body(body),) if body else ())
+    return Mechanism(mech.name, bodies, mech.joints + (extra,), mech.inputs)
+
+
+def test_what_the_point_formulation_does_not_take_is_said() -> None:
+    """A body hanging from one ball; a mechanism locked at fixed inputs (the RSSR's rocker
+    tied to the ground by a second ball); freedoms left (a free rocker ball chain); a C joint:
+    each a CapabilityError that names the body or joint and says what to do."""
+    rssr = _random_rssr(np.random.default_rng(5))
+    hanging = _with_joint(rssr, joint("H", "S", "rod", "pendulum", [2.0, 2.0, 2.0]),
+                          "pendulum")
+    with pytest.raises(CapabilityError, match="'pendulum' has a single joint"):
+        spatial_point_formulation(hanging)
+    locked = _with_joint(rssr, joint("T", "S", "crank", "ground", rssr.joints[1].at))
+    with pytest.raises(CapabilityError, match="locked"):
+        spatial_point_formulation(locked)
+    loose = Mechanism("RSSR without its rocker hinge", rssr.bodies[:2] + (Body("rocker"),),
+                      rssr.joints[:3] + (joint("D", "S", "rocker", "ground",
+                                                rssr.joints[3].at),), ("O.theta",))
+    with pytest.raises(CapabilityError, match=r"2 equations in 3 unknowns; 1 freedom"):
+        spatial_point_formulation(loose)
+    cyl = Mechanism("RSSC", rssr.bodies, rssr.joints[:3] + (
+        joint("D", "C", "rocker", "ground", rssr.joints[3].at, rssr.joints[3].axis),),
+        ("O.theta",))
+    with pytest.raises(CapabilityError, match="C joints"):
+        spatial_point_formulation(cyl)
