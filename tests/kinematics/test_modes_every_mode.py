@@ -81,11 +81,12 @@ def test_a_joint_made_off_its_drawing_is_refused_not_solved_as_drawn(which: str)
 
 
 def test_a_mechanism_no_formulation_takes_is_refused_by_name() -> None:
-    """The 3-UPU is driven at P joints between moving bodies: no formulation takes it, and
-    the message says why the nearest one (the point formulation) does not."""
-    mech = sk.load_spec(EXAMPLES / "three_upu.toml").mechanism
-    with pytest.raises(CapabilityError, match="no polynomial formulation takes.*input joint"
-                                              r"\(s\) P1, P2 and P3 do not place a body"):
+    """The double wishbone driven by its wheel's travel (a body freedom, not a joint): no
+    formulation takes it, and the message says why the nearest one (the point formulation)
+    does not."""
+    mech = sk.load_spec(EXAMPLES / "double_wishbone_travel.toml").mechanism
+    with pytest.raises(CapabilityError, match="no polynomial formulation takes.*driven at a "
+                                              "body's freedom"):
         every_mode(mech, np.zeros((1, len(mech.inputs))))
 
 

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
 
 import screwkit as sk
 from screwkit.algebraic.solve import solve_all
@@ -31,8 +33,9 @@ MECHANISMS = Path(__file__).resolve().parents[2] / "examples" / "mechanisms"
 
 
 def joint(name: str, kind: str, a: str, b: str, at: object,
-          axis: object = (0.0, 0.0, 1.0)) -> MechanismJoint:
-    return MechanismJoint(name, kind, (a, b), np.asarray(at, float), np.asarray(axis, float))
+          axis: object = (0.0, 0.0, 1.0), axis2: object = None) -> MechanismJoint:
+    return MechanismJoint(name, kind, (a, b), np.asarray(at, float), np.asarray(axis, float),
+                          None if axis2 is None else np.asarray(axis2, float))
 
 
 def _random_rssr(rng: np.random.Generator) -> Mechanism:
@@ -204,10 +207,18 @@ def _with_joint(mech: Mechanism, extra: MechanismJoint, body: str | None = None)
 
 
 def test_what_the_point_formulation_does_not_take_is_said() -> None:
-    """A body hanging from one ball; a mechanism locked at fixed inputs (the RSSR's rocker
-    tied to the ground by a second ball); freedoms left (a free rocker ball chain); a C joint:
-    each a CapabilityError that names the body or joint and says what to do."""
+    """A body driven at its freedom; a system too large for monodromy (the 3-UPU's 90
+    unknowns); a body hanging from one ball; a mechanism locked at fixed inputs (the RSSR's
+    crank tied to the ground by a second ball); freedoms left (the rocker's hinge made a
+    ball); an H joint: each a CapabilityError that names the body or joint and says what to
+    do."""
     rssr = _random_rssr(np.random.default_rng(5))
+    travel = sk.load_spec(MECHANISMS / "double_wishbone_travel.toml").mechanism
+    with pytest.raises(CapabilityError, match="driven at a body's freedom"):
+        spatial_point_formulation(travel)
+    upu = sk.load_spec(MECHANISMS / "three_upu.toml").mechanism
+    with pytest.raises(CapabilityError, match="90 unknowns, more than 48"):
+        spatial_point_formulation(upu)
     hanging = _with_joint(rssr, joint("H", "S", "rod", "pendulum", [2.0, 2.0, 2.0]),
                           "pendulum")
     with pytest.raises(CapabilityError, match="'pendulum' has a single joint"):
@@ -220,8 +231,160 @@ def test_what_the_point_formulation_does_not_take_is_said() -> None:
                                                 rssr.joints[3].at),), ("O.theta",))
     with pytest.raises(CapabilityError, match=r"2 equations in 3 unknowns; 1 freedom"):
         spatial_point_formulation(loose)
-    cyl = Mechanism("RSSC", rssr.bodies, rssr.joints[:3] + (
-        joint("D", "C", "rocker", "ground", rssr.joints[3].at, rssr.joints[3].axis),),
-        ("O.theta",))
-    with pytest.raises(CapabilityError, match="C joints"):
-        spatial_point_formulation(cyl)
+    d = rssr.joints[3]
+    helix = Mechanism("RSSH", rssr.bodies, rssr.joints[:3] + (
+        MechanismJoint("D", "H", d.bodies, d.at, d.axis, pitch=0.01),), ("O.theta",))
+    with pytest.raises(CapabilityError, match="H joints"):
+        spatial_point_formulation(helix)
+
+
+def _ups_rocker(s0: np.ndarray) -> Mechanism:
+    """A rocker on an R joint driven by a U–P–S leg whose slide is the input (a cylinder
+    driving an arm): the input P joint lies between two moving bodies."""
+    U0, D, rocker_axis = np.zeros(3), np.array([1.0, -0.2, 0.1]), np.array([0.3, 1.0, 0.2])
+    leg = (s0 - U0) / np.linalg.norm(s0 - U0)
+    e1 = np.array([0.0, 0.0, 1.0]) - leg[2] * leg
+    e1 /= np.linalg.norm(e1)
+    return Mechanism("UPS-driven rocker", (Body("cylinder"), Body("piston"), Body("rocker")),
+                     (joint("U", "U", "ground", "cylinder", U0, e1, np.cross(leg, e1)),
+                      joint("P", "P", "cylinder", "piston", (U0 + s0) / 2, leg),
+                      joint("S", "S", "piston", "rocker", s0),
+                      joint("R", "R", "rocker", "ground", D, rocker_axis)), ("P.s",))
+
+
+def test_a_leg_driven_at_its_slide_between_moving_bodies_has_every_ball_position() -> None:
+    """The input is a P joint between the cylinder and the piston, neither placed: the point
+    formulation holds the slide as a parameter. At three slides the ball lies where the
+    rocker's circle meets the sphere of the leg's length about the U centre (two points, by
+    hand); each comes twice, the cylinder spun half a turn about its axis through the U
+    joint's other root. Every mode closes, is certified, and holds the drawn mode."""
+    s0 = np.array([0.6, 0.3, 0.5])
+    mech = _ups_rocker(s0)
+    form = closure_formulation(mech)
+    assert isinstance(form, SpatialPointFormulation) and len(form.slides) == 1
+    X = np.array([[0.0], [0.05], [-0.1]])
+    found = every_mode(mech, X)
+    assert found.generic_count == 4
+    D, a = mech.joint("R").at, mech.joint("R").axis
+    centre = D + ((s0 - D) @ a) * a  # the ball's circle about the rocker axis
+    radius = np.linalg.norm(s0 - centre)
+    e1 = np.cross(a, [1.0, 0.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(a, e1)
+    for n, (s,) in enumerate(X):
+        length = np.linalg.norm(s0) + s
+        # |centre + r (cos φ e1 + sin φ e2)|² = length²: A cos φ + B sin φ = C
+        A, B = 2 * radius * centre @ e1, 2 * radius * centre @ e2
+        C = length ** 2 - centre @ centre - radius ** 2
+        phi0, off = np.arctan2(B, A), np.arccos(C / np.hypot(A, B))
+        balls = np.array([centre + radius * (np.cos(f) * e1 + np.sin(f) * e2)
+                          for f in (phi0 + off, phi0 - off)])
+        ours = _centres(mech, found.configurations[n])[:, 2]
+        assert found.certified[n].all() and len(ours) == 4
+        assert _matched(ours, np.repeat(balls, 2, axis=0), 1e-12)
+    drawn = follow_drawn_mode(mech, graph_layout(mech), X)
+    for n in range(len(X)):
+        mine = _centres(mech, found.configurations[n])
+        assert np.abs(mine - _centres(mech, drawn.conf.take(slice(n, n + 1)))).reshape(
+            4, -1).max(1).min() <= 1e-12
+
+
+def _macpherson() -> Mechanism:
+    """A MacPherson strut (mm): the lower arm's hinge is the input, the upright slides on
+    the strut (a P joint between moving bodies) whose top turns in a ball on the body, an
+    S–S tie rod steers."""
+    mm = 1e-3
+    T, W = np.array([-20.0, 600.0, 700.0]), np.array([10.0, 690.0, 350.0])
+    return Mechanism("MacPherson strut", (Body("arm"), Body("upright"), Body("strut"),
+                                          Body("tie_rod")),
+                     (joint("L", "R", "ground", "arm", mm * np.array([0.0, 350.0, 160.0]),
+                            (1.0, 0.02, 0.01)),
+                      joint("LB", "S", "arm", "upright", mm * np.array([0.0, 720.0, 150.0])),
+                      joint("P", "P", "upright", "strut", mm * W, T - W),
+                      joint("T", "S", "strut", "ground", mm * T),
+                      joint("TI", "S", "ground", "tie_rod", mm * np.array([-150.0, 380.0, 200.0])),
+                      joint("TO", "S", "tie_rod", "upright",
+                            mm * np.array([-140.0, 700.0, 210.0]))), ("L.theta",))
+
+
+def test_a_macpherson_strut_every_upright_pose_and_no_other() -> None:
+    """A P joint between moving bodies not driven (the strut): its slide is an unknown. At
+    three arm angles the upright poses (turned about the lower ball so that the strut's line
+    passes through the top mount and the tie rod keeps its length) are checked against a
+    second method: Newton (scipy's least squares) from 200 random rotations of the upright,
+    which finds no pose the homotopy misses, and every homotopy pose closes and is
+    certified."""
+    mech = _macpherson()
+    j = {jt.name: jt for jt in mech.joints}
+    LB0, T, W, u = j["LB"].at, j["T"].at, j["P"].at, j["P"].axis
+    TI, TO0 = j["TI"].at, j["TO"].at
+    rod = np.linalg.norm(TO0 - TI)
+    lay = graph_layout(mech)
+    rng = np.random.default_rng(7)
+    for theta in np.radians([0.0, 5.0, -8.0]):
+        found = every_mode(mech, [[theta]])
+        assert found.certified[0].all() and found.worst_closure <= 1e-10 * mech.length_scale
+        fr = graph_forward(mech, lay, found.configurations[0])
+        up = lay.body_of["upright"]
+        ours = fr.R[:, up].reshape(-1, 9)
+        LB = fr.centres[0, 1]
+
+        def residual(r: np.ndarray, LB: np.ndarray = LB) -> np.ndarray:
+            R = Rotation.from_rotvec(r).as_matrix()
+            w, a = LB + R @ (W - LB0), R @ u
+            to = LB + R @ (TO0 - LB0)
+            return np.append(np.cross(T - w, a) / mech.length_scale,
+                             (np.linalg.norm(to - TI) - rod) / mech.length_scale)
+
+        theirs: list[np.ndarray] = []
+        for r0 in rng.normal(size=(200, 3)):
+            sol = least_squares(residual, r0, xtol=1e-15, ftol=1e-15, gtol=1e-15)
+            if np.abs(residual(sol.x)).max() < 1e-11:
+                R = Rotation.from_rotvec(sol.x).as_matrix().reshape(9)
+                if not theirs or np.abs(np.array(theirs) - R).max(1).min() > 1e-6:
+                    theirs.append(R)
+        assert len(theirs) >= 1
+        for R in theirs:  # every pose Newton finds is one of ours
+            assert np.abs(ours - R).max(1).min() <= 1e-8
+
+
+def test_an_r_joint_driven_between_moving_bodies_turns_its_point_with_the_input() -> None:
+    """A loop R–R–S–S driven at its second R joint (between the crank and the coupler, both
+    moving): the point formulation carries a point of the coupler in the crank's frame by the
+    input angle. At three knee angles crank and coupler are one rigid body turning about the
+    ground hinge, so the ball B lies where its circle meets the rod's sphere about C (two
+    points, by hand): the modes are exactly those two, and the drawn one is among them."""
+    O, K, B, C = (np.array(v) for v in ([0.0, 0.0, 0.0], [0.4, 0.1, 0.2], [0.7, 0.5, 0.1],
+                                        [0.3, 1.2, 0.5]))
+    axis_o, axis_k = np.array([0.1, 0.2, 1.0]), np.array([1.0, 0.3, 0.2])
+    mech = Mechanism("RRSS driven at its knee", (Body("crank"), Body("coupler"), Body("rod")),
+                     (joint("O", "R", "ground", "crank", O, axis_o),
+                      joint("K", "R", "crank", "coupler", K, axis_k),
+                      joint("B", "S", "coupler", "rod", B),
+                      joint("C", "S", "rod", "ground", C)), ("K.theta",))
+    form = closure_formulation(mech)
+    assert isinstance(form, SpatialPointFormulation) and len(form.turns) == 1
+    X = np.radians([[0.0], [10.0], [-20.0]])
+    found = every_mode(mech, X)
+    assert found.generic_count == 2
+    a = axis_o / np.linalg.norm(axis_o)
+    ka = axis_k / np.linalg.norm(axis_k)
+    drawn = follow_drawn_mode(mech, graph_layout(mech), X)
+    for n, (q,) in enumerate(X):
+        Kr = np.eye(3) + np.sin(q) * np.cross(np.eye(3), ka) + (1 - np.cos(q)) * (
+            np.outer(ka, ka) - np.eye(3))
+        b0 = K + Kr @ (B - K)  # the ball with the knee turned, the crank as drawn
+        centre = O + ((b0 - O) @ a) * a
+        radius = np.linalg.norm(b0 - centre)
+        e1 = (b0 - centre) / radius
+        e2 = np.cross(a, e1)
+        rod = np.linalg.norm(B - C)
+        A_, B_ = 2 * radius * (centre - C) @ e1, 2 * radius * (centre - C) @ e2
+        C_ = rod ** 2 - (centre - C) @ (centre - C) - radius ** 2
+        phi0, off = np.arctan2(B_, A_), np.arccos(C_ / np.hypot(A_, B_))
+        balls = np.array([centre + radius * (np.cos(f) * e1 + np.sin(f) * e2)
+                          for f in (phi0 + off, phi0 - off)])
+        ours = _centres(mech, found.configurations[n])
+        assert found.certified[n].all() and _matched(ours[:, 2], balls, 1e-12)
+        there = _centres(mech, drawn.conf.take(slice(n, n + 1)))[0]
+        assert np.abs(ours - there).reshape(len(ours), -1).max(1).min() <= 1e-12

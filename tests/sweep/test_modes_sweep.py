@@ -103,9 +103,26 @@ def test_without_shipping_a_process_solves_them_once(spec, monkeypatch):
 
 
 def test_a_graph_without_a_formulation_is_refused_before_any_run(tmp_path):
-    wishbone = EXAMPLES / "mechanisms" / "double_wishbone.toml"
+    # driven by its wheel's travel (a body freedom): no polynomial formulation takes it
+    wishbone = EXAMPLES / "mechanisms" / "double_wishbone_travel.toml"
     with pytest.raises(CapabilityError, match="--job modes solves every assembly mode"):
         define_sweep(wishbone, ["joints.UB.at.z=465:475:2"], "modes")
     r = runner.invoke(app, ["sweep", str(wishbone), "--vary", "joints.UB.at.z=465:475:2",
                             "--job", "modes", "-o", str(tmp_path / "t.csv"), "--workers", "0"])
     assert r.exit_code == 2 and "--job analyze follows the drawn mode" in " ".join(r.output.split())
+
+
+def test_a_spatial_graph_sweeps_every_mode_by_its_point_formulation(tmp_path):
+    """The double wishbone (several loops, S joints): `--job modes` runs on the point
+    formulation (issue 27), each design's 4 modes certified at all 41 samples."""
+    out = tmp_path / "wb.csv"
+    r = runner.invoke(app, ["sweep", str(EXAMPLES / "mechanisms" / "double_wishbone.toml"),
+                            "--vary", "joints.UB.at.z=465:475:3", "--job", "modes", "-o",
+                            str(out), "--workers", "0", "--fresh"])
+    assert r.exit_code == 0, r.output
+    import pandas as pd
+
+    table = pd.read_csv(out)
+    assert list(table["status"]) == ["ok"] * 3
+    assert list(table["modes"]) == [4] * 3 and list(table["modes.certified"]) == [4] * 3
+    assert list(table["generic_count"]) == [4] * 3 and list(table["assembling_samples"]) == [41] * 3

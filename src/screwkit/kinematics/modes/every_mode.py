@@ -125,7 +125,10 @@ def closure_formulation(mech: Mechanism) -> Formulation:
     single = len(mech.topology.loops) == 1 and len(mech.joints) == 4
     if single and sorted(j.kind for j in mech.joints) in (["R", "R", "S", "S"],
                                                           ["C", "R", "R", "S"]):
-        return rod_loop(mech)
+        try:
+            return rod_loop(mech)
+        except CapabilityError:  # not an RSSR/RSRC driven at a ground R: the points below
+            pass
     if single and sorted(j.kind for j in mech.joints) == ["C", "C", "C", "R"]:
         try:
             return rccc_loop(mech)
@@ -143,7 +146,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         from screwkit.kinematics.modes.delta import delta_formulation
 
         return delta_formulation(mech)  # a CapabilityError where it is not a Delta robot
-    if kinds <= {"R", "S", "U", "P"}:
+    if kinds <= {"R", "S", "U", "P", "C"}:
         from screwkit.kinematics.modes.spatial_points import spatial_point_formulation
 
         try:
@@ -159,8 +162,8 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         "single loops of R, P, C and U joints with six free freedoms, "
         "RSSR, RSRC and RCCC loops driven at a ground R joint, 6-6 Stewart–Gough "
         "platforms (U–P–S or S–P–S legs driven at the P joints) and Delta robots (three "
-        "driven arms, each with an S–S parallelogram to the plate), and graphs of R, S and U "
-        f"joints driven from the ground{why}")
+        "driven arms, each with an S–S parallelogram to the plate), and graphs of R, P, C, S "
+        f"and U joints driven at R or P joints{why}")
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""Any spatial graph of R, S and U joints as a polynomial system in its joints' points.
+"""Any spatial graph of R, P, C, S and U joints as a polynomial system in its joints' points.
 
 The spatial counterpart of the planar formulation (modes/planar.py), after the "natural
 coordinates" of García de Jalón & Bayo (*Kinematic and Dynamic Simulation of Multibody
@@ -6,11 +6,16 @@ Systems*, 1994, ch. 2): every body is carried by points, and every constraint is
 
 - An S joint is one point, its centre, in both bodies.
 - An R joint is two points on its axis (its point and one length unit along the axis), in both
-  bodies: the bodies may turn about the line through them and nothing else.
+  bodies: the bodies may turn about the line through them and nothing else. Driven between two
+  moving bodies, its second body also carries a point one unit across the axis, which the
+  first body's base carries with coefficients that follow the input angle.
 - A U joint is its centre in both bodies, a point one unit along its first axis in its first
   body and one along its second axis in its second body, and one equation: the two arms keep
   their drawn angle, (A − C)·(B − C) = g.
-- A P joint is taken only as an input that places a body from a placed one.
+- A P joint is three points in each body (its point, one unit along the axis, one unit across
+  it) and a C joint the first two; the second body's are the first body's slid along the axis,
+  b_i = a_i + s (a_1 − a_0), with the slide s an unknown, or a parameter when it is an input.
+- A P or R input that joins a body to the ground, or to a body so placed, places it.
 
 At given input values the ground and every body driven from it through input joints are
 placed; the points they carry are parameters. Every other point (x, y, z) is an unknown, and
@@ -23,10 +28,13 @@ the inputs place first) gives
 (a triangle fixed by its three sides is the same up to a rotation, so no mirror image is
 admitted; the cross product keeps every other point on its own side). A body whose points lie
 on one line (an S–S rod, an R axis with a ball on it) has one distance and P_m = b1 + a_m u:
-its spin about that line is idle and is not an unknown. An equation among placed points only
-holds by itself and is left out. The system is square exactly when the mechanism has no
-freedom left at fixed inputs but its rods' spins; every equation is of degree two, so the
-total degree is 2^n.
+its spin about that line is idle and is not an unknown. Equations among points whose distances
+hold already are left out: among placed points, among the points a slide carries over, among
+points a body shares with one written before it (an R joint's axis), and among a driven R
+joint's axis and turned point; the base is taken in the largest such group. The system is square exactly when the mechanism has no
+freedom left at fixed inputs but its rods' spins (otherwise, or with more than
+:data:`MAX_UNKNOWNS` unknowns, the formulation refuses it by name); every equation is of degree
+two, so the total degree is 2^n.
 
 Coordinates are taken from the centroid of the drawn joints in units of the mechanism's length
 scale. Every parameter (the placed points, the squared distances, the carried points'
@@ -68,6 +76,8 @@ TOTAL_DEGREE_LIMIT = 1024
 #: monodromy stops after this many loops in a row find nothing new (the five-link example's
 #: 40 need 42 loops from seed 0; at 6 it stopped at 37)
 STALE_LOOPS = 24
+#: larger point systems are refused (monodromy there is slow and unreliable: module docstring)
+MAX_UNKNOWNS = 48
 #: a body's points lie on one line when none is farther than this (in length units) from it
 COLLINEAR = 1e-9
 
@@ -84,6 +94,33 @@ class BodyEquations:
     distances: tuple[tuple[int, int], ...]
     carried: tuple[int, ...]
     coefficients: tuple[tuple[float, ...], ...]
+
+
+@dataclass(frozen=True)
+class SlideJoint:
+    """A P or C joint that places no body: its points in the first body (``a``: the joint's
+    point, one unit along its axis and, for a P joint, one unit across it) and the same
+    drawn points in the second (``b``), with b_i = a_i + s (a_1 − a_0); ``column`` the input
+    column of its slide when it is an input (then s is a parameter), else None (s an
+    unknown)."""
+
+    joint: int
+    a: tuple[int, ...]
+    b: tuple[int, ...]
+    column: int | None
+
+
+@dataclass(frozen=True)
+class TurnJoint:
+    """An R joint driven between two moving bodies: the point ``point`` of its second body
+    (one unit across the axis) is carried by the first body's base with coefficients that
+    follow the input (column ``column``)."""
+
+    joint: int
+    frame: str
+    point: int
+    column: int
+    axis: tuple[int, int] = (-1, -1)
 
 
 @dataclass(frozen=True)
@@ -108,18 +145,43 @@ class SpatialPointFormulation:
     bodies: tuple[BodyEquations, ...]
     u_joints: tuple[tuple[int, int, int], ...]
     source: dict[int, str] = field(default_factory=dict)
+    slides: tuple[SlideJoint, ...] = ()
+    turns: tuple[TurnJoint, ...] = ()
+
+    def _frame_of(self, body: str) -> BodyEquations:
+        return next(be for be in self.bodies if be.body == body)
+
+    def _turn_coefficients(self, t: TurnJoint, X: Array) -> Array:
+        """The driven point's coefficients (N, 3) in its first body's base at inputs X."""
+        j = self.mechanism.joints[t.joint]
+        be = self._frame_of(t.frame)
+        d = self.drawn
+        c = (j.at - self.origin) / self.scale
+        th = X[:, t.column]
+        q0 = d[t.point] - c
+        u = j.axis
+        turned = (c + np.multiply.outer(np.cos(th), q0)
+                  + np.multiply.outer(np.sin(th), np.cross(u, q0))
+                  + np.multiply.outer(1.0 - np.cos(th), (u @ q0) * u))
+        b1, b2, b3 = be.base
+        e1, e2 = d[b2] - d[b1], d[b3] - d[b1]
+        M = np.stack([e1, e2, np.cross(e1, e2)], 1)
+        return np.asarray(np.linalg.solve(M, (turned - d[b1]).T).T)
 
     # ----------------------------------------------------------------- parameters
     def parameters(self, input_values: ArrayLike) -> Array:
         """Parameters at input values (N, n_inputs) or (n_inputs,): the placed points'
         scaled (x, y, z), then per body its squared distances and carried coefficients, then
-        each U joint's g."""
+        each U joint's g, then the driven slides (scaled) and the driven turns' coefficients."""
         X = np.atleast_2d(np.asarray(input_values, dtype=float))
         poses = self.placed_poses(X)
         cols = [self._placed_point(k, poses) for k in self.known]
         known = np.stack(cols, 1).reshape(X.shape[0], -1) if cols else np.zeros((X.shape[0], 0))
-        return np.hstack([known, np.broadcast_to(self._constants(self.drawn),
-                                                 (X.shape[0], self.system.k - known.shape[1]))])
+        const = self._constants(self.drawn)
+        driven = [X[:, sl.column:sl.column + 1] / self.scale for sl in self.slides
+                  if sl.column is not None]
+        driven += [self._turn_coefficients(t, X) for t in self.turns]
+        return np.hstack([known, np.broadcast_to(const, (X.shape[0], const.size)), *driven])
 
     def _constants(self, pts: ArrayLike) -> NDArray[np.complex128] | Array:
         """The distance, coefficient and U parameters of the points ``pts`` (P, 3)."""
@@ -168,6 +230,11 @@ class SpatialPointFormulation:
         computed from them."""
         P = len(self.drawn)
         pts = rng.standard_normal((P, 3)) + 1j * rng.standard_normal((P, 3))
+        slide = {}
+        for sl in self.slides:  # b_i = a_i + s (a_1 − a_0)
+            slide[sl.joint] = rng.standard_normal() + 1j * rng.standard_normal()
+            for ia, ib in zip(sl.a, sl.b, strict=True):
+                pts[ib] = pts[ia] + slide[sl.joint] * (pts[sl.a[1]] - pts[sl.a[0]])
         coef = {}
         for be in self.bodies:
             b1, b2 = be.base[0], be.base[1]
@@ -176,10 +243,10 @@ class SpatialPointFormulation:
                 if m in be.base:
                     continue
                 if len(be.base) == 2:  # on a line: P_m = b1 + a u
-                    a = rng.standard_normal() + 1j * rng.standard_normal()
+                    along = rng.standard_normal() + 1j * rng.standard_normal()
                     if m not in self.known or m in be.carried:
-                        pts[m] = pts[b1] + a * u
-                    coef[(be.body, m)] = (a,)
+                        pts[m] = pts[b1] + along * u
+                    coef[(be.body, m)] = (along,)
                 else:
                     v = pts[be.base[2]] - pts[b1]
                     abc = np.linalg.solve(np.stack([u, v, np.cross(u, v)], 1), pts[m] - pts[b1])
@@ -188,8 +255,15 @@ class SpatialPointFormulation:
         for be in self.bodies:
             out += [complex((pts[j] - pts[i]) @ (pts[j] - pts[i])) for i, j in be.distances]
             out += [c for m in be.carried for c in coef[(be.body, m)]]
-        out += [complex((pts[a] - pts[c]) @ (pts[b] - pts[c])) for c, a, b in self.u_joints]
-        x = pts[list(self.unknown)].reshape(-1)
+        out += [complex((pts[a1] - pts[c]) @ (pts[a2] - pts[c])) for c, a1, a2 in self.u_joints]
+        out += [slide[sl.joint] for sl in self.slides if sl.column is not None]
+        for t in self.turns:
+            b1, b2, b3 = self._frame_of(t.frame).base
+            u, v = pts[b2] - pts[b1], pts[b3] - pts[b1]
+            out += list(np.linalg.solve(np.stack([u, v, np.cross(u, v)], 1),
+                                        pts[t.point] - pts[b1]))
+        x = np.concatenate([pts[list(self.unknown)].reshape(-1),
+                            [slide[sl.joint] for sl in self.slides if sl.column is None]])
         return np.array(out, dtype=complex)[None, :], x[None, :]
 
     def start(self) -> StartSolutions:
@@ -212,7 +286,8 @@ class SpatialPointFormulation:
         world = np.empty((N, len(self.drawn), 3))
         for k in self.known:
             world[:, k] = self._placed_point(k, poses)
-        world[:, list(self.unknown)] = sol.reshape(N, len(self.unknown), 3)
+        world[:, list(self.unknown)] = sol[:, :3 * len(self.unknown)].reshape(
+            N, len(self.unknown), 3)
         world = self.origin + self.scale * world
         drawn = self.origin + self.scale * self.drawn
         for be in self.bodies:
@@ -259,47 +334,71 @@ def _placed_bodies(mech: Mechanism) -> list[tuple[str, int | None]]:
                 placed.append((j.bodies[1] if j.bodies[0] in have else j.bodies[0], k))
                 grew = True
                 break
-    used = {mech.joints[k].name for _, k in placed[1:] if k is not None}
-    stray = sorted(driven - used)
-    if stray:
-        raise _refuse(mech, f"input joint(s) {listing(stray)} do not place a body from the "
-                      "ground through input joints (an input between two moving bodies); "
-                      "follow it with the graph tracker (solve_mechanism)")
-    for _, placing in placed[1:]:
-        assert placing is not None
-        ij = mech.joints[placing]
-        if ij.kind not in ("R", "P"):
-            raise _refuse(mech, f"input joint {ij.name!r} is a {ij.kind} joint; an input "
-                          "here is an R or P joint")
+    for j in mech.joints:
+        if j.name in driven and j.kind not in ("R", "P"):
+            raise _refuse(mech, f"input joint {j.name!r} is a {j.kind} joint; it takes R and P "
+                          "joints as inputs")
     return placed
 
 
-def _points(mech: Mechanism, origin: Array, scale: float
-            ) -> tuple[list[Array], list[frozenset[str]], list[tuple[int, int, int]]]:
-    """Every joint's points (scaled drawn positions, owning bodies) and the U joints'
-    (centre, first arm, second arm) (module docstring)."""
+def _across(u: Array) -> Array:
+    """A unit vector square to the unit vector u."""
+    n = np.cross(u, [1.0, 0.0, 0.0] if abs(u[0]) < 0.9 else [0.0, 1.0, 0.0])
+    return np.asarray(n / np.linalg.norm(n))
+
+
+@dataclass
+class _Points:
+    drawn: list[Array]
+    owners: list[frozenset[str]]
+    u_joints: list[tuple[int, int, int]]
+    slides: list[SlideJoint]
+    turns: list[TurnJoint]
+
+
+def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int]) -> _Points:
+    """Every joint's points (scaled drawn positions, owning bodies), the U joints' (centre,
+    first arm, second arm), the P and C joints that place no body and the R inputs between
+    moving bodies (module docstring)."""
     drawn: list[Array] = []
     owners: list[frozenset[str]] = []
     u_joints = []
+    slides: list[SlideJoint] = []
+    turns: list[TurnJoint] = []
+    columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
 
     def add(at: Array, bodies: tuple[str, ...]) -> int:
         drawn.append((at - origin) / scale)
         owners.append(frozenset(bodies))
         return len(drawn) - 1
 
-    for j in mech.joints:
+    for k, j in enumerate(mech.joints):
+        if k in placing:
+            if j.kind == "R":  # its axis, in both placed bodies
+                add(j.at, j.bodies)
+                add(j.at + scale * j.axis, j.bodies)
+            continue
         if j.kind == "S":
             add(j.at, j.bodies)
         elif j.kind == "R":
-            add(j.at, j.bodies)
-            add(j.at + scale * j.axis, j.bodies)
+            ends = (add(j.at, j.bodies), add(j.at + scale * j.axis, j.bodies))
+            if j.name in columns:  # driven between two moving bodies
+                q = add(j.at + scale * _across(j.axis), (j.bodies[1],))
+                turns.append(TurnJoint(k, j.bodies[0], q, columns[j.name], ends))
+        elif j.kind in ("P", "C"):
+            line = [j.at, j.at + scale * j.axis]
+            if j.kind == "P":
+                line.append(j.at + scale * _across(j.axis))
+            first = tuple(add(e, (j.bodies[0],)) for e in line)
+            second = tuple(add(e, (j.bodies[1],)) for e in line)
+            slides.append(SlideJoint(k, first, second, columns.get(j.name)))
         elif j.kind == "U":
             assert j.axis2 is not None
             c = add(j.at, j.bodies)
             a = add(j.at + scale * j.axis, (j.bodies[0],))
             b = add(j.at + scale * j.axis2, (j.bodies[1],))
             u_joints.append((c, a, b))
-    return drawn, owners, u_joints
+    return _Points(drawn, owners, u_joints, slides, turns)
 
 
 def _third(pts: Array, b1: int, b2: int, candidates: list[int]) -> int | None:
@@ -332,15 +431,23 @@ def _base(pts: Array, placed: list[int], order: list[int]) -> tuple[int, ...]:
 
 
 def _body_equations(mech: Mechanism, body: str, pts: Array, members: list[int],
-                    known: set[int], source: dict[int, str]) -> BodyEquations:
-    """The equations of one unplaced body (module docstring), leaving out those among placed
-    points only."""
+                    known: set[int], source: dict[int, str],
+                    slid: tuple[int, ...] | list[int] = ()) -> BodyEquations:
+    """The equations of one unplaced body (module docstring), leaving out those among
+    points already rigid with each other: the placed points, or ``slid``, points whose
+    distances other equations keep (those a slide carries over from the joint's first body,
+    b_i = a_i + s (a_1 − a_0), or those the body shares with a body before it, e.g. an R
+    joint's axis), whichever group is larger (the base is taken in it; the other group's
+    points are carried by it)."""
     placed_here = [m for m in members if m in known]
     sources = sorted({source[m] for m in placed_here})
     if len(sources) > 1:
         raise _refuse(mech, f"body {body!r} is joined to {listing(sources)}, which the inputs "
                       "place each on its own, so at fixed inputs it cannot move and the "
                       "mechanism is locked (or it has more inputs than freedoms)")
+    if slid and len(slid) >= len(placed_here):  # the larger rigid group makes the base
+        placed_here = list(slid)
+    known = set(placed_here)
     order = placed_here + [m for m in members if m not in known]
     if len(order) < 2 or np.linalg.norm(pts[order] - pts[order[0]], axis=1).max() <= COLLINEAR:
         raise _refuse(mech, f"body {body!r} hangs from a single point (one S joint), so it "
@@ -376,18 +483,13 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     """The point system of ``mech`` (module docstring), or a CapabilityError that says why it
     does not take the mechanism (a joint other than R, S, U or an input P; an input between
     moving bodies; a body that turns freely or is locked; freedoms left at fixed inputs)."""
-    other = sorted({j.kind for j in mech.joints} - {"R", "S", "U", "P"})
+    other = sorted({j.kind for j in mech.joints} - {"R", "S", "U", "P", "C"})
     if other:
-        raise _refuse(mech, f"it has {listing(other)} joints; it takes R, S and U joints, and "
-                      "P joints as inputs")
+        raise _refuse(mech, f"it has {listing(other)} joints; it takes R, P, C, S and U joints")
     if mech.drives:
         raise _refuse(mech, "it is driven at a body's freedom, not at joints")
     placed = _placed_bodies(mech)
-    placing = {k for _, k in placed[1:]}
-    sliding = [j.name for k, j in enumerate(mech.joints) if j.kind == "P" and k not in placing]
-    if sliding:
-        raise _refuse(mech, f"P joint(s) {listing(sliding)} are not inputs; it takes a P joint "
-                      "only as an input that places a body")
+    placing = {k for _, k in placed[1:] if k is not None}
     have = {b for b, _ in placed}
     locked = [j.name for k, j in enumerate(mech.joints)
               if k not in placing and set(j.bodies) <= have]
@@ -395,30 +497,44 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
         raise _refuse(mech, f"joint(s) {listing(locked)} join two bodies the inputs place, so "
                       "the mechanism is locked at fixed inputs (or has more inputs than "
                       "freedoms)")
-    pts_world = np.array([j.at for j in mech.joints])
-    origin = pts_world.mean(0)
+    origin = np.array([j.at for j in mech.joints]).mean(0)
     scale = float(mech.length_scale)
-    drawn_l, owners, u_joints = _points(mech, origin, scale)
-    drawn = np.array(drawn_l)
+    pts = _points(mech, origin, scale, placing)
+    drawn = np.array(pts.drawn)
     known, source = [], {}
-    for k, own in enumerate(owners):
+    for k, own in enumerate(pts.owners):
         mine = [b for b, _ in placed if b in own]
         if mine:
             known.append(k)
             source[k] = mine[0]
     unknown = [k for k in range(len(drawn)) if k not in source]
-    bodies = []
+    bodies: list[BodyEquations] = []
     for b in mech.body_names:
         if b in have:
             continue
-        members = [k for k, own in enumerate(owners) if b in own]
+        members = [k for k, own in enumerate(pts.owners) if b in own]
         joints = [j for j in mech.joints if b in j.bodies]
         if len(joints) < 2:
             raise _refuse(mech, f"body {b!r} has a single joint, so it turns freely about it; "
                           "join it to another body or remove it")
-        bodies.append(_body_equations(mech, b, drawn, members, set(known), source))
-    n = 3 * len(unknown)
-    n_eq = sum(len(be.distances) + 3 * len(be.carried) for be in bodies) + len(u_joints)
+        groups = [list(sl.b) for sl in pts.slides if mech.joints[sl.joint].bodies[1] == b]
+        # a driven R joint's axis and turned point are all placed by its first body's frame
+        groups += [[*t.axis, t.point] for t in pts.turns if mech.joints[t.joint].bodies[1] == b
+                   and any(be.body == t.frame for be in bodies)]
+        groups += [[m for m in members if m in be.points and m not in source] for be in bodies]
+        slid = max(groups, key=len, default=[])
+        bodies.append(_body_equations(mech, b, drawn, members, set(known), source,
+                                      slid if len(slid) >= 2 else ()))
+    for t in pts.turns:
+        frame = next(be for be in bodies if be.body == t.frame)
+        if len(frame.base) != 3:
+            raise _refuse(mech, f"input joint {mech.joints[t.joint].name!r} turns "
+                          f"{mech.joints[t.joint].bodies[1]!r} against {t.frame!r}, whose "
+                          "joints lie on one line, so the angle has no frame to be measured in")
+    passive = [sl for sl in pts.slides if sl.column is None]
+    n = 3 * len(unknown) + len(passive)
+    n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies) + len(pts.u_joints)
+            + sum(3 * len(sl.a) for sl in pts.slides) + 3 * len(pts.turns))
     if n_eq != n:
         more = n - n_eq
         why = (f"{more} freedom(s) are left at fixed inputs beyond the spins of rods about their "
@@ -428,20 +544,32 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                "graph tracker follows it")
         raise _refuse(mech, f"at fixed inputs its point closure has {n_eq} equations in {n} "
                       f"unknowns; {why}")
-    system = _compile(unknown, known, bodies, u_joints)
-    return SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(owners),
+    if n > MAX_UNKNOWNS:
+        raise _refuse(mech, f"its point closure has {n} unknowns, more than {MAX_UNKNOWNS}: "
+                      "the monodromy that would find its start solutions is not practical at "
+                      "that size (the 3-UPU's 90 reached one solution in 36 s); follow the drawn "
+                      "mode with the graph tracker (--modes drawn)")
+    system = _compile(unknown, known, bodies, pts)
+    return SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(pts.owners),
                                    tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
-                                   tuple(u_joints), source)
+                                   tuple(pts.u_joints), source, tuple(pts.slides),
+                                   tuple(pts.turns))
 
 
 def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
-             u_joints: list[tuple[int, int, int]]) -> PolynomialSystem:
+             pts: _Points) -> PolynomialSystem:
     """The system of the module docstring: unknowns the solved points' (x, y, z); parameters
     the placed points', then per body its d's and coefficients, then the U joints' g."""
     counter = iter(range(10**9))
     point: dict[int, list[Poly]] = {}
     for k in unknown:
         point[k] = [Poly.variable(next(counter)) for _ in range(3)]
+    names = [f"{c}{k}" for k in unknown for c in "xyz"]
+    slide: dict[int, Poly] = {}
+    for sl in pts.slides:
+        if sl.column is None:
+            slide[sl.joint] = Poly.variable(next(counter))
+            names.append(f"s{sl.joint}")
     for k in known:
         point[k] = [Poly.variable(next(counter)) for _ in range(3)]
 
@@ -472,9 +600,24 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
                 a, b, c_ = (Poly.variable(next(counter)) for _ in range(3))
                 params += [f"{x}{m}_{be.body}" for x in "abc"]
                 eqs += [point[m][c] - b1[c] - a * u[c] - b * v[c] - c_ * w[c] for c in range(3)]
-    for centre, arm1, arm2 in u_joints:
+    for centre, arm1, arm2 in pts.u_joints:
         eqs.append(dot(sub(point[arm1], point[centre]), sub(point[arm2], point[centre]))
                    - Poly.variable(next(counter)))
         params.append(f"g{centre}")
-    names = [f"{c}{k}" for k in unknown for c in "xyz"]
+    for sl in pts.slides:
+        if sl.column is not None:
+            slide[sl.joint] = Poly.variable(next(counter))
+            params.append(f"s{sl.joint}")
+    for sl in pts.slides:  # b_i = a_i + s (a_1 − a_0)
+        axis = sub(point[sl.a[1]], point[sl.a[0]])
+        for ia, ib in zip(sl.a, sl.b, strict=True):
+            eqs += [point[ib][c] - point[ia][c] - slide[sl.joint] * axis[c] for c in range(3)]
+    for t in pts.turns:
+        be = next(be for be in bodies if be.body == t.frame)
+        b1 = point[be.base[0]]
+        u, v = sub(point[be.base[1]], b1), sub(point[be.base[2]], b1)
+        w = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+        ta, tb, tc = (Poly.variable(next(counter)) for _ in range(3))
+        params += [f"{x}{t.point}_turn" for x in "abc"]
+        eqs += [point[t.point][c] - b1[c] - ta * u[c] - tb * v[c] - tc * w[c] for c in range(3)]
     return compile_system(eqs, names, params)

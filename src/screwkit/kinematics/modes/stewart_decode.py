@@ -81,7 +81,7 @@ def u_rotation(e1: Array, e2: Array, w: Array, d: Array) -> Array:
 def joint_values(mech: Mechanism, lay: GraphLayout, poses: dict[str, Pose]) -> Configuration:
     """The configuration (N) whose joints join the world body poses ``poses`` (name → R
     (N, 3, 3), p (N, 3); the ground may be left out): M_j = T_a⁻¹ T_b per joint (module
-    docstring). R, P and U joints and S joints only."""
+    docstring). R, C, P, U and S joints."""
     N = next(iter(poses.values()))[0].shape[0]
     full = dict(poses)
     full.setdefault(GROUND, (np.broadcast_to(np.eye(3), (N, 3, 3)), np.zeros((N, 3))))
@@ -97,8 +97,10 @@ def joint_values(mech: Mechanism, lay: GraphLayout, poses: dict[str, Pose]) -> C
             spherical[:, lay.spherical_of_joint[i]] = MR
         elif j.kind == "P":
             scalars[:, lay.scalar_col[f0]] = Mp @ j.axis
-        elif j.kind == "R":
+        elif j.kind in ("R", "C"):
             e = j.axis
+            if j.kind == "C":  # its slide along the axis (the turn's part is square to it)
+                scalars[:, lay.scalar_col[f0 + 1]] = Mp @ e
             ref = np.cross(e, [1.0, 0.0, 0.0] if abs(e[0]) < 0.9 else [0.0, 1.0, 0.0])
             scalars[:, lay.scalar_col[f0]] = _angle_about(
                 e, np.broadcast_to(ref, (N, 3)), MR @ ref)
@@ -113,7 +115,7 @@ def joint_values(mech: Mechanism, lay: GraphLayout, poses: dict[str, Pose]) -> C
                 e2, np.broadcast_to(ref, (N, 3)), Q @ ref)
         else:
             raise CapabilityError(f"{mech.name}: joint {j.name!r} is a {j.kind} joint; joint "
-                                  "values are decoded from body poses for R, P, U and S "
+                                  "values are decoded from body poses for R, C, P, U and S "
                                   "joints only")
     return Configuration(scalars, spherical)
 
