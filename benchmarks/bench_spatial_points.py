@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 import screwkit as sk  # noqa: E402
 from screwkit.kinematics.graph import solve_mechanism  # noqa: E402
 from screwkit.kinematics.modes.every_mode import every_mode  # noqa: E402
-from screwkit.kinematics.modes.spatial_points import spatial_point_formulation  # noqa: E402
+from screwkit.kinematics.modes.spatial_points_build import spatial_point_formulation  # noqa: E402
 from screwkit.kinematics.modes.stewart import stewart_parameters  # noqa: E402
 from screwkit.kinematics.modes.stewart_solve import solve_stewart  # noqa: E402
 

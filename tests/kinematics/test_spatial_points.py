@@ -21,10 +21,8 @@ from screwkit.kinematics.graph import solve_mechanism
 from screwkit.kinematics.graph.closure import graph_forward, graph_layout
 from screwkit.kinematics.graph.follow import follow_drawn_mode
 from screwkit.kinematics.modes.every_mode import closure_formulation, every_mode
-from screwkit.kinematics.modes.spatial_points import (
-    SpatialPointFormulation,
-    spatial_point_formulation,
-)
+from screwkit.kinematics.modes.spatial_points import SpatialPointFormulation
+from screwkit.kinematics.modes.spatial_points_build import spatial_point_formulation
 from screwkit.kinematics.modes.stewart import pose_from_study, stewart_parameters
 from screwkit.kinematics.modes.stewart_solve import solve_stewart
 from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
@@ -388,3 +386,76 @@ def test_an_r_joint_driven_between_moving_bodies_turns_its_point_with_the_input(
         assert found.certified[n].all() and _matched(ours[:, 2], balls, 1e-12)
         there = _centres(mech, drawn.conf.take(slice(n, n + 1)))[0]
         assert np.abs(ours - there).reshape(len(ours), -1).max(1).min() <= 1e-12
+
+
+def _rssp(rng: np.random.Generator, drawn_ground_first: bool) -> Mechanism:
+    """A spatial RSSP (a crank drives a slider on a random rail through an S–S rod), its P
+    joint drawn ground-first or slider-first."""
+    O, A, B = (rng.uniform(-1.0, 1.0, 3) for _ in range(3))
+    A = O + 0.3 * (A - O) / np.linalg.norm(A - O)
+    rail = rng.normal(size=3)
+    bodies = ("ground", "slider") if drawn_ground_first else ("slider", "ground")
+    return Mechanism("random RSSP", (Body("crank"), Body("rod"), Body("slider")),
+                     (joint("O", "R", "ground", "crank", O, rng.normal(size=3)),
+                      joint("A", "S", "crank", "rod", A),
+                      joint("B", "S", "rod", "slider", B),
+                      joint("P", "P", *bodies, B, rail)), ("O.theta",))
+
+
+def test_a_passive_slider_drawn_either_way_gives_the_closed_form_modes() -> None:
+    """Ten random RSSPs with the P joint drawn ground-first and slider-first (the slide's
+    carried points are then turned into the body written later, b = a − s (a1 − a0)): both
+    drawings give the closed form's modes (the PSS dyad: the rod's sphere meets the rail)."""
+    for seed in range(10):
+        for first in (True, False):
+            mech = _rssp(np.random.default_rng(seed), first)
+            x = np.array([0.0, 0.7])
+            found = every_mode(mech, x[:, None])
+            closed = solve_mechanism(mech, x, every_mode=True)
+            assert "closed" in closed.method  # the loop's or the dyads' closed form
+            for n in range(x.size):
+                theirs = np.array([md.joint_centres[n] for md in closed.modes
+                                   if md.assembles[n]]).reshape(-1, 4, 3)
+                ours = _centres(mech, found.configurations[n]) if \
+                    found.configurations[n].size else np.zeros((0, 4, 3))
+                assert found.certified[n].all()
+                assert _matched(ours, theirs, 1e-9), (seed, first, n)
+
+
+def test_the_knee_loop_drawn_in_any_order_has_the_same_modes() -> None:
+    """The knee-driven R–R–S–S loop with its bodies listed in either order and its knee joint
+    drawn either way: the same two balls (the builder writes bodies nearest the ground first
+    and carries the turned point in the body written later, so the count holds)."""
+    O, K, B, C = (np.array(v) for v in ([0.0, 0.0, 0.0], [0.4, 0.1, 0.2], [0.7, 0.5, 0.1],
+                                        [0.3, 1.2, 0.5]))
+    balls = []
+    for names in (("crank", "coupler", "rod"), ("coupler", "crank", "rod")):
+        for knee in (("crank", "coupler"), ("coupler", "crank")):
+            sign = 1.0 if knee[0] == "crank" else -1.0
+            mech = Mechanism("knee", tuple(Body(b) for b in names),
+                             (joint("O", "R", "ground", "crank", O, (0.1, 0.2, 1.0)),
+                              joint("K", "R", *knee, K, (1.0, 0.3, 0.2)),
+                              joint("B", "S", "coupler", "rod", B),
+                              joint("C", "S", "rod", "ground", C)), ("K.theta",))
+            found = every_mode(mech, [[sign * np.radians(10.0)]])
+            assert found.generic_count == 2 and found.certified[0].all()
+            ball = _centres(mech, found.configurations[0])[:, 2]
+            balls.append(ball[np.lexsort(ball.T)])
+    for other in balls[1:]:
+        assert np.abs(other - balls[0]).max() <= 1e-12
+
+
+def test_a_square_closure_that_leaves_a_freedom_is_refused() -> None:
+    """Two R hinges and rods that leave the middle body one freedom at a fixed input (its
+    ball on a circle): whatever way the equations are counted, the formulation refuses it by
+    name rather than report no mode."""
+    rng = np.random.default_rng(14)
+    P = lambda: rng.uniform(-1.0, 1.0, 3)  # noqa: E731
+    O, ao, A, B, D, ad = P(), rng.normal(size=3), P(), P(), P(), rng.normal(size=3)
+    O = A + 0.3 * (O - A) / np.linalg.norm(O - A)
+    mech = Mechanism("loose", tuple(Body(b) for b in ("A", "r1", "B", "C")),
+                     (joint("R1", "R", "ground", "A", O, ao), joint("S1", "S", "A", "r1", A),
+                      joint("S2", "S", "r1", "B", B), joint("R2", "R", "B", "C", D, ad),
+                      joint("R3", "R", "C", "ground", P(), rng.normal(size=3))), ("R1.theta",))
+    with pytest.raises(CapabilityError, match="freedom"):
+        spatial_point_formulation(mech)

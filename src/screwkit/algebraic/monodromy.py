@@ -40,6 +40,11 @@ class MonodromyOptions:
     expected: int | None = None
     max_loops: int = 200
     seed: int = 0
+    #: draw each loop point's parameter at that parameter's own size (|p0_i|, at least 1)
+    #: rather than all at the largest one's: systems whose parameters differ in size by an
+    #: order or more (point coordinates and the coefficients of points carried by them,
+    #: modes/spatial_points.py) lose every path on loops drawn at the largest size
+    each_own_size: bool = False
     track: TrackOptions = field(default_factory=TrackOptions)
 
 
@@ -57,11 +62,13 @@ class MonodromyStats:
 
 
 def _loops(system: PolynomialSystem, p0: Complex, x: Complex, count: int,
-           rng: np.random.Generator, options: TrackOptions) -> tuple[Complex, int, int]:
+           rng: np.random.Generator, options: TrackOptions, each_own_size: bool = False
+           ) -> tuple[Complex, int, int]:
     """Track x (m, n) around ``count`` random triangles p0 → p1 → p2 → p0 at once (one
     batched call per edge); the regular end points, the paths tracked and those that failed."""
     m = len(x)
-    scale = np.maximum(1.0, np.abs(p0))  # each parameter at its own size
+    scale = np.maximum(1.0, np.abs(p0)) if each_own_size else \
+        max(1.0, float(np.abs(p0).max(initial=0.0)))
     shape = (count, system.k)
     p1, p2 = (scale * (rng.standard_normal(shape) + 1j * rng.standard_normal(shape))
               for _ in range(2))
@@ -120,7 +127,8 @@ def monodromy_solve(system: PolynomialSystem, p0: Complex, x0: Complex,
             stopped = "stabilised"
             break
         batch = min(options.parallel_loops, options.max_loops - loops)
-        ends, used, lost = _loops(system, p0, known, batch, rng, options.track)
+        ends, used, lost = _loops(system, p0, known, batch, rng, options.track,
+                                  options.each_own_size)
         loops, tracked, failed = loops + batch, tracked + used, failed + lost
         merged = np.concatenate([known, ends])
         label = same_points(merged, np.zeros(len(merged), dtype=np.intp), 1e-8)

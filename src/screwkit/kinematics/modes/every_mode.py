@@ -147,7 +147,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
 
         return delta_formulation(mech)  # a CapabilityError where it is not a Delta robot
     if kinds <= {"R", "S", "U", "P", "C"}:
-        from screwkit.kinematics.modes.spatial_points import spatial_point_formulation
+        from screwkit.kinematics.modes.spatial_points_build import spatial_point_formulation
 
         try:
             return spatial_point_formulation(mech)

@@ -58,7 +58,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
+from screwkit.algebraic.monodromy import MonodromyOptions
+from screwkit.algebraic.polynomial import PolynomialSystem
 from screwkit.algebraic.solve import StartSolutions
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout, joint_motion
@@ -66,7 +67,6 @@ from screwkit.kinematics.modes.rod_loops import least_rotation
 from screwkit.kinematics.modes.starts import start_solutions
 from screwkit.kinematics.modes.stewart_decode import Pose, joint_values
 from screwkit.kinematics.tracker.loop import Configuration
-from screwkit.messages import listing
 from screwkit.model.mechanism import GROUND, Mechanism
 
 Array = NDArray[np.float64]
@@ -76,6 +76,8 @@ TOTAL_DEGREE_LIMIT = 1024
 #: monodromy stops after this many loops in a row find nothing new (the five-link example's
 #: 40 need 42 loops from seed 0; at 6 it stopped at 37)
 STALE_LOOPS = 24
+#: a random instance is the drawing moved by this much (complex, in length units)
+RANDOM_SPREAD = 0.5
 #: larger point systems are refused (monodromy there is slow and unreliable: module docstring)
 MAX_UNKNOWNS = 48
 #: a body's points lie on one line when none is farther than this (in length units) from it
@@ -108,6 +110,9 @@ class SlideJoint:
     a: tuple[int, ...]
     b: tuple[int, ...]
     column: int | None
+    #: +1: ``b`` in the joint's second body; −1: the roles swapped (``b`` in its first body,
+    #: b_i = a_i − s (a_1 − a_0)), so that ``b`` is in the body written later
+    sign: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -121,6 +126,8 @@ class TurnJoint:
     point: int
     column: int
     axis: tuple[int, int] = (-1, -1)
+    #: +1: ``frame`` is the joint's first body; −1: its second (the point turns by −θ)
+    sign: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -157,7 +164,7 @@ class SpatialPointFormulation:
         be = self._frame_of(t.frame)
         d = self.drawn
         c = (j.at - self.origin) / self.scale
-        th = X[:, t.column]
+        th = t.sign * X[:, t.column]
         q0 = d[t.point] - c
         u = j.axis
         turned = (c + np.multiply.outer(np.cos(th), q0)
@@ -226,31 +233,39 @@ class SpatialPointFormulation:
     # ------------------------------------------------------------ start solutions
     def random_instance(self, rng: np.random.Generator) -> tuple[Complex, Complex]:
         """A random complex instance with a known solution (p (1, k), x (1, n)): random
-        points (a body on a line keeps its carried points on the line), the parameters
-        computed from them."""
+        points, a body on a line's points put on its line, a slide's points slid over, and the
+        parameters computed from them; a CapabilityError where these do not agree (a point on
+        a line that a slide also carries)."""
         P = len(self.drawn)
-        pts = rng.standard_normal((P, 3)) + 1j * rng.standard_normal((P, 3))
+        # the drawing moved by a complex random half unit: generic, but with the drawing's
+        # shapes (a skinny random triangle makes huge coefficients, and monodromy loops that
+        # start there lose every path)
+        pts = self.drawn + RANDOM_SPREAD * (rng.standard_normal((P, 3))
+                                            + 1j * rng.standard_normal((P, 3)))
+        for be in self.bodies:  # on a line: P_m = b1 + a u
+            if len(be.base) == 2:
+                b1, b2 = be.base
+                for m in be.points:
+                    if m not in be.base and (m not in self.known or m in be.carried):
+                        along = rng.standard_normal() + 1j * rng.standard_normal()
+                        pts[m] = pts[b1] + along * (pts[b2] - pts[b1])
         slide = {}
-        for sl in self.slides:  # b_i = a_i + s (a_1 − a_0)
+        for sl in self.slides:  # b_i = a_i ± s (a_1 − a_0)
             slide[sl.joint] = rng.standard_normal() + 1j * rng.standard_normal()
             for ia, ib in zip(sl.a, sl.b, strict=True):
-                pts[ib] = pts[ia] + slide[sl.joint] * (pts[sl.a[1]] - pts[sl.a[0]])
+                pts[ib] = pts[ia] + sl.sign * slide[sl.joint] * (pts[sl.a[1]] - pts[sl.a[0]])
         coef = {}
         for be in self.bodies:
             b1, b2 = be.base[0], be.base[1]
             u = pts[b2] - pts[b1]
-            for m in be.points:
-                if m in be.base:
-                    continue
-                if len(be.base) == 2:  # on a line: P_m = b1 + a u
-                    along = rng.standard_normal() + 1j * rng.standard_normal()
-                    if m not in self.known or m in be.carried:
-                        pts[m] = pts[b1] + along * u
-                    coef[(be.body, m)] = (along,)
+            for m in be.carried:
+                if len(be.base) == 2:
+                    coef[(be.body, m)] = (complex(np.sum((pts[m] - pts[b1]) * u)
+                                                  / np.sum(u * u)),)
                 else:
                     v = pts[be.base[2]] - pts[b1]
-                    abc = np.linalg.solve(np.stack([u, v, np.cross(u, v)], 1), pts[m] - pts[b1])
-                    coef[(be.body, m)] = tuple(abc)
+                    coef[(be.body, m)] = tuple(np.linalg.solve(
+                        np.stack([u, v, np.cross(u, v)], 1), pts[m] - pts[b1]))
         out: list[complex] = [c for k in self.known for c in pts[k]]
         for be in self.bodies:
             out += [complex((pts[j] - pts[i]) @ (pts[j] - pts[i])) for i, j in be.distances]
@@ -264,14 +279,22 @@ class SpatialPointFormulation:
                                         pts[t.point] - pts[b1]))
         x = np.concatenate([pts[list(self.unknown)].reshape(-1),
                             [slide[sl.joint] for sl in self.slides if sl.column is None]])
-        return np.array(out, dtype=complex)[None, :], x[None, :]
+        p = np.array(out, dtype=complex)
+        F = self.system.evaluate(x[None, :], p, want_jp=False)[0]
+        if np.abs(F).max(initial=0.0) > 1e-9 * (1.0 + np.abs(x).max()) ** 2:
+            raise CapabilityError(
+                f"{self.mechanism.name}: the spatial point formulation cannot draw a generic "
+                "instance of this topology (a point that a body on a line and a slide both "
+                "carry); follow the drawn mode with the graph tracker (--modes drawn)")
+        return p[None, :], x[None, :]
 
     def start(self) -> StartSolutions:
         """The topology's start solutions (module docstring): total degree up to
         :data:`TOTAL_DEGREE_LIMIT` paths, else monodromy."""
         return start_solutions(self.system, self.random_instance,
                                total_degree_paths=TOTAL_DEGREE_LIMIT, then_monodromy=True,
-                               stale_loops=STALE_LOOPS)
+                               monodromy=MonodromyOptions(stale_loops=STALE_LOOPS,
+                                                          each_own_size=True))
 
     # ------------------------------------------------------------- configurations
     def configuration(self, solutions: ArrayLike, input_values: ArrayLike
@@ -291,8 +314,8 @@ class SpatialPointFormulation:
         world = self.origin + self.scale * world
         drawn = self.origin + self.scale * self.drawn
         for be in self.bodies:
-            poses[be.body] = _fit_pose(drawn[list(be.points)], world[:, list(be.points)],
-                                       len(be.base) == 2)
+            pick = list(be.base) + [m for m in be.points if m not in be.base]
+            poses[be.body] = _fit_pose(drawn[pick], world[:, pick], len(be.base) == 2)
         lay = graph_layout(mech)
         return joint_values(mech, lay, poses), lay
 
@@ -300,7 +323,7 @@ class SpatialPointFormulation:
 def _fit_pose(drawn: Array, solved: Array, on_a_line: bool) -> Pose:
     """The pose (R (N, 3, 3), p (N, 3)) carrying a body's drawn points (k, 3) onto its solved
     ones (N, k, 3): Kabsch's rotation (exact for a rigid image), or the least rotation of the
-    first two points' direction for a body on a line."""
+    first two points' direction (the body's base) for a body on a line."""
     if on_a_line:
         R = least_rotation(drawn[1] - drawn[0], solved[:, 1] - solved[:, 0])
         return R, solved[:, 0] - np.einsum("nij,j->ni", R, drawn[0])
@@ -313,311 +336,3 @@ def _fit_pose(drawn: Array, solved: Array, on_a_line: bool) -> Pose:
     D[:, 2, 2] = d
     R = np.swapaxes(Vt, -1, -2) @ D @ np.swapaxes(U, -1, -2)
     return R, sc - np.einsum("nij,j->ni", R, dc)
-
-
-# --------------------------------------------------------------------------- building
-def _refuse(mech: Mechanism, why: str) -> CapabilityError:
-    return CapabilityError(f"{mech.name}: the spatial point formulation does not take this "
-                           f"mechanism: {why}")
-
-
-def _placed_bodies(mech: Mechanism) -> list[tuple[str, int | None]]:
-    """The ground and every body reached from it through input joints, with the joint."""
-    driven = {x.split(".")[0] for x in mech.inputs}
-    placed: list[tuple[str, int | None]] = [(GROUND, None)]
-    grew = True
-    while grew:
-        grew = False
-        have = {b for b, _ in placed}
-        for k, j in enumerate(mech.joints):
-            if j.name in driven and (j.bodies[0] in have) != (j.bodies[1] in have):
-                placed.append((j.bodies[1] if j.bodies[0] in have else j.bodies[0], k))
-                grew = True
-                break
-    for j in mech.joints:
-        if j.name in driven and j.kind not in ("R", "P"):
-            raise _refuse(mech, f"input joint {j.name!r} is a {j.kind} joint; it takes R and P "
-                          "joints as inputs")
-    return placed
-
-
-def _across(u: Array) -> Array:
-    """A unit vector square to the unit vector u."""
-    n = np.cross(u, [1.0, 0.0, 0.0] if abs(u[0]) < 0.9 else [0.0, 1.0, 0.0])
-    return np.asarray(n / np.linalg.norm(n))
-
-
-@dataclass
-class _Points:
-    drawn: list[Array]
-    owners: list[frozenset[str]]
-    u_joints: list[tuple[int, int, int]]
-    slides: list[SlideJoint]
-    turns: list[TurnJoint]
-
-
-def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int]) -> _Points:
-    """Every joint's points (scaled drawn positions, owning bodies), the U joints' (centre,
-    first arm, second arm), the P and C joints that place no body and the R inputs between
-    moving bodies (module docstring)."""
-    drawn: list[Array] = []
-    owners: list[frozenset[str]] = []
-    u_joints = []
-    slides: list[SlideJoint] = []
-    turns: list[TurnJoint] = []
-    columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
-
-    def add(at: Array, bodies: tuple[str, ...]) -> int:
-        drawn.append((at - origin) / scale)
-        owners.append(frozenset(bodies))
-        return len(drawn) - 1
-
-    for k, j in enumerate(mech.joints):
-        if k in placing:
-            if j.kind == "R":  # its axis, in both placed bodies
-                add(j.at, j.bodies)
-                add(j.at + scale * j.axis, j.bodies)
-            continue
-        if j.kind == "S":
-            add(j.at, j.bodies)
-        elif j.kind == "R":
-            ends = (add(j.at, j.bodies), add(j.at + scale * j.axis, j.bodies))
-            if j.name in columns:  # driven between two moving bodies
-                q = add(j.at + scale * _across(j.axis), (j.bodies[1],))
-                turns.append(TurnJoint(k, j.bodies[0], q, columns[j.name], ends))
-        elif j.kind in ("P", "C"):
-            line = [j.at, j.at + scale * j.axis]
-            if j.kind == "P":
-                line.append(j.at + scale * _across(j.axis))
-            first = tuple(add(e, (j.bodies[0],)) for e in line)
-            second = tuple(add(e, (j.bodies[1],)) for e in line)
-            slides.append(SlideJoint(k, first, second, columns.get(j.name)))
-        elif j.kind == "U":
-            assert j.axis2 is not None
-            c = add(j.at, j.bodies)
-            a = add(j.at + scale * j.axis, (j.bodies[0],))
-            b = add(j.at + scale * j.axis2, (j.bodies[1],))
-            u_joints.append((c, a, b))
-    return _Points(drawn, owners, u_joints, slides, turns)
-
-
-def _third(pts: Array, b1: int, b2: int, candidates: list[int]) -> int | None:
-    """The candidate farthest from the line b1 b2, or None when all are on it."""
-    u = (pts[b2] - pts[b1]) / np.linalg.norm(pts[b2] - pts[b1])
-
-    def off(m: int) -> float:
-        w = pts[m] - pts[b1]
-        return float(np.linalg.norm(w - (w @ u) * u))
-
-    rest = [m for m in candidates if m not in (b1, b2)]
-    if not rest:
-        return None
-    b3 = max(rest, key=off)
-    return b3 if off(b3) > COLLINEAR else None
-
-
-def _base(pts: Array, placed: list[int], order: list[int]) -> tuple[int, ...]:
-    """A well-shaped base among a body's points ``order`` (placed first): the first, the
-    farthest from it, the farthest from their line (two when all lie on a line). With two or
-    more placed points the base is made of placed points as far as they span, so that the
-    equations among placed points only are exactly the ones left out."""
-    pool = placed if len(placed) >= 2 else order
-    b1 = pool[0]
-    b2 = max(pool[1:], key=lambda m: float(np.linalg.norm(pts[m] - pts[b1])))
-    b3 = _third(pts, b1, b2, placed) if len(placed) >= 3 else None
-    if b3 is None:
-        b3 = _third(pts, b1, b2, order)
-    return (b1, b2) if b3 is None else (b1, b2, b3)
-
-
-def _body_equations(mech: Mechanism, body: str, pts: Array, members: list[int],
-                    known: set[int], source: dict[int, str],
-                    slid: tuple[int, ...] | list[int] = ()) -> BodyEquations:
-    """The equations of one unplaced body (module docstring), leaving out those among
-    points already rigid with each other: the placed points, or ``slid``, points whose
-    distances other equations keep (those a slide carries over from the joint's first body,
-    b_i = a_i + s (a_1 − a_0), or those the body shares with a body before it, e.g. an R
-    joint's axis), whichever group is larger (the base is taken in it; the other group's
-    points are carried by it)."""
-    placed_here = [m for m in members if m in known]
-    sources = sorted({source[m] for m in placed_here})
-    if len(sources) > 1:
-        raise _refuse(mech, f"body {body!r} is joined to {listing(sources)}, which the inputs "
-                      "place each on its own, so at fixed inputs it cannot move and the "
-                      "mechanism is locked (or it has more inputs than freedoms)")
-    if slid and len(slid) >= len(placed_here):  # the larger rigid group makes the base
-        placed_here = list(slid)
-    known = set(placed_here)
-    order = placed_here + [m for m in members if m not in known]
-    if len(order) < 2 or np.linalg.norm(pts[order] - pts[order[0]], axis=1).max() <= COLLINEAR:
-        raise _refuse(mech, f"body {body!r} hangs from a single point (one S joint), so it "
-                      "turns freely about it; join it to another body or remove it")
-    base = _base(pts, placed_here, order)
-    b1, b2 = base[0], base[1]
-    u = pts[b2] - pts[b1]
-    pairs = [(b1, b2)] if len(base) == 2 else [(b1, b2), (b1, base[2]), (b2, base[2])]
-    distances = tuple((i, j) for i, j in pairs if not (i in known and j in known))
-    carried: list[int] = []
-    coefficients: list[tuple[float, ...]] = []
-    for m in members:
-        if m in base:
-            coefficients.append(())
-            continue
-        w = pts[m] - pts[b1]
-        if len(base) == 2:
-            abc: tuple[float, ...] = (float(w @ u / (u @ u)),)
-            involved = {m, b1, b2}
-        else:
-            v = pts[base[2]] - pts[b1]
-            abc = tuple(float(c) for c in np.linalg.solve(np.stack([u, v, np.cross(u, v)], 1), w))
-            involved = {m, b1, b2} | ({base[2]} if max(abs(abc[1]), abs(abc[2])) > 1e-12
-                                      else set())
-        coefficients.append(abc)
-        if not involved <= known:
-            carried.append(m)
-    return BodyEquations(body, tuple(members), tuple(base), distances, tuple(carried),
-                         tuple(coefficients))
-
-
-def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
-    """The point system of ``mech`` (module docstring), or a CapabilityError that says why it
-    does not take the mechanism (a joint other than R, S, U or an input P; an input between
-    moving bodies; a body that turns freely or is locked; freedoms left at fixed inputs)."""
-    other = sorted({j.kind for j in mech.joints} - {"R", "S", "U", "P", "C"})
-    if other:
-        raise _refuse(mech, f"it has {listing(other)} joints; it takes R, P, C, S and U joints")
-    if mech.drives:
-        raise _refuse(mech, "it is driven at a body's freedom, not at joints")
-    placed = _placed_bodies(mech)
-    placing = {k for _, k in placed[1:] if k is not None}
-    have = {b for b, _ in placed}
-    locked = [j.name for k, j in enumerate(mech.joints)
-              if k not in placing and set(j.bodies) <= have]
-    if locked:
-        raise _refuse(mech, f"joint(s) {listing(locked)} join two bodies the inputs place, so "
-                      "the mechanism is locked at fixed inputs (or has more inputs than "
-                      "freedoms)")
-    origin = np.array([j.at for j in mech.joints]).mean(0)
-    scale = float(mech.length_scale)
-    pts = _points(mech, origin, scale, placing)
-    drawn = np.array(pts.drawn)
-    known, source = [], {}
-    for k, own in enumerate(pts.owners):
-        mine = [b for b, _ in placed if b in own]
-        if mine:
-            known.append(k)
-            source[k] = mine[0]
-    unknown = [k for k in range(len(drawn)) if k not in source]
-    bodies: list[BodyEquations] = []
-    for b in mech.body_names:
-        if b in have:
-            continue
-        members = [k for k, own in enumerate(pts.owners) if b in own]
-        joints = [j for j in mech.joints if b in j.bodies]
-        if len(joints) < 2:
-            raise _refuse(mech, f"body {b!r} has a single joint, so it turns freely about it; "
-                          "join it to another body or remove it")
-        groups = [list(sl.b) for sl in pts.slides if mech.joints[sl.joint].bodies[1] == b]
-        # a driven R joint's axis and turned point are all placed by its first body's frame
-        groups += [[*t.axis, t.point] for t in pts.turns if mech.joints[t.joint].bodies[1] == b
-                   and any(be.body == t.frame for be in bodies)]
-        groups += [[m for m in members if m in be.points and m not in source] for be in bodies]
-        slid = max(groups, key=len, default=[])
-        bodies.append(_body_equations(mech, b, drawn, members, set(known), source,
-                                      slid if len(slid) >= 2 else ()))
-    for t in pts.turns:
-        frame = next(be for be in bodies if be.body == t.frame)
-        if len(frame.base) != 3:
-            raise _refuse(mech, f"input joint {mech.joints[t.joint].name!r} turns "
-                          f"{mech.joints[t.joint].bodies[1]!r} against {t.frame!r}, whose "
-                          "joints lie on one line, so the angle has no frame to be measured in")
-    passive = [sl for sl in pts.slides if sl.column is None]
-    n = 3 * len(unknown) + len(passive)
-    n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies) + len(pts.u_joints)
-            + sum(3 * len(sl.a) for sl in pts.slides) + 3 * len(pts.turns))
-    if n_eq != n:
-        more = n - n_eq
-        why = (f"{more} freedom(s) are left at fixed inputs beyond the spins of rods about their "
-               "own lines: give it as many inputs as freedoms" if more > 0 else
-               f"{-more} constraint(s) more than unknowns: it is over-constrained in space "
-               "(e.g. a planar or spherical loop drawn with R joints, a Bennett loop); the "
-               "graph tracker follows it")
-        raise _refuse(mech, f"at fixed inputs its point closure has {n_eq} equations in {n} "
-                      f"unknowns; {why}")
-    if n > MAX_UNKNOWNS:
-        raise _refuse(mech, f"its point closure has {n} unknowns, more than {MAX_UNKNOWNS}: "
-                      "the monodromy that would find its start solutions is not practical at "
-                      "that size (the 3-UPU's 90 reached one solution in 36 s); follow the drawn "
-                      "mode with the graph tracker (--modes drawn)")
-    system = _compile(unknown, known, bodies, pts)
-    return SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(pts.owners),
-                                   tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
-                                   tuple(pts.u_joints), source, tuple(pts.slides),
-                                   tuple(pts.turns))
-
-
-def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
-             pts: _Points) -> PolynomialSystem:
-    """The system of the module docstring: unknowns the solved points' (x, y, z); parameters
-    the placed points', then per body its d's and coefficients, then the U joints' g."""
-    counter = iter(range(10**9))
-    point: dict[int, list[Poly]] = {}
-    for k in unknown:
-        point[k] = [Poly.variable(next(counter)) for _ in range(3)]
-    names = [f"{c}{k}" for k in unknown for c in "xyz"]
-    slide: dict[int, Poly] = {}
-    for sl in pts.slides:
-        if sl.column is None:
-            slide[sl.joint] = Poly.variable(next(counter))
-            names.append(f"s{sl.joint}")
-    for k in known:
-        point[k] = [Poly.variable(next(counter)) for _ in range(3)]
-
-    def sub(a: list[Poly], b: list[Poly]) -> list[Poly]:
-        return [x - y for x, y in zip(a, b, strict=True)]
-
-    def dot(a: list[Poly], b: list[Poly]) -> Poly:
-        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-    eqs: list[Poly] = []
-    params = [f"{c}{k}" for k in known for c in "xyz"]
-    for be in bodies:
-        for i, j in be.distances:
-            d = sub(point[j], point[i])
-            eqs.append(dot(d, d) - Poly.variable(next(counter)))
-            params.append(f"d{i}_{j}")
-        b1 = point[be.base[0]]
-        u = sub(point[be.base[1]], b1)
-        if len(be.base) == 3:
-            v = sub(point[be.base[2]], b1)
-            w = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
-        for m in be.carried:
-            if len(be.base) == 2:
-                a = Poly.variable(next(counter))
-                params.append(f"a{m}_{be.body}")
-                eqs += [point[m][c] - b1[c] - a * u[c] for c in range(3)]
-            else:
-                a, b, c_ = (Poly.variable(next(counter)) for _ in range(3))
-                params += [f"{x}{m}_{be.body}" for x in "abc"]
-                eqs += [point[m][c] - b1[c] - a * u[c] - b * v[c] - c_ * w[c] for c in range(3)]
-    for centre, arm1, arm2 in pts.u_joints:
-        eqs.append(dot(sub(point[arm1], point[centre]), sub(point[arm2], point[centre]))
-                   - Poly.variable(next(counter)))
-        params.append(f"g{centre}")
-    for sl in pts.slides:
-        if sl.column is not None:
-            slide[sl.joint] = Poly.variable(next(counter))
-            params.append(f"s{sl.joint}")
-    for sl in pts.slides:  # b_i = a_i + s (a_1 − a_0)
-        axis = sub(point[sl.a[1]], point[sl.a[0]])
-        for ia, ib in zip(sl.a, sl.b, strict=True):
-            eqs += [point[ib][c] - point[ia][c] - slide[sl.joint] * axis[c] for c in range(3)]
-    for t in pts.turns:
-        be = next(be for be in bodies if be.body == t.frame)
-        b1 = point[be.base[0]]
-        u, v = sub(point[be.base[1]], b1), sub(point[be.base[2]], b1)
-        w = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
-        ta, tb, tc = (Poly.variable(next(counter)) for _ in range(3))
-        params += [f"{x}{t.point}_turn" for x in "abc"]
-        eqs += [point[t.point][c] - b1[c] - ta * u[c] - tb * v[c] - tc * w[c] for c in range(3)]
-    return compile_system(eqs, names, params)

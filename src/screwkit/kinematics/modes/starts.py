@@ -52,7 +52,7 @@ def start_solutions(system: PolynomialSystem, random_instance: RandomInstance | 
                     generic_count: int | None = None, seed: int = 0,
                     grouping: Grouping | None = None,
                     total_degree_paths: int = TOTAL_DEGREE_PATHS,
-                    then_monodromy: bool = False, stale_loops: int | None = None
+                    then_monodromy: bool = False, monodromy: MonodromyOptions | None = None
                     ) -> StartSolutions:
     """Every solution of ``system`` at a generic complex parameter vector, kept per topology
     (module docstring): for a Bézout number ≤ :data:`TOTAL_DEGREE_PATHS` (or when no random
@@ -63,16 +63,15 @@ def start_solutions(system: PolynomialSystem, random_instance: RandomInstance | 
     ``generic_count`` solutions are known. ``total_degree_paths`` moves the limit
     (:data:`TOTAL_DEGREE_PATHS`); ``then_monodromy`` loops the total-degree solutions round
     monodromy loops until they stop growing, so that a path the total-degree homotopy lost
-    (systems with solution sets at infinity lose many) is found after all; ``stale_loops``
-    (monodromy without a known count) the loops in a row without a new solution that stop it
-    (:class:`~screwkit.algebraic.monodromy.MonodromyOptions`)."""
+    (systems with solution sets at infinity lose many) is found after all; ``monodromy``
+    the monodromy's options (its expected count and seed are ``generic_count`` and
+    ``seed``)."""
     key = system_key(system)
     if key not in _CACHE:
         found = start_store.load(key, system, generic_count)
         if found is None:
-            options = MonodromyOptions(expected=generic_count, seed=seed)
-            if stale_loops is not None:
-                options = replace(options, stale_loops=stale_loops)
+            options = replace(monodromy or MonodromyOptions(), expected=generic_count,
+                              seed=seed)
             found = _solve(system, random_instance, options, grouping, total_degree_paths)
             if then_monodromy and random_instance is not None and not \
                     found.how_found.startswith("monodromy"):

@@ -1,0 +1,387 @@
+"""Building the point system of a spatial R/P/C/S/U graph (modes/spatial_points.py): its
+points, the bodies' equations with the rigid groups left out, the slides and driven knees turned
+so that their carried points are in the body written later, the count and generic-rank checks,
+and the compiled system.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
+from screwkit.errors import CapabilityError
+from screwkit.kinematics.modes.spatial_points import (
+    COLLINEAR,
+    MAX_UNKNOWNS,
+    Array,
+    BodyEquations,
+    SlideJoint,
+    SpatialPointFormulation,
+    TurnJoint,
+)
+from screwkit.messages import listing
+from screwkit.model.mechanism import GROUND, Mechanism
+
+
+def _refuse(mech: Mechanism, why: str) -> CapabilityError:
+    return CapabilityError(f"{mech.name}: the spatial point formulation does not take this "
+                           f"mechanism: {why}")
+
+
+def _placed_bodies(mech: Mechanism) -> list[tuple[str, int | None]]:
+    """The ground and every body reached from it through input joints, with the joint."""
+    driven = {x.split(".")[0] for x in mech.inputs}
+    placed: list[tuple[str, int | None]] = [(GROUND, None)]
+    grew = True
+    while grew:
+        grew = False
+        have = {b for b, _ in placed}
+        for k, j in enumerate(mech.joints):
+            if j.name in driven and (j.bodies[0] in have) != (j.bodies[1] in have):
+                placed.append((j.bodies[1] if j.bodies[0] in have else j.bodies[0], k))
+                grew = True
+                break
+    for j in mech.joints:
+        if j.name in driven and j.kind not in ("R", "P"):
+            raise _refuse(mech, f"input joint {j.name!r} is a {j.kind} joint; it takes R and P "
+                          "joints as inputs")
+    return placed
+
+
+def _across(u: Array) -> Array:
+    """A unit vector square to the unit vector u."""
+    n = np.cross(u, [1.0, 0.0, 0.0] if abs(u[0]) < 0.9 else [0.0, 1.0, 0.0])
+    return np.asarray(n / np.linalg.norm(n))
+
+
+@dataclass
+class _Points:
+    drawn: list[Array]
+    owners: list[frozenset[str]]
+    u_joints: list[tuple[int, int, int]]
+    slides: list[SlideJoint]
+    turns: list[TurnJoint]
+
+
+def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int]) -> _Points:
+    """Every joint's points (scaled drawn positions, owning bodies), the U joints' (centre,
+    first arm, second arm), the P and C joints that place no body and the R inputs between
+    moving bodies (module docstring)."""
+    drawn: list[Array] = []
+    owners: list[frozenset[str]] = []
+    u_joints = []
+    slides: list[SlideJoint] = []
+    turns: list[TurnJoint] = []
+    columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
+
+    def add(at: Array, bodies: tuple[str, ...]) -> int:
+        drawn.append((at - origin) / scale)
+        owners.append(frozenset(bodies))
+        return len(drawn) - 1
+
+    for k, j in enumerate(mech.joints):
+        if k in placing:
+            if j.kind == "R":  # its axis, in both placed bodies
+                add(j.at, j.bodies)
+                add(j.at + scale * j.axis, j.bodies)
+            continue
+        if j.kind == "S":
+            add(j.at, j.bodies)
+        elif j.kind == "R":
+            ends = (add(j.at, j.bodies), add(j.at + scale * j.axis, j.bodies))
+            if j.name in columns:  # driven between two moving bodies
+                q = add(j.at + scale * _across(j.axis), (j.bodies[1],))
+                turns.append(TurnJoint(k, j.bodies[0], q, columns[j.name], ends))
+        elif j.kind in ("P", "C"):
+            line = [j.at, j.at + scale * j.axis]
+            if j.kind == "P":
+                line.append(j.at + scale * _across(j.axis))
+            first = tuple(add(e, (j.bodies[0],)) for e in line)
+            second = tuple(add(e, (j.bodies[1],)) for e in line)
+            slides.append(SlideJoint(k, first, second, columns.get(j.name)))
+        elif j.kind == "U":
+            assert j.axis2 is not None
+            c = add(j.at, j.bodies)
+            a = add(j.at + scale * j.axis, (j.bodies[0],))
+            b = add(j.at + scale * j.axis2, (j.bodies[1],))
+            u_joints.append((c, a, b))
+    return _Points(drawn, owners, u_joints, slides, turns)
+
+
+def _third(pts: Array, b1: int, b2: int, candidates: list[int]) -> int | None:
+    """The candidate farthest from the line b1 b2, or None when all are on it."""
+    u = (pts[b2] - pts[b1]) / np.linalg.norm(pts[b2] - pts[b1])
+
+    def off(m: int) -> float:
+        w = pts[m] - pts[b1]
+        return float(np.linalg.norm(w - (w @ u) * u))
+
+    rest = [m for m in candidates if m not in (b1, b2)]
+    if not rest:
+        return None
+    b3 = max(rest, key=off)
+    return b3 if off(b3) > COLLINEAR else None
+
+
+def _base(pts: Array, placed: list[int], order: list[int]) -> tuple[int, ...]:
+    """A well-shaped base among a body's points ``order`` (placed first): the first, the
+    farthest from it, the farthest from their line (two when all lie on a line). With two or
+    more placed points the base is made of placed points as far as they span, so that the
+    equations among placed points only are exactly the ones left out."""
+    pool = placed if len(placed) >= 2 else order
+    b1 = pool[0]
+    b2 = max(pool[1:], key=lambda m: float(np.linalg.norm(pts[m] - pts[b1])))
+    b3 = _third(pts, b1, b2, placed) if len(placed) >= 3 else None
+    if b3 is None:
+        b3 = _third(pts, b1, b2, order)
+    return (b1, b2) if b3 is None else (b1, b2, b3)
+
+
+def _body_equations(mech: Mechanism, body: str, pts: Array, members: list[int],
+                    known: set[int], source: dict[int, str],
+                    slid: tuple[int, ...] | list[int] = ()) -> BodyEquations:
+    """The equations of one unplaced body (module docstring), leaving out those among
+    points already rigid with each other: the placed points, or ``slid``, points whose
+    distances other equations keep (those a slide carries over from the joint's first body,
+    b_i = a_i + s (a_1 − a_0), or those the body shares with a body before it, e.g. an R
+    joint's axis), whichever group is larger (the base is taken in it; the other group's
+    points are carried by it)."""
+    placed_here = [m for m in members if m in known]
+    sources = sorted({source[m] for m in placed_here})
+    if len(sources) > 1:
+        raise _refuse(mech, f"body {body!r} is joined to {listing(sources)}, which the inputs "
+                      "place each on its own, so at fixed inputs it cannot move and the "
+                      "mechanism is locked (or it has more inputs than freedoms)")
+    if slid and len(slid) >= len(placed_here):  # the larger rigid group makes the base
+        placed_here = list(slid)
+    known = set(placed_here)
+    order = placed_here + [m for m in members if m not in known]
+    if len(order) < 2 or np.linalg.norm(pts[order] - pts[order[0]], axis=1).max() <= COLLINEAR:
+        raise _refuse(mech, f"body {body!r} hangs from a single point (one S joint), so it "
+                      "turns freely about it; join it to another body or remove it")
+    base = _base(pts, placed_here, order)
+    b1, b2 = base[0], base[1]
+    u = pts[b2] - pts[b1]
+    pairs = [(b1, b2)] if len(base) == 2 else [(b1, b2), (b1, base[2]), (b2, base[2])]
+    distances = tuple((i, j) for i, j in pairs if not (i in known and j in known))
+    carried: list[int] = []
+    coefficients: list[tuple[float, ...]] = []
+    for m in members:
+        if m in base:
+            coefficients.append(())
+            continue
+        w = pts[m] - pts[b1]
+        if len(base) == 2:
+            abc: tuple[float, ...] = (float(w @ u / (u @ u)),)
+            involved = {m, b1, b2}
+        else:
+            v = pts[base[2]] - pts[b1]
+            abc = tuple(float(c) for c in np.linalg.solve(np.stack([u, v, np.cross(u, v)], 1), w))
+            involved = {m, b1, b2} | ({base[2]} if max(abs(abc[1]), abs(abc[2])) > 1e-12
+                                      else set())
+        coefficients.append(abc)
+        if not involved <= known:
+            carried.append(m)
+    return BodyEquations(body, tuple(members), tuple(base), distances, tuple(carried),
+                         tuple(coefficients))
+
+
+def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
+    """The point system of ``mech`` (module docstring), or a CapabilityError that says why it
+    does not take the mechanism (a joint other than R, S, U or an input P; an input between
+    moving bodies; a body that turns freely or is locked; freedoms left at fixed inputs)."""
+    other = sorted({j.kind for j in mech.joints} - {"R", "S", "U", "P", "C"})
+    if other:
+        raise _refuse(mech, f"it has {listing(other)} joints; it takes R, P, C, S and U joints")
+    if mech.drives:
+        raise _refuse(mech, "it is driven at a body's freedom, not at joints")
+    placed = _placed_bodies(mech)
+    placing = {k for _, k in placed[1:] if k is not None}
+    have = {b for b, _ in placed}
+    locked = [j.name for k, j in enumerate(mech.joints)
+              if k not in placing and set(j.bodies) <= have]
+    if locked:
+        raise _refuse(mech, f"joint(s) {listing(locked)} join two bodies the inputs place, so "
+                      "the mechanism is locked at fixed inputs (or has more inputs than "
+                      "freedoms)")
+    origin = np.array([j.at for j in mech.joints]).mean(0)
+    scale = float(mech.length_scale)
+    pts = _points(mech, origin, scale, placing)
+    drawn = np.array(pts.drawn)
+    known, source = [], {}
+    for k, own in enumerate(pts.owners):
+        mine = [b for b, _ in placed if b in own]
+        if mine:
+            known.append(k)
+            source[k] = mine[0]
+    unknown = [k for k in range(len(drawn)) if k not in source]
+    order = _body_order(mech, have)
+    rank = {b: -1 for b in have} | {b: i for i, b in enumerate(order)}
+    _orient(mech, pts, rank)
+    bodies: list[BodyEquations] = []
+    for b in order:
+        members = [k for k, own in enumerate(pts.owners) if b in own]
+        joints = [j for j in mech.joints if b in j.bodies]
+        if len(joints) < 2:
+            raise _refuse(mech, f"body {b!r} has a single joint, so it turns freely about it; "
+                          "join it to another body or remove it")
+        # points other equations keep rigid: a slide's carried-over points, a driven R joint's
+        # axis and turned point (its frame body is written first), points shared with a body
+        # written before
+        groups = [list(sl.b) for sl in pts.slides if b in pts.owners[sl.b[0]]]
+        groups += [[*t.axis, t.point] for t in pts.turns if b in pts.owners[t.point]]
+        groups += [[m for m in members if m in be.points and m not in source] for be in bodies]
+        slid = max(groups, key=len, default=[])
+        bodies.append(_body_equations(mech, b, drawn, members, set(known), source,
+                                      slid if len(slid) >= 2 else ()))
+    for t in pts.turns:
+        frame = next(be for be in bodies if be.body == t.frame)
+        if len(frame.base) != 3:
+            raise _refuse(mech, f"input joint {mech.joints[t.joint].name!r} turns "
+                          f"{mech.joints[t.joint].bodies[1]!r} against {t.frame!r}, whose "
+                          "joints lie on one line, so the angle has no frame to be measured in")
+    passive = [sl for sl in pts.slides if sl.column is None]
+    n = 3 * len(unknown) + len(passive)
+    n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies) + len(pts.u_joints)
+            + sum(3 * len(sl.a) for sl in pts.slides) + 3 * len(pts.turns))
+    if n_eq != n:
+        more = n - n_eq
+        why = (f"{more} freedom(s) are left at fixed inputs beyond the spins of rods about their "
+               "own lines: give it as many inputs as freedoms" if more > 0 else
+               f"{-more} constraint(s) more than unknowns: it is over-constrained in space "
+               "(e.g. a planar or spherical loop drawn with R joints, a Bennett loop); the "
+               "graph tracker follows it")
+        raise _refuse(mech, f"at fixed inputs its point closure has {n_eq} equations in {n} "
+                      f"unknowns; {why}")
+    if n > MAX_UNKNOWNS:
+        raise _refuse(mech, f"its point closure has {n} unknowns, more than {MAX_UNKNOWNS}: "
+                      "the monodromy that would find its start solutions is not practical at "
+                      "that size (the 3-UPU's 90 reached one solution in 36 s); follow the drawn "
+                      "mode with the graph tracker (--modes drawn)")
+    system = _compile(unknown, known, bodies, pts)
+    form = SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(pts.owners),
+                                   tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
+                                   tuple(pts.u_joints), source, tuple(pts.slides),
+                                   tuple(pts.turns))
+    _check_rank(form)
+    return form
+
+
+def _check_rank(form: SpatialPointFormulation) -> None:
+    """Refuse a square system whose Jacobian is singular at a generic instance: it has
+    redundant equations and leaves freedoms at fixed inputs (its solutions would be curves,
+    found as none)."""
+    p, x = form.random_instance(np.random.default_rng(0))
+    J = form.system.evaluate(x, p[0], want_jp=False)[1][0]
+    sv = np.linalg.svd(J, compute_uv=False)
+    short = int(np.count_nonzero(sv <= 1e-8 * sv[0]))
+    if short:
+        raise _refuse(form.mechanism, f"its point closure is square but {short} of its "
+                      "equations repeat others, so the mechanism keeps "
+                      f"{short} freedom(s) at fixed inputs beyond the spins of rods about "
+                      "their own lines (or the formulation wrote a rigid group twice): give it "
+                      "as many inputs as freedoms, or follow it with the graph tracker")
+
+
+def _body_order(mech: Mechanism, placed: set[str]) -> list[str]:
+    """The unplaced bodies, nearest the placed ones first (breadth first through the joints;
+    ties in the spec's order), so that a body shares points mostly with bodies written before
+    it."""
+    depth = {b: 0 for b in placed}
+    frontier = set(placed)
+    while frontier:
+        nxt = set()
+        for j in mech.joints:
+            a, b = j.bodies
+            for x, y in ((a, b), (b, a)):
+                if x in frontier and y not in depth:
+                    depth[y] = depth[x] + 1
+                    nxt.add(y)
+        frontier = nxt
+    rest = [b for b in mech.body_names if b not in placed]
+    return sorted(rest, key=lambda b: (depth.get(b, 10**6), rest.index(b)))
+
+
+def _orient(mech: Mechanism, pts: _Points, rank: dict[str, int]) -> None:
+    """Turn every slide and driven R joint so that its carried points (a slide's ``b``, a
+    knee's turned point) are in the body written later: b_i = a_i − s (a_1 − a_0) and a turn
+    by −θ when the joint is drawn the other way."""
+    for i, sl in enumerate(pts.slides):
+        first, second = mech.joints[sl.joint].bodies
+        if rank[first] > rank[second]:
+            pts.slides[i] = SlideJoint(sl.joint, sl.b, sl.a, sl.column, -sl.sign)
+    for i, t in enumerate(pts.turns):
+        first, second = mech.joints[t.joint].bodies
+        if rank[first] > rank[second]:
+            pts.owners[t.point] = frozenset((first,))
+            pts.turns[i] = TurnJoint(t.joint, second, t.point, t.column, t.axis, -t.sign)
+
+
+def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
+             pts: _Points) -> PolynomialSystem:
+    """The system of the module docstring: unknowns the solved points' (x, y, z); parameters
+    the placed points', then per body its d's and coefficients, then the U joints' g."""
+    counter = iter(range(10**9))
+    point: dict[int, list[Poly]] = {}
+    for k in unknown:
+        point[k] = [Poly.variable(next(counter)) for _ in range(3)]
+    names = [f"{c}{k}" for k in unknown for c in "xyz"]
+    slide: dict[int, Poly] = {}
+    for sl in pts.slides:
+        if sl.column is None:
+            slide[sl.joint] = Poly.variable(next(counter))
+            names.append(f"s{sl.joint}")
+    for k in known:
+        point[k] = [Poly.variable(next(counter)) for _ in range(3)]
+
+    def sub(a: list[Poly], b: list[Poly]) -> list[Poly]:
+        return [x - y for x, y in zip(a, b, strict=True)]
+
+    def dot(a: list[Poly], b: list[Poly]) -> Poly:
+        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+    eqs: list[Poly] = []
+    params = [f"{c}{k}" for k in known for c in "xyz"]
+    for be in bodies:
+        for i, j in be.distances:
+            d = sub(point[j], point[i])
+            eqs.append(dot(d, d) - Poly.variable(next(counter)))
+            params.append(f"d{i}_{j}")
+        b1 = point[be.base[0]]
+        u = sub(point[be.base[1]], b1)
+        if len(be.base) == 3:
+            v = sub(point[be.base[2]], b1)
+            w = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+        for m in be.carried:
+            if len(be.base) == 2:
+                a = Poly.variable(next(counter))
+                params.append(f"a{m}_{be.body}")
+                eqs += [point[m][c] - b1[c] - a * u[c] for c in range(3)]
+            else:
+                a, b, c_ = (Poly.variable(next(counter)) for _ in range(3))
+                params += [f"{x}{m}_{be.body}" for x in "abc"]
+                eqs += [point[m][c] - b1[c] - a * u[c] - b * v[c] - c_ * w[c] for c in range(3)]
+    for centre, arm1, arm2 in pts.u_joints:
+        eqs.append(dot(sub(point[arm1], point[centre]), sub(point[arm2], point[centre]))
+                   - Poly.variable(next(counter)))
+        params.append(f"g{centre}")
+    for sl in pts.slides:
+        if sl.column is not None:
+            slide[sl.joint] = Poly.variable(next(counter))
+            params.append(f"s{sl.joint}")
+    for sl in pts.slides:  # b_i = a_i + s (a_1 − a_0)
+        axis = sub(point[sl.a[1]], point[sl.a[0]])
+        for ia, ib in zip(sl.a, sl.b, strict=True):
+            eqs += [point[ib][c] - point[ia][c] - sl.sign * slide[sl.joint] * axis[c]
+                    for c in range(3)]
+    for t in pts.turns:
+        be = next(be for be in bodies if be.body == t.frame)
+        b1 = point[be.base[0]]
+        u, v = sub(point[be.base[1]], b1), sub(point[be.base[2]], b1)
+        w = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+        ta, tb, tc = (Poly.variable(next(counter)) for _ in range(3))
+        params += [f"{x}{t.point}_turn" for x in "abc"]
+        eqs += [point[t.point][c] - b1[c] - ta * u[c] - tb * v[c] - tc * w[c] for c in range(3)]
+    return compile_system(eqs, names, params)
