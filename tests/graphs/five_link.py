@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from tests.graphs.three_upu import _bar
+from tests.graphs.three_upu import body_lines
 
 PATH = Path(__file__).resolve().parents[2] / "examples" / "mechanisms" / \
     "five_link_suspension.toml"
@@ -39,11 +39,7 @@ def write_spec(path: Path = PATH) -> str:
     bodies.append(("pushrod", [np.array(ROCKER_BALL), np.array(PUSHROD_FOOT)]))
     bodies.append(("upright", [np.array(b) for _, _, b in LINKS] + [np.array(PUSHROD_FOOT)]))
     for name, pts in bodies:
-        m, c, inertia = _bar(pts)
-        out += ["[[bodies]]", f'name = "{name}"', f'mass = "{m * 1000:.4f} g"',
-                f"com = [{', '.join(f'{x:.6f}' for x in c)}]",
-                "inertia = [" + ", ".join("[" + ", ".join(f"{x:.6e}" for x in row) + "]"
-                                          for row in inertia) + "]", ""]
+        out += body_lines(name, pts)
     out += ["# the rocker turns on the chassis; its angle is the input (positive: bump)",
             "[[joints]]", 'name = "rocker_pivot"', 'kind = "R"',
             'between = ["ground", "rocker"]', f"at = {vec(ROCKER_PIVOT)}",

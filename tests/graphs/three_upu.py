@@ -168,6 +168,15 @@ def _bar(points: list[np.ndarray]) -> tuple[float, np.ndarray, np.ndarray]:
     return M, c * 1000, inertia
 
 
+def body_lines(name: str, points: list[np.ndarray]) -> list[str]:
+    """A spec's [[bodies]] block for a body of steel bars joining ``points`` (:func:`_bar`)."""
+    m, c, inertia = _bar(points)
+    return ["[[bodies]]", f'name = "{name}"', f'mass = "{m * 1000:.4f} g"',
+            f"com = [{', '.join(f'{x:.6f}' for x in c)}]",
+            "inertia = [" + ", ".join("[" + ", ".join(f"{x:.6e}" for x in row) + "]"
+                                      for row in inertia) + "]", ""]
+
+
 def write_spec(path: Path = PATH) -> str:
     """The example's TOML text (written to ``path``)."""
     vec = lambda v: "[" + ", ".join(f"{float(x):.12g}" for x in v) + "]"  # noqa: E731
@@ -179,11 +188,7 @@ def write_spec(path: Path = PATH) -> str:
         bodies.append((f"piston{i + 1}", [mid[i], PLATFORM[i]]))
     bodies.append(("platform", list(PLATFORM) + [np.array([0.0, 0.0, HEIGHT])]))
     for name, pts in bodies:
-        m, c, inertia = _bar(pts if name != "platform" else pts[:3])
-        out += ["[[bodies]]", f'name = "{name}"', f'mass = "{m * 1000:.4f} g"',
-                f"com = [{', '.join(f'{x:.6f}' for x in c)}]",
-                "inertia = [" + ", ".join("[" + ", ".join(f"{x:.6e}" for x in row) + "]"
-                                          for row in inertia) + "]", ""]
+        out += body_lines(name, pts if name != "platform" else pts[:3])
     for i in range(3):
         d = LEG[i] / LENGTH[i]
         out += [f"# leg {i + 1}", "[[joints]]", f'name = "Ub{i + 1}"', 'kind = "U"',

@@ -203,16 +203,13 @@ def _plane(mech: Mechanism) -> tuple[Array, Array, Array, Array]:
     return mech.joints[0].at, e1, np.cross(n, e1), n
 
 
-def planar_formulation(mech: Mechanism) -> PlanarFormulation:
-    """The planar system of ``mech`` (module docstring). Raises a CapabilityError for a
-    mechanism that is not planar or has joints other than R, and an InputError when the
-    mechanism keeps a freedom (or is overconstrained) at fixed inputs."""
-    plane = _plane(mech)
-    driven = {mech.joints[[j.name for j in mech.joints].index(x.split(".")[0])].name
-              for x in mech.inputs}
+def placed_by_inputs(mech: Mechanism) -> list[tuple[str, int | None]]:
+    """The ground and every body reached from it through input joints, each with the index
+    of the joint that places it (None for the ground), in placement order."""
+    driven = {x.split(".")[0] for x in mech.inputs}
     placed: list[tuple[str, int | None]] = [(GROUND, None)]
     grew = True
-    while grew:  # bodies reached from the ground through input joints
+    while grew:
         grew = False
         have = {b for b, _ in placed}
         for k, j in enumerate(mech.joints):
@@ -220,6 +217,15 @@ def planar_formulation(mech: Mechanism) -> PlanarFormulation:
                 placed.append((j.bodies[1] if j.bodies[0] in have else j.bodies[0], k))
                 grew = True
                 break
+    return placed
+
+
+def planar_formulation(mech: Mechanism) -> PlanarFormulation:
+    """The planar system of ``mech`` (module docstring). Raises a CapabilityError for a
+    mechanism that is not planar or has joints other than R, and an InputError when the
+    mechanism keeps a freedom (or is overconstrained) at fixed inputs."""
+    plane = _plane(mech)
+    placed = placed_by_inputs(mech)
     have = {b for b, _ in placed}
     known = tuple(k for k, j in enumerate(mech.joints) if set(j.bodies) & have)
     unknown = tuple(k for k in range(len(mech.joints)) if k not in known)

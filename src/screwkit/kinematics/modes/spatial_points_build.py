@@ -12,6 +12,7 @@ import numpy as np
 
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.errors import CapabilityError
+from screwkit.kinematics.modes.planar import placed_by_inputs
 from screwkit.kinematics.modes.spatial_points import (
     COLLINEAR,
     MAX_UNKNOWNS,
@@ -22,7 +23,7 @@ from screwkit.kinematics.modes.spatial_points import (
     TurnJoint,
 )
 from screwkit.messages import listing
-from screwkit.model.mechanism import GROUND, Mechanism
+from screwkit.model.mechanism import Mechanism
 
 
 def _refuse(mech: Mechanism, why: str) -> CapabilityError:
@@ -31,18 +32,10 @@ def _refuse(mech: Mechanism, why: str) -> CapabilityError:
 
 
 def _placed_bodies(mech: Mechanism) -> list[tuple[str, int | None]]:
-    """The ground and every body reached from it through input joints, with the joint."""
+    """The ground and every body reached from it through input joints, with the joint; R
+    and P inputs only."""
+    placed = placed_by_inputs(mech)
     driven = {x.split(".")[0] for x in mech.inputs}
-    placed: list[tuple[str, int | None]] = [(GROUND, None)]
-    grew = True
-    while grew:
-        grew = False
-        have = {b for b, _ in placed}
-        for k, j in enumerate(mech.joints):
-            if j.name in driven and (j.bodies[0] in have) != (j.bodies[1] in have):
-                placed.append((j.bodies[1] if j.bodies[0] in have else j.bodies[0], k))
-                grew = True
-                break
     for j in mech.joints:
         if j.name in driven and j.kind not in ("R", "P"):
             raise _refuse(mech, f"input joint {j.name!r} is a {j.kind} joint; it takes R and P "
