@@ -287,10 +287,11 @@ def test_a_leg_driven_at_its_slide_between_moving_bodies_has_every_ball_position
             4, -1).max(1).min() <= 1e-12
 
 
-def _macpherson() -> Mechanism:
+def _macpherson(kind: str = "P", bodies: tuple[str, str] = ("upright", "strut")) -> Mechanism:
     """A MacPherson strut (mm): the lower arm's hinge is the input, the upright slides on
-    the strut (a P joint between moving bodies) whose top turns in a ball on the body, an
-    S–S tie rod steers."""
+    the strut (a P joint between moving bodies, or a C joint: the strut then spins idly about
+    its own line, which holds its top ball) whose top turns in a ball on the body, an S–S tie
+    rod steers."""
     mm = 1e-3
     T, W = np.array([-20.0, 600.0, 700.0]), np.array([10.0, 690.0, 350.0])
     return Mechanism("MacPherson strut", (Body("arm"), Body("upright"), Body("strut"),
@@ -298,7 +299,7 @@ def _macpherson() -> Mechanism:
                      (joint("L", "R", "ground", "arm", mm * np.array([0.0, 350.0, 160.0]),
                             (1.0, 0.02, 0.01)),
                       joint("LB", "S", "arm", "upright", mm * np.array([0.0, 720.0, 150.0])),
-                      joint("P", "P", "upright", "strut", mm * W, T - W),
+                      joint("P", kind, *bodies, mm * W, T - W),
                       joint("T", "S", "strut", "ground", mm * T),
                       joint("TI", "S", "ground", "tie_rod", mm * np.array([-150.0, 380.0, 200.0])),
                       joint("TO", "S", "tie_rod", "upright",
@@ -459,3 +460,23 @@ def test_a_square_closure_that_leaves_a_freedom_is_refused() -> None:
                       joint("R3", "R", "C", "ground", P(), rng.normal(size=3))), ("R1.theta",))
     with pytest.raises(CapabilityError, match="freedom"):
         spatial_point_formulation(mech)
+
+
+def test_a_macpherson_strut_with_a_c_joint_has_the_p_joints_upright_poses() -> None:
+    """The strut modelled with a C joint, drawn either way: the strut is then a body on a line
+    (its top ball on the C axis) whose points a slide carries, and its random instance puts
+    them back on the line after the slide. The upright poses are those of the P-joint strut
+    (the C joint's extra turn only spins the strut about its line)."""
+    lay = graph_layout(_macpherson())
+    up = lay.body_of["upright"]
+    x = np.radians([[0.0], [5.0]])
+    ref = every_mode(_macpherson(), x)
+    for bodies in (("upright", "strut"), ("strut", "upright")):
+        mech = _macpherson("C", bodies)
+        found = every_mode(mech, x)
+        assert found.generic_count == ref.generic_count
+        for n in range(len(x)):
+            ours = graph_forward(mech, graph_layout(mech), found.configurations[n]).R[:, up]
+            theirs = graph_forward(_macpherson(), lay, ref.configurations[n]).R[:, up]
+            assert found.certified[n].all()
+            assert _matched(ours.reshape(-1, 9), theirs.reshape(-1, 9), 1e-9)

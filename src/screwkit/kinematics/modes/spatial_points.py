@@ -242,18 +242,14 @@ class SpatialPointFormulation:
         # start there lose every path)
         pts = self.drawn + RANDOM_SPREAD * (rng.standard_normal((P, 3))
                                             + 1j * rng.standard_normal((P, 3)))
-        for be in self.bodies:  # on a line: P_m = b1 + a u
-            if len(be.base) == 2:
-                b1, b2 = be.base
-                for m in be.points:
-                    if m not in be.base and (m not in self.known or m in be.carried):
-                        along = rng.standard_normal() + 1j * rng.standard_normal()
-                        pts[m] = pts[b1] + along * (pts[b2] - pts[b1])
+        self._onto_lines(pts, rng, frozenset())
         slide = {}
         for sl in self.slides:  # b_i = a_i ± s (a_1 − a_0)
             slide[sl.joint] = rng.standard_normal() + 1j * rng.standard_normal()
             for ia, ib in zip(sl.a, sl.b, strict=True):
                 pts[ib] = pts[ia] + sl.sign * slide[sl.joint] * (pts[sl.a[1]] - pts[sl.a[0]])
+        # a line whose base a slide has just moved: its other points onto it again
+        self._onto_lines(pts, rng, frozenset(m for sl in self.slides for m in sl.a + sl.b))
         coef = {}
         for be in self.bodies:
             b1, b2 = be.base[0], be.base[1]
@@ -287,6 +283,19 @@ class SpatialPointFormulation:
                 "instance of this topology (a point that a body on a line and a slide both "
                 "carry); follow the drawn mode with the graph tracker (--modes drawn)")
         return p[None, :], x[None, :]
+
+    def _onto_lines(self, pts: Complex, rng: np.random.Generator, keep: frozenset[int]
+                    ) -> None:
+        """Put every body on a line's carried points (not in ``keep``) on its line, at
+        random places."""
+        for be in self.bodies:
+            if len(be.base) == 2:
+                b1, b2 = be.base
+                for m in be.points:
+                    if m not in be.base and m not in keep and (m not in self.known
+                                                               or m in be.carried):
+                        along = rng.standard_normal() + 1j * rng.standard_normal()
+                        pts[m] = pts[b1] + along * (pts[b2] - pts[b1])
 
     def start(self) -> StartSolutions:
         """The topology's start solutions (module docstring): total degree up to
