@@ -240,8 +240,8 @@ class SpatialPointFormulation:
         # the drawing moved by a complex random half unit: generic, but with the drawing's
         # shapes (a skinny random triangle makes huge coefficients, and monodromy loops that
         # start there lose every path)
-        pts = self.drawn + RANDOM_SPREAD * (rng.standard_normal((P, 3))
-                                            + 1j * rng.standard_normal((P, 3)))
+        pts: Complex = self.drawn + RANDOM_SPREAD * (rng.standard_normal((P, 3))
+                                                     + 1j * rng.standard_normal((P, 3)))
         self._onto_lines(pts, rng, frozenset())
         slide = {}
         for sl in self.slides:  # b_i = a_i ± s (a_1 − a_0)
