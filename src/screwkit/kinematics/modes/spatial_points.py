@@ -240,8 +240,9 @@ class SpatialPointFormulation:
         # the drawing moved by a complex random half unit: generic, but with the drawing's
         # shapes (a skinny random triangle makes huge coefficients, and monodromy loops that
         # start there lose every path)
-        pts: Complex = self.drawn + RANDOM_SPREAD * (rng.standard_normal((P, 3))
-                                                     + 1j * rng.standard_normal((P, 3)))
+        pts = np.asarray(self.drawn + RANDOM_SPREAD * (rng.standard_normal((P, 3))
+                                                       + 1j * rng.standard_normal((P, 3))),
+                         dtype=complex)
         self._onto_lines(pts, rng, frozenset())
         slide = {}
         for sl in self.slides:  # b_i = a_i ± s (a_1 − a_0)
