@@ -31,6 +31,38 @@ def rods(mech: Mechanism) -> list[tuple[str, int, int]]:
     return out
 
 
+def spin_lines(mech: Mechanism) -> list[tuple[str, Array, Array]]:
+    """(body, a point on its line, the line's unit direction) of every body that can spin
+    about one line without moving any other body: its joints are S joints centred on the line
+    and R or C joints whose axes are the line (a rod between two balls; a strut held by a C
+    joint and a ball on its axis). The drawn positions decide; the tolerance is 1e-9 of the
+    length scale."""
+    out = []
+    tol = 1e-9 * mech.length_scale
+    for b in mech.body_names:
+        joints = [j for j in mech.joints if b in j.bodies]
+        if len(joints) < 2 or any(j.kind not in ("S", "R", "C") for j in joints):
+            continue
+        axial = [j for j in joints if j.kind != "S"]
+        if axial:
+            c, u = axial[0].at, axial[0].axis
+        else:
+            far = max(joints[1:], key=lambda j: float(np.linalg.norm(j.at - joints[0].at)))
+            c, u = joints[0].at, far.at - joints[0].at
+            if np.linalg.norm(u) <= tol:
+                continue
+            u = u / np.linalg.norm(u)
+
+        def on_line(x: Array, c: Array = c, u: Array = u) -> bool:
+            w = x - c
+            return bool(np.linalg.norm(w - (w @ u) * u) <= tol)
+
+        if all(on_line(j.at) for j in joints) and all(
+                np.linalg.norm(np.cross(j.axis, u)) <= 1e-9 for j in axial):
+            out.append((b, np.asarray(c, float), np.asarray(u, float)))
+    return out
+
+
 def _spin_of(mech: Mechanism, lay: GraphLayout, lin: Linearised, q: Array,
              found: list[tuple[str, int, int]], bias: Array | None = None) -> Array:
     """Each rod's spin ω·u (N, r) under freedom rates ``q`` (N, m); with the joints'

@@ -75,27 +75,25 @@ class Chain:
 
 
 def pose_vectors(mech: Mechanism, lay: GraphLayout, conf: Configuration) -> Array:
-    """Every body's pose as one row per sample (rotation entries, positions / length). A rod
-    held by two balls (graph/idle.py) has an idle spin about its own line, which the tracker's
-    corrector and a formulation's decoding set differently: its rotation R is written as
-    (R u) uᵀ (u its drawn unit line) and its position as its first ball's centre, which that
-    spin does not change."""
-    from screwkit.kinematics.graph.idle import rods
+    """Every body's pose as one row per sample (rotation entries, positions / length). A body
+    that can spin idly about its own line (a rod held by two balls, a strut held by a C joint
+    and a ball on its axis: graph/idle.py ``spin_lines``) has that spin set differently by the
+    tracker's corrector and by a formulation's decoding: its rotation R is written as
+    (R u) uᵀ (u its drawn unit line) and its position as a point of the line, which that spin
+    does not change."""
+    from screwkit.kinematics.graph.idle import spin_lines
 
     if conf.size == 0:  # (every_mode's empty rows have no columns either)
         return np.zeros((0, 12 * (len(mech.bodies) + 1)))
     fr = graph_forward(mech, lay, conf)
     n = conf.size
     R, p = fr.R, fr.p
-    idle = rods(mech)
+    idle = spin_lines(mech)
     if idle:
         R, p = R.copy(), p.copy()
-        for body, j1, j2 in idle:
-            c = mech.joints[j1].at
-            u = mech.joints[j2].at - c
-            u = u / np.linalg.norm(u)
+        for body, c, u in idle:
             b = lay.body_of[body]
-            p[:, b] = p[:, b] + R[:, b] @ c  # the first ball's centre, on the spin's line
+            p[:, b] = p[:, b] + R[:, b] @ c  # a point of the spin's line
             R[:, b] = np.einsum("ni,j->nij", R[:, b] @ u, u)
     return np.concatenate([R.reshape(n, -1), p.reshape(n, -1) / lay.length], axis=1)
 
