@@ -210,42 +210,31 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
             known.append(k)
             source[k] = mine[0]
     unknown = [k for k in range(len(drawn)) if k not in source]
-    order = _body_order(mech, have)
-    rank = {b: -1 for b in have} | {b: i for i, b in enumerate(order)}
-    _orient(mech, pts, rank)
-    bodies: list[BodyEquations] = []
-    for b in order:
-        members = [k for k, own in enumerate(pts.owners) if b in own]
-        joints = [j for j in mech.joints if b in j.bodies]
-        if len(joints) < 2:
-            raise _refuse(mech, f"body {b!r} has a single joint, so it turns freely about it; "
-                          "join it to another body or remove it")
-        # points other equations keep rigid: a slide's carried-over points, a driven R joint's
-        # axis and turned point (its frame body is written first), points shared with a body
-        # written before
-        groups = [list(sl.b) for sl in pts.slides if b in pts.owners[sl.b[0]]]
-        groups += [[*t.axis, t.point] for t in pts.turns if b in pts.owners[t.point]]
-        groups += [[m for m in members if m in be.points and m not in source] for be in bodies]
-        slid = max(groups, key=len, default=[])
-        bodies.append(_body_equations(mech, b, drawn, members, set(known), source,
-                                      slid if len(slid) >= 2 else ()))
-    for t in pts.turns:
-        frame = next(be for be in bodies if be.body == t.frame)
-        if len(frame.base) != 3:
-            raise _refuse(mech, f"input joint {mech.joints[t.joint].name!r} turns "
-                          f"{mech.joints[t.joint].bodies[1]!r} against {t.frame!r}, whose "
-                          "joints lie on one line, so the angle has no frame to be measured in")
-    passive = [sl for sl in pts.slides if sl.column is None]
-    n = 3 * len(unknown) + len(passive)
-    n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies) + len(pts.u_joints)
-            + sum(3 * len(sl.a) for sl in pts.slides) + 3 * len(pts.turns))
+    # the count depends on which rigid group each body's base is taken in, and so on the
+    # order the bodies are written: nearest the inputs first, ties in the spec's order, then
+    # in reverse (RSCR with an S–S dyad is square in one of the two)
+    tried = []
+    for ties_reversed in (False, True):
+        pts = _points(mech, origin, scale, placing)
+        bodies = _write_bodies(mech, pts, _body_order(mech, have, ties_reversed), have, drawn,
+                               known, source)
+        passive = [sl for sl in pts.slides if sl.column is None]
+        n = 3 * len(unknown) + len(passive)
+        n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies)
+                + len(pts.u_joints) + sum(3 * len(sl.a) for sl in pts.slides)
+                + 3 * len(pts.turns))
+        tried.append(n_eq)
+        if n_eq == n:
+            break
     if n_eq != n:
+        n_eq = tried[0]
         more = n - n_eq
         why = (f"{more} freedom(s) are left at fixed inputs beyond the spins of rods about their "
                "own lines: give it as many inputs as freedoms" if more > 0 else
                f"{-more} constraint(s) more than unknowns: it is over-constrained in space "
-               "(e.g. a planar or spherical loop drawn with R joints, a Bennett loop); the "
-               "graph tracker follows it")
+               "(e.g. a planar or spherical loop drawn with R joints, a Bennett loop), or a "
+               "body holds two groups of points already rigid (a slide and an R axis), which "
+               "this formulation writes once too often; the graph tracker follows it")
         raise _refuse(mech, f"at fixed inputs its point closure has {n_eq} equations in {n} "
                       f"unknowns; {why}")
     if n > MAX_UNKNOWNS:
@@ -278,10 +267,42 @@ def _check_rank(form: SpatialPointFormulation) -> None:
                       "as many inputs as freedoms, or follow it with the graph tracker")
 
 
-def _body_order(mech: Mechanism, placed: set[str]) -> list[str]:
+def _write_bodies(mech: Mechanism, pts: _Points, order: list[str], have: set[str],
+                  drawn: Array, known: list[int], source: dict[int, str]
+                  ) -> list[BodyEquations]:
+    """Every unplaced body's equations, written in ``order`` (slides and knees turned to it
+    first), each leaving out its largest group of points already rigid."""
+    rank = {b: -1 for b in have} | {b: i for i, b in enumerate(order)}
+    _orient(mech, pts, rank)
+    bodies: list[BodyEquations] = []
+    for b in order:
+        members = [k for k, own in enumerate(pts.owners) if b in own]
+        joints = [j for j in mech.joints if b in j.bodies]
+        if len(joints) < 2:
+            raise _refuse(mech, f"body {b!r} has a single joint, so it turns freely about it; "
+                          "join it to another body or remove it")
+        # points other equations keep rigid: a slide's carried-over points, a driven R joint's
+        # axis and turned point (its frame body is written first), points shared with a body
+        # written before
+        groups = [list(sl.b) for sl in pts.slides if b in pts.owners[sl.b[0]]]
+        groups += [[*t.axis, t.point] for t in pts.turns if b in pts.owners[t.point]]
+        groups += [[m for m in members if m in be.points and m not in source] for be in bodies]
+        slid = max(groups, key=len, default=[])
+        bodies.append(_body_equations(mech, b, drawn, members, set(known), source,
+                                      slid if len(slid) >= 2 else ()))
+    for t in pts.turns:
+        frame = next(be for be in bodies if be.body == t.frame)
+        if len(frame.base) != 3:
+            raise _refuse(mech, f"input joint {mech.joints[t.joint].name!r} turns "
+                          f"{mech.joints[t.joint].bodies[1]!r} against {t.frame!r}, whose "
+                          "joints lie on one line, so the angle has no frame to be measured in")
+    return bodies
+
+
+def _body_order(mech: Mechanism, placed: set[str], ties_reversed: bool = False) -> list[str]:
     """The unplaced bodies, nearest the placed ones first (breadth first through the joints;
-    ties in the spec's order), so that a body shares points mostly with bodies written before
-    it."""
+    ties in the spec's order, or its reverse), so that a body shares points mostly with bodies
+    written before it."""
     depth = {b: 0 for b in placed}
     frontier = set(placed)
     while frontier:
@@ -294,7 +315,8 @@ def _body_order(mech: Mechanism, placed: set[str]) -> list[str]:
                     nxt.add(y)
         frontier = nxt
     rest = [b for b in mech.body_names if b not in placed]
-    return sorted(rest, key=lambda b: (depth.get(b, 10**6), rest.index(b)))
+    sign = -1 if ties_reversed else 1
+    return sorted(rest, key=lambda b: (depth.get(b, 10**6), sign * rest.index(b)))
 
 
 def _orient(mech: Mechanism, pts: _Points, rank: dict[str, int]) -> None:
