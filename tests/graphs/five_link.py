@@ -10,7 +10,11 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from tests.graphs.three_upu import body_lines
+
+if __name__ == "__main__":  # run as a script: the repository root on the path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+from tests.graphs.three_upu import body_lines  # noqa: E402
 
 PATH = Path(__file__).resolve().parents[2] / "examples" / "mechanisms" / \
     "five_link_suspension.toml"

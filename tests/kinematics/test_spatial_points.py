@@ -537,3 +537,11 @@ def test_a_body_with_two_rigid_groups_is_taken_in_either_body_order() -> None:
             assert np.abs(ours - there).reshape(len(ours), -1).max(1).min() <= 1e-9
         seen.append(np.sort(_centres(mech, found.configurations[1])[:, 4], axis=0))
     assert np.abs(seen[0] - seen[1]).max() <= 1e-9
+
+
+def test_the_five_link_example_is_what_its_generator_writes(tmp_path: Path) -> None:
+    """examples/mechanisms/five_link_suspension.toml is tests/graphs/five_link.py's output."""
+    from tests.graphs.five_link import write_spec
+
+    text = write_spec(tmp_path / "five_link.toml")
+    assert (MECHANISMS / "five_link_suspension.toml").read_text(encoding="utf-8") == text
