@@ -8,11 +8,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from six_sps import six_sps_spec
 
 import screwkit as sk
 from screwkit.dynamics.graph_inverse import graph_inverse_dynamics, graph_regressor
 from screwkit.kinematics.graph import solve_mechanism
 from screwkit.model.mass import MassProperties
+from screwkit.model.spin_groups import spin_groups
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "mechanisms"
 G = np.array([0.3, -9.81, -1.1])
@@ -21,20 +23,24 @@ G = np.array([0.3, -9.81, -1.1])
 def _with_masses(mech: sk.Mechanism, seed: int) -> sk.Mechanism:
     """Random, physically consistent mass properties on every body (world axes, drawing)."""
     rng = np.random.default_rng(seed)
+    # a rod between two balls, or a telescopic leg slid along their line, spins idly: its load
+    # must do no work along the spin, so each body's centre of mass is on the line and its
+    # inertia is symmetric about it
+    legs = {b: tuple(mech.joints[k].at for k in g.balls) for g in spin_groups(mech)
+            for b in g.bodies}
     bodies = []
     for b in mech.bodies:
         joints = [j for j in mech.joints if b.name in j.bodies]
         pts = [j.at for j in joints]
-        if len(joints) == 2 and all(j.kind == "S" for j in joints):
-            # a rod between two balls spins idly: its load must do no work along the spin, so
-            # its centre of mass is on its axis and its inertia is symmetric about it
-            u = (pts[1] - pts[0]) / np.linalg.norm(pts[1] - pts[0])
-            com = pts[0] + rng.uniform(0.3, 0.7) * (pts[1] - pts[0])
+        if b.name in legs:
+            ends = legs[b.name]
+            u = (ends[1] - ends[0]) / np.linalg.norm(ends[1] - ends[0])
+            com = ends[0] + rng.uniform(0.3, 0.7) * (ends[1] - ends[0])
             inertia = 1e-4 * (np.eye(3) - 0.9 * np.outer(u, u))
         else:
             com = np.mean(pts, axis=0) + 0.1 * mech.length_scale * rng.standard_normal(3)
             q, _ = np.linalg.qr(rng.standard_normal((3, 3)))
-            moments = rng.uniform(0.5, 1.5, 3) * 1e-4
+            moments = np.sort(rng.uniform(0.5, 1.5, 3)) * 1e-4  # the largest bounded next
             moments[2] = min(moments[2], moments[0] + moments[1])
             inertia = q @ np.diag(moments) @ q.T
         bodies.append(sk.Body(b.name, MassProperties(rng.uniform(0.2, 2.0), com, inertia)))
@@ -64,14 +70,15 @@ def _energy_and_momentum(mech: sk.Mechanism, md: object, g: np.ndarray
 
 
 @pytest.mark.parametrize("name", ["watt_sixbar", "stephenson3_sixbar", "double_wishbone",
-                                  "stewart_platform", "delta_robot"])
-def test_power_momentum_and_balance_laws(name: str) -> None:
-    spec = sk.load_spec(EXAMPLES / f"{name}.toml")
+                                  "stewart_platform", "delta_robot", "six_sps"])
+def test_power_momentum_and_balance_laws(name: str, tmp_path: Path) -> None:
+    spec = sk.load_spec(six_sps_spec(tmp_path) if name == "six_sps"
+                        else EXAMPLES / f"{name}.toml")
     mech = _with_masses(spec.mechanism, 7)
     x0 = spec.inputs[len(spec.inputs) // 3]
     n_in = len(mech.inputs)
     direction = np.linspace(1.0, 0.4, n_in)  # a constant input rate along this direction
-    h = 1e-3 * (1.0 if not name.startswith("stewart") else mech.length_scale)
+    h = 1e-3 * (mech.length_scale if name in ("stewart_platform", "six_sps") else 1.0)
     steps = np.array([-2, -1, 0, 1, 2], dtype=float)
     X = x0 + steps[:, None] * h * direction
     motion = solve_mechanism(mech, X, rates=direction, accelerations=0.0)

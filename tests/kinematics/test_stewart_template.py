@@ -306,3 +306,37 @@ def test_the_polish_and_alpha_test_in_threads_change_nothing(
     assert one.route == three.route and np.all(one.found == 40)
     for name in ("certified", "real", "alpha", "beta", "gamma"):
         assert np.array_equal(getattr(one, name), getattr(three, name)), name
+
+
+def test_a_batch_in_parts_on_threads_changes_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A batch solved in parts side by side (each part's elimination, polish, α-test and
+    distinctness test on one thread: eigen_first.eigen_route_in_parts) gives bit for bit the
+    points, certificates, verdicts and routes of the batch in one part; the parts start at
+    whole chunks of the template and really ran as parts (the eliminator called once per part
+    and chart, on one thread)."""
+    import dataclasses
+    from functools import partial
+
+    p, _ = random_stewart(np.random.default_rng(47), 5 * stewart_template.CHUNK + 5)
+    p = p.real.astype(complex)
+    route = eigen_first.EigenRoute(stewart_system(), 40, template_solve, (0, 1, 2),
+                                   stewart_start, TEMPLATE, HOMOTOPY, 6,
+                                   stewart_solve.dense_quadrics)
+    one = eigen_first.solve_eigen_first(route, p)
+    monkeypatch.setattr(eigen_first, "PART_INSTANCES", 16)
+    calls: list[tuple[int, int | None]] = []
+
+    def alone(t: np.ndarray, label: int, threads: int | None = None) -> object:
+        calls.append((len(t), threads))
+        return template_solve(t, label, threads)
+
+    parts = dataclasses.replace(route, threads=2, eliminate_alone=partial(alone, threads=1),
+                                part_step=stewart_template.CHUNK)
+    two = eigen_first.solve_eigen_first(parts, p)
+    first = sorted(n for n, _ in calls)[-2:]
+    assert sum(first) == len(p) and any(n % stewart_template.CHUNK == 0 for n in first)
+    assert {t for _, t in calls} == {1}
+    assert np.array_equal(one.x, two.x) and np.array_equal(one.instance, two.instance)
+    assert one.route == two.route and one.how_found == two.how_found
+    for name in ("found", "certified", "real", "alpha", "beta", "gamma", "radius"):
+        assert np.array_equal(getattr(one, name), getattr(two, name)), name

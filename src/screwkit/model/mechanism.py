@@ -242,35 +242,38 @@ class Mechanism:
                                      "parallel")
 
     def _check_rods(self) -> None:
-        """A body held by exactly two ball joints spins idly about the line through them: a
-        point off that line, or an angle of that body, has no defined motion."""
-        for b in self.body_names:
-            joints = [j for j in self.joints if b in j.bodies]
-            if len(joints) != 2 or any(j.kind != "S" for j in joints):
-                continue
-            a, c = joints[0].at, joints[1].at
+        """A rod (a body held by exactly two ball joints, or a telescopic leg of bodies slid
+        along the line through them: model/spin_groups.py) spins idly about that line: a
+        point off the line, or an angle of one of its bodies, has no defined motion."""
+        from screwkit.model.spin_groups import spin_groups
+
+        for g in spin_groups(self):
+            j0, j1 = (self.joints[k] for k in g.balls)
+            a, c = j0.at, j1.at
             u = (c - a) / max(float(np.linalg.norm(c - a)), 1e-300)
+            what = (f"a rod between two balls ({j0.name!r} and {j1.name!r})" if len(g.bodies) == 1
+                    else f"in the leg {g.label} between the balls {j0.name!r} and {j1.name!r} "
+                         "(slid along their line)")
             for p in self.points:
                 off = p.at - a - ((p.at - a) @ u) * u
-                if p.body == b and float(np.linalg.norm(off)) > 1e-9 * self.length_scale:
+                if p.body in g.bodies and float(np.linalg.norm(off)) > 1e-9 * self.length_scale:
                     raise MechanismError(
-                        f"point {p.name!r} is on {b!r}, a rod between the balls "
-                        f"{joints[0].name!r} and {joints[1].name!r}, off their line: the rod's "
-                        "spin about that line is idle, so the point has no defined path; put it "
-                        "on the line, or join the rod by a U joint at one end")
+                        f"point {p.name!r} is on {p.body!r}, {what}, off their line: the "
+                        "rod's spin about that line is idle, so the point has no defined path; "
+                        "put it on the line, or join the rod by a U joint at one end")
             for d in self.drives:
                 off = d.at - a - ((d.at - a) @ u) * u
-                if d.body == b and (not d.is_translation
-                                    or float(np.linalg.norm(off)) > 1e-9 * self.length_scale):
+                if d.body in g.bodies and (not d.is_translation
+                                           or float(np.linalg.norm(off)) > 1e-9 * self.length_scale):
                     raise MechanismError(
-                        f"drive {d.name!r}: {b!r} is a rod between two balls, whose spin is idle; "
-                        "drive a body the joints hold fully (or the travel of a point on the "
-                        "rod's line)")
+                        f"drive {d.name!r}: {d.body!r} is {what}, whose spin is idle; drive a "
+                        "body the joints hold fully (or the travel of a point on the rod's "
+                        "line)")
             for o in self.outputs:
-                if isinstance(o, BodyAngle) and o.body == b:
+                if isinstance(o, BodyAngle) and o.body in g.bodies:
                     raise MechanismError(
-                        f"output {o.name!r}: {b!r} is a rod between two balls, whose spin is "
-                        "idle; measure the angle on a body the joints hold fully")
+                        f"output {o.name!r}: {o.body!r} is {what}, whose spin is idle; measure "
+                        "the angle on a body the joints hold fully")
 
     def _check_outputs(self, known: set[str]) -> None:
         _unique("output", [_name_ok("output", o.name) for o in self.outputs], self.name)

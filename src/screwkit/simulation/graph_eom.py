@@ -104,9 +104,9 @@ def checked_graph_friction(mech: Mechanism, friction: Sequence[JointFriction]
     coefficient needs a joint that turns (not P), a translation one a joint that slides (P or
     C); coefficients are ≥ 0."""
     names = {j.name: j for j in mech.joints}
-    from screwkit.kinematics.graph.idle import rods
+    from screwkit.model.spin_groups import spin_groups
 
-    rod_balls = {mech.joints[k].name: body for body, a, b in rods(mech) for k in (a, b)}
+    rod_balls = {mech.joints[k].name: g.label for g in spin_groups(mech) for k in g.balls}
     merged: dict[str, JointFriction] = {}
     for f in friction:
         j = names.get(f.joint)
@@ -119,7 +119,8 @@ def checked_graph_friction(mech: Mechanism, friction: Sequence[JointFriction]
         if f.rotation and f.joint in rod_balls:
             raise SimulationError(
                 f"{mech.name}: joint {f.joint!r} is a ball joint of the rod "
-                f"{rod_balls[f.joint]!r}, which lies between two ball joints: its spin about "
+                f"{rod_balls[f.joint]!r}, which lies between two ball joints (a body, or a "
+                "telescopic leg slid along their line): its spin about "
                 "its own axis is idle and held at zero, so friction there, which would drive "
                 "that spin, is not modelled; put friction on the other joints")
         if f.rotation and j.kind == "P":

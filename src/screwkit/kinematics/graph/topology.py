@@ -22,6 +22,7 @@ from screwkit.kinematics.graph.closure import GraphLayout, graph_layout
 from screwkit.kinematics.graph.newton import RANK_CUTOFF, linearise
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import GROUND, Mechanism
+from screwkit.model.spin_groups import spin_groups
 
 Array = NDArray[np.float64]
 
@@ -152,7 +153,12 @@ def _null_freedoms(mech: Mechanism, lay: GraphLayout, lin: Any) -> tuple[list[st
     screws = np.broadcast_to(lin.frames.screws, (null.shape[0], *lin.frames.screws.shape[1:]))
     V, _ = body_twists(mech, lay, screws, qd)
     cols = []
+    # a P joint inside a telescopic leg has no centre (its 'at' may be off the leg's line,
+    # which its idle spin turns): the leg's balls and the bodies' other joints tell
+    slides = {k for g in spin_groups(mech) for k in g.slides}
     for i, j in enumerate(mech.joints):
+        if i in slides:
+            continue
         c = lin.frames.centres[0, i]
         for body in j.bodies:
             if body != GROUND:
@@ -187,15 +193,12 @@ def _null_freedoms(mech: Mechanism, lay: GraphLayout, lin: Any) -> tuple[list[st
 
 
 def _rods(mech: Mechanism) -> list[tuple[str, str, str]]:
-    """Bodies held by exactly two ball joints and nothing else: each can spin about the line
-    through its two ball centres, an idle freedom (a point it carries off that line turns with
-    it, but no joint moves)."""
-    out = []
-    for b in mech.body_names:
-        joints = [j for j in mech.joints if b in j.bodies]
-        if len(joints) == 2 and all(j.kind == "S" for j in joints):
-            out.append((b, joints[0].name, joints[1].name))
-    return out
+    """Rods: bodies held by exactly two ball joints and nothing else, and telescopic legs of
+    bodies slid along the line between two balls (model/spin_groups.py): each can spin about
+    the line through its two ball centres, an idle freedom (a point it carries off that line
+    turns with it, but no joint moves)."""
+    return [(g.label, mech.joints[g.balls[0]].name, mech.joints[g.balls[1]].name)
+            for g in spin_groups(mech)]
 
 
 def _driven_verdict(mech: Mechanism, mobility: int, idle: list[str]) -> tuple[list[str], str]:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from typing import Any
 
 import numpy as np
@@ -48,6 +48,8 @@ DISTINCT = 1e-6
 #: points at least per thread when a route polishes and certifies in threads (below, one
 #: thread: a pool costs ~0.1 ms to start)
 THREAD_POINTS = 512
+#: instances at least per part when a batch is solved in parts on threads
+PART_INSTANCES = 64
 #: the fields of a certificate, in order
 _FIELDS = tuple(f.name for f in fields(Certificate))
 
@@ -79,6 +81,12 @@ class EigenRoute:
     #: threads the polish and the fast α-test of a batch's points run on (their compiled
     #: kernels release the GIL and go point by point: the same results on any number)
     threads: int = 1
+    #: the eliminator with no threads of its own, and the step a part of a batch starts at a
+    #: multiple of (the eliminator's own grouping of instances): with both, a batch of at
+    #: least ``threads`` × :data:`PART_INSTANCES` instances is solved in ``threads`` contiguous
+    #: parts side by side, each part wholly on one thread (:func:`eigen_route_in_parts`)
+    eliminate_alone: Callable[[Complex, int], tuple[Complex, Complex]] | None = None
+    part_step: int = 1
 
 
 def newton(system: PolynomialSystem, x: Complex, p: Complex, steps: int) -> Complex:
@@ -181,6 +189,32 @@ def eigen_route(route: EigenRoute, targets: Complex
         cert = joined(cert, c)
     order = np.argsort(inst, kind="stable")
     return _take(xs, order), _take(inst, order), ok, rows_of(cert, order)
+
+
+def eigen_route_in_parts(route: EigenRoute, targets: Complex
+                         ) -> tuple[Complex, NDArray[np.intp], NDArray[np.bool_], Certificate]:
+    """:func:`eigen_route` of a batch in ``route.threads`` contiguous parts side by side, each
+    part's elimination, polish, α-test and distinctness test on one thread (the route's
+    ``eliminate_alone``, no threads within a part), the parts' results joined in order. The
+    same points, certificates and verdicts as one call: every step treats an instance on its
+    own, but for the eliminator's groups of ``part_step`` instances, which the parts' cuts
+    keep whole. One thread's GIL-held numpy steps overlap the other's compiled kernels, where
+    threads within each step (one step at a time) leave a core idle between steps (1,000
+    Stewart instances, 2 cores: wall 0.66–0.73 → see docs/kinematics.md "Speed")."""
+    B, parts = len(targets), route.threads
+    if route.eliminate_alone is None or parts <= 1 or B < parts * PART_INSTANCES:
+        return eigen_route(route, targets)
+    step = route.part_step
+    cuts = [step * (-(-B // step) * t // parts) for t in range(parts)] + [B]
+    alone = replace(route, eliminate=route.eliminate_alone, threads=1, eliminate_alone=None)
+    with ThreadPoolExecutor(parts) as pool:
+        futures = [pool.submit(eigen_route, alone, targets[a:b])
+                   for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
+        results = [f.result() for f in futures]
+    xs = np.concatenate([r[0] for r in results])
+    inst = np.concatenate([r[1] + a for r, a in zip(results, cuts, strict=False)])
+    ok = np.concatenate([r[2] for r in results])
+    return xs, inst, ok, _joined_all([r[3] for r in results])
 
 
 def _eigen_pass(route: EigenRoute, targets: Complex, label: int
@@ -351,7 +385,7 @@ def solve_eigen_first(route: EigenRoute, targets: Complex,
     parameter homotopy (``options``) for the instances it does not settle (module docstring).
     ``route`` of the result says which ran for each instance."""
     B, m = len(targets), route.count
-    x_eig, i_eig, ok, cert = eigen_route(route, targets)
+    x_eig, i_eig, ok, cert = eigen_route_in_parts(route, targets)
     rows = np.flatnonzero(ok[i_eig])
     if len(rows) < len(i_eig):  # (else every row)
         cert, x_eig, i_eig = rows_of(cert, rows), _take(x_eig, rows), _take(i_eig, rows)

@@ -131,6 +131,21 @@ class TurnJoint:
 
 
 @dataclass(frozen=True)
+class TelescopicLeg:
+    """Two bodies slid along the line between their balls by one P joint (model/spin_groups.py):
+    one distance equation between the balls' centres, ‖b − a‖² = ℓ², ℓ = ``length`` + ``sign``
+    · s (scaled; s the slide, a parameter when it is an input: ``column``), or none when the
+    slide is passive (a strut of free length). ``balls`` the centres' points on the P joint's
+    first and second body; the bodies themselves carry no other points and are not unknowns."""
+
+    joint: int
+    balls: tuple[int, int]
+    column: int | None
+    length: float
+    sign: float
+
+
+@dataclass(frozen=True)
 class SpatialPointFormulation:
     """The point system of one mechanism (module docstring) and how to read its solutions.
 
@@ -154,6 +169,7 @@ class SpatialPointFormulation:
     source: dict[int, str] = field(default_factory=dict)
     slides: tuple[SlideJoint, ...] = ()
     turns: tuple[TurnJoint, ...] = ()
+    legs: tuple[TelescopicLeg, ...] = ()
 
     def _frame_of(self, body: str) -> BodyEquations:
         return next(be for be in self.bodies if be.body == body)
@@ -188,7 +204,14 @@ class SpatialPointFormulation:
         driven = [X[:, sl.column:sl.column + 1] / self.scale for sl in self.slides
                   if sl.column is not None]
         driven += [self._turn_coefficients(t, X) for t in self.turns]
+        driven += [self.leg_lengths(leg, X)[:, None] ** 2 for leg in self.legs
+                   if leg.column is not None]
         return np.hstack([known, np.broadcast_to(const, (X.shape[0], const.size)), *driven])
+
+    def leg_lengths(self, leg: TelescopicLeg, X: Array) -> Array:
+        """A driven leg's signed length ℓ (N,) (scaled) at the input rows X."""
+        assert leg.column is not None
+        return np.asarray(leg.length + leg.sign * X[:, leg.column] / self.scale)
 
     def _constants(self, pts: ArrayLike) -> NDArray[np.complex128] | Array:
         """The distance, coefficient and U parameters of the points ``pts`` (P, 3)."""
@@ -274,6 +297,10 @@ class SpatialPointFormulation:
             u, v = pts[b2] - pts[b1], pts[b3] - pts[b1]
             out += list(np.linalg.solve(np.stack([u, v, np.cross(u, v)], 1),
                                         pts[t.point] - pts[b1]))
+        for leg in self.legs:
+            if leg.column is not None:
+                d = pts[leg.balls[1]] - pts[leg.balls[0]]
+                out.append(complex(d @ d))
         x = np.concatenate([pts[list(self.unknown)].reshape(-1),
                             [slide[sl.joint] for sl in self.slides if sl.column is None]])
         p = np.array(out, dtype=complex)
@@ -326,8 +353,27 @@ class SpatialPointFormulation:
         for be in self.bodies:
             pick = list(be.base) + [m for m in be.points if m not in be.base]
             poses[be.body] = _fit_pose(drawn[pick], world[:, pick], len(be.base) == 2)
+        for leg in self.legs:
+            poses.update(self._leg_poses(leg, drawn, world, X))
         lay = graph_layout(mech)
         return joint_values(mech, lay, poses), lay
+
+
+    def _leg_poses(self, leg: TelescopicLeg, drawn: Array, world: Array, X: Array
+                   ) -> dict[str, Pose]:
+        """The poses of a leg's two bodies: the least rotation of the drawn ball-to-ball
+        direction onto the solved one (over the signed length ℓ: a negative ℓ turns the leg
+        over), each body placed by its ball (its spin about the line left at zero)."""
+        i, j = leg.balls
+        d = world[:, j] - world[:, i]
+        if leg.column is None:  # a passive slide: the leg as long as the balls are apart
+            ell = np.linalg.norm(d, axis=1)
+        else:
+            ell = self.scale * self.leg_lengths(leg, X)
+        R = least_rotation(drawn[j] - drawn[i], d * np.sign(ell)[:, None])
+        first, second = self.mechanism.joints[leg.joint].bodies
+        return {first: (R, world[:, i] - np.einsum("nij,j->ni", R, drawn[i])),
+                second: (R, world[:, j] - np.einsum("nij,j->ni", R, drawn[j]))}
 
 
 def _fit_pose(drawn: Array, solved: Array, on_a_line: bool) -> Pose:

@@ -20,10 +20,12 @@ from screwkit.kinematics.modes.spatial_points import (
     BodyEquations,
     SlideJoint,
     SpatialPointFormulation,
+    TelescopicLeg,
     TurnJoint,
 )
 from screwkit.messages import listing
 from screwkit.model.mechanism import Mechanism
+from screwkit.model.spin_groups import SpinGroup, spin_groups
 
 
 def _refuse(mech: Mechanism, why: str) -> CapabilityError:
@@ -56,17 +58,21 @@ class _Points:
     u_joints: list[tuple[int, int, int]]
     slides: list[SlideJoint]
     turns: list[TurnJoint]
+    #: each S joint's centre point
+    centres: dict[int, int]
 
 
-def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int]) -> _Points:
+def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
+            legs: set[int]) -> _Points:
     """Every joint's points (scaled drawn positions, owning bodies), the U joints' (centre,
     first arm, second arm), the P and C joints that place no body and the R inputs between
-    moving bodies (module docstring)."""
+    moving bodies (module docstring); the P joints of telescopic legs (``legs``) have none."""
     drawn: list[Array] = []
     owners: list[frozenset[str]] = []
     u_joints = []
     slides: list[SlideJoint] = []
     turns: list[TurnJoint] = []
+    centres: dict[int, int] = {}
     columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
 
     def add(at: Array, bodies: tuple[str, ...]) -> int:
@@ -75,13 +81,15 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int]) -> 
         return len(drawn) - 1
 
     for k, j in enumerate(mech.joints):
+        if k in legs:
+            continue
         if k in placing:
             if j.kind == "R":  # its axis, in both placed bodies
                 add(j.at, j.bodies)
                 add(j.at + scale * j.axis, j.bodies)
             continue
         if j.kind == "S":
-            add(j.at, j.bodies)
+            centres[k] = add(j.at, j.bodies)
         elif j.kind == "R":
             ends = (add(j.at, j.bodies), add(j.at + scale * j.axis, j.bodies))
             if j.name in columns:  # driven between two moving bodies
@@ -100,7 +108,7 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int]) -> 
             a = add(j.at + scale * j.axis, (j.bodies[0],))
             b = add(j.at + scale * j.axis2, (j.bodies[1],))
             u_joints.append((c, a, b))
-    return _Points(drawn, owners, u_joints, slides, turns)
+    return _Points(drawn, owners, u_joints, slides, turns, centres)
 
 
 def _third(pts: Array, b1: int, b2: int, candidates: list[int]) -> int | None:
@@ -201,7 +209,11 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                       "freedoms)")
     origin = np.array([j.at for j in mech.joints]).mean(0)
     scale = float(mech.length_scale)
-    pts = _points(mech, origin, scale, placing)
+    telescopic = [g for g in spin_groups(mech) if len(g.bodies) == 2 and len(g.slides) == 1]
+    leg_slides = {g.slides[0] for g in telescopic}
+    leg_bodies = {b for g in telescopic for b in g.bodies}
+    pts = _points(mech, origin, scale, placing, leg_slides)
+    legs = [_leg(mech, g, pts, scale) for g in telescopic]
     drawn = np.array(pts.drawn)
     known, source = [], {}
     for k, own in enumerate(pts.owners):
@@ -215,14 +227,14 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     # in reverse (RSCR with an S–S dyad is square in one of the two)
     tried = []
     for ties_reversed in (False, True):
-        pts = _points(mech, origin, scale, placing)
-        bodies = _write_bodies(mech, pts, _body_order(mech, have, ties_reversed), have, drawn,
-                               known, source)
+        pts = _points(mech, origin, scale, placing, leg_slides)
+        order = [b for b in _body_order(mech, have, ties_reversed) if b not in leg_bodies]
+        bodies = _write_bodies(mech, pts, order, have, drawn, known, source)
         passive = [sl for sl in pts.slides if sl.column is None]
         n = 3 * len(unknown) + len(passive)
         n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies)
                 + len(pts.u_joints) + sum(3 * len(sl.a) for sl in pts.slides)
-                + 3 * len(pts.turns))
+                + 3 * len(pts.turns) + sum(leg.column is not None for leg in legs))
         tried.append(n_eq)
         if n_eq == n:
             break
@@ -242,11 +254,11 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                       "the monodromy that would find its start solutions is not practical at "
                       "that size (the 3-UPU's 90 reached one solution in 36 s); follow the drawn "
                       "mode with the graph tracker (--modes drawn)")
-    system = _compile(unknown, known, bodies, pts)
+    system = _compile(unknown, known, bodies, pts, legs)
     form = SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(pts.owners),
                                    tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
                                    tuple(pts.u_joints), source, tuple(pts.slides),
-                                   tuple(pts.turns))
+                                   tuple(pts.turns), tuple(legs))
     _check_rank(form)
     return form
 
@@ -334,10 +346,26 @@ def _orient(mech: Mechanism, pts: _Points, rank: dict[str, int]) -> None:
             pts.turns[i] = TurnJoint(t.joint, second, t.point, t.column, t.axis, -t.sign)
 
 
+def _leg(mech: Mechanism, g: SpinGroup, pts: _Points, scale: float) -> TelescopicLeg:
+    """The telescopic leg of the spin group ``g`` (two bodies, one P joint): its balls'
+    points on the P joint's first and second body, its drawn length (scaled) and the sign of
+    its slide along the first-to-second direction."""
+    k = g.slides[0]
+    j = mech.joints[k]
+    ball = {b: next(m for m in g.balls if b in mech.joints[m].bodies) for b in j.bodies}
+    i0, i1 = pts.centres[ball[j.bodies[0]]], pts.centres[ball[j.bodies[1]]]
+    d = np.asarray(pts.drawn[i1] - pts.drawn[i0])
+    length = float(np.linalg.norm(d))
+    columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
+    return TelescopicLeg(k, (i0, i1), columns.get(j.name), length,
+                         float(np.sign(j.axis @ d)))
+
+
 def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
-             pts: _Points) -> PolynomialSystem:
+             pts: _Points, legs: list[TelescopicLeg]) -> PolynomialSystem:
     """The system of the module docstring: unknowns the solved points' (x, y, z); parameters
-    the placed points', then per body its d's and coefficients, then the U joints' g."""
+    the placed points', then per body its d's and coefficients, then the U joints' g, the
+    driven slides, the driven turns' coefficients and the driven legs' squared lengths."""
     counter = iter(range(10**9))
     point: dict[int, list[Poly]] = {}
     for k in unknown:
@@ -399,4 +427,9 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
         ta, tb, tc = (Poly.variable(next(counter)) for _ in range(3))
         params += [f"{x}{t.point}_turn" for x in "abc"]
         eqs += [point[t.point][c] - b1[c] - ta * u[c] - tb * v[c] - tc * w[c] for c in range(3)]
+    for leg in legs:  # ‖b − a‖² = ℓ² (a passive slide: no equation, a strut of free length)
+        if leg.column is not None:
+            d = sub(point[leg.balls[1]], point[leg.balls[0]])
+            eqs.append(dot(d, d) - Poly.variable(next(counter)))
+            params.append(f"l{leg.joint}")
     return compile_system(eqs, names, params)

@@ -16,17 +16,17 @@ route, with ``route`` naming per instance the method that ran.
 from __future__ import annotations
 
 from concurrent.futures import ThreadPoolExecutor
-from functools import lru_cache
+from functools import lru_cache, partial
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from screwkit.algebraic import compiled
+from screwkit.algebraic import compiled, hessenberg_eig
 from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex
 from screwkit.algebraic.solve import Solutions
 from screwkit.errors import InputError
-from screwkit.kinematics.modes import eigen_first
+from screwkit.kinematics.modes import eigen_first, stewart_sparse
 from screwkit.kinematics.modes.stewart import (
     PATCH,
     STEWART_GENERIC_COUNT,
@@ -116,7 +116,8 @@ def stewart_route() -> eigen_first.EigenRoute:
     polish and fast α-test on the template's :data:`.stewart_template.THREADS` threads."""
     return eigen_first.EigenRoute(stewart_system(), STEWART_GENERIC_COUNT, template_solve, CHARTS,
                                   stewart_start, TEMPLATE, HOMOTOPY, NEWTON_STEPS,
-                                  dense_quadrics, THREADS)
+                                  dense_quadrics, THREADS, partial(template_solve, threads=1),
+                                  CHUNK)
 
 
 def solve_stewart(params: ArrayLike, options: TrackOptions | None = None) -> Solutions:
@@ -130,5 +131,10 @@ def solve_stewart(params: ArrayLike, options: TrackOptions | None = None) -> Sol
     # a batch runs on the cores in threads of its own (template_solve): BLAS's threads held at
     # one for the whole solve, not only the elimination (OpenBLAS's threads, woken by a later
     # small product, spin on the cores the batch's threads use)
+    # the compiled kernels made (or loaded) once, before the parts' threads start
+    if stewart_sparse.AVAILABLE:
+        stewart_sparse.prepare()
+    if hessenberg_eig.AVAILABLE:
+        hessenberg_eig.prepare()
     with blas_controller().limit(limits=1, user_api="blas"):
         return eigen_first.solve_eigen_first(stewart_route(), targets, options)

@@ -280,7 +280,8 @@ def coefficients(params: Complex, label: int = 0) -> Complex:
     return out
 
 
-def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
+def template_solve(params: Complex, label: int = 0, threads: int | None = None
+                   ) -> tuple[Complex, Complex]:
     """The 40 points (B, 40, 8) of the instances (B, 42) in Study coordinates on the patch,
     unpolished, eliminated in the chart ``label``, and their ξ1 (B, 40): the action matrix's
     eigenvalues (for real parameters the template and the action matrix are real, so the
@@ -290,7 +291,8 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
     (LAPACK and the sparse kernel release the GIL); each instance's arithmetic is the same
     either way. It is the same as alone, but for the instances in whole groups of real ones
     (the sparse route, module docstring); a real instance's is real in a batch with complex
-    ones too."""
+    ones too. ``threads`` caps the threads (1: all on the calling thread, for a batch
+    already split among threads by the caller)."""
     B = len(params)
     m = len(data.BASIS)
     points = np.full((B, m, 8), np.nan, dtype=complex)
@@ -309,7 +311,7 @@ def template_solve(params: Complex, label: int = 0) -> tuple[Complex, Complex]:
                     if len(rows):
                         points[rows], keys[rows] = _chunk(params[rows], label, work)
 
-    threads = min(THREADS, -(-B // CHUNK))
+    threads = min(THREADS if threads is None else threads, -(-B // CHUNK))
     # BLAS's own threads held at one: with a batch in threads, else each part's LAPACK calls
     # start threads of their own on the same cores (56 against 1.8 ms per instance in a batch
     # of 1,000 by the LAPACK route, 2.8 against 1.8 by the sparse route, OPENBLAS_NUM_THREADS
