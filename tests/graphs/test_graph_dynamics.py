@@ -70,7 +70,7 @@ def _energy_and_momentum(mech: sk.Mechanism, md: object, g: np.ndarray
 
 
 @pytest.mark.parametrize("name", ["watt_sixbar", "stephenson3_sixbar", "double_wishbone",
-                                  "stewart_platform", "delta_robot", "six_sps"])
+                                  "stewart_platform", "delta_robot", "six_sps", "three_rps"])
 def test_power_momentum_and_balance_laws(name: str, tmp_path: Path) -> None:
     spec = sk.load_spec(six_sps_spec(tmp_path) if name == "six_sps"
                         else EXAMPLES / f"{name}.toml")
@@ -78,7 +78,8 @@ def test_power_momentum_and_balance_laws(name: str, tmp_path: Path) -> None:
     x0 = spec.inputs[len(spec.inputs) // 3]
     n_in = len(mech.inputs)
     direction = np.linspace(1.0, 0.4, n_in)  # a constant input rate along this direction
-    h = 1e-3 * (mech.length_scale if name in ("stewart_platform", "six_sps") else 1.0)
+    h = 1e-3 * (mech.length_scale if name in ("stewart_platform", "six_sps", "three_rps")
+                else 1.0)
     steps = np.array([-2, -1, 0, 1, 2], dtype=float)
     X = x0 + steps[:, None] * h * direction
     motion = solve_mechanism(mech, X, rates=direction, accelerations=0.0)

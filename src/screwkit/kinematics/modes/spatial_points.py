@@ -64,6 +64,7 @@ from screwkit.algebraic.solve import StartSolutions
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout, joint_motion
 from screwkit.kinematics.modes.rod_loops import least_rotation
+from screwkit.kinematics.modes.spatial_point_legs import PivotLeg, circle_parameters, leg_poses
 from screwkit.kinematics.modes.starts import start_solutions
 from screwkit.kinematics.modes.stewart_decode import Pose, joint_values
 from screwkit.kinematics.tracker.loop import Configuration
@@ -170,6 +171,7 @@ class SpatialPointFormulation:
     slides: tuple[SlideJoint, ...] = ()
     turns: tuple[TurnJoint, ...] = ()
     legs: tuple[TelescopicLeg, ...] = ()
+    pivots: tuple[PivotLeg, ...] = ()
 
     def _frame_of(self, body: str) -> BodyEquations:
         return next(be for be in self.bodies if be.body == body)
@@ -206,6 +208,7 @@ class SpatialPointFormulation:
         driven += [self._turn_coefficients(t, X) for t in self.turns]
         driven += [self.leg_lengths(leg, X)[:, None] ** 2 for leg in self.legs
                    if leg.column is not None]
+        driven += [circle_parameters(self.mechanism, leg, X, self.scale) for leg in self.pivots]
         return np.hstack([known, np.broadcast_to(const, (X.shape[0], const.size)), *driven])
 
     def leg_lengths(self, leg: TelescopicLeg, X: Array) -> Array:
@@ -301,6 +304,9 @@ class SpatialPointFormulation:
             if leg.column is not None:
                 d = pts[leg.balls[1]] - pts[leg.balls[0]]
                 out.append(complex(d @ d))
+        for pv in self.pivots:  # the ball's circle: (Q − A)·(A1 − A) = h, ‖Q − A‖² = r²
+            w = pts[pv.ball] - pts[pv.axis[0]]
+            out += [complex(w @ (pts[pv.axis[1]] - pts[pv.axis[0]])), complex(w @ w)]
         x = np.concatenate([pts[list(self.unknown)].reshape(-1),
                             [slide[sl.joint] for sl in self.slides if sl.column is None]])
         p = np.array(out, dtype=complex)
@@ -355,6 +361,8 @@ class SpatialPointFormulation:
             poses[be.body] = _fit_pose(drawn[pick], world[:, pick], len(be.base) == 2)
         for leg in self.legs:
             poses.update(self._leg_poses(leg, drawn, world, X))
+        for pv in self.pivots:
+            poses.update(leg_poses(mech, pv, poses[pv.base], world[:, pv.ball], X))
         lay = graph_layout(mech)
         return joint_values(mech, lay, poses), lay
 

@@ -13,6 +13,7 @@ import numpy as np
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.modes.planar import placed_by_inputs
+from screwkit.kinematics.modes.spatial_point_legs import PivotLeg, pivot_legs
 from screwkit.kinematics.modes.spatial_points import (
     COLLINEAR,
     MAX_UNKNOWNS,
@@ -58,8 +59,9 @@ class _Points:
     u_joints: list[tuple[int, int, int]]
     slides: list[SlideJoint]
     turns: list[TurnJoint]
-    #: each S joint's centre point
+    #: each S joint's centre point, each R joint's two axis points (not the inputs that place)
     centres: dict[int, int]
+    axes: dict[int, tuple[int, int]]
 
 
 def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
@@ -73,6 +75,7 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
     slides: list[SlideJoint] = []
     turns: list[TurnJoint] = []
     centres: dict[int, int] = {}
+    axes: dict[int, tuple[int, int]] = {}
     columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
 
     def add(at: Array, bodies: tuple[str, ...]) -> int:
@@ -91,7 +94,7 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
         if j.kind == "S":
             centres[k] = add(j.at, j.bodies)
         elif j.kind == "R":
-            ends = (add(j.at, j.bodies), add(j.at + scale * j.axis, j.bodies))
+            ends = axes[k] = (add(j.at, j.bodies), add(j.at + scale * j.axis, j.bodies))
             if j.name in columns:  # driven between two moving bodies
                 q = add(j.at + scale * _across(j.axis), (j.bodies[1],))
                 turns.append(TurnJoint(k, j.bodies[0], q, columns[j.name], ends))
@@ -108,7 +111,7 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
             a = add(j.at + scale * j.axis, (j.bodies[0],))
             b = add(j.at + scale * j.axis2, (j.bodies[1],))
             u_joints.append((c, a, b))
-    return _Points(drawn, owners, u_joints, slides, turns, centres)
+    return _Points(drawn, owners, u_joints, slides, turns, centres, axes)
 
 
 def _third(pts: Array, b1: int, b2: int, candidates: list[int]) -> int | None:
@@ -210,10 +213,12 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     origin = np.array([j.at for j in mech.joints]).mean(0)
     scale = float(mech.length_scale)
     telescopic = [g for g in spin_groups(mech) if len(g.bodies) == 2 and len(g.slides) == 1]
-    leg_slides = {g.slides[0] for g in telescopic}
-    leg_bodies = {b for g in telescopic for b in g.bodies}
+    pivoted = pivot_legs(mech, have)
+    leg_slides = {g.slides[0] for g in telescopic} | {k[1] for k in pivoted}
+    leg_bodies = {b for g in telescopic for b in g.bodies} | {b for k in pivoted for b in k[3:5]}
     pts = _points(mech, origin, scale, placing, leg_slides)
     legs = [_leg(mech, g, pts, scale) for g in telescopic]
+    pivots = [_pivot(mech, k, pts) for k in pivoted]
     drawn = np.array(pts.drawn)
     known, source = [], {}
     for k, own in enumerate(pts.owners):
@@ -234,7 +239,8 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
         n = 3 * len(unknown) + len(passive)
         n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies)
                 + len(pts.u_joints) + sum(3 * len(sl.a) for sl in pts.slides)
-                + 3 * len(pts.turns) + sum(leg.column is not None for leg in legs))
+                + 3 * len(pts.turns) + sum(leg.column is not None for leg in legs)
+                + 2 * len(pivots))
         tried.append(n_eq)
         if n_eq == n:
             break
@@ -254,11 +260,11 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                       "the monodromy that would find its start solutions is not practical at "
                       "that size (the 3-UPU's 90 reached one solution in 36 s); follow the drawn "
                       "mode with the graph tracker (--modes drawn)")
-    system = _compile(unknown, known, bodies, pts, legs)
+    system = _compile(unknown, known, bodies, pts, legs, pivots)
     form = SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(pts.owners),
                                    tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
                                    tuple(pts.u_joints), source, tuple(pts.slides),
-                                   tuple(pts.turns), tuple(legs))
+                                   tuple(pts.turns), tuple(legs), tuple(pivots))
     _check_rank(form)
     return form
 
@@ -361,8 +367,19 @@ def _leg(mech: Mechanism, g: SpinGroup, pts: _Points, scale: float) -> Telescopi
                          float(np.sign(j.axis @ d)))
 
 
+def _pivot(mech: Mechanism, found: tuple[int, int, int, str, str, str], pts: _Points
+           ) -> PivotLeg:
+    """The pivoted leg (modes/spatial_point_legs.py) of the joints and bodies ``found``."""
+    kr, kp, ks, arm, slider, base = found
+    columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
+    sign = 1.0 if mech.joints[kp].bodies[1] == slider else -1.0
+    return PivotLeg((kr, kp, ks), arm, slider, base, pts.axes[kr], pts.centres[ks],
+                    columns[mech.joints[kp].name], sign)
+
+
 def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
-             pts: _Points, legs: list[TelescopicLeg]) -> PolynomialSystem:
+             pts: _Points, legs: list[TelescopicLeg], pivots: list[PivotLeg]
+             ) -> PolynomialSystem:
     """The system of the module docstring: unknowns the solved points' (x, y, z); parameters
     the placed points', then per body its d's and coefficients, then the U joints' g, the
     driven slides, the driven turns' coefficients and the driven legs' squared lengths."""
@@ -432,4 +449,9 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
             d = sub(point[leg.balls[1]], point[leg.balls[0]])
             eqs.append(dot(d, d) - Poly.variable(next(counter)))
             params.append(f"l{leg.joint}")
+    for pv in pivots:  # the ball on its circle: (Q − A)·(A1 − A) = h, ‖Q − A‖² = r²
+        w = sub(point[pv.ball], point[pv.axis[0]])
+        eqs.append(dot(w, sub(point[pv.axis[1]], point[pv.axis[0]])) - Poly.variable(next(counter)))
+        eqs.append(dot(w, w) - Poly.variable(next(counter)))
+        params += [f"h{pv.joints[0]}", f"r{pv.joints[0]}"]
     return compile_system(eqs, names, params)

@@ -1,0 +1,119 @@
+"""Pivoted legs of the spatial point formulation (modes/spatial_points.py): an R–P–S leg
+written as two equations on its ball's centre instead of two bodies of points.
+
+A leg of two bodies, an arm turning on an R joint about an axis of a placed body (the ground,
+or a body the inputs place) and a slider on it along a driven P joint, ending in a ball (S)
+joint on another body, and nothing else on the arm or the slider (the legs of a 3-RPS parallel
+robot): at a given slide s the ball's centre Q is a point of the arm, Q0 + σ s u (drawn, u the
+slide's direction, σ its sense), turning about the axis (point A, unit a). So Q is on the
+circle
+
+    (Q − A)·a = h(s),   ‖Q − A‖² = r²(s),   h = (Q0 + σ s u − A)·a,   r² = ‖Q0 + σ s u − A‖²,
+
+two quadrics in Q with the placed axis points A, A + a as parameters and h, r² parameters that
+follow the input. The arm and slider carry no points and are not unknowns (the leg's 21 point
+coordinates become none: a 3-RPS has 9 unknowns, not 63). Their poses are read off Q: the
+arm's turn θ about the axis carries the drawn (Q0 + σ s u − A)'s part square to the axis onto
+the solved one's, the slider is the arm slid by σ s u.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from screwkit.model.mechanism import Mechanism
+
+Array = NDArray[np.float64]
+Pose = tuple[Array, Array]
+#: a leg whose slide or ball is this close (relative) to being along its axis is not taken
+#: (the circle degenerates: the arm's turn does not move the ball)
+ALONG = 1e-6
+
+
+@dataclass(frozen=True)
+class PivotLeg:
+    """An R–P–S leg (module docstring): its joints (R, P, S), its arm and slider, the placed
+    body the R joint turns on, the R joint's two axis points and the ball's point (indices
+    into the formulation's points), the slide's input column and its sense σ (+1: the slider
+    is the P joint's second body)."""
+
+    joints: tuple[int, int, int]
+    arm: str
+    slider: str
+    base: str
+    axis: tuple[int, int]
+    ball: int
+    column: int
+    sign: float
+
+
+def pivot_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str, str]]:
+    """(R, P, S joint indices, arm, slider, base) of every R–P–S leg (module docstring) whose
+    R joint turns on a placed body and whose P joint is an input."""
+    driven = {x.split(".")[0] for x in mech.inputs}
+    held = {b: [k for k, j in enumerate(mech.joints) if b in j.bodies] for b in mech.body_names}
+    out = []
+    for kr, r in enumerate(mech.joints):
+        if r.kind != "R" or r.name in driven:
+            continue
+        for base, arm in (r.bodies, r.bodies[::-1]):
+            if base not in placed or arm in placed or len(held.get(arm, ())) != 2:
+                continue
+            kp = next(k for k in held[arm] if k != kr)
+            p = mech.joints[kp]
+            slider = p.bodies[1] if p.bodies[0] == arm else p.bodies[0]
+            if (p.kind != "P" or p.name not in driven or slider in placed
+                    or len(held.get(slider, ())) != 2):
+                continue
+            ks = next(k for k in held[slider] if k != kp)
+            s = mech.joints[ks]
+            if s.kind != "S" or arm in s.bodies:
+                continue
+            q = s.at - r.at
+            if (np.linalg.norm(np.cross(p.axis, r.axis)) <= ALONG
+                    or np.linalg.norm(np.cross(q, r.axis)) <= ALONG * mech.length_scale):
+                continue
+            out.append((kr, kp, ks, arm, slider, base))
+    return out
+
+
+def arm_point(mech: Mechanism, leg: PivotLeg, X: Array) -> tuple[Array, Array, Array]:
+    """The ball's drawn centre slid as at the input rows X, Q0 + σ s u (N, 3, unscaled world
+    coordinates of the drawing), the R joint's drawn point A and unit axis a."""
+    r, p, s = (mech.joints[k] for k in leg.joints)
+    q = s.at + np.multiply.outer(leg.sign * X[:, leg.column], p.axis)
+    return q, np.asarray(r.at, float), np.asarray(r.axis, float)
+
+
+def circle_parameters(mech: Mechanism, leg: PivotLeg, X: Array, scale: float) -> Array:
+    """The circle's h and r² (N, 2) at the input rows X, in the formulation's scaled
+    coordinates."""
+    q, A, a = arm_point(mech, leg, X)
+    w = (q - A) / scale
+    return np.stack([w @ a, np.einsum("ni,ni->n", w, w)], axis=1)
+
+
+def leg_poses(mech: Mechanism, leg: PivotLeg, base: Pose, ball: Array, X: Array
+              ) -> dict[str, Pose]:
+    """The arm's and slider's poses (R (N, 3, 3), p (N, 3)) with the ball's centre at
+    ``ball`` (N, 3, world), the base body at ``base`` (module docstring)."""
+    Rb, pb = base
+    q0, A, a = arm_point(mech, leg, X)
+    local = np.einsum("nji,nj->ni", Rb, ball - pb) - A  # in the base's drawn frame
+    w0 = q0 - A
+    w0 = w0 - np.multiply.outer(w0 @ a, a)
+    w1 = local - np.multiply.outer(local @ a, a)
+    theta = np.arctan2(np.cross(w0, w1) @ a, np.einsum("ni,ni->n", w0, w1))
+    K = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+    turn = (np.eye(3) + np.sin(theta)[:, None, None] * K
+            + (1.0 - np.cos(theta))[:, None, None] * (K @ K))
+    R = Rb @ turn
+    p = np.einsum("nij,nj->ni", Rb, A - np.einsum("nij,j->ni", turn, A)) + pb
+    u = mech.joints[leg.joints[1]].axis
+    slid = p + np.einsum("nij,j->ni", R, u) * (leg.sign * X[:, leg.column])[:, None]
+    return {leg.arm: (R, p), leg.slider: (R, slid)}
