@@ -81,13 +81,13 @@ def test_a_joint_made_off_its_drawing_is_refused_not_solved_as_drawn(which: str)
 
 
 def test_a_mechanism_no_formulation_takes_is_refused_by_name() -> None:
-    """The double wishbone driven by its wheel's travel (a body freedom, not a joint): no
+    """The Stewart platform driven by its pose, a roll among its drives (a body's turn): no
     formulation takes it, and the message says why the nearest one (the point formulation)
-    does not."""
-    mech = sk.load_spec(EXAMPLES / "double_wishbone_travel.toml").mechanism
-    with pytest.raises(CapabilityError, match="no polynomial formulation takes.*driven at a "
-                                              "body's freedom"):
-        every_mode(mech, np.zeros((1, len(mech.inputs))))
+    does not. (Driven translations are taken: tests/graphs/test_point_drives.py.)"""
+    mech = sk.load_spec(EXAMPLES / "stewart_platform_pose.toml").mechanism
+    with pytest.raises(CapabilityError, match="no polynomial formulation takes.*driven at "
+                                              "platform's roll, a turn"):
+        every_mode(mech, np.zeros((1, len(mech.driven_names))))
 
 
 def test_every_pose_of_the_stewart_example_holds_the_tracked_one() -> None:

@@ -103,13 +103,30 @@ def test_without_shipping_a_process_solves_them_once(spec, monkeypatch):
 
 
 def test_a_graph_without_a_formulation_is_refused_before_any_run(tmp_path):
-    # driven by its wheel's travel (a body freedom): no polynomial formulation takes it
-    wishbone = EXAMPLES / "mechanisms" / "double_wishbone_travel.toml"
-    with pytest.raises(CapabilityError, match="--job modes solves every assembly mode"):
-        define_sweep(wishbone, ["joints.UB.at.z=465:475:2"], "modes")
-    r = runner.invoke(app, ["sweep", str(wishbone), "--vary", "joints.UB.at.z=465:475:2",
+    # driven by its pose, a roll among them (a turn of a body): no polynomial formulation takes it
+    platform = EXAMPLES / "mechanisms" / "stewart_platform_pose.toml"
+    with pytest.raises(CapabilityError, match="--job modes solves every assembly mode.*a turn"):
+        define_sweep(platform, ["joints.S1.at.z=395:405:5"], "modes")
+    r = runner.invoke(app, ["sweep", str(platform), "--vary", "joints.S1.at.z=395:405:5",
                             "--job", "modes", "-o", str(tmp_path / "t.csv"), "--workers", "0"])
     assert r.exit_code == 2 and "--job analyze follows the drawn mode" in " ".join(r.output.split())
+
+
+def test_a_graph_driven_by_a_body_travel_sweeps_every_mode(tmp_path):
+    """The double wishbone driven by its wheel's vertical travel (a body freedom): `--job
+    modes` runs on the point formulation of its augmented mechanism (the travel one linear
+    equation on the wheel centre): 8 modes of 32 complex at the drawing, for each design."""
+    out = tmp_path / "travel.csv"
+    r = runner.invoke(app, ["sweep", str(EXAMPLES / "mechanisms" / "double_wishbone_travel.toml"),
+                            "--vary", "joints.UB.at.z=465:475:2", "--job", "modes", "-o",
+                            str(out), "--workers", "0"])
+    assert r.exit_code == 0, r.output
+    import pandas as pd
+
+    table = pd.read_csv(out)
+    assert list(table["status"]) == ["ok"] * 2
+    assert list(table["modes"]) == [8] * 2 and list(table["modes.certified"]) == [8] * 2
+    assert list(table["generic_count"]) == [32] * 2
 
 
 def test_a_spatial_graph_sweeps_every_mode_by_its_point_formulation(tmp_path):

@@ -16,7 +16,7 @@ system. A row whose paths end singular on a curve of solutions is reported as a 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
@@ -100,7 +100,13 @@ class _RLoopFormulation:
 
 def closure_formulation(mech: Mechanism) -> Formulation:
     """The formulation of this package that takes ``mech``, or a ScrewkitError that says why
-    none does."""
+    none does. A mechanism driven at body freedoms: its augmented mechanism's
+    (kinematics/graph/drives.py; its inputs the joint inputs then the drives), which only the
+    point formulation takes (modes/spatial_point_drives.py)."""
+    if mech.drives:
+        from screwkit.kinematics.graph.drives import augmented
+
+        return closure_formulation(augmented(mech))
     helical = [j.name for j in mech.joints if j.kind == "H"]
     if helical:
         raise CapabilityError(
@@ -211,10 +217,17 @@ def solve_formulation(form: Formulation, p: ArrayLike) -> Solutions:
 
 
 def every_mode(mech: Mechanism, inputs: ArrayLike) -> MechanismModes:
-    """Every real assembly mode of ``mech`` at each row of ``inputs`` (B, n_inputs), radians
-    and metres from the drawing (module docstring). Equal rows are solved once (a closed
+    """Every real assembly mode of ``mech`` at each row of ``inputs`` (B, n_inputs; a
+    mechanism driven at body freedoms: B, joint inputs then drives, ``mech.driven_names``),
+    radians and metres from the drawing (module docstring). Equal rows are solved once (a closed
     motion's first and last rows, both anchors of modes/along.py: one homotopy of the
     Stewart example's eight)."""
+    if mech.drives:  # solved as its augmented mechanism, the virtual chains then left out
+        from screwkit.kinematics.graph.drives import augmented, real_configuration
+
+        whole = every_mode(augmented(mech), inputs)
+        return replace(whole, mechanism=mech, configurations=tuple(
+            real_configuration(mech, c) for c in whole.configurations))
     X = np.atleast_2d(np.asarray(inputs, dtype=float))
     # a structure (no inputs) has rows of nothing: keep their count
     X = X.reshape(X.shape[0], 0) if not mech.inputs else X.reshape(-1, len(mech.inputs))

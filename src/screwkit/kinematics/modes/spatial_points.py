@@ -16,6 +16,11 @@ Systems*, 1994, ch. 2): every body is carried by points, and every constraint is
   it) and a C joint the first two; the second body's are the first body's slid along the axis,
   b_i = a_i + s (a_1 − a_0), with the slide s an unknown, or a parameter when it is an input.
 - A P or R input that joins a body to the ground, or to a body so placed, places it.
+- A telescopic leg (two bodies slid along the line between their balls by one P joint:
+  model/spin_groups.py) is one distance between its balls' centres, ‖b − a‖² = ℓ², ℓ = ℓ0 ± s
+  (:class:`TelescopicLeg`); a pivoted R–P–S leg two equations on its ball's centre
+  (modes/spatial_point_legs.py); a driven body translation one linear equation on the body's
+  drive point (modes/spatial_point_drives.py). Their bodies carry no other points.
 
 At given input values the ground and every body driven from it through input joints are
 placed; the points they carry are parameters. Every other point (x, y, z) is an unknown, and
@@ -64,6 +69,7 @@ from screwkit.algebraic.solve import StartSolutions
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout, joint_motion
 from screwkit.kinematics.modes.rod_loops import least_rotation
+from screwkit.kinematics.modes.spatial_point_drives import PointDrive, chain_poses
 from screwkit.kinematics.modes.spatial_point_legs import PivotLeg, circle_parameters, leg_poses
 from screwkit.kinematics.modes.starts import start_solutions
 from screwkit.kinematics.modes.stewart_decode import Pose, joint_values
@@ -172,6 +178,12 @@ class SpatialPointFormulation:
     turns: tuple[TurnJoint, ...] = ()
     legs: tuple[TelescopicLeg, ...] = ()
     pivots: tuple[PivotLeg, ...] = ()
+    #: driven translations of body points (modes/spatial_point_drives.py), each one's point,
+    #: and the augmented mechanism (with its virtual chains) whose inputs and joints the
+    #: parameters and configurations follow, when the mechanism is driven at body freedoms
+    drives: tuple[PointDrive, ...] = ()
+    drive_points: tuple[int, ...] = ()
+    augmented: Mechanism | None = None
 
     def _frame_of(self, body: str) -> BodyEquations:
         return next(be for be in self.bodies if be.body == body)
@@ -197,11 +209,15 @@ class SpatialPointFormulation:
     def parameters(self, input_values: ArrayLike) -> Array:
         """Parameters at input values (N, n_inputs) or (n_inputs,): the placed points'
         scaled (x, y, z), then per body its squared distances and carried coefficients, then
-        each U joint's g, then the driven slides (scaled) and the driven turns' coefficients."""
+        each U joint's g, then the driven slides (scaled), the driven turns' coefficients, the
+        driven telescopic legs' squared lengths, the pivoted legs' circles (h, r²) and the
+        driven body translations' e·a + v (an augmented mechanism's X: its joint inputs,
+        then its drives)."""
         X = np.atleast_2d(np.asarray(input_values, dtype=float))
         poses = self.placed_poses(X)
         cols = [self._placed_point(k, poses) for k in self.known]
-        known = np.stack(cols, 1).reshape(X.shape[0], -1) if cols else np.zeros((X.shape[0], 0))
+        known = (np.stack(cols, 1).reshape(X.shape[0], 3 * len(cols)) if cols
+                 else np.zeros((X.shape[0], 0)))
         const = self._constants(self.drawn)
         driven = [X[:, sl.column:sl.column + 1] / self.scale for sl in self.slides
                   if sl.column is not None]
@@ -209,6 +225,8 @@ class SpatialPointFormulation:
         driven += [self.leg_lengths(leg, X)[:, None] ** 2 for leg in self.legs
                    if leg.column is not None]
         driven += [circle_parameters(self.mechanism, leg, X, self.scale) for leg in self.pivots]
+        driven += [(d.axis @ (d.at - self.origin) / self.scale + X[:, d.column] / self.scale
+                    )[:, None] for d in self.drives]
         return np.hstack([known, np.broadcast_to(const, (X.shape[0], const.size)), *driven])
 
     def leg_lengths(self, leg: TelescopicLeg, X: Array) -> Array:
@@ -307,6 +325,8 @@ class SpatialPointFormulation:
         for pv in self.pivots:  # the ball's circle: (Q − A)·(A1 − A) = h, ‖Q − A‖² = r²
             w = pts[pv.ball] - pts[pv.axis[0]]
             out += [complex(w @ (pts[pv.axis[1]] - pts[pv.axis[0]])), complex(w @ w)]
+        out += [complex(d.axis @ pts[k]) for d, k in zip(self.drives, self.drive_points,
+                                                         strict=True)]
         x = np.concatenate([pts[list(self.unknown)].reshape(-1),
                             [slide[sl.joint] for sl in self.slides if sl.column is None]])
         p = np.array(out, dtype=complex)
@@ -346,8 +366,9 @@ class SpatialPointFormulation:
         sol = np.real(np.asarray(solutions))
         N = sol.shape[0]
         mech = self.mechanism
+        whole = mech if self.augmented is None else self.augmented
         X = np.broadcast_to(np.atleast_2d(np.asarray(input_values, dtype=float)),
-                            (N, len(mech.inputs)))
+                            (N, len(whole.inputs)))
         poses = self.placed_poses(np.ascontiguousarray(X))
         world = np.empty((N, len(self.drawn), 3))
         for k in self.known:
@@ -363,8 +384,10 @@ class SpatialPointFormulation:
             poses.update(self._leg_poses(leg, drawn, world, X))
         for pv in self.pivots:
             poses.update(leg_poses(mech, pv, poses[pv.base], world[:, pv.ball], X))
-        lay = graph_layout(mech)
-        return joint_values(mech, lay, poses), lay
+        if self.augmented is not None:  # the virtual chains read off their bodies' poses
+            poses.update(chain_poses(self.augmented, poses))
+        lay = graph_layout(whole)
+        return joint_values(whole, lay, poses), lay
 
 
     def _leg_poses(self, leg: TelescopicLeg, drawn: Array, world: Array, X: Array

@@ -13,6 +13,7 @@ import numpy as np
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.modes.planar import placed_by_inputs
+from screwkit.kinematics.modes.spatial_point_drives import PointDrive, real_mechanism
 from screwkit.kinematics.modes.spatial_point_legs import PivotLeg, pivot_legs
 from screwkit.kinematics.modes.spatial_points import (
     COLLINEAR,
@@ -62,13 +63,16 @@ class _Points:
     #: each S joint's centre point, each R joint's two axis points (not the inputs that place)
     centres: dict[int, int]
     axes: dict[int, tuple[int, int]]
+    #: each driven body's drive point
+    drive_points: dict[str, int]
 
 
 def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
-            legs: set[int]) -> _Points:
+            legs: set[int], drives: tuple[PointDrive, ...] = ()) -> _Points:
     """Every joint's points (scaled drawn positions, owning bodies), the U joints' (centre,
     first arm, second arm), the P and C joints that place no body and the R inputs between
-    moving bodies (module docstring); the P joints of telescopic legs (``legs``) have none."""
+    moving bodies (module docstring); the P joints of telescopic legs (``legs``) have none; a
+    driven body carries its drive point (modes/spatial_point_drives.py)."""
     drawn: list[Array] = []
     owners: list[frozenset[str]] = []
     u_joints = []
@@ -111,7 +115,8 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
             a = add(j.at + scale * j.axis, (j.bodies[0],))
             b = add(j.at + scale * j.axis2, (j.bodies[1],))
             u_joints.append((c, a, b))
-    return _Points(drawn, owners, u_joints, slides, turns, centres, axes)
+    drive_points = {d.body: add(d.at, (d.body,)) for d in drives}
+    return _Points(drawn, owners, u_joints, slides, turns, centres, axes, drive_points)
 
 
 def _third(pts: Array, b1: int, b2: int, candidates: list[int]) -> int | None:
@@ -200,7 +205,10 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     if other:
         raise _refuse(mech, f"it has {listing(other)} joints; it takes R, P, C, S and U joints")
     if mech.drives:
-        raise _refuse(mech, "it is driven at a body's freedom, not at joints")
+        raise _refuse(mech, "it is driven at a body's freedom, not at joints (its augmented "
+                      "mechanism, kinematics/graph/drives.py, is taken)")
+    whole = mech
+    mech, drives = real_mechanism(whole)  # an augmented mechanism's real one and its drives
     placed = _placed_bodies(mech)
     placing = {k for _, k in placed[1:] if k is not None}
     have = {b for b, _ in placed}
@@ -216,7 +224,7 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     pivoted = pivot_legs(mech, have)
     leg_slides = {g.slides[0] for g in telescopic} | {k[1] for k in pivoted}
     leg_bodies = {b for g in telescopic for b in g.bodies} | {b for k in pivoted for b in k[3:5]}
-    pts = _points(mech, origin, scale, placing, leg_slides)
+    pts = _points(mech, origin, scale, placing, leg_slides, drives)
     legs = [_leg(mech, g, pts, scale) for g in telescopic]
     pivots = [_pivot(mech, k, pts) for k in pivoted]
     drawn = np.array(pts.drawn)
@@ -232,7 +240,7 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     # in reverse (RSCR with an S–S dyad is square in one of the two)
     tried = []
     for ties_reversed in (False, True):
-        pts = _points(mech, origin, scale, placing, leg_slides)
+        pts = _points(mech, origin, scale, placing, leg_slides, drives)
         order = [b for b in _body_order(mech, have, ties_reversed) if b not in leg_bodies]
         bodies = _write_bodies(mech, pts, order, have, drawn, known, source)
         passive = [sl for sl in pts.slides if sl.column is None]
@@ -240,7 +248,7 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
         n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies)
                 + len(pts.u_joints) + sum(3 * len(sl.a) for sl in pts.slides)
                 + 3 * len(pts.turns) + sum(leg.column is not None for leg in legs)
-                + 2 * len(pivots))
+                + 2 * len(pivots) + len(drives))
         tried.append(n_eq)
         if n_eq == n:
             break
@@ -260,11 +268,13 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                       "the monodromy that would find its start solutions is not practical at "
                       "that size (the 3-UPU's 90 reached one solution in 36 s); follow the drawn "
                       "mode with the graph tracker (--modes drawn)")
-    system = _compile(unknown, known, bodies, pts, legs, pivots)
+    system = _compile(unknown, known, bodies, pts, legs, pivots, drives)
     form = SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(pts.owners),
                                    tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
                                    tuple(pts.u_joints), source, tuple(pts.slides),
-                                   tuple(pts.turns), tuple(legs), tuple(pivots))
+                                   tuple(pts.turns), tuple(legs), tuple(pivots), drives,
+                                   tuple(pts.drive_points[d.body] for d in drives),
+                                   whole if drives else None)
     _check_rank(form)
     return form
 
@@ -378,8 +388,8 @@ def _pivot(mech: Mechanism, found: tuple[int, int, int, str, str, str], pts: _Po
 
 
 def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
-             pts: _Points, legs: list[TelescopicLeg], pivots: list[PivotLeg]
-             ) -> PolynomialSystem:
+             pts: _Points, legs: list[TelescopicLeg], pivots: list[PivotLeg],
+             drives: tuple[PointDrive, ...]) -> PolynomialSystem:
     """The system of the module docstring: unknowns the solved points' (x, y, z); parameters
     the placed points', then per body its d's and coefficients, then the U joints' g, the
     driven slides, the driven turns' coefficients and the driven legs' squared lengths."""
@@ -454,4 +464,8 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
         eqs.append(dot(w, sub(point[pv.axis[1]], point[pv.axis[0]])) - Poly.variable(next(counter)))
         eqs.append(dot(w, w) - Poly.variable(next(counter)))
         params += [f"h{pv.joints[0]}", f"r{pv.joints[0]}"]
+    for drive in drives:  # e · P_a = e · a + v
+        q = point[pts.drive_points[drive.body]]
+        eqs.append(q["xyz".index(drive.freedom)] - Poly.variable(next(counter)))
+        params.append(f"v{drive.body}_{drive.freedom}")
     return compile_system(eqs, names, params)
