@@ -65,16 +65,39 @@ def test_the_legs_are_found_and_their_spins_are_idle(specs: tuple[sk.Spec, sk.Sp
     assert (off.mobility, off.idle, off.free) == (top.mobility, top.idle, top.free)
 
 
-def test_a_leg_slid_off_its_line_is_no_rod(tmp_path: Path) -> None:
-    """A P joint across the leg's line is no telescopic leg (the slide would change the leg's
-    direction, not only its length): no group, and its spin counts as a freedom."""
+def test_a_leg_slid_at_a_slant_still_spins_idly(specs: tuple[sk.Spec, sk.Spec],
+                                               tmp_path: Path) -> None:
+    """A P joint at a slant to its leg's line (its slide changes the leg's direction in its
+    bodies as well as its length): the leg still turns as one body about the line through its
+    balls, an idle spin; the point formulation's distance ‖d0 + s e‖ and the Stewart route's
+    (the same leg vector) give the same platform poses at a slide of 10 mm, and each mode's
+    slide reads back as the input."""
+    from screwkit.kinematics.modes.every_mode import every_mode, solve_formulation
+    from screwkit.kinematics.modes.spatial_points_build import spatial_point_formulation
+
     text = six_sps_text().replace(
         "axis = [-0.33579650605959055, -0.13857379078588428, 0.9316855751944436]",
         "axis = [0, 0, 1]")
-    path = tmp_path / "across.toml"
+    path = tmp_path / "slant.toml"
     path.write_text(text)
-    with pytest.raises(sk.ScrewkitError, match="do not drive the mechanism"):
-        sk.load_spec(path)
+    mech = sk.load_spec(path).mechanism
+    assert [g.bodies for g in spin_groups(mech)][0] == ("cylinder1", "piston1")
+    top = mechanism_topology(mech)
+    assert len(top.idle) == 6 and "mobility 6 + 6 idle" in top.verdict
+    form = spatial_point_formulation(mech)
+    X = np.array([[0.010, 0.0, 0.0, 0.0, 0.0, 0.0]])
+    sol = solve_formulation(form, form.parameters(X))
+    conf, lay = form.configuration(sol.x[sol.real], X[0])
+    stewart = every_mode(mech, X).configurations[0]
+    k = lay.body_of["platform"]
+    a, b = graph_forward(mech, lay, conf), graph_forward(mech, lay, stewart)
+    ours = np.concatenate([a.R[:, k].reshape(-1, 9), a.p[:, k] / mech.length_scale], 1)
+    theirs = np.concatenate([b.R[:, k].reshape(-1, 9), b.p[:, k] / mech.length_scale], 1)
+    assert len(ours) == len(theirs) >= 2
+    assert all(np.abs(theirs - x).max(1).min() <= 1e-8 for x in ours)
+    np.testing.assert_allclose(conf.scalars[:, lay.scalar_col[lay.names.index("P1.s")]], 0.010,
+                               atol=1e-12)
+    assert np.abs(a.residual).max() <= 1e-10 * mech.length_scale
 
 
 def test_the_platform_moves_as_on_the_ups_legs(specs: tuple[sk.Spec, sk.Spec]) -> None:
@@ -278,3 +301,81 @@ def test_the_six_sps_by_points_is_the_stewart_template(specs: tuple[sk.Spec, sk.
         theirs = np.concatenate([b.R[:, k].reshape(-1, 9), b.p[:, k] / mech.length_scale], 1)
         assert len(ours) == len(theirs) >= 2
         assert all(np.abs(theirs - x).max(1).min() <= 1e-8 for x in ours)
+
+
+def _rssr(strut: str | None) -> sk.Mechanism:
+    """An RSSR (a crank, a rod, a rocker; the crank driven) with a collar slid along its rod
+    (``strut="collar"``: the rod and collar a leg whose balls are both on the rod) or a passive
+    strut of free length from a ground ball to the rocker's ball (``strut="damper"``)."""
+    from screwkit.model.mechanism import Body, BodyPoint, Mechanism, MechanismJoint
+
+    z = np.array([0.0, 0.0, 1.0])
+    c0, c1 = np.zeros(3), np.array([0.05, 0.02, 0.03])
+    f0, f1 = np.array([0.2, 0.05, -0.02]), np.array([0.18, 0.1, 0.06])
+    joints = [MechanismJoint("A", "R", ("ground", "crank"), c0, np.array([0.0, 0.3, 1.0])),
+              MechanismJoint("S1", "S", ("crank", "rod"), c1, z),
+              MechanismJoint("S2", "S", ("rod", "rocker"), f1, z),
+              MechanismJoint("B", "R", ("ground", "rocker"), f0, np.array([1.0, 0.2, 0.1]))]
+    bodies = [Body("crank"), Body("rod"), Body("rocker")]
+    inputs: tuple[str, ...] = ("A.theta",)
+    points: tuple[BodyPoint, ...] = ()
+    if strut == "collar":
+        u = (f1 - c1) / np.linalg.norm(f1 - c1)
+        joints.append(MechanismJoint("P", "P", ("rod", "collar"), (c1 + f1) / 2, u))
+        bodies.append(Body("collar"))
+        inputs += ("P.s",)
+        points = (BodyPoint("m", "collar", (c1 + f1) / 2),)
+    elif strut == "damper":
+        g = np.array([0.1, -0.1, 0.0])
+        u = (f1 - g) / np.linalg.norm(f1 - g)
+        joints += [MechanismJoint("T1", "S", ("ground", "cylinder"), g, z),
+                   MechanismJoint("P", "P", ("cylinder", "piston"), (g + f1) / 2, u),
+                   MechanismJoint("T2", "S", ("piston", "rocker"), f1, z)]
+        bodies += [Body("cylinder"), Body("piston")]
+    return Mechanism("RSSR", tuple(bodies), tuple(joints), inputs, points)
+
+
+def test_struts_and_collars_the_formulation_writes_or_refuses_by_name() -> None:
+    """Found by review: a collar slid along a rod (a leg whose two balls are on one body) is
+    left to the general point system, which refuses it by name (the collar held by one
+    joint), its drawn mode followed (before, a bare StopIteration); a passive
+    damper strut from the ground to the rocker of an RSSR carries no equation and reads its
+    slide back from its balls (the rocker's ball distance less the drawn one); and a crank
+    that only a passive strut joins to the ground is placed by its input alone: refused by
+    name (nothing to solve), its drawn mode followed."""
+    from screwkit.errors import CapabilityError
+    from screwkit.kinematics.modes.every_mode import closure_formulation, every_mode
+    from screwkit.model.mechanism import Body, Mechanism, MechanismJoint
+
+    collar = _rssr("collar")
+    motion = solve_mechanism(collar, [[0.0, 0.0], [0.1, 0.01]], every_mode=True)
+    assert motion.modes[0].assembles.all()
+    assert "'collar' has a single joint" in motion.notes[0]
+    damper = _rssr("damper")
+    form = closure_formulation(damper)
+    assert len(form.legs) == 1 and form.legs[0].column is None  # type: ignore[attr-defined]
+    found = every_mode(damper, [[0.4]])
+    conf = found.configurations[0]
+    assert conf.size == 2 and found.worst_closure <= 1e-12
+    lay = graph_layout(damper)
+    fr = graph_forward(damper, lay, conf)
+    f1, g = damper.joint("T2").at, damper.joint("T1").at
+    ball = np.einsum("nij,j->ni", fr.R[:, lay.body_of["rocker"]], f1) + \
+        fr.p[:, lay.body_of["rocker"]]
+    np.testing.assert_allclose(conf.scalars[:, lay.scalar_col[lay.names.index("P.s")]],
+                               np.linalg.norm(ball - g, axis=1) - np.linalg.norm(f1 - g),
+                               atol=1e-12)
+    z = np.array([0.0, 0.0, 1.0])
+    b, g = np.array([0.3, 0.1, 0.05]), np.array([0.05, 0.25, 0.0])
+    u = (b - g) / np.linalg.norm(b - g)
+    placed = Mechanism("rocker and damper", (Body("rocker"), Body("cylinder"), Body("piston")),
+                       (MechanismJoint("R", "R", ("ground", "rocker"), np.zeros(3),
+                                       np.array([0.0, 0.2, 1.0])),
+                        MechanismJoint("S1", "S", ("ground", "cylinder"), g, z),
+                        MechanismJoint("P", "P", ("cylinder", "piston"), (b + g) / 2, u),
+                        MechanismJoint("S2", "S", ("piston", "rocker"), b, z)), ("R.theta",))
+    with pytest.raises(CapabilityError, match="inputs place every body"):
+        closure_formulation(placed)
+    motion = solve_mechanism(placed, [[0.0], [0.3]], every_mode=True)
+    assert len(motion.modes) == 1 and motion.modes[0].assembles.all()
+    assert "inputs place every body" in motion.notes[0]

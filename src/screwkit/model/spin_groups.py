@@ -2,10 +2,11 @@
 
 A body held by exactly two ball (S) joints can spin about the line through their centres
 without moving any other body (a rod). So can a telescopic leg: bodies joined to one another
-only by prismatic (P) joints that slide along that line, and to the rest of the mechanism only
-by two ball joints at its ends (the S–P–S leg of a 6-SPS platform, a strut of cylinder and
-piston). The P joints lock the bodies' turns relative to one another, so the leg has one idle
-spin, shared by its bodies. Such a spin is an idle freedom (Hunt 1978, §2.5: a passive
+only by prismatic (P) joints, and to the rest of the mechanism only by two ball joints (the
+S–P–S leg of a 6-SPS platform, a strut of cylinder and piston). The P joints lock the bodies'
+turns relative to one another, so the leg turns as one body about the line through its balls
+at any slide (its slides along that line, or at a slant to it: the spin moves no joint either
+way), one idle spin shared by its bodies. Such a spin is an idle freedom (Hunt 1978, §2.5: a passive
 freedom that moves no joint): the mobility counts it apart, and the kinematics holds it at
 zero (kinematics/graph/idle.py).
 """
@@ -19,11 +20,6 @@ import numpy as np
 
 if TYPE_CHECKING:
     from screwkit.model.mechanism import Mechanism
-
-#: a P joint's axis counts as along the rod's line when |axis × u| is below this (the drawn
-#: directions are unit vectors)
-ALONG = 1e-9
-
 
 @dataclass(frozen=True)
 class SpinGroup:
@@ -44,8 +40,7 @@ class SpinGroup:
 def spin_groups(mech: Mechanism) -> list[SpinGroup]:
     """Every :class:`SpinGroup` of ``mech``, in the order of their first bodies: the sets of
     moving bodies joined to one another by P joints only (none for a rod) whose other joints
-    are exactly two S joints with distinct centres, every P axis along the line through them
-    (as drawn)."""
+    are exactly two S joints with distinct centres (as drawn)."""
     moving = list(mech.body_names)  # (the ground is not among them)
     slid: dict[str, set[str]] = {b: {b} for b in moving}
     for j in mech.joints:  # the P-connected sets of moving bodies
@@ -68,11 +63,7 @@ def spin_groups(mech: Mechanism) -> list[SpinGroup]:
         if any(mech.joints[k].kind != "P" for k in inner):
             continue
         start, end = (np.asarray(mech.joints[k].at, float) for k in outer)
-        size = float(np.linalg.norm(end - start))
-        if size == 0.0:
-            continue
-        u = (end - start) / size
-        if any(float(np.linalg.norm(np.cross(mech.joints[k].axis, u))) > ALONG for k in inner):
+        if float(np.linalg.norm(end - start)) == 0.0:
             continue
         bodies = tuple(b for b in moving if b in group)
         out.append(SpinGroup(bodies, (outer[0], outer[1]), tuple(inner)))

@@ -1,5 +1,14 @@
-"""Pivoted legs of the spatial point formulation (modes/spatial_points.py): an R–P–S leg
-written as two equations on its ball's centre instead of two bodies of points.
+"""Legs of the spatial point formulation (modes/spatial_points.py) written as equations on
+their balls' centres instead of bodies of points: telescopic S–P–S legs and pivoted R–P–S legs.
+
+A telescopic leg (model/spin_groups.py: two bodies slid by one P joint, each holding one of
+the leg's two balls) keeps its balls' centres a and b at the distance its slide s sets: at s
+the second body's ball is the first body's drawn vector d0 = b0 − a0 slid by s along the P
+joint's axis e, so ‖b − a‖² = ‖d0 + s e‖², a parameter that follows the input (no equation
+when the slide is passive: a strut of free length). Its bodies are read off the balls: the
+least rotation of d0 + s e onto b − a (the spin about the leg's line left at zero), each body
+placed by its ball; a passive slide from the root of ‖d0 + s e‖ = ‖b − a‖ that is 0 at the
+drawn distance.
 
 A leg of two bodies, an arm turning on an R joint about an axis of a placed body (the ground,
 or a body the inputs place) and a slider on it along a driven P joint, ending in a ball (S)
@@ -33,6 +42,65 @@ Pose = tuple[Array, Array]
 #: a leg whose slide or ball is this close (relative) to being along its axis is not taken
 #: (the circle degenerates: the arm's turn does not move the ball)
 ALONG = 1e-6
+
+
+@dataclass(frozen=True)
+class TelescopicLeg:
+    """A telescopic leg (module docstring): its P joint, its balls' centres' points on the P
+    joint's first and second body and those balls' joints (indices into the formulation's
+    points and ``mech.joints``), and the slide's input column (None: passive)."""
+
+    joint: int
+    balls: tuple[int, int]
+    ball_joints: tuple[int, int]
+    column: int | None
+
+
+def leg_vectors(mech: Mechanism, leg: TelescopicLeg, s: Array) -> Array:
+    """The ball-to-ball vectors d0 + s e (N, 3, unscaled) at the slides s (N,)."""
+    a, b = (np.asarray(mech.joints[k].at, float) for k in leg.ball_joints)
+    return (b - a) + np.multiply.outer(s, mech.joints[leg.joint].axis)
+
+
+def leg_slides(mech: Mechanism, leg: TelescopicLeg, distance: Array) -> Array:
+    """A passive leg's slides (N,) at the ball distances (N,): the root of
+    ‖d0 + s e‖ = distance that is 0 at the drawn distance (NaN where none is real)."""
+    a, b = (np.asarray(mech.joints[k].at, float) for k in leg.ball_joints)
+    d0, e = b - a, mech.joints[leg.joint].axis
+    along = float(d0 @ e)
+    with np.errstate(invalid="ignore"):
+        root = np.sqrt(along**2 - d0 @ d0 + distance**2)
+    return np.asarray(-along + (1.0 if along >= 0.0 else -1.0) * root)
+
+
+def telescopic_poses(mech: Mechanism, leg: TelescopicLeg, balls: tuple[Array, Array],
+                     X: Array) -> dict[str, Pose]:
+    """The leg's two bodies' poses with its balls' centres at ``balls`` ((N, 3) each, world):
+    the least rotation of d0 + s e onto b − a, each body placed by its ball."""
+    a, b = balls
+    w = b - a
+    s = (X[:, leg.column] if leg.column is not None
+         else leg_slides(mech, leg, np.linalg.norm(w, axis=1)))
+    R = least_rotations(leg_vectors(mech, leg, s), w)
+    first, second = mech.joints[leg.joint].bodies
+    a0, b0 = (np.asarray(mech.joints[k].at, float) for k in leg.ball_joints)
+    return {first: (R, a - np.einsum("nij,j->ni", R, a0)),
+            second: (R, b - np.einsum("nij,j->ni", R, b0))}
+
+
+def least_rotations(v: Array, w: Array) -> Array:
+    """The rotations (N, 3, 3) turning each v onto each w (N, 3) about v × w (Rodrigues)."""
+    u = v / np.linalg.norm(v, axis=1)[:, None]
+    t = w / np.linalg.norm(w, axis=1)[:, None]
+    axis = np.cross(u, t)
+    sine = np.linalg.norm(axis, axis=1)
+    axis = axis / np.maximum(sine, 1e-300)[:, None]
+    angle = np.arctan2(sine, np.einsum("ni,ni->n", u, t))
+    K = np.zeros((len(v), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -axis[:, 2], axis[:, 1], -axis[:, 0]
+    K = K - np.swapaxes(K, 1, 2)
+    return np.asarray(np.eye(3) + np.sin(angle)[:, None, None] * K
+                      + (1 - np.cos(angle))[:, None, None] * (K @ K))
 
 
 @dataclass(frozen=True)

@@ -16,10 +16,9 @@ Systems*, 1994, ch. 2): every body is carried by points, and every constraint is
   it) and a C joint the first two; the second body's are the first body's slid along the axis,
   b_i = a_i + s (a_1 − a_0), with the slide s an unknown, or a parameter when it is an input.
 - A P or R input that joins a body to the ground, or to a body so placed, places it.
-- A telescopic leg (two bodies slid along the line between their balls by one P joint:
-  model/spin_groups.py) is one distance between its balls' centres, ‖b − a‖² = ℓ², ℓ = ℓ0 ± s
-  (:class:`TelescopicLeg`); a pivoted R–P–S leg two equations on its ball's centre
-  (modes/spatial_point_legs.py); a driven body translation one linear equation on the body's
+- A telescopic leg (two bodies slid by one P joint between two balls: model/spin_groups.py)
+  is one distance between its balls' centres, ‖b − a‖² = ‖d0 + s e‖²; a pivoted R–P–S leg two
+  equations on its ball's centre (both modes/spatial_point_legs.py); a driven body translation one linear equation on the body's
   drive point (modes/spatial_point_drives.py). Their bodies carry no other points.
 
 At given input values the ground and every body driven from it through input joints are
@@ -70,7 +69,14 @@ from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout, joint_motion
 from screwkit.kinematics.modes.rod_loops import least_rotation
 from screwkit.kinematics.modes.spatial_point_drives import PointDrive, chain_poses
-from screwkit.kinematics.modes.spatial_point_legs import PivotLeg, circle_parameters, leg_poses
+from screwkit.kinematics.modes.spatial_point_legs import (
+    PivotLeg,
+    TelescopicLeg,
+    circle_parameters,
+    leg_poses,
+    leg_vectors,
+    telescopic_poses,
+)
 from screwkit.kinematics.modes.starts import start_solutions
 from screwkit.kinematics.modes.stewart_decode import Pose, joint_values
 from screwkit.kinematics.tracker.loop import Configuration
@@ -135,21 +141,6 @@ class TurnJoint:
     axis: tuple[int, int] = (-1, -1)
     #: +1: ``frame`` is the joint's first body; −1: its second (the point turns by −θ)
     sign: float = 1.0
-
-
-@dataclass(frozen=True)
-class TelescopicLeg:
-    """Two bodies slid along the line between their balls by one P joint (model/spin_groups.py):
-    one distance equation between the balls' centres, ‖b − a‖² = ℓ², ℓ = ``length`` + ``sign``
-    · s (scaled; s the slide, a parameter when it is an input: ``column``), or none when the
-    slide is passive (a strut of free length). ``balls`` the centres' points on the P joint's
-    first and second body; the bodies themselves carry no other points and are not unknowns."""
-
-    joint: int
-    balls: tuple[int, int]
-    column: int | None
-    length: float
-    sign: float
 
 
 @dataclass(frozen=True)
@@ -222,17 +213,13 @@ class SpatialPointFormulation:
         driven = [X[:, sl.column:sl.column + 1] / self.scale for sl in self.slides
                   if sl.column is not None]
         driven += [self._turn_coefficients(t, X) for t in self.turns]
-        driven += [self.leg_lengths(leg, X)[:, None] ** 2 for leg in self.legs
-                   if leg.column is not None]
+        driven += [np.sum(leg_vectors(self.mechanism, leg, X[:, leg.column]) ** 2, axis=1,
+                          keepdims=True) / self.scale**2
+                   for leg in self.legs if leg.column is not None]
         driven += [circle_parameters(self.mechanism, leg, X, self.scale) for leg in self.pivots]
         driven += [(d.axis @ (d.at - self.origin) / self.scale + X[:, d.column] / self.scale
                     )[:, None] for d in self.drives]
         return np.hstack([known, np.broadcast_to(const, (X.shape[0], const.size)), *driven])
-
-    def leg_lengths(self, leg: TelescopicLeg, X: Array) -> Array:
-        """A driven leg's signed length ℓ (N,) (scaled) at the input rows X."""
-        assert leg.column is not None
-        return np.asarray(leg.length + leg.sign * X[:, leg.column] / self.scale)
 
     def _constants(self, pts: ArrayLike) -> NDArray[np.complex128] | Array:
         """The distance, coefficient and U parameters of the points ``pts`` (P, 3)."""
@@ -381,30 +368,14 @@ class SpatialPointFormulation:
             pick = list(be.base) + [m for m in be.points if m not in be.base]
             poses[be.body] = _fit_pose(drawn[pick], world[:, pick], len(be.base) == 2)
         for leg in self.legs:
-            poses.update(self._leg_poses(leg, drawn, world, X))
+            poses.update(telescopic_poses(mech, leg, (world[:, leg.balls[0]],
+                                                      world[:, leg.balls[1]]), X))
         for pv in self.pivots:
             poses.update(leg_poses(mech, pv, poses[pv.base], world[:, pv.ball], X))
         if self.augmented is not None:  # the virtual chains read off their bodies' poses
             poses.update(chain_poses(self.augmented, poses))
         lay = graph_layout(whole)
         return joint_values(whole, lay, poses), lay
-
-
-    def _leg_poses(self, leg: TelescopicLeg, drawn: Array, world: Array, X: Array
-                   ) -> dict[str, Pose]:
-        """The poses of a leg's two bodies: the least rotation of the drawn ball-to-ball
-        direction onto the solved one (over the signed length ℓ: a negative ℓ turns the leg
-        over), each body placed by its ball (its spin about the line left at zero)."""
-        i, j = leg.balls
-        d = world[:, j] - world[:, i]
-        if leg.column is None:  # a passive slide: the leg as long as the balls are apart
-            ell = np.linalg.norm(d, axis=1)
-        else:
-            ell = self.scale * self.leg_lengths(leg, X)
-        R = least_rotation(drawn[j] - drawn[i], d * np.sign(ell)[:, None])
-        first, second = self.mechanism.joints[leg.joint].bodies
-        return {first: (R, world[:, i] - np.einsum("nij,j->ni", R, drawn[i])),
-                second: (R, world[:, j] - np.einsum("nij,j->ni", R, drawn[j]))}
 
 
 def _fit_pose(drawn: Array, solved: Array, on_a_line: bool) -> Pose:

@@ -14,7 +14,7 @@ from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.modes.planar import placed_by_inputs
 from screwkit.kinematics.modes.spatial_point_drives import PointDrive, real_mechanism
-from screwkit.kinematics.modes.spatial_point_legs import PivotLeg, pivot_legs
+from screwkit.kinematics.modes.spatial_point_legs import PivotLeg, TelescopicLeg, pivot_legs
 from screwkit.kinematics.modes.spatial_points import (
     COLLINEAR,
     MAX_UNKNOWNS,
@@ -22,7 +22,6 @@ from screwkit.kinematics.modes.spatial_points import (
     BodyEquations,
     SlideJoint,
     SpatialPointFormulation,
-    TelescopicLeg,
     TurnJoint,
 )
 from screwkit.messages import listing
@@ -220,8 +219,11 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                       "freedoms)")
     origin = np.array([j.at for j in mech.joints]).mean(0)
     scale = float(mech.length_scale)
-    telescopic = [g for g in spin_groups(mech) if len(g.bodies) == 2 and len(g.slides) == 1]
-    pivoted = pivot_legs(mech, have)
+    # legs written on their balls: not where a body of theirs is driven (its drive point needs
+    # the body's points), and a telescopic one only where each slid body holds one ball
+    driven = {d.body for d in drives}
+    telescopic = [g for g in spin_groups(mech) if _telescopic(mech, g) and not driven & set(g.bodies)]
+    pivoted = [k for k in pivot_legs(mech, have) if not driven & set(k[3:5])]
     leg_slides = {g.slides[0] for g in telescopic} | {k[1] for k in pivoted}
     leg_bodies = {b for g in telescopic for b in g.bodies} | {b for k in pivoted for b in k[3:5]}
     pts = _points(mech, origin, scale, placing, leg_slides, drives)
@@ -263,6 +265,10 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                "this formulation writes once too often; the graph tracker follows it")
         raise _refuse(mech, f"at fixed inputs its point closure has {n_eq} equations in {n} "
                       f"unknowns; {why}")
+    if n == 0:
+        raise _refuse(mech, "its inputs place every body (but struts of free length, which "
+                      "follow their balls), so it has one mode at each input, the one the graph "
+                      "tracker follows; there is nothing for the homotopy to solve")
     if n > MAX_UNKNOWNS:
         raise _refuse(mech, f"its point closure has {n} unknowns, more than {MAX_UNKNOWNS}: "
                       "the monodromy that would find its start solutions is not practical at "
@@ -362,19 +368,25 @@ def _orient(mech: Mechanism, pts: _Points, rank: dict[str, int]) -> None:
             pts.turns[i] = TurnJoint(t.joint, second, t.point, t.column, t.axis, -t.sign)
 
 
+def _telescopic(mech: Mechanism, g: SpinGroup) -> bool:
+    """Whether the spin group ``g`` is a telescopic leg the formulation writes as one distance:
+    two bodies, one P joint, each body holding one of the two balls."""
+    if len(g.bodies) != 2 or len(g.slides) != 1:
+        return False
+    holders = [set(mech.joints[k].bodies) & set(g.bodies) for k in g.balls]
+    return holders[0] != holders[1]
+
+
 def _leg(mech: Mechanism, g: SpinGroup, pts: _Points, scale: float) -> TelescopicLeg:
-    """The telescopic leg of the spin group ``g`` (two bodies, one P joint): its balls'
-    points on the P joint's first and second body, its drawn length (scaled) and the sign of
-    its slide along the first-to-second direction."""
+    """The telescopic leg of the spin group ``g`` (:func:`_telescopic`): its balls' points
+    and joints on the P joint's first and second body, and its slide's input column."""
     k = g.slides[0]
     j = mech.joints[k]
     ball = {b: next(m for m in g.balls if b in mech.joints[m].bodies) for b in j.bodies}
-    i0, i1 = pts.centres[ball[j.bodies[0]]], pts.centres[ball[j.bodies[1]]]
-    d = np.asarray(pts.drawn[i1] - pts.drawn[i0])
-    length = float(np.linalg.norm(d))
+    joints = (ball[j.bodies[0]], ball[j.bodies[1]])
     columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
-    return TelescopicLeg(k, (i0, i1), columns.get(j.name), length,
-                         float(np.sign(j.axis @ d)))
+    return TelescopicLeg(k, (pts.centres[joints[0]], pts.centres[joints[1]]), joints,
+                         columns.get(j.name))
 
 
 def _pivot(mech: Mechanism, found: tuple[int, int, int, str, str, str], pts: _Points
