@@ -253,7 +253,7 @@ class Mechanism:
             u = (c - a) / max(float(np.linalg.norm(c - a)), 1e-300)
             what = (f"a rod between two balls ({j0.name!r} and {j1.name!r})" if len(g.bodies) == 1
                     else f"in the leg {g.label} between the balls {j0.name!r} and {j1.name!r} "
-                         "(slid along their line)")
+                         "(slid by a P joint)")
             for p in self.points:
                 off = p.at - a - ((p.at - a) @ u) * u
                 if p.body in g.bodies and float(np.linalg.norm(off)) > 1e-9 * self.length_scale:

@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class SpinGroup:
     """Bodies that spin together about the line through two ball joints' centres, and
-    nothing else moves: ``bodies`` (one for a rod; a leg's slid along the line by P joints),
+    nothing else moves: ``bodies`` (one for a rod; a leg's slid by P joints),
     the two ball joints (indices into ``mech.joints``) and the P joints among the bodies."""
 
     bodies: tuple[str, ...]

@@ -120,7 +120,7 @@ def checked_graph_friction(mech: Mechanism, friction: Sequence[JointFriction]
             raise SimulationError(
                 f"{mech.name}: joint {f.joint!r} is a ball joint of the rod "
                 f"{rod_balls[f.joint]!r}, which lies between two ball joints (a body, or a "
-                "telescopic leg slid along their line): its spin about "
+                "telescopic leg slid between them): its spin about "
                 "its own axis is idle and held at zero, so friction there, which would drive "
                 "that spin, is not modelled; put friction on the other joints")
         if f.rotation and j.kind == "P":

@@ -1,5 +1,5 @@
 """Idle rod spins held still: a body joined by exactly two ball joints (or a telescopic leg of
-bodies slid along one line between two balls, model/spin_groups.py) can spin about the line
+bodies slid by P joints between two balls, model/spin_groups.py) can spin about the line
 through their centres without moving anything else. The minimum-norm rates leave some of that
 spin in (the norm is the joints', not the rod's); here the idle part of the rates is chosen so
 that every such rod's angular velocity and acceleration have no component along its axis
@@ -25,7 +25,7 @@ Array = NDArray[np.float64]
 
 def rods(mech: Mechanism) -> list[tuple[str, int, int]]:
     """(body, first ball joint, second ball joint) of every rod: a body held by exactly two
-    balls, or a telescopic leg of bodies slid along the line between its two balls
+    balls, or a telescopic leg of bodies slid by P joints between its two balls
     (model/spin_groups.py; its first body, whose spin the leg's bodies share)."""
     return [(g.bodies[0], g.balls[0], g.balls[1]) for g in spin_groups(mech)]
 
@@ -59,7 +59,7 @@ def spin_lines(mech: Mechanism) -> list[tuple[str, Array, Array]]:
         if all(on_line(j.at) for j in joints) and all(
                 np.linalg.norm(np.cross(j.axis, u)) <= 1e-9 for j in axial):
             out.append((b, np.asarray(c, float), np.asarray(u, float)))
-    # and every body of a telescopic leg (bodies slid along the line between two balls)
+    # and every body of a telescopic leg (bodies slid by P joints between two balls)
     for g in spin_groups(mech):
         if len(g.bodies) > 1:
             near, end = (np.asarray(mech.joints[k].at, float) for k in g.balls)

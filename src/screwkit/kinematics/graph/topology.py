@@ -194,7 +194,7 @@ def _null_freedoms(mech: Mechanism, lay: GraphLayout, lin: Any) -> tuple[list[st
 
 def _rods(mech: Mechanism) -> list[tuple[str, str, str]]:
     """Rods: bodies held by exactly two ball joints and nothing else, and telescopic legs of
-    bodies slid along the line between two balls (model/spin_groups.py): each can spin about
+    bodies slid by P joints between two balls (model/spin_groups.py): each can spin about
     the line through its two ball centres, an idle freedom (a point it carries off that line
     turns with it, but no joint moves)."""
     return [(g.label, mech.joints[g.balls[0]].name, mech.joints[g.balls[1]].name)
