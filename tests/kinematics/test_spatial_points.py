@@ -545,3 +545,20 @@ def test_the_five_link_example_is_what_its_generator_writes(tmp_path: Path) -> N
 
     text = write_spec(tmp_path / "five_link.toml")
     assert (MECHANISMS / "five_link_suspension.toml").read_text(encoding="utf-8") == text
+
+
+def test_the_least_rotation_turns_a_reversed_direction_over() -> None:
+    """least_rotation (the rods' and legs' poses): every row turns its d0 onto d, d0 given
+    once or per row, also where d is exactly d0 reversed (a half turn; it was the identity)."""
+    from screwkit.kinematics.modes.rod_loops import least_rotation
+
+    rng = np.random.default_rng(3)
+    d0 = rng.standard_normal(3)
+    d = np.stack([-d0, d0, *(rng.standard_normal((5, 3)))])
+    d *= np.linalg.norm(d0) / np.linalg.norm(d, axis=1)[:, None]
+    for first in (d0, np.broadcast_to(d0, d.shape)):
+        R = least_rotation(first, d)
+        np.testing.assert_allclose(np.einsum("nij,j->ni", R, d0), d, atol=1e-14)
+        np.testing.assert_allclose(R @ np.swapaxes(R, 1, 2), np.broadcast_to(np.eye(3), R.shape),
+                                   atol=1e-14)
+        np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-14)

@@ -183,18 +183,28 @@ class RodLoop:
 
 
 def least_rotation(d0: Array, d: Array) -> Array:
-    """The rotations (N, 3, 3) turning d0 onto d (N, 3) about d0 × d (equal lengths)."""
-    u = d0 / np.linalg.norm(d0)
+    """The rotations (N, 3, 3) turning d0 (3,) or (N, 3) onto d (N, 3) about d0 × d (equal
+    lengths). Where d is d0 reversed, the half turn about an axis square to d0 (the identity
+    would not turn d0 onto d)."""
+    u = np.broadcast_to(d0 / np.linalg.norm(d0, axis=-1, keepdims=True), np.shape(d))
     v = d / np.linalg.norm(d, axis=-1)[:, None]
     axis = np.cross(u, v)
     s = np.linalg.norm(axis, axis=-1)
-    axis = axis / np.maximum(s, 1e-300)[:, None]
-    angle = np.arctan2(s, v @ u)
+    cosine = np.einsum("ni,ni->n", u, v)
+    reversed_ = (s <= 1e-15) & (cosine < 0.0)
+    if reversed_.any():  # any axis square to u: u × (the world axis least along u)
+        ur = u[reversed_]
+        pick = np.eye(3)[np.argmin(np.abs(ur), axis=1)]
+        axis[reversed_] = np.cross(ur, pick)
+        s = np.where(reversed_, 0.0, s)
+    size = np.linalg.norm(axis, axis=-1)
+    axis = axis / np.maximum(size, 1e-300)[:, None]
+    angle = np.arctan2(s, cosine)
     K = np.zeros((len(d), 3, 3))
     K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -axis[:, 2], axis[:, 1], -axis[:, 0]
     K = K - np.swapaxes(K, 1, 2)
-    return (np.eye(3) + np.sin(angle)[:, None, None] * K
-            + (1 - np.cos(angle))[:, None, None] * (K @ K))
+    return np.asarray(np.eye(3) + np.sin(angle)[:, None, None] * K
+                      + (1 - np.cos(angle))[:, None, None] * (K @ K))
 
 
 def _joint_values(mech: Mechanism, pose: dict[str, tuple[Array, Array]], q: Array, phi: Array,

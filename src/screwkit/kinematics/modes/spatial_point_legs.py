@@ -34,6 +34,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.kinematics.modes.rod_loops import least_rotation
+
 if TYPE_CHECKING:
     from screwkit.model.mechanism import Mechanism
 
@@ -81,26 +83,11 @@ def telescopic_poses(mech: Mechanism, leg: TelescopicLeg, balls: tuple[Array, Ar
     w = b - a
     s = (X[:, leg.column] if leg.column is not None
          else leg_slides(mech, leg, np.linalg.norm(w, axis=1)))
-    R = least_rotations(leg_vectors(mech, leg, s), w)
+    R = least_rotation(leg_vectors(mech, leg, s), w)
     first, second = mech.joints[leg.joint].bodies
     a0, b0 = (np.asarray(mech.joints[k].at, float) for k in leg.ball_joints)
     return {first: (R, a - np.einsum("nij,j->ni", R, a0)),
             second: (R, b - np.einsum("nij,j->ni", R, b0))}
-
-
-def least_rotations(v: Array, w: Array) -> Array:
-    """The rotations (N, 3, 3) turning each v onto each w (N, 3) about v × w (Rodrigues)."""
-    u = v / np.linalg.norm(v, axis=1)[:, None]
-    t = w / np.linalg.norm(w, axis=1)[:, None]
-    axis = np.cross(u, t)
-    sine = np.linalg.norm(axis, axis=1)
-    axis = axis / np.maximum(sine, 1e-300)[:, None]
-    angle = np.arctan2(sine, np.einsum("ni,ni->n", u, t))
-    K = np.zeros((len(v), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -axis[:, 2], axis[:, 1], -axis[:, 0]
-    K = K - np.swapaxes(K, 1, 2)
-    return np.asarray(np.eye(3) + np.sin(angle)[:, None, None] * K
-                      + (1 - np.cos(angle))[:, None, None] * (K @ K))
 
 
 @dataclass(frozen=True)
