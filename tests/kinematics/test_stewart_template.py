@@ -317,6 +317,8 @@ def test_a_batch_in_parts_on_threads_changes_nothing(monkeypatch: pytest.MonkeyP
     import dataclasses
     from functools import partial
 
+    from threadpoolctl import threadpool_info, threadpool_limits
+
     p, _ = random_stewart(np.random.default_rng(47), 5 * stewart_template.CHUNK + 5)
     p = p.real.astype(complex)
     route = eigen_first.EigenRoute(stewart_system(), 40, template_solve, (0, 1, 2),
@@ -325,14 +327,21 @@ def test_a_batch_in_parts_on_threads_changes_nothing(monkeypatch: pytest.MonkeyP
     one = eigen_first.solve_eigen_first(route, p)
     monkeypatch.setattr(eigen_first, "PART_INSTANCES", 16)
     calls: list[tuple[int, int | None]] = []
+    blas: list[int] = []
 
     def alone(t: np.ndarray, label: int, threads: int | None = None) -> object:
         calls.append((len(t), threads))
+        blas.extend(i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas")
         return template_solve(t, label, threads)
 
     parts = dataclasses.replace(route, threads=2, eliminate_alone=partial(alone, threads=1),
                                 part_step=stewart_template.CHUNK)
-    two = eigen_first.solve_eigen_first(parts, p)
+    # BLAS held at one thread around the parts, not by each part's own limit (a limit is
+    # process-wide: the parts' own would restore each other's counts; found as 1e-13
+    # differences in one run of three with BLAS at two threads)
+    with threadpool_limits(2, user_api="blas"):
+        two = eigen_first.solve_eigen_first(parts, p)
+    assert blas and set(blas) == {1}
     first = sorted(n for n, _ in calls)[-2:]
     assert sum(first) == len(p) and any(n % stewart_template.CHUNK == 0 for n in first)
     assert {t for _, t in calls} == {1}

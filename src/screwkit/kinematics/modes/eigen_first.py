@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.algebraic import compiled
+from screwkit.algebraic.blas import one_blas_thread
 from screwkit.algebraic.certify import Certificate, bombieri_weyl_norm, certify
 from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
@@ -207,7 +208,9 @@ def eigen_route_in_parts(route: EigenRoute, targets: Complex
     step = route.part_step
     cuts = [step * (-(-B // step) * t // parts) for t in range(parts)] + [B]
     alone = replace(route, eliminate=route.eliminate_alone, threads=1, eliminate_alone=None)
-    with ThreadPoolExecutor(parts) as pool:
+    # BLAS held at one thread around every part (a limit is process-wide: parts entering and
+    # leaving limits of their own would restore each other's counts; algebraic/blas.py)
+    with one_blas_thread(), ThreadPoolExecutor(parts) as pool:
         futures = [pool.submit(eigen_route, alone, targets[a:b])
                    for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
         results = [f.result() for f in futures]

@@ -172,3 +172,104 @@ def leg_poses(mech: Mechanism, leg: PivotLeg, base: Pose, ball: Array, X: Array
     u = mech.joints[leg.joints[1]].axis
     slid = p + np.einsum("nij,j->ni", R, u) * (leg.sign * X[:, leg.column])[:, None]
     return {leg.arm: (R, p), leg.slider: (R, slid)}
+
+
+@dataclass(frozen=True)
+class GimbalLeg:
+    """A U–P–U leg with square axes (the legs of a translational 3-UPU; module text below):
+    its joints (base U, P, top U), its cylinder and piston, the placed body its base U is on,
+    the base U's centre C and its arm point E on that body, the top U's centre Q and its arm
+    point A on the top body (indices into the formulation's points), the slide's input column
+    and its sense (+1: the piston is the P joint's second body).
+
+    The base U turns the cylinder about e1 = E − C (fixed in the base) and then about e2 (fixed
+    in the cylinder, square to e1); the leg's vector w(s) = Q0 − C0 + σ s u and its slide u are
+    square to e2, and the top U's piston axis is e2 again, its top axis square to it. Then e2 is
+    along e1 × (Q − C), and the leg is two equations on Q and A:
+
+        ‖Q − C‖² = ‖w(s)‖²,   ((E − C) × (Q − C)) · (A − Q) = g   (g = 0 drawn)
+
+    (g a free parameter, so the topology's family is generic). Its bodies are read off Q: e2
+    the sign of e1 × (Q − C) nearer its drawn direction (the U joint's root nearer the
+    drawing, as the Stewart route decodes a U–P–S leg), the cylinder the rotation carrying
+    the drawn frame (e2, w, e2 × w) onto the solved one, the piston slid along it."""
+
+    joints: tuple[int, int, int]
+    cylinder: str
+    piston: str
+    base: str
+    centre: int
+    arm: int
+    ball: int
+    top_arm: int
+    column: int
+    sign: float
+
+
+def gimbal_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str]]:
+    """(base U, P, top U joint indices, cylinder, piston) of every U–P–U leg with square axes
+    (:class:`GimbalLeg`) whose base U is on a placed body and whose P joint is an input."""
+    driven = {x.split(".")[0] for x in mech.inputs}
+    held = {b: [k for k, j in enumerate(mech.joints) if b in j.bodies] for b in mech.body_names}
+    tol = 1e-9
+    out = []
+    for ku, u in enumerate(mech.joints):
+        if u.kind != "U" or u.axis2 is None:
+            continue
+        for side in (0, 1):
+            base, cyl = u.bodies[side], u.bodies[1 - side]
+            if base not in placed or cyl in placed or len(held.get(cyl, ())) != 2:
+                continue
+            kp = next(k for k in held[cyl] if k != ku)
+            p = mech.joints[kp]
+            piston = p.bodies[1] if p.bodies[0] == cyl else p.bodies[0]
+            if (p.kind != "P" or p.name not in driven or piston in placed
+                    or len(held.get(piston, ())) != 2):
+                continue
+            kt = next(k for k in held[piston] if k != kp)
+            t = mech.joints[kt]
+            if t.kind != "U" or t.axis2 is None or cyl in t.bodies:
+                continue
+            e1, e2 = (u.axis, u.axis2) if side == 0 else (u.axis2, u.axis)
+            e3, e4 = (t.axis, t.axis2) if t.bodies[0] == piston else (t.axis2, t.axis)
+            w = (t.at - u.at) / mech.length_scale
+            if (abs(e1 @ e2) <= tol and abs(e2 @ w) <= tol and abs(e2 @ p.axis) <= tol
+                    and np.linalg.norm(np.cross(e2, e3)) <= tol and abs(e3 @ e4) <= tol):
+                out.append((ku, kp, kt, cyl, piston))
+    return out
+
+
+def gimbal_parameters(mech: Mechanism, leg: GimbalLeg, X: Array, scale: float) -> Array:
+    """The leg's squared length ‖w(s)‖² and g = 0 (N, 2) at the input rows X (scaled)."""
+    u, p, t = (mech.joints[k] for k in leg.joints)
+    w = (t.at - u.at) + np.multiply.outer(leg.sign * X[:, leg.column], p.axis)
+    return np.stack([np.einsum("ni,ni->n", w, w) / scale**2, np.zeros(len(X))], axis=1)
+
+
+def gimbal_poses(mech: Mechanism, leg: GimbalLeg, world: Array, X: Array) -> dict[str, Pose]:
+    """The cylinder's and piston's poses from the solved points ``world`` (N, P, 3)
+    (:class:`GimbalLeg`)."""
+    u, p, t = (mech.joints[k] for k in leg.joints)
+    e2_0 = u.axis2 if u.bodies[0] == leg.base else u.axis
+    s = leg.sign * X[:, leg.column]
+    w0 = (t.at - u.at) + np.multiply.outer(s, p.axis)
+    C, E, Q = world[:, leg.centre], world[:, leg.arm], world[:, leg.ball]
+    d = Q - C
+    e2 = np.cross(E - C, d)
+    e2 /= np.linalg.norm(e2, axis=1)[:, None]
+    # the root nearer the drawing: e2 turned least from its drawn direction (about e1)
+    drawn_e2 = np.asarray(e2_0, float)
+    e2 *= np.where(e2 @ drawn_e2 >= 0.0, 1.0, -1.0)[:, None]
+    F0 = _frame(np.broadcast_to(drawn_e2, w0.shape), w0)
+    F = _frame(e2, d)
+    R = F @ np.swapaxes(F0, 1, 2)
+    pc = C - np.einsum("nij,j->ni", R, u.at)
+    return {leg.cylinder: (R, pc),
+            leg.piston: (R, pc + np.einsum("nij,j->ni", R, p.axis) * s[:, None])}
+
+
+def _frame(a: Array, b: Array) -> Array:
+    """Orthonormal frames (N, 3, 3), columns a/|a|, b/|b| (b square to a) and their cross."""
+    x = a / np.linalg.norm(a, axis=1)[:, None]
+    y = b / np.linalg.norm(b, axis=1)[:, None]
+    return np.stack([x, y, np.cross(x, y)], axis=2)

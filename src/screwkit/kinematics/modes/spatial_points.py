@@ -18,7 +18,8 @@ Systems*, 1994, ch. 2): every body is carried by points, and every constraint is
 - A P or R input that joins a body to the ground, or to a body so placed, places it.
 - A telescopic leg (two bodies slid by one P joint between two balls: model/spin_groups.py)
   is one distance between its balls' centres, ‖b − a‖² = ‖d0 + s e‖²; a pivoted R–P–S leg two
-  equations on its ball's centre (both modes/spatial_point_legs.py); a driven body translation one linear equation on the body's
+  equations on its ball's centre, a U–P–U leg with square axes two equations on its top U's
+  centre and platform arm (all modes/spatial_point_legs.py); a driven body translation one linear equation on the body's
   drive point (modes/spatial_point_drives.py). Their bodies carry no other points.
 
 At given input values the ground and every body driven from it through input joints are
@@ -70,9 +71,12 @@ from screwkit.kinematics.graph.closure import GraphLayout, graph_layout, joint_m
 from screwkit.kinematics.modes.rod_loops import least_rotation
 from screwkit.kinematics.modes.spatial_point_drives import PointDrive, chain_poses
 from screwkit.kinematics.modes.spatial_point_legs import (
+    GimbalLeg,
     PivotLeg,
     TelescopicLeg,
     circle_parameters,
+    gimbal_parameters,
+    gimbal_poses,
     leg_poses,
     leg_vectors,
     telescopic_poses,
@@ -175,6 +179,7 @@ class SpatialPointFormulation:
     drives: tuple[PointDrive, ...] = ()
     drive_points: tuple[int, ...] = ()
     augmented: Mechanism | None = None
+    gimbals: tuple[GimbalLeg, ...] = ()
 
     def _frame_of(self, body: str) -> BodyEquations:
         return next(be for be in self.bodies if be.body == body)
@@ -219,6 +224,7 @@ class SpatialPointFormulation:
         driven += [circle_parameters(self.mechanism, leg, X, self.scale) for leg in self.pivots]
         driven += [(d.axis @ (d.at - self.origin) / self.scale + X[:, d.column] / self.scale
                     )[:, None] for d in self.drives]
+        driven += [gimbal_parameters(self.mechanism, gl, X, self.scale) for gl in self.gimbals]
         return np.hstack([known, np.broadcast_to(const, (X.shape[0], const.size)), *driven])
 
     def _constants(self, pts: ArrayLike) -> NDArray[np.complex128] | Array:
@@ -314,6 +320,10 @@ class SpatialPointFormulation:
             out += [complex(w @ (pts[pv.axis[1]] - pts[pv.axis[0]])), complex(w @ w)]
         out += [complex(d.axis @ pts[k]) for d, k in zip(self.drives, self.drive_points,
                                                          strict=True)]
+        for gl in self.gimbals:  # ‖Q − C‖², ((E − C) × (Q − C))·(A − Q)
+            d = pts[gl.ball] - pts[gl.centre]
+            n = np.cross(pts[gl.arm] - pts[gl.centre], d)
+            out += [complex(d @ d), complex(n @ (pts[gl.top_arm] - pts[gl.ball]))]
         x = np.concatenate([pts[list(self.unknown)].reshape(-1),
                             [slide[sl.joint] for sl in self.slides if sl.column is None]])
         p = np.array(out, dtype=complex)
@@ -372,6 +382,8 @@ class SpatialPointFormulation:
                                                       world[:, leg.balls[1]]), X))
         for pv in self.pivots:
             poses.update(leg_poses(mech, pv, poses[pv.base], world[:, pv.ball], X))
+        for gl in self.gimbals:
+            poses.update(gimbal_poses(mech, gl, world, X))
         if self.augmented is not None:  # the virtual chains read off their bodies' poses
             poses.update(chain_poses(self.augmented, poses))
         lay = graph_layout(whole)

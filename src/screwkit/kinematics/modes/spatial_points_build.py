@@ -14,7 +14,13 @@ from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.modes.planar import placed_by_inputs
 from screwkit.kinematics.modes.spatial_point_drives import PointDrive, real_mechanism
-from screwkit.kinematics.modes.spatial_point_legs import PivotLeg, TelescopicLeg, pivot_legs
+from screwkit.kinematics.modes.spatial_point_legs import (
+    GimbalLeg,
+    PivotLeg,
+    TelescopicLeg,
+    gimbal_legs,
+    pivot_legs,
+)
 from screwkit.kinematics.modes.spatial_points import (
     COLLINEAR,
     MAX_UNKNOWNS,
@@ -67,7 +73,8 @@ class _Points:
 
 
 def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
-            legs: set[int], drives: tuple[PointDrive, ...] = ()) -> _Points:
+            legs: set[int], drives: tuple[PointDrive, ...] = (),
+            leg_u: dict[int, str] | None = None) -> _Points:
     """Every joint's points (scaled drawn positions, owning bodies), the U joints' (centre,
     first arm, second arm), the P and C joints that place no body and the R inputs between
     moving bodies (module docstring); the P joints of telescopic legs (``legs``) have none; a
@@ -108,6 +115,12 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
             first = tuple(add(e, (j.bodies[0],)) for e in line)
             second = tuple(add(e, (j.bodies[1],)) for e in line)
             slides.append(SlideJoint(k, first, second, columns.get(j.name)))
+        elif j.kind == "U" and leg_u and k in leg_u:  # a gimballed leg's (modes/spatial_point_legs.py)
+            assert j.axis2 is not None
+            centres[k] = add(j.at, j.bodies)
+            off = 1 if j.bodies[0] == leg_u[k] else 0  # the body off the leg, its axis
+            arm = j.axis2 if off == 1 else j.axis
+            axes[k] = (centres[k], add(j.at + scale * arm, (j.bodies[off],)))
         elif j.kind == "U":
             assert j.axis2 is not None
             c = add(j.at, j.bodies)
@@ -224,11 +237,19 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     driven = {d.body for d in drives}
     telescopic = [g for g in spin_groups(mech) if _telescopic(mech, g) and not driven & set(g.bodies)]
     pivoted = [k for k in pivot_legs(mech, have) if not driven & set(k[3:5])]
-    leg_slides = {g.slides[0] for g in telescopic} | {k[1] for k in pivoted}
-    leg_bodies = {b for g in telescopic for b in g.bodies} | {b for k in pivoted for b in k[3:5]}
-    pts = _points(mech, origin, scale, placing, leg_slides, drives)
+    gimballed = [k for k in gimbal_legs(mech, have) if not driven & set(k[3:5])]
+    leg_slides = ({g.slides[0] for g in telescopic} | {k[1] for k in pivoted}
+                  | {k[1] for k in gimballed})
+    leg_bodies = ({b for g in telescopic for b in g.bodies} | {b for k in pivoted for b in k[3:5]}
+                  | {b for k in gimballed for b in k[3:5]})
+    # a gimballed leg's U joints: their centres and their arms on the bodies off the leg only
+    leg_u = {}
+    for ku, _, kt, cylinder, piston in gimballed:
+        leg_u[ku], leg_u[kt] = cylinder, piston
+    pts = _points(mech, origin, scale, placing, leg_slides, drives, leg_u)
     legs = [_leg(mech, g, pts, scale) for g in telescopic]
     pivots = [_pivot(mech, k, pts) for k in pivoted]
+    gimbals = [_gimbal(mech, k, pts, have) for k in gimballed]
     drawn = np.array(pts.drawn)
     known, source = [], {}
     for k, own in enumerate(pts.owners):
@@ -242,7 +263,7 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     # in reverse (RSCR with an S–S dyad is square in one of the two)
     tried = []
     for ties_reversed in (False, True):
-        pts = _points(mech, origin, scale, placing, leg_slides, drives)
+        pts = _points(mech, origin, scale, placing, leg_slides, drives, leg_u)
         order = [b for b in _body_order(mech, have, ties_reversed) if b not in leg_bodies]
         bodies = _write_bodies(mech, pts, order, have, drawn, known, source)
         passive = [sl for sl in pts.slides if sl.column is None]
@@ -250,7 +271,7 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
         n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies)
                 + len(pts.u_joints) + sum(3 * len(sl.a) for sl in pts.slides)
                 + 3 * len(pts.turns) + sum(leg.column is not None for leg in legs)
-                + 2 * len(pivots) + len(drives))
+                + 2 * len(pivots) + 2 * len(gimbals) + len(drives))
         tried.append(n_eq)
         if n_eq == n:
             break
@@ -272,15 +293,15 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     if n > MAX_UNKNOWNS:
         raise _refuse(mech, f"its point closure has {n} unknowns, more than {MAX_UNKNOWNS}: "
                       "the monodromy that would find its start solutions is not practical at "
-                      "that size (the 3-UPU's 90 reached one solution in 36 s); follow the drawn "
+                      "that size (a 3-UPU whose U axes are not square, 90 unknowns, reached one solution in 36 s); follow the drawn "
                       "mode with the graph tracker (--modes drawn)")
-    system = _compile(unknown, known, bodies, pts, legs, pivots, drives)
+    system = _compile(unknown, known, bodies, pts, legs, pivots, drives, gimbals)
     form = SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(pts.owners),
                                    tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
                                    tuple(pts.u_joints), source, tuple(pts.slides),
                                    tuple(pts.turns), tuple(legs), tuple(pivots), drives,
                                    tuple(pts.drive_points[d.body] for d in drives),
-                                   whole if drives else None)
+                                   whole if drives else None, tuple(gimbals))
     _check_rank(form)
     return form
 
@@ -399,9 +420,22 @@ def _pivot(mech: Mechanism, found: tuple[int, int, int, str, str, str], pts: _Po
                     columns[mech.joints[kp].name], sign)
 
 
+def _gimbal(mech: Mechanism, found: tuple[int, int, int, str, str], pts: _Points,
+            placed: set[str]) -> GimbalLeg:
+    """The gimballed leg (modes/spatial_point_legs.py) of the joints and bodies ``found``."""
+    ku, kp, kt, cyl, piston = found
+    u = mech.joints[ku]
+    base = u.bodies[0] if u.bodies[0] in placed else u.bodies[1]
+    columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
+    sign = 1.0 if mech.joints[kp].bodies[1] == piston else -1.0
+    (c, e), (q, a) = pts.axes[ku], pts.axes[kt]
+    return GimbalLeg((ku, kp, kt), cyl, piston, base, c, e, q, a,
+                     columns[mech.joints[kp].name], sign)
+
+
 def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
              pts: _Points, legs: list[TelescopicLeg], pivots: list[PivotLeg],
-             drives: tuple[PointDrive, ...]) -> PolynomialSystem:
+             drives: tuple[PointDrive, ...], gimbals: list[GimbalLeg]) -> PolynomialSystem:
     """The system of the module docstring: unknowns the solved points' (x, y, z); parameters
     the placed points', then per body its d's and coefficients, then the U joints' g, the
     driven slides, the driven turns' coefficients and the driven legs' squared lengths."""
@@ -480,4 +514,11 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
         q = point[pts.drive_points[drive.body]]
         eqs.append(q["xyz".index(drive.freedom)] - Poly.variable(next(counter)))
         params.append(f"v{drive.body}_{drive.freedom}")
+    for gl in gimbals:  # ‖Q − C‖² = ‖w(s)‖², ((E − C) × (Q − C))·(A − Q) = g
+        pc, pe, pq, pa = (point[k] for k in (gl.centre, gl.arm, gl.ball, gl.top_arm))
+        d, r = sub(pq, pc), sub(pe, pc)
+        n = [r[1] * d[2] - r[2] * d[1], r[2] * d[0] - r[0] * d[2], r[0] * d[1] - r[1] * d[0]]
+        eqs.append(dot(d, d) - Poly.variable(next(counter)))
+        eqs.append(dot(n, sub(pa, pq)) - Poly.variable(next(counter)))
+        params += [f"w{gl.joints[1]}", f"g{gl.joints[1]}"]
     return compile_system(eqs, names, params)

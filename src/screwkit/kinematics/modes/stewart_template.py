@@ -54,6 +54,7 @@ from numpy.typing import NDArray
 from scipy.linalg import lapack
 
 from screwkit.algebraic import hessenberg_eig
+from screwkit.algebraic.blas import blas_controller
 from screwkit.algebraic.polynomial import Complex
 from screwkit.kinematics.modes import stewart_sparse
 from screwkit.kinematics.modes import stewart_template_data as data
@@ -332,15 +333,6 @@ def template_solve(params: Complex, label: int = 0, threads: int | None = None
                       for a, b in zip(cuts[:-1], cuts[1:], strict=True)]:
                 f.result()
     return points, keys
-
-
-@lru_cache(maxsize=1)
-def blas_controller() -> Any:
-    """threadpoolctl's view of the BLAS libraries loaded (found once: ~3 ms; a limit then
-    costs ~20 µs), for holding BLAS's threads at one while a batch runs in threads."""
-    from threadpoolctl import ThreadpoolController
-
-    return ThreadpoolController()
 
 
 def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Complex]:
