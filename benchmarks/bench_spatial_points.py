@@ -11,7 +11,9 @@ against:
 - the double wishbone (generic count 4) at the spec's 41 samples: every mode by the point
   homotopy against the closed-form dyads;
 - the 3-RPS robot (examples/mechanisms/three_rps.toml, generic count 16): the start set, every
-  mode at one input, and every mode along its 37 samples against the drawn mode alone.
+  mode at one input, and every mode along its 37 samples against the drawn mode alone;
+- the 3-UPU (examples/mechanisms/three_upu.toml, 84 by monodromy): the start set and every
+  mode at one input.
 
 Times are CPU seconds (process time, best of 3), OPENBLAS_NUM_THREADS=1.
 """
@@ -94,6 +96,14 @@ def run() -> list[dict[str, Any]]:
     t_rps_all = _best(lambda: solve_mechanism(rps.mechanism, xr, every_mode=True), 1)
     t_rps_drawn = _best(lambda: solve_mechanism(rps.mechanism, xr))
     rps_modes = len(solve_mechanism(rps.mechanism, xr, every_mode=True).modes)
+    upu = sk.load_spec(MECHANISMS / "three_upu.toml")
+    xu = np.asarray(upu.inputs, dtype=float)
+    t = time.process_time()
+    upu_start = spatial_point_formulation(upu.mechanism).start()
+    t_upu_start = time.process_time() - t
+    every_mode(upu.mechanism, xu[:1])
+    t_upu_one = _best(lambda: every_mode(upu.mechanism, xu[10:11]))
+    upu_real = every_mode(upu.mechanism, xu[10:11]).configurations[0].size
     return [
         {"name": "five-link suspension: start solutions (first solve of the topology)",
          "value": t_start, "unit": "s", "target": None,
@@ -123,4 +133,9 @@ def run() -> list[dict[str, Any]]:
          "value": t_rps_all / t_rps_drawn, "unit": "x", "target": None,
          "note": f"{rps_modes} modes in {t_rps_all:.3g} s (homotopy at anchors, tracking "
                  f"between) against {t_rps_drawn * 1e3:.3g} ms for the drawn mode followed"},
+        {"name": "3-UPU: start solutions, then every mode at one input",
+         "value": t_upu_one * 1e3, "unit": "ms", "target": None,
+         "note": f"{upu_start.generic_count} solutions (18 unknowns: its U–P–U legs as two "
+                 f"equations each), {upu_real} real at sample 10; the start set "
+                 f"{t_upu_start:.3g} s once, {upu_start.paths} paths"},
     ]
