@@ -233,31 +233,42 @@ def test_what_the_point_formulation_does_not_take_is_said() -> None:
         spatial_point_formulation(helix)
 
 
-def _ups_rocker(s0: np.ndarray) -> Mechanism:
+def _ups_rocker(s0: np.ndarray, flipped: bool = False) -> Mechanism:
     """A rocker on an R joint driven by a U–P–S leg whose slide is the input (a cylinder
-    driving an arm): the input P joint lies between two moving bodies."""
+    driving an arm): the input P joint lies between two moving bodies. Flipped: the leg's
+    ball on the ground and its U joint on the rocker (the same points: U0 the fixed end, s0
+    the rocker's)."""
     U0, D, rocker_axis = np.zeros(3), np.array([1.0, -0.2, 0.1]), np.array([0.3, 1.0, 0.2])
     leg = (s0 - U0) / np.linalg.norm(s0 - U0)
     e1 = np.array([0.0, 0.0, 1.0]) - leg[2] * leg
     e1 /= np.linalg.norm(e1)
+    ends = ((joint("S", "S", "ground", "cylinder", U0),
+             joint("U", "U", "piston", "rocker", s0, e1, np.cross(leg, e1))) if flipped else
+            (joint("U", "U", "ground", "cylinder", U0, e1, np.cross(leg, e1)),
+             joint("S", "S", "piston", "rocker", s0)))
     return Mechanism("UPS-driven rocker", (Body("cylinder"), Body("piston"), Body("rocker")),
-                     (joint("U", "U", "ground", "cylinder", U0, e1, np.cross(leg, e1)),
-                      joint("P", "P", "cylinder", "piston", (U0 + s0) / 2, leg),
-                      joint("S", "S", "piston", "rocker", s0),
-                      joint("R", "R", "rocker", "ground", D, rocker_axis)), ("P.s",))
+                     (ends[0], joint("P", "P", "cylinder", "piston", (U0 + s0) / 2, leg),
+                      ends[1], joint("R", "R", "rocker", "ground", D, rocker_axis)), ("P.s",))
 
 
 def test_a_leg_driven_at_its_slide_between_moving_bodies_has_every_ball_position() -> None:
-    """The input is a P joint between the cylinder and the piston, neither placed: the point
-    formulation holds the slide as a parameter. At three slides the ball lies where the
-    rocker's circle meets the sphere of the leg's length about the U centre (two points, by
-    hand); each comes twice, the cylinder spun half a turn about its axis through the U
-    joint's other root. Every mode closes, is certified, and holds the drawn mode."""
+    """The input is a P joint between the cylinder and the piston, neither placed. With the
+    leg's U joint on the rocker (flipped) the point formulation writes the leg as points and
+    holds the slide as a parameter; at three slides the rocker's point lies where its circle
+    meets the sphere of the leg's length about the ground ball (two points, by hand), each
+    twice, the U joint's two roots. With the U joint on the ground the leg is one sphere
+    (modes/spatial_point_legs.py ``UniversalLeg``): each point once, the U on its root nearer
+    the drawing. Every mode closes, is certified, and holds the drawn mode."""
     s0 = np.array([0.6, 0.3, 0.5])
-    mech = _ups_rocker(s0)
+    X = np.array([[0.0], [0.05], [-0.1]])
+    sphere = _ups_rocker(s0)
+    form = closure_formulation(sphere)
+    assert isinstance(form, SpatialPointFormulation) and len(form.universals) == 1
+    once = every_mode(sphere, X)
+    assert once.generic_count == 2 and once.worst_closure <= 1e-12
+    mech = _ups_rocker(s0, flipped=True)
     form = closure_formulation(mech)
     assert isinstance(form, SpatialPointFormulation) and len(form.slides) == 1
-    X = np.array([[0.0], [0.05], [-0.1]])
     found = every_mode(mech, X)
     assert found.generic_count == 4
     D, a = mech.joint("R").at, mech.joint("R").axis
@@ -277,11 +288,14 @@ def test_a_leg_driven_at_its_slide_between_moving_bodies_has_every_ball_position
         ours = _centres(mech, found.configurations[n])[:, 2]
         assert found.certified[n].all() and len(ours) == 4
         assert _matched(ours, np.repeat(balls, 2, axis=0), 1e-12)
-    drawn = follow_drawn_mode(mech, graph_layout(mech), X)
-    for n in range(len(X)):
-        mine = _centres(mech, found.configurations[n])
-        assert np.abs(mine - _centres(mech, drawn.conf.take(slice(n, n + 1)))).reshape(
-            4, -1).max(1).min() <= 1e-12
+        ours = _centres(sphere, once.configurations[n])[:, 2]
+        assert once.certified[n].all() and _matched(ours, balls, 1e-12)
+    for m, every in ((mech, found), (sphere, once)):
+        drawn = follow_drawn_mode(m, graph_layout(m), X)
+        for n in range(len(X)):
+            mine = _centres(m, every.configurations[n])
+            assert np.abs(mine - _centres(m, drawn.conf.take(slice(n, n + 1)))).reshape(
+                len(mine), -1).max(1).min() <= 1e-12
 
 
 def _macpherson(kind: str = "P", bodies: tuple[str, str] = ("upright", "strut")) -> Mechanism:

@@ -273,3 +273,76 @@ def _frame(a: Array, b: Array) -> Array:
     x = a / np.linalg.norm(a, axis=1)[:, None]
     y = b / np.linalg.norm(b, axis=1)[:, None]
     return np.stack([x, y, np.cross(x, y)], axis=2)
+
+
+@dataclass(frozen=True)
+class UniversalLeg:
+    """A U–P–S leg (a Stewart–Gough platform's, outside the Stewart route): its base U on a
+    placed body, its P joint driven, its ball on another body. At slide s the ball's centre Q
+    is the cylinder's drawn w(s) = Q0 − C0 + σ s u from the U's centre C, turned by the U: Q
+    is on the sphere ‖Q − C‖² = ‖w(s)‖², one equation. Its bodies are read off Q, the U on its
+    root nearer the drawing (the Stewart route's rule, modes/stewart_decode.py
+    ``u_rotation``; a Q out of the U's reach gives a pose that does not close, which the
+    closure check drops). ``joints`` (U, P, S), the cylinder and piston, the placed base, the
+    U's and the ball's centre points, the slide's input column and sense."""
+
+    joints: tuple[int, int, int]
+    cylinder: str
+    piston: str
+    base: str
+    centre: int
+    ball: int
+    column: int
+    sign: float
+
+
+def universal_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str]]:
+    """(U, P, S joint indices, cylinder, piston) of every U–P–S leg (:class:`UniversalLeg`)
+    whose U is on a placed body and whose P joint is an input."""
+    driven = {x.split(".")[0] for x in mech.inputs}
+    held = {b: [k for k, j in enumerate(mech.joints) if b in j.bodies] for b in mech.body_names}
+    out = []
+    for ku, u in enumerate(mech.joints):
+        if u.kind != "U" or u.axis2 is None:
+            continue
+        for side in (0, 1):
+            base, cyl = u.bodies[side], u.bodies[1 - side]
+            if base not in placed or cyl in placed or len(held.get(cyl, ())) != 2:
+                continue
+            kp = next(k for k in held[cyl] if k != ku)
+            p = mech.joints[kp]
+            piston = p.bodies[1] if p.bodies[0] == cyl else p.bodies[0]
+            if (p.kind != "P" or p.name not in driven or piston in placed
+                    or len(held.get(piston, ())) != 2):
+                continue
+            ks = next(k for k in held[piston] if k != kp)
+            if mech.joints[ks].kind == "S" and cyl not in mech.joints[ks].bodies:
+                out.append((ku, kp, ks, cyl, piston))
+    return out
+
+
+def universal_parameters(mech: Mechanism, leg: UniversalLeg, X: Array, scale: float) -> Array:
+    """The leg's squared length ‖w(s)‖² (N, 1) at the input rows X (scaled)."""
+    u, p, s = (mech.joints[k] for k in leg.joints)
+    w = (s.at - u.at) + np.multiply.outer(leg.sign * X[:, leg.column], p.axis)
+    return (np.einsum("ni,ni->n", w, w) / scale**2)[:, None]
+
+
+def universal_poses(mech: Mechanism, leg: UniversalLeg, base: Pose, world: Array, X: Array
+                    ) -> dict[str, Pose]:
+    """The cylinder's and piston's poses from the solved points ``world`` (N, P, 3), the base
+    body at ``base`` (:class:`UniversalLeg`)."""
+    from screwkit.kinematics.modes.stewart_decode import u_rotation
+
+    u, p, b = (mech.joints[k] for k in leg.joints)
+    assert u.axis2 is not None
+    e1, e2 = (u.axis, u.axis2) if u.bodies[0] == leg.base else (u.axis2, u.axis)
+    s = leg.sign * X[:, leg.column]
+    w = (b.at - u.at) + np.multiply.outer(s, p.axis)
+    Rb, pb = base
+    C = world[:, leg.centre]
+    d = np.einsum("nji,nj->ni", Rb, world[:, leg.ball] - C)  # in the base's drawn frame
+    R = Rb @ u_rotation(np.asarray(e1, float), np.asarray(e2, float), w, d)
+    pc = C - np.einsum("nij,j->ni", R, u.at)
+    return {leg.cylinder: (R, pc),
+            leg.piston: (R, pc + np.einsum("nij,j->ni", R, p.axis) * s[:, None])}

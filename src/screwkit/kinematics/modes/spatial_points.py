@@ -74,12 +74,15 @@ from screwkit.kinematics.modes.spatial_point_legs import (
     GimbalLeg,
     PivotLeg,
     TelescopicLeg,
+    UniversalLeg,
     circle_parameters,
     gimbal_parameters,
     gimbal_poses,
     leg_poses,
     leg_vectors,
     telescopic_poses,
+    universal_parameters,
+    universal_poses,
 )
 from screwkit.kinematics.modes.starts import start_solutions
 from screwkit.kinematics.modes.stewart_decode import Pose, joint_values
@@ -180,6 +183,7 @@ class SpatialPointFormulation:
     drive_points: tuple[int, ...] = ()
     augmented: Mechanism | None = None
     gimbals: tuple[GimbalLeg, ...] = ()
+    universals: tuple[UniversalLeg, ...] = ()
 
     def _frame_of(self, body: str) -> BodyEquations:
         return next(be for be in self.bodies if be.body == body)
@@ -225,6 +229,8 @@ class SpatialPointFormulation:
         driven += [(d.axis @ (d.at - self.origin) / self.scale + X[:, d.column] / self.scale
                     )[:, None] for d in self.drives]
         driven += [gimbal_parameters(self.mechanism, gl, X, self.scale) for gl in self.gimbals]
+        driven += [universal_parameters(self.mechanism, ul, X, self.scale)
+                   for ul in self.universals]
         return np.hstack([known, np.broadcast_to(const, (X.shape[0], const.size)), *driven])
 
     def _constants(self, pts: ArrayLike) -> NDArray[np.complex128] | Array:
@@ -324,6 +330,9 @@ class SpatialPointFormulation:
             d = pts[gl.ball] - pts[gl.centre]
             n = np.cross(pts[gl.arm] - pts[gl.centre], d)
             out += [complex(d @ d), complex(n @ (pts[gl.top_arm] - pts[gl.ball]))]
+        for ul in self.universals:  # ‖Q − C‖²
+            d = pts[ul.ball] - pts[ul.centre]
+            out.append(complex(d @ d))
         x = np.concatenate([pts[list(self.unknown)].reshape(-1),
                             [slide[sl.joint] for sl in self.slides if sl.column is None]])
         p = np.array(out, dtype=complex)
@@ -384,6 +393,8 @@ class SpatialPointFormulation:
             poses.update(leg_poses(mech, pv, poses[pv.base], world[:, pv.ball], X))
         for gl in self.gimbals:
             poses.update(gimbal_poses(mech, gl, world, X))
+        for ul in self.universals:
+            poses.update(universal_poses(mech, ul, poses[ul.base], world, X))
         if self.augmented is not None:  # the virtual chains read off their bodies' poses
             poses.update(chain_poses(self.augmented, poses))
         lay = graph_layout(whole)

@@ -18,8 +18,10 @@ from screwkit.kinematics.modes.spatial_point_legs import (
     GimbalLeg,
     PivotLeg,
     TelescopicLeg,
+    UniversalLeg,
     gimbal_legs,
     pivot_legs,
+    universal_legs,
 )
 from screwkit.kinematics.modes.spatial_points import (
     COLLINEAR,
@@ -74,7 +76,7 @@ class _Points:
 
 def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
             legs: set[int], drives: tuple[PointDrive, ...] = (),
-            leg_u: dict[int, str] | None = None) -> _Points:
+            leg_u: dict[int, str | None] | None = None) -> _Points:
     """Every joint's points (scaled drawn positions, owning bodies), the U joints' (centre,
     first arm, second arm), the P and C joints that place no body and the R inputs between
     moving bodies (module docstring); the P joints of telescopic legs (``legs``) have none; a
@@ -115,6 +117,8 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
             first = tuple(add(e, (j.bodies[0],)) for e in line)
             second = tuple(add(e, (j.bodies[1],)) for e in line)
             slides.append(SlideJoint(k, first, second, columns.get(j.name)))
+        elif j.kind == "U" and leg_u and k in leg_u and leg_u[k] is None:  # a U–P–S leg's
+            centres[k] = add(j.at, j.bodies)
         elif j.kind == "U" and leg_u and k in leg_u:  # a gimballed leg's (modes/spatial_point_legs.py)
             assert j.axis2 is not None
             centres[k] = add(j.at, j.bodies)
@@ -238,18 +242,22 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
     telescopic = [g for g in spin_groups(mech) if _telescopic(mech, g) and not driven & set(g.bodies)]
     pivoted = [k for k in pivot_legs(mech, have) if not driven & set(k[3:5])]
     gimballed = [k for k in gimbal_legs(mech, have) if not driven & set(k[3:5])]
+    swung = [k for k in universal_legs(mech, have) if not driven & set(k[3:5])]
     leg_slides = ({g.slides[0] for g in telescopic} | {k[1] for k in pivoted}
-                  | {k[1] for k in gimballed})
+                  | {k[1] for k in gimballed} | {k[1] for k in swung})
     leg_bodies = ({b for g in telescopic for b in g.bodies} | {b for k in pivoted for b in k[3:5]}
-                  | {b for k in gimballed for b in k[3:5]})
+                  | {b for k in gimballed for b in k[3:5]} | {b for k in swung for b in k[3:5]})
     # a gimballed leg's U joints: their centres and their arms on the bodies off the leg only
-    leg_u = {}
+    leg_u: dict[int, str | None] = {}
     for ku, _, kt, cylinder, piston in gimballed:
         leg_u[ku], leg_u[kt] = cylinder, piston
+    for ku, *_ in swung:  # a U–P–S leg's U: its centre only
+        leg_u[ku] = None
     pts = _points(mech, origin, scale, placing, leg_slides, drives, leg_u)
     legs = [_leg(mech, g, pts, scale) for g in telescopic]
     pivots = [_pivot(mech, k, pts) for k in pivoted]
     gimbals = [_gimbal(mech, k, pts, have) for k in gimballed]
+    universals = [_universal(mech, k, pts, have) for k in swung]
     drawn = np.array(pts.drawn)
     known, source = [], {}
     for k, own in enumerate(pts.owners):
@@ -271,7 +279,7 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
         n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies)
                 + len(pts.u_joints) + sum(3 * len(sl.a) for sl in pts.slides)
                 + 3 * len(pts.turns) + sum(leg.column is not None for leg in legs)
-                + 2 * len(pivots) + 2 * len(gimbals) + len(drives))
+                + 2 * len(pivots) + 2 * len(gimbals) + len(universals) + len(drives))
         tried.append(n_eq)
         if n_eq == n:
             break
@@ -295,13 +303,13 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                       "the monodromy that would find its start solutions is not practical at "
                       "that size (a 3-UPU whose U axes are not square, 90 unknowns, reached one solution in 36 s); follow the drawn "
                       "mode with the graph tracker (--modes drawn)")
-    system = _compile(unknown, known, bodies, pts, legs, pivots, drives, gimbals)
+    system = _compile(unknown, known, bodies, pts, legs, pivots, drives, gimbals, universals)
     form = SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(pts.owners),
                                    tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
                                    tuple(pts.u_joints), source, tuple(pts.slides),
                                    tuple(pts.turns), tuple(legs), tuple(pivots), drives,
                                    tuple(pts.drive_points[d.body] for d in drives),
-                                   whole if drives else None, tuple(gimbals))
+                                   whole if drives else None, tuple(gimbals), tuple(universals))
     _check_rank(form)
     return form
 
@@ -433,9 +441,22 @@ def _gimbal(mech: Mechanism, found: tuple[int, int, int, str, str], pts: _Points
                      columns[mech.joints[kp].name], sign)
 
 
+def _universal(mech: Mechanism, found: tuple[int, int, int, str, str], pts: _Points,
+               placed: set[str]) -> UniversalLeg:
+    """The U–P–S leg (modes/spatial_point_legs.py) of the joints and bodies ``found``."""
+    ku, kp, ks, cyl, piston = found
+    u = mech.joints[ku]
+    base = u.bodies[0] if u.bodies[0] in placed else u.bodies[1]
+    columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
+    sign = 1.0 if mech.joints[kp].bodies[1] == piston else -1.0
+    return UniversalLeg((ku, kp, ks), cyl, piston, base, pts.centres[ku], pts.centres[ks],
+                        columns[mech.joints[kp].name], sign)
+
+
 def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
              pts: _Points, legs: list[TelescopicLeg], pivots: list[PivotLeg],
-             drives: tuple[PointDrive, ...], gimbals: list[GimbalLeg]) -> PolynomialSystem:
+             drives: tuple[PointDrive, ...], gimbals: list[GimbalLeg],
+             universals: list[UniversalLeg]) -> PolynomialSystem:
     """The system of the module docstring: unknowns the solved points' (x, y, z); parameters
     the placed points', then per body its d's and coefficients, then the U joints' g, the
     driven slides, the driven turns' coefficients and the driven legs' squared lengths."""
@@ -521,4 +542,8 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
         eqs.append(dot(d, d) - Poly.variable(next(counter)))
         eqs.append(dot(n, sub(pa, pq)) - Poly.variable(next(counter)))
         params += [f"w{gl.joints[1]}", f"g{gl.joints[1]}"]
+    for ul in universals:  # ‖Q − C‖² = ‖w(s)‖²
+        d = sub(point[ul.ball], point[ul.centre])
+        eqs.append(dot(d, d) - Poly.variable(next(counter)))
+        params.append(f"w{ul.joints[1]}")
     return compile_system(eqs, names, params)
