@@ -11,8 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.optimize import least_squares
-from scipy.spatial.transform import Rotation
+from tests.graphs.newton_poses import newton_poses
 
 import screwkit as sk
 from screwkit.errors import CapabilityError
@@ -42,25 +41,12 @@ def _platform_poses(mech: sk.Mechanism, s: np.ndarray, rng: np.random.Generator,
     length2 = np.sum((q - C + (s / L)[:, None] * u) ** 2, axis=1)
     centre = q.mean(0)
 
-    def F(z: np.ndarray) -> np.ndarray:
-        R = Rotation.from_rotvec(z[:3]).as_matrix()
-        Q = (q - centre) @ R.T + centre + z[3:]
-        d = Q - C
+    def F(R: np.ndarray, c: np.ndarray) -> np.ndarray:
+        d = (q - centre) @ R.T + c - C
         return np.concatenate([np.sum(d * d, axis=1) - length2,
                                np.einsum("ij,ij->i", np.cross(e1, d), a @ R.T)])
 
-    found: list[np.ndarray] = []
-    for _ in range(starts):
-        z0 = np.concatenate([Rotation.random(random_state=rng).as_rotvec(),
-                             rng.uniform(-3.0, 3.0, 3)])
-        r = least_squares(F, z0, xtol=1e-15, ftol=1e-15, gtol=1e-15, method="lm")
-        if np.abs(F(r.x)).max() > 1e-12:
-            continue
-        R = Rotation.from_rotvec(r.x[:3]).as_matrix()
-        pose = np.concatenate([R.ravel(), centre - R @ centre + r.x[3:]])
-        if all(np.abs(pose - f).max() > 1e-6 for f in found):
-            found.append(pose)
-    return np.array(found)
+    return newton_poses(F, centre, rng, starts)
 
 
 @pytest.fixture(scope="module")

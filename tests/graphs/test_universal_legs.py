@@ -10,8 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import least_squares
-from scipy.spatial.transform import Rotation
+from tests.graphs.newton_poses import newton_poses
 
 import screwkit as sk
 from screwkit.kinematics.graph import solve_mechanism
@@ -65,20 +64,10 @@ def _rotations(mech: Mechanism, s: np.ndarray, rng: np.random.Generator, starts:
     u = np.array([mech.joint(f"P{i}").axis for i in (1, 2, 3)])
     length2 = np.sum((q - B + s[:, None] * u) ** 2, axis=1)
 
-    def F(z: np.ndarray) -> np.ndarray:
-        R = Rotation.from_rotvec(z).as_matrix()
-        return (np.sum(((q - O) @ R.T + O - B) ** 2, axis=1) - length2) / 0.01
+    def F(R: np.ndarray, c: np.ndarray) -> np.ndarray:
+        return (np.sum(((q - O) @ R.T + c - B) ** 2, axis=1) - length2) / 0.01
 
-    found: list[np.ndarray] = []
-    for _ in range(starts):
-        r = least_squares(F, Rotation.random(random_state=rng).as_rotvec(), xtol=1e-15,
-                          ftol=1e-15, gtol=1e-15, method="lm")
-        if np.abs(F(r.x)).max() > 1e-11:
-            continue
-        R = Rotation.from_rotvec(r.x).as_matrix().ravel()
-        if all(np.abs(R - f).max() > 1e-6 for f in found):
-            found.append(R)
-    return np.array(found)
+    return newton_poses(F, O, rng, starts, turn_only=True, residual=1e-11)[:, :9]
 
 
 def test_every_wrist_mode_is_newtons_and_the_drawn_one_is_the_trackers() -> None:

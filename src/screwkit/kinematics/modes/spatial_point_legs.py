@@ -107,32 +107,41 @@ class PivotLeg:
     sign: float
 
 
-def pivot_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str, str]]:
-    """(R, P, S joint indices, arm, slider, base) of every R–P–S leg (module docstring) whose
-    R joint turns on a placed body and whose P joint is an input."""
+def leg_chains(mech: Mechanism, placed: set[str], kind: str, end: str
+               ) -> list[tuple[int, int, int, str, str, str]]:
+    """(base joint, P, end joint indices, first body, second body, base body) of every
+    two-body leg: a ``kind`` joint (not an input) from a placed body to a first body that
+    holds only it and a driven P joint, the P joint's second body holding only it and an
+    ``end`` joint to a third body."""
     driven = {x.split(".")[0] for x in mech.inputs}
     held = {b: [k for k, j in enumerate(mech.joints) if b in j.bodies] for b in mech.body_names}
     out = []
-    for kr, r in enumerate(mech.joints):
-        if r.kind != "R" or r.name in driven:
+    for kb, j in enumerate(mech.joints):
+        if j.kind != kind or j.name in driven:
             continue
-        for base, arm in (r.bodies, r.bodies[::-1]):
-            if base not in placed or arm in placed or len(held.get(arm, ())) != 2:
+        for base, first in (j.bodies, j.bodies[::-1]):
+            if base not in placed or first in placed or len(held.get(first, ())) != 2:
                 continue
-            kp = next(k for k in held[arm] if k != kr)
+            kp = next(k for k in held[first] if k != kb)
             p = mech.joints[kp]
-            slider = p.bodies[1] if p.bodies[0] == arm else p.bodies[0]
-            if (p.kind != "P" or p.name not in driven or slider in placed
-                    or len(held.get(slider, ())) != 2):
+            second = p.bodies[1] if p.bodies[0] == first else p.bodies[0]
+            if (p.kind != "P" or p.name not in driven or second in placed
+                    or len(held.get(second, ())) != 2):
                 continue
-            ks = next(k for k in held[slider] if k != kp)
-            s = mech.joints[ks]
-            if s.kind != "S" or arm in s.bodies:
-                continue
-            q = s.at - r.at
-            if (np.linalg.norm(np.cross(p.axis, r.axis)) <= ALONG
-                    or np.linalg.norm(np.cross(q, r.axis)) <= ALONG * mech.length_scale):
-                continue
+            ke = next(k for k in held[second] if k != kp)
+            if mech.joints[ke].kind == end and first not in mech.joints[ke].bodies:
+                out.append((kb, kp, ke, first, second, base))
+    return out
+
+
+def pivot_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str, str]]:
+    """(R, P, S joint indices, arm, slider, base) of every R–P–S leg (module docstring)
+    whose R joint turns on a placed body and whose P joint is an input."""
+    out = []
+    for kr, kp, ks, arm, slider, base in leg_chains(mech, placed, "R", "S"):
+        r, p, s = (mech.joints[k] for k in (kr, kp, ks))
+        if (np.linalg.norm(np.cross(p.axis, r.axis)) > ALONG
+                and np.linalg.norm(np.cross(s.at - r.at, r.axis)) > ALONG * mech.length_scale):
             out.append((kr, kp, ks, arm, slider, base))
     return out
 
@@ -209,33 +218,17 @@ class GimbalLeg:
 def gimbal_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str]]:
     """(base U, P, top U joint indices, cylinder, piston) of every U–P–U leg with square axes
     (:class:`GimbalLeg`) whose base U is on a placed body and whose P joint is an input."""
-    driven = {x.split(".")[0] for x in mech.inputs}
-    held = {b: [k for k, j in enumerate(mech.joints) if b in j.bodies] for b in mech.body_names}
     tol = 1e-9
     out = []
-    for ku, u in enumerate(mech.joints):
-        if u.kind != "U" or u.axis2 is None:
-            continue
-        for side in (0, 1):
-            base, cyl = u.bodies[side], u.bodies[1 - side]
-            if base not in placed or cyl in placed or len(held.get(cyl, ())) != 2:
-                continue
-            kp = next(k for k in held[cyl] if k != ku)
-            p = mech.joints[kp]
-            piston = p.bodies[1] if p.bodies[0] == cyl else p.bodies[0]
-            if (p.kind != "P" or p.name not in driven or piston in placed
-                    or len(held.get(piston, ())) != 2):
-                continue
-            kt = next(k for k in held[piston] if k != kp)
-            t = mech.joints[kt]
-            if t.kind != "U" or t.axis2 is None or cyl in t.bodies:
-                continue
-            e1, e2 = (u.axis, u.axis2) if side == 0 else (u.axis2, u.axis)
-            e3, e4 = (t.axis, t.axis2) if t.bodies[0] == piston else (t.axis2, t.axis)
-            w = (t.at - u.at) / mech.length_scale
-            if (abs(e1 @ e2) <= tol and abs(e2 @ w) <= tol and abs(e2 @ p.axis) <= tol
-                    and np.linalg.norm(np.cross(e2, e3)) <= tol and abs(e3 @ e4) <= tol):
-                out.append((ku, kp, kt, cyl, piston))
+    for ku, kp, kt, cyl, piston, base in leg_chains(mech, placed, "U", "U"):
+        u, p, t = (mech.joints[k] for k in (ku, kp, kt))
+        assert u.axis2 is not None and t.axis2 is not None
+        e1, e2 = (u.axis, u.axis2) if u.bodies[0] == base else (u.axis2, u.axis)
+        e3, e4 = (t.axis, t.axis2) if t.bodies[0] == piston else (t.axis2, t.axis)
+        w = (t.at - u.at) / mech.length_scale
+        if (abs(e1 @ e2) <= tol and abs(e2 @ w) <= tol and abs(e2 @ p.axis) <= tol
+                and np.linalg.norm(np.cross(e2, e3)) <= tol and abs(e3 @ e4) <= tol):
+            out.append((ku, kp, kt, cyl, piston))
     return out
 
 
@@ -299,26 +292,7 @@ class UniversalLeg:
 def universal_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str]]:
     """(U, P, S joint indices, cylinder, piston) of every U–P–S leg (:class:`UniversalLeg`)
     whose U is on a placed body and whose P joint is an input."""
-    driven = {x.split(".")[0] for x in mech.inputs}
-    held = {b: [k for k, j in enumerate(mech.joints) if b in j.bodies] for b in mech.body_names}
-    out = []
-    for ku, u in enumerate(mech.joints):
-        if u.kind != "U" or u.axis2 is None:
-            continue
-        for side in (0, 1):
-            base, cyl = u.bodies[side], u.bodies[1 - side]
-            if base not in placed or cyl in placed or len(held.get(cyl, ())) != 2:
-                continue
-            kp = next(k for k in held[cyl] if k != ku)
-            p = mech.joints[kp]
-            piston = p.bodies[1] if p.bodies[0] == cyl else p.bodies[0]
-            if (p.kind != "P" or p.name not in driven or piston in placed
-                    or len(held.get(piston, ())) != 2):
-                continue
-            ks = next(k for k in held[piston] if k != kp)
-            if mech.joints[ks].kind == "S" and cyl not in mech.joints[ks].bodies:
-                out.append((ku, kp, ks, cyl, piston))
-    return out
+    return [k[:5] for k in leg_chains(mech, placed, "U", "S")]
 
 
 def universal_parameters(mech: Mechanism, leg: UniversalLeg, X: Array, scale: float) -> Array:

@@ -422,35 +422,37 @@ def _pivot(mech: Mechanism, found: tuple[int, int, int, str, str, str], pts: _Po
            ) -> PivotLeg:
     """The pivoted leg (modes/spatial_point_legs.py) of the joints and bodies ``found``."""
     kr, kp, ks, arm, slider, base = found
+    _, column, sign = _leg_ends(mech, kr, kp, slider, {base})
+    return PivotLeg((kr, kp, ks), arm, slider, base, pts.axes[kr], pts.centres[ks], column,
+                    sign)
+
+
+def _leg_ends(mech: Mechanism, kb: int, kp: int, second: str, placed: set[str]
+              ) -> tuple[str, int, float]:
+    """A leg's placed base body (across its base joint ``kb``), its slide's input column and
+    the slide's sense (+1: ``second`` is the P joint ``kp``'s second body)."""
+    b = mech.joints[kb]
     columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
-    sign = 1.0 if mech.joints[kp].bodies[1] == slider else -1.0
-    return PivotLeg((kr, kp, ks), arm, slider, base, pts.axes[kr], pts.centres[ks],
-                    columns[mech.joints[kp].name], sign)
+    return (b.bodies[0] if b.bodies[0] in placed else b.bodies[1],
+            columns[mech.joints[kp].name], 1.0 if mech.joints[kp].bodies[1] == second else -1.0)
 
 
 def _gimbal(mech: Mechanism, found: tuple[int, int, int, str, str], pts: _Points,
             placed: set[str]) -> GimbalLeg:
     """The gimballed leg (modes/spatial_point_legs.py) of the joints and bodies ``found``."""
     ku, kp, kt, cyl, piston = found
-    u = mech.joints[ku]
-    base = u.bodies[0] if u.bodies[0] in placed else u.bodies[1]
-    columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
-    sign = 1.0 if mech.joints[kp].bodies[1] == piston else -1.0
+    base, column, sign = _leg_ends(mech, ku, kp, piston, placed)
     (c, e), (q, a) = pts.axes[ku], pts.axes[kt]
-    return GimbalLeg((ku, kp, kt), cyl, piston, base, c, e, q, a,
-                     columns[mech.joints[kp].name], sign)
+    return GimbalLeg((ku, kp, kt), cyl, piston, base, c, e, q, a, column, sign)
 
 
 def _universal(mech: Mechanism, found: tuple[int, int, int, str, str], pts: _Points,
                placed: set[str]) -> UniversalLeg:
     """The U–P–S leg (modes/spatial_point_legs.py) of the joints and bodies ``found``."""
     ku, kp, ks, cyl, piston = found
-    u = mech.joints[ku]
-    base = u.bodies[0] if u.bodies[0] in placed else u.bodies[1]
-    columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
-    sign = 1.0 if mech.joints[kp].bodies[1] == piston else -1.0
+    base, column, sign = _leg_ends(mech, ku, kp, piston, placed)
     return UniversalLeg((ku, kp, ks), cyl, piston, base, pts.centres[ku], pts.centres[ks],
-                        columns[mech.joints[kp].name], sign)
+                        column, sign)
 
 
 def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
