@@ -1,5 +1,7 @@
 """Legs of the spatial point formulation (modes/spatial_points.py) written as equations on
-their balls' centres instead of bodies of points: telescopic S–P–S legs and pivoted R–P–S legs.
+their end joints' centres instead of bodies of points: telescopic S–P–S legs, pivoted R–P–S
+legs (below), U–P–U legs with square axes (:class:`GimbalLeg`) and U–P–S legs
+(:class:`UniversalLeg`). Their two bodies carry no points and are read off the solved centres.
 
 A telescopic leg (model/spin_groups.py: two bodies slid by one P joint, each holding one of
 the leg's two balls) keeps its balls' centres a and b at the distance its slide s sets: at s
