@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from tests.graphs.newton_poses import newton_poses
+from tests.graphs.three_upu import write_tilted
 
 import screwkit as sk
 from screwkit.errors import CapabilityError
@@ -102,22 +103,10 @@ def test_legs_whose_axes_are_not_square_are_written_as_points(tmp_path: Path) ->
     """A platform U axis tilted off square to its piston axis: that leg is no gimballed leg
     and is written as points (one tilted: 42 unknowns, two legs gimballed); all three tilted:
     90 unknowns, refused by name."""
-    drawn = {1: ("[-0, 1, 0]", (0.0, 1.0, 0.0)),
-             2: ("[-0.866025403784, -0.5, 0]", (-0.866025403784, -0.5, 0.0)),
-             3: ("[0.866025403784, -0.5, 0]", (0.866025403784, -0.5, 0.0))}
+    def tilted(legs: tuple[int, ...]) -> sk.Mechanism:
+        return sk.load_spec(write_tilted(tmp_path / f"tilted{len(legs)}.toml", legs)).mechanism
 
-    def tilted(text: str, legs: tuple[int, ...]) -> sk.Mechanism:
-        for i in legs:  # the platform arm tipped up by 0.1 (a unit vector again)
-            line, axis = drawn[i]
-            a = np.array(axis) + [0.0, 0.0, 0.1]
-            a /= np.linalg.norm(a)
-            text = text.replace(f"axis2 = {line}", f"axis2 = [{a[0]:.15g}, {a[1]:.15g}, {a[2]:.15g}]")
-        path = tmp_path / f"tilted{len(legs)}.toml"
-        path.write_text(text)
-        return sk.load_spec(path).mechanism
-
-    text = EXAMPLE.read_text()
-    one = spatial_point_formulation(tilted(text, (1,)))
+    one = spatial_point_formulation(tilted((1,)))
     assert (one.system.n, len(one.gimbals)) == (42, 2)
     with pytest.raises(CapabilityError, match="90 unknowns, more than 48"):
-        spatial_point_formulation(tilted(text, (1, 2, 3)))
+        spatial_point_formulation(tilted((1, 2, 3)))

@@ -238,3 +238,20 @@ angle = "deg"
 
 if __name__ == "__main__":
     write_spec(Path(sys.argv[1]) if len(sys.argv) > 1 else PATH)
+
+
+#: each leg's platform U axis as the example draws it
+_PLATFORM_AXES = {1: "[-0, 1, 0]", 2: "[-0.866025403784, -0.5, 0]", 3: "[0.866025403784, -0.5, 0]"}
+
+
+def write_tilted(path: Path, legs: tuple[int, ...]) -> Path:
+    """The example with the platform U axes of ``legs`` tipped up by 0.1 (unit vectors again),
+    so that those legs' axes are not square (written to ``path``)."""
+    text = PATH.read_text(encoding="utf-8")
+    for i in legs:
+        line = _PLATFORM_AXES[i]
+        a = np.array([float(x) for x in line.strip("[]").split(",")]) + [0.0, 0.0, 0.1]
+        a /= np.linalg.norm(a)
+        text = text.replace(f"axis2 = {line}", f"axis2 = [{a[0]:.15g}, {a[1]:.15g}, {a[2]:.15g}]")
+    path.write_text(text, encoding="utf-8")
+    return path

@@ -80,14 +80,14 @@ def test_a_joint_made_off_its_drawing_is_refused_not_solved_as_drawn(which: str)
         every_mode(off, X)
 
 
-def test_a_mechanism_no_formulation_takes_is_refused_by_name() -> None:
-    """The Stewart platform driven by its pose, a roll among its drives (a body's turn): no
-    formulation takes it, and the message says why the nearest one (the point formulation)
-    does not. (Driven translations are taken: tests/graphs/test_point_drives.py.)"""
-    mech = sk.load_spec(EXAMPLES / "stewart_platform_pose.toml").mechanism
-    with pytest.raises(CapabilityError, match="no polynomial formulation takes.*driven at "
-                                              "platform's roll, a turn"):
-        every_mode(mech, np.zeros((1, len(mech.driven_names))))
+def test_a_mechanism_no_formulation_takes_is_refused_by_name(tmp_path: Path) -> None:
+    """A 3-UPU whose platform U axes are not square to its legs: no formulation takes it, and
+    the message says why the nearest one (the point formulation: 90 unknowns) does not."""
+    from tests.graphs.three_upu import write_tilted
+
+    mech = sk.load_spec(write_tilted(tmp_path / "tilted.toml", (1, 2, 3))).mechanism
+    with pytest.raises(CapabilityError, match="no polynomial formulation takes.*90 unknowns"):
+        every_mode(mech, np.zeros((1, len(mech.inputs))))
 
 
 def test_every_pose_of_the_stewart_example_holds_the_tracked_one() -> None:

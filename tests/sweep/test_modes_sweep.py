@@ -103,13 +103,31 @@ def test_without_shipping_a_process_solves_them_once(spec, monkeypatch):
 
 
 def test_a_graph_without_a_formulation_is_refused_before_any_run(tmp_path):
-    # driven by its pose, a roll among them (a turn of a body): no polynomial formulation takes it
-    platform = EXAMPLES / "mechanisms" / "stewart_platform_pose.toml"
-    with pytest.raises(CapabilityError, match="--job modes solves every assembly mode.*a turn"):
-        define_sweep(platform, ["joints.S1.at.z=395:405:5"], "modes")
-    r = runner.invoke(app, ["sweep", str(platform), "--vary", "joints.S1.at.z=395:405:5",
+    # a 3-UPU whose platform U axes are not square: 90 point unknowns, over the limit
+    from tests.graphs.three_upu import write_tilted
+
+    tilted = write_tilted(tmp_path / "tilted.toml", (1, 2, 3))
+    with pytest.raises(CapabilityError, match="--job modes solves every assembly mode.*90 unknowns"):
+        define_sweep(tilted, ["joints.Up1.at.z=299:301:1"], "modes")
+    r = runner.invoke(app, ["sweep", str(tilted), "--vary", "joints.Up1.at.z=299:301:1",
                             "--job", "modes", "-o", str(tmp_path / "t.csv"), "--workers", "0"])
     assert r.exit_code == 2 and "--job analyze follows the drawn mode" in " ".join(r.output.split())
+
+
+def test_a_platform_driven_at_its_pose_sweeps_its_one_mode(tmp_path):
+    """The Stewart platform driven at its pose (three driven turns of one body): `--job modes`
+    runs on the point formulation; each design has one mode at the drawing (the three other
+    rotations that satisfy the turns' equations dropped), certified."""
+    out = tmp_path / "pose.csv"
+    r = runner.invoke(app, ["sweep", str(EXAMPLES / "mechanisms" / "stewart_platform_pose.toml"),
+                            "--vary", "joints.S1.at.z=395:405:2", "--job", "modes", "-o",
+                            str(out), "--workers", "0"])
+    assert r.exit_code == 0, r.output
+    import pandas as pd
+
+    table = pd.read_csv(out)
+    assert list(table["status"]) == ["ok"] * 2
+    assert list(table["modes"]) == [1] * 2 and list(table["modes.certified"]) == [1] * 2
 
 
 def test_a_graph_driven_by_a_body_travel_sweeps_every_mode(tmp_path):

@@ -10,8 +10,8 @@ S–P–S legs) by the Study-coordinate system, its poses decoded into joint var
 points (modes/delta.py). Each real solution is turned into the
 graph tracker's :class:`Configuration` and kept only if the tracker's own closure
 (``graph_forward``, the exact SE(3) logarithm round every loop) is within
-:data:`CLOSURE_TOLERANCE` of the length scale: the check is independent of the polynomial
-system. A row whose paths end singular on a curve of solutions is reported as a continuum.
+:data:`CLOSURE_TOLERANCE` of the length scale, and its input freedoms read back are the
+inputs: the checks are independent of the polynomial system. A row whose paths end singular on a curve of solutions is reported as a continuum.
 """
 
 from __future__ import annotations
@@ -41,6 +41,8 @@ from screwkit.model.mechanism import Mechanism
 Array = NDArray[np.float64]
 #: a real solution is a mode when every loop closes to this, relative to the length scale
 CLOSURE_TOLERANCE = 1e-10
+#: and its input freedoms, read back, are the inputs to this (radians, or relative)
+INPUT_TOLERANCE = 1e-8
 
 
 class Formulation(Protocol):
@@ -169,7 +171,7 @@ def closure_formulation(mech: Mechanism) -> Formulation:
         "RSSR, RSRC and RCCC loops driven at a ground R joint, 6-6 Stewart–Gough "
         "platforms (U–P–S or S–P–S legs driven at the P joints) and Delta robots (three "
         "driven arms, each with an S–S parallelogram to the plate), and graphs of R, P, C, S "
-        f"and U joints driven at R or P joints{why}")
+        f"and U joints driven at R or P joints or at body freedoms{why}")
 
 
 @dataclass(frozen=True)
@@ -193,6 +195,22 @@ class MechanismModes:
     how_found: str
     worst_closure: float
     rejected: NDArray[np.int64]
+
+
+def _at_inputs(mech: Mechanism, lay: GraphLayout, conf: Configuration, x: Array
+               ) -> NDArray[np.bool_]:
+    """Whether each configuration's input freedoms, read back, are the inputs ``x`` (angles
+    modulo a turn; to :data:`INPUT_TOLERANCE`). Not so for the poses a body with two or more
+    driven turns also satisfies in the point formulation, each turn taken from the other
+    Tait–Bryan triple of the same rotation (modes/spatial_point_drives.py)."""
+    ok = np.ones(conf.size, dtype=bool)
+    for c, f in enumerate(lay.inputs):
+        d = conf.scalars[:, lay.scalar_col[f]] - x[c]
+        if lay.is_translation[f]:
+            ok &= np.abs(d) <= INPUT_TOLERANCE * max(mech.length_scale, 1.0)
+        else:
+            ok &= np.abs(np.angle(np.exp(1j * d))) <= INPUT_TOLERANCE
+    return ok
 
 
 def formulation_start(form: Formulation) -> StartSolutions:
@@ -261,8 +279,10 @@ def _every_mode_rows(mech: Mechanism, X: Array) -> MechanismModes:
         conf, lay = form.configuration(sol.x[rows], X[b])
         residual = np.abs(graph_forward(mech, lay, conf).residual).max(axis=(1, 2))
         regular = sol.status[rows] == PathStatus.REGULAR
+        at_inputs = _at_inputs(mech, lay, conf, X[b])
         keep = (residual <= CLOSURE_TOLERANCE * max(mech.length_scale, 1.0)) & regular
         rejected[b] = int(np.count_nonzero(regular & ~keep))
+        keep &= at_inputs
         worst = max(worst, float(residual[keep].max(initial=0.0)))
         confs.append(conf.take(np.flatnonzero(keep)))
         certs.append(sol.certified_real[rows][keep])

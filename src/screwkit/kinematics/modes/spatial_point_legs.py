@@ -25,7 +25,10 @@ two quadrics in Q with the placed axis points A, A + a as parameters and h, r² 
 follow the input. The arm and slider carry no points and are not unknowns (the leg's 21 point
 coordinates become none: a 3-RPS has 9 unknowns, not 63). Their poses are read off Q: the
 arm's turn θ about the axis carries the drawn (Q0 + σ s u − A)'s part square to the axis onto
-the solved one's, the slider is the arm slid by σ s u.
+the solved one's, the slider is the arm slid by σ s u. A passive slide square to the axis
+(a 3-RPS driven at its platform) leaves the ball its plane alone, (Q − A)·a = h, one
+equation; σ s is read off the ball's distance from A (:func:`free_slide`, the root that is 0
+at the drawn distance).
 """
 
 from __future__ import annotations
@@ -66,15 +69,20 @@ def leg_vectors(mech: Mechanism, leg: TelescopicLeg, s: Array) -> Array:
     return (b - a) + np.multiply.outer(s, mech.joints[leg.joint].axis)
 
 
-def leg_slides(mech: Mechanism, leg: TelescopicLeg, distance: Array) -> Array:
-    """A passive leg's slides (N,) at the ball distances (N,): the root of
-    ‖d0 + s e‖ = distance that is 0 at the drawn distance (NaN where none is real)."""
-    a, b = (np.asarray(mech.joints[k].at, float) for k in leg.ball_joints)
-    d0, e = b - a, mech.joints[leg.joint].axis
+def free_slide(d0: Array, e: Array, distance: Array) -> Array:
+    """A passive slide's travels t (N,) at the distances (N,): the root of
+    ‖d0 + t e‖ = distance (e a unit vector) that is 0 at the drawn distance ‖d0‖ (NaN where
+    none is real)."""
     along = float(d0 @ e)
     with np.errstate(invalid="ignore"):
         root = np.sqrt(along**2 - d0 @ d0 + distance**2)
     return np.asarray(-along + (1.0 if along >= 0.0 else -1.0) * root)
+
+
+def leg_slides(mech: Mechanism, leg: TelescopicLeg, distance: Array) -> Array:
+    """A passive leg's slides (N,) at the ball distances (N,) (:func:`free_slide`)."""
+    a, b = (np.asarray(mech.joints[k].at, float) for k in leg.ball_joints)
+    return free_slide(b - a, np.asarray(mech.joints[leg.joint].axis, float), distance)
 
 
 def telescopic_poses(mech: Mechanism, leg: TelescopicLeg, balls: tuple[Array, Array],
@@ -105,16 +113,16 @@ class PivotLeg:
     base: str
     axis: tuple[int, int]
     ball: int
-    column: int
+    column: int | None
     sign: float
 
 
-def leg_chains(mech: Mechanism, placed: set[str], kind: str, end: str
+def leg_chains(mech: Mechanism, placed: set[str], kind: str, end: str, passive: bool = False
                ) -> list[tuple[int, int, int, str, str, str]]:
     """(base joint, P, end joint indices, first body, second body, base body) of every
     two-body leg: a ``kind`` joint (not an input) from a placed body to a first body that
-    holds only it and a driven P joint, the P joint's second body holding only it and an
-    ``end`` joint to a third body."""
+    holds only it and a P joint (driven, or also passive with ``passive``), the P joint's
+    second body holding only it and an ``end`` joint to a third body."""
     driven = {x.split(".")[0] for x in mech.inputs}
     held = {b: [k for k, j in enumerate(mech.joints) if b in j.bodies] for b in mech.body_names}
     out = []
@@ -127,7 +135,7 @@ def leg_chains(mech: Mechanism, placed: set[str], kind: str, end: str
             kp = next(k for k in held[first] if k != kb)
             p = mech.joints[kp]
             second = p.bodies[1] if p.bodies[0] == first else p.bodies[0]
-            if (p.kind != "P" or p.name not in driven or second in placed
+            if (p.kind != "P" or (p.name not in driven and not passive) or second in placed
                     or len(held.get(second, ())) != 2):
                 continue
             ke = next(k for k in held[second] if k != kp)
@@ -138,10 +146,14 @@ def leg_chains(mech: Mechanism, placed: set[str], kind: str, end: str
 
 def pivot_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str, str]]:
     """(R, P, S joint indices, arm, slider, base) of every R–P–S leg (module docstring)
-    whose R joint turns on a placed body and whose P joint is an input."""
+    whose R joint turns on a placed body and whose P joint is an input, or is passive and
+    square to the R axis."""
+    driven = {x.split(".")[0] for x in mech.inputs}
     out = []
-    for kr, kp, ks, arm, slider, base in leg_chains(mech, placed, "R", "S"):
+    for kr, kp, ks, arm, slider, base in leg_chains(mech, placed, "R", "S", passive=True):
         r, p, s = (mech.joints[k] for k in (kr, kp, ks))
+        if p.name not in driven and abs(float(p.axis @ r.axis)) > ALONG:
+            continue
         if (np.linalg.norm(np.cross(p.axis, r.axis)) > ALONG
                 and np.linalg.norm(np.cross(s.at - r.at, r.axis)) > ALONG * mech.length_scale):
             out.append((kr, kp, ks, arm, slider, base))
@@ -152,15 +164,18 @@ def arm_point(mech: Mechanism, leg: PivotLeg, X: Array) -> tuple[Array, Array, A
     """The ball's drawn centre slid as at the input rows X, Q0 + σ s u (N, 3, unscaled world
     coordinates of the drawing), the R joint's drawn point A and unit axis a."""
     r, p, s = (mech.joints[k] for k in leg.joints)
-    q = s.at + np.multiply.outer(leg.sign * X[:, leg.column], p.axis)
+    t = leg.sign * X[:, leg.column] if leg.column is not None else np.zeros(len(X))
+    q = s.at + np.multiply.outer(t, p.axis)
     return q, np.asarray(r.at, float), np.asarray(r.axis, float)
 
 
 def circle_parameters(mech: Mechanism, leg: PivotLeg, X: Array, scale: float) -> Array:
     """The circle's h and r² (N, 2) at the input rows X, in the formulation's scaled
-    coordinates."""
+    coordinates; a passive slide's plane's h alone (N, 1)."""
     q, A, a = arm_point(mech, leg, X)
     w = (q - A) / scale
+    if leg.column is None:
+        return (w @ a)[:, None]
     return np.stack([w @ a, np.einsum("ni,ni->n", w, w)], axis=1)
 
 
@@ -171,6 +186,12 @@ def leg_poses(mech: Mechanism, leg: PivotLeg, base: Pose, ball: Array, X: Array
     Rb, pb = base
     q0, A, a = arm_point(mech, leg, X)
     local = np.einsum("nji,nj->ni", Rb, ball - pb) - A  # in the base's drawn frame
+    u = np.asarray(mech.joints[leg.joints[1]].axis, float)
+    if leg.column is None:  # a passive slide square to the axis: from the ball's distance
+        t = free_slide(mech.joints[leg.joints[2]].at - A, u, np.linalg.norm(local, axis=1))
+        q0 = q0 + np.multiply.outer(t, u)
+    else:
+        t = leg.sign * X[:, leg.column]
     w0 = q0 - A
     w0 = w0 - np.multiply.outer(w0 @ a, a)
     w1 = local - np.multiply.outer(local @ a, a)
@@ -180,8 +201,7 @@ def leg_poses(mech: Mechanism, leg: PivotLeg, base: Pose, ball: Array, X: Array
             + (1.0 - np.cos(theta))[:, None, None] * (K @ K))
     R = Rb @ turn
     p = np.einsum("nij,nj->ni", Rb, A - np.einsum("nij,j->ni", turn, A)) + pb
-    u = mech.joints[leg.joints[1]].axis
-    slid = p + np.einsum("nij,j->ni", R, u) * (leg.sign * X[:, leg.column])[:, None]
+    slid = p + np.einsum("nij,j->ni", R, u) * t[:, None]
     return {leg.arm: (R, p), leg.slider: (R, slid)}
 
 
@@ -275,11 +295,13 @@ class UniversalLeg:
     """A U–P–S leg (a Stewart–Gough platform's, outside the Stewart route): its base U on a
     placed body, its P joint driven, its ball on another body. At slide s the ball's centre Q
     is the cylinder's drawn w(s) = Q0 − C0 + σ s u from the U's centre C, turned by the U: Q
-    is on the sphere ‖Q − C‖² = ‖w(s)‖², one equation. Its bodies are read off Q, the U on its
-    root nearer the drawing (the Stewart route's rule, modes/stewart_decode.py
+    is on the sphere ‖Q − C‖² = ‖w(s)‖², one equation; a passive slide (a platform driven at
+    its pose) gives none, a strut of free length, and s is read off ‖Q − C‖
+    (:func:`free_slide`, the root that is 0 at the drawn length). Its bodies are read off Q,
+    the U on its root nearer the drawing (the Stewart route's rule, modes/stewart_decode.py
     ``u_rotation``; a Q out of the U's reach gives a pose that does not close, which the
     closure check drops). ``joints`` (U, P, S), the cylinder and piston, the placed base, the
-    U's and the ball's centre points, the slide's input column and sense."""
+    U's and the ball's centre points, the slide's input column (None: passive) and sense."""
 
     joints: tuple[int, int, int]
     cylinder: str
@@ -287,14 +309,14 @@ class UniversalLeg:
     base: str
     centre: int
     ball: int
-    column: int
+    column: int | None
     sign: float
 
 
 def universal_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str]]:
     """(U, P, S joint indices, cylinder, piston) of every U–P–S leg (:class:`UniversalLeg`)
-    whose U is on a placed body and whose P joint is an input."""
-    return [k[:5] for k in leg_chains(mech, placed, "U", "S")]
+    whose U is on a placed body, its P joint an input or passive."""
+    return [k[:5] for k in leg_chains(mech, placed, "U", "S", passive=True)]
 
 
 def universal_parameters(mech: Mechanism, leg: UniversalLeg, X: Array, scale: float) -> Array:
@@ -313,10 +335,14 @@ def universal_poses(mech: Mechanism, leg: UniversalLeg, base: Pose, world: Array
     u, p, b = (mech.joints[k] for k in leg.joints)
     assert u.axis2 is not None
     e1, e2 = (u.axis, u.axis2) if u.bodies[0] == leg.base else (u.axis2, u.axis)
-    s = leg.sign * X[:, leg.column]
-    w = (b.at - u.at) + np.multiply.outer(s, p.axis)
     Rb, pb = base
     C = world[:, leg.centre]
+    if leg.column is None:  # a strut of free length: the slide from the ball's distance
+        s = free_slide(b.at - u.at, np.asarray(p.axis, float),
+                       np.linalg.norm(world[:, leg.ball] - C, axis=1))
+    else:
+        s = leg.sign * X[:, leg.column]
+    w = (b.at - u.at) + np.multiply.outer(s, p.axis)
     d = np.einsum("nji,nj->ni", Rb, world[:, leg.ball] - C)  # in the base's drawn frame
     R = Rb @ u_rotation(np.asarray(e1, float), np.asarray(e2, float), w, d)
     pc = C - np.einsum("nij,j->ni", R, u.at)

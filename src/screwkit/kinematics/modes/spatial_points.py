@@ -18,9 +18,11 @@ Systems*, 1994, ch. 2): every body is carried by points, and every constraint is
 - A P or R input that joins a body to the ground, or to a body so placed, places it.
 - A telescopic leg (two bodies slid by one P joint between two balls: model/spin_groups.py)
   is one distance between its balls' centres, ‖b − a‖² = ‖d0 + s e‖²; a pivoted R–P–S leg two
-  equations on its ball's centre, a U–P–U leg with square axes two equations on its top U's
-  centre and platform arm (all modes/spatial_point_legs.py); a driven body translation one linear equation on the body's
-  drive point (modes/spatial_point_drives.py). Their bodies carry no other points.
+  equations on its ball's centre (one, its plane, when the slide is passive and square to the
+  axis), a U–P–U leg with square axes two equations on its top U's centre and platform arm, a
+  U–P–S leg one sphere (none when passive) (all modes/spatial_point_legs.py). Their bodies
+  carry no other points. A driven body translation is one linear equation on the body's drive
+  point, a driven body turn one quadric in its base points (modes/spatial_point_drives.py).
 
 At given input values the ground and every body driven from it through input joints are
 placed; the points they carry are parameters. Every other point (x, y, z) is an unknown, and
@@ -69,7 +71,11 @@ from screwkit.algebraic.solve import StartSolutions
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.closure import GraphLayout, graph_layout, joint_motion
 from screwkit.kinematics.modes.rod_loops import least_rotation
-from screwkit.kinematics.modes.spatial_point_drives import PointDrive, chain_poses
+from screwkit.kinematics.modes.spatial_point_drives import (
+    PointDrive,
+    chain_poses,
+    turn_parameters,
+)
 from screwkit.kinematics.modes.spatial_point_legs import (
     GimbalLeg,
     PivotLeg,
@@ -180,13 +186,19 @@ class SpatialPointFormulation:
     #: and the augmented mechanism (with its virtual chains) whose inputs and joints the
     #: parameters and configurations follow, when the mechanism is driven at body freedoms
     drives: tuple[PointDrive, ...] = ()
-    drive_points: tuple[int, ...] = ()
+    drive_points: tuple[int, ...] = ()  # −1 for a turn
     augmented: Mechanism | None = None
     gimbals: tuple[GimbalLeg, ...] = ()
     universals: tuple[UniversalLeg, ...] = ()
 
     def _frame_of(self, body: str) -> BodyEquations:
         return next(be for be in self.bodies if be.body == body)
+
+    def _base_frame(self, body: str, pts: Array) -> Array:
+        """``body``'s base frame U = [u, v, u × v] (3, 3) on the points ``pts``."""
+        b1, b2, b3 = self._frame_of(body).base
+        u, v = pts[b2] - pts[b1], pts[b3] - pts[b1]
+        return np.stack([u, v, np.cross(u, v)], 1)
 
     def _turn_coefficients(self, t: TurnJoint, X: Array) -> Array:
         """The driven point's coefficients (N, 3) in its first body's base at inputs X."""
@@ -226,11 +238,13 @@ class SpatialPointFormulation:
                           keepdims=True) / self.scale**2
                    for leg in self.legs if leg.column is not None]
         driven += [circle_parameters(self.mechanism, leg, X, self.scale) for leg in self.pivots]
-        driven += [(d.axis @ (d.at - self.origin) / self.scale + X[:, d.column] / self.scale
+        driven += [turn_parameters(d, X[:, d.column], self._base_frame(d.body, self.drawn))
+                   if d.is_turn else
+                   (d.axis @ (d.at - self.origin) / self.scale + X[:, d.column] / self.scale
                     )[:, None] for d in self.drives]
         driven += [gimbal_parameters(self.mechanism, gl, X, self.scale) for gl in self.gimbals]
         driven += [universal_parameters(self.mechanism, ul, X, self.scale)
-                   for ul in self.universals]
+                   for ul in self.universals if ul.column is not None]
         return np.hstack([known, np.broadcast_to(const, (X.shape[0], const.size)), *driven])
 
     def _constants(self, pts: ArrayLike) -> NDArray[np.complex128] | Array:
@@ -323,14 +337,21 @@ class SpatialPointFormulation:
                 out.append(complex(d @ d))
         for pv in self.pivots:  # the ball's circle: (Q − A)·(A1 − A) = h, ‖Q − A‖² = r²
             w = pts[pv.ball] - pts[pv.axis[0]]
-            out += [complex(w @ (pts[pv.axis[1]] - pts[pv.axis[0]])), complex(w @ w)]
-        out += [complex(d.axis @ pts[k]) for d, k in zip(self.drives, self.drive_points,
-                                                         strict=True)]
+            out += [complex(w @ (pts[pv.axis[1]] - pts[pv.axis[0]]))]
+            out += [complex(w @ w)] if pv.column is not None else []
+        for d, k in zip(self.drives, self.drive_points, strict=True):
+            if d.is_turn:  # Σ W_ik U_ik = h, W random
+                W = rng.standard_normal(9) + 1j * rng.standard_normal(9)
+                out += [*W, complex(np.sum(W * self._base_frame(d.body, pts).reshape(-1)))]
+            else:
+                out.append(complex(d.axis @ pts[k]))
         for gl in self.gimbals:  # ‖Q − C‖², ((E − C) × (Q − C))·(A − Q)
             d = pts[gl.ball] - pts[gl.centre]
             n = np.cross(pts[gl.arm] - pts[gl.centre], d)
             out += [complex(d @ d), complex(n @ (pts[gl.top_arm] - pts[gl.ball]))]
-        for ul in self.universals:  # ‖Q − C‖²
+        for ul in self.universals:  # ‖Q − C‖² (a passive slide: none)
+            if ul.column is None:
+                continue
             d = pts[ul.ball] - pts[ul.centre]
             out.append(complex(d @ d))
         x = np.concatenate([pts[list(self.unknown)].reshape(-1),
@@ -396,7 +417,7 @@ class SpatialPointFormulation:
         for ul in self.universals:
             poses.update(universal_poses(mech, ul, poses[ul.base], world, X))
         if self.augmented is not None:  # the virtual chains read off their bodies' poses
-            poses.update(chain_poses(self.augmented, poses))
+            poses.update(chain_poses(self.augmented, poses, X))
         lay = graph_layout(whole)
         return joint_values(whole, lay, poses), lay
 

@@ -70,7 +70,7 @@ class _Points:
     #: each S joint's centre point, each R joint's two axis points (not the inputs that place)
     centres: dict[int, int]
     axes: dict[int, tuple[int, int]]
-    #: each driven body's drive point
+    #: each body driven at a translation: its drive point
     drive_points: dict[str, int]
 
 
@@ -80,7 +80,7 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
     """Every joint's points (scaled drawn positions, owning bodies), the U joints' (centre,
     first arm, second arm), the P and C joints that place no body and the R inputs between
     moving bodies (module docstring); the P joints of telescopic legs (``legs``) have none; a
-    driven body carries its drive point (modes/spatial_point_drives.py)."""
+    body driven at a translation carries its drive point (modes/spatial_point_drives.py)."""
     drawn: list[Array] = []
     owners: list[frozenset[str]] = []
     u_joints = []
@@ -131,7 +131,7 @@ def _points(mech: Mechanism, origin: Array, scale: float, placing: set[int],
             a = add(j.at + scale * j.axis, (j.bodies[0],))
             b = add(j.at + scale * j.axis2, (j.bodies[1],))
             u_joints.append((c, a, b))
-    drive_points = {d.body: add(d.at, (d.body,)) for d in drives}
+    drive_points = {d.body: add(d.at, (d.body,)) for d in drives if not d.is_turn}
     return _Points(drawn, owners, u_joints, slides, turns, centres, axes, drive_points)
 
 
@@ -279,7 +279,8 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
         n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies)
                 + len(pts.u_joints) + sum(3 * len(sl.a) for sl in pts.slides)
                 + 3 * len(pts.turns) + sum(leg.column is not None for leg in legs)
-                + 2 * len(pivots) + 2 * len(gimbals) + len(universals) + len(drives))
+                + sum(1 if pv.column is None else 2 for pv in pivots) + 2 * len(gimbals)
+                + sum(ul.column is not None for ul in universals) + len(drives))
         tried.append(n_eq)
         if n_eq == n:
             break
@@ -308,7 +309,7 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                                    tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
                                    tuple(pts.u_joints), source, tuple(pts.slides),
                                    tuple(pts.turns), tuple(legs), tuple(pivots), drives,
-                                   tuple(pts.drive_points[d.body] for d in drives),
+                                   tuple(pts.drive_points.get(d.body, -1) for d in drives),
                                    whole if drives else None, tuple(gimbals), tuple(universals))
     _check_rank(form)
     return form
@@ -428,13 +429,14 @@ def _pivot(mech: Mechanism, found: tuple[int, int, int, str, str, str], pts: _Po
 
 
 def _leg_ends(mech: Mechanism, kb: int, kp: int, second: str, placed: set[str]
-              ) -> tuple[str, int, float]:
-    """A leg's placed base body (across its base joint ``kb``), its slide's input column and
-    the slide's sense (+1: ``second`` is the P joint ``kp``'s second body)."""
+              ) -> tuple[str, int | None, float]:
+    """A leg's placed base body (across its base joint ``kb``), its slide's input column (None:
+    passive) and the slide's sense (+1: ``second`` is the P joint ``kp``'s second body)."""
     b = mech.joints[kb]
     columns = {x.split(".")[0]: c for c, x in enumerate(mech.inputs)}
     return (b.bodies[0] if b.bodies[0] in placed else b.bodies[1],
-            columns[mech.joints[kp].name], 1.0 if mech.joints[kp].bodies[1] == second else -1.0)
+            columns.get(mech.joints[kp].name),
+            1.0 if mech.joints[kp].bodies[1] == second else -1.0)
 
 
 def _gimbal(mech: Mechanism, found: tuple[int, int, int, str, str], pts: _Points,
@@ -442,6 +444,7 @@ def _gimbal(mech: Mechanism, found: tuple[int, int, int, str, str], pts: _Points
     """The gimballed leg (modes/spatial_point_legs.py) of the joints and bodies ``found``."""
     ku, kp, kt, cyl, piston = found
     base, column, sign = _leg_ends(mech, ku, kp, piston, placed)
+    assert column is not None  # (gimbal_legs takes driven slides only)
     (c, e), (q, a) = pts.axes[ku], pts.axes[kt]
     return GimbalLeg((ku, kp, kt), cyl, piston, base, c, e, q, a, column, sign)
 
@@ -453,6 +456,30 @@ def _universal(mech: Mechanism, found: tuple[int, int, int, str, str], pts: _Poi
     base, column, sign = _leg_ends(mech, ku, kp, piston, placed)
     return UniversalLeg((ku, kp, ks), cyl, piston, base, pts.centres[ku], pts.centres[ks],
                         column, sign)
+
+
+def _sub(a: list[Poly], b: list[Poly]) -> list[Poly]:
+    return [x - y for x, y in zip(a, b, strict=True)]
+
+
+def _dot(a: list[Poly], b: list[Poly]) -> Poly:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _cross(u: list[Poly], v: list[Poly]) -> list[Poly]:
+    return [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+
+
+def _base_sides(point: dict[int, list[Poly]], be: BodyEquations
+          ) -> tuple[list[Poly], list[Poly], list[Poly], list[Poly]]:
+    """A body's base point b1 and sides u = b2 − b1, v = b3 − b1 and u × v (v and u × v
+    empty for a body on a line)."""
+    b1 = point[be.base[0]]
+    u = _sub(point[be.base[1]], b1)
+    if len(be.base) == 2:
+        return b1, u, [], []
+    v = _sub(point[be.base[2]], b1)
+    return b1, u, v, _cross(u, v)
 
 
 def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
@@ -475,12 +502,7 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
     for k in known:
         point[k] = [Poly.variable(next(counter)) for _ in range(3)]
 
-    def sub(a: list[Poly], b: list[Poly]) -> list[Poly]:
-        return [x - y for x, y in zip(a, b, strict=True)]
-
-    def dot(a: list[Poly], b: list[Poly]) -> Poly:
-        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
+    sub, dot = _sub, _dot
     eqs: list[Poly] = []
     params = [f"{c}{k}" for k in known for c in "xyz"]
     for be in bodies:
@@ -488,11 +510,7 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
             d = sub(point[j], point[i])
             eqs.append(dot(d, d) - Poly.variable(next(counter)))
             params.append(f"d{i}_{j}")
-        b1 = point[be.base[0]]
-        u = sub(point[be.base[1]], b1)
-        if len(be.base) == 3:
-            v = sub(point[be.base[2]], b1)
-            w = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+        b1, u, v, w = _base_sides(point, be)
         for m in be.carried:
             if len(be.base) == 2:
                 a = Poly.variable(next(counter))
@@ -516,10 +534,7 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
             eqs += [point[ib][c] - point[ia][c] - sl.sign * slide[sl.joint] * axis[c]
                     for c in range(3)]
     for t in pts.turns:
-        be = next(be for be in bodies if be.body == t.frame)
-        b1 = point[be.base[0]]
-        u, v = sub(point[be.base[1]], b1), sub(point[be.base[2]], b1)
-        w = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+        b1, u, v, w = _base_sides(point, next(be for be in bodies if be.body == t.frame))
         ta, tb, tc = (Poly.variable(next(counter)) for _ in range(3))
         params += [f"{x}{t.point}_turn" for x in "abc"]
         eqs += [point[t.point][c] - b1[c] - ta * u[c] - tb * v[c] - tc * w[c] for c in range(3)]
@@ -531,20 +546,35 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
     for pv in pivots:  # the ball on its circle: (Q − A)·(A1 − A) = h, ‖Q − A‖² = r²
         w = sub(point[pv.ball], point[pv.axis[0]])
         eqs.append(dot(w, sub(point[pv.axis[1]], point[pv.axis[0]])) - Poly.variable(next(counter)))
-        eqs.append(dot(w, w) - Poly.variable(next(counter)))
-        params += [f"h{pv.joints[0]}", f"r{pv.joints[0]}"]
-    for drive in drives:  # e · P_a = e · a + v
+        params.append(f"h{pv.joints[0]}")
+        if pv.column is not None:  # (a passive slide: its plane alone)
+            eqs.append(dot(w, w) - Poly.variable(next(counter)))
+            params.append(f"r{pv.joints[0]}")
+    for drive in drives:  # e · P_a = e · a + v; a turn Σ W_ik U_ik = h
+        if drive.is_turn:  # (the model refuses a turn of a rod, or of a placed body)
+            be = next(be for be in bodies if be.body == drive.body)
+            assert len(be.base) == 3, f"{drive.body} is driven at a turn but lies on a line"
+            _, u, v, w = _base_sides(point, be)
+            W = [Poly.variable(next(counter)) for _ in range(9)]
+            eqs.append(sum((W[3 * i + k] * col[i] for k, col in enumerate((u, v, w))
+                            for i in range(3)), start=Poly.constant(0.0))
+                       - Poly.variable(next(counter)))
+            params += [f"W{i}{k}{drive.body}_{drive.freedom}" for i in range(3) for k in range(3)]
+            params.append(f"h{drive.body}_{drive.freedom}")
+            continue
         q = point[pts.drive_points[drive.body]]
         eqs.append(q["xyz".index(drive.freedom)] - Poly.variable(next(counter)))
         params.append(f"v{drive.body}_{drive.freedom}")
     for gl in gimbals:  # ‖Q − C‖² = ‖w(s)‖², ((E − C) × (Q − C))·(A − Q) = g
         pc, pe, pq, pa = (point[k] for k in (gl.centre, gl.arm, gl.ball, gl.top_arm))
-        d, r = sub(pq, pc), sub(pe, pc)
-        n = [r[1] * d[2] - r[2] * d[1], r[2] * d[0] - r[0] * d[2], r[0] * d[1] - r[1] * d[0]]
+        d = sub(pq, pc)
+        n = _cross(sub(pe, pc), d)
         eqs.append(dot(d, d) - Poly.variable(next(counter)))
         eqs.append(dot(n, sub(pa, pq)) - Poly.variable(next(counter)))
         params += [f"w{gl.joints[1]}", f"g{gl.joints[1]}"]
-    for ul in universals:  # ‖Q − C‖² = ‖w(s)‖²
+    for ul in universals:  # ‖Q − C‖² = ‖w(s)‖² (a passive slide: none)
+        if ul.column is None:
+            continue
         d = sub(point[ul.ball], point[ul.centre])
         eqs.append(dot(d, d) - Poly.variable(next(counter)))
         params.append(f"w{ul.joints[1]}")
