@@ -7,6 +7,7 @@ values: the decoded U roots are the drawing's), and by every mode's loop closure
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,7 @@ from screwkit.kinematics.graph.closure import graph_forward, graph_layout
 from screwkit.kinematics.modes.every_mode import closure_formulation, every_mode
 from screwkit.kinematics.modes.spatial_points import SpatialPointFormulation
 from screwkit.kinematics.modes.spatial_points_build import spatial_point_formulation
+from screwkit.model.mechanism_drives import BodyDrive
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "mechanisms" / "three_upu.toml"
 
@@ -110,3 +112,46 @@ def test_legs_whose_axes_are_not_square_are_written_as_points(tmp_path: Path) ->
     assert (one.system.n, len(one.gimbals)) == (42, 2)
     with pytest.raises(CapabilityError, match="90 unknowns, more than 48"):
         spatial_point_formulation(tilted((1, 2, 3)))
+
+
+def test_a_3upu_driven_at_its_platforms_travel_has_its_operation_modes(tmp_path: Path) -> None:
+    """The 3-UPU driven at its platform's x, y and z (its legs' slides passive: each leg one
+    equation, ((E − C) × (Q − C))·(A − Q) = g, the slide read off ‖Q − C‖): at three travels
+    the platform rotations of its modes are exactly those Newton finds on the rotation (the
+    centre held at its travel) from 300 random starts on the leg condition written as in
+    :func:`_platform_poses`; the translational mode (no turn) is among them, and rotated
+    ones (the 3-UPU's other operation modes)."""
+    legs = sk.load_spec(EXAMPLE).mechanism
+    L = legs.length_scale
+    q = np.array([legs.joint(f"Up{i}").at for i in (1, 2, 3)])
+    centre = q.mean(0)
+    mech = replace(legs, inputs=(), drives=tuple(
+        BodyDrive(f"platform.{f}", "platform", f, centre) for f in "xyz"))
+    form = closure_formulation(mech)
+    assert isinstance(form, SpatialPointFormulation)
+    assert [gl.column for gl in form.gimbals] == [None] * 3
+    X = np.array([[0.0, 0.0, 0.0], [0.05 * L, -0.02 * L, 0.1 * L], [-0.1 * L, 0.07 * L, -0.2 * L]])
+    found = every_mode(mech, X)
+    assert found.worst_closure <= 1e-10 * L
+    lay = graph_layout(mech)
+    k = lay.body_of["platform"]
+    C = np.array([legs.joint(f"Ub{i}").at for i in (1, 2, 3)]) / L
+    e1 = np.array([legs.joint(f"Ub{i}").axis for i in (1, 2, 3)])
+    a = np.array([legs.joint(f"Up{i}").axis2 for i in (1, 2, 3)])
+    c0 = centre / L
+    rng = np.random.default_rng(2)
+    for n, v in enumerate(X):
+        conf = found.configurations[n]
+        assert conf.size >= 2 and found.certified[n].all()
+        R = graph_forward(mech, lay, conf).R[:, k]
+
+        def F(Rn: np.ndarray, _: np.ndarray, v: np.ndarray = v) -> np.ndarray:
+            d = (q / L - c0) @ Rn.T + c0 + v / L - C
+            return np.einsum("ij,ij->i", np.cross(e1, d), a @ Rn.T)
+
+        theirs = newton_poses(F, c0, rng, 300, turn_only=True)[:, :9]
+        ours = R.reshape(-1, 9)
+        assert len(ours) == len(theirs), (n, len(ours), len(theirs))
+        assert all(np.abs(theirs - x).max(1).min() <= 1e-8 for x in ours)
+        turned = np.degrees(np.arccos(np.clip((np.trace(R, axis1=1, axis2=2) - 1) / 2, -1, 1)))
+        assert (turned < 1e-6).any() and (turned > 1.0).any()

@@ -220,7 +220,9 @@ class GimbalLeg:
 
         ‖Q − C‖² = ‖w(s)‖²,   ((E − C) × (Q − C)) · (A − Q) = g   (g = 0 drawn)
 
-    (g a free parameter, so the topology's family is generic). Its bodies are read off Q: e2
+    (g a free parameter, so the topology's family is generic); a passive slide (a platform
+    driven at its translation) gives the second alone, and s is read off ‖Q − C‖
+    (:func:`free_slide`). Its bodies are read off Q: e2
     the sign of e1 × (Q − C) nearer its drawn direction (the U joint's root nearer the
     drawing, as the Stewart route decodes a U–P–S leg), the cylinder the rotation carrying
     the drawn frame (e2, w, e2 × w) onto the solved one, the piston slid along it."""
@@ -233,16 +235,16 @@ class GimbalLeg:
     arm: int
     ball: int
     top_arm: int
-    column: int
+    column: int | None
     sign: float
 
 
 def gimbal_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, str, str]]:
     """(base U, P, top U joint indices, cylinder, piston) of every U–P–U leg with square axes
-    (:class:`GimbalLeg`) whose base U is on a placed body and whose P joint is an input."""
+    (:class:`GimbalLeg`) whose base U is on a placed body, its P joint an input or passive."""
     tol = 1e-9
     out = []
-    for ku, kp, kt, cyl, piston, base in leg_chains(mech, placed, "U", "U"):
+    for ku, kp, kt, cyl, piston, base in leg_chains(mech, placed, "U", "U", passive=True):
         u, p, t = (mech.joints[k] for k in (ku, kp, kt))
         assert u.axis2 is not None and t.axis2 is not None
         e1, e2 = (u.axis, u.axis2) if u.bodies[0] == base else (u.axis2, u.axis)
@@ -255,7 +257,10 @@ def gimbal_legs(mech: Mechanism, placed: set[str]) -> list[tuple[int, int, int, 
 
 
 def gimbal_parameters(mech: Mechanism, leg: GimbalLeg, X: Array, scale: float) -> Array:
-    """The leg's squared length ‖w(s)‖² and g = 0 (N, 2) at the input rows X (scaled)."""
+    """The leg's squared length ‖w(s)‖² and g = 0 (N, 2) at the input rows X (scaled); g
+    alone (N, 1) for a passive slide."""
+    if leg.column is None:
+        return np.zeros((len(X), 1))
     u, p, t = (mech.joints[k] for k in leg.joints)
     w = (t.at - u.at) + np.multiply.outer(leg.sign * X[:, leg.column], p.axis)
     return np.stack([np.einsum("ni,ni->n", w, w) / scale**2, np.zeros(len(X))], axis=1)
@@ -266,9 +271,10 @@ def gimbal_poses(mech: Mechanism, leg: GimbalLeg, world: Array, X: Array) -> dic
     (:class:`GimbalLeg`)."""
     u, p, t = (mech.joints[k] for k in leg.joints)
     e2_0 = u.axis2 if u.bodies[0] == leg.base else u.axis
-    s = leg.sign * X[:, leg.column]
-    w0 = (t.at - u.at) + np.multiply.outer(s, p.axis)
     C, E, Q = world[:, leg.centre], world[:, leg.arm], world[:, leg.ball]
+    s = (leg.sign * X[:, leg.column] if leg.column is not None else
+         free_slide(t.at - u.at, np.asarray(p.axis, float), np.linalg.norm(Q - C, axis=1)))
+    w0 = (t.at - u.at) + np.multiply.outer(s, p.axis)
     d = Q - C
     e2 = np.cross(E - C, d)
     e2 /= np.linalg.norm(e2, axis=1)[:, None]

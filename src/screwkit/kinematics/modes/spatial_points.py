@@ -348,7 +348,8 @@ class SpatialPointFormulation:
         for gl in self.gimbals:  # ‖Q − C‖², ((E − C) × (Q − C))·(A − Q)
             d = pts[gl.ball] - pts[gl.centre]
             n = np.cross(pts[gl.arm] - pts[gl.centre], d)
-            out += [complex(d @ d), complex(n @ (pts[gl.top_arm] - pts[gl.ball]))]
+            out += [complex(d @ d)] if gl.column is not None else []
+            out.append(complex(n @ (pts[gl.top_arm] - pts[gl.ball])))
         for ul in self.universals:  # ‖Q − C‖² (a passive slide: none)
             if ul.column is None:
                 continue

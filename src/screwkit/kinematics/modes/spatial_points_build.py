@@ -276,11 +276,7 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
         bodies = _write_bodies(mech, pts, order, have, drawn, known, source)
         passive = [sl for sl in pts.slides if sl.column is None]
         n = 3 * len(unknown) + len(passive)
-        n_eq = (sum(len(be.distances) + 3 * len(be.carried) for be in bodies)
-                + len(pts.u_joints) + sum(3 * len(sl.a) for sl in pts.slides)
-                + 3 * len(pts.turns) + sum(leg.column is not None for leg in legs)
-                + sum(1 if pv.column is None else 2 for pv in pivots) + 2 * len(gimbals)
-                + sum(ul.column is not None for ul in universals) + len(drives))
+        n_eq = _equation_count(bodies, pts, legs + pivots + gimbals + universals, drives)
         tried.append(n_eq)
         if n_eq == n:
             break
@@ -313,6 +309,18 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                                    whole if drives else None, tuple(gimbals), tuple(universals))
     _check_rank(form)
     return form
+
+
+def _equation_count(bodies: list[BodyEquations], pts: _Points,
+                    legs: list[TelescopicLeg | PivotLeg | GimbalLeg | UniversalLeg],
+                    drives: tuple[PointDrive, ...]) -> int:
+    """The number of equations :func:`_compile` writes (a leg's: its kind's count when its
+    slide is driven, one fewer when passive)."""
+    driven = {TelescopicLeg: 1, PivotLeg: 2, GimbalLeg: 2, UniversalLeg: 1}
+    return (sum(len(be.distances) + 3 * len(be.carried) for be in bodies)
+            + len(pts.u_joints) + sum(3 * len(sl.a) for sl in pts.slides)
+            + 3 * len(pts.turns) + len(drives)
+            + sum(driven[type(leg)] - (leg.column is None) for leg in legs))
 
 
 def _check_rank(form: SpatialPointFormulation) -> None:
@@ -444,7 +452,6 @@ def _gimbal(mech: Mechanism, found: tuple[int, int, int, str, str], pts: _Points
     """The gimballed leg (modes/spatial_point_legs.py) of the joints and bodies ``found``."""
     ku, kp, kt, cyl, piston = found
     base, column, sign = _leg_ends(mech, ku, kp, piston, placed)
-    assert column is not None  # (gimbal_legs takes driven slides only)
     (c, e), (q, a) = pts.axes[ku], pts.axes[kt]
     return GimbalLeg((ku, kp, kt), cyl, piston, base, c, e, q, a, column, sign)
 
@@ -569,9 +576,11 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
         pc, pe, pq, pa = (point[k] for k in (gl.centre, gl.arm, gl.ball, gl.top_arm))
         d = sub(pq, pc)
         n = _cross(sub(pe, pc), d)
-        eqs.append(dot(d, d) - Poly.variable(next(counter)))
+        if gl.column is not None:  # (a passive slide: the second alone)
+            eqs.append(dot(d, d) - Poly.variable(next(counter)))
+            params.append(f"w{gl.joints[1]}")
         eqs.append(dot(n, sub(pa, pq)) - Poly.variable(next(counter)))
-        params += [f"w{gl.joints[1]}", f"g{gl.joints[1]}"]
+        params.append(f"g{gl.joints[1]}")
     for ul in universals:  # ‖Q − C‖² = ‖w(s)‖² (a passive slide: none)
         if ul.column is None:
             continue
