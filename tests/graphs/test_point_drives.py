@@ -10,6 +10,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import screwkit as sk
 from screwkit.kinematics.graph import solve_mechanism
@@ -203,3 +204,18 @@ def test_every_mode_of_a_driven_mechanism_is_its_augmented_ones_restricted() -> 
         assert a.size == b.size >= 2
         np.testing.assert_array_equal(a.scalars, real_configuration(travel, b).scalars)
         assert a.scalars.shape[1] == graph_layout(travel).n_scalar
+
+
+def test_a_turn_of_a_body_without_a_rotation_is_refused_by_name() -> None:
+    """A driven turn of a body the point formulation writes no base triangle for (the model
+    refuses the usual ways in: a rod's turn, a turn of a body the inputs place) is refused
+    by name, not a StopIteration from the compiler."""
+    from screwkit.errors import CapabilityError
+    from screwkit.kinematics.modes.spatial_point_drives import PointDrive, check_turns
+
+    mech = sk.load_spec(EXAMPLES / "double_wishbone_travel.toml").mechanism
+    roll = PointDrive("upright", "roll", np.zeros(3), 0)
+    check_turns(mech, (roll,), {"upright"})
+    with pytest.raises(CapabilityError, match="driven at upright's roll, a turn, but the "
+                                              "formulation writes no rotation for upright"):
+        check_turns(mech, (roll,), {"lower_arm"})

@@ -140,15 +140,12 @@ def fold_in_step(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
     """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the
     straight way to ``x_to``: :func:`fold_between`'s input and configuration, or None where
     its bisection reaches ``x_to`` (to 2¹⁻:data:`FOLD_STEPS` of the step: a fold closer to the
-    step's end than that is not told from none). The whole step is tried first, by the
-    continuation the bisection's halves use: where it gets there (most steps searched hold no
-    fold), the bisection would reach the end too, and is not run."""
+    step's end than that is not told from none). (The whole step is not tried first: a
+    continuation over a long step can land across a fold on another branch, where the
+    bisection's halves stop at the fold.)"""
+    at, near = fold_between(mech, lay, conf, x_from, x_to)
     scale = input_scale(lay)
     step = float(np.max(np.abs(np.asarray(x_to) - x_from) / scale))
-    if reach(mech, lay, conf, x_from, x_to, SMALLEST_STEP if step > FINE_HALF
-             else max(step / FOLD_SPLIT, 1e-12)) is not None:
-        return None
-    at, near = fold_between(mech, lay, conf, x_from, x_to)
     if float(np.max(np.abs(at - x_to) / scale)) <= 2.0 ** (1 - FOLD_STEPS) * step:
         return None
     return at, near

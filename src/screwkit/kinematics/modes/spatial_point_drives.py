@@ -23,8 +23,11 @@ in the drawing. The chain's R = Rz(ψ) Ry(φ) Rx(ρ) has its roll equal to ρ ex
     pitch φ:  e3ᵀ R e1 = −sin φ
 
 Each is  Σ W_ik U_ik = h  with W = r (U0⁻¹ m)ᵀ for the row and column vectors r, m above. The
-equation is quadratic in the points, since u × v is. No root is spurious: every solution is
-a pose of the chain with that drive value. W (nine numbers) and h are parameters; the generic
+equation is quadratic in the points, since u × v is. One driven turn has no spurious root:
+every solution is a pose of the chain with that drive value. Two or three turns of one body
+also hold at rotations that take each turn from the other Tait–Bryan triple (below); those
+are not poses of the chain, and every_mode drops them (their turns read back are not the
+inputs). W (nine numbers) and h are parameters; the generic
 family takes them all free.
 
 The virtual chain's joint values are read back off the body's solved pose. The travel is that
@@ -39,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from screwkit.errors import CapabilityError
 from screwkit.kinematics.graph.drives import PREFIX
 from screwkit.model.mechanism import Mechanism
 
@@ -86,6 +90,18 @@ def turn_parameters(drive: PointDrive, angle: Array, drawn_frame: Array) -> Arra
     m = np.linalg.solve(drawn_frame, m.T).T  # rᵀ R m = rᵀ U (U0⁻¹ m)
     W = np.einsum("ni,nk->nik", r, m).reshape(len(angle), 9)
     return np.hstack([W, h[:, None]])
+
+
+def check_turns(mech: Mechanism, drives: tuple[PointDrive, ...], rotated: set[str]) -> None:
+    """Refuse a driven turn of a body the formulation writes no base triangle for (not in
+    ``rotated``: one the inputs place, or whose points lie on one line)."""
+    for d in drives:
+        if d.is_turn and d.body not in rotated:
+            raise CapabilityError(
+                f"{mech.name}: the spatial point formulation does not take this mechanism: it "
+                f"is driven at {d.body}'s {d.freedom}, a turn, but the formulation writes no "
+                f"rotation for {d.body} (the inputs place it, or its points lie on one line); "
+                "follow the drawn mode with the graph tracker (--modes drawn)")
 
 
 def real_mechanism(mech: Mechanism) -> tuple[Mechanism, tuple[PointDrive, ...]]:

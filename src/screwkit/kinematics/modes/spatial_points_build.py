@@ -13,7 +13,11 @@ import numpy as np
 from screwkit.algebraic.polynomial import Poly, PolynomialSystem, compile_system
 from screwkit.errors import CapabilityError
 from screwkit.kinematics.modes.planar import placed_by_inputs
-from screwkit.kinematics.modes.spatial_point_drives import PointDrive, real_mechanism
+from screwkit.kinematics.modes.spatial_point_drives import (
+    PointDrive,
+    check_turns,
+    real_mechanism,
+)
 from screwkit.kinematics.modes.spatial_point_legs import (
     GimbalLeg,
     PivotLeg,
@@ -300,6 +304,7 @@ def spatial_point_formulation(mech: Mechanism) -> SpatialPointFormulation:
                       "the monodromy that would find its start solutions is not practical at "
                       "that size (a 3-UPU whose U axes are not square, 90 unknowns, reached one solution in 36 s); follow the drawn "
                       "mode with the graph tracker (--modes drawn)")
+    check_turns(mech, drives, {be.body for be in bodies if len(be.base) == 3})
     system = _compile(unknown, known, bodies, pts, legs, pivots, drives, gimbals, universals)
     form = SpatialPointFormulation(mech, system, origin, scale, drawn, tuple(pts.owners),
                                    tuple(placed), tuple(known), tuple(unknown), tuple(bodies),
@@ -558,9 +563,8 @@ def _compile(unknown: list[int], known: list[int], bodies: list[BodyEquations],
             eqs.append(dot(w, w) - Poly.variable(next(counter)))
             params.append(f"r{pv.joints[0]}")
     for drive in drives:  # e · P_a = e · a + v; a turn Σ W_ik U_ik = h
-        if drive.is_turn:  # (the model refuses a turn of a rod, or of a placed body)
+        if drive.is_turn:  # (a body with a base triangle: check_turns)
             be = next(be for be in bodies if be.body == drive.body)
-            assert len(be.base) == 3, f"{drive.body} is driven at a turn but lies on a line"
             _, u, v, w = _base_sides(point, be)
             W = [Poly.variable(next(counter)) for _ in range(9)]
             eqs.append(sum((W[3 * i + k] * col[i] for k, col in enumerate((u, v, w))
