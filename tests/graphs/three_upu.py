@@ -236,10 +236,6 @@ length = "mm"
 angle = "deg"
 """
 
-if __name__ == "__main__":
-    write_spec(Path(sys.argv[1]) if len(sys.argv) > 1 else PATH)
-
-
 #: each leg's platform U axis as the example draws it
 _PLATFORM_AXES = {1: "[-0, 1, 0]", 2: "[-0.866025403784, -0.5, 0]", 3: "[0.866025403784, -0.5, 0]"}
 
@@ -255,3 +251,7 @@ def write_tilted(path: Path, legs: tuple[int, ...]) -> Path:
         text = text.replace(f"axis2 = {line}", f"axis2 = [{a[0]:.15g}, {a[1]:.15g}, {a[2]:.15g}]")
     path.write_text(text, encoding="utf-8")
     return path
+
+
+if __name__ == "__main__":
+    write_spec(Path(sys.argv[1]) if len(sys.argv) > 1 else PATH)
