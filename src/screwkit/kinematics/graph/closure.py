@@ -20,6 +20,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.dual.spatial import MATVEC_FROM, cross, matvec
+from screwkit.kinematics.graph.joint_motions import (
+    MotionTable,
+    joint_motions,
+    motion_table,
+    tree_poses,
+)
 from screwkit.kinematics.tracker.loop import (
     Configuration,
     closure_error,
@@ -87,34 +93,11 @@ def axis_rotation(u: Array, th: Array) -> Array:
 def joint_motion(mech: Mechanism, lay: GraphLayout, conf: Configuration, i: int
                  ) -> tuple[Array, Array]:
     """M_j(q) (R (N, 3, 3), p (N, 3)) of joint ``i`` in drawn world coordinates (times
-    Trans(seat_offset) for a joint made off its drawing, model/mechanism.py)."""
-    j = mech.joints[i]
-    N = conf.size
-    f0 = lay.first_freedom[i]
-    c, u = j.at, j.axis
-    if j.kind == "S":
-        R = conf.spherical[:, lay.spherical_of_joint[i]]
-    elif j.kind == "P":
-        s = conf.scalars[:, lay.scalar_col[f0]]
-        slide = s[:, None] * u
-        if j.seat_offset is not None:
-            slide = slide + j.seat_offset
-        return np.broadcast_to(np.eye(3), (N, 3, 3)), slide
-    elif j.kind == "U":
-        assert j.axis2 is not None
-        R = (axis_rotation(u, conf.scalars[:, lay.scalar_col[f0]])
-             @ axis_rotation(j.axis2, conf.scalars[:, lay.scalar_col[f0 + 1]]))
-    else:  # R, C, H
-        th = conf.scalars[:, lay.scalar_col[f0]]
-        R = axis_rotation(u, th)
-    p = c - matvec(R, c)
-    if j.kind == "C":
-        p = p + conf.scalars[:, lay.scalar_col[f0 + 1], None] * u
-    elif j.kind == "H":
-        p = p + (j.pitch * conf.scalars[:, lay.scalar_col[f0]])[:, None] * u
-    if j.seat_offset is not None:  # M_j(q) · Trans(δ): the second body's seat is off by δ
-        p = p + matvec(R, j.seat_offset)
-    return R, p
+    Trans(seat_offset) for a joint made off its drawing, model/mechanism.py): joint ``i``'s
+    part of :func:`.joint_motions.joint_motions` (the same arithmetic as every joint's at
+    once)."""
+    R, p = joint_motions(joint_table(mech, lay).motion, conf)
+    return R[:, i], p[:, i]
 
 
 @dataclass(frozen=True)
@@ -136,37 +119,27 @@ def graph_forward(mech: Mechanism, lay: GraphLayout, conf: Configuration, exact:
     closure twist (module docstring): the exact logarithm, or with ``exact=False`` its
     first-order form (loop.closure_error: the same zero and the same derivative there, for a
     corrector that starts close)."""
-    N = conf.size
-    B = len(mech.bodies) + 1
-    R = np.empty((N, B, 3, 3))
-    p = np.empty((N, B, 3))
-    g = lay.body_of[GROUND]
-    R[:, g] = np.eye(3)
-    p[:, g] = 0.0
-    for k, parent, child in mech.topology.tree:
-        Mr, Mp = joint_motion(mech, lay, conf, k)
-        a, b = lay.body_of[parent], lay.body_of[child]
-        if mech.joints[k].bodies[0] != parent:  # the tree runs against the joint: M⁻¹
-            Mr = np.swapaxes(Mr, -1, -2)
-            Mp = -np.einsum("nij,nj->ni", Mr, Mp)
-        R[:, b] = R[:, a] @ Mr
-        p[:, b] = np.einsum("nij,nj->ni", R[:, a], Mp) + p[:, a]
-    residual = loop_residuals(mech, lay, conf, R, p, exact)
+    t = joint_table(mech, lay).motion
+    Mr, Mp = joint_motions(t, conf)
+    R, p = tree_poses(t, Mr, Mp, len(mech.bodies) + 1, lay.body_of[GROUND])
+    residual = loop_residuals(mech, lay, conf, R, p, exact, (Mr, Mp))
     screws, centres, axes = joint_screws(mech, lay, R, p)
     return GraphFrames(R, p, screws, residual, centres, axes)
 
 
 def loop_residuals(mech: Mechanism, lay: GraphLayout, conf: Configuration, R: Array, p: Array,
-                   exact: bool = True) -> Array:
+                   exact: bool = True, motions: tuple[Array, Array] | None = None) -> Array:
     """Every loop's closure twist (N, L, 6) from the body poses: E_j = T_a M_j T_b⁻¹ at each
-    chord j, by the exact logarithm or its first-order form (:func:`graph_forward`)."""
-    chords = mech.topology.chords
+    chord j, by the exact logarithm or its first-order form (:func:`graph_forward`);
+    ``motions``: every joint's M_j(q) at ``conf`` where already known
+    (:func:`.joint_motions.joint_motions`)."""
+    chords = list(mech.topology.chords)
     N, L = conf.size, len(chords)
     if L == 0:
         return np.empty((N, 0, 6))
-    Mr, Mp = np.empty((N, L, 3, 3)), np.empty((N, L, 3))
-    for l, k in enumerate(chords):
-        Mr[:, l], Mp[:, l] = joint_motion(mech, lay, conf, k)
+    Mr, Mp = motions if motions is not None else joint_motions(joint_table(mech, lay).motion,
+                                                               conf)
+    Mr, Mp = Mr[:, chords], Mp[:, chords]
     a = [lay.body_of[mech.joints[k].bodies[0]] for k in chords]
     b = [lay.body_of[mech.joints[k].bodies[1]] for k in chords]
     # every chord at once: per chord the same products as one chord at a time (bit for bit,
@@ -176,10 +149,6 @@ def loop_residuals(mech: Mechanism, lay: GraphLayout, conf: Configuration, R: Ar
     ER = Ra @ np.swapaxes(R[:, b], -1, -2)
     Ep = pa - np.einsum("nlij,nlj->nli", ER, p[:, b])
     return closure_twist(ER, Ep) if exact else closure_error(ER, Ep)
-
-
-def _line_screw(u: Array, c: Array, pitch: float = 0.0) -> Array:
-    return np.concatenate([u, cross(c, u) + pitch * u], -1)
 
 
 def joint_screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
@@ -200,22 +169,21 @@ def joint_screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
             a = t.first[i]
             centres[:, i] = matvec(R[:, a], j.at) + p[:, a]
             axes[:, i] = matvec(R[:, a], j.axis)
-    for i, j in enumerate(mech.joints):
-        c, u = centres[:, i], axes[:, i]
-        f = lay.first_freedom[i]
-        if j.kind == "P":
-            S[:, :3, f] = 0.0
-            S[:, 3:, f] = u
-        elif j.kind in "RH":
-            S[:, :, f] = _line_screw(u, c, j.pitch if j.kind == "H" else 0.0)
-        elif j.kind == "C":
-            S[:, :, f] = _line_screw(u, c)
-            S[:, :3, f + 1] = 0.0
-            S[:, 3:, f + 1] = u
-        elif j.kind == "U":
-            assert j.axis2 is not None
-            S[:, :, f] = _line_screw(u, c)
-            S[:, :, f + 1] = _line_screw(matvec(R[:, lay.body_of[j.bodies[1]]], j.axis2), c)
+    k = t.kinds
+    if k.line.size:  # R, H, C and a U's first freedom: the line screw (u; c × u + pitch·u)
+        u = axes[:, k.line]
+        moment = cross(centres[:, k.line], u)
+        if k.helical.size:
+            moment[:, k.helical] += k.pitch[:, None] * u[:, k.helical]
+        S[:, :3, k.line_col] = u.transpose(0, 2, 1)
+        S[:, 3:, k.line_col] = moment.transpose(0, 2, 1)
+    if k.slide.size:  # P and a C's second freedom: the free vector (0; u)
+        S[:, :3, k.slide_col] = 0.0
+        S[:, 3:, k.slide_col] = axes[:, k.slide].transpose(0, 2, 1)
+    if k.second.size:  # a U's second axis, fixed in its second body
+        u2 = (R[:, k.second_body] @ k.axis2[:, :, None])[..., 0]
+        S[:, :3, k.second_col] = u2.transpose(0, 2, 1)
+        S[:, 3:, k.second_col] = cross(centres[:, k.second], u2).transpose(0, 2, 1)
     if t.balls.size:  # S: body increments about the child's own axes through the centre
         out = np.empty((N, t.balls.size, 6, 3))
         _put_ball_screws(out, R[:, t.ball_child], centres[:, t.balls])
@@ -235,6 +203,46 @@ class JointTable:
     ball_child: NDArray[np.intp]
     ball_cols: NDArray[np.intp]
     loop_signs: Array
+    motion: MotionTable
+    kinds: ScrewColumns
+
+
+@dataclass(frozen=True)
+class ScrewColumns:
+    """Which joints' freedoms are line screws (R, H, C, a U's first axis: joints ``line``,
+    columns ``line_col``; the H joints among them at ``helical`` with their ``pitch``), free
+    vectors (P, a C's slide: ``slide``, ``slide_col``) and a U's second axis (``second``, its
+    column, its second body and its drawn axis2)."""
+
+    line: NDArray[np.intp]
+    line_col: NDArray[np.intp]
+    helical: NDArray[np.intp]
+    pitch: Array
+    slide: NDArray[np.intp]
+    slide_col: NDArray[np.intp]
+    second: NDArray[np.intp]
+    second_col: NDArray[np.intp]
+    second_body: NDArray[np.intp]
+    axis2: Array
+
+
+def _screw_columns(mech: Mechanism, lay: GraphLayout) -> ScrewColumns:
+    joints, first = mech.joints, lay.first_freedom
+    line = [i for i, j in enumerate(joints) if j.kind in "RHCU"]
+    helical = [n for n, i in enumerate(line) if joints[i].kind == "H"]
+    slide = [i for i, j in enumerate(joints) if j.kind in "PC"]
+    second = [i for i, j in enumerate(joints) if j.kind == "U"]
+
+    def ints(v: list[int]) -> NDArray[np.intp]:
+        return np.array(v, dtype=np.intp)
+
+    return ScrewColumns(
+        ints(line), ints([first[i] for i in line]), ints(helical),
+        np.array([joints[line[n]].pitch for n in helical], dtype=float),
+        ints(slide), ints([first[i] + (joints[i].kind == "C") for i in slide]),
+        ints(second), ints([first[i] + 1 for i in second]),
+        ints([lay.body_of[joints[i].bodies[1]] for i in second]),
+        np.array([joints[i].axis2 for i in second], dtype=float).reshape(-1, 3))
 
 
 _TABLES: dict[tuple[int, int], tuple[Mechanism, GraphLayout, JointTable]] = {}
@@ -254,7 +262,8 @@ def joint_table(mech: Mechanism, lay: GraphLayout) -> JointTable:
             np.array(balls, dtype=np.intp),
             np.array([lay.body_of[mech.joints[i].bodies[1]] for i in balls], dtype=np.intp),
             np.array([[lay.first_freedom[i] + k for k in range(3)] for i in balls],
-                     dtype=np.intp).reshape(-1, 3), _loop_signs(mech, lay))
+                     dtype=np.intp).reshape(-1, 3), _loop_signs(mech, lay),
+            motion_table(mech, lay), _screw_columns(mech, lay))
         _TABLES[key] = (mech, lay, table)
     return _TABLES[key][2]
 
@@ -272,7 +281,7 @@ def _loop_signs(mech: Mechanism, lay: GraphLayout) -> Array:
 
 def _put_ball_screws(out: Array, Rb: Array, c: Array) -> None:
     """The three line screws (u_k; c × u_k) of a ball's freedoms, u_k the columns of Rb
-    (..., 3, 3), into ``out`` (..., 6, 3): :func:`_line_screw` for k = 0, 1, 2 at once, the same
+    (..., 3, 3), into ``out`` (..., 6, 3): :func:`joint_screws`' line screw for k = 0, 1, 2 at once, the same
     products and differences as ``cross`` (bit for bit), without a call per column."""
     out[..., :3, :] = Rb
     c0, c1, c2 = c[..., 0, None], c[..., 1, None], c[..., 2, None]
