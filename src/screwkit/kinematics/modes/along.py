@@ -12,8 +12,9 @@ or two that meet the same one, is a path jump: the segment is tracked again with
 :data:`REFINE` sub-steps per sample, and where that still does not match uniquely the mode is cut
 at the anchor before (an event says so) rather than switched. An anchor mode that no tracked
 mode reaches is born in the segment: it is tracked backward to where it stops assembling, and
-the fold is located by bisection of that step (:func:`fold_between`, as graph/closed_modes.py
-does for dyads). A tracked mode that stops assembling dies there, located the same way.
+the fold is located within that step (:func:`fold_between`: a bracket narrowed by probes at
+σ²'s extrapolated zero and by bisection). A tracked mode that stops assembling dies there,
+located the same way.
 A track must not continue onto another mode across a fold inside a step (modes/along_folds.py):
 a backward track that reaches a known mode's configuration is not taken past it and the step is
 bisected for its fold; after the segments, two modes at one configuration are cut at the fold
@@ -227,7 +228,7 @@ def _island(mech: Mechanism, lay: GraphLayout, X: Array, n: int, conf: Configura
             anchors: NDArray[np.intp], chains: list[Chain], fmt: object, where: str,
             certified: bool) -> None:
     """A mode found at sample ``n`` between anchors, tracked to where it is born and where it
-    dies (both located by bisection); dropped where it reaches an anchor (there it is a mode
+    dies (both located by :func:`fold_between`); dropped where it reaches an anchor (there it is a mode
     already followed)."""
     write = fmt if callable(fmt) else str
     fwd = np.arange(n + 1, int(anchors[anchors > n].min()) + 1)
@@ -245,7 +246,7 @@ def _island(mech: Mechanism, lay: GraphLayout, X: Array, n: int, conf: Configura
     at, near = fold_between(mech, lay, chain.conf_at(k), X[k], X[k - 1])
     chain.folds.append((at, near))
     chain.events.append(f"is born at {write(at)}: it starts assembling there (a fold, located "
-                        "by bisection between samples)")
+                        "between samples)")
     k = int(fwd[mf][-1]) if mf.any() else n
     at, near = fold_between(mech, lay, chain.conf_at(k), X[k], X[k + 1])
     chain.folds.append((at, near))
@@ -297,7 +298,7 @@ def _segment(mech: Mechanism, lay: GraphLayout, X: Array, anchors: NDArray[np.in
             at, near = fold_between(mech, lay, chain.conf_at(k), X[k], X[k + 1])
             chain.folds.append((at, near))
             chain.events.append(f"dies at {fmt(at)}: it stops assembling there (a fold, located "
-                                "by bisection between samples)")
+                                "between samples)")
             continue
         j = claims[c]
         chain.put(rows, conf)
@@ -333,7 +334,7 @@ def _claims(mech: Mechanism, lay: GraphLayout,
 def _born(mech: Mechanism, lay: GraphLayout, X: Array, A: int, B: int, conf: Configuration,
           chains: list[Chain], fmt: object) -> int:
     """A mode found at anchor B that no mode tracked from anchor A reaches: tracked back to
-    where it is born (a fold, by bisection), or to A where a path jump cut a mode there."""
+    where it is born (a fold, :func:`fold_between`), or to A where a path jump cut a mode there."""
     write = fmt if callable(fmt) else str
     c = _new_chain(chains, lay, X.shape[0])
     chain = chains[c]
@@ -363,7 +364,7 @@ def _born(mech: Mechanism, lay: GraphLayout, X: Array, A: int, B: int, conf: Con
     at, near = found
     chain.folds.append((at, near))
     chain.events.append(f"is born at {write(at)}: it starts assembling there (a fold, located "
-                        "by bisection between samples)")
+                        "between samples)")
     return c
 
 

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from screwkit.kinematics.graph.closure import GraphLayout, graph_forward
-from screwkit.kinematics.graph.follow import SMALLEST_STEP, reach
+from screwkit.kinematics.graph.follow import SMALLEST_STEP, graph_system, reach
 from screwkit.kinematics.tracker.loop import Configuration
 from screwkit.model.mechanism import Mechanism
 
@@ -38,8 +38,14 @@ Array = NDArray[np.float64]
 _PIECE = ("a piece of a track that went on past samples where it was at another mode's "
           "configuration: its ends are where that track was cut or ended")
 
-#: bisection steps locating a birth or death between two samples (2⁻²⁶ of the step)
+#: a birth or death between two samples is located to 2⁻²⁶ of the step (the halvings of a
+#: bisection)
 FOLD_STEPS = 26
+#: the fold search probes this fraction of the distance to σ²'s extrapolated zero short of and
+#: beyond it (:func:`fold_between`)
+FOLD_PROBE = 0.05
+#: ... for this many pairs at most, then bisects
+FOLD_ROUNDS = 8
 #: a bisection step's continuation may split it down to this fraction of its length
 FOLD_SPLIT = 8
 #: ... once the half is this short (rad, or fraction of the length scale): a half wrongly
@@ -110,24 +116,87 @@ def pose_distance(mech: Mechanism, lay: GraphLayout, a: Configuration, b: Config
 def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from: Array,
                  x_to: Array) -> tuple[Array, Configuration]:
     """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the way
-    to ``x_to`` (which it does not reach): bisection of the segment, :data:`FOLD_STEPS`
-    halvings, each half reached by continuation (graph/follow.py ``reach``, in steps down to
-    the tracker's smallest while a half is longer than :data:`FINE_HALF`, then to
-    1/:data:`FOLD_SPLIT` of the half); the input there and the last configuration reached."""
-    lo, hi = np.asarray(x_from, dtype=float), np.asarray(x_to, dtype=float)
-    scale = input_scale(lay)
-    for _ in range(FOLD_STEPS):
-        mid = 0.5 * (lo + hi)
-        h = float(np.max(np.abs(mid - lo) / scale))
-        # a half that ends just short of the fold needs steps as short as its distance to
-        # it: down to the tracker's smallest while the half is long, 1/FOLD_SPLIT of it after
-        got = reach(mech, lay, conf, lo, mid, SMALLEST_STEP if h > FINE_HALF
-                    else max(h / FOLD_SPLIT, 1e-12))
+    to ``x_to`` (which it does not reach): a bracket [lo, hi] of the segment (lo reached, hi
+    not) shrunk to 2⁻:data:`FOLD_STEPS` of it, each trial point reached by continuation from
+    lo (graph/follow.py ``reach``, in steps down to the tracker's smallest while the way is
+    longer than :data:`FINE_HALF`, then to 1/:data:`FOLD_SPLIT` of it); the input at the
+    bracket's middle and the configuration at lo.
+
+    The trial points: halvings of the bracket until one fails (no σ² wanted where the step
+    holds no fold: those searches are bisection as before), then where σ² (σ_r/σ₁ of the
+    passive Jacobian, squared, which falls to 0 linearly in the input at a quadratic fold)
+    extrapolates to 0 from the last three points reached (a parabola through them; a line through two), probed short of it and beyond it,
+    each by :data:`FOLD_PROBE` of its distance from lo or by twice the guess's move since
+    the last pair, whichever is more (Keller's fold is a regular zero of σ² along the branch:
+    Allgower & Georg 1990, *Numerical Continuation Methods*, §9); a halving of the bracket
+    where that zero is not inside it, and for good after :data:`FOLD_ROUNDS` pairs (a fold
+    that is not quadratic, or none in the step: σ² does not fall to 0). Every trial keeps
+    the bracket, so it ends as narrow as bisection's; on the gapped six-bar of
+    tests/graphs/test_step_folds.py it takes 16–17 reaches against bisection's 26
+    (tests/graphs/test_fold_search.py). A trial within ~1e-7 of the fold can fail short of
+    it (the corrector next to it); then the fold moves by less than that, as with bisection's
+    last halves."""
+    x0 = np.asarray(x_from, dtype=float)
+    dx = np.asarray(x_to, dtype=float) - x0
+    length = float(np.max(np.abs(dx) / input_scale(lay)))
+    system = graph_system(mech, lay)
+    lo, hi, goal = 0.0, 1.0, 2.0 ** -FOLD_STEPS
+    seen: list[tuple[float, float]] = []  # (t, σ²) reached, once a trial has failed
+
+    def trial(t: float) -> None:
+        nonlocal lo, hi, conf
+        h = (t - lo) * length
+        # a way that ends just short of the fold needs steps as short as its distance to it:
+        # down to the tracker's smallest while it is long, 1/FOLD_SPLIT of it after
+        got = reach(mech, lay, conf, x0 + lo * dx, x0 + t * dx,
+                    SMALLEST_STEP if h > FINE_HALF else max(h / FOLD_SPLIT, 1e-12))
         if got is None:
-            hi = mid
+            if not seen:  # a fold (or a stop) in the step: σ² from here on
+                seen.append((lo, float(system.sigma(conf)[0]) ** 2))
+            hi = t
         else:
-            lo, conf = mid, got
-    return np.asarray(0.5 * (lo + hi)), conf
+            lo, conf = t, got
+            if seen:
+                seen.append((t, float(system.sigma(got)[0]) ** 2))
+
+    last = None
+    rounds = 0
+    while hi - lo > goal:
+        guess = _sigma_zero(seen) if rounds < FOLD_ROUNDS else None
+        if guess is None or not lo < guess < hi:
+            trial(0.5 * (lo + hi))
+            continue
+        rounds += 1
+        # the probes as far from the guess as it moved since the last one (its error, for a
+        # guess converging faster than linearly), at least FOLD_PROBE of its distance
+        d = max(FOLD_PROBE * (guess - lo), 0.25 * goal,
+                0.0 if last is None else 2.0 * abs(guess - last))
+        last = guess
+        short, far = guess - d, guess + d
+        if lo < short:
+            trial(short)
+        if lo < far < hi and hi - lo > goal:  # (not where the short probe failed)
+            trial(far)
+    return np.asarray(x0 + 0.5 * (lo + hi) * dx), conf
+
+
+def _sigma_zero(seen: list[tuple[float, float]]) -> float | None:
+    """Where σ² through the last three (t, σ²) reached (a parabola; the last two: a line)
+    first meets 0 ahead of them (None where σ² does not fall towards 0 there)."""
+    pts = seen[-3:]
+    t, s = np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
+    if len(pts) < 2 or not (np.isfinite(s).all() and np.all(np.diff(t) > 0)
+                            and s[-2] > s[-1] > 0.0):
+        return None
+    line = t[-1] + s[-1] * (t[-1] - t[-2]) / (s[-2] - s[-1])
+    if len(pts) < 3:
+        return float(line)
+    u = t - t[-1]  # Newton's divided differences at u = 0, u₂, u₁
+    d32 = (s[1] - s[2]) / u[1]
+    d321 = ((s[0] - s[1]) / (u[0] - u[1]) - d32) / u[0]
+    roots = np.roots([d321, d32 - d321 * u[1], s[2]])  # σ² ≈ s₃ + d32 u + d321 u (u − u₂)
+    ahead = [float(r.real) for r in roots if abs(r.imag) <= 1e-12 * (1 + abs(r)) and r.real > 0]
+    return t[-1] + min(ahead) if ahead else float(line)
 
 
 def input_scale(lay: GraphLayout) -> Array:
@@ -204,7 +273,7 @@ def _cut(mech: Mechanism, lay: GraphLayout, X: Array, chains: list[Chain],
                     verb = "starts" if m > n1 else "stops"
                     chain.events.append(
                         f"{what} at {write(got[0])}: it {verb} assembling there (a fold, located "
-                        f"by bisection between samples; tracked on across it, it landed on another "
+                        f"between samples; tracked on across it, it landed on another "
                         f"mode's configuration at {write(X[edge])}, which is not taken)")
                     return
     # no fold next to the shared samples tells which jumped: the later-found mode is cut
@@ -300,7 +369,7 @@ def _split(mech: Mechanism, lay: GraphLayout, X: Array, chains: list[Chain], o: 
     if dies is None:
         return 0
     born = fold_in_step(mech, lay, chains[o].conf_at(k + 1), X[k + 1], X[k])
-    how = ("(a fold, located by bisection between samples; its track had crossed it onto "
+    how = ("(a fold, located between samples; its track had crossed it onto "
            "another branch, found from a mode that meets no other at a fold in that step)")
     lead = (f"is born at {write(born[0])}: it starts assembling there {how}" if born is not None
             else f"starts at {write(X[k + 1])}: it is a track that crossed a fold onto another "
