@@ -336,6 +336,82 @@ def _stacked_rows() -> list[dict[str, Any]]:
     return rows
 
 
+def _forward_rows() -> list[dict[str, Any]]:
+    """``graph_forward`` (every body pose, screw and closure twist) at one sample, the call the
+    tracker, the fold searches and every-mode decoding repeat thousands of times (wall time
+    per call, best of 3 runs of 300 calls, at a random configuration); and the fold search
+    (modes/along_folds.py) on the gapped six-bar of tests/graphs/test_step_folds.py against
+    plain bisection of the same step, side by side (reaches and wall time)."""
+    from screwkit.kinematics.graph.closure import graph_forward
+    from screwkit.kinematics.tracker.loop import Configuration, rotation_matrix
+
+    rows: list[dict[str, Any]] = []
+    rng = np.random.default_rng(0)
+    for name in ("watt_sixbar", "jansen_leg", "delta_robot", "three_upu", "stewart_platform"):
+        mech = sk.load_spec(ROOT / "examples" / "mechanisms" / f"{name}.toml").mechanism
+        lay = graph_layout(mech)
+        conf = Configuration(0.1 * rng.normal(size=(1, lay.n_scalar)), rotation_matrix(
+            0.1 * rng.normal(size=(lay.n_spherical, 3))).reshape(1, lay.n_spherical, 3, 3))
+        graph_forward(mech, lay, conf)
+        best = math.inf
+        for _ in range(3):
+            t0 = time.perf_counter()
+            for _ in range(300):
+                graph_forward(mech, lay, conf)
+            best = min(best, (time.perf_counter() - t0) / 300)
+        rows.append({"name": f"{name}: graph_forward at one sample ({len(mech.joints)} joints, "
+                             f"{len(mech.topology.chords)} loops)",
+                     "value": best * 1e6, "unit": "µs/call", "target": None,
+                     "note": "every joint's motion at once, the tree by levels "
+                             "(graph/joint_motions.py); the per-joint loop before: ~470 µs "
+                             "on the 3-UPU (docs/kinematics.md)"})
+    rows.append(_fold_search_row())
+    return rows
+
+
+def _fold_search_row() -> dict[str, Any]:
+    import sys
+
+    from screwkit.kinematics.graph import follow
+    from screwkit.kinematics.graph.closure import zero_configuration
+    from screwkit.kinematics.modes import along_folds
+
+    sys.path.insert(0, str(ROOT))
+    from tests.graphs.test_step_folds import GAP, GAP_DRAWN, _sixbar
+
+    mech = _sixbar(*GAP, GAP_DRAWN)
+    lay = graph_layout(mech)
+    x0, x1 = np.radians([60.0]), np.radians([100.0])
+    conf = follow.reach(mech, lay, zero_configuration(lay), np.zeros(1), x0)
+    assert conf is not None
+    real, count = along_folds.reach, [0]
+
+    def counted(*args: Any, **kwargs: Any) -> Any:
+        count[0] += 1
+        return real(*args, **kwargs)
+
+    along_folds.reach = counted
+    rounds = along_folds.FOLD_ROUNDS
+    out: dict[int, tuple[int, float, float]] = {}
+    try:
+        for r in (rounds, 0, rounds, 0):  # alternating; FOLD_ROUNDS = 0 is plain bisection
+            along_folds.FOLD_ROUNDS = r
+            count[0] = 0
+            t0 = time.perf_counter()
+            at, _ = along_folds.fold_between(mech, lay, conf, x0, x1)
+            dt = time.perf_counter() - t0
+            if r not in out or dt < out[r][1]:
+                out[r] = (count[0], dt, float(at[0]))
+    finally:
+        along_folds.reach, along_folds.FOLD_ROUNDS = real, rounds
+    probe, plain = out[rounds], out[0]
+    return {"name": "gapped six-bar: the fold between 60° and 100° of input (probes / bisection)",
+            "value": probe[1] / plain[1], "unit": "x", "target": None,
+            "note": f"{probe[0]} reaches against {plain[0]}, {probe[1] * 1e3:.0f} against "
+                    f"{plain[1] * 1e3:.0f} ms (best of 2, wall); the two folds "
+                    f"{abs(probe[2] - plain[2]):.1e} rad apart"}
+
+
 def run() -> list[dict[str, Any]]:
     spec = sk.load_spec(WATT)
     mech = spec.mechanism
@@ -367,6 +443,7 @@ def run() -> list[dict[str, Any]]:
     rows += _single_loop_rows(theta)
     rows += _loop_stage_rows(theta)
     rows += _stacked_rows()
+    rows += _forward_rows()
     return rows
 
 
