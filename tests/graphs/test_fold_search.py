@@ -64,3 +64,43 @@ def test_a_step_with_no_fold_is_told_from_one() -> None:
     assert fold_in_step(mech, lay, zero_configuration(lay), x_from, x_to) is None
     got = fold_in_step(mech, lay, zero_configuration(lay), x_from, np.radians([100.0]))
     assert got is not None and abs(float(got[0][0]) - _gap_fold()) <= 1e-7
+
+
+@pytest.mark.parametrize(("law", "most"), [
+    ("quadratic fold", 21), ("sigma linear", 28), ("sigma's zero off the stop", 28),
+    ("quarter power", 28)])
+def test_the_bracket_holds_on_model_branches(law: str, most: int,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    """On model branches that stop at a random t* of the step (a reach succeeds exactly below
+    it) with σ following a given law, every search ends with its last point reached below t*
+    and the fold within 2⁻²⁶ of t*, every trial ahead of the last point reached, in at most
+    ``most`` reaches (bisection: 26; a quadratic fold: σ ∝ √(t* − t))."""
+    rng = np.random.default_rng(7)
+    monkeypatch.setattr(along_folds, "input_scale", lambda lay: np.ones(1))
+    counts, calls = [], [0]
+    for _ in range(300):
+        stop = float(rng.uniform(0.01, 0.99))
+        zero = {"quadratic fold": stop, "sigma linear": stop,
+                "sigma's zero off the stop": stop + float(rng.uniform(-0.05, 0.05)),
+                "quarter power": stop + float(rng.uniform(0.0, 0.01))}[law]
+        power = {"quadratic fold": 0.5, "sigma linear": 1.0, "sigma's zero off the stop": 0.5,
+                 "quarter power": 0.25}[law]
+        calls[0] = 0
+
+        def reach(mech: object, lay: object, conf: float, a: np.ndarray, b: np.ndarray,
+                  smallest: float, stop: float = stop) -> float | None:
+            calls[0] += 1
+            assert float(b[0]) > float(a[0]) == conf
+            return float(b[0]) if float(b[0]) < stop else None
+
+        class Model:
+            def sigma(self, t: float, zero: float = zero, power: float = power) -> np.ndarray:
+                return np.array([abs(zero - t) ** power])
+
+        monkeypatch.setattr(along_folds, "reach", reach)
+        monkeypatch.setattr(along_folds, "graph_system", lambda mech, lay: Model())
+        at, last = fold_between(None, None, 0.0, np.zeros(1), np.ones(1))  # type: ignore[arg-type]
+        assert last < stop  # type: ignore[operator]
+        assert abs(float(at[0]) - stop) <= 2.0 ** -FOLD_STEPS
+        counts.append(calls[0])
+    assert max(counts) <= most, (law, max(counts))

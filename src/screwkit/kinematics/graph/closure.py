@@ -24,6 +24,7 @@ from screwkit.kinematics.graph.joint_motions import (
     MotionTable,
     joint_motions,
     motion_table,
+    rotate,
     tree_poses,
 )
 from screwkit.kinematics.tracker.loop import (
@@ -95,9 +96,9 @@ def joint_motion(mech: Mechanism, lay: GraphLayout, conf: Configuration, i: int
     """M_j(q) (R (N, 3, 3), p (N, 3)) of joint ``i`` in drawn world coordinates (times
     Trans(seat_offset) for a joint made off its drawing, model/mechanism.py): joint ``i``'s
     part of :func:`.joint_motions.joint_motions` (the same arithmetic as every joint's at
-    once)."""
-    R, p = joint_motions(joint_table(mech, lay).motion, conf)
-    return R[:, i], p[:, i]
+    once), computed for that joint alone."""
+    R, p = joint_motions(joint_table(mech, lay).motion, conf, np.array([i], dtype=np.intp))
+    return R[:, 0], p[:, 0]
 
 
 @dataclass(frozen=True)
@@ -137,9 +138,11 @@ def loop_residuals(mech: Mechanism, lay: GraphLayout, conf: Configuration, R: Ar
     N, L = conf.size, len(chords)
     if L == 0:
         return np.empty((N, 0, 6))
-    Mr, Mp = motions if motions is not None else joint_motions(joint_table(mech, lay).motion,
-                                                               conf)
-    Mr, Mp = Mr[:, chords], Mp[:, chords]
+    if motions is None:  # the chords' alone
+        Mr, Mp = joint_motions(joint_table(mech, lay).motion, conf,
+                               np.array(chords, dtype=np.intp))
+    else:
+        Mr, Mp = motions[0][:, chords], motions[1][:, chords]
     a = [lay.body_of[mech.joints[k].bodies[0]] for k in chords]
     b = [lay.body_of[mech.joints[k].bodies[1]] for k in chords]
     # every chord at once: per chord the same products as one chord at a time (bit for bit,
@@ -181,7 +184,7 @@ def joint_screws(mech: Mechanism, lay: GraphLayout, R: Array, p: Array
         S[:, :3, k.slide_col] = 0.0
         S[:, 3:, k.slide_col] = axes[:, k.slide].transpose(0, 2, 1)
     if k.second.size:  # a U's second axis, fixed in its second body
-        u2 = (R[:, k.second_body] @ k.axis2[:, :, None])[..., 0]
+        u2 = rotate(R[:, k.second_body], k.axis2)
         S[:, :3, k.second_col] = u2.transpose(0, 2, 1)
         S[:, 3:, k.second_col] = cross(centres[:, k.second], u2).transpose(0, 2, 1)
     if t.balls.size:  # S: body increments about the child's own axes through the centre

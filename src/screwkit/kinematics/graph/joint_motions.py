@@ -124,6 +124,14 @@ def _levels(mech: Mechanism, lay: GraphLayout
     return tuple(out)
 
 
+def rotate(R: Array, v: Array) -> Array:
+    """R v for stacks of 3 × 3 matrices R (..., 3, 3) and vectors v (..., 3) broadcast
+    against them, by columns (R's columns times v's entries, summed): a few array
+    operations whatever the stack, where numpy's matmul calls BLAS once per small matrix."""
+    return np.asarray(R[..., :, 0] * v[..., 0, None] + R[..., :, 1] * v[..., 1, None]
+                      + R[..., :, 2] * v[..., 2, None])
+
+
 def _rodrigues(s: Array, c: Array, K: Array, K2: Array) -> Array:
     """I + sin θ K + (1 − cos θ) K² for every sample and joint (N, J, 3, 3), in
     :func:`.closure.axis_rotation`'s order of operations."""
@@ -133,11 +141,15 @@ def _rodrigues(s: Array, c: Array, K: Array, K2: Array) -> Array:
     return out
 
 
-def joint_motions(t: MotionTable, conf: Configuration) -> tuple[Array, Array]:
+def joint_motions(t: MotionTable, conf: Configuration, joints: Index | None = None
+                  ) -> tuple[Array, Array]:
     """M_j(q) of every joint (R (N, J, 3, 3), p (N, J, 3)) in drawn world coordinates (times
-    Trans(seat_offset) for a joint made off its drawing): a rotation about the joint's axis
+    Trans(seat_offset) for a joint made off its drawing), or of the joints ``joints`` only
+    (in that order; each joint's the same arithmetic): a rotation about the joint's axis
     through its point (R, C, H; a U's two in turn; an S's own rotation), p = c − R c, plus the
     slide along the axis (P, C, H); a P joint's R = I and p its slide alone."""
+    if joints is not None:
+        t = _subset(t, np.asarray(joints, dtype=np.intp))
     N = conf.size
     q = np.concatenate([conf.scalars, np.zeros((N, 1))], axis=1)
     th = q[:, t.angle]
@@ -150,13 +162,34 @@ def joint_motions(t: MotionTable, conf: Configuration) -> tuple[Array, Array]:
         R[:, t.balls] = conf.spherical[:, t.ball_index]
     if t.prismatic.size:
         R[:, t.prismatic] = np.eye(3)
-    p = t.at - (R @ t.at[:, :, None])[..., 0]
+    p = t.at - rotate(R, t.at)
     p += (q[:, t.slide] * t.gain)[..., None] * t.axis
     if t.prismatic.size:  # c − I c is 0: the slide alone
         p[:, t.prismatic] = (q[:, t.slide[t.prismatic]])[..., None] * t.axis[t.prismatic]
     if t.seated.size:  # M_j(q) · Trans(δ): the second body's seat is off by δ
-        p[:, t.seated] += (R[:, t.seated] @ t.seat[:, :, None])[..., 0]
+        p[:, t.seated] += rotate(R[:, t.seated], t.seat)
     return R, p
+
+
+def _subset(t: MotionTable, joints: Index) -> MotionTable:
+    """The table of the joints ``joints`` alone (their rows, renumbered in that order)."""
+    where = np.full(len(t.at), -1, dtype=np.intp)
+    where[joints] = np.arange(len(joints))
+
+    def renumbered(idx: Index, rows: Array | Index | None = None
+                   ) -> tuple[Index, Array | Index | None]:
+        keep = where[idx] >= 0
+        return where[idx][keep], (None if rows is None else rows[keep])
+
+    universal, _ = renumbered(t.universal)
+    balls, ball_index = renumbered(t.balls, t.ball_index)
+    prismatic, _ = renumbered(t.prismatic)
+    seated, seat = renumbered(t.seated, t.seat)
+    return MotionTable(t.at[joints], t.axis[joints], t.K[joints], t.K2[joints], t.L[joints],
+                       t.L2[joints], t.angle[joints], t.angle2[joints], t.slide[joints],
+                       t.gain[joints], prismatic, universal, balls,
+                       np.asarray(ball_index, dtype=np.intp), seated,
+                       np.asarray(seat, dtype=float).reshape(-1, 3), ())
 
 
 def tree_poses(t: MotionTable, Mr: Array, Mp: Array, bodies: int, ground: int
@@ -173,8 +206,8 @@ def tree_poses(t: MotionTable, Mr: Array, Mp: Array, bodies: int, ground: int
         Rk, pk = Mr[:, k], Mp[:, k]
         if rev.any():
             Rk[:, rev] = np.swapaxes(Rk[:, rev], -1, -2)
-            pk[:, rev] = -(Rk[:, rev] @ pk[:, rev, :, None])[..., 0]
+            pk[:, rev] = -rotate(Rk[:, rev], pk[:, rev])
         Ra = R[:, a]
         R[:, b] = Ra @ Rk
-        p[:, b] = (Ra @ pk[..., None])[..., 0] + p[:, a]
+        p[:, b] = rotate(Ra, pk) + p[:, a]
     return R, p

@@ -1,6 +1,6 @@
 """Folds and path jumps along the motion (issue 27, "a motion never switches mode silently"):
-the pose comparison, the fold bisection and the shared-configuration check of
-kinematics/modes/along.py.
+the pose comparison, the fold search between two samples and the shared-configuration check
+of kinematics/modes/along.py.
 
 A continuation step that spans a fold (the branch stops assembling inside the step while another
 branch holds at the step's end, e.g. a gap or an island inside one sample step) can converge onto
@@ -8,7 +8,7 @@ that other branch: graph/follow.py's contraction and step-halving tests see only
 Such a jump is caught where it lands on a mode already known: two modes at one configuration at a
 sample (every body pose equal to along.py's MATCH_TOLERANCE) are one mode counted twice, so one
 of them jumped. :func:`unshare` finds which: the one whose step into the shared samples, from its
-own configuration next to them, meets a fold (:func:`fold_in_step`, the bisection of
+own configuration next to them, meets a fold (:func:`fold_in_step`, the bracket search of
 :func:`fold_between`, as graph/closed_modes.py locates a dyad's fold between samples). It is cut
 at that fold (it dies, or is born, there: an event says so, and the fold is kept for
 :func:`fold_meetings`). Where neither step meets a fold the later-found mode is cut at the
@@ -129,8 +129,10 @@ def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
     each by :data:`FOLD_PROBE` of its distance from lo or by twice the guess's move since
     the last pair, whichever is more (Keller's fold is a regular zero of σ² along the branch:
     Allgower & Georg 1990, *Numerical Continuation Methods*, §9); a halving of the bracket
-    where that zero is not inside it, and for good after :data:`FOLD_ROUNDS` pairs (a fold
-    that is not quadratic, or none in the step: σ² does not fall to 0). Every trial keeps
+    where that zero is not inside it, and for good after :data:`FOLD_ROUNDS` pairs or after
+    two pairs in a row that did not put the fold between them (a stop that is not a
+    quadratic fold: σ² does not fall to 0 there). Each probe is at least a quarter of the
+    final width from the guess. Every trial keeps
     the bracket, so it ends as narrow as bisection's; on the gapped six-bar of
     tests/graphs/test_step_folds.py it takes 16–17 reaches against bisection's 26
     (tests/graphs/test_fold_search.py). A trial within ~1e-7 of the fold can fail short of
@@ -160,13 +162,14 @@ def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
                 seen.append((t, float(system.sigma(got)[0]) ** 2))
 
     last = None
-    rounds = 0
+    rounds = misses = 0
     while hi - lo > goal:
-        guess = _sigma_zero(seen) if rounds < FOLD_ROUNDS else None
+        guess = _sigma_zero(seen) if rounds < FOLD_ROUNDS and misses < 2 else None
         if guess is None or not lo < guess < hi:
             trial(0.5 * (lo + hi))
             continue
         rounds += 1
+        before = (lo, hi)
         # the probes as far from the guess as it moved since the last one (its error, for a
         # guess converging faster than linearly), at least FOLD_PROBE of its distance
         d = max(FOLD_PROBE * (guess - lo), 0.25 * goal,
@@ -177,6 +180,10 @@ def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
             trial(short)
         if lo < far < hi and hi - lo > goal:  # (not where the short probe failed)
             trial(far)
+        # a pair that did not put the fold between its probes (both reached, or the short
+        # one not): two in a row and σ² is no guide here (the fold is not quadratic)
+        bracketed = lo >= short and hi == far and before != (lo, hi)
+        misses = 0 if bracketed else misses + 1
     return np.asarray(x0 + 0.5 * (lo + hi) * dx), conf
 
 
@@ -195,7 +202,8 @@ def _sigma_zero(seen: list[tuple[float, float]]) -> float | None:
     d32 = (s[1] - s[2]) / u[1]
     d321 = ((s[0] - s[1]) / (u[0] - u[1]) - d32) / u[0]
     roots = np.roots([d321, d32 - d321 * u[1], s[2]])  # σ² ≈ s₃ + d32 u + d321 u (u − u₂)
-    ahead = [float(r.real) for r in roots if abs(r.imag) <= 1e-12 * (1 + abs(r)) and r.real > 0]
+    # a double zero (σ linear in t) comes out as a pair with a small imaginary part
+    ahead = [float(r.real) for r in roots if abs(r.imag) <= 1e-6 * abs(r) and r.real > 0]
     return t[-1] + min(ahead) if ahead else float(line)
 
 
@@ -208,10 +216,10 @@ def fold_in_step(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
                  x_to: Array) -> tuple[Array, Configuration] | None:
     """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the
     straight way to ``x_to``: :func:`fold_between`'s input and configuration, or None where
-    its bisection reaches ``x_to`` (to 2¹⁻:data:`FOLD_STEPS` of the step: a fold closer to the
-    step's end than that is not told from none). (The whole step is not tried first: a
-    continuation over a long step can land across a fold on another branch, where the
-    bisection's halves stop at the fold.)"""
+    its search reaches ``x_to`` (to 2¹⁻:data:`FOLD_STEPS` of the step: a fold closer to the
+    step's end than that is not told from none; with no trial failing, the search is
+    bisection). (The whole step is not tried first: a continuation over a long step can land
+    across a fold on another branch, where the bisection's halves stop at the fold.)"""
     at, near = fold_between(mech, lay, conf, x_from, x_to)
     scale = input_scale(lay)
     step = float(np.max(np.abs(np.asarray(x_to) - x_from) / scale))

@@ -8,10 +8,10 @@ configuration curve's projection onto the input (modes/planar_folds.py, one homo
 mechanism). A mode is a branch over an interval between folds, so every island inside a
 step lies over an interval between two consecutive fold inputs inside that step: the
 homotopy (modes/every_mode.py) is solved at the middle of each such interval, and a mode
-there whose continuation reaches neither of the step's samples (bisection of each half,
-modes/along_folds.py ``fold_in_step``) is an island. Its birth and death are the critical
-inputs next to the bisection's (within :data:`SNAP`; the bisection's own value, with a note,
-where none is).
+there whose continuation reaches neither of the step's samples (the fold search of each
+half, modes/along_folds.py ``fold_in_step``) is an island. Its birth and death are the
+critical inputs next to the search's (within :data:`SNAP`; the search's own value, with a
+note, where none is).
 
 Taken: a formulation with an ``input_folds`` method (the planar R formulation,
 modes/planar.py) and a motion in which one input varies (the others constant). Not taken
@@ -216,14 +216,14 @@ def _island(mech: Mechanism, lay: GraphLayout, X: Array, k: int, conf: Configura
                   np.broadcast_to(np.eye(3), (N, lay.n_spherical, 3, 3)).copy(),
                   np.zeros(N, dtype=bool))
     how = ("(a fold: a critical point of the input found by the homotopy with every other, "
-           "and the end of this mode's continuation by bisection)")
+           "and the end of this mode's continuation)")
     for (at, near), word in ((born, "is born"), (dies, "dies")):
         fixed, snapped = _snap(at, inside, j)
         chain.folds.append((fixed, near))
         verb = "starts" if word == "is born" else "stops"
         chain.events.append(
             f"{word} at {write(fixed)}: it {verb} assembling there "
-            + (how if snapped else "(a fold located by bisection between samples; no critical "
+            + (how if snapped else "(a fold located between samples; no critical "
                "point of the input within 1e-6 rad of it)"))
     chain.events.append(f"found by the homotopy at {write(x)}, between two folds inside the "
                         f"step from {write(X[k])} to {write(X[k + 1])}: an island inside one "
