@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from screwkit.algebraic import compiled
+from screwkit.errors import InputError
 from screwkit.kinematics.modes import stewart_sparse, stewart_template
 from screwkit.kinematics.modes import stewart_template_data as data
 from screwkit.kinematics.modes.stewart import random_stewart
@@ -121,13 +122,22 @@ def test_an_instance_failing_the_check_is_solved_by_lapack(
         monkeypatch: pytest.MonkeyPatch) -> None:
     """With the growth bound at 0 every instance fails the check: the action matrices are the
     LAPACK route's, bit for bit; with one instance's coefficients not finite, only it fails."""
-    p, _ = random_stewart(np.random.default_rng(44), 9)
+    p, _ = random_stewart(np.random.default_rng(44), stewart_sparse.GROUP)
     p = p.real.astype(complex)
+    calls: list[int] = []
+    inner = stewart_sparse.r_rows
+
+    def spy(c: np.ndarray, work: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(len(c))
+        return inner(c, work)
+
+    monkeypatch.setattr(stewart_sparse, "r_rows", spy)
     monkeypatch.setattr(stewart_sparse, "AVAILABLE", False)
     ref, good_ref = stewart_template.action_matrices(p)
     monkeypatch.setattr(stewart_sparse, "AVAILABLE", True)
     monkeypatch.setattr(stewart_sparse, "GROWTH", 0.0)
     forced, good = stewart_template.action_matrices(p)
+    assert calls == [stewart_sparse.GROUP]  # (a whole group: the sparse route ran, and failed)
     assert good.all() and good_ref.all()
     np.testing.assert_array_equal(forced, ref)
     monkeypatch.setattr(stewart_sparse, "GROWTH", 1e12)
@@ -187,3 +197,67 @@ def test_a_mixed_batch_gives_each_instance_its_poses(monkeypatch: pytest.MonkeyP
         assert _matched(x, alone_real.of(k)) <= MATCH and _matched(x, x.conj()) <= MATCH, b
     for k, b in enumerate(where_complex):
         assert _matched(sol.of(b), alone_complex.of(k)) <= MATCH, b
+
+
+def test_the_routes_of_template_solve(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``route="sparse"``: a whole group of real instances gets the points of the default
+    route bit for bit, a short group of at least FEWEST the sparse route too (the default
+    route gives it LAPACK's), a lone instance NaN points (the LAPACK pass after it solves
+    them), and so does a growth-check reject; ``route="lapack"``: each instance's points as
+    alone, bit for bit (the LAPACK route's arithmetic is the instance's own); an unknown
+    route is refused."""
+    G = stewart_sparse.GROUP
+    p, _ = random_stewart(np.random.default_rng(50), G + 3)
+    p = p.real.astype(complex)
+    either, keys = stewart_template.template_solve(p, 1)
+    sparse, sparse_keys = stewart_template.template_solve(p, 1, route="sparse")
+    assert np.isfinite(sparse[:G]).all()
+    np.testing.assert_array_equal(sparse[:G], either[:G])
+    np.testing.assert_array_equal(sparse_keys[:G], keys[:G])
+    assert 2 <= stewart_sparse.FEWEST <= 3 and np.isfinite(sparse[G:]).all()
+    short = stewart_template.template_solve(p[G:], 1, route="sparse")[0]
+    np.testing.assert_array_equal(sparse[G:], short)  # (a short group of its own)
+    assert not np.array_equal(short, either[G:])  # (the default route: LAPACK's)
+    lone, lone_keys = stewart_template.template_solve(p[:1], 1, route="sparse")
+    assert np.isnan(lone).all() and np.isnan(lone_keys).all()
+    lapack, _ = stewart_template.template_solve(p, 1, route="lapack")
+    for b in (0, G - 1, G + 2):
+        alone, _ = stewart_template.template_solve(p[b:b + 1], 1)
+        np.testing.assert_array_equal(lapack[b], alone[0])
+    assert not np.array_equal(lapack[:G], sparse[:G])  # (two eliminations: it ran LAPACK)
+    monkeypatch.setattr(stewart_sparse, "GROWTH", 0.0)  # every instance a reject
+    rejected, _ = stewart_template.template_solve(p[:G], 1, route="sparse")
+    assert np.isnan(rejected).all()
+    with pytest.raises(InputError, match="route must be one of"):
+        stewart_template.template_solve(p, 0, route="fast")
+
+
+def test_the_passes_take_only_what_the_pass_before_left() -> None:
+    """A batch's template passes in turn (stewart_solve.PASSES: chart 0, then chart 1 by the
+    sparse route, then charts 1 and 2 by LAPACK): chart 0 leaves some instances unsettled,
+    exactly those go to chart 1's sparse route, which settles some of them, and only the rest
+    go on; every instance ends with its 40 poses by the template."""
+    import dataclasses
+    from functools import partial
+
+    from screwkit.kinematics.modes import eigen_first, stewart_solve
+
+    p, _ = random_stewart(np.random.default_rng(51), 10 * stewart_sparse.GROUP)
+    p = p.real.astype(complex)
+    seen: dict[int, int] = {}
+
+    def spy(t: np.ndarray, label: int, threads: int | None = None) -> tuple:
+        seen[label] = seen.get(label, 0) + len(t)
+        return stewart_solve.eliminate_pass(t, label, threads)
+
+    route = dataclasses.replace(stewart_solve.stewart_route(), eliminate=spy,
+                                eliminate_alone=partial(spy, threads=1))
+    _, _, first, _ = eigen_first.eigen_route(dataclasses.replace(route, labels=(0,)), p)
+    _, _, second, _ = eigen_first.eigen_route(dataclasses.replace(route, labels=(0, 1)), p)
+    seen.clear()
+    sol = eigen_first.solve_eigen_first(route, p)
+    left = int((~first).sum())
+    assert left >= 1 and seen[0] == len(p) and seen[1] == left
+    assert int((~second).sum()) < left and seen.get(2, 0) == int((~second).sum())
+    assert np.all(sol.found == 40) and sol.route == (TEMPLATE,) * len(p)
+    assert stewart_solve.PASSES[1] == (1, "sparse")

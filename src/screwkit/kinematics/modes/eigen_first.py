@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from screwkit.algebraic import compiled
 from screwkit.algebraic.blas import one_blas_thread
-from screwkit.algebraic.certify import Certificate, bombieri_weyl_norm, certify
+from screwkit.algebraic.certify import Certificate, bombieri_weyl_norm, certify, distinct
 from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.solve import Solutions, StartSolutions, collect_solutions
@@ -227,7 +227,8 @@ def _eigen_pass(route: EigenRoute, targets: Complex, label: int
     system = route.system
     x, key = route.eliminate(targets, label)
     real = np.all(targets.imag == 0, axis=1)[:, None]
-    sel = np.flatnonzero((~real | (key.imag >= 0)).ravel())
+    # an instance the eliminator did not solve (NaN points and keys) has no point to polish
+    sel = np.flatnonzero(((~real | (key.imag >= 0)) & np.isfinite(key)).ravel())
     inst = sel // m
     twin = np.flatnonzero((real & (key.imag > 0)).ravel()[sel])  # their conjugates solve too
     p = _take(targets, inst)
@@ -395,6 +396,7 @@ def solve_eigen_first(route: EigenRoute, targets: Complex,
     xs, inst = [x_eig], [i_eig]
     status = [np.full(len(inst[0]), int(PathStatus.REGULAR), dtype=np.int8)]
     mult = [np.ones(len(inst[0]), dtype=np.int64)]
+    labels = [np.arange(len(inst[0]))]
     at_infinity, failed = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)
     redo = np.flatnonzero(~ok)
     how = f"{route.elimination} on {int(ok.sum())} of {B} instances"
@@ -408,7 +410,14 @@ def solve_eigen_first(route: EigenRoute, targets: Complex,
                                        np.tile(start.x, (len(redo), 1)), options,
                                        instance=np.repeat(np.arange(len(redo)), r))
         end = (res.status == PathStatus.REGULAR) | (res.status == PathStatus.SINGULAR)
-        cert = joined(cert, certify(system, res.x[end], targets[instance[end]]))
+        mine = certify(system, res.x[end], targets[instance[end]])
+        cert = joined(cert, mine)
+        # duplicates among the homotopy's points only (the eigen route's instances are others,
+        # their points already pairwise apart): collect_solutions' rule on these alone
+        regular = (res.status[end] == PathStatus.REGULAR) & mine.certified
+        radius = np.where(regular, mine.radius,
+                          DISTINCT * (1.0 + np.abs(res.x[end]).max(axis=1, initial=0.0)))
+        labels.append(len(xs[0]) + distinct(res.x[end], radius, instance[end]))
         xs.append(res.x[end])
         inst.append(instance[end])
         status.append(res.status[end])
@@ -417,5 +426,4 @@ def solve_eigen_first(route: EigenRoute, targets: Complex,
         failed += np.bincount(instance[res.status == PathStatus.FAILED], minlength=B)
     names = tuple(route.elimination if good else route.homotopy for good in ok)
     return collect_solutions(system, targets, _cat(xs), _cat(inst), _cat(status), _cat(mult),
-                             at_infinity, failed, m, how, names, cert,
-                             None if len(redo) else np.arange(len(xs[0])))
+                             at_infinity, failed, m, how, names, cert, _cat(labels))

@@ -35,6 +35,9 @@ from screwkit.kinematics.modes.stewart import (
 )
 from screwkit.kinematics.modes.stewart_template import (
     CHUNK,
+    EITHER,
+    LAPACK,
+    SPARSE,
     THREADS,
     blas_controller,
     quadric_forms,
@@ -42,8 +45,13 @@ from screwkit.kinematics.modes.stewart_template import (
     template_solve,
 )
 
-#: the charts of the template tried in turn on the instances still unsettled
-CHARTS = (0, 1, 2)
+#: the template's passes, tried in turn on the instances still unsettled: (chart, route of
+#: :func:`.stewart_template.template_solve`). A batch's sparse route leaves ~4 % unsettled in
+#: chart 0 (a pivot fixed beforehand is small at that instance); chart 1's sparse route settles
+#: ~80 % of those at an eighth of the LAPACK route's cost, and the LAPACK route in charts 1
+#: and 2 the rest but a few in a thousand (docs/kinematics.md, "Speed"). A lone instance (no
+#: whole group for the sparse route) skips the sparse pass: chart 0, 1 and 2 by LAPACK.
+PASSES = ((0, EITHER), (1, SPARSE), (1, LAPACK), (2, LAPACK))
 #: Newton steps at most per point: the template's points arrive within ~1e-8 (relative) at
 #: the median, a few percent 1e-3..0.2 off (the block-triangular solve pivots within blocks
 #: only); a point stops once its step is at round-off
@@ -110,14 +118,22 @@ def _kernel_forms() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[n
     return G, H, S, np.ascontiguousarray(PATCH, dtype=float)
 
 
+def eliminate_pass(params: Complex, label: int, threads: int | None = None
+                   ) -> tuple[Complex, Complex]:
+    """The template's points and keys (:func:`.stewart_template.template_solve`) of the
+    instances (B, 42) in the pass ``label`` of :data:`PASSES`."""
+    chart, route = PASSES[label]
+    return template_solve(params, chart, threads, route)
+
+
 @lru_cache(maxsize=1)
 def stewart_route() -> eigen_first.EigenRoute:
     """The Stewart–Gough platform's eigen route (module docstring), keyed by ξ1; a batch's
     polish and fast α-test on the template's :data:`.stewart_template.THREADS` threads."""
-    return eigen_first.EigenRoute(stewart_system(), STEWART_GENERIC_COUNT, template_solve, CHARTS,
-                                  stewart_start, TEMPLATE, HOMOTOPY, NEWTON_STEPS,
-                                  dense_quadrics, THREADS, partial(template_solve, threads=1),
-                                  CHUNK)
+    return eigen_first.EigenRoute(stewart_system(), STEWART_GENERIC_COUNT, eliminate_pass,
+                                  tuple(range(len(PASSES))), stewart_start, TEMPLATE, HOMOTOPY,
+                                  NEWTON_STEPS, dense_quadrics, THREADS,
+                                  partial(eliminate_pass, threads=1), CHUNK)
 
 
 def solve_stewart(params: ArrayLike, options: TrackOptions | None = None) -> Solutions:

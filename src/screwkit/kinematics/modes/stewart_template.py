@@ -56,6 +56,7 @@ from scipy.linalg import lapack
 from screwkit.algebraic import hessenberg_eig
 from screwkit.algebraic.blas import blas_controller
 from screwkit.algebraic.polynomial import Complex
+from screwkit.errors import InputError
 from screwkit.kinematics.modes import stewart_sparse
 from screwkit.kinematics.modes import stewart_template_data as data
 from screwkit.kinematics.modes.stewart import PATCH, quaternion_product, rotation_numerator
@@ -66,6 +67,9 @@ UNKNOWNS = 7
 #: instances eliminated together: one group of the sparse route (:mod:`.stewart_sparse`); the
 #: LAPACK route's solves are one by one, so its chunk size matters little
 CHUNK = stewart_sparse.GROUP
+#: how :func:`template_solve` eliminates: the sparse route where it applies and the LAPACK
+#: route elsewhere, the sparse route alone, the LAPACK route alone
+EITHER, SPARSE, LAPACK = ROUTES = ("either", "sparse", "lapack")
 #: threads over the chunks of a batch: the cores this process may use
 THREADS = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
@@ -281,8 +285,8 @@ def coefficients(params: Complex, label: int = 0) -> Complex:
     return out
 
 
-def template_solve(params: Complex, label: int = 0, threads: int | None = None
-                   ) -> tuple[Complex, Complex]:
+def template_solve(params: Complex, label: int = 0, threads: int | None = None,
+                   route: str = EITHER) -> tuple[Complex, Complex]:
     """The 40 points (B, 40, 8) of the instances (B, 42) in Study coordinates on the patch,
     unpolished, eliminated in the chart ``label``, and their ξ1 (B, 40): the action matrix's
     eigenvalues (for real parameters the template and the action matrix are real, so the
@@ -293,7 +297,13 @@ def template_solve(params: Complex, label: int = 0, threads: int | None = None
     either way. It is the same as alone, but for the instances in whole groups of real ones
     (the sparse route, module docstring); a real instance's is real in a batch with complex
     ones too. ``threads`` caps the threads (1: all on the calling thread, for a batch
-    already split among threads by the caller)."""
+    already split among threads by the caller). ``route`` (:data:`ROUTES`): the sparse route
+    for whole groups of real instances and the LAPACK route for the others (``"either"``),
+    the sparse route alone (``"sparse"``: the others, and the sparse route's growth-check
+    rejects, get NaN points, for a caller that tries the LAPACK route next), or the LAPACK
+    route alone (``"lapack"``)."""
+    if route not in ROUTES:
+        raise InputError(f"template_solve: route must be one of {ROUTES}, not {route!r}")
     B = len(params)
     m = len(data.BASIS)
     points = np.full((B, m, 8), np.nan, dtype=complex)
@@ -310,7 +320,7 @@ def template_solve(params: Complex, label: int = 0, threads: int | None = None
                 for mine in (real[s:s + CHUNK], ~real[s:s + CHUNK]):
                     rows = s + np.flatnonzero(mine[:hi - s])
                     if len(rows):
-                        points[rows], keys[rows] = _chunk(params[rows], label, work)
+                        points[rows], keys[rows] = _chunk(params[rows], label, work, route)
 
     threads = min(THREADS if threads is None else threads, -(-B // CHUNK))
     # BLAS's own threads held at one: with a batch in threads, else each part's LAPACK calls
@@ -318,7 +328,8 @@ def template_solve(params: Complex, label: int = 0, threads: int | None = None
     # of 1,000 by the LAPACK route, 2.8 against 1.8 by the sparse route, OPENBLAS_NUM_THREADS
     # unset; 2 cores, load ~3); alone too, so that the arithmetic (a threaded LU sums in
     # another order) is the same whatever the threads
-    if stewart_sparse.AVAILABLE and label == 0 and real.sum() >= stewart_sparse.GROUP:
+    fewest = stewart_sparse.GROUP if route == EITHER else stewart_sparse.FEWEST
+    if stewart_sparse.AVAILABLE and route != LAPACK and real.sum() >= fewest:
         stewart_sparse.prepare()
     if hessenberg_eig.AVAILABLE and real.any():
         hessenberg_eig.prepare()
@@ -335,14 +346,18 @@ def template_solve(params: Complex, label: int = 0, threads: int | None = None
     return points, keys
 
 
-def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Complex]:
+def _chunk(p: Complex, label: int, work: dict[str, Any], route: str = EITHER
+           ) -> tuple[Complex, Complex]:
     """:func:`template_solve` of a few instances: the action matrices, their eigenproblem
     and the points read off the eigenvectors (a real action matrix's by
     :func:`.hessenberg_eig.eig_rows`: the eigenvalues and the 8 rows read, 0.22 against
     0.28–0.29 ms per matrix by numpy's eig; a complex one's by numpy's eig)."""
     lay = _layout()
     m = len(data.BASIS)
-    Am, good = action_matrices(p, label, work)
+    Am, good = action_matrices(p, label, work, route)
+    if not good.any():  # (the sparse route alone on instances it does not take)
+        return np.full((len(p), m, 8), np.nan, dtype=complex), np.full((len(p), m), np.nan,
+                                                                       dtype=complex)
     if Am.dtype == np.float64 and hessenberg_eig.AVAILABLE:
         # eigenvalues, and the eigenvectors at the 8 rows read (1 and the unknowns) alone
         vals, vecs, fine = hessenberg_eig.eig_rows(Am, lay["unit"])
@@ -357,14 +372,15 @@ def _chunk(p: Complex, label: int, work: dict[str, Any]) -> tuple[Complex, Compl
     return np.where(good[:, None, None], z, np.nan), np.where(good[:, None], vals, np.nan)
 
 
-def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = None
-                    ) -> tuple[Any, NDArray[np.bool_]]:
+def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = None,
+                    route: str = EITHER) -> tuple[Any, NDArray[np.bool_]]:
     """The action matrices of ξ1 (B, 40, 40) of the instances p (B, 42) in the chart
-    ``label`` (module docstring; real for real parameters), by the block-triangular solve of
-    :func:`_plan`, and whether each is finite (an instance whose template is singular or not
-    finite gets the identity, marked False). ``work`` keeps one thread's zero-filled arrays
-    from call to call: every call writes the same (structurally nonzero) entries of them,
-    and LAPACK's solves do not overwrite them."""
+    ``label`` (module docstring; real for real parameters), by the sparse route or the
+    block-triangular solve of :func:`_plan` (``route``: :func:`template_solve`), and whether
+    each is finite (an instance whose template is singular or not finite, or not taken by the
+    sparse route alone, gets the identity, marked False). ``work`` keeps one thread's
+    zero-filled arrays from call to call: every call writes the same (structurally nonzero)
+    entries of them, and LAPACK's solves do not overwrite them."""
     work = {} if work is None else work
     lay = _layout()
     real = bool(np.all(p.imag == 0))
@@ -372,12 +388,19 @@ def action_matrices(p: Complex, label: int = 0, work: dict[str, Any] | None = No
     c: Any = coefficients(p, label).reshape(len(p), -1)
     c = c.real if real else c
     good: NDArray[np.bool_] = np.asarray(np.isfinite(c).all(axis=1), dtype=bool)
-    # a whole group of real instances in chart 0: the sparse route (one group costs about
-    # what the LAPACK route costs per instance, so a lone instance stays with LAPACK)
-    if real and label == 0 and stewart_sparse.AVAILABLE and len(p) >= stewart_sparse.GROUP:
+    # a whole group of real instances: the sparse route (a group, padded to whole, costs about
+    # what the LAPACK route costs per instance, so a lone instance stays with LAPACK); the
+    # sparse route alone (a retry pass, whose instances are few) from FEWEST instances
+    fewest = stewart_sparse.GROUP if route == EITHER else stewart_sparse.FEWEST
+    sparse = real and stewart_sparse.AVAILABLE and len(p) >= fewest
+    if route == SPARSE and not sparse:
+        return np.broadcast_to(np.eye(m), (len(p), m, m)), np.zeros(len(p), dtype=bool)
+    if sparse and route != LAPACK:
         R, fine = stewart_sparse.r_rows(np.where(good[:, None], c, 0.0), work)
         redo = np.flatnonzero(good & ~fine)  # the growth check's rejects: by LAPACK
-        if len(redo):
+        if route == SPARSE:
+            good &= fine
+        elif len(redo):
             some = good[redo]
             R[redo] = _r_by_blocks(c[redo], some, work)
             good[redo] = some
