@@ -349,3 +349,39 @@ def test_a_batch_in_parts_on_threads_changes_nothing(monkeypatch: pytest.MonkeyP
     assert one.route == two.route and one.how_found == two.how_found
     for name in ("found", "certified", "real", "alpha", "beta", "gamma", "radius"):
         assert np.array_equal(getattr(one, name), getattr(two, name)), name
+
+
+def test_duplicates_are_sought_among_the_homotopys_points_alone(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """With one instance of a batch left to the homotopy, the duplicate labels passed to
+    collect_solutions (the homotopy's points tested among themselves, the eigen route's taken
+    as distinct) give the Solutions of the whole duplicate test over every point."""
+    import dataclasses
+
+    p, _ = random_stewart(np.random.default_rng(53), 3)
+    p = p.real.astype(complex)
+
+    def eliminate(t: np.ndarray, label: int, threads: int | None = None) -> tuple:
+        x, key = stewart_solve.eliminate_pass(t, label, threads)
+        first = np.all(t == p[0], axis=1)
+        x[first], key[first] = np.nan, np.nan  # instance 0: unsettled in every pass
+        return x, key
+
+    route = dataclasses.replace(stewart_solve.stewart_route(), eliminate=eliminate,
+                                eliminate_alone=None)
+    inner = eigen_first.collect_solutions
+    checked: list[int] = []
+
+    def both(*args: object) -> Solutions:
+        given = inner(*args)
+        whole = inner(*args[:-1], None)
+        for name in ("x", "instance", "certified", "real", "found", "real_count", "residual",
+                     "multiplicity"):
+            np.testing.assert_array_equal(getattr(given, name), getattr(whole, name))
+        checked.append(len(given.x))
+        return given
+
+    monkeypatch.setattr(eigen_first, "collect_solutions", both)
+    sol = eigen_first.solve_eigen_first(route, p)
+    assert checked and sol.route == (HOMOTOPY, TEMPLATE, TEMPLATE)
+    assert np.all(sol.found == 40)
