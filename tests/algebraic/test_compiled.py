@@ -226,3 +226,42 @@ def test_the_compiled_bombieri_weyl_norm_equals_the_numpy_one(monkeypatch, famil
         m.setattr(compiled, "AVAILABLE", False)
         old = bombieri_weyl_norm(system, p)
     assert np.allclose(new, old, rtol=1e-13, atol=0) and (old > 0).all()
+
+
+def test_a_track_spread_over_threads_is_the_same_bit_for_bit(monkeypatch):
+    """The compiled track of many paths runs in interleaved parts on a pool of threads (each
+    path on its own in the kernel): the same end points, statuses and step counts bit for bit
+    as on one thread; the parts really went to the pool, and a track called from another
+    thread stays on it (no pool inside a pool)."""
+    import threading
+
+    system, start = stewart_system(), stewart_start()
+    p, _ = random_stewart(np.random.default_rng(61), 2)
+    inst = np.repeat(np.arange(2), len(start.x))
+
+    def solve():
+        return track_parameter_homotopy(system, start.p, p[inst], np.tile(start.x, (2, 1)),
+                                        instance=inst)
+
+    monkeypatch.setattr(compiled, "THREADS", 1)
+    one = solve()
+    monkeypatch.setattr(compiled, "THREADS", 2)
+    handed: list[int] = []
+    inner = compiled._pool
+
+    class Spy:
+        def submit(self, fn, rows):
+            handed.append(len(rows))
+            return inner().submit(fn, rows)
+
+    monkeypatch.setattr(compiled, "_pool", lambda: Spy())
+    two = solve()
+    assert handed and max(handed) <= len(inst) // 2
+    for name in ("x", "y", "status", "condition", "winding", "steps"):
+        np.testing.assert_array_equal(getattr(one, name), getattr(two, name), err_msg=name)
+    handed.clear()
+    box = []
+    worker = threading.Thread(target=lambda: box.append(solve()))
+    worker.start()
+    worker.join()
+    assert not handed and np.array_equal(box[0].y, one.y, equal_nan=True)

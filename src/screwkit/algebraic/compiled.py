@@ -41,6 +41,9 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import threading
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
 from typing import Any
 
@@ -127,19 +130,67 @@ def track_compiled(dense: DenseQuadrics, instance: Index,
     if _TRACK is None:
         _TRACK = _kernels()
     Ls = dense.L
-    linear_of = (np.zeros(len(instance), dtype=np.int64) if len(Ls) == 1
-                 else instance.astype(np.int64))
+    inst = instance.astype(np.int64)
+    linear_of = np.zeros(len(instance), dtype=np.int64) if len(Ls) == 1 else inst
     cols = columns_of(dense)
-    y, reached, steps = _TRACK(
-        cols.qr, cols.qi, cols.ck, cols.cu, dense.K,
-        np.ascontiguousarray(Ls), dense.linear.astype(np.int64), patch,
-        instance.astype(np.int64), linear_of, np.ascontiguousarray(y0, dtype=complex),
-        np.ascontiguousarray(tau0, dtype=float), np.ascontiguousarray(tau1, dtype=float),
-        kind, np.ascontiguousarray(radius, dtype=float), float(options.initial_step),
-        float(options.max_step), float(options.min_step), int(options.max_steps),
-        float(options.predictor_tolerance), float(options.corrector_tolerance),
-        float(options.contraction))
+    per_path = (inst, linear_of, np.ascontiguousarray(y0, dtype=complex),
+                np.ascontiguousarray(tau0, dtype=float), np.ascontiguousarray(tau1, dtype=float),
+                np.ascontiguousarray(radius, dtype=float))
+
+    def run(rows: Index | slice) -> tuple[Complex, NDArray[np.bool_], NDArray[np.int64]]:
+        i, lin, y, t0, t1, r = (np.ascontiguousarray(a[rows]) for a in per_path)
+        out: tuple[Complex, NDArray[np.bool_], NDArray[np.int64]] = _TRACK(
+            cols.qr, cols.qi, cols.ck, cols.cu, dense.K, np.ascontiguousarray(Ls),
+            dense.linear.astype(np.int64), patch, i, lin, y, t0, t1, kind, r,
+            float(options.initial_step), float(options.max_step), float(options.min_step),
+            int(options.max_steps), float(options.predictor_tolerance),
+            float(options.corrector_tolerance), float(options.contraction))
+        return out
+
+    P = len(inst)
+    count = min(P // PART_PATHS, PARTS_PER_THREAD * THREADS)
+    if THREADS <= 1 or count < 2 or threading.current_thread() is not threading.main_thread():
+        return run(slice(None))
+    # the paths in interleaved parts, handed to the cores as they come free (a hard path takes
+    # many times an easy one's steps): each path is tracked on its own (the kernel goes path
+    # by path and releases the GIL), so the result is the same bit for bit
+    parts = [np.arange(k, P, count) for k in range(count)]
+    y = np.empty((P, y0.shape[1]), dtype=complex)
+    reached = np.empty(P, dtype=bool)
+    steps = np.empty(P, dtype=np.int64)
+    for rows, f in zip(parts, [_pool().submit(run, rows) for rows in parts], strict=True):
+        y[rows], reached[rows], steps[rows] = f.result()
     return y, reached, steps
+
+
+#: paths at least per part when a compiled track is spread over threads (a call with fewer
+#: than two parts' worth runs on the calling thread: a hand-over to the pool costs ~50 µs, a
+#: path ~0.1 ms or more), and parts at most per thread
+PART_PATHS = 4
+PARTS_PER_THREAD = 8
+#: threads a compiled track of many paths runs on: the cores this process may use
+THREADS = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+_POOL: ThreadPoolExecutor | None = None
+
+
+def threads_held() -> AbstractContextManager[Any]:
+    """Around a homotopy's tracks on the main thread, where :func:`track_compiled` spreads its
+    paths over threads: BLAS held at one thread (algebraic/blas.py); elsewhere nothing."""
+    if not AVAILABLE or THREADS <= 1 or threading.current_thread() is not threading.main_thread():
+        return nullcontext()
+    from screwkit.algebraic.blas import one_blas_thread
+
+    held: AbstractContextManager[Any] = one_blas_thread()
+    return held
+
+
+def _pool() -> ThreadPoolExecutor:
+    """The threads of :func:`track_compiled` (made once; used from the main thread only, so
+    that a track run inside another pool's thread never waits on this one)."""
+    global _POOL
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(THREADS, thread_name_prefix="screwkit-track")
+    return _POOL
 
 
 def newton_terms(system: PolynomialSystem, x: Complex, p: Complex, steps: int,

@@ -39,6 +39,7 @@ from enum import IntEnum
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from screwkit.algebraic import compiled
 from screwkit.algebraic.endgame import cauchy_endgame
 from screwkit.algebraic.path import Homotopy, TrackOptions, line, newton, track
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
@@ -262,37 +263,40 @@ def track_parameter_homotopy(system: PolynomialSystem, p_start: ArrayLike,
                          f"{given.shape}")
     group: NDArray[np.intp] = np.unique(given, return_inverse=True)[1].reshape(-1).astype(
         np.intp)
-    rows = np.arange(P)
-    out = _run_in_chunks(system, hom, x, rows, options)
-    retracked = np.zeros(P, dtype=bool)
-    if options.retrack:
-        _retrack_lost(system, hom, x, rows, group, out, retracked, options)
-    failed = out["status"] == PathStatus.FAILED
-    if failed.any() and options.detour:
-        # every path of an instance with a failed path, through the detour (all of them: a
-        # detour for some paths only could permute the solutions they reach, by monodromy);
-        # kept for the instances where fewer paths fail than on the straight segment
-        touched = np.flatnonzero(np.isin(group, group[failed]))
-        other = _detour(system, hsys, patch, ps[touched], pt[touched], x[touched], rng,
-                        options)
-        before = np.bincount(group[touched], weights=failed[touched], minlength=P)
-        after = np.bincount(group[touched],
-                            weights=other["status"] == PathStatus.FAILED, minlength=P)
-        better = (after < before)[group[touched]]
-        for key, value in other.items():
-            out[key][touched[better]] = value[better]
-        retracked[touched[better]] = True
-    jumped = _jumps(out["y"], out["status"], group, options)
-    if jumped.size and options.retrack:
-        again = _run_in_chunks(system, hom, x[jumped], rows[jumped], options.tighter())
-        for key, value in again.items():
-            out[key][jumped] = value
-        retracked[jumped] = True
-        still = _jumps(out["y"], out["status"], group, options)
-        out["status"][still] = PathStatus.FAILED
-    elif jumped.size:
-        out["status"][jumped] = PathStatus.FAILED
-    return _result(system, out, pt, group, retracked, options)
+    # BLAS held at one thread while the compiled tracks run on the cores in threads of their
+    # own (OpenBLAS's threads, woken by a small product, spin on the same cores)
+    with compiled.threads_held():
+        rows = np.arange(P)
+        out = _run_in_chunks(system, hom, x, rows, options)
+        retracked = np.zeros(P, dtype=bool)
+        if options.retrack:
+            _retrack_lost(system, hom, x, rows, group, out, retracked, options)
+        failed = out["status"] == PathStatus.FAILED
+        if failed.any() and options.detour:
+            # every path of an instance with a failed path, through the detour (all of them: a
+            # detour for some paths only could permute the solutions they reach, by monodromy);
+            # kept for the instances where fewer paths fail than on the straight segment
+            touched = np.flatnonzero(np.isin(group, group[failed]))
+            other = _detour(system, hsys, patch, ps[touched], pt[touched], x[touched], rng,
+                            options)
+            before = np.bincount(group[touched], weights=failed[touched], minlength=P)
+            after = np.bincount(group[touched],
+                                weights=other["status"] == PathStatus.FAILED, minlength=P)
+            better = (after < before)[group[touched]]
+            for key, value in other.items():
+                out[key][touched[better]] = value[better]
+            retracked[touched[better]] = True
+        jumped = _jumps(out["y"], out["status"], group, options)
+        if jumped.size and options.retrack:
+            again = _run_in_chunks(system, hom, x[jumped], rows[jumped], options.tighter())
+            for key, value in again.items():
+                out[key][jumped] = value
+            retracked[jumped] = True
+            still = _jumps(out["y"], out["status"], group, options)
+            out["status"][still] = PathStatus.FAILED
+        elif jumped.size:
+            out["status"][jumped] = PathStatus.FAILED
+        return _result(system, out, pt, group, retracked, options)
 
 
 def _homotopy(hsys: PolynomialSystem, patch: Complex, ps: Complex, pt: Complex,
