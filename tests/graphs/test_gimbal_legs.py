@@ -153,5 +153,8 @@ def test_a_3upu_driven_at_its_platforms_travel_has_its_operation_modes(tmp_path:
         ours = R.reshape(-1, 9)
         assert len(ours) == len(theirs), (n, len(ours), len(theirs))
         assert all(np.abs(theirs - x).max(1).min() <= 1e-8 for x in ours)
-        turned = np.degrees(np.arccos(np.clip((np.trace(R, axis1=1, axis2=2) - 1) / 2, -1, 1)))
+        # the turn from ‖R − I‖_F = 2√2 sin(θ/2): good to rounding at θ ≈ 0, where arccos of
+        # (tr R − 1)/2 loses half the digits (a last-bit change reads as ~1e-6°)
+        gap = np.linalg.norm(R - np.eye(3), axis=(1, 2)) / (2.0 * np.sqrt(2.0))
+        turned = np.degrees(2.0 * np.arcsin(np.clip(gap, 0.0, 1.0)))
         assert (turned < 1e-6).any() and (turned > 1.0).any()

@@ -138,7 +138,7 @@ def track_compiled(dense: DenseQuadrics, instance: Index,
                 np.ascontiguousarray(radius, dtype=float))
 
     def run(rows: Index | slice) -> tuple[Complex, NDArray[np.bool_], NDArray[np.int64]]:
-        i, lin, y, t0, t1, r = (np.ascontiguousarray(a[rows]) for a in per_path)
+        i, lin, y, t0, t1, r = (_part_of(a, rows) for a in per_path)
         out: tuple[Complex, NDArray[np.bool_], NDArray[np.int64]] = _TRACK(
             cols.qr, cols.qi, cols.ck, cols.cu, dense.K, np.ascontiguousarray(Ls),
             dense.linear.astype(np.int64), patch, i, lin, y, t0, t1, kind, r,
@@ -161,6 +161,16 @@ def track_compiled(dense: DenseQuadrics, instance: Index,
     for rows, f in zip(parts, [_pool().submit(run, rows) for rows in parts], strict=True):
         y[rows], reached[rows], steps[rows] = f.result()
     return y, reached, steps
+
+
+def _part_of(a: NDArray[Any], rows: Index | slice) -> NDArray[Any]:
+    """The rows of a per-path array for a part of a track, read-only where ``a`` is: numba
+    compiles a read-only array's kernel apart, and the two compilations may round apart
+    (FMA contraction), so a part keeps the whole call's kernel and its result bit for bit."""
+    out = np.ascontiguousarray(a[rows])
+    if not a.flags.writeable and out.flags.writeable:
+        out.setflags(write=False)
+    return out
 
 
 #: paths at least per part when a compiled track is spread over threads (a call with fewer
