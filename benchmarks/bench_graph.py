@@ -9,7 +9,10 @@ forms (kinematics/graph/dyads.py); the continuation the other graphs use (the lo
 Tracker on the stacked closure, graph/follow.py) is timed beside it on the same six-bar, and on
 the bundled several-loop examples (six-bars, Jansen's leg, Delta robot, 3-UPU, Stewart platform). Every mode: the body poses of all 4 branch combinations at every
 sample (``closed_modes.every_mode``, target ≤ 10 ms, issue 27), and the whole motion of every mode
-with rates and accelerations (``every_mode=True``).
+with rates and accelerations (``every_mode=True``); every mode of the 3-UPU along its motion
+(the homotopy at anchors, tracking, fold searches: wall, the homotopy's compiled tracks on the
+cores against one thread); the fold search on the gapped six-bar (probes against bisection),
+and on a step with no fold (heading for the step's end against halvings).
 pylinkage: ``Linkage.step_fast`` (numba-compiled when numba is installed) on the same six-bar
 built from a crank, two RRR dyads and two fixed points (one mode, joint positions only). Both
 are checked to give the same path of joint G to 1e-9 of the length scale. Targets: ≤ 20 µs per
@@ -366,6 +369,8 @@ def _forward_rows() -> list[dict[str, Any]]:
                              "(graph/joint_motions.py); the per-joint loop before: ~470 µs "
                              "on the 3-UPU (docs/kinematics.md)"})
     rows.append(_fold_search_row())
+    rows.append(_no_fold_row())
+    rows.append(_every_mode_along_row())
     return rows
 
 
@@ -394,8 +399,9 @@ def _fold_search_row() -> dict[str, Any]:
     rounds = along_folds.FOLD_ROUNDS
     out: dict[int, tuple[int, float, float]] = {}
     try:
-        for r in (rounds, 0, rounds, 0):  # alternating; FOLD_ROUNDS = 0 is plain bisection
-            along_folds.FOLD_ROUNDS = r
+        for r in (rounds, 0, rounds, 0):  # alternating; FOLD_ROUNDS = 0 and halvings
+            along_folds.FOLD_ROUNDS = r    # first: plain bisection
+            along_folds.HEAD_FOR_END = r != 0
             count[0] = 0
             t0 = time.perf_counter()
             at, _ = along_folds.fold_between(mech, lay, conf, x0, x1)
@@ -404,12 +410,79 @@ def _fold_search_row() -> dict[str, Any]:
                 out[r] = (count[0], dt, float(at[0]))
     finally:
         along_folds.reach, along_folds.FOLD_ROUNDS = real, rounds
+        along_folds.HEAD_FOR_END = True
     probe, plain = out[rounds], out[0]
     return {"name": "gapped six-bar: the fold between 60° and 100° of input (probes / bisection)",
             "value": probe[1] / plain[1], "unit": "x", "target": None,
             "note": f"{probe[0]} reaches against {plain[0]}, {probe[1] * 1e3:.0f} against "
                     f"{plain[1] * 1e3:.0f} ms (best of 2, wall); the two folds "
                     f"{abs(probe[2] - plain[2]):.1e} rad apart"}
+
+
+def _no_fold_row() -> dict[str, Any]:
+    """A step with no fold (the gapped six-bar from 0° to 20° of input) told from one: the
+    first trials heading for the step's end (the gap squared) against halvings."""
+    import sys
+
+    from screwkit.kinematics.graph.closure import zero_configuration
+    from screwkit.kinematics.modes import along_folds
+
+    sys.path.insert(0, str(ROOT))
+    from tests.graphs.test_step_folds import GAP, GAP_DRAWN, _sixbar
+
+    mech = _sixbar(*GAP, GAP_DRAWN)
+    lay = graph_layout(mech)
+    conf = zero_configuration(lay)
+    x0, x1 = np.zeros(1), np.radians([20.0])
+    real, count = along_folds.reach, [0]
+
+    def counted(*args: Any, **kwargs: Any) -> Any:
+        count[0] += 1
+        return real(*args, **kwargs)
+
+    along_folds.reach = counted
+    out: dict[bool, tuple[int, float]] = {}
+    try:
+        for head in (True, False, True, False):  # alternating
+            along_folds.HEAD_FOR_END = head
+            count[0] = 0
+            t0 = time.perf_counter()
+            assert along_folds.fold_in_step(mech, lay, conf, x0, x1) is None
+            dt = time.perf_counter() - t0
+            if head not in out or dt < out[head][1]:
+                out[head] = (count[0], dt)
+    finally:
+        along_folds.reach, along_folds.HEAD_FOR_END = real, True
+    new, old = out[True], out[False]
+    return {"name": "gapped six-bar: a step with no fold, 0° to 20° (heading for the end / "
+                    "halvings)",
+            "value": new[1] / old[1], "unit": "x", "target": None,
+            "note": f"{new[0]} reaches against {old[0]}, {new[1] * 1e3:.0f} against "
+                    f"{old[1] * 1e3:.0f} ms (best of 2, wall); no fold either way"}
+
+
+def _every_mode_along_row() -> dict[str, Any]:
+    """Every mode of the bundled 3-UPU along its spec's motion (solve_mechanism, every_mode):
+    wall time with the homotopy's compiled tracks on the cores (algebraic/compiled.py THREADS)
+    against one thread, one run each (~25 s), the same modes."""
+    from screwkit.algebraic import compiled
+
+    spec = sk.load_spec(ROOT / "examples" / "mechanisms" / "three_upu.toml")
+    threads = compiled.THREADS
+    out: dict[int, tuple[float, int]] = {}
+    try:
+        for n in (threads, 1):
+            compiled.THREADS = n
+            t0 = time.perf_counter()
+            got = solve_mechanism(spec.mechanism, spec.inputs, every_mode=True)
+            out[n] = (time.perf_counter() - t0, len(got.modes))
+    finally:
+        compiled.THREADS = threads
+    assert out[threads][1] == out[1][1]
+    return {"name": "3-UPU, every mode along its 50 samples (solve_mechanism, every_mode)",
+            "value": out[threads][0], "unit": "s", "target": None,
+            "note": f"wall, the homotopy's tracks on {threads} thread(s); on one: "
+                    f"{out[1][0]:.1f} s; {out[1][1]} modes either way"}
 
 
 def run() -> list[dict[str, Any]]:

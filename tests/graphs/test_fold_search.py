@@ -51,6 +51,7 @@ def test_a_quadratic_fold_is_the_distance_laws_in_few_reaches(
     assert calls[0] <= 18, calls[0]  # bisection: 26
     # plain bisection of the same step (the probes off) ends at the same fold
     monkeypatch.setattr(along_folds, "FOLD_ROUNDS", 0)
+    monkeypatch.setattr(along_folds, "HEAD_FOR_END", False)
     calls[0] = 0
     plain, _ = fold_between(mech, lay, conf, x_from, x_to)
     assert calls[0] == FOLD_STEPS
@@ -66,6 +67,10 @@ def test_a_step_with_no_fold_is_told_from_one(monkeypatch: pytest.MonkeyPatch) -
     calls = _counting(monkeypatch)
     assert fold_in_step(mech, lay, zero_configuration(lay), x_from, x_to) is None
     assert calls[0] == 6
+    monkeypatch.setattr(along_folds, "HEAD_FOR_END", False)  # halvings: bisection's 26
+    calls[0] = 0
+    assert fold_in_step(mech, lay, zero_configuration(lay), x_from, x_to) is None
+    assert calls[0] == FOLD_STEPS
     got = fold_in_step(mech, lay, zero_configuration(lay), x_from, np.radians([100.0]))
     assert got is not None and abs(float(got[0][0]) - _gap_fold()) <= 1e-7
 

@@ -46,6 +46,10 @@ FOLD_STEPS = 26
 FOLD_PROBE = 0.05
 #: ... for this many pairs at most, then bisects
 FOLD_ROUNDS = 8
+#: until a trial fails, the trials head for the step's end, each gap to it the square of the
+#: last (:func:`fold_between`); False: halvings of the bracket, as bisection (a benchmark's
+#: side-by-side)
+HEAD_FOR_END = True
 #: a bisection step's continuation may split it down to this fraction of its length
 FOLD_SPLIT = 8
 #: ... once the half is this short (rad, or fraction of the length scale): a half wrongly
@@ -167,7 +171,8 @@ def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
     last = None
     rounds = misses = 0
     while hi - lo > goal:
-        if not seen:  # no trial failed yet (hi is the step's end): the gap to it squared
+        if not seen and HEAD_FOR_END:  # no trial failed yet (hi is the step's end): the gap
+            # to the end squared
             gap = hi - lo
             trial(hi - max(min(0.5 * gap, gap * gap), goal))
             continue
