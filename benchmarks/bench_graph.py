@@ -466,6 +466,7 @@ def _every_mode_along_row() -> dict[str, Any]:
     wall time with the homotopy's compiled tracks on the cores (algebraic/compiled.py THREADS)
     against one thread, one run each (~25 s), the same modes."""
     from screwkit.algebraic import compiled
+    from screwkit.algebraic.blas import one_blas_thread
 
     spec = sk.load_spec(ROOT / "examples" / "mechanisms" / "three_upu.toml")
     threads = compiled.THREADS
@@ -474,7 +475,8 @@ def _every_mode_along_row() -> dict[str, Any]:
         for n in (threads, 1):
             compiled.THREADS = n
             t0 = time.perf_counter()
-            got = solve_mechanism(spec.mechanism, spec.inputs, every_mode=True)
+            with one_blas_thread():  # BLAS at one thread for both (the threaded run holds it)
+                got = solve_mechanism(spec.mechanism, spec.inputs, every_mode=True)
             out[n] = (time.perf_counter() - t0, len(got.modes))
     finally:
         compiled.THREADS = threads

@@ -261,7 +261,7 @@ def test_a_track_spread_over_threads_is_the_same_bit_for_bit(monkeypatch):
 
     monkeypatch.setattr(compiled, "_pool", lambda: Spy())
     two = solve()
-    assert handed and max(handed) <= len(inst) // 2
+    assert len(handed) >= 2 and sum(handed) >= len(inst)  # (the anchors' paths, in parts)
     for name in ("x", "y", "status", "condition", "winding", "steps"):
         np.testing.assert_array_equal(getattr(one, name), getattr(two, name), err_msg=name)
     handed.clear()

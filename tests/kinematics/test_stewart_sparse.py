@@ -232,12 +232,13 @@ def test_the_routes_of_template_solve(monkeypatch: pytest.MonkeyPatch) -> None:
         stewart_template.template_solve(p, 0, route="fast")
 
 
-def test_the_passes_take_only_what_the_pass_before_left() -> None:
+def test_the_passes_take_only_what_the_pass_before_left(monkeypatch: pytest.MonkeyPatch) -> None:
     """A batch's template passes in turn (stewart_solve.PASSES: chart 0, then chart 1 by the
     sparse route, then charts 1 and 2 by LAPACK): chart 0 leaves some instances unsettled,
     exactly those go to chart 1's sparse route, which settles some of them, and only the rest
     go on; every instance ends with its 40 poses by the template."""
     import dataclasses
+    import threading
     from functools import partial
 
     from screwkit.kinematics.modes import eigen_first, stewart_solve
@@ -245,19 +246,38 @@ def test_the_passes_take_only_what_the_pass_before_left() -> None:
     p, _ = random_stewart(np.random.default_rng(51), 10 * stewart_sparse.GROUP)
     p = p.real.astype(complex)
     seen: dict[int, int] = {}
+    sparse_in: dict[int, int] = {}  # instances the sparse kernel got, per pass
+    inner = stewart_sparse.r_rows
+    now = threading.local()  # the pass each part's thread is in (the parts run side by side)
+    lock = threading.Lock()
+
+    def sparse(c: np.ndarray, work: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+        label = getattr(now, "label", -1)  # (-1: the template's own threads, outside parts)
+        with lock:
+            sparse_in[label] = sparse_in.get(label, 0) + len(c)
+        return inner(c, work)
 
     def spy(t: np.ndarray, label: int, threads: int | None = None) -> tuple:
-        seen[label] = seen.get(label, 0) + len(t)
+        with lock:
+            seen[label] = seen.get(label, 0) + len(t)
+        now.label = label
         return stewart_solve.eliminate_pass(t, label, threads)
+
+    monkeypatch.setattr(stewart_sparse, "r_rows", sparse)
 
     route = dataclasses.replace(stewart_solve.stewart_route(), eliminate=spy,
                                 eliminate_alone=partial(spy, threads=1))
     _, _, first, _ = eigen_first.eigen_route(dataclasses.replace(route, labels=(0,)), p)
     _, _, second, _ = eigen_first.eigen_route(dataclasses.replace(route, labels=(0, 1)), p)
     seen.clear()
+    sparse_in.clear()
     sol = eigen_first.solve_eigen_first(route, p)
     left = int((~first).sum())
     assert left >= 1 and seen[0] == len(p) and seen[1] == left
+    # the sparse kernel ran in passes 0 and 1 (pass 1's own instances; a group of fewer than
+    # FEWEST goes to LAPACK) and never in the LAPACK passes
+    assert sparse_in.get(0, 0) >= len(p) and 0 < sparse_in.get(1, 0) <= left
+    assert not sparse_in.get(2) and not sparse_in.get(3)
     assert int((~second).sum()) < left and seen.get(2, 0) == int((~second).sum())
     assert np.all(sol.found == 40) and sol.route == (TEMPLATE,) * len(p)
     assert stewart_solve.PASSES[1] == (1, "sparse")

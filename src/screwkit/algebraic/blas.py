@@ -17,6 +17,9 @@ from typing import Any
 def blas_controller() -> Any:
     """threadpoolctl's view of the BLAS libraries loaded (found once: ~3 ms; a limit then
     costs ~20 µs), for holding BLAS's threads at one while a batch runs in threads."""
+    # scipy's LAPACK may be a BLAS library of its own (scipy's wheels bundle their OpenBLAS),
+    # loaded only with scipy.linalg: loaded first, so that the controller, made once, holds it
+    import scipy.linalg  # noqa: F401
     from threadpoolctl import ThreadpoolController
 
     return ThreadpoolController()

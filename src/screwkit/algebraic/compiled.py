@@ -158,8 +158,17 @@ def track_compiled(dense: DenseQuadrics, instance: Index,
     y = np.empty((P, y0.shape[1]), dtype=complex)
     reached = np.empty(P, dtype=bool)
     steps = np.empty(P, dtype=np.int64)
-    for rows, f in zip(parts, [_pool().submit(run, rows) for rows in parts], strict=True):
-        y[rows], reached[rows], steps[rows] = f.result()
+    try:
+        futures = [_pool().submit(run, rows) for rows in parts]
+    except RuntimeError:  # the interpreter shutting down: no new threads, so on this one
+        return run(slice(None))
+    try:
+        for rows, f in zip(parts, futures, strict=True):
+            y[rows], reached[rows], steps[rows] = f.result()
+    except BaseException:  # (an interrupt): the parts not started are dropped
+        for f in futures:
+            f.cancel()
+        raise
     return y, reached, steps
 
 
@@ -185,7 +194,11 @@ _POOL: ThreadPoolExecutor | None = None
 
 def threads_held() -> AbstractContextManager[Any]:
     """Around a homotopy's tracks on the main thread, where :func:`track_compiled` spreads its
-    paths over threads: BLAS held at one thread (algebraic/blas.py); elsewhere nothing."""
+    paths over threads: BLAS held at one thread (algebraic/blas.py; its threads, woken by a
+    small product between the tracks, would spin on the cores the tracks use, and a limit
+    taken inside the tracks alone comes too late for them); elsewhere nothing. So a homotopy
+    on the main thread rounds its BLAS products as on one thread, in another thread as BLAS
+    is set there (the same to rounding)."""
     if not AVAILABLE or THREADS <= 1 or threading.current_thread() is not threading.main_thread():
         return nullcontext()
     from screwkit.algebraic.blas import one_blas_thread
@@ -195,12 +208,22 @@ def threads_held() -> AbstractContextManager[Any]:
 
 
 def _pool() -> ThreadPoolExecutor:
-    """The threads of :func:`track_compiled` (made once; used from the main thread only, so
-    that a track run inside another pool's thread never waits on this one)."""
+    """The threads of :func:`track_compiled` (made once per process; used from the main
+    thread only, so that a track run inside another pool's thread never waits on this one)."""
     global _POOL
     if _POOL is None:
         _POOL = ThreadPoolExecutor(THREADS, thread_name_prefix="screwkit-track")
     return _POOL
+
+
+def _forget_pool() -> None:
+    """In a forked child: the parent's pool has no threads here (a new one is made)."""
+    global _POOL
+    _POOL = None
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_pool)
 
 
 def newton_terms(system: PolynomialSystem, x: Complex, p: Complex, steps: int,

@@ -128,9 +128,8 @@ def fold_between(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
 
     The trial points: towards the step's end until one fails, each trial's gap to the end the
     square of the last one's (1/2, 1/4, 1/16, 2⁻⁸, 2⁻¹⁶, then 2⁻:data:`FOLD_STEPS`: a step
-    with no fold is crossed in 6 reaches, not bisection's 26, each reach no longer than
-    twice the bisection's at the same point, so no more likely to cross a fold onto another
-    branch; no σ² wanted there), then where σ² (σ_r/σ₁ of the
+    with no fold is crossed in 6 reaches, not bisection's 26, each reach at most twice as
+    long as bisection's at the same point; no σ² wanted there), then where σ² (σ_r/σ₁ of the
     passive Jacobian, squared, which falls to 0 linearly in the input at a quadratic fold)
     extrapolates to 0 from the last three points reached (a parabola through them; a line through two), probed short of it and beyond it,
     each by :data:`FOLD_PROBE` of its distance from lo or by twice the guess's move since
@@ -229,8 +228,8 @@ def fold_in_step(mech: Mechanism, lay: GraphLayout, conf: Configuration, x_from:
     """Where the branch through ``conf`` (closed at ``x_from``) stops assembling on the
     straight way to ``x_to``: :func:`fold_between`'s input and configuration, or None where
     its search reaches ``x_to`` (to 2¹⁻:data:`FOLD_STEPS` of the step: a fold closer to the
-    step's end than that is not told from none; with no trial failing, the search is
-    bisection). (The whole step is not tried first: a continuation over a long step can land
+    step's end than that is not told from none; with no trial failing, the search heads for
+    the step's end in 6 reaches). (The whole step is not tried first: a continuation over a long step can land
     across a fold on another branch, where the bisection's halves stop at the fold.)"""
     at, near = fold_between(mech, lay, conf, x_from, x_to)
     scale = input_scale(lay)

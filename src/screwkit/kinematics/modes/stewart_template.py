@@ -30,10 +30,11 @@ The square matrix is solved in its block triangular form (:func:`block_triangula
 later block and holds one of them: it is solved for that row alone, as the row of its inverse
 times the right-hand side (one transposed solve of its LU with one right-hand side, not 40;
 Golub & Van Loan 2013, *Matrix Computations*, §3.2). That is the LAPACK route; a whole
-group of :data:`.stewart_sparse.GROUP` real instances in chart 0 takes the sparse route
-instead (:mod:`.stewart_sparse`: one pivot sequence for every instance, the group side by side
-in vector operations, ~2.3× less CPU per instance in a batch; its rejects go to the LAPACK
-route), and a lone instance, a short group, a complex one or another chart the LAPACK route.
+group of :data:`.stewart_sparse.GROUP` real instances takes the sparse route instead
+(:mod:`.stewart_sparse`: one pivot sequence for every instance, the group side by side in
+vector operations, ~2.3× less CPU per instance in a batch; its rejects go to the LAPACK route),
+and a lone instance, a short group or a complex one the LAPACK route (``route`` of
+:func:`template_solve` takes one of the two alone: modes/stewart_solve.py's passes).
 So an instance's raw points alone and in a batch can differ (two pivotings); after the polish
 they agree to ~1e-10 (relative). A batch's chunks are spread over the
 cores in threads (LAPACK releases the GIL; BLAS's own threads held at one meanwhile, by
