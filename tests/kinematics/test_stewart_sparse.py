@@ -46,6 +46,19 @@ def _dense_r_rows(c: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
+def _sparse_groups(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """The sizes of the groups the sparse kernel gets from now on (stewart_sparse.r_rows)."""
+    groups: list[int] = []
+    inner = stewart_sparse.r_rows
+
+    def spy(c: np.ndarray, work: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+        groups.append(len(c))
+        return inner(c, work)
+
+    monkeypatch.setattr(stewart_sparse, "r_rows", spy)
+    return groups
+
+
 def _matched(a: np.ndarray, b: np.ndarray) -> float:
     d = np.abs(a[:, None, :] - b[None, :, :]).max(axis=2) / (
         1.0 + np.maximum(np.abs(a).max(axis=1)[:, None], np.abs(b).max(axis=1)[None, :]))
@@ -124,14 +137,7 @@ def test_an_instance_failing_the_check_is_solved_by_lapack(
     LAPACK route's, bit for bit; with one instance's coefficients not finite, only it fails."""
     p, _ = random_stewart(np.random.default_rng(44), stewart_sparse.GROUP)
     p = p.real.astype(complex)
-    calls: list[int] = []
-    inner = stewart_sparse.r_rows
-
-    def spy(c: np.ndarray, work: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
-        calls.append(len(c))
-        return inner(c, work)
-
-    monkeypatch.setattr(stewart_sparse, "r_rows", spy)
+    calls = _sparse_groups(monkeypatch)
     monkeypatch.setattr(stewart_sparse, "AVAILABLE", False)
     ref, good_ref = stewart_template.action_matrices(p)
     monkeypatch.setattr(stewart_sparse, "AVAILABLE", True)
@@ -179,14 +185,8 @@ def test_a_mixed_batch_gives_each_instance_its_poses(monkeypatch: pytest.MonkeyP
     mixed = np.concatenate([real[:G], q[:1], real[G:], q[1:]])
     where_real = np.r_[0:G, G + 1:2 * G + 1]
     where_complex = (G, 2 * G + 1, 2 * G + 2)
-    groups: list[int] = []
     inner = stewart_sparse.r_rows
-
-    def spy(c: np.ndarray, work: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
-        groups.append(len(c))
-        return inner(c, work)
-
-    monkeypatch.setattr(stewart_sparse, "r_rows", spy)
+    groups = _sparse_groups(monkeypatch)
     sol = solve_stewart(mixed)
     assert groups == [G]  # the first chunk, real only; the others hold complex instances
     monkeypatch.setattr(stewart_sparse, "r_rows", inner)
