@@ -19,7 +19,10 @@ pivot LAPACK's zgetrf picks). Measured on the Stewart system (9 × 128 columns):
 evaluation, ~0.7 µs per solve, ~8 µs per step (5 of each), against ~11 µs before (complex V,
 a scatter per column into F and J, |·| by hypot in the pivot search). The arithmetic is the same up
 to rounding, so both routes reach the same end points (to the Newton polish's accuracy) with the
-same statuses; tests/algebraic/test_compiled.py checks it.
+same statuses; tests/algebraic/test_compiled.py checks it. A call of many paths from the main
+thread runs in interleaved parts on a pool of one thread per core (:func:`track_compiled`; the
+kernel releases the GIL, and each path's arithmetic is its own, so the result is the same bit
+for bit), with BLAS held at one thread around the homotopy (:func:`threads_held`).
 
 The same module compiles three per-point passes over a term table
 (:class:`.polynomial.PolynomialSystem`), each the numpy route's arithmetic one point at a time
