@@ -10,8 +10,10 @@ against:
   tracking between) against the drawn mode followed alone;
 - the double wishbone (generic count 4) at the spec's 41 samples: every mode by the point
   homotopy against the closed-form dyads;
-- the 3-RPS robot (examples/mechanisms/three_rps.toml, generic count 16): the start set, every
-  mode at one input, and every mode along its 37 samples against the drawn mode alone;
+- the 3-RPS robot (examples/mechanisms/three_rps.toml, generic count 16): the start set, the
+  count check on it (the trace test, algebraic/trace_test.py) against the start set's own
+  solve, every mode at one input, and every mode along its 37 samples against the drawn mode
+  alone;
 - the 3-UPU (examples/mechanisms/three_upu.toml, 84 by monodromy): the start set and every
   mode at one input;
 - the Stewart platform driven by its pose (examples/mechanisms/stewart_platform_pose.toml:
@@ -34,6 +36,7 @@ os.environ["SCREWKIT_CACHE_DIR"] = "off"
 import numpy as np  # noqa: E402
 
 import screwkit as sk  # noqa: E402
+from screwkit.algebraic.trace_test import trace_test  # noqa: E402
 from screwkit.kinematics.graph import solve_mechanism  # noqa: E402
 from screwkit.kinematics.modes.every_mode import every_mode  # noqa: E402
 from screwkit.kinematics.modes.spatial_points_build import spatial_point_formulation  # noqa: E402
@@ -94,6 +97,9 @@ def run() -> list[dict[str, Any]]:
     t = time.process_time()
     rps_start = rps_form.start()
     t_rps_start = time.process_time() - t
+    t = time.process_time()
+    rps_check = trace_test(rps_form.system, rps_start.p, rps_start.x)
+    t_rps_check = time.process_time() - t
     every_mode(rps.mechanism, xr[:1])
     t_rps_one = _best(lambda: every_mode(rps.mechanism, xr[1:2]))
     t_rps_all = _best(lambda: solve_mechanism(rps.mechanism, xr, every_mode=True), 1)
@@ -138,6 +144,12 @@ def run() -> list[dict[str, Any]]:
          "note": f"{rps_start.generic_count} solutions (9 unknowns: its R–P–S legs as circles "
                  f"of their balls); the start set {t_rps_start:.3g} s once, {rps_start.paths} "
                  "paths"},
+        {"name": "3-RPS robot: count check (trace test) / start set",
+         "value": t_rps_check / t_rps_start, "unit": "x", "target": None,
+         "note": f"{rps_check.verdict} in {t_rps_check:.3g} s: {rps_check.solutions} solutions "
+                 f"and {rps_check.witnesses} slice witnesses, {rps_check.paths} paths, "
+                 f"deviation {rps_check.deviation:.1e} within {rps_check.bound:.1e}; the start "
+                 f"set {t_rps_start:.3g} s"},
         {"name": f"3-RPS robot, {len(xr)} samples: every mode / drawn mode",
          "value": t_rps_all / t_rps_drawn, "unit": "x", "target": None,
          "note": f"{rps_modes} modes in {t_rps_all:.3g} s (homotopy at anchors, tracking "

@@ -9,6 +9,7 @@ This package knows nothing of mechanisms (docs/kinematics.md, "How every mode is
 - :mod:`.multi_homogeneous`: ``solve_multi_homogeneous``, the first solve from a linear-product
   start system when a grouping of the unknowns has a smaller Bézout number;
 - :mod:`.monodromy`: ``monodromy_solve``, every solution at a generic point from one;
+- :mod:`.trace_test`: ``trace_test``, whether a set of solutions at a generic point is all;
 - :mod:`.certify`: Smale's α-test, real and distinct certificates;
 - :mod:`.solve`: ``solve_all`` from ``StartSolutions``.
 

@@ -12,7 +12,7 @@ tracked around each of them in one batched call of the tracker per edge.
 The stopping rule is the paper's heuristic: stop when a given expected count is reached, or
 after ``stale_loops`` loops in a row that found nothing new. Without an expected count the
 result is every solution reached by those loops: a lower bound on the generic count, not a
-proof of it.
+proof of it (the trace test, :mod:`.trace_test`, decides whether it is all).
 """
 
 from __future__ import annotations

@@ -11,8 +11,9 @@ What is and is not guaranteed. With p_start generic, every isolated solution at 
 the end of one path (probability one), so a complete start set and paths that all end
 (none failed) give every isolated solution. The start set's completeness is as good as the
 method that found it: a total-degree solve is complete when no path failed; monodromy is
-complete only when it reached an expected count (otherwise it stopped when loops stopped
-finding new solutions, a heuristic). Solutions on positive-dimensional components are not
+complete when it reached an expected count or the trace test shows it complete
+(:mod:`.trace_test`; otherwise it stopped when loops stopped finding new solutions, a
+heuristic). Solutions on positive-dimensional components are not
 reported as isolated solutions.
 """
 
@@ -31,19 +32,31 @@ from screwkit.algebraic.total_degree import bezout_number, solve_total_degree
 from screwkit.algebraic.track import PathStatus, track_parameter_homotopy
 from screwkit.errors import InputError
 
+#: the words with which ``how_found`` marks a count that monodromy may have left short
+LOWER_BOUND = "a lower bound on the generic count"
+
 
 @dataclass(frozen=True)
 class StartSolutions:
     """Every solution x (m, n) of the system at one generic complex parameter vector p (k,):
     the start of every later parameter homotopy of this system (cache it per topology).
     ``generic_count`` is m; ``how_found`` says by which method and how complete it is;
-    ``paths`` counts the paths tracked to find them."""
+    ``paths`` counts the paths tracked to find them; ``count_check`` the verdict of the trace
+    test on them (:mod:`.trace_test`: "complete", "incomplete" or "inconclusive"; "" when it
+    has not run)."""
 
     p: Complex
     x: Complex
     generic_count: int
     how_found: str
     paths: int = 0
+    count_check: str = ""
+
+    @property
+    def lower_bound(self) -> bool:
+        """Whether the count is only a lower bound: monodromy stopped without a known count
+        and no trace test has shown the set complete."""
+        return LOWER_BOUND in self.how_found and self.count_check != "complete"
 
     @staticmethod
     def by_total_degree(system: PolynomialSystem, seed: int = 0,
@@ -66,9 +79,8 @@ class StartSolutions:
         p, x, stats = monodromy_solve(system, np.asarray(p0, dtype=complex),
                                       np.asarray(x0, dtype=complex), options)
         how = (f"monodromy: {stats.found} solutions after {stats.loops} loops, stopped by "
-               f"{stats.stopped_by}" + (" (a lower bound on the generic count: no proof that "
-                                        "none is missing)" if stats.stopped_by != "expected count"
-                                        else ""))
+               f"{stats.stopped_by}" + (f" ({LOWER_BOUND}: no proof that none is missing)"
+                                        if stats.stopped_by != "expected count" else ""))
         return StartSolutions(p, x, stats.found, how, stats.paths_tracked)
 
 

@@ -124,6 +124,7 @@ def register(app: typer.Typer) -> None:
         method: Annotated[str, typer.Option("--method", help="auto (closed form where the family has one), closed, or generic (any loop; every joint variable).")] = "auto",
         plot: Annotated[Path | None, typer.Option("--plot", help="Write a PNG of every variable and its rates over the input (display units), the coupler curves (projections and 3-D) and the transmission quality.")] = None,
         modes: Annotated[str, typer.Option("--modes", help=MODES_HELP)] = "every",
+        check_count: Annotated[bool, typer.Option("--check-count", help="Put start solutions that monodromy found without a known count to the trace test, so that 'every mode' is shown complete (or the missing ones found): seconds for small systems, many minutes for large ones; once per topology, kept in the start-solution store (docs/kinematics.md).")] = False,
     ) -> None:
         """Positions, velocities and accelerations of every joint variable in every assembly mode, the coupler curves of the spec's coupler points and the transmission quality over the cycle."""
         from screwkit.cli.common import every_modes, guard
@@ -138,8 +139,10 @@ def register(app: typer.Typer) -> None:
         every = every_modes(modes, s)
         if getattr(s, "family", None) == "graph":  # any mechanism as a graph
             from screwkit.cli.graph_views import analyze_graph
+            from screwkit.kinematics.modes.starts import count_check
 
-            return analyze_graph(s, out, plot, every_mode=every)
+            with count_check(check_count):
+                return analyze_graph(s, out, plot, every_mode=every)
         du = out.units_for(s.units)
         stages = ["solving", "coupler curves and transmission", "tables"]
         # a long sweep shows its stages (stderr, terminals only; the solver's own bar is off);

@@ -51,7 +51,8 @@ family whose start solutions are found once: by the total-degree homotopy when i
 system of natural coordinates has solution sets at infinity, and the total-degree homotopy
 loses paths there: 23 of the double wishbone's 64), else by monodromy from a random complex
 instance; monodromy stops when :data:`STALE_LOOPS` loops in a row find nothing new, so its
-count is a lower bound on the generic count, and ``how_found`` says so.
+count is a lower bound on the generic count, and ``how_found`` says so, until the count check
+(modes/starts.py ``count_check``: the trace test) shows it complete.
 
 The solutions are turned into body poses (the rotation that carries a body's drawn points onto
 its solved ones, Kabsch's least-squares fit, exact for a rigid image; the least rotation for a

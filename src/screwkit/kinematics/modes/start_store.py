@@ -76,7 +76,8 @@ def save(key: str, start: StartSolutions) -> Path | None:
             with os.fdopen(fd, "wb") as f:
                 np.savez(f, format=np.int64(FORMAT), key=np.str_(key), p=start.p, x=start.x,
                          generic_count=np.int64(start.generic_count),
-                         how_found=np.str_(start.how_found), paths=np.int64(start.paths))
+                         how_found=np.str_(start.how_found), paths=np.int64(start.paths),
+                         count_check=np.str_(start.count_check))
             os.replace(tmp, path)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
@@ -100,8 +101,10 @@ def load(key: str, system: PolynomialSystem,
                 return None
             p = np.asarray(f["p"], dtype=complex)
             x = np.asarray(f["x"], dtype=complex)
+            # (a file written before the trace test has no count_check: not checked)
+            check = str(f["count_check"]) if "count_check" in f.files else ""
             start = StartSolutions(p, x, int(f["generic_count"]), str(f["how_found"]),
-                                   int(f["paths"]))
+                                   int(f["paths"]), check)
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):  # damaged, foreign
         return None
     if expected is not None and start.generic_count != expected:

@@ -14,12 +14,20 @@ disk (:mod:`.start_store`, checked on load), and only then solves, writing what 
 store. A sweep finds them on the scheduler's side and ships them to its workers
 (:func:`install`), so no worker solves them again. :func:`first_solve_paths` counts the paths
 this process tracked to find start solutions (0 when every topology came from memory or disk).
+
+A monodromy run without a known count stops when its loops stop finding new solutions, so its
+count is a lower bound. With the count check on (:func:`count_check`, ``screwkit analyze
+--check-count``) such a set is put to the trace test (:mod:`screwkit.algebraic.trace_test`): a
+set it finds incomplete gets more monodromy loops and is tested again, up to
+:data:`CHECK_ROUNDS` times, and the verdict is kept with the set (in memory and in the store),
+so a topology is checked once.
 """
 
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import replace
 
 import numpy as np
@@ -27,14 +35,18 @@ import numpy as np
 from screwkit.algebraic.monodromy import MonodromyOptions
 from screwkit.algebraic.multi_homogeneous import Grouping, mhom_bezout_of, solve_multi_homogeneous
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
-from screwkit.algebraic.solve import StartSolutions
+from screwkit.algebraic.solve import LOWER_BOUND, StartSolutions
 from screwkit.algebraic.total_degree import bezout_number
+from screwkit.algebraic.trace_test import INCOMPLETE, Completeness, TraceOptions, trace_test
 from screwkit.kinematics.modes import start_store
 
 #: systems with at most this many total-degree paths are started by the total-degree homotopy
 TOTAL_DEGREE_PATHS = 64
+#: trace tests (and monodromy runs after an "incomplete") of one count check
+CHECK_ROUNDS = 3
 _CACHE: dict[str, StartSolutions] = {}
 _PATHS = [0]
+_CHECK = [False]
 
 RandomInstance = Callable[[np.random.Generator], tuple[Complex, Complex]]
 
@@ -78,7 +90,50 @@ def start_solutions(system: PolynomialSystem, random_instance: RandomInstance | 
                 found = _then_monodromy(system, found, random_instance, options)
             start_store.save(key, found)
         _CACHE[key] = found
+    if _CHECK[0] and _CACHE[key].lower_bound and not _CACHE[key].count_check:
+        options = replace(monodromy or MonodromyOptions(), expected=None, seed=seed)
+        _CACHE[key] = checked(system, _CACHE[key], options)
+        start_store.save(key, _CACHE[key])
     return _CACHE[key]
+
+
+@contextmanager
+def count_check(on: bool = True) -> Iterator[None]:
+    """Within the block, start sets that monodromy found without a known count are put to the
+    trace test as they are found or loaded (module docstring)."""
+    before = _CHECK[0]
+    _CHECK[0] = on
+    try:
+        yield
+    finally:
+        _CHECK[0] = before
+
+
+def checked(system: PolynomialSystem, found: StartSolutions,
+            options: MonodromyOptions | None = None) -> StartSolutions:
+    """``found`` after the trace test (module docstring): completed by more monodromy loops
+    (``options``, a new seed each round) while the test finds it incomplete, with the last
+    verdict in ``count_check`` and in ``how_found``."""
+    options = options or MonodromyOptions()
+    verdict: Completeness | None = None
+    paths = 0
+    for round_ in range(CHECK_ROUNDS):
+        verdict = trace_test(system, found.p, found.x, TraceOptions(seed=round_))
+        paths += verdict.paths
+        if verdict.verdict != INCOMPLETE or round_ == CHECK_ROUNDS - 1:
+            break
+        more = StartSolutions.by_monodromy(system, found.p, found.x, replace(
+            options, expected=None, seed=options.seed + 101 * (round_ + 1)))
+        paths += more.paths
+        found = replace(found, x=more.x, generic_count=more.generic_count,
+                        how_found=f"{found.how_found}; then {more.how_found}")
+    assert verdict is not None
+    _PATHS[0] += paths
+    how = found.how_found
+    if verdict.complete:
+        how = how.replace(f" ({LOWER_BOUND}: no proof that none is missing)", "")
+    return replace(found, how_found=f"{how}; {verdict}", paths=found.paths + paths,
+                   count_check=verdict.verdict)
 
 
 def install(starts: Mapping[str, StartSolutions]) -> None:

@@ -1,0 +1,252 @@
+"""The trace test: whether a set of solutions at a generic parameter point is all of them.
+
+Monodromy (:mod:`.monodromy`) stops when its loops stop finding new solutions, so without a
+count known in advance its set is a lower bound. The trace test decides it (Leykin, Rodriguez
+& Sottile, "Trace test", Arnold Math. J. 4, 2018; for a parametrised system in the form of
+del Campo & Rodriguez, "Critical points via monodromy and local methods", J. Symb. Comput. 79,
+2017, which HomotopyContinuation.jl's ``verify_solution_completeness`` also uses).
+
+Take a random complex direction v in parameter space and a random affine function
+ℓ(x) = a·x − 1, and the system in the unknowns (x, λ) with the pencil value t:
+
+    F(x; p0 + λ v) = 0,      ℓ(x)·λ + t = 0.
+
+Over t = 0 its solutions are two witness sets of the curve C = {(x, λ): F(x; p0 + λ v) = 0}:
+the solutions W0 at p0 (λ = 0), and the points W1 of C on the hyperplane ℓ(x) = 0. As t moves,
+they move together on C, cut by the (1, 1)-forms ℓ(x)·λ = −t; the sum of all of them, the
+trace, is then an affine function of t, and the sum of a proper part of the solutions of an
+irreducible curve is not (Leykin, Rodriguez & Sottile 2018, §4). So the test tracks
+W0 ∪ W1 from t = 0 to two pencil values t1, t2 and checks that the three traces lie on a line:
+
+    Σ_i δ_i = 0,   δ_i = (z_i(t1) − z_i(0))/t1 − (z_i(t2) − z_i(0))/t2,   z = (x, λ).
+
+W1 is found here as well: points of C from W0 tracked to p0 + v (λ = 1), put on a hyperplane
+through them and carried to the random one, then monodromy loops on the slice system
+F(x; p + λ v) = 0, ℓ(x) = 0. An incomplete W1 fails the test just as an incomplete W0 does, so
+W1 gets more loops until the test passes or the rounds run out.
+
+What it decides, honestly. The deviation |Σ δ_i| is compared with an error bound: the end
+points' distances to their true solutions (2β, Newton's step, bounded by Smale's α-test where
+it certifies them: :mod:`.certify`) and the rounding of the sum. A deviation above the bound
+means the true traces are not collinear, so a solution is missing ("incomplete"); a deviation
+within it, with the bound small beside the traces' own nonlinearity Σ|δ_i|, is "complete"; a
+failed path or a bound too large to tell is "inconclusive". Like monodromy itself, the test
+sees only the irreducible components of the solution variety that hold some of the given
+solutions: a component none of them lies on is beyond it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from screwkit.algebraic.certify import UNIT_ROUNDOFF, certify
+from screwkit.algebraic.monodromy import MonodromyOptions, monodromy_solve
+from screwkit.algebraic.path import TrackOptions
+from screwkit.algebraic.polynomial import Complex, Poly, PolynomialSystem, compile_system
+from screwkit.algebraic.track import PathStatus, track_parameter_homotopy
+from screwkit.errors import InputError
+
+#: the verdicts of :class:`Completeness`
+COMPLETE, INCOMPLETE, INCONCLUSIVE = "complete", "incomplete", "inconclusive"
+
+
+@dataclass(frozen=True)
+class TraceOptions:
+    """``pencil``: |t| of the two pencil values (a path that fails there is tried again in
+    another direction, up to ``tries`` times, at a fifth of the size each time: a shorter
+    segment passes fewer of the pencil's branch points, at the price of a larger error
+    bound); ``rounds`` of
+    monodromy loops for the second witness set, each stopped after ``stale_loops`` loops in a
+    row found nothing new; ``resolution``: the largest error bound, relative to the traces'
+    nonlinearity Σ|δ_i|, at which the test still decides; ``seed`` for v, ℓ and the loops."""
+
+    pencil: float = 0.5
+    tries: int = 3
+    rounds: int = 4
+    stale_loops: int = 6
+    resolution: float = 1e-5
+    seed: int = 0
+    track: TrackOptions = field(default_factory=TrackOptions)
+
+
+@dataclass(frozen=True)
+class Completeness:
+    """The trace test's verdict (:data:`COMPLETE`, :data:`INCOMPLETE` or
+    :data:`INCONCLUSIVE`) on ``solutions`` solutions; ``deviation`` |Σδ_i| / Σ|δ_i| and
+    ``bound``, the error bound on it (NaN when no pencil was tracked); ``witnesses`` the points
+    of the second witness set W1; ``certified`` how many of the tracked points the α-test
+    certified (the others' errors are Newton's step, an estimate); ``paths`` tracked in all;
+    ``reason`` in words."""
+
+    verdict: str
+    solutions: int
+    deviation: float
+    bound: float
+    witnesses: int
+    certified: int
+    paths: int
+    reason: str
+
+    @property
+    def complete(self) -> bool:
+        return self.verdict == COMPLETE
+
+    def __str__(self) -> str:
+        return f"trace test: {self.verdict} ({self.reason})"
+
+
+def trace_systems(system: PolynomialSystem) -> tuple[PolynomialSystem, PolynomialSystem]:
+    """The slice system F(x; p + λ v) = 0, a·x − 1 = 0 (unknowns x, λ; parameters p, v, a)
+    and the pencil system F(x; p + λ v) = 0, (a·x − 1)·λ + t = 0 (parameters t, p, v, a) of
+    ``system`` (module docstring); built once and kept on the system."""
+    kept = system.__dict__.get("_trace_systems")
+    if kept is None:
+        kept = (_build(system, pencil=False), _build(system, pencil=True))
+        object.__setattr__(system, "_trace_systems", kept)
+    return kept  # type: ignore[no-any-return]
+
+
+def _build(system: PolynomialSystem, pencil: bool) -> PolynomialSystem:
+    n, k = system.n, system.k
+    lam = n
+    first = n + 1 + int(pencil)  # p, then v, then a
+    p_of, v_of, a_of = first, first + k, first + 2 * k
+    lam_poly = Poly.variable(lam)
+    powers: dict[tuple[int, int], Poly] = {}
+    equations = [Poly() for _ in range(n)]
+    for term in range(len(system.eq)):
+        poly = Poly.constant(complex(system.coef[term]))
+        for s, e in zip(system.sym[term].tolist(), system.pw[term].tolist(), strict=True):
+            if e == 0:
+                continue
+            if s < n:
+                poly = poly * Poly.variable(s) ** e
+                continue
+            j = s - n
+            if (j, e) not in powers:
+                powers[j, e] = (Poly.variable(p_of + j)
+                                + lam_poly * Poly.variable(v_of + j)) ** e
+            poly = poly * powers[j, e]
+        e_ = int(system.eq[term])
+        equations[e_] = equations[e_] + poly
+    slice_ = sum((Poly.variable(a_of + i) * Poly.variable(i) for i in range(n)), Poly()) - 1.0
+    equations.append(slice_ * lam_poly + Poly.variable(n + 1) if pencil else slice_)
+    name = "lambda"
+    while name in system.variables:
+        name += "_"
+    names = [*("t" for _ in range(int(pencil))), *(f"p.{q}" for q in system.parameters),
+             *(f"v.{q}" for q in system.parameters), *(f"a.{q}" for q in system.variables)]
+    return compile_system(equations, [*system.variables, name], names)
+
+
+def trace_test(system: PolynomialSystem, p0: Complex, x0: Complex,
+               options: TraceOptions | None = None) -> Completeness:
+    """Whether the solutions x0 (m, n) of F(x; p0) = 0, p0 (k,) generic complex, are all of
+    the isolated solutions there (module docstring)."""
+    options = options or TraceOptions()
+    p0 = np.asarray(p0, dtype=complex)
+    x0 = np.atleast_2d(np.asarray(x0, dtype=complex))
+    n, k, m = system.n, system.k, len(x0)
+    if p0.shape != (k,) or x0.shape[1:] != (n,) or m == 0:
+        raise InputError(f"the trace test needs p0 of shape ({k},) and at least one solution "
+                         f"of shape ({n},); got {p0.shape} and {x0.shape}")
+    if k == 0:
+        raise InputError("the trace test moves the parameters; this system has none")
+    rng = np.random.default_rng(options.seed)
+    slice_sys, pencil_sys = trace_systems(system)
+    v = np.maximum(1.0, np.abs(p0)) * (rng.standard_normal(k) + 1j * rng.standard_normal(k))
+    a = rng.standard_normal(n) + 1j * rng.standard_normal(n)
+    q = np.concatenate([p0, v, a])
+    w1, paths = _seeds(system, slice_sys, p0, v, q, x0, options)
+    failed = Completeness(INCONCLUSIVE, m, np.nan, np.nan, len(w1), 0, paths,
+                          "no point of the curve reached the slice")
+    result = failed
+    for r in range(options.rounds):
+        if not len(w1):
+            break
+        mono = MonodromyOptions(stale_loops=options.stale_loops, each_own_size=True,
+                                seed=options.seed * 1000 + r, track=options.track)
+        _, w1, stats = monodromy_solve(slice_sys, q, w1, mono)
+        paths += stats.paths_tracked
+        z0 = np.concatenate([np.column_stack([x0, np.zeros(m)]), w1])
+        result = _pencil(pencil_sys, np.concatenate([[0.0], q]), z0, m, rng, options)
+        result = replace(result, solutions=m, witnesses=len(w1),
+                         paths=paths + result.paths)
+        paths = result.paths
+        if result.verdict != INCOMPLETE:
+            break
+    return result
+
+
+def _seeds(system: PolynomialSystem, slice_sys: PolynomialSystem, p0: Complex, v: Complex,
+           q: Complex, x0: Complex, options: TraceOptions) -> tuple[Complex, int]:
+    """Points of the curve C on the slice a·x = 1 (q = (p0, v, a)): the solutions tracked to
+    p0 + v (λ = 1), up to n of them put on the hyperplane a'·x = 1 through them, and carried
+    from a' to a along the slice system."""
+    n = system.n
+    moved = track_parameter_homotopy(system, p0, p0 + v, x0, options.track)
+    y = moved.x[moved.status == PathStatus.REGULAR][:n]
+    paths = len(x0)
+    if not len(y):
+        return np.empty((0, n + 1), dtype=complex), paths
+    a_seed = np.linalg.lstsq(y, np.ones(len(y), dtype=complex), rcond=None)[0]
+    q_seed = np.concatenate([q[: len(q) - n], a_seed])
+    carried = track_parameter_homotopy(slice_sys, q_seed, q, np.column_stack(
+        [y, np.ones(len(y))]), options.track)
+    return carried.x[carried.status == PathStatus.REGULAR], paths + len(y)
+
+
+def _pencil(pencil_sys: PolynomialSystem, q0: Complex, z0: Complex, m: int,
+            rng: np.random.Generator, options: TraceOptions) -> Completeness:
+    """Track z0 (the m solutions, then the slice's witnesses) from t = 0 to two pencil values
+    and compare the traces (module docstring)."""
+    size = options.pencil
+    paths = 0
+    for _ in range(options.tries):
+        ts = size * np.exp(2j * np.pi * rng.random(2))
+        ends, lost = [], 0
+        for t in ts:
+            q1 = q0.copy()
+            q1[0] = t
+            moved = track_parameter_homotopy(pencil_sys, q0, q1, z0, options.track)
+            paths += len(z0)
+            lost += int((moved.status != PathStatus.REGULAR).sum())
+            ends.append(moved.x)
+        if not lost:
+            return _verdict(pencil_sys, q0, z0, m, ts, ends, paths, options)
+        size /= 5
+    return Completeness(INCONCLUSIVE, 0, np.nan, np.nan, 0, 0, paths,
+                        f"paths of the pencil failed in each of {options.tries} directions")
+
+
+def _verdict(pencil_sys: PolynomialSystem, q0: Complex, z0: Complex, m: int, ts: Complex,
+             ends: list[Complex], paths: int, options: TraceOptions) -> Completeness:
+    """The verdict from the points z0 at t = 0 and ``ends`` at ts (module docstring)."""
+    points = [z0, *ends]
+    params = [q0, *(np.concatenate([[t], q0[1:]]) for t in ts)]
+    error, certified = [], 0
+    for z, q in zip(points, params, strict=True):
+        cert = certify(pencil_sys, z, q)
+        error.append(cert.radius)
+        certified += int(cert.certified.sum())
+    delta = (ends[0] - z0) / ts[0] - (ends[1] - z0) / ts[1]
+    spread = float(np.linalg.norm(delta, axis=1).sum())
+    gap = float(np.linalg.norm(delta.sum(axis=0)))
+    bound_abs = float(((error[0] + error[1]) / abs(ts[0])
+                       + (error[0] + error[2]) / abs(ts[1])).sum()
+                      + 4 * len(z0) * UNIT_ROUNDOFF * spread)
+    deviation, bound = gap / spread, bound_abs / spread
+    said = (f"{m} solutions and {len(z0) - m} slice witnesses traced, deviation "
+            f"{deviation:.1e} against an error bound {bound:.1e}")
+    if gap > bound_abs:
+        verdict = INCOMPLETE
+        reason = f"{said}: the traces are not on a line, so a solution is missing"
+    elif bound <= options.resolution:
+        verdict = COMPLETE
+        reason = f"{said}: the traces are on a line"
+    else:
+        verdict = INCONCLUSIVE
+        reason = f"{said}: the bound is too large to tell"
+    return Completeness(verdict, 0, deviation, bound, 0, certified, paths, reason)

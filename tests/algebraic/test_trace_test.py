@@ -1,0 +1,112 @@
+"""The trace test (algebraic/trace_test.py): a complete set of solutions passes, a set with any
+one solution left out fails, the second witness set has the count that multi-homogeneous
+Bézout gives for the curve, and bad input is refused by name."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from homotopy_helpers import dense_family, generic_point, monomials
+from screwkit.algebraic.monodromy import MonodromyOptions
+from screwkit.algebraic.polynomial import Poly, compile_system
+from screwkit.algebraic.solve import StartSolutions
+from screwkit.algebraic.trace_test import (
+    COMPLETE,
+    INCOMPLETE,
+    TraceOptions,
+    trace_systems,
+    trace_test,
+)
+from screwkit.errors import InputError
+
+
+@pytest.fixture(scope="module")
+def dense3() -> tuple:
+    """Three dense quadrics in three unknowns, every coefficient a parameter: 8 solutions
+    (Bézout, reached by monodromy with that count expected)."""
+    system = dense_family(3)
+    p0, x0 = generic_point(system, len(monomials(3, 2)), seed=2)
+    start = StartSolutions.by_monodromy(system, p0, x0, MonodromyOptions(expected=8))
+    assert start.generic_count == 8
+    return system, start
+
+
+def test_every_solution_passes_and_the_slice_holds_the_curves_degree(dense3):
+    """F(x; p0 + λv) is of bidegree (2, 1) in (x, λ), so the curve meets a hyperplane
+    a·x = 1 in the coefficient of X³Λ in (2X + Λ)³·X: 3·2² = 12 points. The traces of all
+    8 + 12 points lie on a line to rounding, well within the certified error bound."""
+    system, start = dense3
+    verdict = trace_test(system, start.p, start.x)
+    assert verdict.verdict == COMPLETE and verdict.complete
+    assert verdict.solutions == 8 and verdict.witnesses == 12
+    assert verdict.deviation <= verdict.bound <= TraceOptions().resolution
+    assert verdict.deviation < 1e-11
+    assert verdict.certified == 3 * 20  # every traced point, at t = 0, t1 and t2
+    assert "complete" in str(verdict) and "on a line" in str(verdict)
+
+
+@pytest.mark.parametrize("left_out", [0, 3, 7])
+def test_a_set_missing_one_solution_fails(dense3, left_out):
+    """The trace of a proper part of an irreducible curve's points is not affine in the
+    pencil value: with one of the 8 left out the deviation is orders above the bound."""
+    system, start = dense3
+    x = np.delete(start.x, left_out, axis=0)
+    verdict = trace_test(system, start.p, x, TraceOptions(rounds=1))
+    assert verdict.verdict == INCOMPLETE and not verdict.complete
+    assert verdict.solutions == 7 and verdict.witnesses == 12
+    assert verdict.deviation > 1e3 * verdict.bound
+    assert "a solution is missing" in str(verdict)
+
+
+def test_a_circle_and_a_line():
+    """x² + y² = 1 and a line with its three coefficients as parameters: 2 solutions, and the
+    curve of the moving line meets a·x = 1 where the circle does (2 points)."""
+    x, y = Poly.variable(0), Poly.variable(1)
+    a, b, c = (Poly.variable(i) for i in (2, 3, 4))
+    system = compile_system([x * x + y * y - 1.0, a * x + b * y + c], ["x", "y"],
+                            ["a", "b", "c"])
+    p0 = np.array([1.0 + 0.3j, 2.0 - 0.1j, 0.5 + 0.7j])
+    # the two points: y from the line, x² + y² = 1 a quadratic in x
+    A, B, C = p0
+    roots = np.roots([1 + (A / B) ** 2, 2 * A * C / B ** 2, (C / B) ** 2 - 1])
+    sols = np.column_stack([roots, -(A * roots + C) / B])
+    verdict = trace_test(system, p0, sols)
+    assert verdict.verdict == COMPLETE and verdict.witnesses == 2
+    assert trace_test(system, p0, sols[:1]).verdict == INCOMPLETE
+
+
+def test_the_built_systems_hold_the_moved_parameters(dense3):
+    """The slice and pencil systems are F(x; p + λv) with the slice a·x − 1 (= 0, or times λ
+    plus t): evaluated against the system at p + λv at random points."""
+    system, start = dense3
+    slice_sys, pencil_sys = trace_systems(system)
+    assert trace_systems(system)[0] is slice_sys  # kept on the system
+    n, k = system.n, system.k
+    assert (slice_sys.n, slice_sys.k, pencil_sys.k) == (n + 1, 2 * k + n, 2 * k + n + 1)
+    rng = np.random.default_rng(5)
+    z = rng.standard_normal((4, n + 1)) + 1j * rng.standard_normal((4, n + 1))
+    p, v, a = (rng.standard_normal(size) + 1j * rng.standard_normal(size)
+               for size in (k, k, n))
+    t = 0.3 - 0.2j
+    F_slice, _, _ = slice_sys.evaluate(z, np.concatenate([p, v, a]), want_jp=False)
+    F_pencil, _, _ = pencil_sys.evaluate(z, np.concatenate([[t], p, v, a]), want_jp=False)
+    F_moved = np.stack([system.evaluate(z[i:i + 1, :n], p + z[i, n] * v,
+                                        want_jp=False)[0][0] for i in range(4)])
+    ell = z[:, :n] @ a - 1.0
+    np.testing.assert_allclose(F_slice[:, :n], F_moved, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(F_slice[:, n], ell, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(F_pencil[:, :n], F_moved, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(F_pencil[:, n], ell * z[:, n] + t, rtol=1e-12, atol=1e-12)
+
+
+def test_bad_input_is_refused_by_name(dense3):
+    system, start = dense3
+    with pytest.raises(InputError, match="p0 of shape"):
+        trace_test(system, start.p[:-1], start.x)
+    with pytest.raises(InputError, match="at least one solution"):
+        trace_test(system, start.p, start.x[:0])
+    x = Poly.variable(0)
+    bare = compile_system([x * x - 2.0], ["x"])
+    with pytest.raises(InputError, match="has none"):
+        trace_test(bare, np.zeros(0, dtype=complex), np.array([[np.sqrt(2.0)]]))
