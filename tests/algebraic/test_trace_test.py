@@ -110,3 +110,44 @@ def test_bad_input_is_refused_by_name(dense3):
     bare = compile_system([x * x - 2.0], ["x"])
     with pytest.raises(InputError, match="has none"):
         trace_test(bare, np.zeros(0, dtype=complex), np.array([[np.sqrt(2.0)]]))
+
+
+def test_a_lost_pencil_path_is_tracked_again_and_a_jump_is_not_trusted(dense3, monkeypatch):
+    """A pencil path that fails is tracked again alone with tighter steps (the verdict stands,
+    its paths counted); when the retrack lands on another path's end (a jump) it is lost at
+    that pencil value, another value is drawn, and when every value loses it the verdict is
+    inconclusive, not complete."""
+    from dataclasses import replace as dc_replace
+
+    import screwkit.algebraic.trace_test as tt
+    from screwkit.algebraic.track import PathStatus
+
+    system, start = dense3
+    real = tt.track_parameter_homotopy
+    calls: list[int] = []
+
+    def first_path_fails(sys_, q0, q1, z, options=None):
+        result = real(sys_, q0, q1, z, options)
+        calls.append(len(z))
+        if sys_.n == system.n + 1 and np.ndim(q1) == 1 and q1[0] != 0 and len(z) > 1:
+            status = result.status.copy()
+            status[0] = PathStatus.FAILED
+            return dc_replace(result, status=status)
+        return result
+
+    monkeypatch.setattr(tt, "track_parameter_homotopy", first_path_fails)
+    verdict = trace_test(system, start.p, start.x)
+    assert verdict.verdict == COMPLETE
+    assert calls.count(1) == 2  # one retrack of one path at each of the two pencil values
+
+    second = np.column_stack([start.x[1:2], np.zeros(1)])  # the second solution, λ = 0
+
+    def retrack_jumps(sys_, q0, q1, z, options=None):
+        result = first_path_fails(sys_, q0, q1, z, options)
+        if sys_.n == system.n + 1 and np.ndim(q1) == 1 and q1[0] != 0 and len(z) == 1:
+            return real(sys_, q0, q1, second, options)  # lands on the second path's end
+        return result
+
+    monkeypatch.setattr(tt, "track_parameter_homotopy", retrack_jumps)
+    verdict = trace_test(system, start.p, start.x, TraceOptions(rounds=1))
+    assert verdict.verdict == "inconclusive" and "failed at" in verdict.reason
