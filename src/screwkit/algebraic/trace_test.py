@@ -28,7 +28,10 @@ W1 gets more loops until the test passes or the rounds run out.
 What it decides, honestly. The deviation |Σ δ_i| is compared with an error bound: the end
 points' distances to their true solutions (2β, Newton's step, bounded by Smale's α-test where
 it certifies them: :mod:`.certify`) and the rounding of the sum. A deviation above the bound
-means the true traces are not collinear, so a solution is missing ("incomplete"); a deviation
+means the true traces are not collinear, so a point is missing from W0 or from W1
+("incomplete": the W1 rounds above make the second less likely, and a caller that can run
+more monodromy loops on W0 and finds nothing new should read it as inconclusive, as the count
+check of docs/kinematics.md does); a deviation
 within it, with the bound small beside the traces' own nonlinearity Σ|δ_i|, is "complete"; a
 failed path or a bound too large to tell is "inconclusive". Like monodromy itself, the test
 sees only the irreducible components of the solution variety that hold some of the given

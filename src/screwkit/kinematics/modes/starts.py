@@ -37,7 +37,13 @@ from screwkit.algebraic.multi_homogeneous import Grouping, mhom_bezout_of, solve
 from screwkit.algebraic.polynomial import Complex, PolynomialSystem
 from screwkit.algebraic.solve import LOWER_BOUND, StartSolutions
 from screwkit.algebraic.total_degree import bezout_number
-from screwkit.algebraic.trace_test import INCOMPLETE, Completeness, TraceOptions, trace_test
+from screwkit.algebraic.trace_test import (
+    INCOMPLETE,
+    INCONCLUSIVE,
+    Completeness,
+    TraceOptions,
+    trace_test,
+)
 from screwkit.kinematics.modes import start_store
 
 #: systems with at most this many total-degree paths are started by the total-degree homotopy
@@ -113,7 +119,10 @@ def checked(system: PolynomialSystem, found: StartSolutions,
             options: MonodromyOptions | None = None) -> StartSolutions:
     """``found`` after the trace test (module docstring): completed by more monodromy loops
     (``options``, a new seed each round) while the test finds it incomplete, with the last
-    verdict in ``count_check`` and in ``how_found``."""
+    verdict in ``count_check`` and in ``how_found``. When the test finds it incomplete but the
+    loops find nothing new, the verdict is inconclusive: the point the test misses may be one
+    of its own slice witnesses, or a solution these loops cannot reach, and the check does not
+    claim either (docs/kinematics.md, "The count check")."""
     options = options or MonodromyOptions()
     verdict: Completeness | None = None
     paths = 0
@@ -125,6 +134,11 @@ def checked(system: PolynomialSystem, found: StartSolutions,
         more = StartSolutions.by_monodromy(system, found.p, found.x, replace(
             options, expected=None, seed=options.seed + 101 * (round_ + 1)))
         paths += more.paths
+        if more.generic_count == found.generic_count:  # nothing new: see the docstring
+            verdict = replace(verdict, verdict=INCONCLUSIVE, reason=(
+                f"{verdict.reason}; but more monodromy loops found no further solution, so "
+                "the missing point may be one of the test's own slice witnesses"))
+            break
         found = replace(found, x=more.x, generic_count=more.generic_count,
                         how_found=f"{found.how_found}; then {more.how_found}")
     assert verdict is not None
