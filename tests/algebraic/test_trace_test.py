@@ -35,12 +35,15 @@ def dense3() -> tuple:
 def test_every_solution_passes_and_the_slice_holds_the_curves_degree(dense3):
     """F(x; p0 + λv) is of bidegree (2, 1) in (x, λ), so the curve meets a hyperplane
     a·x = 1 in the coefficient of X³Λ in (2X + Λ)³·X: 3·2² = 12 points. The traces of all
-    8 + 12 points lie on a line to rounding, well within the certified error bound."""
+    8 + 12 points lie on a line to rounding, within the certified error bound and far below
+    the least share of any one solution (the yardstick of "complete")."""
     system, start = dense3
     verdict = trace_test(system, start.p, start.x)
     assert verdict.verdict == COMPLETE and verdict.complete
     assert verdict.solutions == 8 and verdict.witnesses == 12
-    assert verdict.deviation <= verdict.bound <= TraceOptions().resolution
+    assert verdict.deviation <= verdict.bound
+    assert verdict.deviation <= TraceOptions().separation * verdict.least_share
+    assert 1e-4 < verdict.least_share < 1 / 8
     assert verdict.deviation < 1e-11
     assert verdict.certified == 3 * 20  # every traced point, at t = 0, t1 and t2
     assert "complete" in str(verdict) and "on a line" in str(verdict)
@@ -56,6 +59,7 @@ def test_a_set_missing_one_solution_fails(dense3, left_out):
     assert verdict.verdict == INCOMPLETE and not verdict.complete
     assert verdict.solutions == 7 and verdict.witnesses == 12
     assert verdict.deviation > 1e3 * verdict.bound
+    assert verdict.deviation > verdict.least_share / 10  # the missing one's share
     assert "a solution is missing" in str(verdict)
 
 

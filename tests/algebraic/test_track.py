@@ -238,3 +238,27 @@ def test_a_lost_path_retracked_onto_another_paths_end_sends_its_instance_round(m
     assert result.counts()["regular"] == 4 and result.retracked.all()
     expected = np.roots(np.r_[1.0, target[::-1]])
     assert _matches(result.x[:, 0], expected, 1e-10)
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_a_root_at_its_rounding_floor_needs_the_converged_option(compiled):
+    """(x − p)(x − p − 10⁻⁴): the root x = p moves exactly as the predictor says, so Newton's
+    first correction is pure rounding, ~10⁻¹¹ here (f' = 10⁻⁴ against terms of size 1), and
+    the second is as large. With the contraction test (second ≤ first / 10) waived only below
+    10⁻¹² (the tracker before), every step is rejected and the step collapses: the path
+    fails. With the default ``converged`` (both corrections ≤ 10⁻⁹) those steps are accepted
+    and the path arrives, regular, in a few steps (the trace test's far-out witnesses:
+    algebraic/trace_test.py)."""
+    from dataclasses import replace
+
+    x, p = Poly.variable(0), Poly.variable(1)
+    system = compile_system([(x - p) * (x - p - 1e-4)], ["x"], ["p"])
+    options = replace(TrackOptions(), retrack=False, detour=False, compiled=compiled)
+    assert options.converged == 1e-9
+    start, target = np.array([0.3]), np.array([1.7 + 0.2j])
+    strict = replace(options, converged=1e-12)
+    stuck = track_parameter_homotopy(system, start, target, np.array([[0.3]]), strict)
+    assert stuck.status[0] == PathStatus.FAILED and stuck.steps[0] > 100
+    moved = track_parameter_homotopy(system, start, target, np.array([[0.3]]), options)
+    assert moved.status[0] == PathStatus.REGULAR and moved.steps[0] < 20
+    assert abs(moved.x[0, 0] - (1.7 + 0.2j)) < 1e-10  # its floor: ~u·|terms| / f' ≈ 1e-11

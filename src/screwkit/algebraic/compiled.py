@@ -147,7 +147,8 @@ def track_compiled(dense: DenseQuadrics, instance: Index,
             dense.linear.astype(np.int64), patch, i, lin, y, t0, t1, kind, r,
             float(options.initial_step), float(options.max_step), float(options.min_step),
             int(options.max_steps), float(options.predictor_tolerance),
-            float(options.corrector_tolerance), float(options.contraction))
+            float(options.corrector_tolerance), float(options.contraction),
+            float(options.converged))
         return out
 
     P = len(inst)

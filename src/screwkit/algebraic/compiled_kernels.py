@@ -198,7 +198,7 @@ def track(qrs: Any, qis: Any, ck: Any, cu: Any, K: int,
           Ls: Any, linear: Any, patch: Any, instance: Any, linear_of: Any, y0: Any,
           tau0: Any, tau1: Any, kind: int, radius: Any, initial_step: float,
           max_step: float, min_step: float, max_steps: int, ptol: float, ctol: float,
-          contraction: float) -> tuple[Any, Any, Any]:
+          contraction: float, converged: float) -> tuple[Any, Any, Any]:
     P, m = y0.shape
     C = ck.shape[0]
     y_out = y0.copy()
@@ -245,7 +245,8 @@ def track(qrs: Any, qis: Any, ck: Any, cu: Any, K: int,
             first /= scale
             second /= scale
             accept = (first <= ptol and second <= ctol
-                      and (second <= contraction * first or first <= 1e-12) and finite)
+                      and (second <= contraction * first
+                           or max(first, second) <= converged) and finite)
             ratio = 0.6 * (ptol / max(first, 1e-300)) ** 0.2
             if not np.isfinite(ratio):
                 ratio = 0.25

@@ -62,6 +62,13 @@ class TrackOptions:
     end_corrector_tolerance: float = 1e-5
     #: the second Newton correction must be at most this fraction of the first
     contraction: float = 0.1
+    #: ... unless both are at most this (relative): then they are at the rounding floor and
+    #: the contraction says nothing. 1e-12 (the first alone) before: an ill-conditioned point's
+    #: floor is higher (the trace test's far-out witnesses, corrections of 1e-11 to 3e-11 at
+    #: κ ≈ 2e6; a root 1e-4 from another, tests/algebraic/test_track.py), every step there
+    #: was rejected and the step collapsed. The 3-UPU's every mode along its motion is the
+    #: same with 1e-9 (every number of its JSON to 1e-9) and takes 30 s instead of 33
+    converged: float = 1e-9
     #: the endgame starts on the circle |1 − σ| = endgame_radius and shrinks it by 4 a level
     endgame_radius: float = 0.05
     endgame_levels: int = 5
@@ -296,7 +303,8 @@ def track(hom: Homotopy, curve: Curve, y0: Complex, rows: Index, tau0: Real, tau
             # Newton must contract fast (quadratic convergence from the predicted point, the
             # guard against converging onto a neighbouring path) and end within tol_c
             accept = ((first <= options.predictor_tolerance) & (second <= tol_c)
-                      & ((second <= options.contraction * first) | (first <= 1e-12)))
+                      & ((second <= options.contraction * first)
+                         | (np.maximum(first, second) <= options.converged)))
             accept &= np.isfinite(yc).all(axis=1)
             # the first correction is the RK4 predictor's error, O(h^5): aim the next step at
             # 0.6^5 ≈ 0.08 of the tolerance (fewer rejections than 0.8, measured), growing at

@@ -31,9 +31,14 @@ it certifies them: :mod:`.certify`) and the rounding of the sum. A deviation abo
 means the true traces are not collinear, so a point is missing from W0 or from W1
 ("incomplete": the W1 rounds above make the second less likely, and a caller that can run
 more monodromy loops on W0 and finds nothing new should read it as inconclusive, as the count
-check of docs/kinematics.md does); a deviation
-within it, with the bound small beside the traces' own nonlinearity Σ|δ_i|, is "complete"; a
-failed path or a bound too large to tell is "inconclusive". Like monodromy itself, the test
+check of docs/kinematics.md does). Within the bound, the verdict weighs the deviation against
+the least share ‖δ_i‖ / Σ‖δ_j‖ of any given solution: a missing solution would add its own
+share, so a deviation at most 10⁻³ of the least share is "complete" (it would take a missing
+solution a thousand times less nonlinear than every one found, or an error cancelling its
+share to 0.1 %); otherwise, or when paths are lost, "inconclusive". The bound itself, with
+the α-test's rounding margins, is pessimistic for far-out ill-conditioned witnesses (10⁴ times
+the Newton step on the 3-RPS), which is why it decides "incomplete" and not "complete".
+Like monodromy itself, the test
 sees only the irreducible components of the solution variety that hold some of the given
 solutions: a component none of them lies on is beyond it.
 """
@@ -61,15 +66,15 @@ class TraceOptions:
     one in another direction, up to ``tries`` times, a fifth the size each time: a shorter
     segment passes fewer of the pencil's branch points, at the price of a larger error
     bound); ``rounds`` of monodromy loops for the second witness set, each stopped after
-    ``stale_loops`` loops in a row found nothing new; ``resolution``: the largest error bound, relative to the traces'
-    nonlinearity Σ|δ_i|, at which the test still decides; ``hyperplanes`` tried for the
-    slice; ``seed`` for v, ℓ and the loops."""
+    ``stale_loops`` loops in a row found nothing new; ``separation``: "complete" needs the
+    deviation at most this fraction of the least share of any given solution (module
+    docstring); ``hyperplanes`` tried for the slice; ``seed`` for v, ℓ and the loops."""
 
     pencil: float = 0.5
     tries: int = 3
     rounds: int = 4
     stale_loops: int = 6
-    resolution: float = 1e-5
+    separation: float = 1e-3
     #: random hyperplanes a·x = 1 tried for the slice, the best kept (:func:`_best_hyperplane`)
     hyperplanes: int = 4
     seed: int = 0
@@ -83,7 +88,7 @@ class Completeness:
     ``bound``, the error bound on it (NaN when no pencil was tracked); ``witnesses`` the points
     of the second witness set W1; ``certified`` how many of the tracked points the α-test
     certified (the others' errors are Newton's step, an estimate); ``paths`` tracked in all;
-    ``reason`` in words."""
+    ``reason`` in words; ``least_share`` the yardstick of "complete" (module docstring)."""
 
     verdict: str
     solutions: int
@@ -93,6 +98,8 @@ class Completeness:
     certified: int
     paths: int
     reason: str
+    #: the least share ‖δ_i‖ / Σ‖δ_j‖ among the given solutions (NaN when none was traced)
+    least_share: float = np.nan
 
     @property
     def complete(self) -> bool:
@@ -307,15 +314,18 @@ def _verdict(pencil_sys: PolynomialSystem, q0: Complex, z0: Complex, m: int, ts:
                             "every traced point moves affinely with t, so no part of them "
                             "can be told from the whole")
     deviation, bound = gap / spread, bound_abs / spread
+    least = float(np.linalg.norm(delta[:m], axis=1).min()) / spread
     said = (f"{m} solutions and {len(z0) - m} slice witnesses traced, deviation "
-            f"{deviation:.1e} against an error bound {bound:.1e}")
+            f"{deviation:.1e} against an error bound {bound:.1e} and a least share of a "
+            f"solution {least:.1e}")
     if gap > bound_abs:
         verdict = INCOMPLETE
         reason = f"{said}: the traces are not on a line, so a solution is missing"
-    elif bound <= options.resolution:
+    elif deviation <= options.separation * least:
         verdict = COMPLETE
         reason = f"{said}: the traces are on a line"
     else:
         verdict = INCONCLUSIVE
-        reason = f"{said}: the bound is too large to tell"
-    return Completeness(verdict, 0, deviation, bound, 0, certified, paths, reason)
+        reason = (f"{said}: within the bound, but not {1 / options.separation:.0f} times below "
+                  "the least share")
+    return Completeness(verdict, 0, deviation, bound, 0, certified, paths, reason, least)
