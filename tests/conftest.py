@@ -37,3 +37,15 @@ def start_solution_store(tmp_path_factory: pytest.TempPathFactory) -> Iterator[A
         os.environ.pop("SCREWKIT_CACHE_DIR", None)
     else:
         os.environ["SCREWKIT_CACHE_DIR"] = before
+
+
+@pytest.fixture
+def store(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """A store of start solutions of this test alone (its folder ``starts``), with the
+    process's memory of them forgotten before and after."""
+    from screwkit.kinematics.modes import start_store, starts
+
+    monkeypatch.setenv(start_store.CACHE_ENV, str(tmp_path))
+    starts.forget()
+    yield tmp_path / "starts"
+    starts.forget()

@@ -256,9 +256,11 @@ def test_a_root_at_its_rounding_floor_needs_the_converged_option(compiled):
     options = replace(TrackOptions(), retrack=False, detour=False, compiled=compiled)
     assert options.converged == 1e-9
     start, target = np.array([0.3]), np.array([1.7 + 0.2j])
-    strict = replace(options, converged=1e-12)
-    stuck = track_parameter_homotopy(system, start, target, np.array([[0.3]]), strict)
-    assert stuck.status[0] == PathStatus.FAILED and stuck.steps[0] > 100
+    if not compiled:  # the numpy route's rounding (the compiled kernel's last bits vary
+        # with its compilation, so whether some step slips through there varies too: seen)
+        strict = replace(options, converged=1e-12)
+        stuck = track_parameter_homotopy(system, start, target, np.array([[0.3]]), strict)
+        assert stuck.status[0] == PathStatus.FAILED and stuck.steps[0] > 100
     moved = track_parameter_homotopy(system, start, target, np.array([[0.3]]), options)
     assert moved.status[0] == PathStatus.REGULAR and moved.steps[0] < 20
     assert abs(moved.x[0, 0] - (1.7 + 0.2j)) < 1e-10  # its floor: ~u·|terms| / f' ≈ 1e-11

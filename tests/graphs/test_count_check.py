@@ -28,14 +28,6 @@ from screwkit.kinematics.modes.spatial_points_build import spatial_point_formula
 SPEC = Path(__file__).resolve().parents[2] / "examples" / "mechanisms" / "three_rps.toml"
 
 
-@pytest.fixture
-def store(tmp_path, monkeypatch):
-    monkeypatch.setenv(start_store.CACHE_ENV, str(tmp_path))
-    starts.forget()
-    yield tmp_path / "starts"
-    starts.forget()
-
-
 @pytest.fixture(scope="module")
 def three_rps():
     return spatial_point_formulation(sk.load_spec(SPEC).mechanism)

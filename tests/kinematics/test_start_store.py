@@ -23,14 +23,6 @@ from screwkit.kinematics.modes.planar import planar_formulation
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "mechanisms"
 
 
-@pytest.fixture
-def store(tmp_path, monkeypatch):
-    monkeypatch.setenv(start_store.CACHE_ENV, str(tmp_path))
-    starts.forget()
-    yield tmp_path / "starts"
-    starts.forget()
-
-
 @pytest.fixture(scope="module")
 def sixbar():
     path = EXAMPLES / "stephenson3_sixbar.toml"

@@ -15,7 +15,7 @@ Over t = 0 its solutions are two witness sets of the curve C = {(x, λ): F(x; p0
 the solutions W0 at p0 (λ = 0), and the points W1 of C on the hyperplane ℓ(x) = 0. As t moves,
 they move together on C, cut by the (1, 1)-forms ℓ(x)·λ = −t; the sum of all of them, the
 trace, is then an affine function of t, and the sum of a proper part of the solutions of an
-irreducible curve is not (Leykin, Rodriguez & Sottile 2018, §4). So the test tracks
+irreducible curve is not (Leykin, Rodriguez & Sottile 2018). So the test tracks
 W0 ∪ W1 from t = 0 to two pencil values t1, t2 and checks that the three traces lie on a line:
 
     Σ_i δ_i = 0,   δ_i = (z_i(t1) − z_i(0))/t1 − (z_i(t2) − z_i(0))/t2,   z = (x, λ).
@@ -38,9 +38,8 @@ solution a thousand times less nonlinear than every one found, or an error cance
 share to 0.1 %); otherwise, or when paths are lost, "inconclusive". The bound itself, with
 the α-test's rounding margins, is pessimistic for far-out ill-conditioned witnesses (10⁴ times
 the Newton step on the 3-RPS), which is why it decides "incomplete" and not "complete".
-Like monodromy itself, the test
-sees only the irreducible components of the solution variety that hold some of the given
-solutions: a component none of them lies on is beyond it.
+Like monodromy itself, the test sees only the irreducible components of the solution variety
+that hold some of the given solutions: a component none of them lies on is beyond it.
 """
 
 from __future__ import annotations
