@@ -110,6 +110,14 @@ def test_bad_input_is_refused_by_name(dense3):
         trace_test(system, start.p[:-1], start.x)
     with pytest.raises(InputError, match="at least one solution"):
         trace_test(system, start.p, start.x[:0])
+    with pytest.raises(InputError, match=r"solution\(s\) \[2\] do not solve"):
+        trace_test(system, start.p, np.vstack([start.x[:2], start.x[2] + 0.1]))
+    with pytest.raises(InputError, match=r"solution\(s\) \[3\] repeat"):
+        trace_test(system, start.p, np.vstack([start.x[:3], start.x[1]]))
+    with pytest.raises(InputError, match="finite"):
+        trace_test(system, np.where(np.arange(system.k) == 0, np.nan, start.p), start.x)
+    with pytest.raises(InputError, match="pencil, rounds out of range"):
+        TraceOptions(pencil=0.0, rounds=0)
     x = Poly.variable(0)
     bare = compile_system([x * x - 2.0], ["x"])
     with pytest.raises(InputError, match="has none"):
@@ -127,13 +135,15 @@ def test_a_lost_pencil_path_is_tracked_again_and_a_jump_is_not_trusted(dense3, m
     from screwkit.algebraic.track import PathStatus
 
     system, start = dense3
+    pencil_sys = trace_systems(system)[1]
     real = tt.track_parameter_homotopy
     calls: list[int] = []
 
     def first_path_fails(sys_, q0, q1, z, options=None):
         result = real(sys_, q0, q1, z, options)
-        calls.append(len(z))
-        if sys_.n == system.n + 1 and np.ndim(q1) == 1 and q1[0] != 0 and len(z) > 1:
+        if sys_ is pencil_sys:
+            calls.append(len(z))
+        if sys_ is pencil_sys and len(z) > 1:
             status = result.status.copy()
             status[0] = PathStatus.FAILED
             return dc_replace(result, status=status)
@@ -148,10 +158,38 @@ def test_a_lost_pencil_path_is_tracked_again_and_a_jump_is_not_trusted(dense3, m
 
     def retrack_jumps(sys_, q0, q1, z, options=None):
         result = first_path_fails(sys_, q0, q1, z, options)
-        if sys_.n == system.n + 1 and np.ndim(q1) == 1 and q1[0] != 0 and len(z) == 1:
+        if sys_ is pencil_sys and len(z) == 1:
             return real(sys_, q0, q1, second, options)  # lands on the second path's end
         return result
 
     monkeypatch.setattr(tt, "track_parameter_homotopy", retrack_jumps)
     verdict = trace_test(system, start.p, start.x, TraceOptions(rounds=1))
     assert verdict.verdict == "inconclusive" and "failed at" in verdict.reason
+
+
+
+def test_solutions_in_pairs_through_the_origin_still_seed_the_slice():
+    """An even system (x ↦ −x maps solutions to solutions) has its 4 solutions in ± pairs;
+    with a pair first, no hyperplane a'·x = 1 passes through the first two, so the seeds are
+    taken among linearly independent points: all 4 complete, 3 of 4 incomplete, whatever the
+    order."""
+    from screwkit.algebraic.monodromy import monodromy_solve
+
+    x1, x2 = Poly.variable(0), Poly.variable(1)
+    c = [Poly.variable(2 + i) for i in range(6)]
+    system = compile_system([x1 * x1 + c[0] * x1 * x2 + c[1] * x2 * x2 - c[2],
+                             x1 * x1 + c[3] * x1 * x2 + c[4] * x2 * x2 - c[5]],
+                            ["x1", "x2"], [f"c{i}" for i in range(6)])
+    rng = np.random.default_rng(1)
+    p = rng.standard_normal(6) + 1j * rng.standard_normal(6)
+    x0 = rng.standard_normal(2) + 1j * rng.standard_normal(2)
+    F, _, _ = system.evaluate(x0[None], p, want_jp=False)
+    p[2] += F[0, 0]
+    p[5] += F[0, 1]
+    _, X, _ = monodromy_solve(system, p, x0, MonodromyOptions(expected=4))
+    assert len(X) == 4
+    partner = int(np.argmin(np.abs(X + X[0]).max(axis=1)))
+    assert np.abs(X[partner] + X[0]).max() < 1e-10  # the pair (x, −x)
+    order = [0, partner] + [i for i in range(4) if i not in (0, partner)]
+    assert trace_test(system, p, X[order]).verdict == COMPLETE
+    assert trace_test(system, p, X[order][:3]).verdict == INCOMPLETE

@@ -12,7 +12,8 @@ One step for all active paths: a fourth-order Runge–Kutta predictor on dy/dτ 
 then two Newton corrections at the new τ; the step is accepted when the first correction (the
 predictor's error) is within ``predictor_tolerance`` and the second is within
 ``corrector_tolerance`` and at most ``contraction`` times the first (Newton converging fast,
-the guard against landing on a neighbouring path); the next step is sized from the error as
+the guard against landing on a neighbouring path; waived when both are at most ``converged``,
+at the rounding floor where the contraction says nothing); the next step is sized from the error as
 (tolerance / error)^(1/5), between ½× and 2×, a rejected one at most ½×. The main leg
 (s up to 1 − ``endgame_radius``) runs with the looser pair of tolerances (1e-2, 1e-4), the rest
 and the Cauchy endgame with the tighter one (1e-3, 1e-5) (:meth:`TrackOptions.near_end`).

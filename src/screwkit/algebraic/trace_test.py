@@ -33,11 +33,12 @@ means the true traces are not collinear, so a point is missing from W0 or from W
 more monodromy loops on W0 and finds nothing new should read it as inconclusive, as the count
 check of docs/kinematics.md does). Within the bound, the verdict weighs the deviation against
 the least share ‖δ_i‖ / Σ‖δ_j‖ of any given solution: a missing solution would add its own
-share, so a deviation at most 10⁻³ of the least share is "complete" (it would take a missing
-solution a thousand times less nonlinear than every one found, or an error cancelling its
-share to 0.1 %); otherwise, or when paths are lost, "inconclusive". The bound itself, with
-the α-test's rounding margins, is pessimistic for far-out ill-conditioned witnesses (10⁴ times
-the Newton step on the 3-RPS), which is why it decides "incomplete" and not "complete".
+share, so a deviation at most 10⁻³ of the least share, with the bound at most half of it, is
+"complete" (a missing solution as nonlinear as the least one found would show at least half
+its share through any error within the bound; it would take one a thousand times less
+nonlinear than every one found to hide); otherwise, when two ends' error balls meet, or when
+paths are lost, "inconclusive". The bound, with the α-test's rounding margins, is pessimistic
+for far-out ill-conditioned witnesses (10⁴ times the Newton step on the 3-RPS).
 Like monodromy itself, the test sees only the irreducible components of the solution variety
 that hold some of the given solutions: a component none of them lies on is beyond it.
 """
@@ -48,7 +49,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from screwkit.algebraic.certify import UNIT_ROUNDOFF, certify
+from screwkit.algebraic.certify import UNIT_ROUNDOFF, certify, distinct
 from screwkit.algebraic.monodromy import MonodromyOptions, monodromy_solve
 from screwkit.algebraic.path import TrackOptions
 from screwkit.algebraic.polynomial import Complex, Poly, PolynomialSystem, compile_system
@@ -78,6 +79,16 @@ class TraceOptions:
     hyperplanes: int = 4
     seed: int = 0
     track: TrackOptions = field(default_factory=TrackOptions)
+
+    def __post_init__(self) -> None:
+        checks = {"pencil": self.pencil > 0, "tries": self.tries >= 0,
+                  "rounds": self.rounds >= 1, "stale_loops": self.stale_loops >= 1,
+                  "hyperplanes": self.hyperplanes >= 1, "separation": 0 < self.separation < 1}
+        wrong = [name for name, ok in checks.items() if not ok]
+        if wrong:
+            raise InputError(f"TraceOptions: {', '.join(wrong)} out of range (pencil > 0, "
+                             "tries ≥ 0, rounds, stale_loops and hyperplanes ≥ 1, "
+                             "0 < separation < 1)")
 
 
 @dataclass(frozen=True)
@@ -165,6 +176,7 @@ def trace_test(system: PolynomialSystem, p0: Complex, x0: Complex,
                          f"of shape ({n},); got {p0.shape} and {x0.shape}")
     if k == 0:
         raise InputError("the trace test moves the parameters; this system has none")
+    _check_solutions(system, p0, x0)
     rng = np.random.default_rng(options.seed)
     slice_sys, pencil_sys = trace_systems(system)
     v = np.maximum(1.0, np.abs(p0)) * (rng.standard_normal(k) + 1j * rng.standard_normal(k))
@@ -191,6 +203,26 @@ def trace_test(system: PolynomialSystem, p0: Complex, x0: Complex,
         if result.verdict != INCOMPLETE:
             break
     return result
+
+
+def _check_solutions(system: PolynomialSystem, p0: Complex, x0: Complex) -> None:
+    """Refuse, by name, solutions that are not finite, do not solve F(x; p0) = 0 (the
+    residual test of :func:`.monodromy.monodromy_solve`) or repeat one another."""
+    if not (np.isfinite(p0).all() and np.isfinite(x0).all()):
+        raise InputError("the trace test needs finite p0 and solutions; got NaN or inf")
+    F, _, _ = system.evaluate(x0, p0, want_jp=False)
+    scale = 1.0 + np.abs(system.coef).max(initial=0.0) * (1.0 + np.abs(x0).max()) ** max(
+        system.degrees, default=1)
+    bad = np.flatnonzero(np.abs(F).max(axis=1) > 1e-8 * scale)
+    if len(bad):
+        raise InputError(f"solution(s) {bad.tolist()[:5]} do not solve the system at p0 "
+                         f"(residual up to {np.abs(F[bad]).max():.3g}); give the solutions "
+                         "at p0 itself")
+    label = same_points(x0, np.zeros(len(x0), dtype=np.intp), 1e-8)
+    twice = np.flatnonzero(label != np.arange(len(x0)))
+    if len(twice):
+        raise InputError(f"solution(s) {twice.tolist()[:5]} repeat earlier ones (to 1e-8); "
+                         "give each solution once")
 
 
 def _best_hyperplane(slice_sys: PolynomialSystem, pencil_sys: PolynomialSystem, q: Complex,
@@ -226,12 +258,21 @@ def _best_hyperplane(slice_sys: PolynomialSystem, pencil_sys: PolynomialSystem, 
 def _seeds(system: PolynomialSystem, slice_sys: PolynomialSystem, p0: Complex, v: Complex,
            q: Complex, x0: Complex, options: TraceOptions) -> tuple[Complex, int]:
     """Points of the curve C on the slice a·x = 1 (q = (p0, v, a)): the solutions tracked to
-    p0 + v (λ = 1), up to n of them put on the hyperplane a'·x = 1 through them, and carried
-    from a' to a along the slice system."""
+    p0 + v (λ = 1), up to n linearly independent ones put on the hyperplane a'·x = 1 through
+    them, and carried from a' to a along the slice system."""
+    from scipy.linalg import qr
+
     n = system.n
     moved = track_parameter_homotopy(system, p0, p0 + v, x0, options.track)
-    y = moved.x[moved.status == PathStatus.REGULAR][:n]
+    y = moved.x[moved.status == PathStatus.REGULAR]
     paths = len(x0)
+    if not len(y):
+        return np.empty((0, n + 1), dtype=complex), paths
+    # up to n linearly independent points (a system symmetric under x ↦ −x has its solutions
+    # in ± pairs, through which no hyperplane a'·x = 1 passes)
+    _, r, pivot = qr(y.T, mode="economic", pivoting=True)
+    diag = np.abs(np.diag(r))
+    y = y[pivot[: int((diag > 1e-10 * diag[0]).sum())]] if diag[0] > 0 else y[:0]
     if not len(y):
         return np.empty((0, n + 1), dtype=complex), paths
     a_seed = np.linalg.lstsq(y, np.ones(len(y), dtype=complex), rcond=None)[0]
@@ -297,17 +338,22 @@ def _verdict(pencil_sys: PolynomialSystem, q0: Complex, z0: Complex, m: int, ts:
     """The verdict from the points z0 at t = 0 and ``ends`` at ts (module docstring)."""
     points = [z0, *ends]
     params = [q0, *(np.concatenate([[t], q0[1:]]) for t in ts)]
-    error, certified = [], 0
+    error, certified, overlap = [], 0, False
     for z, q in zip(points, params, strict=True):
         cert = certify(pencil_sys, z, q)
         error.append(cert.radius)
         certified += int(cert.certified.sum())
+        # ends whose error balls meet may stand for one true solution: no certified verdict
+        overlap |= bool((distinct(z, cert.radius, np.zeros(len(z), dtype=np.intp))
+                         != np.arange(len(z))).any())
     delta = (ends[0] - z0) / ts[0] - (ends[1] - z0) / ts[1]
     spread = float(np.linalg.norm(delta, axis=1).sum())
     gap = float(np.linalg.norm(delta.sum(axis=0)))
+    size = [np.linalg.norm(z, axis=1) for z in points]
     bound_abs = float(((error[0] + error[1]) / abs(ts[0])
                        + (error[0] + error[2]) / abs(ts[1])).sum()
-                      + 4 * len(z0) * UNIT_ROUNDOFF * spread)
+                      + 4 * len(z0) * UNIT_ROUNDOFF * ((size[0] + size[1]) / abs(ts[0])
+                                                       + (size[0] + size[2]) / abs(ts[1])).sum())
     if spread == 0.0:  # every point moves affinely: any part's trace would too
         return Completeness(INCONCLUSIVE, 0, np.nan, np.nan, 0, certified, paths,
                             "every traced point moves affinely with t, so no part of them "
@@ -317,12 +363,19 @@ def _verdict(pencil_sys: PolynomialSystem, q0: Complex, z0: Complex, m: int, ts:
     said = (f"{m} solutions and {len(z0) - m} slice witnesses traced, deviation "
             f"{deviation:.1e} against an error bound {bound:.1e} and a least share of a "
             f"solution {least:.1e}")
-    if gap > bound_abs:
+    if overlap:
+        verdict = INCONCLUSIVE
+        reason = f"{said}: two traced points' error balls meet, so they may be one solution"
+    elif gap > bound_abs:
         verdict = INCOMPLETE
         reason = f"{said}: the traces are not on a line, so a solution is missing"
-    elif deviation <= options.separation * least:
+    elif deviation <= options.separation * least and bound <= least / 2:
         verdict = COMPLETE
         reason = f"{said}: the traces are on a line"
+    elif bound > least / 2:
+        verdict = INCONCLUSIVE
+        reason = (f"{said}: the bound exceeds half the least share, so rounding could hide a "
+                  "missing solution")
     else:
         verdict = INCONCLUSIVE
         reason = (f"{said}: within the bound, but not {1 / options.separation:.0f} times below "

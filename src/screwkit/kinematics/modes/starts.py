@@ -129,7 +129,7 @@ def checked(system: PolynomialSystem, found: StartSolutions,
     for round_ in range(CHECK_ROUNDS):
         verdict = trace_test(system, found.p, found.x, TraceOptions(seed=round_))
         paths += verdict.paths
-        if verdict.verdict != INCOMPLETE or round_ == CHECK_ROUNDS - 1:
+        if verdict.verdict != INCOMPLETE:
             break
         more = StartSolutions.by_monodromy(system, found.p, found.x, replace(
             options, expected=None, seed=options.seed + 101 * (round_ + 1)))
@@ -141,6 +141,10 @@ def checked(system: PolynomialSystem, found: StartSolutions,
             break
         found = replace(found, x=more.x, generic_count=more.generic_count,
                         how_found=f"{found.how_found}; then {more.how_found}")
+        if round_ == CHECK_ROUNDS - 1:  # grown, but not tested again
+            verdict = replace(verdict, verdict=INCONCLUSIVE, reason=(
+                f"{verdict.reason}; more loops then found {found.generic_count} in all, not "
+                f"tested again after {CHECK_ROUNDS} rounds"))
     assert verdict is not None
     _PATHS[0] += paths
     how = found.how_found
