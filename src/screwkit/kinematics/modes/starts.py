@@ -118,8 +118,9 @@ def count_check(on: bool = True) -> Iterator[None]:
 def checked(system: PolynomialSystem, found: StartSolutions,
             options: MonodromyOptions | None = None) -> StartSolutions:
     """``found`` after the trace test (module docstring): completed by more monodromy loops
-    (``options``, a new seed each round) while the test finds it incomplete, with the last
-    verdict in ``count_check`` and in ``how_found``. When the test finds it incomplete but the
+    (``options``, a new seed each round) while the test finds it incomplete, tested again
+    with new random choices while it is inconclusive (the bound depends on the hyperplane's
+    far-out witnesses), with the last verdict in ``count_check`` and in ``how_found``. When the test finds it incomplete but the
     loops find nothing new, the verdict is inconclusive: the point the test misses may be one
     of its own slice witnesses, or a solution these loops cannot reach, and the check does not
     claim either (docs/kinematics.md, "The count check")."""
@@ -129,6 +130,8 @@ def checked(system: PolynomialSystem, found: StartSolutions,
     for round_ in range(CHECK_ROUNDS):
         verdict = trace_test(system, found.p, found.x, TraceOptions(seed=round_))
         paths += verdict.paths
+        if verdict.verdict == INCONCLUSIVE:  # another pencil and hyperplane may decide
+            continue
         if verdict.verdict != INCOMPLETE:
             break
         more = StartSolutions.by_monodromy(system, found.p, found.x, replace(
